@@ -1,0 +1,66 @@
+// Small GL helpers shared by the passes, the scenes and the tests. GL object names are
+// std::uint32_t (GLuint) and enums std::uint32_t (GLenum): no loader header here. Every function
+// requires a current OpenGL 4.5 context (the caller's or GlContext).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace crep::gl {
+
+enum class ObjectType { Texture, Buffer, Framebuffer, Renderbuffer, VertexArray, Program, Shader, Query, Sampler };
+
+/// Move-only owner of one GL object name; deletes it with the matching glDelete* on destruction.
+class Handle {
+public:
+  Handle() = default;
+  Handle(ObjectType type, std::uint32_t name) noexcept : type_(type), name_(name) {}
+  ~Handle();
+  Handle(Handle&& other) noexcept;
+  Handle& operator=(Handle&& other) noexcept;
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+
+  std::uint32_t get() const noexcept { return name_; }
+  explicit operator bool() const noexcept { return name_ != 0; }
+  std::uint32_t release() noexcept; ///< gives up ownership
+  void reset() noexcept;            ///< deletes the object now
+
+private:
+  ObjectType type_ = ObjectType::Texture;
+  std::uint32_t name_ = 0;
+};
+
+/// glCreate* wrappers (DSA). `target` is a GLenum such as GL_TEXTURE_2D or GL_TIME_ELAPSED.
+Handle createTexture(std::uint32_t target);
+Handle createBuffer();
+Handle createFramebuffer();
+Handle createVertexArray();
+Handle createQuery(std::uint32_t target);
+Handle createSampler();
+
+/// Implementation limits.
+int maxTextureSize();      ///< GL_MAX_TEXTURE_SIZE
+int maxArrayTextureLayers(); ///< GL_MAX_ARRAY_TEXTURE_LAYERS
+
+/// Throws InvalidArgument naming `parameter` when width/height are <= 0, and GlError when they
+/// exceed GL_MAX_TEXTURE_SIZE (the message gives the limit).
+void checkTextureSize(const char* parameter, int width, int height);
+
+/// Throws GlError naming `what` when glGetError() reports an error (drains all pending errors).
+void checkError(const char* what);
+
+/// Measures GPU time between begin() and end() with a GL_TIME_ELAPSED query.
+class GpuTimer {
+public:
+  GpuTimer();
+  void begin();
+  void end();
+  /// Waits for the result. Milliseconds of GPU time between begin() and end().
+  double milliseconds();
+
+private:
+  Handle query_;
+};
+
+} // namespace crep::gl

@@ -1,0 +1,25 @@
+# Script mode: installs the build tree into WORK_DIR/prefix, then configures, builds and runs the
+# consumer project against it with find_package(crepuscular), and checks the pkg-config file.
+file(REMOVE_RECURSE ${WORK_DIR})
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "command failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  message(STATUS "${out}")
+endfunction()
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
+    -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+run(${WORK_DIR}/build/consumer)
+# pkg-config: the .pc file resolves and names the library.
+find_program(PKG_CONFIG pkg-config REQUIRED)
+file(GLOB_RECURSE pc ${WORK_DIR}/prefix/*/crepuscular.pc)
+get_filename_component(pcdir "${pc}" DIRECTORY)
+set(ENV{PKG_CONFIG_PATH} "${pcdir}")
+execute_process(COMMAND ${PKG_CONFIG} --libs --cflags crepuscular RESULT_VARIABLE rc OUTPUT_VARIABLE flags)
+if(NOT rc EQUAL 0 OR NOT flags MATCHES "-lcrepuscular")
+  message(FATAL_ERROR "pkg-config crepuscular failed: ${flags}")
+endif()
+message(STATUS "pkg-config crepuscular: ${flags}")
