@@ -1,0 +1,64 @@
+#include <crep/core/error.h>
+#include <crep/core/light.h>
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace crep {
+
+namespace {
+std::string vecString(const glm::dvec3& v) {
+  return "(" + detail::formatValue(v.x) + ", " + detail::formatValue(v.y) + ", " + detail::formatValue(v.z) + ")";
+}
+glm::dvec3 unitDirection(const char* parameter, const glm::dvec3& v) {
+  const double len = glm::length(v);
+  if (!std::isfinite(len) || !(len > 0.0))
+    throw InvalidArgument(parameter, vecString(v), "must be a finite, non-zero vector");
+  return v / len;
+}
+void requireColor(const char* parameter, const glm::dvec3& c) {
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(c[i]) || c[i] < 0.0) throw InvalidArgument(parameter, vecString(c), "components must be finite and >= 0");
+}
+} // namespace
+
+glm::dvec3 anyOrthogonal(const glm::dvec3& n) {
+  // Branch-free orthonormal basis (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1.0 / (sign + n.z);
+  const double b = n.x * n.y * a;
+  return glm::dvec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+}
+
+DirectionalLight::DirectionalLight(const glm::dvec3& direction, const glm::dvec3& irradiance)
+    : direction_(unitDirection("DirectionalLight.direction", direction)), irradiance_(irradiance) {
+  requireColor("DirectionalLight.irradiance", irradiance);
+}
+
+SpotLight::SpotLight(const glm::dvec3& position, const glm::dvec3& direction, double coneAngle, double range,
+                     const glm::dvec3& intensity, double nearPlane)
+    : position_(position), direction_(unitDirection("SpotLight.direction", direction)), coneAngle_(coneAngle),
+      range_(range), near_(nearPlane), intensity_(intensity) {
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(position[i])) throw InvalidArgument("SpotLight.position", vecString(position), "components must be finite");
+  if (!std::isfinite(coneAngle) || !(coneAngle > 0.0) || !(coneAngle < 0.5 * std::numbers::pi))
+    throw InvalidArgument("SpotLight.coneAngle", detail::formatValue(coneAngle), "half angle in radians, must be in (0, pi/2)");
+  requirePositive("SpotLight.range", range);
+  if (nearPlane == -1.0) near_ = range * 1e-3;
+  if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range))
+    throw InvalidArgument("SpotLight.nearPlane", detail::formatValue(nearPlane), "must be in (0, range)");
+  requireColor("SpotLight.intensity", intensity);
+}
+
+glm::dmat4 SpotLight::lightViewFromWorld() const {
+  // Up vector: any direction orthogonal to the axis, so no direction is degenerate.
+  return glm::lookAtRH(position_, position_ + direction_, anyOrthogonal(direction_));
+}
+
+glm::dmat4 SpotLight::lightClipFromLightView() const {
+  return glm::perspectiveRH_NO(2.0 * coneAngle_, 1.0, near_, range_);
+}
+
+} // namespace crep

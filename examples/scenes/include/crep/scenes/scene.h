@@ -1,0 +1,69 @@
+// Built-in procedural scenes used by the crep tool, the tests and the benchmarks. Each scene is a
+// triangle mesh with a default camera, sun direction and medium, plus an exact CPU ray cast so tests
+// can compute ground truth without any shadow map.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <crep/core/camera.h>
+#include <crep/core/image.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+
+namespace crep::scenes {
+
+/// Indexed triangle list, world space.
+struct Mesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals; ///< one per position
+  std::vector<std::uint32_t> indices;
+  std::size_t triangleCount() const { return indices.size() / 3; }
+};
+
+/// Axis-aligned box, world space.
+struct Box {
+  glm::dvec3 min, max;
+};
+
+struct Scene {
+  std::string name;
+  Mesh mesh;
+  Camera camera;
+  DirectionalLight sun;
+  Medium medium;
+  glm::dvec3 boundsMin, boundsMax; ///< world-space bounds of the mesh
+};
+
+/// Names accepted by makeScene: "colonnade" (default), "forest", "terrain", "boxes" (an analytic
+/// arrangement: a ground plane and a few boxes, for exact tests).
+std::vector<std::string> sceneNames();
+/// Builds a scene. `aspect` sets the default camera's aspect ratio. Throws InvalidArgument naming
+/// "scene" for an unknown name.
+Scene makeScene(std::string_view name, double aspect = 16.0 / 9.0);
+
+/// Mesh helpers used by the generators (and by tests building their own arrangements).
+void appendBox(Mesh& mesh, const Box& box);
+void appendQuad(Mesh& mesh, const glm::dvec3& corner, const glm::dvec3& edgeU, const glm::dvec3& edgeV);
+
+/// Exact first hit of the ray origin + t * direction (direction need not be unit) against the
+/// mesh's triangles for t in (tMin, tMax); returns t. Uses a BVH built on first use.
+class RayCaster {
+public:
+  explicit RayCaster(const Mesh& mesh);
+  ~RayCaster();
+  RayCaster(RayCaster&&) noexcept;
+  RayCaster& operator=(RayCaster&&) noexcept;
+  std::optional<double> firstHit(const glm::dvec3& origin, const glm::dvec3& direction, double tMin,
+                                 double tMax) const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace crep::scenes

@@ -1,0 +1,52 @@
+// GL rasterization of a built-in scene: camera depth buffers, shadow maps for any light matrix
+// (standard or rectified), and a simple lit colour image. Requires a current OpenGL 4.5 context;
+// owns only its own GL objects (mesh buffers, programs), not the context.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include <crep/core/gl.h>
+#include <crep/core/image.h>
+#include <crep/scenes/scene.h>
+
+namespace crep::scenes {
+
+struct DepthRenderOptions {
+  /// GL_DEPTH_CLAMP: fragments outside the near/far planes are kept with clamped depth (rectified
+  /// shadow maps need this so casters between the light and the frustum still cast).
+  bool depthClamp = false;
+  /// Depth comparison: GL_LESS semantics, cleared to 1.
+  bool cullBackFaces = false;
+};
+
+class SceneRenderer {
+public:
+  explicit SceneRenderer(const Mesh& mesh);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
+
+  /// Rasterizes the mesh's depth with `clipFromWorld` into layer `layer` (0 for a 2D texture) of the
+  /// caller's depth texture (GL_DEPTH_COMPONENT32F, 2D or 2D array), in the viewport (x, y, width,
+  /// height). Clears that viewport to depth 1 first. Values are depth-buffer values in [0, 1].
+  void renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x, int y, int width,
+                   int height, const DepthRenderOptions& options = {});
+
+  /// Convenience: renders into a new width x height depth texture and reads it back as a 1-channel
+  /// image of depth-buffer values (row 0 = bottom).
+  Image renderDepthImage(const glm::dmat4& clipFromWorld, int width, int height,
+                         const DepthRenderOptions& options = {});
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Creates a GL_DEPTH_COMPONENT32F 2D texture (nearest filtering, clamp to edge) of the given size;
+/// checks the size against GL limits (throws InvalidArgument / GlError naming `parameter`).
+gl::Handle createDepthTexture(int width, int height, const char* parameter = "depth texture size");
+/// Reads back a depth texture (2D, or one layer of a 2D array) as a 1-channel image.
+Image readDepthTexture(std::uint32_t texture, int width, int height, int layer = 0);
+
+} // namespace crep::scenes
