@@ -1,6 +1,8 @@
 #include <crep/core/camera.h>
 #include <crep/core/error.h>
 
+#include "validate.h"
+
 #include <cmath>
 #include <numbers>
 
@@ -8,21 +10,10 @@
 
 namespace crep {
 
-namespace {
-void requireFiniteVec(const char* parameter, const glm::dvec3& v) {
-  for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(v[i]))
-      throw InvalidArgument(parameter,
-                            "(" + detail::formatValue(v.x) + ", " + detail::formatValue(v.y) + ", " +
-                                detail::formatValue(v.z) + ")",
-                            "components must be finite");
-}
-} // namespace
-
 Camera::Camera(const glm::dvec3& position, const glm::dquat& orientation, double fovY, double aspect, double near,
                double far)
     : position_(position), fovY_(fovY), aspect_(aspect), near_(near), far_(far) {
-  requireFiniteVec("Camera.position", position);
+  detail::requireFiniteVec3("Camera.position", position);
   const double qlen = std::sqrt(orientation.w * orientation.w + orientation.x * orientation.x +
                                 orientation.y * orientation.y + orientation.z * orientation.z);
   if (!std::isfinite(qlen) || qlen < 1e-12)
@@ -41,9 +32,9 @@ Camera::Camera(const glm::dvec3& position, const glm::dquat& orientation, double
 
 Camera Camera::lookAt(const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& up, double fovY,
                       double aspect, double near, double far) {
-  requireFiniteVec("Camera.position", position);
-  requireFiniteVec("Camera.target", target);
-  requireFiniteVec("Camera.up", up);
+  detail::requireFiniteVec3("Camera.position", position);
+  detail::requireFiniteVec3("Camera.target", target);
+  detail::requireFiniteVec3("Camera.up", up);
   const glm::dvec3 toTarget = target - position;
   const double dist = glm::length(toTarget);
   if (!(dist > 0.0) || !std::isfinite(dist))

@@ -1,6 +1,8 @@
 #include <crep/core/error.h>
 #include <crep/core/light.h>
 
+#include "validate.h"
+
 #include <cmath>
 #include <numbers>
 
@@ -9,18 +11,15 @@
 namespace crep {
 
 namespace {
-std::string vecString(const glm::dvec3& v) {
-  return "(" + detail::formatValue(v.x) + ", " + detail::formatValue(v.y) + ", " + detail::formatValue(v.z) + ")";
-}
+using detail::formatVec3;
 glm::dvec3 unitDirection(const char* parameter, const glm::dvec3& v) {
   const double len = glm::length(v);
   if (!std::isfinite(len) || !(len > 0.0))
-    throw InvalidArgument(parameter, vecString(v), "must be a finite, non-zero vector");
+    throw InvalidArgument(parameter, formatVec3(v), "must be a finite, non-zero vector");
   return v / len;
 }
 void requireColor(const char* parameter, const glm::dvec3& c) {
-  for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(c[i]) || c[i] < 0.0) throw InvalidArgument(parameter, vecString(c), "components must be finite and >= 0");
+  detail::requireNonNegativeVec3(parameter, c, "components must be finite and >= 0");
 }
 } // namespace
 
@@ -41,8 +40,7 @@ SpotLight::SpotLight(const glm::dvec3& position, const glm::dvec3& direction, do
                      const glm::dvec3& intensity, double nearPlane)
     : position_(position), direction_(unitDirection("SpotLight.direction", direction)), coneAngle_(coneAngle),
       range_(range), near_(nearPlane), intensity_(intensity) {
-  for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(position[i])) throw InvalidArgument("SpotLight.position", vecString(position), "components must be finite");
+  detail::requireFiniteVec3("SpotLight.position", position);
   if (!std::isfinite(coneAngle) || !(coneAngle > 0.0) || !(coneAngle < 0.5 * std::numbers::pi))
     throw InvalidArgument("SpotLight.coneAngle", detail::formatValue(coneAngle), "half angle in radians, must be in (0, pi/2)");
   requirePositive("SpotLight.range", range);

@@ -1,6 +1,8 @@
 #include <crep/core/error.h>
 #include <crep/core/medium.h>
 
+#include "validate.h"
+
 #include <cmath>
 #include <numbers>
 
@@ -15,12 +17,7 @@ double rayleighPhase(double cosTheta) { return 3.0 / (16.0 * std::numbers::pi) *
 
 namespace {
 void requireCoefficients(const char* parameter, const glm::dvec3& c) {
-  for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(c[i]) || c[i] < 0.0)
-      throw InvalidArgument(parameter,
-                            "(" + detail::formatValue(c.x) + ", " + detail::formatValue(c.y) + ", " +
-                                detail::formatValue(c.z) + ")",
-                            "coefficients must be finite and >= 0 (1/world unit)");
+  detail::requireNonNegativeVec3(parameter, c, "coefficients must be finite and >= 0 (1/world unit)");
 }
 } // namespace
 

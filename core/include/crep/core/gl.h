@@ -50,17 +50,21 @@ void checkTextureSize(const char* parameter, int width, int height);
 /// Throws GlError naming `what` when glGetError() reports an error (drains all pending errors).
 void checkError(const char* what);
 
-/// Measures GPU time between begin() and end() with a GL_TIME_ELAPSED query.
+/// Measures GPU time between begin() and end() with a GL_TIME_ELAPSED query. Only one
+/// GL_TIME_ELAPSED query can be active at a time, so timers do not nest.
 class GpuTimer {
 public:
   GpuTimer();
   void begin();
   void end();
-  /// Waits for the result. Milliseconds of GPU time between begin() and end().
+  /// Waits for the result. Milliseconds of GPU time between the last begin() and end(). Throws
+  /// GlError when called before a begin()/end() pair has completed.
   double milliseconds();
 
 private:
+  enum class State { Idle, Running, Ended };
   Handle query_;
+  State state_ = State::Idle;
 };
 
 } // namespace crep::gl

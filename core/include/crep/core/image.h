@@ -24,6 +24,14 @@ public:
   int channels() const noexcept { return channels_; }
   bool empty() const noexcept { return data_.empty(); }
   std::size_t pixelCount() const noexcept { return static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_); }
+  /// Number of floats: pixelCount() * channels().
+  std::size_t sampleCount() const noexcept { return data_.size(); }
+  /// Size of the pixel data in bytes: sampleCount() * sizeof(float).
+  std::size_t byteSize() const noexcept { return data_.size() * sizeof(float); }
+  /// Same width, height and channel count.
+  bool sameShape(const Image& other) const noexcept {
+    return width_ == other.width_ && height_ == other.height_ && channels_ == other.channels_;
+  }
 
   float& at(int x, int y, int c = 0) noexcept { return data_[index(x, y, c)]; }
   float at(int x, int y, int c = 0) const noexcept { return data_[index(x, y, c)]; }

@@ -67,3 +67,11 @@ private:
 };
 
 } // namespace crep::scenes
+
+namespace crep::scenes {
+/// A standard (non-rectified) orthographic light matrix for a directional light: looks along the
+/// light direction and tightly encloses the axis-aligned box [boundsMin, boundsMax], so every caster
+/// of the scene is in the map. OpenGL clip conventions (depth-buffer value 0 nearest to the light).
+glm::dmat4 standardLightClipFromWorld(const DirectionalLight& light, const glm::dvec3& boundsMin,
+                                      const glm::dvec3& boundsMax);
+} // namespace crep::scenes

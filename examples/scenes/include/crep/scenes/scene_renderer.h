@@ -33,6 +33,21 @@ public:
   void renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x, int y, int width,
                    int height, const DepthRenderOptions& options = {});
 
+  /// Inputs of the lit surface pass: Lambert with a standard shadow map plus a constant ambient term.
+  struct ShadeInputs {
+    glm::dmat4 clipFromWorld{1.0};
+    glm::dmat4 shadowClipFromWorld{1.0}; ///< the light matrix the shadow map was rendered with
+    std::uint32_t shadowMap = 0;         ///< GL_DEPTH_COMPONENT32F 2D texture (depth-buffer values)
+    glm::dvec3 lightDirection{0, -1, 0}; ///< direction the light travels
+    glm::dvec3 lightIrradiance{1.0};
+    glm::dvec3 ambient{0.05};
+    glm::dvec3 albedo{0.5};
+  };
+  /// Renders lit surfaces into the caller's colour texture (RGBA16F or RGBA32F) and depth texture
+  /// (GL_DEPTH_COMPONENT32F), both width x height. Background: colour 0, depth 1.
+  void renderShaded(const ShadeInputs& inputs, std::uint32_t colorTexture, std::uint32_t depthTexture, int width,
+                    int height);
+
   /// Convenience: renders into a new width x height depth texture and reads it back as a 1-channel
   /// image of depth-buffer values (row 0 = bottom).
   Image renderDepthImage(const glm::dmat4& clipFromWorld, int width, int height,

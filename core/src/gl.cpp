@@ -1,0 +1,165 @@
+#include <crep/core/error.h>
+#include <crep/core/gl.h>
+
+#include <epoxy/gl.h>
+
+#include <cstdio>
+#include <string>
+
+namespace crep::gl {
+
+namespace {
+
+void deleteObject(ObjectType type, GLuint name) {
+  switch (type) {
+  case ObjectType::Texture: glDeleteTextures(1, &name); break;
+  case ObjectType::Buffer: glDeleteBuffers(1, &name); break;
+  case ObjectType::Framebuffer: glDeleteFramebuffers(1, &name); break;
+  case ObjectType::Renderbuffer: glDeleteRenderbuffers(1, &name); break;
+  case ObjectType::VertexArray: glDeleteVertexArrays(1, &name); break;
+  case ObjectType::Program: glDeleteProgram(name); break;
+  case ObjectType::Shader: glDeleteShader(name); break;
+  case ObjectType::Query: glDeleteQueries(1, &name); break;
+  case ObjectType::Sampler: glDeleteSamplers(1, &name); break;
+  }
+}
+
+std::string hex(std::uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%04X", v);
+  return buf;
+}
+
+std::string errorName(GLenum error) {
+  switch (error) {
+  case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+  case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+  case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+  case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+  case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+  case GL_STACK_UNDERFLOW: return "GL_STACK_UNDERFLOW";
+  case GL_STACK_OVERFLOW: return "GL_STACK_OVERFLOW";
+  case GL_CONTEXT_LOST: return "GL_CONTEXT_LOST";
+  default: return hex(error);
+  }
+}
+
+Handle checked(ObjectType type, GLuint name, const char* function, const std::string& args = {}) {
+  if (name == 0) throw GlError(std::string("crep: ") + function + "(" + args + ") created no object");
+  return Handle(type, name);
+}
+
+int getInteger(GLenum pname) {
+  GLint value = 0;
+  glGetIntegerv(pname, &value);
+  return value;
+}
+
+} // namespace
+
+Handle::~Handle() { reset(); }
+
+Handle::Handle(Handle&& other) noexcept : type_(other.type_), name_(other.release()) {}
+
+Handle& Handle::operator=(Handle&& other) noexcept {
+  if (this != &other) {
+    reset();
+    type_ = other.type_;
+    name_ = other.release();
+  }
+  return *this;
+}
+
+std::uint32_t Handle::release() noexcept {
+  const std::uint32_t name = name_;
+  name_ = 0;
+  return name;
+}
+
+void Handle::reset() noexcept {
+  if (name_ != 0) deleteObject(type_, name_);
+  name_ = 0;
+}
+
+Handle createTexture(std::uint32_t target) {
+  GLuint name = 0;
+  glCreateTextures(target, 1, &name);
+  return checked(ObjectType::Texture, name, "glCreateTextures", "target=" + hex(target));
+}
+
+Handle createBuffer() {
+  GLuint name = 0;
+  glCreateBuffers(1, &name);
+  return checked(ObjectType::Buffer, name, "glCreateBuffers");
+}
+
+Handle createFramebuffer() {
+  GLuint name = 0;
+  glCreateFramebuffers(1, &name);
+  return checked(ObjectType::Framebuffer, name, "glCreateFramebuffers");
+}
+
+Handle createVertexArray() {
+  GLuint name = 0;
+  glCreateVertexArrays(1, &name);
+  return checked(ObjectType::VertexArray, name, "glCreateVertexArrays");
+}
+
+Handle createQuery(std::uint32_t target) {
+  GLuint name = 0;
+  glCreateQueries(target, 1, &name);
+  return checked(ObjectType::Query, name, "glCreateQueries", "target=" + hex(target));
+}
+
+Handle createSampler() {
+  GLuint name = 0;
+  glCreateSamplers(1, &name);
+  return checked(ObjectType::Sampler, name, "glCreateSamplers");
+}
+
+int maxTextureSize() { return getInteger(GL_MAX_TEXTURE_SIZE); }
+int maxArrayTextureLayers() { return getInteger(GL_MAX_ARRAY_TEXTURE_LAYERS); }
+
+void checkTextureSize(const char* parameter, int width, int height) {
+  const std::string value = std::to_string(width) + " x " + std::to_string(height);
+  if (width <= 0 || height <= 0) throw InvalidArgument(parameter, value, "width and height must be > 0");
+  const int limit = maxTextureSize();
+  if (width > limit || height > limit)
+    throw GlError(std::string("crep: ") + parameter + " = " + value + " exceeds GL_MAX_TEXTURE_SIZE = " +
+                  std::to_string(limit) + " of this OpenGL implementation");
+}
+
+void checkError(const char* what) {
+  std::string errors;
+  // A lost context can report GL_CONTEXT_LOST forever: bound the loop.
+  for (int i = 0; i < 32; ++i) {
+    const GLenum error = glGetError();
+    if (error == GL_NO_ERROR) break;
+    errors += (errors.empty() ? "" : ", ") + errorName(error);
+  }
+  if (!errors.empty()) throw GlError(std::string("crep: GL error in ") + what + ": " + errors);
+}
+
+GpuTimer::GpuTimer() : query_(createQuery(GL_TIME_ELAPSED)) {}
+
+void GpuTimer::begin() {
+  if (state_ == State::Running) throw GlError("crep: GpuTimer::begin() called twice without end()");
+  glBeginQuery(GL_TIME_ELAPSED, query_.get());
+  state_ = State::Running;
+}
+
+void GpuTimer::end() {
+  if (state_ != State::Running) throw GlError("crep: GpuTimer::end() called without begin()");
+  glEndQuery(GL_TIME_ELAPSED);
+  state_ = State::Ended;
+}
+
+double GpuTimer::milliseconds() {
+  if (state_ != State::Ended)
+    throw GlError("crep: GpuTimer::milliseconds() needs a completed begin()/end() pair");
+  GLuint64 nanoseconds = 0;
+  glGetQueryObjectui64v(query_.get(), GL_QUERY_RESULT, &nanoseconds);
+  return static_cast<double>(nanoseconds) * 1e-6;
+}
+
+} // namespace crep::gl

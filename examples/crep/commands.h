@@ -1,0 +1,11 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace crep::tool {
+
+/// Each command takes its arguments (after the command name) and returns the process exit status.
+int renderCommand(const std::vector<std::string>& args);
+
+} // namespace crep::tool

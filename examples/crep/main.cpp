@@ -1,0 +1,56 @@
+// crep: the command-line tool of crepuscular. See `crep help`.
+#include "args.h"
+#include "commands.h"
+
+#include <crep/core/error.h>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char* kUsage = R"(crep - single scattering from rectified shadow maps
+
+usage: crep <command> [options]
+
+commands:
+  render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
+            --scene NAME        colonnade (default) | forest | terrain | boxes
+            --size WxH          image size (default 1280x720)
+            --map-size N        shadow map size (default 2048)
+            --steps N           ray-march samples per pixel (default 128)
+            --exposure X        PNG exposure (default 1)
+            --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
+            --debug-gl          debug GL context; GL errors abort the command
+  help      this text
+
+Exit status: 0 success, 1 runtime error (GL, I/O, invalid parameter), 2 usage error.
+)";
+
+} // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+    std::fputs(kUsage, args.empty() ? stderr : stdout);
+    return args.empty() ? 2 : 0;
+  }
+  const std::string command = args[0];
+  args.erase(args.begin());
+  try {
+    if (command == "render") return crep::tool::renderCommand(args);
+    std::fprintf(stderr, "crep: unknown command '%s' (see crep help)\n", command.c_str());
+    return 2;
+  } catch (const crep::tool::UsageError& e) {
+    std::fprintf(stderr, "crep %s: %s\n", command.c_str(), e.what());
+    return 2;
+  } catch (const crep::Error& e) {
+    std::fprintf(stderr, "crep %s: %s\n", command.c_str(), e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "crep %s: unexpected error: %s\n", command.c_str(), e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,166 @@
+// `crep render`: the main job. Renders a built-in scene (shadow pass, lit camera pass), computes
+// single scattering and writes the scattering and composited images to EXR plus a tone-mapped PNG.
+#include "args.h"
+#include "commands.h"
+#include "timings.h"
+
+#include <crep/core/exr.h>
+#include <crep/core/gl.h>
+#include <crep/core/gl_context.h>
+#include <crep/core/png.h>
+#include <crep/core/shader_library.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace crep::tool {
+
+namespace {
+
+gl::Handle createColorTexture(int width, int height, GLenum format) {
+  gl::Handle tex = gl::createTexture(GL_TEXTURE_2D);
+  glTextureStorage2D(tex.get(), 1, format, width, height);
+  glTextureParameteri(tex.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(tex.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
+Image readRgba(GLuint texture, int width, int height) {
+  Image image(width, height, 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(image.data().size_bytes()), image.data().data());
+  gl::checkError("readback");
+  return image;
+}
+
+void setVec3(GLuint program, GLint location, const glm::dvec3& v) {
+  glProgramUniform3f(program, location, static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
+}
+
+} // namespace
+
+int renderCommand(const std::vector<std::string>& argv) {
+  const Args args(argv, {"scene", "size", "map-size", "steps", "exposure", "out"}, {"debug-gl"});
+  const std::string sceneName = args.string("scene", "colonnade");
+  const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension);
+  const int mapSize = args.integer("map-size", 2048, 1, Image::kMaxDimension);
+  const int steps = args.integer("steps", 128, 1, 65536);
+  const double exposure = args.number("exposure", 1.0);
+  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const std::string out = args.string("out", "crep-" + sceneName);
+  if (out.empty()) throw UsageError("option --out: must not be empty");
+
+  StageTimings timings;
+  GlContextOptions contextOptions;
+  contextOptions.debug = args.has("debug-gl");
+  bool glFailed = false;
+  std::string glMessage;
+  if (contextOptions.debug)
+    contextOptions.debugCallback = [&](const GlDebugMessage& m) {
+      if (m.isError() && !glFailed) {
+        glFailed = true;
+        glMessage = m.text;
+      }
+    };
+  auto context = timings.time("gl context", [&] { return std::make_unique<GlContext>(contextOptions); });
+  std::fprintf(stderr, "crep render: %s, %s\n", context->renderer().c_str(), context->version().c_str());
+
+  const scenes::Scene scene =
+      timings.time("scene build", [&] { return scenes::makeScene(sceneName, double(size.x) / double(size.y)); });
+  gl::checkTextureSize("--map-size", mapSize, mapSize);
+  gl::checkTextureSize("--size", size.x, size.y);
+
+  auto renderer = timings.time("scene upload + shaders", [&] {
+    auto r = std::make_unique<scenes::SceneRenderer>(scene.mesh);
+    glFinish();
+    return r;
+  });
+  gl::Handle marchProgram = timings.time("scattering shader", [&] {
+    return buildProgram({{ShaderStage::Compute, "passes/march_world.comp", {{"CREP_MARCH_STEPS", std::to_string(steps)}}}});
+  });
+
+  const glm::dmat4 shadowClipFromWorld = scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
+  gl::Handle shadowMap = scenes::createDepthTexture(mapSize, mapSize, "--map-size");
+  timings.time("shadow pass", [&] {
+    renderer->renderDepth(shadowClipFromWorld, shadowMap.get(), 0, 0, 0, mapSize, mapSize, {.depthClamp = true});
+    glFinish();
+  });
+
+  gl::Handle color = createColorTexture(size.x, size.y, GL_RGBA32F);
+  gl::Handle depth = scenes::createDepthTexture(size.x, size.y, "--size");
+  timings.time("camera pass", [&] {
+    scenes::SceneRenderer::ShadeInputs in;
+    in.clipFromWorld = scene.camera.clipFromWorld();
+    in.shadowClipFromWorld = shadowClipFromWorld;
+    in.shadowMap = shadowMap.get();
+    in.lightDirection = scene.sun.direction();
+    in.lightIrradiance = scene.sun.irradiance();
+    renderer->renderShaded(in, color.get(), depth.get(), size.x, size.y);
+    glFinish();
+  });
+
+  gl::Handle scattering = createColorTexture(size.x, size.y, GL_RGBA32F);
+  gl::Handle composite = createColorTexture(size.x, size.y, GL_RGBA32F);
+  timings.time("scattering (world march)", [&] {
+    const GLuint p = marchProgram.get();
+    glUseProgram(p);
+    const glm::mat4 worldFromClip(glm::inverse(scene.camera.clipFromWorld()));
+    const glm::mat4 shadow(shadowClipFromWorld);
+    glProgramUniformMatrix4fv(p, 0, 1, GL_FALSE, &worldFromClip[0][0]);
+    glProgramUniformMatrix4fv(p, 1, 1, GL_FALSE, &shadow[0][0]);
+    setVec3(p, 2, scene.camera.position());
+    setVec3(p, 3, scene.sun.direction());
+    setVec3(p, 4, scene.sun.irradiance());
+    setVec3(p, 5, scene.medium.mieScattering());
+    setVec3(p, 6, scene.medium.rayleighScattering());
+    setVec3(p, 7, scene.medium.extinction());
+    glProgramUniform1f(p, 8, static_cast<float>(scene.medium.hgG()));
+    glProgramUniform2i(p, 9, size.x, size.y);
+    glProgramUniform1f(p, 10, 2e-4f);
+    glBindTextureUnit(0, depth.get());
+    glBindTextureUnit(1, shadowMap.get());
+    glBindTextureUnit(2, color.get());
+    glBindImageTexture(0, scattering.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, composite.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>((size.x + 7) / 8), static_cast<GLuint>((size.y + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glUseProgram(0);
+    for (GLuint unit = 0; unit < 3; ++unit) glBindTextureUnit(unit, 0);
+    glFinish();
+    gl::checkError("scattering pass");
+  });
+
+  Image scatteringImage, compositeImage;
+  timings.time("readback", [&] {
+    scatteringImage = readRgba(scattering.get(), size.x, size.y);
+    compositeImage = readRgba(composite.get(), size.x, size.y);
+  });
+  if (glFailed) throw GlError("GL error during rendering: " + glMessage);
+
+  // Refuse to write a silently wrong image.
+  long long nonFinite = 0;
+  for (float v : compositeImage.data()) nonFinite += std::isfinite(v) ? 0 : 1;
+  if (nonFinite > 0) throw Error("render produced " + std::to_string(nonFinite) + " non-finite samples");
+
+  const std::string exrPath = out + ".exr", pngPath = out + ".png";
+  timings.time("write exr", [&] {
+    const ExrLayer layers[] = {{"composite", &compositeImage}, {"scattering", &scatteringImage}};
+    writeExrLayers(exrPath, layers);
+  });
+  timings.time("write png", [&] { writePng(pngPath, compositeImage, ToneMap{static_cast<float>(exposure)}); });
+
+  std::printf("crep render: scene %s, %dx%d, shadow map %d^2, %d march steps\n", scene.name.c_str(), size.x, size.y,
+              mapSize, steps);
+  timings.print(stdout);
+  std::printf("wrote %s (layers composite.RGBA, scattering.RGBA) and %s\n", exrPath.c_str(), pngPath.c_str());
+  return 0;
+}
+
+} // namespace crep::tool

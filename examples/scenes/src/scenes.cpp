@@ -1,0 +1,179 @@
+// The built-in procedural scenes. Deterministic: a fixed-seed generator of our own (the standard
+// distributions are not specified bit-for-bit across implementations).
+#include <crep/core/error.h>
+#include <crep/scenes/scene.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace crep::scenes {
+
+namespace {
+
+class Rng { // splitmix64
+public:
+  explicit Rng(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; } ///< [0, 1)
+  double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+
+private:
+  std::uint64_t state_;
+};
+
+void appendGround(Mesh& mesh, double halfSize) {
+  appendQuad(mesh, {-halfSize, 0, -halfSize}, {0, 0, 2 * halfSize}, {2 * halfSize, 0, 0});
+}
+
+void computeBounds(Scene& s) {
+  s.boundsMin = glm::dvec3(std::numeric_limits<double>::max());
+  s.boundsMax = glm::dvec3(-std::numeric_limits<double>::max());
+  for (const auto& p : s.mesh.positions) {
+    s.boundsMin = glm::min(s.boundsMin, glm::dvec3(p));
+    s.boundsMax = glm::max(s.boundsMax, glm::dvec3(p));
+  }
+}
+
+// Ground, two rows of pillars along z, a roof with a grid of openings: clean shafts, simple depth.
+Mesh colonnadeMesh() {
+  Mesh m;
+  appendGround(m, 60.0);
+  const double pillarHalf = 0.6, height = 9.0;
+  for (int row = 0; row < 2; ++row) {
+    const double x = row == 0 ? -6.0 : 6.0;
+    for (int i = 0; i < 10; ++i) {
+      const double z = -30.0 + 6.0 * i;
+      appendBox(m, {{x - pillarHalf, 0, z - pillarHalf}, {x + pillarHalf, height, z + pillarHalf}});
+    }
+  }
+  // Roof slab from x = -8..8, z = -33..27 at y = 9..9.6, with 2 x 10 openings cut as a grid of beams.
+  const double y0 = height, y1 = height + 0.6;
+  const double x0 = -8.0, x1 = 8.0, z0 = -33.0, z1 = 27.0;
+  // Beams along z (three: both edges and the centre line).
+  for (double x : {x0, -1.0, 6.0}) appendBox(m, {{x, y0, z0}, {x + 2.0, y1, z1}});
+  // Cross beams along x between openings.
+  for (int i = 0; i <= 10; ++i) {
+    const double z = z0 + 6.0 * i;
+    appendBox(m, {{x0, y0, z}, {x1, y1, z + 1.5}});
+  }
+  // A back wall closing the hall, so the far end is dark.
+  appendBox(m, {{x0, 0, z0 - 1.0}, {x1, y1, z0}});
+  return m;
+}
+
+// Hundreds of thin trunks and thousands of small leaf quads: high depth complexity.
+Mesh forestMesh() {
+  Mesh m;
+  appendGround(m, 80.0);
+  Rng rng(0xf04e57);
+  const int trunks = 320, leavesPerTree = 16;
+  for (int t = 0; t < trunks; ++t) {
+    const double x = rng.uniform(-45.0, 45.0), z = rng.uniform(-60.0, 20.0);
+    const double h = rng.uniform(7.0, 14.0), r = rng.uniform(0.12, 0.3);
+    appendBox(m, {{x - r, 0, z - r}, {x + r, h, z + r}});
+    for (int l = 0; l < leavesPerTree; ++l) {
+      const glm::dvec3 c(x + rng.uniform(-2.5, 2.5), h + rng.uniform(-3.0, 1.0), z + rng.uniform(-2.5, 2.5));
+      const double s = rng.uniform(0.4, 0.9);
+      const double a = rng.uniform(0.0, 2.0 * std::numbers::pi), b = rng.uniform(0.2, 1.3);
+      const glm::dvec3 u(std::cos(a) * s, 0.0, std::sin(a) * s);
+      const glm::dvec3 v(-std::sin(a) * std::cos(b) * s, std::sin(b) * s, std::cos(a) * std::cos(b) * s);
+      appendQuad(m, c - 0.5 * (u + v), u, v);
+    }
+  }
+  return m;
+}
+
+double terrainHeight(double x, double z) {
+  return 3.0 * std::sin(0.045 * x) * std::cos(0.038 * z) + 1.6 * std::sin(0.11 * x + 0.7) * std::sin(0.09 * z + 1.3) +
+         0.5 * std::cos(0.23 * x - 0.31 * z) + 0.002 * (x * x + z * z) * 0.2;
+}
+
+// A smooth height field with a few blockers: smooth shadow-map depth.
+Mesh terrainMesh() {
+  Mesh m;
+  const int n = 160;
+  const double half = 90.0, step = 2.0 * half / n;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = -half + i * step, z = -half + j * step;
+      const double h = terrainHeight(x, z), e = 0.5 * step;
+      const glm::dvec3 nrm = glm::normalize(glm::dvec3(terrainHeight(x - e, z) - terrainHeight(x + e, z), 2.0 * e,
+                                                       terrainHeight(x, z - e) - terrainHeight(x, z + e)));
+      m.positions.emplace_back(x, h, z);
+      m.normals.emplace_back(nrm);
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const auto a = static_cast<std::uint32_t>(j * (n + 1) + i), b = a + 1, c = a + static_cast<std::uint32_t>(n + 1),
+                 d = c + 1;
+      for (std::uint32_t k : {a, c, b, b, c, d}) m.indices.push_back(k);
+    }
+  // Blockers: a few tall slabs and towers standing on the terrain.
+  const struct {
+    double x, z, w, d, h;
+  } blockers[] = {{-12, -25, 3, 3, 16}, {8, -40, 10, 2, 12}, {22, -15, 2, 2, 20}, {-30, -55, 14, 3, 10}, {0, -70, 4, 4, 25}};
+  for (const auto& bl : blockers) {
+    const double y = terrainHeight(bl.x, bl.z) - 1.0;
+    appendBox(m, {{bl.x - bl.w / 2, y, bl.z - bl.d / 2}, {bl.x + bl.w / 2, y + bl.h, bl.z + bl.d / 2}});
+  }
+  return m;
+}
+
+// A ground plane and a few boxes: an arrangement simple enough for exact tests.
+Mesh boxesMesh() {
+  Mesh m;
+  appendGround(m, 20.0);
+  appendBox(m, {{-4, 0, -6}, {-2, 3, -4}});
+  appendBox(m, {{1, 0, -9}, {3, 5, -7}});
+  appendBox(m, {{-1, 4, -3}, {1, 4.5, -1}}); // floating slab
+  appendBox(m, {{4, 0, -3}, {5, 2, 1}});
+  return m;
+}
+
+Medium defaultMedium() { return Medium(glm::dvec3(0.02, 0.022, 0.025), glm::dvec3(0.004), 0.6); }
+
+} // namespace
+
+std::vector<std::string> sceneNames() { return {"colonnade", "forest", "terrain", "boxes"}; }
+
+Scene makeScene(std::string_view name, double aspect) {
+  const double fov = 60.0 * std::numbers::pi / 180.0;
+  if (name == "colonnade") {
+    Scene s{"colonnade", colonnadeMesh(),
+            Camera::lookAt({-3.0, 2.2, 24.0}, {0.5, 5.0, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
+            DirectionalLight(glm::dvec3(0.55, -0.75, -0.35), glm::dvec3(4.0, 3.7, 3.2)), defaultMedium(), {}, {}};
+    computeBounds(s);
+    return s;
+  }
+  if (name == "forest") {
+    Scene s{"forest", forestMesh(),
+            Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
+            DirectionalLight(glm::dvec3(-0.45, -0.6, -0.65), glm::dvec3(4.0, 3.8, 3.4)),
+            Medium(glm::dvec3(0.025, 0.027, 0.03), glm::dvec3(0.005), 0.7), {}, {}};
+    computeBounds(s);
+    return s;
+  }
+  if (name == "terrain") {
+    Scene s{"terrain", terrainMesh(),
+            Camera::lookAt({0.0, 12.0, 40.0}, {0.0, 6.0, -40.0}, {0, 1, 0}, fov, aspect, 0.1, 200.0),
+            DirectionalLight(glm::dvec3(0.6, -0.35, -0.72), glm::dvec3(4.0, 3.5, 2.8)),
+            Medium(glm::dvec3(0.012, 0.014, 0.018), glm::dvec3(0.002), 0.5, glm::dvec3(0.002, 0.004, 0.008)), {}, {}};
+    computeBounds(s);
+    return s;
+  }
+  if (name == "boxes") {
+    Scene s{"boxes", boxesMesh(), Camera::lookAt({0.0, 3.0, 10.0}, {0.0, 1.5, -5.0}, {0, 1, 0}, fov, aspect, 0.1, 60.0),
+            DirectionalLight(glm::dvec3(0.5, -0.8, -0.3), glm::dvec3(3.0)), defaultMedium(), {}, {}};
+    computeBounds(s);
+    return s;
+  }
+  throw InvalidArgument("scene", std::string(name), "must be one of colonnade, forest, terrain, boxes");
+}
+
+} // namespace crep::scenes

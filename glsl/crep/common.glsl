@@ -1,0 +1,39 @@
+// crepuscular: constants and small helpers shared by every crepuscular shader.
+//
+// Public include: an engine can `#include "crep/common.glsl"` in its own shaders (the installed copy
+// is under <prefix>/share/crepuscular/glsl/). No #version here: the including shader has one
+// (GLSL 4.50 core is assumed). The crepuscular shader library includes each file once per shader;
+// the guard below is for include mechanisms without that rule. Names start with crep_ / CREP_.
+#ifndef CREP_COMMON_GLSL
+#define CREP_COMMON_GLSL
+
+#define CREP_PI 3.14159265358979323846
+#define CREP_TWO_PI 6.28318530717958647693
+#define CREP_FOUR_PI 12.5663706143591729539
+#define CREP_INV_PI 0.31830988618379067154
+#define CREP_INV_FOUR_PI 0.07957747154594766788
+
+// View-space distance along -Z (positive, in world units) of a depth-buffer value `depth` in [0, 1]
+// written with a standard OpenGL perspective projection (clip z in [-w, w], glDepthRange(0, 1)) with
+// near and far planes at zNear and zFar. depth = 0 gives zNear, depth = 1 gives zFar.
+float crep_linearDepth(float depth, float zNear, float zFar) {
+  float ndcZ = 2.0 * depth - 1.0;
+  return 2.0 * zNear * zFar / (zFar + zNear - ndcZ * (zFar - zNear));
+}
+
+// sRGB transfer function (IEC 61966-2-1): linear [0, 1] to encoded [0, 1], per channel.
+vec3 crep_srgbEncode(vec3 linearColor) {
+  vec3 c = clamp(linearColor, 0.0, 1.0);
+  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
+}
+
+// Inverse of crep_srgbEncode.
+vec3 crep_srgbDecode(vec3 encoded) {
+  vec3 c = clamp(encoded, 0.0, 1.0);
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+// Relative luminance of linear Rec. 709 / sRGB primaries.
+float crep_luminance(vec3 linearColor) { return dot(linearColor, vec3(0.2126, 0.7152, 0.0722)); }
+
+#endif // CREP_COMMON_GLSL

@@ -1,0 +1,3 @@
+// include_a
+#include "sub/include_b.glsl"
+const int crep_test_a = 1;

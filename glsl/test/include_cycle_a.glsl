@@ -1,0 +1,2 @@
+// Test fixture: include cycle a -> b -> a.
+#include "include_cycle_b.glsl"

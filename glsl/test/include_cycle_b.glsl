@@ -1,0 +1,3 @@
+// Test fixture: include cycle a -> b -> a.
+
+#include "include_cycle_a.glsl"

@@ -1,0 +1,1 @@
+const int crep_test_shadowed_sub = 3;

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Shared set-up for the two README commands: installs the Debian 12 packages that are missing,
+# then configures and builds crepuscular in ./build (Release, warnings as errors).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+CREP_PACKAGES=(
+  build-essential cmake pkg-config
+  libglm-dev libeigen3-dev libopenexr-dev doctest-dev libstb-dev
+  libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
+  glslang-tools
+)
+
+crep_install_packages() {
+  local missing=()
+  for p in "${CREP_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if ((${#missing[@]})); then
+    echo "crep: installing ${missing[*]}" >&2
+    local sudo=""
+    [ "$(id -u)" -eq 0 ] || sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  fi
+}
+
+crep_build() {
+  local dir=${1:-build}
+  shift || true
+  cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@"
+  cmake --build "$dir" -j "$(nproc)"
+}

@@ -1,0 +1,114 @@
+#include <crep/core/error.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+namespace {
+const double kNan = std::numeric_limits<double>::quiet_NaN();
+
+template <class F>
+void expectInvalid(const std::string& parameter, F&& f) {
+  try {
+    f();
+    FAIL("expected InvalidArgument for " << parameter);
+  } catch (const crep::InvalidArgument& e) {
+    CHECK(e.parameter() == parameter);
+    CHECK(std::string(e.what()).find(parameter) != std::string::npos);
+  }
+}
+
+// Integral of a phase function over the sphere, 2 pi * int_{-1}^{1} p(mu) d mu (Simpson, 20000 panels).
+template <class P>
+double sphereIntegral(P&& p) {
+  const int n = 20000;
+  const double h = 2.0 / n;
+  double sum = p(-1.0) + p(1.0);
+  for (int i = 1; i < n; ++i) sum += (i % 2 ? 4.0 : 2.0) * p(-1.0 + i * h);
+  return 2.0 * std::numbers::pi * sum * h / 3.0;
+}
+} // namespace
+
+TEST_CASE("DirectionalLight: direction normalized, invalid input named") {
+  const crep::DirectionalLight light({0, -3, 4}, {1, 2, 3});
+  CHECK(glm::length(light.direction()) == doctest::Approx(1.0).epsilon(1e-15));
+  CHECK(light.direction().y == doctest::Approx(-0.6));
+  expectInvalid("DirectionalLight.direction", [] { crep::DirectionalLight({0, 0, 0}); });
+  expectInvalid("DirectionalLight.direction", [] { crep::DirectionalLight({kNan, 1, 0}); });
+  expectInvalid("DirectionalLight.irradiance", [] { crep::DirectionalLight({0, -1, 0}, {-1, 0, 0}); });
+}
+
+TEST_CASE("anyOrthogonal: unit and orthogonal for every axis and sign") {
+  for (glm::dvec3 n : {glm::dvec3(0, 0, 1), glm::dvec3(0, 0, -1), glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0),
+                       glm::normalize(glm::dvec3(1, 2, -3)), glm::normalize(glm::dvec3(1e-9, 0, -1))}) {
+    const glm::dvec3 t = crep::anyOrthogonal(n);
+    CHECK(glm::length(t) == doctest::Approx(1.0).epsilon(1e-12));
+    CHECK(std::abs(glm::dot(t, n)) < 1e-12);
+  }
+}
+
+TEST_CASE("SpotLight: cone maps to the NDC square; invalid input named") {
+  const double cone = 0.4;
+  const crep::SpotLight spot({1, 5, 2}, {0.2, -1, 0.1}, cone, 50.0);
+  const glm::dmat4 m = spot.lightClipFromWorld();
+  // A point on the axis maps to the NDC centre; a point at the cone edge (rotated about an axis
+  // orthogonal to the light's up/right frame) maps to |x| or |y| = 1.
+  const glm::dvec3 onAxis = spot.position() + 10.0 * spot.direction();
+  glm::dvec4 c = m * glm::dvec4(onAxis, 1.0);
+  CHECK(std::abs(c.x / c.w) < 1e-12);
+  CHECK(std::abs(c.y / c.w) < 1e-12);
+  const glm::dmat4 viewFromWorld = spot.lightViewFromWorld();
+  const glm::dvec3 edgeView(std::tan(cone) * 10.0, 0.0, -10.0);
+  const glm::dvec3 edgeWorld(glm::inverse(viewFromWorld) * glm::dvec4(edgeView, 1.0));
+  c = m * glm::dvec4(edgeWorld, 1.0);
+  CHECK(c.x / c.w == doctest::Approx(1.0).epsilon(1e-12));
+  // Near and far planes map to -1 and 1.
+  c = m * glm::dvec4(spot.position() + spot.range() * spot.direction(), 1.0);
+  CHECK(c.z / c.w == doctest::Approx(1.0).epsilon(1e-12));
+  expectInvalid("SpotLight.coneAngle", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.0, 10.0); });
+  expectInvalid("SpotLight.coneAngle", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 1.6, 10.0); });
+  expectInvalid("SpotLight.range", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 0.0); });
+  expectInvalid("SpotLight.direction", [] { crep::SpotLight({0, 0, 0}, {0, 0, 0}, 0.5, 10.0); });
+  expectInvalid("SpotLight.position", [] { crep::SpotLight({kNan, 0, 0}, {0, -1, 0}, 0.5, 10.0); });
+  expectInvalid("SpotLight.nearPlane", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 10.0, {1, 1, 1}, 20.0); });
+}
+
+TEST_CASE("Phase functions are normalized over the sphere") {
+  for (double g : {-0.9, -0.3, 0.0, 0.5, 0.8}) {
+    INFO("g = " << g);
+    // g = +-0.9 is sharply peaked; Simpson with 20000 panels still gets 1e-6.
+    CHECK(sphereIntegral([g](double mu) { return crep::henyeyGreenstein(g, mu); }) ==
+          doctest::Approx(1.0).epsilon(1e-6));
+    // Mean cosine of HG equals g: 2 pi int mu p(mu) dmu.
+    CHECK(sphereIntegral([g](double mu) { return mu * crep::henyeyGreenstein(g, mu); }) ==
+          doctest::Approx(g).epsilon(1e-6).scale(1.0));
+  }
+  CHECK(crep::henyeyGreenstein(0.0, 0.3) == doctest::Approx(1.0 / (4.0 * std::numbers::pi)).epsilon(1e-15));
+  CHECK(sphereIntegral([](double mu) { return crep::rayleighPhase(mu); }) == doctest::Approx(1.0).epsilon(1e-10));
+  CHECK(crep::rayleighPhase(1.0) == doctest::Approx(2.0 * crep::rayleighPhase(0.0)));
+}
+
+TEST_CASE("Medium: extinction derived; scatteringTimesPhase combines HG and Rayleigh") {
+  const crep::Medium m({0.1, 0.2, 0.3}, {0.01, 0.02, 0.03}, 0.7, {0.001, 0.002, 0.004});
+  CHECK(m.extinction().x == doctest::Approx(0.111));
+  CHECK(m.extinction().z == doctest::Approx(0.334));
+  CHECK(m.scattering().y == doctest::Approx(0.202));
+  const glm::dvec3 sp = m.scatteringTimesPhase(0.25);
+  CHECK(sp.y == doctest::Approx(0.2 * crep::henyeyGreenstein(0.7, 0.25) + 0.002 * crep::rayleighPhase(0.25)));
+}
+
+TEST_CASE("Medium: invalid coefficients are named") {
+  expectInvalid("Medium.mieScattering", [] { crep::Medium({-0.1, 0.1, 0.1}); });
+  expectInvalid("Medium.mieScattering", [] { crep::Medium({kNan, 0.1, 0.1}); });
+  expectInvalid("Medium.absorption", [] { crep::Medium({0.1, 0.1, 0.1}, {0, -1e-3, 0}); });
+  expectInvalid("Medium.rayleighScattering", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 0.0, {0, 0, -1}); });
+  expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 1.0); });
+  expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, kNan); });
+  expectInvalid("Medium.extinction.g", [] { crep::Medium({0.1, 0.0, 0.1}); });
+  expectInvalid("Medium.extinction.r", [] { crep::Medium({0, 0, 0}); });
+}
