@@ -12,15 +12,33 @@ namespace {
 
 void deleteObject(ObjectType type, GLuint name) {
   switch (type) {
-  case ObjectType::Texture: glDeleteTextures(1, &name); break;
-  case ObjectType::Buffer: glDeleteBuffers(1, &name); break;
-  case ObjectType::Framebuffer: glDeleteFramebuffers(1, &name); break;
-  case ObjectType::Renderbuffer: glDeleteRenderbuffers(1, &name); break;
-  case ObjectType::VertexArray: glDeleteVertexArrays(1, &name); break;
-  case ObjectType::Program: glDeleteProgram(name); break;
-  case ObjectType::Shader: glDeleteShader(name); break;
-  case ObjectType::Query: glDeleteQueries(1, &name); break;
-  case ObjectType::Sampler: glDeleteSamplers(1, &name); break;
+  case ObjectType::Texture:
+    glDeleteTextures(1, &name);
+    break;
+  case ObjectType::Buffer:
+    glDeleteBuffers(1, &name);
+    break;
+  case ObjectType::Framebuffer:
+    glDeleteFramebuffers(1, &name);
+    break;
+  case ObjectType::Renderbuffer:
+    glDeleteRenderbuffers(1, &name);
+    break;
+  case ObjectType::VertexArray:
+    glDeleteVertexArrays(1, &name);
+    break;
+  case ObjectType::Program:
+    glDeleteProgram(name);
+    break;
+  case ObjectType::Shader:
+    glDeleteShader(name);
+    break;
+  case ObjectType::Query:
+    glDeleteQueries(1, &name);
+    break;
+  case ObjectType::Sampler:
+    glDeleteSamplers(1, &name);
+    break;
   }
 }
 
@@ -32,15 +50,24 @@ std::string hex(std::uint32_t v) {
 
 std::string errorName(GLenum error) {
   switch (error) {
-  case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
-  case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
-  case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
-  case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
-  case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
-  case GL_STACK_UNDERFLOW: return "GL_STACK_UNDERFLOW";
-  case GL_STACK_OVERFLOW: return "GL_STACK_OVERFLOW";
-  case GL_CONTEXT_LOST: return "GL_CONTEXT_LOST";
-  default: return hex(error);
+  case GL_INVALID_ENUM:
+    return "GL_INVALID_ENUM";
+  case GL_INVALID_VALUE:
+    return "GL_INVALID_VALUE";
+  case GL_INVALID_OPERATION:
+    return "GL_INVALID_OPERATION";
+  case GL_INVALID_FRAMEBUFFER_OPERATION:
+    return "GL_INVALID_FRAMEBUFFER_OPERATION";
+  case GL_OUT_OF_MEMORY:
+    return "GL_OUT_OF_MEMORY";
+  case GL_STACK_UNDERFLOW:
+    return "GL_STACK_UNDERFLOW";
+  case GL_STACK_OVERFLOW:
+    return "GL_STACK_OVERFLOW";
+  case GL_CONTEXT_LOST:
+    return "GL_CONTEXT_LOST";
+  default:
+    return hex(error);
   }
 }
 
@@ -57,7 +84,9 @@ int getInteger(GLenum pname) {
 
 } // namespace
 
-Handle::~Handle() { reset(); }
+Handle::~Handle() {
+  reset();
+}
 
 Handle::Handle(Handle&& other) noexcept : type_(other.type_), name_(other.release()) {}
 
@@ -117,8 +146,12 @@ Handle createSampler() {
   return checked(ObjectType::Sampler, name, "glCreateSamplers");
 }
 
-int maxTextureSize() { return getInteger(GL_MAX_TEXTURE_SIZE); }
-int maxArrayTextureLayers() { return getInteger(GL_MAX_ARRAY_TEXTURE_LAYERS); }
+int maxTextureSize() {
+  return getInteger(GL_MAX_TEXTURE_SIZE);
+}
+int maxArrayTextureLayers() {
+  return getInteger(GL_MAX_ARRAY_TEXTURE_LAYERS);
+}
 
 void checkTextureSize(const char* parameter, int width, int height) {
   const std::string value = std::to_string(width) + " x " + std::to_string(height);

@@ -31,21 +31,36 @@ bool hasToken(const char* list, std::string_view name) {
 
 std::string eglErrorName(EGLint error) {
   switch (error) {
-  case EGL_SUCCESS: return "EGL_SUCCESS";
-  case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-  case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-  case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-  case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-  case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-  case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-  case EGL_BAD_CURRENT_SURFACE: return "EGL_BAD_CURRENT_SURFACE";
-  case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-  case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-  case EGL_BAD_NATIVE_PIXMAP: return "EGL_BAD_NATIVE_PIXMAP";
-  case EGL_BAD_NATIVE_WINDOW: return "EGL_BAD_NATIVE_WINDOW";
-  case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-  case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
-  case EGL_CONTEXT_LOST: return "EGL_CONTEXT_LOST";
+  case EGL_SUCCESS:
+    return "EGL_SUCCESS";
+  case EGL_NOT_INITIALIZED:
+    return "EGL_NOT_INITIALIZED";
+  case EGL_BAD_ACCESS:
+    return "EGL_BAD_ACCESS";
+  case EGL_BAD_ALLOC:
+    return "EGL_BAD_ALLOC";
+  case EGL_BAD_ATTRIBUTE:
+    return "EGL_BAD_ATTRIBUTE";
+  case EGL_BAD_CONFIG:
+    return "EGL_BAD_CONFIG";
+  case EGL_BAD_CONTEXT:
+    return "EGL_BAD_CONTEXT";
+  case EGL_BAD_CURRENT_SURFACE:
+    return "EGL_BAD_CURRENT_SURFACE";
+  case EGL_BAD_DISPLAY:
+    return "EGL_BAD_DISPLAY";
+  case EGL_BAD_MATCH:
+    return "EGL_BAD_MATCH";
+  case EGL_BAD_NATIVE_PIXMAP:
+    return "EGL_BAD_NATIVE_PIXMAP";
+  case EGL_BAD_NATIVE_WINDOW:
+    return "EGL_BAD_NATIVE_WINDOW";
+  case EGL_BAD_PARAMETER:
+    return "EGL_BAD_PARAMETER";
+  case EGL_BAD_SURFACE:
+    return "EGL_BAD_SURFACE";
+  case EGL_CONTEXT_LOST:
+    return "EGL_CONTEXT_LOST";
   default: {
     char buf[32];
     std::snprintf(buf, sizeof buf, "0x%x", static_cast<unsigned>(error));
@@ -54,8 +69,12 @@ std::string eglErrorName(EGLint error) {
   }
 }
 
-[[noreturn]] void fail(const std::string& step) { throw GlUnavailable("crep: no OpenGL context: " + step); }
-[[noreturn]] void failEgl(const std::string& step) { fail(step + " failed (" + eglErrorName(eglGetError()) + ")"); }
+[[noreturn]] void fail(const std::string& step) {
+  throw GlUnavailable("crep: no OpenGL context: " + step);
+}
+[[noreturn]] void failEgl(const std::string& step) {
+  fail(step + " failed (" + eglErrorName(eglGetError()) + ")");
+}
 
 /// eglTerminate acts on the whole display, which is shared by every context of the process (the
 /// surfaceless display is a singleton), so the last GlContext alive terminates it.
@@ -63,12 +82,15 @@ std::mutex gDisplayMutex;
 int gDisplayUsers = 0;
 
 void defaultDebugCallback(const GlDebugMessage& message) {
-  if (message.isError()) std::fprintf(stderr, "crep: GL error (id %u): %s\n", message.id, message.text.c_str());
+  if (message.isError())
+    std::fprintf(stderr, "crep: GL error (id %u): %s\n", message.id, message.text.c_str());
 }
 
 } // namespace
 
-bool GlDebugMessage::isError() const { return type == GL_DEBUG_TYPE_ERROR; }
+bool GlDebugMessage::isError() const {
+  return type == GL_DEBUG_TYPE_ERROR;
+}
 
 struct GlContext::Impl {
   EGLDisplay display = EGL_NO_DISPLAY;
@@ -102,8 +124,8 @@ struct GlContext::Impl {
   }
 
   // Called by the driver inside GL calls, i.e. from C code: nothing may propagate out of it.
-  static void GLAPIENTRY onDebugMessage(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
-                                        const GLchar* text, const void* user) {
+  static void GLAPIENTRY onDebugMessage(GLenum source, GLenum type, GLuint id, GLenum severity,
+                                        GLsizei length, const GLchar* text, const void* user) {
     const Impl* self = static_cast<const Impl*>(user);
     try {
       GlDebugMessage message;
@@ -140,7 +162,8 @@ GlContext::GlContext(const GlContextOptions& options) : impl_(std::make_unique<I
   EGLint eglMajor = 0, eglMinor = 0;
   {
     const std::lock_guard lock(gDisplayMutex);
-    if (!eglInitialize(impl.display, &eglMajor, &eglMinor)) failEgl("eglInitialize on the surfaceless display");
+    if (!eglInitialize(impl.display, &eglMajor, &eglMinor))
+      failEgl("eglInitialize on the surfaceless display");
     impl.initialized = true;
     ++gDisplayUsers;
   }
@@ -186,7 +209,8 @@ GlContext::GlContext(const GlContextOptions& options) : impl_(std::make_unique<I
   attribs[n++] = EGL_NONE;
 
   const std::string requested = "OpenGL " + std::to_string(options.majorVersion) + "." +
-                                std::to_string(options.minorVersion) + " core" + (options.debug ? " debug" : "");
+                                std::to_string(options.minorVersion) + " core" +
+                                (options.debug ? " debug" : "");
   impl.previousDisplay = eglGetCurrentDisplay();
   impl.previousContext = eglGetCurrentContext();
   impl.previousDraw = eglGetCurrentSurface(EGL_DRAW);
@@ -231,7 +255,9 @@ std::string GlContext::version() const {
   return s != nullptr ? reinterpret_cast<const char*>(s) : "";
 }
 
-bool GlContext::isDebug() const { return impl_->debug; }
+bool GlContext::isDebug() const {
+  return impl_->debug;
+}
 
 void GlContext::setDebugCallback(std::function<void(const GlDebugMessage&)> callback) {
   impl_->callback = callback ? std::move(callback) : defaultDebugCallback;

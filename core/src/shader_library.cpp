@@ -12,6 +12,11 @@
 //   compiler's business). Lines inside /* */ comments are ignored.
 // - Only the top-level file may have a #version line; it is moved to the top of the output and
 //   replaced by an empty line, so line numbers stay those of the file.
+//
+// Markers: the top-level file is source string 0 with its own line numbers; the n-th included file is
+// source string n and its line k is numbered n * kLineStride + k. Mesa sets the source-string number
+// of most parser-level errors to 0 (its YYLLOC_DEFAULT resets it) while keeping the line, so the
+// line alone must identify the file; other compilers (glslang, NVIDIA) report both correctly.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 
@@ -62,14 +67,24 @@ const File* findFile(std::string_view path) {
   return it != files.end() && it->path == path ? &*it : nullptr;
 }
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-bool isDigit(char c) { return c >= '0' && c <= '9'; }
-bool isIdentStart(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; }
-bool isIdentChar(char c) { return isIdentStart(c) || isDigit(c); }
+bool isSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+bool isDigit(char c) {
+  return c >= '0' && c <= '9';
+}
+bool isIdentStart(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+bool isIdentChar(char c) {
+  return isIdentStart(c) || isDigit(c);
+}
 
 std::string_view trim(std::string_view s) {
-  while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
-  while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
+  while (!s.empty() && isSpace(s.front()))
+    s.remove_prefix(1);
+  while (!s.empty() && isSpace(s.back()))
+    s.remove_suffix(1);
   return s;
 }
 
@@ -81,12 +96,15 @@ struct Directive {
 /// A preprocessor directive: optional blanks, '#', optional blanks, a name.
 std::optional<Directive> parseDirective(std::string_view line) {
   std::size_t i = 0;
-  while (i < line.size() && isSpace(line[i])) ++i;
+  while (i < line.size() && isSpace(line[i]))
+    ++i;
   if (i == line.size() || line[i] != '#') return std::nullopt;
   ++i;
-  while (i < line.size() && isSpace(line[i])) ++i;
+  while (i < line.size() && isSpace(line[i]))
+    ++i;
   const std::size_t start = i;
-  while (i < line.size() && isIdentChar(line[i])) ++i;
+  while (i < line.size() && isIdentChar(line[i]))
+    ++i;
   return Directive{line.substr(start, i - start), line.substr(i)};
 }
 
@@ -132,7 +150,15 @@ std::optional<std::string> normalizePath(std::string_view path) {
   return out;
 }
 
-std::string quoted(std::string_view s) { return "\"" + std::string(s) + "\""; }
+std::string quoted(std::string_view s) {
+  return "\"" + std::string(s) + "\"";
+}
+
+/// `#line` marker before line `line` of source string `number`.
+std::string lineMarker(int number, int line) {
+  const long long markerLine = static_cast<long long>(number) * ExpandedShader::kLineStride + line;
+  return "#line " + std::to_string(markerLine) + " " + std::to_string(number) + "\n";
+}
 
 class Expander {
 public:
@@ -168,11 +194,14 @@ private:
       source.remove_prefix(newline == std::string_view::npos ? source.size() : newline + 1);
       ++lineNo;
       stack_.back().line = lineNo;
+      if (lineNo >= ExpandedShader::kLineStride)
+        fail(path, lineNo, "too many lines for the #line bookkeeping of the shader library");
       const bool startsInComment = inComment;
       inComment = blockCommentOpenAfter(line, inComment);
       const std::optional<Directive> directive = startsInComment ? std::nullopt : parseDirective(line);
       if (directive && directive->name == "version") {
-        if (!top) fail(path, lineNo, "#version is only allowed in the top-level shader, not in an included file");
+        if (!top)
+          fail(path, lineNo, "#version is only allowed in the top-level shader, not in an included file");
         if (version.empty()) {
           version = std::string(trim(line));
           body += '\n'; // keeps the line numbers
@@ -188,28 +217,34 @@ private:
     stack_.pop_back();
   }
 
-  void includeFile(std::string_view path, int lineNo, std::string_view line, std::string_view rest, int number) {
+  void includeFile(std::string_view path, int lineNo, std::string_view line, std::string_view rest,
+                   int number) {
     rest = trim(rest);
-    const std::size_t close = rest.size() > 1 && rest.front() == '"' ? rest.find('"', 1) : std::string_view::npos;
+    const std::size_t close =
+        rest.size() > 1 && rest.front() == '"' ? rest.find('"', 1) : std::string_view::npos;
     const std::string_view after = close == std::string_view::npos ? "" : trim(rest.substr(close + 1));
     if (close == std::string_view::npos || close == 1 || (!after.empty() && after.substr(0, 2) != "//"))
-      fail(path, lineNo, "malformed #include (expected #include \"file\" on a line of its own): " +
-                             std::string(trim(line)));
+      fail(path, lineNo,
+           "malformed #include (expected #include \"file\" on a line of its own): " +
+               std::string(trim(line)));
     const std::string_view name = rest.substr(1, close - 1);
 
     // Relative to the including file's folder first, then to the glsl/ root.
     std::vector<std::string> candidates;
     const std::size_t slash = path.rfind('/');
     if (slash != std::string_view::npos && name.front() != '/') {
-      if (auto p = normalizePath(std::string(path.substr(0, slash + 1)) + std::string(name))) candidates.push_back(*p);
+      if (auto p = normalizePath(std::string(path.substr(0, slash + 1)) + std::string(name)))
+        candidates.push_back(*p);
     }
-    if (auto p = normalizePath(name); p && (candidates.empty() || candidates.front() != *p)) candidates.push_back(*p);
+    if (auto p = normalizePath(name); p && (candidates.empty() || candidates.front() != *p))
+      candidates.push_back(*p);
     const File* file = nullptr;
     for (const std::string& candidate : candidates)
       if ((file = findFile(candidate)) != nullptr) break;
     if (file == nullptr) {
       std::string tried;
-      for (const std::string& c : candidates) tried += (tried.empty() ? "" : ", ") + quoted(c);
+      for (const std::string& c : candidates)
+        tried += (tried.empty() ? "" : ", ") + quoted(c);
       fail(path, lineNo,
            "cannot find #include " + quoted(name) + " in the embedded shader library (tried " + tried + ")");
     }
@@ -234,9 +269,9 @@ private:
     const int included = static_cast<int>(out_.files.size());
     out_.files.emplace_back(file->path);
     included_.insert(file->path);
-    body += "#line 1 " + std::to_string(included) + "\n";
+    body += lineMarker(included, 1);
     expandFile(file->path, file->source, included, false);
-    body += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(number) + "\n";
+    body += lineMarker(number, lineNo + 1);
   }
 
   ExpandedShader& out_;
@@ -244,33 +279,52 @@ private:
   std::vector<Frame> stack_;
 };
 
-/// If `line` holds a source-string number at `pos` followed by ':' or '(' and a digit (the
-/// "N:line" of Mesa and glslang, the "N(line)" of NVIDIA), replaces it with the file's path.
-bool replaceSourceNumber(std::string& line, std::size_t pos, const std::vector<std::string>& files) {
-  std::size_t end = pos;
-  while (end < line.size() && isDigit(line[end])) ++end;
-  if (end == pos || end - pos > 6 || end + 1 >= line.size()) return false;
-  if ((line[end] != ':' && line[end] != '(') || !isDigit(line[end + 1])) return false;
-  const std::size_t number = std::stoul(line.substr(pos, end - pos));
+/// If `line` holds "N:L" (Mesa, glslang) or "N(L)" (NVIDIA) at `pos`, N a source-string number and
+/// L a line, replaces them with the file's path and its own line.
+bool replaceLocation(std::string& line, std::size_t pos, const std::vector<std::string>& files) {
+  const auto digitsEnd = [&](std::size_t from) {
+    std::size_t end = from;
+    while (end < line.size() && end - from < 9 && isDigit(line[end]))
+      ++end;
+    return end;
+  };
+  const std::size_t numberEnd = digitsEnd(pos);
+  if (numberEnd == pos || numberEnd >= line.size() || (line[numberEnd] != ':' && line[numberEnd] != '('))
+    return false;
+  const std::size_t lineEnd = digitsEnd(numberEnd + 1);
+  if (lineEnd == numberEnd + 1) return false;
+  std::size_t number = std::stoul(line.substr(pos, numberEnd - pos));
+  std::size_t lineNo = std::stoul(line.substr(numberEnd + 1, lineEnd - numberEnd - 1));
+  const std::size_t stride = ExpandedShader::kLineStride;
+  if (lineNo >= stride) {
+    number = lineNo / stride; // the line identifies the file even when the number is wrong
+    lineNo %= stride;
+  }
   if (number >= files.size()) return false;
-  line.replace(pos, end - pos, files[number]);
+  line.replace(pos, lineEnd - pos, files[number] + line[numberEnd] + std::to_string(lineNo));
   return true;
 }
 
 GLenum glShaderType(ShaderStage stage) {
   switch (stage) {
-  case ShaderStage::Vertex: return GL_VERTEX_SHADER;
-  case ShaderStage::Fragment: return GL_FRAGMENT_SHADER;
-  case ShaderStage::Compute: return GL_COMPUTE_SHADER;
+  case ShaderStage::Vertex:
+    return GL_VERTEX_SHADER;
+  case ShaderStage::Fragment:
+    return GL_FRAGMENT_SHADER;
+  case ShaderStage::Compute:
+    return GL_COMPUTE_SHADER;
   }
   return GL_NONE;
 }
 
 const char* stageName(ShaderStage stage) {
   switch (stage) {
-  case ShaderStage::Vertex: return "vertex";
-  case ShaderStage::Fragment: return "fragment";
-  case ShaderStage::Compute: return "compute";
+  case ShaderStage::Vertex:
+    return "vertex";
+  case ShaderStage::Fragment:
+    return "fragment";
+  case ShaderStage::Compute:
+    return "compute";
   }
   return "unknown";
 }
@@ -278,17 +332,21 @@ const char* stageName(ShaderStage stage) {
 std::string describeDefines(const std::vector<ShaderDefine>& defines) {
   if (defines.empty()) return "";
   std::string s = " with";
-  for (const ShaderDefine& d : defines) s += " " + d.name + (d.value.empty() ? "" : "=" + d.value);
+  for (const ShaderDefine& d : defines)
+    s += " " + d.name + (d.value.empty() ? "" : "=" + d.value);
   return s;
 }
 
 } // namespace
 
-std::span<const ShaderLibrary::File> ShaderLibrary::files() { return allFiles(); }
+std::span<const ShaderLibrary::File> ShaderLibrary::files() {
+  return allFiles();
+}
 
 std::string_view ShaderLibrary::source(std::string_view path) {
   const File* file = findFile(path);
-  if (file == nullptr) throw ShaderError("crep: no shader file " + quoted(path) + " in the embedded shader library");
+  if (file == nullptr)
+    throw ShaderError("crep: no shader file " + quoted(path) + " in the embedded shader library");
   return file->source;
 }
 
@@ -301,30 +359,32 @@ ExpandedShader ShaderLibrary::expand(std::string_view path, std::span<const Shad
       throw InvalidArgument("ShaderDefine.value", quoted(d.value), "must be a single line");
   }
   const File* top = findFile(path);
-  if (top == nullptr) throw ShaderError("crep: no shader file " + quoted(path) + " in the embedded shader library");
+  if (top == nullptr)
+    throw ShaderError("crep: no shader file " + quoted(path) + " in the embedded shader library");
 
   ExpandedShader out;
   Expander expander(out);
   expander.expandTop(top->path, top->source);
   out.text = expander.version.empty() ? "#version 450 core" : expander.version;
   out.text += '\n';
-  for (const ShaderDefine& d : defines) out.text += "#define " + d.name + (d.value.empty() ? "" : " " + d.value) + "\n";
+  for (const ShaderDefine& d : defines)
+    out.text += "#define " + d.name + (d.value.empty() ? "" : " " + d.value) + "\n";
   out.text += "#line 1 0\n";
   out.text += expander.body;
   return out;
 }
 
 std::string ExpandedShader::translateLog(std::string_view log) const {
-  static constexpr std::string_view kPrefixes[] = {"ERROR: ", "WARNING: ", "NOTE: ", "INTERNAL ERROR: ",
-                                                   "UNIMPLEMENTED: "};
+  static constexpr std::string_view kPrefixes[] = {
+      "ERROR: ", "WARNING: ", "NOTE: ", "INTERNAL ERROR: ", "UNIMPLEMENTED: "};
   std::string out;
   while (!log.empty()) {
     const std::size_t newline = log.find('\n');
     std::string line(log.substr(0, newline));
     log.remove_prefix(newline == std::string_view::npos ? log.size() : newline + 1);
-    if (!replaceSourceNumber(line, 0, files)) {
+    if (!replaceLocation(line, 0, files)) {
       for (const std::string_view prefix : kPrefixes)
-        if (line.starts_with(prefix) && replaceSourceNumber(line, prefix.size(), files)) break;
+        if (line.starts_with(prefix) && replaceLocation(line, prefix.size(), files)) break;
     }
     out += line;
     if (newline != std::string_view::npos) out += '\n';
@@ -343,7 +403,8 @@ gl::Handle buildProgram(std::span<const ShaderStageSource> stages) {
   for (const ShaderStageSource& stage : stages) {
     const ExpandedShader expanded = ShaderLibrary::expand(stage.path, stage.defines);
     gl::Handle shader(gl::ObjectType::Shader, glCreateShader(glShaderType(stage.stage)));
-    if (!shader) throw ShaderError(std::string("crep: glCreateShader(") + stageName(stage.stage) + ") failed");
+    if (!shader)
+      throw ShaderError(std::string("crep: glCreateShader(") + stageName(stage.stage) + ") failed");
     const GLchar* text = expanded.text.c_str();
     const GLint length = static_cast<GLint>(expanded.text.size());
     glShaderSource(shader.get(), 1, &text, &length);
@@ -365,9 +426,11 @@ gl::Handle buildProgram(std::span<const ShaderStageSource> stages) {
 
   gl::Handle program(gl::ObjectType::Program, glCreateProgram());
   if (!program) throw ShaderError("crep: glCreateProgram() failed");
-  for (const gl::Handle& shader : shaders) glAttachShader(program.get(), shader.get());
+  for (const gl::Handle& shader : shaders)
+    glAttachShader(program.get(), shader.get());
   glLinkProgram(program.get());
-  for (const gl::Handle& shader : shaders) glDetachShader(program.get(), shader.get());
+  for (const gl::Handle& shader : shaders)
+    glDetachShader(program.get(), shader.get());
   GLint ok = GL_FALSE, logLength = 0;
   glGetProgramiv(program.get(), GL_LINK_STATUS, &ok);
   if (ok != GL_TRUE) {

@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "timings.h"
 
+#include <crep/core/error.h>
 #include <crep/core/exr.h>
 #include <crep/core/gl.h>
 #include <crep/core/gl_context.h>

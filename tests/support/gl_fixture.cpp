@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string_view>
+#include <utility>
 
 namespace crep::test {
 
@@ -41,9 +42,10 @@ void failOnGlError(const GlDebugMessage& message) {
   if (!message.isError() || message.source == kDebugSourceShaderCompiler) return;
   ++gErrorCount;
   if (doctest::is_running_in_test) {
-    ADD_FAIL_CHECK("GL error (KHR_debug id " << message.id << "): " << message.text);
+    FAIL_CHECK("GL error (KHR_debug id " << message.id << "): " << message.text);
   } else {
-    std::fprintf(stderr, "GL error outside a test case (KHR_debug id %u): %s\n", message.id, message.text.c_str());
+    std::fprintf(stderr, "GL error outside a test case (KHR_debug id %u): %s\n", message.id,
+                 message.text.c_str());
   }
 }
 
@@ -67,9 +69,13 @@ GlContext* sharedGlContext() {
   return s.context.get();
 }
 
-std::string glUnavailableReason() { return state().unavailable; }
+std::string glUnavailableReason() {
+  return state().unavailable;
+}
 
-int glErrorCount() { return gErrorCount.load(); }
+int glErrorCount() {
+  return gErrorCount.load();
+}
 
 GlContext& requireGl() {
   GlContext* context = sharedGlContext();

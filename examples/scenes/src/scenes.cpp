@@ -146,8 +146,9 @@ Scene makeScene(std::string_view name, double aspect) {
   const double fov = 60.0 * std::numbers::pi / 180.0;
   if (name == "colonnade") {
     Scene s{"colonnade", colonnadeMesh(),
-            Camera::lookAt({-3.0, 2.2, 24.0}, {0.5, 5.0, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
-            DirectionalLight(glm::dvec3(0.55, -0.75, -0.35), glm::dvec3(4.0, 3.7, 3.2)), defaultMedium(), {}, {}};
+            Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
+            DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(5.0, 4.6, 4.0)),
+            Medium(glm::dvec3(0.04, 0.042, 0.045), glm::dvec3(0.004), 0.5), {}, {}};
     computeBounds(s);
     return s;
   }

@@ -23,6 +23,10 @@ struct ShaderDefine {
 
 /// A fully expanded shader source ready for glShaderSource.
 struct ExpandedShader {
+  /// Line k of files[n] is numbered n * kLineStride + k in the `#line` markers, so the line number
+  /// alone identifies the file: Mesa reports source-string number 0 for many errors in included files.
+  static constexpr int kLineStride = 100000;
+
   std::string text;
   /// Source-string numbers used in the `#line <line> <number>` markers: files[number] is the
   /// path (relative to glsl/) of that file. Number 0 is the top-level file.

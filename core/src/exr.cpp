@@ -1,0 +1,660 @@
+// EXR I/O. Writing uses the OpenEXR C++ API. Reading first validates the file structure with a
+// small bounded parser of our own (magic, version flags, every header attribute size, the data
+// window against the size limits, the chunk offset table and every chunk header of the part that is
+// read), so that OpenEXR never sees a header that would make it allocate according to an absurd
+// size and truncated pixel data is detected independently of OpenEXR's behaviour. Pixels are then
+// decoded by OpenEXR (Imf::MultiPartInputFile / Imf::InputPart) without chunk table
+// reconstruction; every OpenEXR exception becomes a crep::FormatError naming the file.
+#include <crep/core/exr.h>
+
+#include <crep/core/error.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfPartType.h>
+#include <half.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+namespace crep {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// ------------------------------------------------------------------------------------------------
+// Errors
+
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+[[noreturn]] void throwFormat(const fs::path& path, const std::string& what) {
+  throw FormatError("crep: cannot read EXR file " + quoted(path) + ": " + what);
+}
+
+[[noreturn]] void throwRead(const fs::path& path, const std::string& what) {
+  throw IoError("crep: cannot read EXR file " + quoted(path) + ": " + what);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Writing
+
+const char* const kChannelSuffixes[4][4] = {
+    {"Y", nullptr, nullptr, nullptr},
+    {"R", "G", nullptr, nullptr},
+    {"R", "G", "B", nullptr},
+    {"R", "G", "B", "A"},
+};
+
+Imf::Compression toImf(ExrCompression compression) {
+  switch (compression) {
+  case ExrCompression::None:
+    return Imf::NO_COMPRESSION;
+  case ExrCompression::Zip:
+    return Imf::ZIP_COMPRESSION;
+  case ExrCompression::Piz:
+    return Imf::PIZ_COMPRESSION;
+  }
+  throw InvalidArgument("ExrWriteOptions.compression",
+                        detail::formatValue(static_cast<long long>(compression)), "unknown compression");
+}
+
+Imf::PixelType toImf(ExrPixelType type) {
+  switch (type) {
+  case ExrPixelType::Half:
+    return Imf::HALF;
+  case ExrPixelType::Float:
+    return Imf::FLOAT;
+  }
+  throw InvalidArgument("ExrWriteOptions.pixelType", detail::formatValue(static_cast<long long>(type)),
+                        "unknown pixel type");
+}
+
+std::string channelName(const std::string& layer, const char* suffix) {
+  return layer.empty() ? std::string(suffix) : layer + "." + suffix;
+}
+
+void writeLayers(const fs::path& path, std::span<const ExrLayer> layers, const ExrWriteOptions& options) {
+  if (layers.empty()) throw InvalidArgument("layers", "0 layers", "at least one layer is required");
+  const Imf::Compression compression = toImf(options.compression);
+  const Imf::PixelType pixelType = toImf(options.pixelType);
+
+  std::set<std::string> names;
+  for (const ExrLayer& layer : layers) {
+    if (layer.image == nullptr) throw InvalidArgument("ExrLayer.image", "null", "layer '" + layer.name + "'");
+    if (layer.image->empty())
+      throw InvalidArgument("ExrLayer.image", "empty image", "layer '" + layer.name + "' must not be empty");
+    if (!names.insert(layer.name).second)
+      throw InvalidArgument("ExrLayer.name", "'" + layer.name + "'", "layer names must be unique");
+    const Image& first = *layers.front().image;
+    if (layer.image->width() != first.width() || layer.image->height() != first.height())
+      throw InvalidArgument("ExrLayer.image",
+                            std::to_string(layer.image->width()) + "x" + std::to_string(layer.image->height()),
+                            "layer '" + layer.name + "' must have the size of the first layer (" +
+                                std::to_string(first.width()) + "x" + std::to_string(first.height()) + ")");
+  }
+
+  const int width = layers.front().image->width();
+  const int height = layers.front().image->height();
+
+  // EXR wants the top row first: flipped copies, interleaved as in the Image, in the file's type
+  // (OpenEXR does not convert float frame buffers to half file channels).
+  const std::size_t sampleBytes = pixelType == Imf::HALF ? sizeof(Imath::half) : sizeof(float);
+  std::vector<std::vector<float>> floats(layers.size());
+  std::vector<std::vector<Imath::half>> halves(layers.size());
+  Imf::Header header(width, height);
+  header.compression() = compression;
+  Imf::FrameBuffer frameBuffer;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const Image& image = *layers[i].image;
+    const std::size_t channels = static_cast<std::size_t>(image.channels());
+    const std::size_t rowSamples = static_cast<std::size_t>(width) * channels;
+    const std::span<const float> src = image.data();
+    char* base = nullptr;
+    if (pixelType == Imf::HALF) {
+      std::vector<Imath::half>& rows = halves[i];
+      rows.reserve(image.sampleCount());
+      for (int y = height - 1; y >= 0; --y)
+        for (std::size_t k = 0; k < rowSamples; ++k)
+          rows.emplace_back(src[static_cast<std::size_t>(y) * rowSamples + k]);
+      base = reinterpret_cast<char*>(rows.data());
+    } else {
+      std::vector<float>& rows = floats[i];
+      rows.reserve(image.sampleCount());
+      for (int y = height - 1; y >= 0; --y) {
+        const auto row = src.subspan(static_cast<std::size_t>(y) * rowSamples, rowSamples);
+        rows.insert(rows.end(), row.begin(), row.end());
+      }
+      base = reinterpret_cast<char*>(rows.data());
+    }
+    for (std::size_t c = 0; c < channels; ++c) {
+      const std::string name = channelName(layers[i].name, kChannelSuffixes[channels - 1][c]);
+      if (header.channels().findChannel(name) != nullptr)
+        throw InvalidArgument("ExrLayer.name", "'" + layers[i].name + "'",
+                              "channel '" + name + "' would be written twice");
+      header.channels().insert(name, Imf::Channel(pixelType));
+      frameBuffer.insert(name, Imf::Slice(pixelType, base + c * sampleBytes, channels * sampleBytes,
+                                          rowSamples * sampleBytes));
+    }
+  }
+
+  // Write to a temporary name and rename, so a failure never leaves a truncated file at `path`.
+  fs::path temporary = path;
+  temporary += ".partial";
+  try {
+    {
+      Imf::OutputFile file(temporary.c_str(), header, 0);
+      file.setFrameBuffer(frameBuffer);
+      file.writePixels(height);
+    }
+    fs::rename(temporary, path);
+  } catch (const std::exception& e) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw IoError("crep: cannot write EXR file " + quoted(path) + ": " + e.what());
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
+// Structural validation (bounded work and memory, no OpenEXR involved)
+
+constexpr std::uint32_t kMagic = 20000630;
+constexpr std::uint32_t kFlagTiled = 0x200;
+constexpr std::uint32_t kFlagLongNames = 0x400;
+constexpr std::uint32_t kFlagNonImage = 0x800;
+constexpr std::uint32_t kFlagMultiPart = 0x1000;
+constexpr std::uint32_t kKnownFlags = kFlagTiled | kFlagLongNames | kFlagNonImage | kFlagMultiPart;
+
+// Sequential and random access reads on the file with the size known up front.
+class FileReader {
+public:
+  FileReader(const fs::path& path) : path_(path) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (ec || !fs::exists(status)) throwRead(path, "file does not exist");
+    if (fs::is_directory(status)) throwRead(path, "is a directory");
+    in_.open(path, std::ios::binary);
+    if (!in_) throwRead(path, "cannot open file for reading");
+    in_.seekg(0, std::ios::end);
+    const std::streamoff end = in_.tellg();
+    if (end < 0) throwRead(path, "cannot determine the file size");
+    size_ = static_cast<std::uint64_t>(end);
+    in_.seekg(0);
+  }
+
+  std::uint64_t size() const { return size_; }
+  std::uint64_t position() const { return position_; }
+  std::uint64_t remaining() const { return size_ - position_; }
+
+  // Reads n bytes at `offset`; false if the file is shorter.
+  bool readAt(std::uint64_t offset, void* dst, std::size_t n) {
+    if (offset > size_ || n > size_ - offset) return false;
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(offset));
+    in_.read(static_cast<char*>(dst), static_cast<std::streamsize>(n));
+    if (static_cast<std::size_t>(in_.gcount()) != n) throwRead(path_, "read error");
+    return true;
+  }
+
+  void read(void* dst, std::size_t n, const char* what) {
+    if (!readAt(position_, dst, n)) throwFormat(path_, std::string("truncated file (") + what + ")");
+    position_ += n;
+  }
+  void skip(std::uint64_t n, const char* what) {
+    if (n > remaining()) throwFormat(path_, std::string("truncated file (") + what + ")");
+    position_ += n;
+  }
+  std::uint8_t u8(const char* what) {
+    std::uint8_t v = 0;
+    read(&v, 1, what);
+    return v;
+  }
+  std::uint32_t u32(const char* what) {
+    std::array<std::uint8_t, 4> b{};
+    read(b.data(), 4, what);
+    return decode32(b.data());
+  }
+  std::uint64_t u64(const char* what) {
+    std::array<std::uint8_t, 8> b{};
+    read(b.data(), 8, what);
+    return decode64(b.data());
+  }
+  // Null-terminated string of at most maxLength characters.
+  std::string cstring(std::size_t maxLength, const char* what) {
+    std::string s;
+    for (;;) {
+      const std::uint8_t c = u8(what);
+      if (c == 0) return s;
+      if (s.size() == maxLength) throwFormat(path_, std::string(what) + " is too long or not terminated");
+      s.push_back(static_cast<char>(c));
+    }
+  }
+
+  static std::uint32_t decode32(const std::uint8_t* b) {
+    return static_cast<std::uint32_t>(b[0]) | (static_cast<std::uint32_t>(b[1]) << 8) |
+           (static_cast<std::uint32_t>(b[2]) << 16) | (static_cast<std::uint32_t>(b[3]) << 24);
+  }
+  static std::uint64_t decode64(const std::uint8_t* b) {
+    return static_cast<std::uint64_t>(decode32(b)) | (static_cast<std::uint64_t>(decode32(b + 4)) << 32);
+  }
+  static std::int32_t toSigned(std::uint32_t v) {
+    std::int32_t s = 0;
+    std::memcpy(&s, &v, sizeof s);
+    return s;
+  }
+
+private:
+  fs::path path_;
+  std::ifstream in_;
+  std::uint64_t size_ = 0;
+  std::uint64_t position_ = 0;
+};
+
+struct PartLayout {
+  bool hasDataWindow = false;
+  std::int32_t minX = 0, minY = 0, maxX = -1, maxY = -1;
+  int compression = -1;
+  bool hasTiles = false;
+  std::uint32_t tileWidth = 0, tileHeight = 0;
+  int levelMode = 0, roundingMode = 0;
+  std::string type;
+  bool hasChunkCount = false;
+  std::int32_t chunkCount = 0;
+  long long width() const { return static_cast<long long>(maxX) - minX + 1; }
+  long long height() const { return static_cast<long long>(maxY) - minY + 1; }
+  bool tiled(std::uint32_t flags) const {
+    return type.empty() ? (flags & kFlagTiled) != 0 : (type == "tiledimage" || type == "deeptile");
+  }
+  bool deep(std::uint32_t flags) const {
+    return type.empty() ? (flags & kFlagNonImage) != 0 : (type == "deepscanline" || type == "deeptile");
+  }
+};
+
+struct FileLayout {
+  std::uint32_t flags = 0;
+  std::vector<PartLayout> parts;
+  std::uint64_t tablesStart = 0; // first byte after the headers
+};
+
+int linesPerChunk(int compression) {
+  switch (compression) {
+  case 0: // NONE
+  case 1: // RLE
+  case 2: // ZIPS
+    return 1;
+  case 3: // ZIP
+  case 5: // PXR24
+    return 16;
+  case 4: // PIZ
+  case 6: // B44
+  case 7: // B44A
+  case 8: // DWAA
+    return 32;
+  case 9: // DWAB
+    return 256;
+  default:
+    return 0;
+  }
+}
+
+FileLayout scanHeaders(FileReader& reader, const fs::path& path) {
+  if (reader.size() == 0) throwFormat(path, "empty file");
+  if (reader.size() < 8) throwFormat(path, "not an OpenEXR file (only " + std::to_string(reader.size()) + " bytes)");
+  if (reader.u32("magic number") != kMagic) throwFormat(path, "not an OpenEXR file (bad magic number)");
+  const std::uint32_t version = reader.u32("version");
+  FileLayout layout;
+  layout.flags = version & ~0xFFu;
+  if ((version & 0xFFu) != 2) throwFormat(path, "unsupported EXR version " + std::to_string(version & 0xFFu));
+  if ((layout.flags & ~kKnownFlags) != 0) throwFormat(path, "unknown version flags");
+  const bool multiPart = (layout.flags & kFlagMultiPart) != 0;
+  const std::size_t maxName = (layout.flags & kFlagLongNames) != 0 ? 255 : 31;
+
+  for (;;) {
+    // Multi-part files end the header list with an empty header (a lone 0 byte).
+    if (multiPart && !layout.parts.empty()) {
+      std::uint8_t next = 0;
+      if (!reader.readAt(reader.position(), &next, 1)) throwFormat(path, "truncated file (header list)");
+      if (next == 0) {
+        reader.skip(1, "header list");
+        break;
+      }
+    }
+    if (layout.parts.size() >= 4096) throwFormat(path, "too many parts");
+    PartLayout part;
+    for (int attribute = 0;; ++attribute) {
+      const std::string name = reader.cstring(maxName, "attribute name");
+      if (name.empty()) break;
+      if (attribute > 100000) throwFormat(path, "too many header attributes");
+      const std::string typeName = reader.cstring(maxName, "attribute type name");
+      const std::int32_t size = FileReader::toSigned(reader.u32("attribute size"));
+      if (size < 0 || static_cast<std::uint64_t>(size) > reader.remaining())
+        throwFormat(path, "invalid size " + std::to_string(size) + " of header attribute '" + name + "'");
+      const std::uint64_t valueStart = reader.position();
+      if (name == "dataWindow" && typeName == "box2i" && size == 16) {
+        part.hasDataWindow = true;
+        part.minX = FileReader::toSigned(reader.u32("dataWindow"));
+        part.minY = FileReader::toSigned(reader.u32("dataWindow"));
+        part.maxX = FileReader::toSigned(reader.u32("dataWindow"));
+        part.maxY = FileReader::toSigned(reader.u32("dataWindow"));
+      } else if (name == "compression" && typeName == "compression" && size == 1) {
+        part.compression = reader.u8("compression");
+      } else if (name == "tiles" && typeName == "tiledesc" && size == 9) {
+        part.hasTiles = true;
+        part.tileWidth = reader.u32("tiles");
+        part.tileHeight = reader.u32("tiles");
+        const std::uint8_t mode = reader.u8("tiles");
+        part.levelMode = mode & 0x0F;
+        part.roundingMode = mode >> 4;
+      } else if (name == "type" && typeName == "string" && size <= 64) {
+        part.type.resize(static_cast<std::size_t>(size));
+        reader.read(part.type.data(), part.type.size(), "type");
+      } else if (name == "chunkCount" && typeName == "int" && size == 4) {
+        part.hasChunkCount = true;
+        part.chunkCount = FileReader::toSigned(reader.u32("chunkCount"));
+      }
+      reader.skip(valueStart + static_cast<std::uint64_t>(size) - reader.position(), "header attribute");
+    }
+    layout.parts.push_back(std::move(part));
+    if (!multiPart) break;
+  }
+  if (layout.parts.empty()) throwFormat(path, "no parts");
+  layout.tablesStart = reader.position();
+  return layout;
+}
+
+int roundedLog2(long long x, int roundingMode) {
+  int floorLog = 0;
+  while ((x >> (floorLog + 1)) != 0) ++floorLog;
+  const bool exact = x == (1LL << floorLog);
+  return roundingMode == 0 || exact ? floorLog : floorLog + 1;
+}
+
+long long levelSize(long long base, int level, int roundingMode) {
+  const long long size = roundingMode == 0 ? base >> level : (base + (1LL << level) - 1) >> level;
+  return std::max(size, 1LL);
+}
+
+long long tilesIn(long long w, long long h, const PartLayout& part) {
+  return ((w + part.tileWidth - 1) / part.tileWidth) * ((h + part.tileHeight - 1) / part.tileHeight);
+}
+
+// Number of chunks of a tiled part, all levels (as laid out in its offset table).
+long long tiledChunkCount(const PartLayout& part, long long w, long long h) {
+  switch (part.levelMode) {
+  case 0: // ONE_LEVEL
+    return tilesIn(w, h, part);
+  case 1: { // MIPMAP_LEVELS
+    const int levels = roundedLog2(std::max(w, h), part.roundingMode) + 1;
+    long long count = 0;
+    for (int l = 0; l < levels; ++l)
+      count += tilesIn(levelSize(w, l, part.roundingMode), levelSize(h, l, part.roundingMode), part);
+    return count;
+  }
+  case 2: { // RIPMAP_LEVELS
+    const int levelsX = roundedLog2(w, part.roundingMode) + 1, levelsY = roundedLog2(h, part.roundingMode) + 1;
+    long long count = 0;
+    for (int ly = 0; ly < levelsY; ++ly)
+      for (int lx = 0; lx < levelsX; ++lx)
+        count += tilesIn(levelSize(w, lx, part.roundingMode), levelSize(h, ly, part.roundingMode), part);
+    return count;
+  }
+  default:
+    return -1;
+  }
+}
+
+// Checks, before OpenEXR sees the file:
+// - every part's data window against the size limits (OpenEXR sets up every part),
+// - the tile description and the chunk count of every part,
+// - that the offset tables fit in the file,
+// - that every chunk of every part starts after the tables and, with its size field, ends inside
+//   the file (this is what detects truncated pixel data).
+// The work is bounded by the file size: a table entry takes 8 bytes of the file.
+// Returns the layout of part `partIndex`.
+const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, int partIndex, long long maxPixels,
+                                 const fs::path& path) {
+  const bool multiPart = (layout.flags & kFlagMultiPart) != 0;
+  if (partIndex >= static_cast<int>(layout.parts.size()))
+    throwFormat(path, "part " + std::to_string(partIndex) + " requested but the file has " +
+                          std::to_string(layout.parts.size()) + " part(s)");
+
+  // Pass 1: sizes and chunk counts.
+  std::vector<long long> counts;
+  std::uint64_t tablesEnd = layout.tablesStart;
+  for (std::size_t p = 0; p < layout.parts.size(); ++p) {
+    const PartLayout& part = layout.parts[p];
+    const bool selected = static_cast<int>(p) == partIndex;
+    const std::string which = multiPart ? "part " + std::to_string(p) + ": " : std::string();
+    if (!part.hasDataWindow) throwFormat(path, which + "missing or invalid dataWindow attribute");
+    const long long w = part.width(), h = part.height();
+    if (w <= 0 || h <= 0)
+      throwFormat(path, which + "empty or inverted data window (" + std::to_string(part.minX) + ", " +
+                            std::to_string(part.minY) + ") - (" + std::to_string(part.maxX) + ", " +
+                            std::to_string(part.maxY) + ")");
+    const long long pixelLimit = selected ? std::min(maxPixels, Image::kMaxPixels) : Image::kMaxPixels;
+    if (w > Image::kMaxDimension || h > Image::kMaxDimension || w * h > pixelLimit)
+      throwFormat(path, which + "data window " + std::to_string(w) + "x" + std::to_string(h) +
+                            " is too large (limits: " + std::to_string(Image::kMaxDimension) + " per side, " +
+                            std::to_string(pixelLimit) + " pixels)");
+    if (selected && part.deep(layout.flags)) throwFormat(path, which + "deep images are not supported");
+    long long count = 0;
+    if (part.tiled(layout.flags)) {
+      if (!part.hasTiles) throwFormat(path, which + "tiled part without a valid tiles attribute");
+      if (part.tileWidth == 0 || part.tileHeight == 0 || part.tileWidth > Image::kMaxDimension ||
+          part.tileHeight > Image::kMaxDimension ||
+          static_cast<long long>(part.tileWidth) * part.tileHeight > std::max(w * h, 1LL << 20))
+        throwFormat(path, which + "invalid tile size " + std::to_string(part.tileWidth) + "x" +
+                              std::to_string(part.tileHeight));
+      if (part.roundingMode > 1) throwFormat(path, which + "invalid tile rounding mode");
+      count = tiledChunkCount(part, w, h);
+      if (count < 0) throwFormat(path, which + "invalid tile level mode " + std::to_string(part.levelMode));
+    } else {
+      const int lines = linesPerChunk(part.compression);
+      if (lines == 0) throwFormat(path, which + "missing or unknown compression " + std::to_string(part.compression));
+      count = (h + lines - 1) / lines;
+    }
+    if (multiPart && (!part.hasChunkCount || part.chunkCount != count))
+      throwFormat(path, which + "missing or inconsistent chunkCount attribute (expected " + std::to_string(count) + ")");
+    if (static_cast<std::uint64_t>(count) > (reader.size() - tablesEnd) / 8)
+      throwFormat(path, which + "truncated file (chunk offset table of " + std::to_string(count) + " entries)");
+    tablesEnd += static_cast<std::uint64_t>(count) * 8;
+    counts.push_back(count);
+  }
+
+  // Pass 2: every chunk of every part.
+  std::uint64_t tableOffset = layout.tablesStart;
+  std::vector<std::uint8_t> table;
+  for (std::size_t p = 0; p < layout.parts.size(); ++p) {
+    const PartLayout& part = layout.parts[p];
+    const std::string which = multiPart ? "part " + std::to_string(p) + ": " : std::string();
+    const long long count = counts[p];
+    // Deep chunks have a different header; only their position and part number are checked.
+    const bool deep = part.deep(layout.flags);
+    const std::uint64_t headerBytes = (multiPart ? 4u : 0u) + (deep ? 0u : (part.tiled(layout.flags) ? 20u : 8u));
+    table.resize(static_cast<std::size_t>(count) * 8);
+    if (!reader.readAt(tableOffset, table.data(), table.size()))
+      throwFormat(path, which + "truncated file (chunk offset table)");
+    tableOffset += table.size();
+    for (long long i = 0; i < count; ++i) {
+      const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
+      std::array<std::uint8_t, 24> chunkHeader{};
+      if (offset == 0) throwFormat(path, which + "incomplete file (chunk " + std::to_string(i) + " is missing)");
+      if (offset < tablesEnd || offset >= reader.size() || !reader.readAt(offset, chunkHeader.data(), headerBytes))
+        throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " at offset " +
+                              std::to_string(offset) + " lies outside the pixel data of the " +
+                              std::to_string(reader.size()) + "-byte file)");
+      if (multiPart && FileReader::decode32(chunkHeader.data()) != static_cast<std::uint32_t>(p))
+        throwFormat(path, which + "corrupt chunk " + std::to_string(i) + " (wrong part number)");
+      if (deep) continue;
+      const std::int32_t dataSize = FileReader::toSigned(FileReader::decode32(chunkHeader.data() + headerBytes - 4));
+      if (dataSize < 0 || static_cast<std::uint64_t>(dataSize) > reader.size() - offset - headerBytes)
+        throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " of " +
+                              std::to_string(dataSize) + " bytes at offset " + std::to_string(offset) +
+                              " ends beyond the " + std::to_string(reader.size()) + "-byte file)");
+    }
+  }
+  return layout.parts[static_cast<std::size_t>(partIndex)];
+}
+
+// ------------------------------------------------------------------------------------------------
+// Channel selection
+
+std::vector<std::string> selectChannels(const std::vector<std::string>& available, const std::string& layer,
+                                        const fs::path& path) {
+  const std::string prefix = layer.empty() ? std::string() : layer + ".";
+  std::vector<std::string> inLayer; // suffixes
+  for (const std::string& name : available) {
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string suffix = name.substr(prefix.size());
+    if (suffix.find('.') == std::string::npos) inLayer.push_back(suffix);
+  }
+  const auto has = [&](const char* s) { return std::find(inLayer.begin(), inLayer.end(), s) != inLayer.end(); };
+  std::vector<std::string> chosen;
+  if (has("R") && has("G") && has("B")) {
+    chosen = {"R", "G", "B"};
+    if (has("A")) chosen.push_back("A");
+  } else if (has("R") && has("G")) {
+    chosen = {"R", "G"};
+  } else {
+    for (const char* single : {"Y", "Z", "depth", "R"})
+      if (has(single)) {
+        chosen = {single};
+        break;
+      }
+    if (chosen.empty() && inLayer.size() == 1) chosen = inLayer;
+  }
+  if (chosen.empty()) {
+    std::string list;
+    for (const std::string& name : available) list += (list.empty() ? "" : ", ") + name;
+    throwFormat(path, "no usable channels in layer '" + layer + "' (channels: " + (list.empty() ? "none" : list) +
+                          "; expected R,G,B[,A], R,G, Y, Z, depth or a single channel)");
+  }
+  for (std::string& s : chosen) s = prefix + s;
+  return chosen;
+}
+
+std::vector<std::string> channelNames(const Imf::Header& header) {
+  std::vector<std::string> names;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) names.emplace_back(it.name());
+  return names;
+}
+
+} // namespace
+
+// --------------------------------------------------------------------------------------------------
+
+void writeExr(const std::filesystem::path& path, const Image& image, const ExrWriteOptions& options) {
+  if (image.empty()) throw InvalidArgument("image", "empty image", "writeExr needs a non-empty image");
+  const ExrLayer layer{std::string(), &image};
+  writeLayers(path, std::span<const ExrLayer>(&layer, 1), options);
+}
+
+void writeExrLayers(const std::filesystem::path& path, std::span<const ExrLayer> layers,
+                    const ExrWriteOptions& options) {
+  writeLayers(path, layers, options);
+}
+
+Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) {
+  if (options.maxPixels <= 0)
+    throw InvalidArgument("ExrReadOptions.maxPixels", detail::formatValue(options.maxPixels), "must be > 0");
+  if (options.part < 0)
+    throw InvalidArgument("ExrReadOptions.part", detail::formatValue(options.part), "must be >= 0");
+
+  FileReader reader(path);
+  const FileLayout layout = scanHeaders(reader, path);
+  const PartLayout& part = validateLayout(reader, layout, options.part, options.maxPixels, path);
+  const int width = static_cast<int>(part.width());
+  const int height = static_cast<int>(part.height());
+
+  try {
+    Imf::MultiPartInputFile file(path.c_str(), 0, /*reconstructChunkOffsetTable=*/false);
+    if (options.part >= file.parts()) throwFormat(path, "part " + std::to_string(options.part) + " not found");
+    const Imf::Header& header = file.header(options.part);
+    if (header.hasType() && Imf::isDeepData(header.type())) throwFormat(path, "deep images are not supported");
+    const Imath::Box2i& dataWindow = header.dataWindow();
+    if (dataWindow.min.x != part.minX || dataWindow.min.y != part.minY || dataWindow.max.x != part.maxX ||
+        dataWindow.max.y != part.maxY)
+      throwFormat(path, "inconsistent data window");
+
+    const std::vector<std::string> selected = selectChannels(channelNames(header), options.layer, path);
+    for (const std::string& name : selected) {
+      const Imf::Channel& channel = header.channels()[name];
+      if (channel.xSampling != 1 || channel.ySampling != 1)
+        throwFormat(path, "channel '" + name + "' is subsampled, which is not supported");
+    }
+
+    Imf::InputPart input(file, options.part);
+    if (!input.isComplete()) throwFormat(path, "incomplete file (missing pixel data)");
+
+    Image image(width, height, static_cast<int>(selected.size()));
+    const std::size_t channels = selected.size();
+    const std::size_t xStride = channels * sizeof(float);
+    const std::size_t yStride = static_cast<std::size_t>(width) * xStride;
+    Imf::FrameBuffer frameBuffer;
+    for (std::size_t c = 0; c < channels; ++c)
+      frameBuffer.insert(selected[c], Imf::Slice::Make(Imf::FLOAT, image.data().data() + c, dataWindow, xStride,
+                                                       yStride, 1, 1, 0.0));
+    input.setFrameBuffer(frameBuffer);
+    input.readPixels(dataWindow.min.y, dataWindow.max.y);
+
+    // The rows were read top first; the Image wants the bottom row first.
+    const std::span<float> data = image.data();
+    const std::size_t rowFloats = static_cast<std::size_t>(width) * channels;
+    for (int y = 0; y < height / 2; ++y) {
+      auto top = data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * rowFloats);
+      auto bottom = data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(height - 1 - y) * rowFloats);
+      std::swap_ranges(top, top + static_cast<std::ptrdiff_t>(rowFloats), bottom);
+    }
+    return image;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throwFormat(path, e.what());
+  }
+}
+
+ExrFileInfo readExrInfo(const std::filesystem::path& path, int part) {
+  if (part < 0) throw InvalidArgument("part", detail::formatValue(part), "must be >= 0");
+  FileReader reader(path);
+  const FileLayout layout = scanHeaders(reader, path);
+  const PartLayout& selected = validateLayout(reader, layout, part, Image::kMaxPixels, path);
+  try {
+    Imf::MultiPartInputFile file(path.c_str(), 0, /*reconstructChunkOffsetTable=*/false);
+    const Imf::Header& header = file.header(part);
+    ExrFileInfo info;
+    info.width = static_cast<int>(selected.width());
+    info.height = static_cast<int>(selected.height());
+    info.dataWindowMinX = selected.minX;
+    info.dataWindowMinY = selected.minY;
+    info.partCount = file.parts();
+    info.tiled = selected.tiled(layout.flags);
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      ExrChannelInfo channel;
+      channel.name = it.name();
+      channel.isUint = it.channel().type == Imf::UINT;
+      channel.pixelType = it.channel().type == Imf::FLOAT ? ExrPixelType::Float : ExrPixelType::Half;
+      info.channels.push_back(std::move(channel));
+    }
+    return info;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throwFormat(path, e.what());
+  }
+}
+
+} // namespace crep

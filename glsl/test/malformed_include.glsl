@@ -1,0 +1,2 @@
+// Test fixture: a malformed #include (angle brackets are not supported).
+#include <crep/common.glsl>

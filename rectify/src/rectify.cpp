@@ -1,0 +1,397 @@
+// Projective rectification: construction and fallback decision.
+// Klehm, Seidel, Eisemann 2014, "Filter-based real-time single scattering using rectified shadow maps",
+// JCGT 3(3), Sec. 4.2 (light view along the bisectrix, projection along X with the camera as centre,
+// depth clamping, splits), Sec. 3.2 (spot lights via their perspective space, point lights as faces).
+// The formulas are summarized at the top of crep/rectify/rectify.h.
+#include <crep/core/error.h>
+#include <crep/rectify/rectify.h>
+
+#include "region.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+
+namespace crep {
+
+using rectify_detail::Pyramid;
+
+const char* toString(FallbackReason reason) {
+  switch (reason) {
+  case FallbackReason::None: return "none";
+  case FallbackReason::ViewRayParallelToLight: return "view-ray-parallel-to-light";
+  case FallbackReason::NonLinearity: return "non-linearity";
+  case FallbackReason::EmptyRegion: return "empty-region";
+  }
+  return "unknown";
+}
+
+const char* toString(RectifyStatus status) {
+  switch (status) {
+  case RectifyStatus::Projective: return "projective";
+  case RectifyStatus::Fallback: return "fallback";
+  case RectifyStatus::Empty: return "empty";
+  }
+  return "unknown";
+}
+
+glm::dmat4 RectifiedFrame::frameFromWorld() const {
+  glm::dmat4 m(1.0);
+  for (int i = 0; i < 3; ++i) {
+    m[i][0] = axisX[i];
+    m[i][1] = axisY[i];
+    m[i][2] = axisZ[i];
+  }
+  m[3][0] = -glm::dot(axisX, origin);
+  m[3][1] = -glm::dot(axisY, origin);
+  m[3][2] = -glm::dot(axisZ, origin);
+  return m;
+}
+
+void validate(const RectifyOptions& o) {
+  if (o.splits < 1 || o.splits > RectifyOptions::kMaxSplits)
+    throw InvalidArgument("RectifyOptions.splits", detail::formatValue(o.splits),
+                          "must be in [1, " + std::to_string(RectifyOptions::kMaxSplits) + "]");
+  if (!std::isfinite(o.blend) || o.blend < 0.0 || o.blend > 1.0)
+    throw InvalidArgument("RectifyOptions.blend", detail::formatValue(o.blend), "must be in [0, 1]");
+  if (!std::isfinite(o.maxSpanDegrees) || !(o.maxSpanDegrees > 0.0) || o.maxSpanDegrees > 180.0)
+    throw InvalidArgument("RectifyOptions.maxSpanDegrees", detail::formatValue(o.maxSpanDegrees),
+                          "degrees, must be in (0, 180]");
+  switch (o.scheme) {
+  case SplitScheme::Uniform:
+  case SplitScheme::Logarithmic:
+  case SplitScheme::Blend: break;
+  default:
+    throw InvalidArgument("RectifyOptions.scheme", detail::formatValue(static_cast<int>(o.scheme)),
+                          "must be Uniform, Logarithmic or Blend");
+  }
+  if (o.layout != SplitLayout::Regions && o.layout != SplitLayout::Layers)
+    throw InvalidArgument("RectifyOptions.layout", detail::formatValue(static_cast<int>(o.layout)),
+                          "must be Regions or Layers");
+  if (o.referenceRay != ReferenceRay::Bisectrix && o.referenceRay != ReferenceRay::Optimal)
+    throw InvalidArgument("RectifyOptions.referenceRay", detail::formatValue(static_cast<int>(o.referenceRay)),
+                          "must be Bisectrix or Optimal");
+}
+
+std::vector<double> splitPositions(double xmin, double xmax, int splits, SplitScheme scheme, double blend) {
+  if (!std::isfinite(xmin) || !(xmin > 0.0))
+    throw InvalidArgument("splitPositions.xmin", detail::formatValue(xmin), "must be finite and > 0");
+  if (!std::isfinite(xmax) || !(xmax > xmin))
+    throw InvalidArgument("splitPositions.xmax", detail::formatValue(xmax), "must be finite and > xmin");
+  RectifyOptions o;
+  o.splits = splits;
+  o.scheme = scheme;
+  o.blend = blend;
+  validate(o);
+  std::vector<double> x(static_cast<std::size_t>(splits) + 1);
+  const double logRatio = std::log(xmax / xmin);
+  const double lambda = scheme == SplitScheme::Uniform ? 0.0 : scheme == SplitScheme::Logarithmic ? 1.0 : blend;
+  for (int j = 1; j < splits; ++j) {
+    const double f = static_cast<double>(j) / splits;
+    const double uni = xmin + (xmax - xmin) * f;
+    const double lg = xmin * std::exp(logRatio * f);
+    x[static_cast<std::size_t>(j)] = lambda * lg + (1.0 - lambda) * uni;
+  }
+  x.front() = xmin;
+  x.back() = xmax;
+  return x;
+}
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+Pyramid cameraPyramid(const Camera& camera) {
+  Pyramid p;
+  p.apex = camera.position();
+  p.axis = camera.forward();
+  const double ty = std::tan(0.5 * camera.fovY()), tx = ty * camera.aspect();
+  const glm::dvec3 r = camera.right(), u = camera.up();
+  // Same corner order as Camera::frustumCorners: (-x,-y), (+x,-y), (+x,+y), (-x,+y).
+  const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+  for (unsigned i = 0; i < 4; ++i) p.edges[i] = p.axis + sx[i] * tx * r + sy[i] * ty * u;
+  p.near = camera.near();
+  p.far = camera.far();
+  return p;
+}
+
+Pyramid lightPyramid(const glm::dvec3& apex, const glm::dvec3& axis, const glm::dvec3& right,
+                     const glm::dvec3& up, double tanHalf, double near, double far) {
+  Pyramid p;
+  p.apex = apex;
+  p.axis = axis;
+  const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+  for (unsigned i = 0; i < 4; ++i) p.edges[i] = axis + sx[i] * tanHalf * right + sy[i] * tanHalf * up;
+  p.near = near;
+  p.far = far;
+  return p;
+}
+
+/// Angle between direction w and the convex cone of the camera's view rays (0 inside).
+double angleToViewCone(const Pyramid& cam, const glm::dvec3& w) {
+  const auto normals = cam.sideNormals();
+  bool inside = true;
+  for (const auto& n : normals) inside = inside && glm::dot(n, w) >= 0.0;
+  if (inside) return 0.0;
+  double best = kPi;
+  for (unsigned i = 0; i < 4; ++i) {
+    const glm::dvec3 a = glm::normalize(cam.edges[i]), b = glm::normalize(cam.edges[(i + 1) % 4]);
+    const glm::dvec3& n = normals[i];
+    const glm::dvec3 wp = w - glm::dot(w, n) * n;
+    const glm::dvec3 ab = glm::cross(a, b);
+    const bool inWedge = glm::dot(glm::cross(a, wp), ab) >= 0.0 && glm::dot(glm::cross(wp, b), ab) >= 0.0 &&
+                         glm::dot(wp, a + b) > 0.0;
+    double angle;
+    if (inWedge)
+      angle = std::atan2(std::abs(glm::dot(w, n)), glm::length(wp));
+    else
+      angle = std::min(std::acos(std::clamp(glm::dot(w, a), -1.0, 1.0)),
+                       std::acos(std::clamp(glm::dot(w, b), -1.0, 1.0)));
+    best = std::min(best, angle);
+  }
+  return best;
+}
+
+std::string fmt(const char* format, double a, double b = 0.0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, format, a, b);
+  return buf;
+}
+
+/// The common construction. `region` are the vertices of the convex region to cover, `lightDir` the
+/// direction light travels at the camera (unit), `rho` = 1 / |camera - light| (0: directional).
+Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region, const glm::dvec3& lightDir,
+                    double rho, const RectifyOptions& options, bool pointLike) {
+  Rectification r;
+  r.threshold = options.maxSpanDegrees;
+  r.layout = options.layout;
+  r.referenceRay = options.referenceRay;
+  r.regionVertices = region;
+  const Pyramid cam = cameraPyramid(camera);
+  r.epipoleAngle = std::min(angleToViewCone(cam, lightDir), angleToViewCone(cam, -lightDir)) * kDeg;
+  const glm::dvec3 c = camera.position();
+
+  if (region.empty()) {
+    r.status = RectifyStatus::Empty;
+    r.reason = FallbackReason::EmptyRegion;
+    r.message = "the light's frustum does not intersect the camera frustum: nothing is lit";
+    return r;
+  }
+
+  // 2D directions of the region's vertices seen from the camera, projected along the light (Sec. 4.2
+  // "find the 2D vectors ... that span the biggest angle"). Any basis of the plane will do: the
+  // bisectrix found below does not depend on it, so the result is continuous in the light direction.
+  const glm::dvec3 b1 = anyOrthogonal(lightDir), b2 = glm::cross(lightDir, b1);
+  std::vector<double> angles;
+  angles.reserve(region.size());
+  bool onLightLine = false;
+  for (const auto& v : region) {
+    const glm::dvec3 d = v - c;
+    const double q1 = glm::dot(d, b1), q2 = glm::dot(d, b2);
+    const double len = glm::length(d);
+    // A vertex on the camera's light line: its view ray is a light ray (relative 1e-12 ~ rounding).
+    if (!(std::hypot(q1, q2) > 1e-12 * len)) {
+      onLightLine = true;
+      break;
+    }
+    angles.push_back(std::atan2(q2, q1));
+  }
+  double span = kPi, start = 0.0;
+  if (!onLightLine) {
+    std::sort(angles.begin(), angles.end());
+    // The largest circular gap between consecutive directions; the span is its complement.
+    double gap = angles.front() + 2.0 * kPi - angles.back();
+    start = angles.front();
+    for (std::size_t i = 1; i < angles.size(); ++i) {
+      const double g = angles[i] - angles[i - 1];
+      if (g > gap) {
+        gap = g;
+        start = angles[i];
+      }
+    }
+    span = 2.0 * kPi - gap;
+  }
+  // Not inside an open half-plane (up to rounding): some view ray through the region is a light ray.
+  const bool parallel = onLightLine || span >= kPi * (1.0 - 1e-12);
+  r.measure = parallel ? 180.0 : span * kDeg;
+  if (parallel) {
+    r.status = RectifyStatus::Fallback;
+    r.reason = FallbackReason::ViewRayParallelToLight;
+    r.message = pointLike ? "a view ray through the lit region passes through the light (camera-light line "
+                            "crosses it): projective rectification impossible"
+                          : "a view ray is parallel to the light direction (epipole on screen): projective "
+                            "rectification impossible";
+    return r;
+  }
+  if (r.measure >= options.maxSpanDegrees) {
+    r.status = RectifyStatus::Fallback;
+    r.reason = FallbackReason::NonLinearity;
+    r.message = fmt("angular span of the lit region around the light axis %.6g deg >= threshold %.6g deg: "
+                    "rectification too non-linear",
+                    r.measure, options.maxSpanDegrees);
+    return r;
+  }
+
+  // Frame: X along the bisectrix (orthogonal to the light), Z along the light, Y = Z x X.
+  const double mid = start + 0.5 * span;
+  RectifiedFrame& f = r.frame;
+  f.origin = c;
+  f.axisZ = lightDir;
+  f.axisX = glm::normalize(std::cos(mid) * b1 + std::sin(mid) * b2);
+  f.axisY = glm::cross(f.axisZ, f.axisX);
+  f.inverseLightDistance = rho;
+
+  // Bounds from the *slopes* of the vertices (the camera is the centre of projection).
+  double yMin = std::numeric_limits<double>::infinity(), yMax = -yMin, zMin = yMin, zMax = -yMin;
+  std::vector<glm::dvec3> xyz;
+  xyz.reserve(region.size());
+  std::vector<glm::dvec2> slopes;
+  slopes.reserve(region.size());
+  for (const auto& v : region) {
+    const glm::dvec3 d = v - c;
+    const glm::dvec3 p(glm::dot(f.axisX, d), glm::dot(f.axisY, d), glm::dot(f.axisZ, d));
+    xyz.push_back(p);
+    const double y = p.y / p.x, z = p.z / p.x;
+    slopes.emplace_back(y, z);
+    yMin = std::min(yMin, y);
+    yMax = std::max(yMax, y);
+    zMin = std::min(zMin, z);
+    zMax = std::max(zMax, z);
+  }
+  double etaMin = std::numeric_limits<double>::infinity(), etaMax = -etaMin;
+  for (const auto& p : xyz) {
+    const double eta = 1.0 / p.x + rho * (p.z / p.x - zMin);
+    etaMin = std::min(etaMin, eta);
+    etaMax = std::max(etaMax, eta);
+  }
+  const double yScale = 1.0 + std::max(std::abs(yMin), std::abs(yMax));
+  const double zScale = 1.0 + std::max(std::abs(zMin), std::abs(zMax));
+  if (!(yMax - yMin > 1e-12 * yScale) || !(zMax - zMin > 1e-12 * zScale) || !(etaMax - etaMin > 1e-12 * etaMax) ||
+      !(etaMin > 0.0)) {
+    // Only a spot/point region can be flat (the frusta touch along a face, an edge or a point).
+    r.status = RectifyStatus::Empty;
+    r.reason = FallbackReason::EmptyRegion;
+    r.message = "the lit part of the camera frustum is flat (the frusta only touch): nothing is lit";
+    r.frame = RectifiedFrame{};
+    return r;
+  }
+  f.rowSlopeMin = yMin;
+  f.rowSlopeMax = yMax;
+  f.depthSlopeMin = zMin;
+  f.depthSlopeMax = zMax;
+  f.axisMin = 1.0 / etaMax;
+  f.axisMax = 1.0 / etaMin;
+  r.slopeHull = rectify_detail::convexHull(slopes);
+
+  // Splits (Sec. 4.2 "Non-linearity"): shared row and depth slopes, one column projection each.
+  const int K = options.splits;
+  const std::vector<double> x = splitPositions(f.axisMin, f.axisMax, K, options.scheme, options.blend);
+  const glm::dmat4 frameFromWorld = f.frameFromWorld();
+  const double alpha = 2.0 / (yMax - yMin), beta = -1.0 - alpha * yMin;
+  const double gamma = 2.0 / (zMax - zMin), delta = -1.0 - gamma * zMin;
+  r.splits.resize(static_cast<std::size_t>(K));
+  for (int k = 0; k < K; ++k) {
+    Split& s = r.splits[static_cast<std::size_t>(k)];
+    s.rangeBegin = x[static_cast<std::size_t>(k)];
+    s.rangeEnd = x[static_cast<std::size_t>(k) + 1];
+    const double eta0 = 1.0 / s.rangeBegin, eta1 = 1.0 / s.rangeEnd;
+    const double b = 2.0 / (eta1 - eta0), a = -1.0 - b * eta0; // ndc.x = a + b eta: eta0 -> -1, eta1 -> +1
+    glm::dmat4 S(0.0);                                          // frame (X, Y, Z, 1) -> clip; S[col][row]
+    S[0][0] = a - b * rho * zMin;
+    S[2][0] = b * rho;
+    S[3][0] = b;
+    S[0][1] = beta;
+    S[1][1] = alpha;
+    S[0][2] = delta;
+    S[2][2] = gamma;
+    S[0][3] = 1.0;
+    s.rectClipFromWorld = S * frameFromWorld;
+    if (options.layout == SplitLayout::Regions) {
+      s.layer = 0;
+      s.columnBegin = static_cast<double>(k) / K;
+      s.columnEnd = static_cast<double>(k + 1) / K;
+    } else {
+      s.layer = k;
+      s.columnBegin = 0.0;
+      s.columnEnd = 1.0;
+    }
+  }
+  r.status = RectifyStatus::Projective;
+  r.reason = FallbackReason::None;
+  r.message = fmt("projective: angular span %.6g deg < threshold %.6g deg", r.measure, options.maxSpanDegrees);
+  return r;
+}
+
+Rectification buildPointLike(const Camera& camera, const glm::dvec3& lightPos, const Pyramid& lightFrustum,
+                             const RectifyOptions& options) {
+  const Pyramid cam = cameraPyramid(camera);
+  std::vector<glm::dvec3> region = rectify_detail::intersectionVertices(cam, lightFrustum);
+  const glm::dvec3 toCamera = camera.position() - lightPos;
+  const double dist = glm::length(toCamera);
+  const double scale = std::max({1.0, glm::length(camera.position()), glm::length(lightPos)});
+  if (!region.empty() && !(dist > 1e-12 * scale)) {
+    Rectification r;
+    r.threshold = options.maxSpanDegrees;
+    r.layout = options.layout;
+    r.referenceRay = options.referenceRay;
+    r.regionVertices = region;
+    r.measure = 180.0;
+    r.status = RectifyStatus::Fallback;
+    r.reason = FallbackReason::ViewRayParallelToLight;
+    r.message = "the camera is at the light position: every view ray is a light ray";
+    return r;
+  }
+  const glm::dvec3 lightDir = dist > 0.0 ? toCamera / dist : lightFrustum.axis;
+  return build(camera, region, lightDir, dist > 0.0 ? 1.0 / dist : 0.0, options, true);
+}
+
+} // namespace
+
+Rectification rectify(const Camera& camera, const DirectionalLight& light, const RectifyOptions& options) {
+  validate(options);
+  const auto corners = camera.frustumCorners();
+  const std::vector<glm::dvec3> region(corners.begin(), corners.end());
+  return build(camera, region, light.direction(), 0.0, options, false);
+}
+
+Rectification rectify(const Camera& camera, const SpotLight& light, const RectifyOptions& options) {
+  validate(options);
+  // The spot's shadow frustum, oriented exactly as its lightViewFromWorld (square, half angle coneAngle).
+  const glm::dmat4 lightFromWorld = light.lightViewFromWorld();
+  const glm::dmat3 worldFromLightRot = glm::transpose(glm::dmat3(lightFromWorld));
+  const glm::dvec3 right = worldFromLightRot[0], up = worldFromLightRot[1], axis = -worldFromLightRot[2];
+  const Pyramid frustum = lightPyramid(light.position(), axis, right, up, std::tan(light.coneAngle()),
+                                       light.nearPlane(), light.range());
+  return buildPointLike(camera, light.position(), frustum, options);
+}
+
+std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::dvec3& position, double range,
+                                               const RectifyOptions& options, double nearPlane) {
+  validate(options);
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(position[i]))
+      throw InvalidArgument("PointLight.position",
+                            "(" + detail::formatValue(position.x) + ", " + detail::formatValue(position.y) + ", " +
+                                detail::formatValue(position.z) + ")",
+                            "components must be finite");
+  requirePositive("PointLight.range", range);
+  const double near = nearPlane <= 0.0 ? range * 1e-3 : nearPlane;
+  if (!std::isfinite(near) || !(near < range))
+    throw InvalidArgument("PointLight.nearPlane", detail::formatValue(nearPlane), "must be < range");
+  std::array<Rectification, 6> faces;
+  for (int i = 0; i < 6; ++i) {
+    glm::dvec3 axis(0.0);
+    axis[i / 2] = (i % 2 == 0) ? 1.0 : -1.0;
+    glm::dvec3 u(0.0), v(0.0);
+    u[(i / 2 + 1) % 3] = 1.0;
+    v[(i / 2 + 2) % 3] = 1.0;
+    faces[static_cast<std::size_t>(i)] =
+        buildPointLike(camera, position, lightPyramid(position, axis, u, v, 1.0, near, range), options);
+  }
+  return faces;
+}
+
+} // namespace crep

@@ -1,0 +1,107 @@
+// End-to-end tests of the crep tool: run the built binary as a user would.
+#include "support/gl_fixture.h"
+#include "support/image_check.h"
+
+#include <crep/core/exr.h>
+
+#include <doctest/doctest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+#ifndef CREP_TOOL_PATH
+#error "CREP_TOOL_PATH must be defined by the build"
+#endif
+
+namespace {
+struct RunResult {
+  int status;
+  std::string output; // stdout + stderr
+};
+
+RunResult runCrep(const std::string& args) {
+  const std::string command = std::string("'") + CREP_TOOL_PATH + "' " + args + " 2>&1";
+  RunResult r{-1, {}};
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 4096> buf{};
+  while (std::fgets(buf.data(), static_cast<int>(buf.size()), pipe)) r.output += buf.data();
+  const int raw = pclose(pipe);
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+} // namespace
+
+TEST_CASE("crep render: default scene at test size writes a finite, non-empty EXR and PNG with timings") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir;
+  const std::string prefix = (dir.path() / "frame").string();
+  const RunResult r = runCrep("render --size 160x90 --map-size 128 --steps 32 --out '" + prefix + "'");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  for (const char* stage : {"shadow pass", "camera pass", "scattering", "write exr", "total"})
+    CHECK(r.output.find(stage) != std::string::npos);
+  REQUIRE(std::filesystem::exists(prefix + ".png"));
+  CHECK(std::filesystem::file_size(prefix + ".png") > 100);
+  crep::ExrReadOptions compositeLayer, scatteringLayer;
+  compositeLayer.layer = "composite";
+  scatteringLayer.layer = "scattering";
+  const crep::Image composite = crep::readExr(prefix + ".exr", compositeLayer);
+  const crep::Image scattering = crep::readExr(prefix + ".exr", scatteringLayer);
+  REQUIRE(composite.width() == 160);
+  REQUIRE(composite.height() == 90);
+  double sum = 0, scatterSum = 0, minT = 1, maxT = 0;
+  for (float v : composite.data()) {
+    REQUIRE(std::isfinite(v));
+    sum += v;
+  }
+  for (int y = 0; y < 90; ++y)
+    for (int x = 0; x < 160; ++x) {
+      for (int c = 0; c < 3; ++c) scatterSum += scattering.at(x, y, c);
+      minT = std::min(minT, double(scattering.at(x, y, 3)));
+      maxT = std::max(maxT, double(scattering.at(x, y, 3)));
+    }
+  CHECK(sum > 0.0);
+  CHECK(scatterSum > 0.0);
+  // Transmittance is a fraction and varies with the depth of the scene.
+  CHECK(minT >= 0.0);
+  CHECK(maxT <= 1.0);
+  CHECK(maxT > minT);
+}
+
+TEST_CASE("crep: usage errors exit 2 and name the option") {
+  // These fail before any GL work, so they need no context.
+  struct Case {
+    const char* args;
+    const char* mentions;
+  };
+  for (const Case& c : {Case{"render --size 0x90", "--size"}, Case{"render --size abc", "--size"},
+                        Case{"render --map-size -3", "--map-size"}, Case{"render --exposure nan", "--exposure"},
+                        Case{"render --bogus 1", "--bogus"}, Case{"render --steps", "--steps"},
+                        Case{"frobnicate", "frobnicate"}}) {
+    const RunResult r = runCrep(c.args);
+    INFO(c.args << " -> " << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.mentions) != std::string::npos);
+  }
+  const RunResult help = runCrep("help");
+  CHECK(help.status == 0);
+  CHECK(help.output.find("render") != std::string::npos);
+}
+
+TEST_CASE("crep render: unknown scene and oversized map are runtime errors naming the parameter") {
+  CREP_REQUIRE_GL();
+  const RunResult unknown = runCrep("render --scene cathedral --size 16x9");
+  INFO(unknown.output);
+  CHECK(unknown.status == 1);
+  CHECK(unknown.output.find("scene") != std::string::npos);
+  const RunResult huge = runCrep("render --size 16x9 --map-size 32768");
+  INFO(huge.output);
+  CHECK(huge.status == 1);
+  CHECK(huge.output.find("--map-size") != std::string::npos);
+}
