@@ -17,6 +17,12 @@ install(TARGETS crepuscular EXPORT crepuscularTargets
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT crepuscularTargets NAMESPACE crep:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular)
 
+get_target_property(crep_library_type crepuscular TYPE)
+if(crep_library_type STREQUAL "STATIC_LIBRARY")
+  set(CREP_CONFIG_STATIC ON)
+else()
+  set(CREP_CONFIG_STATIC OFF)
+endif()
 configure_package_config_file(${CMAKE_CURRENT_SOURCE_DIR}/cmake/crepuscularConfig.cmake.in
   ${CMAKE_CURRENT_BINARY_DIR}/crepuscularConfig.cmake
   INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular

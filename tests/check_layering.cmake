@@ -1,3 +1,4 @@
+cmake_minimum_required(VERSION 3.25)
 # Script mode: fails when a module includes a header of a module above it (DESIGN.md "Modules").
 set(allowed_core "core")
 set(allowed_rectify "core;rectify")

@@ -52,7 +52,7 @@ TEST_CASE("anyOrthogonal: unit and orthogonal for every axis and sign") {
   }
 }
 
-TEST_CASE("SpotLight: cone maps to the NDC square; invalid input named") {
+TEST_CASE("SpotLight: cone maps to the NDC square, invalid input named") {
   const double cone = 0.4;
   const crep::SpotLight spot({1, 5, 2}, {0.2, -1, 0.1}, cone, 50.0);
   const glm::dmat4 m = spot.lightClipFromWorld();
@@ -93,7 +93,7 @@ TEST_CASE("Phase functions are normalized over the sphere") {
   CHECK(crep::rayleighPhase(1.0) == doctest::Approx(2.0 * crep::rayleighPhase(0.0)));
 }
 
-TEST_CASE("Medium: extinction derived; scatteringTimesPhase combines HG and Rayleigh") {
+TEST_CASE("Medium: extinction derived, scatteringTimesPhase combines HG and Rayleigh") {
   const crep::Medium m({0.1, 0.2, 0.3}, {0.01, 0.02, 0.03}, 0.7, {0.001, 0.002, 0.004});
   CHECK(m.extinction().x == doctest::Approx(0.111));
   CHECK(m.extinction().z == doctest::Approx(0.334));

@@ -1,3 +1,4 @@
+cmake_minimum_required(VERSION 3.25)
 # Script mode: installs the build tree into WORK_DIR/prefix, then configures, builds and runs the
 # consumer project against it with find_package(crepuscular), and checks the pkg-config file.
 file(REMOVE_RECURSE ${WORK_DIR})

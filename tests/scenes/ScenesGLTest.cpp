@@ -65,7 +65,8 @@ TEST_CASE("SceneRenderer: depth clamp keeps casters in front of the near plane")
   int recovered = 0;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
-      REQUIRE(clamped.at(x, y) <= clipped.at(x, y)); // clamping only adds casters
+      // Clamping only adds casters (clipped triangles interpolate depth slightly differently).
+      REQUIRE(clamped.at(x, y) <= clipped.at(x, y) + 1e-6f);
       // A caster cut away by the near plane comes back at depth 0 where something farther showed.
       recovered += clamped.at(x, y) == 0.0f && clipped.at(x, y) > 1e-3f;
     }
