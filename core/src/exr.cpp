@@ -40,7 +40,9 @@ namespace fs = std::filesystem;
 // ------------------------------------------------------------------------------------------------
 // Errors
 
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+std::string quoted(const fs::path& path) {
+  return "'" + path.string() + "'";
+}
 
 [[noreturn]] void throwFormat(const fs::path& path, const std::string& what) {
   throw FormatError("crep: cannot read EXR file " + quoted(path) + ": " + what);
@@ -88,6 +90,9 @@ std::string channelName(const std::string& layer, const char* suffix) {
   return layer.empty() ? std::string(suffix) : layer + "." + suffix;
 }
 
+void writeValidated(const fs::path& path, std::span<const ExrLayer> layers, Imf::Compression compression,
+                    Imf::PixelType pixelType);
+
 void writeLayers(const fs::path& path, std::span<const ExrLayer> layers, const ExrWriteOptions& options) {
   if (layers.empty()) throw InvalidArgument("layers", "0 layers", "at least one layer is required");
   const Imf::Compression compression = toImf(options.compression);
@@ -98,16 +103,30 @@ void writeLayers(const fs::path& path, std::span<const ExrLayer> layers, const E
     if (layer.image == nullptr) throw InvalidArgument("ExrLayer.image", "null", "layer '" + layer.name + "'");
     if (layer.image->empty())
       throw InvalidArgument("ExrLayer.image", "empty image", "layer '" + layer.name + "' must not be empty");
+    if (layer.name.size() > 200)
+      throw InvalidArgument("ExrLayer.name", "'" + layer.name + "'", "must be at most 200 characters");
     if (!names.insert(layer.name).second)
       throw InvalidArgument("ExrLayer.name", "'" + layer.name + "'", "layer names must be unique");
     const Image& first = *layers.front().image;
     if (layer.image->width() != first.width() || layer.image->height() != first.height())
       throw InvalidArgument("ExrLayer.image",
-                            std::to_string(layer.image->width()) + "x" + std::to_string(layer.image->height()),
+                            std::to_string(layer.image->width()) + "x" +
+                                std::to_string(layer.image->height()),
                             "layer '" + layer.name + "' must have the size of the first layer (" +
                                 std::to_string(first.width()) + "x" + std::to_string(first.height()) + ")");
   }
 
+  try {
+    writeValidated(path, layers, compression, pixelType);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw IoError("crep: cannot write EXR file " + quoted(path) + ": " + e.what());
+  }
+}
+
+void writeValidated(const fs::path& path, std::span<const ExrLayer> layers, Imf::Compression compression,
+                    Imf::PixelType pixelType) {
   const int width = layers.front().image->width();
   const int height = layers.front().image->height();
 
@@ -313,7 +332,8 @@ int linesPerChunk(int compression) {
 
 FileLayout scanHeaders(FileReader& reader, const fs::path& path) {
   if (reader.size() == 0) throwFormat(path, "empty file");
-  if (reader.size() < 8) throwFormat(path, "not an OpenEXR file (only " + std::to_string(reader.size()) + " bytes)");
+  if (reader.size() < 8)
+    throwFormat(path, "not an OpenEXR file (only " + std::to_string(reader.size()) + " bytes)");
   if (reader.u32("magic number") != kMagic) throwFormat(path, "not an OpenEXR file (bad magic number)");
   const std::uint32_t version = reader.u32("version");
   FileLayout layout;
@@ -378,7 +398,8 @@ FileLayout scanHeaders(FileReader& reader, const fs::path& path) {
 
 int roundedLog2(long long x, int roundingMode) {
   int floorLog = 0;
-  while ((x >> (floorLog + 1)) != 0) ++floorLog;
+  while ((x >> (floorLog + 1)) != 0)
+    ++floorLog;
   const bool exact = x == (1LL << floorLog);
   return roundingMode == 0 || exact ? floorLog : floorLog + 1;
 }
@@ -405,7 +426,8 @@ long long tiledChunkCount(const PartLayout& part, long long w, long long h) {
     return count;
   }
   case 2: { // RIPMAP_LEVELS
-    const int levelsX = roundedLog2(w, part.roundingMode) + 1, levelsY = roundedLog2(h, part.roundingMode) + 1;
+    const int levelsX = roundedLog2(w, part.roundingMode) + 1,
+              levelsY = roundedLog2(h, part.roundingMode) + 1;
     long long count = 0;
     for (int ly = 0; ly < levelsY; ++ly)
       for (int lx = 0; lx < levelsX; ++lx)
@@ -425,8 +447,8 @@ long long tiledChunkCount(const PartLayout& part, long long w, long long h) {
 //   the file (this is what detects truncated pixel data).
 // The work is bounded by the file size: a table entry takes 8 bytes of the file.
 // Returns the layout of part `partIndex`.
-const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, int partIndex, long long maxPixels,
-                                 const fs::path& path) {
+const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, int partIndex,
+                                 long long maxPixels, const fs::path& path) {
   const bool multiPart = (layout.flags & kFlagMultiPart) != 0;
   if (partIndex >= static_cast<int>(layout.parts.size()))
     throwFormat(path, "part " + std::to_string(partIndex) + " requested but the file has " +
@@ -464,13 +486,16 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
       if (count < 0) throwFormat(path, which + "invalid tile level mode " + std::to_string(part.levelMode));
     } else {
       const int lines = linesPerChunk(part.compression);
-      if (lines == 0) throwFormat(path, which + "missing or unknown compression " + std::to_string(part.compression));
+      if (lines == 0)
+        throwFormat(path, which + "missing or unknown compression " + std::to_string(part.compression));
       count = (h + lines - 1) / lines;
     }
     if (multiPart && (!part.hasChunkCount || part.chunkCount != count))
-      throwFormat(path, which + "missing or inconsistent chunkCount attribute (expected " + std::to_string(count) + ")");
+      throwFormat(path, which + "missing or inconsistent chunkCount attribute (expected " +
+                            std::to_string(count) + ")");
     if (static_cast<std::uint64_t>(count) > (reader.size() - tablesEnd) / 8)
-      throwFormat(path, which + "truncated file (chunk offset table of " + std::to_string(count) + " entries)");
+      throwFormat(path,
+                  which + "truncated file (chunk offset table of " + std::to_string(count) + " entries)");
     tablesEnd += static_cast<std::uint64_t>(count) * 8;
     counts.push_back(count);
   }
@@ -484,7 +509,8 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
     const long long count = counts[p];
     // Deep chunks have a different header; only their position and part number are checked.
     const bool deep = part.deep(layout.flags);
-    const std::uint64_t headerBytes = (multiPart ? 4u : 0u) + (deep ? 0u : (part.tiled(layout.flags) ? 20u : 8u));
+    const std::uint64_t headerBytes =
+        (multiPart ? 4u : 0u) + (deep ? 0u : (part.tiled(layout.flags) ? 20u : 8u));
     table.resize(static_cast<std::size_t>(count) * 8);
     if (!reader.readAt(tableOffset, table.data(), table.size()))
       throwFormat(path, which + "truncated file (chunk offset table)");
@@ -492,15 +518,18 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
     for (long long i = 0; i < count; ++i) {
       const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
       std::array<std::uint8_t, 24> chunkHeader{};
-      if (offset == 0) throwFormat(path, which + "incomplete file (chunk " + std::to_string(i) + " is missing)");
-      if (offset < tablesEnd || offset >= reader.size() || !reader.readAt(offset, chunkHeader.data(), headerBytes))
+      if (offset == 0)
+        throwFormat(path, which + "incomplete file (chunk " + std::to_string(i) + " is missing)");
+      if (offset < tablesEnd || offset >= reader.size() ||
+          !reader.readAt(offset, chunkHeader.data(), headerBytes))
         throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " at offset " +
                               std::to_string(offset) + " lies outside the pixel data of the " +
                               std::to_string(reader.size()) + "-byte file)");
       if (multiPart && FileReader::decode32(chunkHeader.data()) != static_cast<std::uint32_t>(p))
         throwFormat(path, which + "corrupt chunk " + std::to_string(i) + " (wrong part number)");
       if (deep) continue;
-      const std::int32_t dataSize = FileReader::toSigned(FileReader::decode32(chunkHeader.data() + headerBytes - 4));
+      const std::int32_t dataSize =
+          FileReader::toSigned(FileReader::decode32(chunkHeader.data() + headerBytes - 4));
       if (dataSize < 0 || static_cast<std::uint64_t>(dataSize) > reader.size() - offset - headerBytes)
         throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " of " +
                               std::to_string(dataSize) + " bytes at offset " + std::to_string(offset) +
@@ -522,7 +551,9 @@ std::vector<std::string> selectChannels(const std::vector<std::string>& availabl
     const std::string suffix = name.substr(prefix.size());
     if (suffix.find('.') == std::string::npos) inLayer.push_back(suffix);
   }
-  const auto has = [&](const char* s) { return std::find(inLayer.begin(), inLayer.end(), s) != inLayer.end(); };
+  const auto has = [&](const char* s) {
+    return std::find(inLayer.begin(), inLayer.end(), s) != inLayer.end();
+  };
   std::vector<std::string> chosen;
   if (has("R") && has("G") && has("B")) {
     chosen = {"R", "G", "B"};
@@ -539,17 +570,21 @@ std::vector<std::string> selectChannels(const std::vector<std::string>& availabl
   }
   if (chosen.empty()) {
     std::string list;
-    for (const std::string& name : available) list += (list.empty() ? "" : ", ") + name;
-    throwFormat(path, "no usable channels in layer '" + layer + "' (channels: " + (list.empty() ? "none" : list) +
+    for (const std::string& name : available)
+      list += (list.empty() ? "" : ", ") + name;
+    throwFormat(path, "no usable channels in layer '" + layer +
+                          "' (channels: " + (list.empty() ? "none" : list) +
                           "; expected R,G,B[,A], R,G, Y, Z, depth or a single channel)");
   }
-  for (std::string& s : chosen) s = prefix + s;
+  for (std::string& s : chosen)
+    s = prefix + s;
   return chosen;
 }
 
 std::vector<std::string> channelNames(const Imf::Header& header) {
   std::vector<std::string> names;
-  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) names.emplace_back(it.name());
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+    names.emplace_back(it.name());
   return names;
 }
 
@@ -582,9 +617,11 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
 
   try {
     Imf::MultiPartInputFile file(path.c_str(), 0, /*reconstructChunkOffsetTable=*/false);
-    if (options.part >= file.parts()) throwFormat(path, "part " + std::to_string(options.part) + " not found");
+    if (options.part >= file.parts())
+      throwFormat(path, "part " + std::to_string(options.part) + " not found");
     const Imf::Header& header = file.header(options.part);
-    if (header.hasType() && Imf::isDeepData(header.type())) throwFormat(path, "deep images are not supported");
+    if (header.hasType() && Imf::isDeepData(header.type()))
+      throwFormat(path, "deep images are not supported");
     const Imath::Box2i& dataWindow = header.dataWindow();
     if (dataWindow.min.x != part.minX || dataWindow.min.y != part.minY || dataWindow.max.x != part.maxX ||
         dataWindow.max.y != part.maxY)
@@ -597,6 +634,17 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
         throwFormat(path, "channel '" + name + "' is subsampled, which is not supported");
     }
 
+    // The codecs other than DWA cannot shrink pixel data by much more than zlib's ~1032:1 (half
+    // samples, 2 bytes, become 4-byte floats: 2064:1): a header promising far more pixels than the
+    // file can hold is rejected before the image is allocated. DWAA/DWAB (zlib over RLE or DCT
+    // coefficients) can legitimately exceed this on constant images and are only size-limited.
+    const bool dwa = part.compression == 8 || part.compression == 9;
+    const double imageBytes =
+        static_cast<double>(width) * height * static_cast<double>(selected.size()) * 4.0;
+    if (!dwa && imageBytes > 4096.0 * static_cast<double>(reader.size()) + 16.0 * 1024 * 1024)
+      throwFormat(path, "data window " + std::to_string(width) + "x" + std::to_string(height) +
+                            " is implausibly large for a " + std::to_string(reader.size()) + "-byte file");
+
     Imf::InputPart input(file, options.part);
     if (!input.isComplete()) throwFormat(path, "incomplete file (missing pixel data)");
 
@@ -606,8 +654,8 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
     const std::size_t yStride = static_cast<std::size_t>(width) * xStride;
     Imf::FrameBuffer frameBuffer;
     for (std::size_t c = 0; c < channels; ++c)
-      frameBuffer.insert(selected[c], Imf::Slice::Make(Imf::FLOAT, image.data().data() + c, dataWindow, xStride,
-                                                       yStride, 1, 1, 0.0));
+      frameBuffer.insert(selected[c], Imf::Slice::Make(Imf::FLOAT, image.data().data() + c, dataWindow,
+                                                       xStride, yStride, 1, 1, 0.0));
     input.setFrameBuffer(frameBuffer);
     input.readPixels(dataWindow.min.y, dataWindow.max.y);
 
@@ -616,7 +664,8 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
     const std::size_t rowFloats = static_cast<std::size_t>(width) * channels;
     for (int y = 0; y < height / 2; ++y) {
       auto top = data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * rowFloats);
-      auto bottom = data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(height - 1 - y) * rowFloats);
+      auto bottom =
+          data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(height - 1 - y) * rowFloats);
       std::swap_ranges(top, top + static_cast<std::ptrdiff_t>(rowFloats), bottom);
     }
     return image;

@@ -12,20 +12,24 @@ namespace crep {
 
 namespace {
 
-std::string size(const Image& image) { return std::to_string(image.width()) + "x" + std::to_string(image.height()); }
+std::string size(const Image& image) {
+  return std::to_string(image.width()) + "x" + std::to_string(image.height());
+}
 
 // Returns the number of channels to compare.
 int checkComparable(const Image& actual, const Image& reference, int channels) {
   if (actual.empty()) throw InvalidArgument("actual", "empty image", "must not be empty");
   if (reference.empty()) throw InvalidArgument("reference", "empty image", "must not be empty");
   if (actual.width() != reference.width() || actual.height() != reference.height())
-    throw InvalidArgument("actual", "size " + size(actual), "must match the reference size " + size(reference));
+    throw InvalidArgument("actual", "size " + size(actual),
+                          "must match the reference size " + size(reference));
   if (channels < 0 || channels > 4)
     throw InvalidArgument("CompareOptions.channels", detail::formatValue(channels), "must be in [0, 4]");
   if (channels == 0) {
     if (actual.channels() != reference.channels())
       throw InvalidArgument("actual", std::to_string(actual.channels()) + " channels",
-                            "must match the reference's " + std::to_string(reference.channels()) + " channels");
+                            "must match the reference's " + std::to_string(reference.channels()) +
+                                " channels");
     return actual.channels();
   }
   if (actual.channels() < channels)
@@ -37,7 +41,9 @@ int checkComparable(const Image& actual, const Image& reference, int channels) {
   return channels;
 }
 
-std::string num(double v) { return detail::formatValue(v); }
+std::string num(double v) {
+  return detail::formatValue(v);
+}
 
 std::string shortNum(double v) {
   if (!std::isfinite(v)) return detail::formatValue(v);
@@ -52,7 +58,8 @@ ImageMetrics compareImages(const Image& actual, const Image& reference, const Co
   const int channels = checkComparable(actual, reference, options.channels);
   requireNonNegative("CompareOptions.overThreshold", options.overThreshold);
   if (!std::isfinite(options.peak) || options.peak < 0.0)
-    throw InvalidArgument("CompareOptions.peak", detail::formatValue(options.peak), "must be finite and >= 0");
+    throw InvalidArgument("CompareOptions.peak", detail::formatValue(options.peak),
+                          "must be finite and >= 0");
 
   ImageMetrics m;
   m.overThreshold = options.overThreshold;
@@ -101,17 +108,21 @@ ImageMetrics compareImages(const Image& actual, const Image& reference, const Co
 }
 
 std::string describe(const ImageMetrics& m) {
-  std::string s = std::to_string(m.comparedSamples) + "/" + std::to_string(m.totalSamples) + " samples compared: ";
+  std::string s =
+      std::to_string(m.comparedSamples) + "/" + std::to_string(m.totalSamples) + " samples compared: ";
   s += "maxAbs=" + shortNum(m.maxAbsError);
   if (m.worstChannel >= 0)
-    s += " at (" + std::to_string(m.worstX) + "," + std::to_string(m.worstY) + ",c" + std::to_string(m.worstChannel) +
-         ") [actual " + num(m.worstActual) + ", ref " + num(m.worstReference) + "]";
+    s += " at (" + std::to_string(m.worstX) + "," + std::to_string(m.worstY) + ",c" +
+         std::to_string(m.worstChannel) + ") [actual " + num(m.worstActual) + ", ref " +
+         num(m.worstReference) + "]";
   s += ", meanAbs=" + shortNum(m.meanAbsError) + ", rmse=" + shortNum(m.rmse) +
-       ", relRmse=" + shortNum(m.relativeRmse) + ", psnr=" + shortNum(m.psnr) + " dB (peak " + shortNum(m.peak) +
-       "), over " + shortNum(m.overThreshold) + ": " + shortNum(m.fractionOver * 100.0) + "%";
+       ", relRmse=" + shortNum(m.relativeRmse) + ", psnr=" + shortNum(m.psnr) + " dB (peak " +
+       shortNum(m.peak) + "), over " + shortNum(m.overThreshold) + ": " + shortNum(m.fractionOver * 100.0) +
+       "%";
   s += ", actual NaN/Inf=" + std::to_string(m.nanCount) + "/" + std::to_string(m.infCount);
   if (m.referenceNanCount > 0 || m.referenceInfCount > 0)
-    s += ", reference NaN/Inf=" + std::to_string(m.referenceNanCount) + "/" + std::to_string(m.referenceInfCount);
+    s += ", reference NaN/Inf=" + std::to_string(m.referenceNanCount) + "/" +
+         std::to_string(m.referenceInfCount);
   return s;
 }
 
@@ -125,13 +136,16 @@ Image differenceImage(const Image& actual, const Image& reference, double amplif
       bool finite = true;
       for (int c = 0; c < channels; ++c) {
         const float a = actual.at(x, y, c), r = reference.at(x, y, c);
-        if (!std::isfinite(a) || !std::isfinite(r)) finite = false;
-        else d[c] = std::abs(static_cast<double>(a) - static_cast<double>(r)) * amplification;
+        if (!std::isfinite(a) || !std::isfinite(r))
+          finite = false;
+        else
+          d[c] = std::abs(static_cast<double>(a) - static_cast<double>(r)) * amplification;
       }
       double rgb[3] = {d[0], d[1], d[2]};
       if (channels == 1) rgb[1] = rgb[2] = d[0];
       if (channels == 4)
-        for (double& v : rgb) v = std::max(v, d[3]);
+        for (double& v : rgb)
+          v = std::max(v, d[3]);
       if (!finite) {
         rgb[0] = 1.0;
         rgb[1] = 0.0;
@@ -161,11 +175,15 @@ bool withinTolerance(const ImageMetrics& m, const ImageTolerance& t, std::string
   std::string why;
   const auto fail = [&](const std::string& s) { why += (why.empty() ? "" : "; ") + s; };
   if (!t.allowNonFinite && (m.nanCount > 0 || m.infCount > 0))
-    fail("actual has " + std::to_string(m.nanCount) + " NaN and " + std::to_string(m.infCount) + " Inf samples");
+    fail("actual has " + std::to_string(m.nanCount) + " NaN and " + std::to_string(m.infCount) +
+         " Inf samples");
   if (m.comparedSamples == 0) fail("no finite samples were compared");
-  if (!(m.maxAbsError <= t.maxAbsError)) fail("maxAbsError " + num(m.maxAbsError) + " > " + num(t.maxAbsError));
-  if (!(m.meanAbsError <= t.meanAbsError)) fail("meanAbsError " + num(m.meanAbsError) + " > " + num(t.meanAbsError));
-  if (!(m.relativeRmse <= t.relativeRmse)) fail("relativeRmse " + num(m.relativeRmse) + " > " + num(t.relativeRmse));
+  if (!(m.maxAbsError <= t.maxAbsError))
+    fail("maxAbsError " + num(m.maxAbsError) + " > " + num(t.maxAbsError));
+  if (!(m.meanAbsError <= t.meanAbsError))
+    fail("meanAbsError " + num(m.meanAbsError) + " > " + num(t.meanAbsError));
+  if (!(m.relativeRmse <= t.relativeRmse))
+    fail("relativeRmse " + num(m.relativeRmse) + " > " + num(t.relativeRmse));
   if (!(m.psnr >= t.minPsnr)) fail("psnr " + num(m.psnr) + " dB < " + num(t.minPsnr) + " dB");
   if (!(m.fractionOver <= t.maxFractionOver))
     fail("fraction of samples with error > " + num(t.overThreshold) + " is " + num(m.fractionOver) + " > " +

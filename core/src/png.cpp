@@ -26,11 +26,17 @@ namespace crep {
 
 namespace {
 
-double clamp01(double v) { return std::min(1.0, std::max(0.0, v)); }
+double clamp01(double v) {
+  return std::min(1.0, std::max(0.0, v));
+}
 
-double oetf(double x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055; }
+double oetf(double x) {
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+}
 
-std::uint8_t quantize(double s) { return static_cast<std::uint8_t>(std::floor(clamp01(s) * 255.0 + 0.5)); }
+std::uint8_t quantize(double s) {
+  return static_cast<std::uint8_t>(std::floor(clamp01(s) * 255.0 + 0.5));
+}
 
 std::uint8_t encodeColour(float v, double exposure) {
   if (!std::isfinite(v)) return 0;
@@ -58,7 +64,9 @@ float linearToSrgb(float linear) {
   return static_cast<float>(oetf(clamp01(static_cast<double>(linear))));
 }
 
-std::uint8_t encodeSrgb8(float linear) { return encodeColour(linear, 1.0); }
+std::uint8_t encodeSrgb8(float linear) {
+  return encodeColour(linear, 1.0);
+}
 
 float srgbToLinear(float encoded) {
   if (std::isnan(encoded)) return 0.0f;
@@ -82,7 +90,8 @@ void writePng(const std::filesystem::path& path, const Image& image, const ToneM
         pixels[o++] = encodeColour(image.at(x, y, 0), exposure);
         continue;
       }
-      for (int c = 0; c < 3; ++c) pixels[o++] = c < channels ? encodeColour(image.at(x, y, c), exposure) : 0;
+      for (int c = 0; c < 3; ++c)
+        pixels[o++] = c < channels ? encodeColour(image.at(x, y, c), exposure) : 0;
       if (outChannels == 4) pixels[o++] = encodeAlpha(image.at(x, y, 3));
     }
   }

@@ -18,9 +18,9 @@ void appendNumber(std::string& out, double v) {
 
 std::string toJson(const Rectification& r) {
   std::string out = "{\"status\": \"";
-  out += toString(r.status);
+  out += statusToken(r.status);
   out += "\", \"reason\": \"";
-  out += toString(r.reason);
+  out += reasonToken(r.reason);
   out += "\", \"measure\": ";
   appendNumber(out, r.measure);
   out += ", \"threshold\": ";

@@ -18,7 +18,7 @@ std::string vecString(const glm::dvec3& v) {
 
 void requireProjective(const Rectification& r) {
   if (!r.projective() || r.splits.empty())
-    throw InvalidArgument("Rectification.status", toString(r.status),
+    throw InvalidArgument("Rectification.status", statusToken(r.status),
                           "the mapping helpers need a projective rectification");
 }
 
@@ -33,16 +33,18 @@ double depthSlope(const RectifiedFrame& f, double depth) {
   return f.depthSlopeMin + depth * (f.depthSlopeMax - f.depthSlopeMin);
 }
 
-/// eta of a global column (splits extrapolate linearly beyond [0, 1]).
-double etaOfColumn(const Rectification& r, double column) {
+/// zeta of a global column (the end splits extrapolate beyond [0, 1]).
+double zetaOfColumn(const Rectification& r, double column) {
   const int K = r.splitCount();
   const double scaled = column * K;
   const int k = std::clamp(static_cast<int>(std::floor(scaled)), 0, K - 1);
   const double u = scaled - k;
   const Split& s = r.splits[static_cast<std::size_t>(k)];
-  const double eta0 = 1.0 / s.rangeBegin, eta1 = 1.0 / s.rangeEnd;
-  return eta0 + u * (eta1 - eta0);
+  return s.zetaBegin + u * (s.zetaEnd - s.zetaBegin);
 }
+
+/// 1 / X of the point with column parameter zeta on the view ray of depth slope z (> 0 if it exists).
+double inverseX(const RectifiedFrame& f, double zeta, double z) { return zeta - f.inverseLightDistance * z; }
 
 } // namespace
 
@@ -55,18 +57,19 @@ RectPoint Rectification::toRectified(const glm::dvec3& world) const {
     throw InvalidArgument("Rectification.toRectified.world", vecString(world),
                           "must be finite and in front of the rectification (X > 0)");
   const double y = Y / X, z = Z / X;
-  const double eta = 1.0 / X + f.inverseLightDistance * (z - f.depthSlopeMin);
+  // zeta = (1 + rho Z) / X with 1 + rho Z = rho dot(axisZ, p - L) (precise next to the light).
+  const double rho = f.inverseLightDistance;
+  const double zeta = rho == 0.0 ? 1.0 / X : rho * glm::dot(f.axisZ, world - f.lightPosition) / X;
   RectPoint p;
   p.row = (y - f.rowSlopeMin) / (f.rowSlopeMax - f.rowSlopeMin);
   p.depth = (z - f.depthSlopeMin) / (f.depthSlopeMax - f.depthSlopeMin);
-  // Split k covers eta in [1/x_k+1, 1/x_k]; on a shared boundary take the lower split.
+  // Split k covers zeta in [zetaEnd, zetaBegin]; on a shared boundary take the lower split.
   const int K = splitCount();
   int k = 0;
-  while (k < K - 1 && eta < 1.0 / splits[static_cast<std::size_t>(k)].rangeEnd) ++k;
+  while (k < K - 1 && zeta < splits[static_cast<std::size_t>(k)].zetaEnd) ++k;
   const Split& s = splits[static_cast<std::size_t>(k)];
-  const double eta0 = 1.0 / s.rangeBegin, eta1 = 1.0 / s.rangeEnd;
   p.split = k;
-  p.splitColumn = (eta0 - eta) / (eta0 - eta1);
+  p.splitColumn = (s.zetaBegin - zeta) / (s.zetaBegin - s.zetaEnd);
   p.column = (k + p.splitColumn) / K;
   return p;
 }
@@ -78,7 +81,7 @@ glm::dvec3 Rectification::toWorld(double column, double row, double depth) const
   requireFiniteArg("Rectification.toWorld.depth", depth);
   const RectifiedFrame& f = frame;
   const double y = rowSlope(f, row), z = depthSlope(f, depth);
-  const double den = etaOfColumn(*this, column) - f.inverseLightDistance * (z - f.depthSlopeMin);
+  const double den = inverseX(f, zetaOfColumn(*this, column), z);
   if (!(den > 0.0))
     throw InvalidArgument("Rectification.toWorld.column", detail::formatValue(column),
                           "no world point has this column at depth " + detail::formatValue(depth) +
@@ -92,19 +95,18 @@ LightRay Rectification::lightRay(double column, double row) const {
   requireFiniteArg("Rectification.lightRay.column", column);
   requireFiniteArg("Rectification.lightRay.row", row);
   const RectifiedFrame& f = frame;
-  const double y = rowSlope(f, row), eta = etaOfColumn(*this, column);
+  const double y = rowSlope(f, row), zeta = zetaOfColumn(*this, column);
   const double rho = f.inverseLightDistance;
   if (rho == 0.0) {
-    if (!(eta > 0.0))
+    if (!(zeta > 0.0))
       throw InvalidArgument("Rectification.lightRay.column", detail::formatValue(column),
                             "beyond the far end of the map");
-    const double X = 1.0 / eta;
+    const double X = 1.0 / zeta;
     return {f.origin + X * (f.axisX + y * f.axisY), f.axisZ};
   }
-  // Point light at L = c - R axisZ: points L + X (axisX + y axisY + (eta R + zmin) axisZ), X >= 0.
-  const double R = 1.0 / rho;
-  const glm::dvec3 dir = f.axisX + y * f.axisY + (eta * R + f.depthSlopeMin) * f.axisZ;
-  return {f.origin - R * f.axisZ, glm::normalize(dir)};
+  // Point light at L: the points L + X (axisX + y axisY + (zeta / rho) axisZ), X >= 0.
+  const glm::dvec3 dir = f.axisX + y * f.axisY + (zeta / rho) * f.axisZ;
+  return {f.lightPosition, glm::normalize(dir)};
 }
 
 glm::dvec3 Rectification::viewRayDirection(double row, double depth) const {
@@ -117,7 +119,7 @@ double Rectification::rayDistance(double row, double depth, double column) const
   requireProjective(*this);
   const RectifiedFrame& f = frame;
   const double y = rowSlope(f, row), z = depthSlope(f, depth);
-  const double den = etaOfColumn(*this, column) - f.inverseLightDistance * (z - f.depthSlopeMin);
+  const double den = inverseX(f, zetaOfColumn(*this, column), z);
   if (!(den > 0.0)) return std::numeric_limits<double>::infinity();
   return std::sqrt(1.0 + y * y + z * z) / den;
 }

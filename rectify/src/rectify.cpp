@@ -18,17 +18,18 @@ namespace crep {
 
 using rectify_detail::Pyramid;
 
-const char* toString(FallbackReason reason) {
+const char* reasonToken(FallbackReason reason) {
   switch (reason) {
   case FallbackReason::None: return "none";
   case FallbackReason::ViewRayParallelToLight: return "view-ray-parallel-to-light";
   case FallbackReason::NonLinearity: return "non-linearity";
+  case FallbackReason::EpipoleTooClose: return "epipole-too-close";
   case FallbackReason::EmptyRegion: return "empty-region";
   }
   return "unknown";
 }
 
-const char* toString(RectifyStatus status) {
+const char* statusToken(RectifyStatus status) {
   switch (status) {
   case RectifyStatus::Projective: return "projective";
   case RectifyStatus::Fallback: return "fallback";
@@ -67,6 +68,9 @@ void validate(const RectifyOptions& o) {
     throw InvalidArgument("RectifyOptions.scheme", detail::formatValue(static_cast<int>(o.scheme)),
                           "must be Uniform, Logarithmic or Blend");
   }
+  if (!std::isfinite(o.minEpipoleAngleDegrees) || o.minEpipoleAngleDegrees < 0.0 || o.minEpipoleAngleDegrees >= 90.0)
+    throw InvalidArgument("RectifyOptions.minEpipoleAngleDegrees", detail::formatValue(o.minEpipoleAngleDegrees),
+                          "degrees, must be in [0, 90)");
   if (o.layout != SplitLayout::Regions && o.layout != SplitLayout::Layers)
     throw InvalidArgument("RectifyOptions.layout", detail::formatValue(static_cast<int>(o.layout)),
                           "must be Regions or Layers");
@@ -85,14 +89,13 @@ std::vector<double> splitPositions(double xmin, double xmax, int splits, SplitSc
   o.scheme = scheme;
   o.blend = blend;
   validate(o);
-  std::vector<double> x(static_cast<std::size_t>(splits) + 1);
-  const double logRatio = std::log(xmax / xmin);
+  // x_j = xmin (1 + g_j) with relative offsets g_j, exact at both ends.
+  const double q = (xmax - xmin) / xmin, logRatio = std::log1p(q);
   const double lambda = scheme == SplitScheme::Uniform ? 0.0 : scheme == SplitScheme::Logarithmic ? 1.0 : blend;
+  std::vector<double> x(static_cast<std::size_t>(splits) + 1);
   for (int j = 1; j < splits; ++j) {
-    const double f = static_cast<double>(j) / splits;
-    const double uni = xmin + (xmax - xmin) * f;
-    const double lg = xmin * std::exp(logRatio * f);
-    x[static_cast<std::size_t>(j)] = lambda * lg + (1.0 - lambda) * uni;
+    const double t = static_cast<double>(j) / splits;
+    x[static_cast<std::size_t>(j)] = xmin * (1.0 + lambda * std::expm1(logRatio * t) + (1.0 - lambda) * q * t);
   }
   x.front() = xmin;
   x.back() = xmax;
@@ -130,48 +133,77 @@ Pyramid lightPyramid(const glm::dvec3& apex, const glm::dvec3& axis, const glm::
   return p;
 }
 
-/// Angle between direction w and the convex cone of the camera's view rays (0 inside).
-double angleToViewCone(const Pyramid& cam, const glm::dvec3& w) {
-  const auto normals = cam.sideNormals();
-  bool inside = true;
-  for (const auto& n : normals) inside = inside && glm::dot(n, w) >= 0.0;
-  if (inside) return 0.0;
-  double best = kPi;
-  for (unsigned i = 0; i < 4; ++i) {
-    const glm::dvec3 a = glm::normalize(cam.edges[i]), b = glm::normalize(cam.edges[(i + 1) % 4]);
-    const glm::dvec3& n = normals[i];
-    const glm::dvec3 wp = w - glm::dot(w, n) * n;
-    const glm::dvec3 ab = glm::cross(a, b);
-    const bool inWedge = glm::dot(glm::cross(a, wp), ab) >= 0.0 && glm::dot(glm::cross(wp, b), ab) >= 0.0 &&
-                         glm::dot(wp, a + b) > 0.0;
-    double angle;
-    if (inWedge)
-      angle = std::atan2(std::abs(glm::dot(w, n)), glm::length(wp));
-    else
-      angle = std::min(std::acos(std::clamp(glm::dot(w, a), -1.0, 1.0)),
-                       std::acos(std::clamp(glm::dot(w, b), -1.0, 1.0)));
-    best = std::min(best, angle);
-  }
-  return best;
-}
-
 std::string fmt(const char* format, double a, double b = 0.0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, format, a, b);
   return buf;
 }
 
+/// Smallest angle between the light line (the frame's Z axis, either direction) and a view ray of the
+/// region: the minimum of tan^2(angle) = (1 + y^2) / z^2 over the slope hull. Its sublevel sets are
+/// convex on each side of z = 0, so along a hull edge (split at z = 0) it is quasi-convex.
+double epipoleAngle(const std::vector<glm::dvec2>& hull) {
+  const auto tan2 = [](const glm::dvec2& p) {
+    return p.y == 0.0 ? std::numeric_limits<double>::infinity() : (1.0 + p.x * p.x) / (p.y * p.y);
+  };
+  double best = std::numeric_limits<double>::infinity();
+  const std::size_t n = hull.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec2 a = hull[i], b = hull[(i + 1) % n];
+    best = std::min({best, tan2(a), tan2(b)});
+    std::array<std::pair<glm::dvec2, glm::dvec2>, 2> parts{{{a, b}, {b, b}}};
+    if ((a.y < 0.0 && b.y > 0.0) || (a.y > 0.0 && b.y < 0.0)) {
+      const glm::dvec2 m = a + (b - a) * (a.y / (a.y - b.y));
+      parts = {{{a, m}, {m, b}}};
+    }
+    for (const auto& [p, q] : parts) {
+      double lo = 0.0, hi = 1.0;
+      for (int it = 0; it < 100 && hi - lo > 1e-15; ++it) { // golden section on a quasi-convex function
+        const double m1 = lo + 0.381966011250105 * (hi - lo), m2 = hi - 0.381966011250105 * (hi - lo);
+        if (tan2(p + m1 * (q - p)) < tan2(p + m2 * (q - p)))
+          hi = m2;
+        else
+          lo = m1;
+      }
+      best = std::min(best, tan2(p + 0.5 * (lo + hi) * (q - p)));
+    }
+  }
+  return std::atan(std::sqrt(best));
+}
+
+/// Fractions f_j in [0, 1] of the zeta range at the split boundaries (f_0 = 0 at zetaMax, f_K = 1 at
+/// zetaMin), for boundaries placed in xh = 1 / (zeta + offset) by the scheme. Written with the relative
+/// offsets g_j = x_j / x_0 - 1 so that a very narrow or very wide range loses no precision.
+std::vector<double> splitFractions(double zetaMax, double zetaMin, double offset, const RectifyOptions& o) {
+  const int K = o.splits;
+  const double q = (zetaMax - zetaMin) / (zetaMin + offset); // x_K / x_0 - 1
+  const double logRatio = std::log1p(q);
+  const double lambda = o.scheme == SplitScheme::Uniform       ? 0.0
+                        : o.scheme == SplitScheme::Logarithmic ? 1.0
+                                                               : o.blend;
+  std::vector<double> f(static_cast<std::size_t>(K) + 1);
+  f.front() = 0.0;
+  f.back() = 1.0;
+  for (int j = 1; j < K; ++j) {
+    const double t = static_cast<double>(j) / K;
+    const double g = lambda * std::expm1(logRatio * t) + (1.0 - lambda) * q * t;
+    double fj = (g / (1.0 + g)) * ((1.0 + q) / q);
+    if (!(fj > f[static_cast<std::size_t>(j) - 1]) || !(fj < 1.0)) fj = t; // rounding on a degenerate range
+    f[static_cast<std::size_t>(j)] = fj;
+  }
+  return f;
+}
+
 /// The common construction. `region` are the vertices of the convex region to cover, `lightDir` the
-/// direction light travels at the camera (unit), `rho` = 1 / |camera - light| (0: directional).
+/// direction light travels at the camera (unit), `rho` = 1 / |camera - light| (0: directional) and
+/// `lightPos` the light's position (point-like lights only).
 Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region, const glm::dvec3& lightDir,
-                    double rho, const RectifyOptions& options, bool pointLike) {
+                    double rho, const glm::dvec3& lightPos, const RectifyOptions& options, bool pointLike) {
   Rectification r;
   r.threshold = options.maxSpanDegrees;
   r.layout = options.layout;
   r.referenceRay = options.referenceRay;
   r.regionVertices = region;
-  const Pyramid cam = cameraPyramid(camera);
-  r.epipoleAngle = std::min(angleToViewCone(cam, lightDir), angleToViewCone(cam, -lightDir)) * kDeg;
   const glm::dvec3 c = camera.position();
 
   if (region.empty()) {
@@ -191,9 +223,8 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
   for (const auto& v : region) {
     const glm::dvec3 d = v - c;
     const double q1 = glm::dot(d, b1), q2 = glm::dot(d, b2);
-    const double len = glm::length(d);
     // A vertex on the camera's light line: its view ray is a light ray (relative 1e-12 ~ rounding).
-    if (!(std::hypot(q1, q2) > 1e-12 * len)) {
+    if (!(std::hypot(q1, q2) > 1e-12 * glm::length(d))) {
       onLightLine = true;
       break;
     }
@@ -215,92 +246,114 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
     span = 2.0 * kPi - gap;
   }
   // Not inside an open half-plane (up to rounding): some view ray through the region is a light ray.
-  const bool parallel = onLightLine || span >= kPi * (1.0 - 1e-12);
-  r.measure = parallel ? 180.0 : span * kDeg;
-  if (parallel) {
+  if (onLightLine || span >= kPi * (1.0 - 1e-12)) {
+    r.span = r.measure = 180.0;
+    r.epipoleAngle = 0.0;
     r.status = RectifyStatus::Fallback;
     r.reason = FallbackReason::ViewRayParallelToLight;
-    r.message = pointLike ? "a view ray through the lit region passes through the light (camera-light line "
+    r.message = pointLike ? "a view ray through the lit region passes through the light (the camera-light line "
                             "crosses it): projective rectification impossible"
                           : "a view ray is parallel to the light direction (epipole on screen): projective "
                             "rectification impossible";
     return r;
   }
-  if (r.measure >= options.maxSpanDegrees) {
-    r.status = RectifyStatus::Fallback;
-    r.reason = FallbackReason::NonLinearity;
-    r.message = fmt("angular span of the lit region around the light axis %.6g deg >= threshold %.6g deg: "
-                    "rectification too non-linear",
-                    r.measure, options.maxSpanDegrees);
-    return r;
-  }
+  r.span = span * kDeg;
 
   // Frame: X along the bisectrix (orthogonal to the light), Z along the light, Y = Z x X.
   const double mid = start + 0.5 * span;
-  RectifiedFrame& f = r.frame;
+  RectifiedFrame f;
   f.origin = c;
   f.axisZ = lightDir;
   f.axisX = glm::normalize(std::cos(mid) * b1 + std::sin(mid) * b2);
   f.axisY = glm::cross(f.axisZ, f.axisX);
   f.inverseLightDistance = rho;
+  f.lightPosition = lightPos;
 
-  // Bounds from the *slopes* of the vertices (the camera is the centre of projection).
-  double yMin = std::numeric_limits<double>::infinity(), yMax = -yMin, zMin = yMin, zMax = -yMin;
-  std::vector<glm::dvec3> xyz;
-  xyz.reserve(region.size());
+  // Bounds from the *slopes* of the vertices (the camera is the centre of projection), and of zeta.
+  const double inf = std::numeric_limits<double>::infinity();
+  double yMin = inf, yMax = -inf, zMin = inf, zMax = -inf, zetaMin = inf, zetaMax = -inf;
   std::vector<glm::dvec2> slopes;
   slopes.reserve(region.size());
   for (const auto& v : region) {
     const glm::dvec3 d = v - c;
-    const glm::dvec3 p(glm::dot(f.axisX, d), glm::dot(f.axisY, d), glm::dot(f.axisZ, d));
-    xyz.push_back(p);
-    const double y = p.y / p.x, z = p.z / p.x;
+    const double X = glm::dot(f.axisX, d), Y = glm::dot(f.axisY, d), Z = glm::dot(f.axisZ, d);
+    const double y = Y / X, z = Z / X;
+    // 1 + rho Z = rho dot(axisZ, p - L), evaluated from L for precision next to the light.
+    const double zeta = rho == 0.0 ? 1.0 / X : rho * glm::dot(f.axisZ, v - lightPos) / X;
     slopes.emplace_back(y, z);
     yMin = std::min(yMin, y);
     yMax = std::max(yMax, y);
     zMin = std::min(zMin, z);
     zMax = std::max(zMax, z);
-  }
-  double etaMin = std::numeric_limits<double>::infinity(), etaMax = -etaMin;
-  for (const auto& p : xyz) {
-    const double eta = 1.0 / p.x + rho * (p.z / p.x - zMin);
-    etaMin = std::min(etaMin, eta);
-    etaMax = std::max(etaMax, eta);
+    zetaMin = std::min(zetaMin, zeta);
+    zetaMax = std::max(zetaMax, zeta);
   }
   const double yScale = 1.0 + std::max(std::abs(yMin), std::abs(yMax));
   const double zScale = 1.0 + std::max(std::abs(zMin), std::abs(zMax));
-  if (!(yMax - yMin > 1e-12 * yScale) || !(zMax - zMin > 1e-12 * zScale) || !(etaMax - etaMin > 1e-12 * etaMax) ||
-      !(etaMin > 0.0)) {
+  const double zetaScale = std::max(std::abs(zetaMin), std::abs(zetaMax));
+  if (!(yMax - yMin > 1e-12 * yScale) || !(zMax - zMin > 1e-12 * zScale) ||
+      !(zetaMax - zetaMin > 1e-12 * zetaScale)) {
     // Only a spot/point region can be flat (the frusta touch along a face, an edge or a point).
     r.status = RectifyStatus::Empty;
     r.reason = FallbackReason::EmptyRegion;
     r.message = "the lit part of the camera frustum is flat (the frusta only touch): nothing is lit";
-    r.frame = RectifiedFrame{};
     return r;
   }
+  std::vector<glm::dvec2> hull = rectify_detail::convexHull(slopes);
+  r.epipoleAngle = epipoleAngle(hull) * kDeg;
+
+  if (r.span >= options.maxSpanDegrees) {
+    r.status = RectifyStatus::Fallback;
+    r.reason = FallbackReason::NonLinearity;
+    r.measure = r.span;
+    r.message = fmt("angular span of the lit region around the light axis %.6g deg >= threshold %.6g deg: "
+                    "rectification too non-linear",
+                    r.span, options.maxSpanDegrees);
+    return r;
+  }
+  if (r.epipoleAngle < options.minEpipoleAngleDegrees) {
+    r.status = RectifyStatus::Fallback;
+    r.reason = FallbackReason::EpipoleTooClose;
+    r.measure = r.epipoleAngle;
+    r.threshold = options.minEpipoleAngleDegrees;
+    r.message = fmt("a view ray of the lit region is %.6g deg from the light line < threshold %.6g deg: "
+                    "step ratios too large",
+                    r.epipoleAngle, options.minEpipoleAngleDegrees);
+    return r;
+  }
+  r.measure = r.span;
+
   f.rowSlopeMin = yMin;
   f.rowSlopeMax = yMax;
   f.depthSlopeMin = zMin;
   f.depthSlopeMax = zMax;
-  f.axisMin = 1.0 / etaMax;
-  f.axisMax = 1.0 / etaMin;
-  r.slopeHull = rectify_detail::convexHull(slopes);
+  const double offset = -rho * zMin; // xh = 1 / (zeta + offset) > 0 on the region
+  f.axisMin = 1.0 / (zetaMax + offset);
+  f.axisMax = 1.0 / (zetaMin + offset);
+  r.frame = f;
+  r.slopeHull = std::move(hull);
 
   // Splits (Sec. 4.2 "Non-linearity"): shared row and depth slopes, one column projection each.
   const int K = options.splits;
-  const std::vector<double> x = splitPositions(f.axisMin, f.axisMax, K, options.scheme, options.blend);
+  const std::vector<double> frac = splitFractions(zetaMax, zetaMin, offset, options);
+  std::vector<double> zeta(frac.size());
+  for (std::size_t j = 0; j < frac.size(); ++j) zeta[j] = zetaMax - frac[j] * (zetaMax - zetaMin);
+  zeta.front() = zetaMax;
+  zeta.back() = zetaMin;
   const glm::dmat4 frameFromWorld = f.frameFromWorld();
   const double alpha = 2.0 / (yMax - yMin), beta = -1.0 - alpha * yMin;
   const double gamma = 2.0 / (zMax - zMin), delta = -1.0 - gamma * zMin;
   r.splits.resize(static_cast<std::size_t>(K));
   for (int k = 0; k < K; ++k) {
-    Split& s = r.splits[static_cast<std::size_t>(k)];
-    s.rangeBegin = x[static_cast<std::size_t>(k)];
-    s.rangeEnd = x[static_cast<std::size_t>(k) + 1];
-    const double eta0 = 1.0 / s.rangeBegin, eta1 = 1.0 / s.rangeEnd;
-    const double b = 2.0 / (eta1 - eta0), a = -1.0 - b * eta0; // ndc.x = a + b eta: eta0 -> -1, eta1 -> +1
-    glm::dmat4 S(0.0);                                          // frame (X, Y, Z, 1) -> clip; S[col][row]
-    S[0][0] = a - b * rho * zMin;
+    const auto ku = static_cast<std::size_t>(k);
+    Split& s = r.splits[ku];
+    s.zetaBegin = zeta[ku];
+    s.zetaEnd = zeta[ku + 1];
+    s.rangeBegin = k == 0 ? f.axisMin : r.splits[ku - 1].rangeEnd;
+    s.rangeEnd = k == K - 1 ? f.axisMax : 1.0 / (s.zetaEnd + offset);
+    const double b = 2.0 / (s.zetaEnd - s.zetaBegin), a = -1.0 - b * s.zetaBegin; // ndc.x = a + b zeta
+    glm::dmat4 S(0.0); // frame (X, Y, Z, 1) -> clip; S[column][row]
+    S[0][0] = a;
     S[2][0] = b * rho;
     S[3][0] = b;
     S[0][1] = beta;
@@ -321,7 +374,8 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
   }
   r.status = RectifyStatus::Projective;
   r.reason = FallbackReason::None;
-  r.message = fmt("projective: angular span %.6g deg < threshold %.6g deg", r.measure, options.maxSpanDegrees);
+  r.message = fmt("projective: angular span %.6g deg < %.6g deg", r.span, options.maxSpanDegrees) +
+              fmt(", epipole angle %.6g deg >= %.6g deg", r.epipoleAngle, options.minEpipoleAngleDegrees);
   return r;
 }
 
@@ -338,14 +392,14 @@ Rectification buildPointLike(const Camera& camera, const glm::dvec3& lightPos, c
     r.layout = options.layout;
     r.referenceRay = options.referenceRay;
     r.regionVertices = region;
-    r.measure = 180.0;
+    r.span = r.measure = 180.0;
     r.status = RectifyStatus::Fallback;
     r.reason = FallbackReason::ViewRayParallelToLight;
     r.message = "the camera is at the light position: every view ray is a light ray";
     return r;
   }
   const glm::dvec3 lightDir = dist > 0.0 ? toCamera / dist : lightFrustum.axis;
-  return build(camera, region, lightDir, dist > 0.0 ? 1.0 / dist : 0.0, options, true);
+  return build(camera, region, lightDir, dist > 0.0 ? 1.0 / dist : 0.0, lightPos, options, true);
 }
 
 } // namespace
@@ -354,7 +408,7 @@ Rectification rectify(const Camera& camera, const DirectionalLight& light, const
   validate(options);
   const auto corners = camera.frustumCorners();
   const std::vector<glm::dvec3> region(corners.begin(), corners.end());
-  return build(camera, region, light.direction(), 0.0, options, false);
+  return build(camera, region, light.direction(), 0.0, glm::dvec3(0.0), options, false);
 }
 
 Rectification rectify(const Camera& camera, const SpotLight& light, const RectifyOptions& options) {

@@ -48,7 +48,9 @@ void writeFile(const fs::path& path, const Bytes& bytes, std::size_t length) {
   out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(length));
   REQUIRE(out);
 }
-void writeFile(const fs::path& path, const Bytes& bytes) { writeFile(path, bytes, bytes.size()); }
+void writeFile(const fs::path& path, const Bytes& bytes) {
+  writeFile(path, bytes, bytes.size());
+}
 
 std::uint32_t get32(const Bytes& b, std::size_t at) {
   REQUIRE(at + 4 <= b.size());
@@ -66,7 +68,8 @@ float getFloat(const Bytes& b, std::size_t at) {
 }
 void put32(Bytes& b, std::size_t at, std::uint32_t v) {
   REQUIRE(at + 4 <= b.size());
-  for (int i = 0; i < 4; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+  for (int i = 0; i < 4; ++i)
+    b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
 // Position of the value of header attribute `name` (single-part files), or 0.
@@ -86,9 +89,11 @@ std::size_t headerEnd(const Bytes& b) {
   for (;;) {
     REQUIRE(at < b.size());
     if (b[at] == 0) return at + 1;
-    while (b[at] != 0) ++at; // name
+    while (b[at] != 0)
+      ++at; // name
     ++at;
-    while (b[at] != 0) ++at; // type
+    while (b[at] != 0)
+      ++at; // type
     ++at;
     const std::uint32_t size = get32(b, at);
     at += 4 + size;
@@ -106,7 +111,8 @@ struct Writer {
     u8(static_cast<std::uint8_t>(v >> 8));
   }
   void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));
+    for (int i = 0; i < 4; ++i)
+      u8(static_cast<std::uint8_t>(v >> (8 * i)));
   }
   void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
   void u64(std::uint64_t v) {
@@ -119,7 +125,8 @@ struct Writer {
     u32(bits);
   }
   void str0(const std::string& s) {
-    for (char c : s) u8(static_cast<std::uint8_t>(c));
+    for (char c : s)
+      u8(static_cast<std::uint8_t>(c));
     u8(0);
   }
   void append(const Bytes& other) { b.insert(b.end(), other.begin(), other.end()); }
@@ -144,7 +151,9 @@ struct RawPart {
   int minX = 0, minY = 0, maxX = 0, maxY = 0;
   int tileWidth = 0, tileHeight = 0; // tiled when > 0
   std::string name = "part";
-  std::string type; // explicit type attribute (multi-part files always get one)
+  std::string type;        // explicit type attribute (multi-part files always get one)
+  int compression = 0;     // attribute value only: the data written is always uncompressed...
+  int fakeChunkBytes = -1; // ...unless >= 0: then every chunk holds this many zero bytes
 };
 
 // The value stored for channel c of part p at EXR coordinates (x, y): an integer in [0, 1024),
@@ -161,15 +170,19 @@ std::uint16_t halfOfSmallInteger(float v) {
   REQUIRE(n < 2048);
   if (n == 0) return 0;
   int e = 0;
-  while ((n >> (e + 1)) != 0) ++e;
+  while ((n >> (e + 1)) != 0)
+    ++e;
   const int mantissa = (n - (1 << e)) << (10 - e);
   return static_cast<std::uint16_t>(((e + 15) << 10) | mantissa);
 }
 
 void sample(Writer& w, int type, float v) {
-  if (type == kUint) w.u32(static_cast<std::uint32_t>(v));
-  else if (type == kHalf) w.u16(halfOfSmallInteger(v));
-  else w.f32(v);
+  if (type == kUint)
+    w.u32(static_cast<std::uint32_t>(v));
+  else if (type == kHalf)
+    w.u16(halfOfSmallInteger(v));
+  else
+    w.f32(v);
 }
 
 Bytes partHeader(const RawPart& part, bool multiPart, int chunkCount, const RawPart& displayPart) {
@@ -192,7 +205,7 @@ Bytes partHeader(const RawPart& part, bool multiPart, int chunkCount, const RawP
     count.i32(chunkCount);
     h.attribute("chunkCount", "int", count.b);
   }
-  h.attribute("compression", "compression", {0});
+  h.attribute("compression", "compression", {static_cast<std::uint8_t>(part.compression)});
   Writer box;
   box.i32(part.minX);
   box.i32(part.minY);
@@ -208,7 +221,8 @@ Bytes partHeader(const RawPart& part, bool multiPart, int chunkCount, const RawP
   h.attribute("lineOrder", "lineOrder", {0});
   if (multiPart) {
     Writer name;
-    for (char c : part.name) name.u8(static_cast<std::uint8_t>(c));
+    for (char c : part.name)
+      name.u8(static_cast<std::uint8_t>(c));
     h.attribute("name", "string", name.b);
   }
   Writer one;
@@ -230,14 +244,17 @@ Bytes partHeader(const RawPart& part, bool multiPart, int chunkCount, const RawP
   if (type.empty() && multiPart) type = part.tileWidth > 0 ? "tiledimage" : "scanlineimage";
   if (!type.empty()) {
     Writer t;
-    for (char c : type) t.u8(static_cast<std::uint8_t>(c));
+    for (char c : type)
+      t.u8(static_cast<std::uint8_t>(c));
     h.attribute("type", "string", t.b);
   }
   h.u8(0);
   return h.b;
 }
 
-bool sampled(int v, int sampling) { return ((v % sampling) + sampling) % sampling == 0; }
+bool sampled(int v, int sampling) {
+  return ((v % sampling) + sampling) % sampling == 0;
+}
 
 // The chunks of one part (without the multi-part part number prefix).
 std::vector<Bytes> partChunks(const RawPart& part, int p) {
@@ -251,6 +268,7 @@ std::vector<Bytes> partChunks(const RawPart& part, int p) {
         for (int x = part.minX; x <= part.maxX; ++x)
           if (sampled(x, ch.xSampling)) sample(data, ch.type, rawValue(p, static_cast<int>(c), x, y));
       }
+      if (part.fakeChunkBytes >= 0) data.b.assign(static_cast<std::size_t>(part.fakeChunkBytes), 0);
       Writer chunk;
       chunk.i32(y);
       chunk.i32(static_cast<std::int32_t>(data.b.size()));
@@ -265,7 +283,8 @@ std::vector<Bytes> partChunks(const RawPart& part, int p) {
   for (int ty = 0; ty < tilesY; ++ty) {
     for (int tx = 0; tx < tilesX; ++tx) {
       const int x0 = part.minX + tx * part.tileWidth, y0 = part.minY + ty * part.tileHeight;
-      const int x1 = std::min(x0 + part.tileWidth - 1, part.maxX), y1 = std::min(y0 + part.tileHeight - 1, part.maxY);
+      const int x1 = std::min(x0 + part.tileWidth - 1, part.maxX),
+                y1 = std::min(y0 + part.tileHeight - 1, part.maxY);
       Writer data;
       for (int y = y0; y <= y1; ++y)
         for (std::size_t c = 0; c < part.channels.size(); ++c)
@@ -287,18 +306,22 @@ std::vector<Bytes> partChunks(const RawPart& part, int p) {
 Bytes buildExr(const std::vector<RawPart>& parts, std::uint32_t extraFlags = 0) {
   const bool multiPart = parts.size() > 1;
   std::vector<std::vector<Bytes>> chunks;
-  for (std::size_t p = 0; p < parts.size(); ++p) chunks.push_back(partChunks(parts[p], static_cast<int>(p)));
+  for (std::size_t p = 0; p < parts.size(); ++p)
+    chunks.push_back(partChunks(parts[p], static_cast<int>(p)));
   Writer w;
   w.u32(20000630);
   std::uint32_t version = 2 | extraFlags;
-  if (multiPart) version |= 0x1000;
-  else if (parts[0].tileWidth > 0) version |= 0x200;
+  if (multiPart)
+    version |= 0x1000;
+  else if (parts[0].tileWidth > 0)
+    version |= 0x200;
   w.u32(version);
   for (std::size_t p = 0; p < parts.size(); ++p)
     w.append(partHeader(parts[p], multiPart, static_cast<int>(chunks[p].size()), parts[0]));
   if (multiPart) w.u8(0);
   std::size_t tableEntries = 0;
-  for (const auto& c : chunks) tableEntries += c.size();
+  for (const auto& c : chunks)
+    tableEntries += c.size();
   std::uint64_t offset = w.b.size() + tableEntries * 8;
   for (const auto& partChunkList : chunks) {
     for (const Bytes& chunk : partChunkList) {
@@ -335,7 +358,8 @@ void checkRawContent(const Image& image, const RawPart& part, int p, const std::
   for (int y = 0; y < image.height(); ++y)
     for (int x = 0; x < image.width(); ++x)
       for (int c = 0; c < image.channels(); ++c) {
-        const float expected = rawValue(p, fileChannels[static_cast<std::size_t>(c)], part.minX + x, part.maxY - y);
+        const float expected =
+            rawValue(p, fileChannels[static_cast<std::size_t>(c)], part.minX + x, part.maxY - y);
         if (image.at(x, y, c) != expected && bad++ < 5)
           FAIL_CHECK("pixel (" << x << "," << y << "," << c << ") = " << image.at(x, y, c) << ", expected "
                                << expected);
@@ -382,7 +406,9 @@ std::string expectThrows(const fs::path& path, const crep::ExrReadOptions& optio
   return {};
 }
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
 
 } // namespace
 
@@ -403,7 +429,8 @@ TEST_CASE("EXR: half round trip is exact for values k/1024, for 1 to 4 channels 
       CHECK(info.width == 37);
       CHECK(info.height == 23);
       REQUIRE(info.channels.size() == static_cast<std::size_t>(channels));
-      for (const auto& channel : info.channels) CHECK(channel.pixelType == crep::ExrPixelType::Half);
+      for (const auto& channel : info.channels)
+        CHECK(channel.pixelType == crep::ExrPixelType::Half);
     }
   }
 }
@@ -416,15 +443,25 @@ TEST_CASE("EXR: channel names written for 1, 2, 3 and 4 channels") {
     crep::writeExr(dir / "names.exr", Image(3, 2, channels));
     const crep::ExrFileInfo info = crep::readExrInfo(dir / "names.exr");
     std::vector<std::string> names;
-    for (const auto& c : info.channels) names.push_back(c.name);
+    for (const auto& c : info.channels)
+      names.push_back(c.name);
     CHECK(names == expected[static_cast<std::size_t>(channels - 1)]);
   }
 }
 
 TEST_CASE("EXR: float round trip is bit exact, including extremes, denormals, NaN and Inf") {
   crep::test::TempDir dir;
-  const float specials[] = {1.0f / 3.0f, -1e-30f, 1e30f, 1e-40f /* denormal */, 0.1f, -0.0f,
-                            std::numeric_limits<float>::max(), kInf, -kInf, kNan, 123456.789f};
+  const float specials[] = {1.0f / 3.0f,
+                            -1e-30f,
+                            1e30f,
+                            1e-40f /* denormal */,
+                            0.1f,
+                            -0.0f,
+                            std::numeric_limits<float>::max(),
+                            kInf,
+                            -kInf,
+                            kNan,
+                            123456.789f};
   for (int channels : {1, 2, 3, 4}) {
     Image image(37, 23, channels);
     std::size_t i = 0;
@@ -435,7 +472,8 @@ TEST_CASE("EXR: float round trip is bit exact, including extremes, denormals, Na
     const fs::path path = dir / "float.exr";
     crep::writeExr(path, image, crep::ExrPixelType::Float);
     requireIdentical(crep::readExr(path), image);
-    for (const auto& channel : crep::readExrInfo(path).channels) CHECK(channel.pixelType == crep::ExrPixelType::Float);
+    for (const auto& channel : crep::readExrInfo(path).channels)
+      CHECK(channel.pixelType == crep::ExrPixelType::Float);
   }
 }
 
@@ -464,9 +502,10 @@ TEST_CASE("EXR: orientation: Image (0, 0) is the bottom-left pixel, written as t
   crep::test::TempDir dir;
   const int w = 37, h = 23;
   Image image(w, h, 1);
-  image.at(0, 0) = 1.0f;      // bottom-left
+  image.at(0, 0) = 1.0f;         // bottom-left
   image.at(w - 1, h - 1) = 2.0f; // top-right
-  for (int x = 0; x < w; ++x) image.at(x, 1) = 0.5f; // second row from the bottom
+  for (int x = 0; x < w; ++x)
+    image.at(x, 1) = 0.5f; // second row from the bottom
   const fs::path path = dir / "orientation.exr";
   crep::writeExr(path, image, crep::ExrWriteOptions(crep::ExrPixelType::Float, crep::ExrCompression::None));
 
@@ -479,15 +518,18 @@ TEST_CASE("EXR: orientation: Image (0, 0) is the bottom-left pixel, written as t
     const Bytes bytes = readFile(path);
     const std::size_t tableStart = headerEnd(bytes);
     for (int y = 0; y < h; ++y) {
-      const std::size_t chunk = static_cast<std::size_t>(get64(bytes, tableStart + static_cast<std::size_t>(y) * 8));
+      const std::size_t chunk =
+          static_cast<std::size_t>(get64(bytes, tableStart + static_cast<std::size_t>(y) * 8));
       REQUIRE(static_cast<int>(get32(bytes, chunk)) == y);
       REQUIRE(get32(bytes, chunk + 4) == static_cast<std::uint32_t>(w * 4));
-      for (int x = 0; x < w; ++x) CHECK(getFloat(bytes, chunk + 8 + static_cast<std::size_t>(x) * 4) == image.at(x, h - 1 - y));
+      for (int x = 0; x < w; ++x)
+        CHECK(getFloat(bytes, chunk + 8 + static_cast<std::size_t>(x) * 4) == image.at(x, h - 1 - y));
     }
     // Explicitly: the first EXR row's last pixel is the top-right 2, the last row's first pixel the 1.
     const std::size_t first = static_cast<std::size_t>(get64(bytes, tableStart));
     CHECK(getFloat(bytes, first + 8 + static_cast<std::size_t>(w - 1) * 4) == 2.0f);
-    const std::size_t last = static_cast<std::size_t>(get64(bytes, tableStart + static_cast<std::size_t>(h - 1) * 8));
+    const std::size_t last =
+        static_cast<std::size_t>(get64(bytes, tableStart + static_cast<std::size_t>(h - 1) * 8));
     CHECK(getFloat(bytes, last + 8) == 1.0f);
   }
 }
@@ -566,7 +608,8 @@ TEST_CASE("EXR: channel selection rules") {
   };
   for (const Case& c : cases) {
     std::vector<RawChannel> channels;
-    for (const std::string& name : c.channels) channels.push_back({name, kHalf});
+    for (const std::string& name : c.channels)
+      channels.push_back({name, kHalf});
     CAPTURE(c.layer);
     CAPTURE(c.channels.front());
     CAPTURE(c.channels.size());
@@ -606,7 +649,8 @@ TEST_CASE("EXR: writeExrLayers round trip, channel naming and validation") {
     const fs::path path = dir / "layers.exr";
     crep::writeExrLayers(path, layers, type);
     std::vector<std::string> names;
-    for (const auto& c : crep::readExrInfo(path).channels) names.push_back(c.name);
+    for (const auto& c : crep::readExrInfo(path).channels)
+      names.push_back(c.name);
     CHECK(names == std::vector<std::string>{"A", "B", "G", "R", "depth.Y", "motion.G", "motion.R"});
     requireIdentical(crep::readExr(path), beauty);
     crep::ExrReadOptions options;
@@ -669,7 +713,8 @@ TEST_CASE("EXR: missing, empty, non-EXR and too-large files") {
   SUBCASE("random bytes and text") {
     std::mt19937 random(12345);
     Bytes noise(4096);
-    for (auto& b : noise) b = static_cast<std::uint8_t>(random());
+    for (auto& b : noise)
+      b = static_cast<std::uint8_t>(random());
     writeFile(dir / "noise.exr", noise);
     CHECK(contains(expectThrows<crep::FormatError>(dir / "noise.exr"), "not an OpenEXR file"));
     const std::string text = "P3\n1 1\n255\n0 0 0\n";
@@ -693,12 +738,21 @@ TEST_CASE("EXR: missing, empty, non-EXR and too-large files") {
       return expectThrows<crep::FormatError>(dir / "patched.exr");
     };
     CHECK(contains(patched(0, 0, 99999, 99999), "too large"));
-    CHECK(contains(patched(0, 0, 32768, 0), "too large")); // 32769 wide
+    CHECK(contains(patched(0, 0, 32768, 0), "too large"));     // 32769 wide
     CHECK(contains(patched(0, 0, 20000, 20000), "too large")); // sides ok, pixel count not
-    const std::int32_t lo = std::numeric_limits<std::int32_t>::min(), hi = std::numeric_limits<std::int32_t>::max();
+    const std::int32_t lo = std::numeric_limits<std::int32_t>::min(),
+                       hi = std::numeric_limits<std::int32_t>::max();
     CHECK(contains(patched(lo, lo, hi, hi), "too large"));
     CHECK(contains(patched(10, 10, 0, 0), "data window"));
     CHECK(contains(patched(0, 0, 36, 40), "patched.exr")); // larger than the data: table/chunks don't match
+  }
+  SUBCASE("a small file claiming many pixels is rejected before allocating the image") {
+    // 32768 x 2048 float (256 MiB) in a ~37 KB file: RLE chunks of 2 bytes each.
+    RawPart part = scanlinePart({{"Y", kFloat}}, 32768, 2048);
+    part.compression = 1; // RLE: one line per chunk
+    part.fakeChunkBytes = 2;
+    writeFile(dir / "bomb.exr", buildExr({part}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "bomb.exr"), "implausibly large"));
   }
   SUBCASE("ExrReadOptions.maxPixels is checked before reading") {
     crep::writeExr(dir / "small.exr", patternImage(37, 23, 3));
@@ -724,6 +778,20 @@ TEST_CASE("EXR: missing, empty, non-EXR and too-large files") {
   }
 }
 
+TEST_CASE("EXR: large constant images (maximal compression ratio) are not mistaken for bombs") {
+  crep::test::TempDir dir;
+  const Image image(2048, 1024, 4, 0.25f); // 32 MiB as float
+  for (crep::ExrCompression compression : {crep::ExrCompression::Zip, crep::ExrCompression::Piz}) {
+    CAPTURE(static_cast<int>(compression));
+    crep::writeExr(dir / "constant.exr", image, crep::ExrWriteOptions(crep::ExrPixelType::Half, compression));
+    const auto fileSize = fs::file_size(dir / "constant.exr");
+    CAPTURE(fileSize);
+    const Image back = crep::readExr(dir / "constant.exr");
+    REQUIRE(back.sameShape(image));
+    CHECK(std::all_of(back.data().begin(), back.data().end(), [](float v) { return v == 0.25f; }));
+  }
+}
+
 TEST_CASE("EXR: every truncation of a valid file is a FormatError, never a crash or a partial image") {
   crep::test::TempDir dir;
   const auto start = std::chrono::steady_clock::now();
@@ -732,8 +800,10 @@ TEST_CASE("EXR: every truncation of a valid file is a FormatError, never a crash
     Bytes bytes;
   };
   std::vector<Variant> variants;
-  for (crep::ExrCompression compression : {crep::ExrCompression::Zip, crep::ExrCompression::Piz, crep::ExrCompression::None}) {
-    crep::writeExr(dir / "full.exr", patternImage(37, 23, 4), crep::ExrWriteOptions(crep::ExrPixelType::Half, compression));
+  for (crep::ExrCompression compression :
+       {crep::ExrCompression::Zip, crep::ExrCompression::Piz, crep::ExrCompression::None}) {
+    crep::writeExr(dir / "full.exr", patternImage(37, 23, 4),
+                   crep::ExrWriteOptions(crep::ExrPixelType::Half, compression));
     variants.push_back({"writer", readFile(dir / "full.exr")});
   }
   RawPart tiled = scanlinePart({{"G", kHalf}, {"R", kFloat}}, 13, 11);
@@ -751,17 +821,22 @@ TEST_CASE("EXR: every truncation of a valid file is a FormatError, never a crash
     // (including 10%, 50%, 90%) and the last 16 (all but 1 byte, ...).
     const std::size_t size = variant.bytes.size();
     std::set<std::size_t> lengths;
-    for (std::size_t length = 0; length < std::min<std::size_t>(size, 600); ++length) lengths.insert(length);
-    for (std::size_t k = 0; k < 200; ++k) lengths.insert(k * size / 200);
-    for (std::size_t k = 1; k <= 16 && k <= size; ++k) lengths.insert(size - k);
+    for (std::size_t length = 0; length < std::min<std::size_t>(size, 600); ++length)
+      lengths.insert(length);
+    for (std::size_t k = 0; k < 200; ++k)
+      lengths.insert(k * size / 200);
+    for (std::size_t k = 1; k <= 16 && k <= size; ++k)
+      lengths.insert(size - k);
     int wrong = 0;
     for (const std::size_t length : lengths) {
       writeFile(dir / "cut.exr", variant.bytes, length);
       try {
         (void)crep::readExr(dir / "cut.exr");
-        if (wrong++ < 5) FAIL_CHECK("truncated to " << length << " of " << variant.bytes.size() << " bytes: no error");
+        if (wrong++ < 5)
+          FAIL_CHECK("truncated to " << length << " of " << variant.bytes.size() << " bytes: no error");
       } catch (const crep::FormatError& e) {
-        if (!contains(e.what(), "cut.exr") && wrong++ < 5) FAIL_CHECK("message does not name the file: " << e.what());
+        if (!contains(e.what(), "cut.exr") && wrong++ < 5)
+          FAIL_CHECK("message does not name the file: " << e.what());
       } catch (const std::exception& e) {
         if (wrong++ < 5) FAIL_CHECK("truncated to " << length << ": wrong exception type: " << e.what());
       }
@@ -776,8 +851,10 @@ TEST_CASE("EXR: corrupted bytes give an image or a FormatError, never a crash or
   crep::test::TempDir dir;
   const auto start = std::chrono::steady_clock::now();
   std::vector<Bytes> originals;
-  for (crep::ExrCompression compression : {crep::ExrCompression::Zip, crep::ExrCompression::Piz, crep::ExrCompression::None}) {
-    crep::writeExr(dir / "ok.exr", patternImage(37, 23, 3), crep::ExrWriteOptions(crep::ExrPixelType::Half, compression));
+  for (crep::ExrCompression compression :
+       {crep::ExrCompression::Zip, crep::ExrCompression::Piz, crep::ExrCompression::None}) {
+    crep::writeExr(dir / "ok.exr", patternImage(37, 23, 3),
+                   crep::ExrWriteOptions(crep::ExrPixelType::Half, compression));
     originals.push_back(readFile(dir / "ok.exr"));
   }
   std::mt19937 random(20240601);
@@ -802,8 +879,9 @@ TEST_CASE("EXR: corrupted bytes give an image or a FormatError, never a crash or
       FAIL_CHECK("iteration " << iteration << ": unexpected exception type: " << e.what());
     }
   }
-  MESSAGE("corrupted files: " << successes << " read, " << formatErrors << " rejected");
+  // Both outcomes occur (e.g. a changed pixel value of an uncompressed file is still a valid file).
   CHECK(formatErrors > 0);
+  CHECK(successes > 0);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   CHECK_MESSAGE(seconds < 60.0, "corruption sweep took " << seconds << " s");
 }

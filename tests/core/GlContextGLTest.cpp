@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -49,7 +50,9 @@ TEST_CASE("GlContext: the debug callback reports a deliberate GL error and check
   std::vector<crep::GlDebugMessage> messages;
   {
     // A private callback, so the fixture's fail-on-error callback does not fail this test.
-    crep::test::ScopedGlDebugCallback scoped([&](const crep::GlDebugMessage& m) { messages.push_back(m); });
+    crep::test::ScopedGlDebugCallback scoped([&](const crep::GlDebugMessage& m) {
+      if (m.isError()) messages.push_back(m); // drivers may add notifications
+    });
     glBindTexture(0x1234, 0); // not a texture target: GL_INVALID_ENUM
     REQUIRE(messages.size() == 1);
     CHECK(messages[0].isError());
@@ -242,24 +245,56 @@ TEST_CASE("gl::Handle owns exactly one object") {
   }
 }
 
-TEST_CASE("GL tests are skipped, not failed, without OpenGL (CREP_TEST_FORCE_NO_GL)") {
-  // Runs this executable again, restricted to the first test case, as ctest would without OpenGL.
-  // Needs no context itself.
+namespace {
+/// Runs this test executable again with `arguments` (a shell fragment); returns the exit code and
+/// fills `output` with stdout + stderr.
+int runSelf(const std::string& arguments, std::string& output) {
   char exe[4096] = {};
   const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
   REQUIRE(n > 0);
-  const std::string command = "CREP_TEST_FORCE_NO_GL=1 '" + std::string(exe) +
-                              "' --test-case='GlContext: OpenGL 4.5 core debug context*' 2>&1";
+  const std::string command = arguments.substr(0, arguments.find('|')) + " '" + std::string(exe) + "' " +
+                              arguments.substr(arguments.find('|') + 1) + " 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");
   REQUIRE(pipe != nullptr);
-  std::string output;
   char buffer[1024];
   std::size_t got;
   while ((got = std::fread(buffer, 1, sizeof buffer, pipe)) > 0)
     output.append(buffer, got);
   const int status = ::pclose(pipe);
-  CAPTURE(output);
   REQUIRE(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 77);
+  return WEXITSTATUS(status);
+}
+} // namespace
+
+TEST_CASE("GL tests are skipped, not failed, without OpenGL (CREP_TEST_FORCE_NO_GL)") {
+  // Runs the first test case in a child process, as ctest would on a machine without OpenGL. Needs
+  // no context itself.
+  std::string output;
+  const int code =
+      runSelf("CREP_TEST_FORCE_NO_GL=1|--test-case='GlContext: OpenGL 4.5 core debug context*'", output);
+  CAPTURE(output);
+  CHECK(code == 77);
   CHECK(contains(output, "skipped: CREP_TEST_FORCE_NO_GL"));
+}
+
+// Run only by the next test case, in a child process (skipped otherwise): a GL error that no test
+// asked for.
+TEST_CASE("GL fixture self-test: an unexpected GL error" * doctest::skip()) {
+  CREP_REQUIRE_GL();
+  glBindTexture(0x1234, 0);
+  glGetError();
+}
+
+TEST_CASE("The GL fixture turns an unexpected GL error into a test failure") {
+  std::string output;
+  const int code = runSelf("|--no-skip --test-case='GL fixture self-test: an unexpected GL error'", output);
+  CAPTURE(output);
+  if (code == 77) {
+    std::printf("skipped: %s\n", output.c_str());
+    std::exit(77);
+  }
+  CHECK(code == 1);
+  CHECK(contains(output, "GL error (KHR_debug id"));
+  CHECK(contains(output, "GL_INVALID_ENUM"));
+  CHECK(contains(output, "1 failed"));
 }

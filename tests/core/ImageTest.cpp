@@ -11,7 +11,8 @@ using crep::InvalidArgument;
 namespace {
 
 // Expects InvalidArgument whose parameter() is `parameter` and whose message names it and the value.
-void expectInvalid(int width, int height, int channels, const std::string& parameter, const std::string& value) {
+void expectInvalid(int width, int height, int channels, const std::string& parameter,
+                   const std::string& value) {
   CAPTURE(width);
   CAPTURE(height);
   CAPTURE(channels);
@@ -61,7 +62,8 @@ TEST_CASE("Image: limits are inclusive") {
   CHECK(wide.width() == Image::kMaxDimension);
   const Image tall(1, Image::kMaxDimension, 4);
   CHECK(tall.height() == Image::kMaxDimension);
-  for (int channels = 1; channels <= 4; ++channels) CHECK(Image(2, 3, channels).channels() == channels);
+  for (int channels = 1; channels <= 4; ++channels)
+    CHECK(Image(2, 3, channels).channels() == channels);
 }
 
 TEST_CASE("Image: sizes and fill value") {
@@ -73,25 +75,29 @@ TEST_CASE("Image: sizes and fill value") {
   CHECK(image.sampleCount() == 105);
   CHECK(image.byteSize() == 105 * sizeof(float));
   CHECK(image.data().size() == 105);
-  for (float v : image.data()) CHECK(v == 0.25f);
+  for (float v : image.data())
+    CHECK(v == 0.25f);
   CHECK(Image(2, 2, 1).data()[3] == 0.0f);
 }
 
-TEST_CASE("Image: interleaved layout, rows bottom to top: at(x, y, c) = data[(y * width + x) * channels + c]") {
+TEST_CASE(
+    "Image: interleaved layout, rows bottom to top: at(x, y, c) = data[(y * width + x) * channels + c]") {
   Image image(4, 3, 2);
   for (int y = 0; y < 3; ++y)
     for (int x = 0; x < 4; ++x)
-      for (int c = 0; c < 2; ++c) image.at(x, y, c) = static_cast<float>(100 * y + 10 * x + c);
+      for (int c = 0; c < 2; ++c)
+        image.at(x, y, c) = static_cast<float>(100 * y + 10 * x + c);
   const auto data = image.data();
   for (int y = 0; y < 3; ++y)
     for (int x = 0; x < 4; ++x)
       for (int c = 0; c < 2; ++c)
-        CHECK(data[static_cast<std::size_t>((y * 4 + x) * 2 + c)] == static_cast<float>(100 * y + 10 * x + c));
-  CHECK(data[0] == 0.0f);         // (0, 0) bottom-left, channel 0
-  CHECK(data[1] == 1.0f);         // (0, 0) channel 1
-  CHECK(data[2] == 10.0f);        // (1, 0)
-  CHECK(data[8] == 100.0f);       // (0, 1): second row from the bottom
-  CHECK(data.back() == 231.0f);   // (3, 2, 1): top-right, last channel
+        CHECK(data[static_cast<std::size_t>((y * 4 + x) * 2 + c)] ==
+              static_cast<float>(100 * y + 10 * x + c));
+  CHECK(data[0] == 0.0f);       // (0, 0) bottom-left, channel 0
+  CHECK(data[1] == 1.0f);       // (0, 0) channel 1
+  CHECK(data[2] == 10.0f);      // (1, 0)
+  CHECK(data[8] == 100.0f);     // (0, 1): second row from the bottom
+  CHECK(data.back() == 231.0f); // (3, 2, 1): top-right, last channel
   const Image& constImage = image;
   CHECK(constImage.at(3, 2, 1) == 231.0f);
   CHECK(constImage.at(2, 1) == 120.0f); // channel defaults to 0

@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
-#include <memory>
 #include <string_view>
 #include <utility>
 
@@ -21,7 +20,10 @@ constexpr std::uint32_t kDebugSourceShaderCompiler = 0x8248; // GL_DEBUG_SOURCE_
 std::atomic<int> gErrorCount{0};
 
 struct SharedState {
-  std::unique_ptr<GlContext> context;
+  // Never destroyed: destroying the last context terminates the EGL display, which unloads Mesa's
+  // driver, and LeakSanitizer then reports a one-time allocation of the driver (128 bytes from a
+  // pthread_once in an "<unknown module>") as leaked. Process exit reclaims everything anyway.
+  GlContext* context = nullptr;
   std::string unavailable;
   bool attempted = false;
 };
@@ -60,13 +62,13 @@ GlContext* sharedGlContext() {
         GlContextOptions options;
         options.debug = true;
         options.debugCallback = failOnGlError;
-        s.context = std::make_unique<GlContext>(options);
+        s.context = new GlContext(options);
       } catch (const GlUnavailable& e) {
         s.unavailable = e.what();
       }
     }
   }
-  return s.context.get();
+  return s.context;
 }
 
 std::string glUnavailableReason() {

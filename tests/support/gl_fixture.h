@@ -19,8 +19,8 @@
 
 namespace crep::test {
 
-/// The process-wide debug context, created on first use (current on the calling thread); nullptr when
-/// OpenGL is unavailable (see glUnavailableReason()).
+/// The process-wide debug context, created on first use (current on the calling thread) and never
+/// destroyed (see gl_fixture.cpp); nullptr when OpenGL is unavailable (see glUnavailableReason()).
 GlContext* sharedGlContext();
 /// Why sharedGlContext() returned nullptr (empty otherwise).
 std::string glUnavailableReason();

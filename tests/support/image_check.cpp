@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <random>
 #include <system_error>
@@ -26,39 +27,6 @@ std::string sanitize(const std::string& name) {
     if (!ok) c = '_';
   }
   return s;
-}
-
-// Writes what can be written; returns a description of the files (or of the failures).
-std::string writeArtifacts(const Image& actual, const Image& reference, const std::string& name,
-                           double maxAbsError) {
-  std::string report;
-  std::filesystem::path dir;
-  try {
-    dir = testOutputDir();
-  } catch (const std::exception& e) {
-    return std::string("(no artifacts: ") + e.what() + ")";
-  }
-  const std::string base = sanitize(name);
-  const auto attempt = [&](const std::string& file, auto&& write) {
-    const std::filesystem::path path = dir / file;
-    try {
-      write(path);
-      report += "\n  wrote " + path.string();
-    } catch (const std::exception& e) {
-      report += "\n  could not write " + path.string() + ": " + e.what();
-    }
-  };
-  if (!actual.empty())
-    attempt(base + ".actual.exr", [&](const auto& p) { writeExr(p, actual, ExrPixelType::Float); });
-  if (!reference.empty())
-    attempt(base + ".reference.exr", [&](const auto& p) { writeExr(p, reference, ExrPixelType::Float); });
-  if (!actual.empty() && actual.sameShape(reference)) {
-    const double amplification =
-        maxAbsError > 0.0 && std::isfinite(maxAbsError) ? std::clamp(1.0 / maxAbsError, 1e-6, 1e12) : 1.0;
-    attempt(base + ".diff.png", [&](const auto& p) { writePng(p, differenceImage(actual, reference, amplification)); });
-    report += " (difference amplified " + detail::formatValue(amplification) + "x)";
-  }
-  return report;
 }
 
 } // namespace
@@ -79,34 +47,69 @@ std::filesystem::path testOutputDir() {
   return dir;
 }
 
+std::vector<std::filesystem::path> writeFailureArtifacts(const Image& actual, const Image& reference,
+                                                         const std::string& name, double amplification) {
+  const std::filesystem::path dir = testOutputDir();
+  const std::string base = sanitize(name);
+  std::vector<std::filesystem::path> written;
+  if (!actual.empty()) {
+    written.push_back(dir / (base + ".actual.exr"));
+    writeExr(written.back(), actual, ExrPixelType::Float);
+  }
+  if (!reference.empty()) {
+    written.push_back(dir / (base + ".reference.exr"));
+    writeExr(written.back(), reference, ExrPixelType::Float);
+  }
+  if (!actual.empty() && actual.sameShape(reference)) {
+    written.push_back(dir / (base + ".diff.png"));
+    writePng(written.back(), differenceImage(actual, reference, amplification));
+  }
+  return written;
+}
+
+ImageCheckResult evaluateImage(const Image& actual, const Image& reference, const ImageTolerance& tolerance,
+                               const std::string& name) {
+  ImageCheckResult result;
+  std::string problem;
+  try {
+    result.metrics = compareImages(actual, reference, compareOptionsFor(tolerance));
+    std::string whyNot;
+    result.passed = withinTolerance(result.metrics, tolerance, &whyNot);
+    result.message = "image '" + name + "': " + describe(result.metrics);
+    if (result.passed) return result;
+    result.message += "; outside tolerance: " + whyNot;
+  } catch (const Error& e) {
+    result.message = "image '" + name + "' cannot be compared: " + e.what();
+  }
+  // Failed: leave the images for inspection.
+  const double maxAbs = result.metrics.maxAbsError;
+  const double amplification =
+      maxAbs > 0.0 && std::isfinite(maxAbs) ? std::clamp(1.0 / maxAbs, 1e-6, 1e12) : 1.0;
+  try {
+    result.artifacts = writeFailureArtifacts(actual, reference, name, amplification);
+    for (const auto& path : result.artifacts)
+      result.message += "\n  wrote " + path.string();
+    result.message +=
+        "\n  (difference amplified " + detail::formatValue(amplification) + "x, NaN/Inf magenta)";
+  } catch (const std::exception& e) {
+    result.message += std::string("\n  could not write the artifacts: ") + e.what();
+  }
+  return result;
+}
+
 bool checkImage(const Image& actual, const Image& reference, const ImageTolerance& tolerance,
                 const std::string& name) {
-  ImageMetrics metrics;
-  try {
-    metrics = compareImages(actual, reference, compareOptionsFor(tolerance));
-  } catch (const Error& e) {
-    const std::string artifacts = writeArtifacts(actual, reference, name, 0.0);
-    FAIL_CHECK("image '" << name << "' cannot be compared: " << e.what() << artifacts);
-    return false;
-  }
-  std::string whyNot;
-  const bool ok = withinTolerance(metrics, tolerance, &whyNot);
-  if (ok) {
-    CHECK_MESSAGE(ok, "image '" << name << "': " << describe(metrics));
-    return true;
-  }
-  const std::string artifacts = writeArtifacts(actual, reference, name, metrics.maxAbsError);
-  INFO("image '" << name << "': " << describe(metrics));
-  CHECK_MESSAGE(ok, "image '" << name << "' outside tolerance: " << whyNot << artifacts);
-  return false;
+  const ImageCheckResult result = evaluateImage(actual, reference, tolerance, name);
+  CHECK_MESSAGE(result.passed, result.message);
+  return result.passed;
 }
 
 TempDir::TempDir(const std::string& prefix) {
   static std::atomic<unsigned> counter{0};
   const std::filesystem::path root = std::filesystem::temp_directory_path();
   std::random_device device;
-  std::mt19937_64 random(device() ^ static_cast<std::uint64_t>(
-                                        std::chrono::steady_clock::now().time_since_epoch().count()));
+  std::mt19937_64 random(
+      device() ^ static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()));
   for (int attempt = 0; attempt < 100; ++attempt) {
     const std::filesystem::path candidate =
         root / (sanitize(prefix) + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" +

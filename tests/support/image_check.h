@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace crep::test {
 
@@ -15,13 +16,31 @@ namespace crep::test {
 /// Created if missing.
 std::filesystem::path testOutputDir();
 
-/// Compares `actual` against `reference` with compareOptionsFor(tolerance) and records a doctest
-/// CHECK with the metrics. On failure (including a size/channel mismatch) writes
+struct ImageCheckResult {
+  bool passed = false;
+  crep::ImageMetrics metrics;                   ///< valid when the images could be compared
+  std::string message;                          ///< one line: name, metrics, failed bounds, files
+  std::vector<std::filesystem::path> artifacts; ///< files written on failure
+};
+
+/// The work of checkImage without doctest: compares `actual` against `reference` with
+/// compareOptionsFor(tolerance); on failure (including a size/channel mismatch) writes
 /// <testOutputDir()>/<name>.actual.exr, <name>.reference.exr (float) and <name>.diff.png (difference
-/// normalised so that maxAbsError is white, NaN/Inf magenta) and names them in the failure message.
-/// `name` is sanitised to [A-Za-z0-9._-]. Returns whether the check passed.
-bool checkImage(const crep::Image& actual, const crep::Image& reference, const crep::ImageTolerance& tolerance,
-                const std::string& name);
+/// normalised so that maxAbsError is white, NaN/Inf magenta). `name` is sanitised to [A-Za-z0-9._-].
+ImageCheckResult evaluateImage(const crep::Image& actual, const crep::Image& reference,
+                               const crep::ImageTolerance& tolerance, const std::string& name);
+
+/// evaluateImage + a doctest CHECK carrying the message (metrics, failed bounds, artifact paths).
+/// Returns whether the check passed.
+bool checkImage(const crep::Image& actual, const crep::Image& reference,
+                const crep::ImageTolerance& tolerance, const std::string& name);
+
+/// What checkImage writes on failure: the files that exist afterwards (actual/reference EXR when
+/// non-empty, the difference PNG when both have the same shape), with `amplification` applied to the
+/// difference. Throws crep::Error if the output directory cannot be created or a file not written.
+std::vector<std::filesystem::path> writeFailureArtifacts(const crep::Image& actual,
+                                                         const crep::Image& reference,
+                                                         const std::string& name, double amplification);
 
 /// A fresh, uniquely named directory under the system temporary directory, removed with its
 /// content on destruction.

@@ -71,7 +71,7 @@ struct ExrChannelInfo {
   bool isUint = false; ///< UINT channel (pixelType is then meaningless)
 };
 struct ExrFileInfo {
-  int width = 0, height = 0;         ///< data window size
+  int width = 0, height = 0; ///< data window size
   int dataWindowMinX = 0, dataWindowMinY = 0;
   int partCount = 1;
   bool tiled = false;
@@ -90,13 +90,19 @@ void writeExrLayers(const std::filesystem::path& path, std::span<const ExrLayer>
 /// Reads one layer of a scanline or tiled (level 0 of mip/rip maps) part into a float image.
 /// The image is the data window (the display window is ignored); data window row maxY (the bottom
 /// row in EXR's y-down convention) becomes row 0.
+/// Before any pixel memory is allocated, the whole file structure is validated: header attribute
+/// sizes, every part's data window (<= kMaxDimension per side and kMaxPixels; the selected part also
+/// <= options.maxPixels), the offset tables, and the position and size of every chunk of every part
+/// (so truncated pixel data is always detected), and the image size must be plausible for the file
+/// size (at most 4096 bytes of float output per byte of file, plus 16 MiB; not applied to DWAA/DWAB,
+/// whose ratio on constant images is unbounded in practice).
 /// Throws IoError if the file is missing or unreadable; FormatError naming the file if it is not an
-/// EXR file, is corrupt or truncated (every chunk is checked), is deep, has no matching channels,
-/// or its data window exceeds kMaxDimension, kMaxPixels or options.maxPixels.
-/// InvalidArgument for options.maxPixels <= 0 or options.part < 0.
+/// EXR file, is corrupt or truncated, is deep, has no matching channels or subsampled ones, or is too
+/// large. InvalidArgument for options.maxPixels <= 0 or options.part < 0.
 Image readExr(const std::filesystem::path& path, const ExrReadOptions& options = {});
 
-/// Reads the header of part `part` only. Same errors as readExr (except pixel data problems).
+/// Describes part `part` from its header, after the same structural validation as readExr (a
+/// truncated file is rejected even though no pixel is decoded). Same exceptions as readExr.
 ExrFileInfo readExrInfo(const std::filesystem::path& path, int part = 0);
 
 } // namespace crep

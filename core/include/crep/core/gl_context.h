@@ -22,12 +22,16 @@ struct GlContextOptions {
   int minorVersion = 5;
   /// Debug context with synchronous KHR_debug output; messages go to `debugCallback`.
   bool debug = false;
-  /// Called for each debug message (debug contexts only). Default: GL errors are printed to stderr.
+  /// Called for each debug message (debug contexts only), synchronously inside the GL call that
+  /// caused it; must not throw (an exception is caught and reported on stderr). Default: GL errors
+  /// are printed to stderr.
   std::function<void(const GlDebugMessage&)> debugCallback;
 };
 
 /// Owns an EGL display connection and a surfaceless OpenGL context, current on the creating thread
-/// for its whole lifetime. Not copyable, not movable.
+/// for its whole lifetime. Not copyable, not movable. A GlContext created while another context is
+/// current makes that one current again when it is destroyed; the EGL display is terminated when
+/// the last GlContext of the process is destroyed.
 class GlContext {
 public:
   /// Throws GlUnavailable with a message naming the failing step (no EGL, no surfaceless platform,

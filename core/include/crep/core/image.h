@@ -23,7 +23,9 @@ public:
   int height() const noexcept { return height_; }
   int channels() const noexcept { return channels_; }
   bool empty() const noexcept { return data_.empty(); }
-  std::size_t pixelCount() const noexcept { return static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_); }
+  std::size_t pixelCount() const noexcept {
+    return static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  }
   /// Number of floats: pixelCount() * channels().
   std::size_t sampleCount() const noexcept { return data_.size(); }
   /// Size of the pixel data in bytes: sampleCount() * sizeof(float).

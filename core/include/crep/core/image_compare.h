@@ -66,7 +66,7 @@ struct ImageTolerance {
   double relativeRmse = std::numeric_limits<double>::infinity();
   double minPsnr = -std::numeric_limits<double>::infinity();
   double maxFractionOver = 1.0;
-  double overThreshold = 0.0; ///< threshold for maxFractionOver (use compareOptionsFor)
+  double overThreshold = 0.0;  ///< threshold for maxFractionOver (use compareOptionsFor)
   bool allowNonFinite = false; ///< otherwise any NaN/Inf in actual fails
 };
 
@@ -78,6 +78,7 @@ CompareOptions compareOptionsFor(const ImageTolerance& tolerance);
 /// compared. Otherwise false and, if whyNot is given, the failed bounds separated by "; ".
 /// Throws InvalidArgument ("ImageTolerance.overThreshold") when maxFractionOver < 1 but the metrics
 /// were computed with a different overThreshold.
-bool withinTolerance(const ImageMetrics& metrics, const ImageTolerance& tolerance, std::string* whyNot = nullptr);
+bool withinTolerance(const ImageMetrics& metrics, const ImageTolerance& tolerance,
+                     std::string* whyNot = nullptr);
 
 } // namespace crep

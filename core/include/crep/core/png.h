@@ -20,7 +20,7 @@
 namespace crep {
 
 struct ToneMap {
-  float exposure = 1.0f; ///< multiplies linear RGB before encoding; must be finite and >= 0
+  float exposure = 1.0f;  ///< multiplies linear RGB before encoding; must be finite and >= 0
   bool keepAlpha = false; ///< 4-channel images: write RGBA instead of RGB
 };
 

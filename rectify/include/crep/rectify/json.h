@@ -8,7 +8,7 @@
 namespace crep {
 
 /// One JSON object, exactly:
-///   {"status": "projective" | "fallback" | "empty", "reason": "<toString(FallbackReason)>",
+///   {"status": "projective" | "fallback" | "empty", "reason": "<reasonToken(reason)>",
 ///    "measure": <degrees>, "threshold": <degrees>,
 ///    "splits": [{"rectClipFromWorld": [16 numbers, column-major as in GLSL], "range": [begin, end]}, ...]}
 /// "splits" is empty unless projective ("empty" only for spot / point light faces). Numbers are printed

@@ -17,27 +17,38 @@
 // at L, (c - L) / |c - L|); axisX orthogonal to axisZ along the 2D bisectrix of the lit region's
 // vertices projected along axisZ as seen from c (Sec. 4.2); axisY = axisZ x axisX. A world point p has
 // frame coordinates X, Y, Z = dot(axis, p - c). The construction needs X > 0 on the whole region.
-//   row slope    y = Y / X                       (constant on a view ray and on an epipolar plane)
-//   depth slope  z = Z / X                       (constant on a view ray)
-//   axis coord   xh = 1 / eta, eta = 1 / X + rho * (z - depthSlopeMin), rho = 1 / |c - L| (0 for a
-//                directional light, so xh == X: world distance from the camera along axisX)
+//   row slope     y = Y / X                  (constant on a view ray and on an epipolar plane)
+//   depth slope   z = Z / X                  (constant on a view ray)
+//   column param  zeta = (1 + rho Z) / X     (rho = 1 / |c - L|, 0 for a directional light: zeta = 1/X;
+//                 for a point light 1 + rho Z = rho dot(axisZ, p - L), constant ratio on a light ray)
+//   axis coord    xh = 1 / (zeta - rho zmin) (= X, world distance along axisX, for a directional light;
+//                 splits are placed in xh; it is > 0 on the region)
 // Normalized map coordinates (all in [0, 1] on the region, bounds are tight):
 //   row   = (y - rowSlopeMin) / (rowSlopeMax - rowSlopeMin)
 //   depth = (z - depthSlopeMin) / (depthSlopeMax - depthSlopeMin)     (= the depth-buffer value)
-//   split k covers xh in [x_k, x_k+1]; splitColumn = (1/x_k - eta) / (1/x_k - 1/x_k+1)
-//   column = (k + splitColumn) / K  (one continuous, piecewise-projective column axis per row)
+//   split k covers zeta in [zetaEnd_k, zetaBegin_k]; splitColumn = (zetaBegin_k - zeta) / (zetaBegin_k -
+//   zetaEnd_k); column = (k + splitColumn) / K  (one continuous, piecewise-projective axis per row)
 // Why: on a view ray c + s w, y and z are constant (the camera is the centre of projection) and
-// eta = 1 / (s w_X) + const decreases with s, so columns run left to right. On a light ray X and Y are
-// constant (directional), or X, Y and Z + |c - L| all scale with the distance from L (point light), so
-// (column, row) is constant and the depth grows in the direction of travel: GL_LESS keeps the first
-// occluder. World distance along a view ray of slopes (y, z) at eta (closed form, Sec. 3.2 weights):
-//   s = sqrt(1 + y^2 + z^2) / (eta - rho * (z - depthSlopeMin)).
-// The split matrix: clip = (a_k X + b_k (1 + rho (Z - zmin X)), alpha Y + beta X, gamma Z + delta X, X),
-// i.e. Split::rectClipFromWorld = S_k * frameFromWorld (GL clip conventions, NDC in [-1, 1]^3).
-// A spot or point light is first taken into a perspective space centred at the light (where its rays
-// are parallel); we orient that transform from the light toward the camera rather than along the
-// spot's axis, because the spot's own projection sends the camera to infinity when the camera lies in
-// the spot's plane (columns then collapse). Distances stay world distances (formula above).
+// zeta = 1 / (s w_X) + rho z decreases with s, so columns run left to right. On a light ray X and Y
+// are constant (directional), or X, Y and 1 + rho Z all scale with the distance from L (point light),
+// so (column, row) is constant and the depth grows in the direction of travel: GL_LESS keeps the first
+// occluder. World distance along a view ray of slopes (y, z) at zeta (closed form, Sec. 3.2 weights):
+//   s = sqrt(1 + y^2 + z^2) / (zeta - rho z).
+// The split matrix: clip = (a_k X + b_k (1 + rho Z), alpha Y + beta X, gamma Z + delta X, X), i.e.
+// Split::rectClipFromWorld = S_k * frameFromWorld (GL clip conventions, NDC in [-1, 1]^3).
+// A spot or point light is taken into a perspective space centred at the light (where its rays are
+// parallel) before the directional construction; we orient that transform from the light toward the
+// camera rather than along the spot's axis, because the spot's own projection sends the camera to
+// infinity when the camera lies in the spot's plane (the columns then collapse onto the rows).
+// Distances stay world distances (formula above).
+//
+// Fallback decision (Rectification::measure, README "Fallback"): (1) the lit region's vertices,
+// seen from c and projected along axisZ, do not fit in an open half-plane (span >= 180 degrees): a view
+// ray through the region is a light ray (epipole on screen), impossible; (2) span >= maxSpanDegrees:
+// rows are uniform in tan(angle), too non-linear; (3) some view ray of the region is within
+// minEpipoleAngleDegrees of the light line through c (the paper's "distance of the epipole to the
+// screen border", as an angle): depth slopes and the row step ratios of Sec. 3.2 blow up as
+// 1 / sin(angle). A spot lit near its apex can trigger (3) without (2). All measures are continuous.
 //
 // ---------------------------------------------------------------------------------------------------
 // What the engine must set when rendering a split (also in rectify/README.md)
@@ -96,11 +107,16 @@ struct RectifyOptions {
   /// lambda in [0, 1] for SplitScheme::Blend: weight of the logarithmic positions.
   double blend = 0.5;
   SplitLayout layout = SplitLayout::Regions;
-  /// Fallback threshold on RectifyResult::measure, the angular span (degrees) of the lit region seen
-  /// from the camera and projected along the light, in (0, 180]. 180 = fall back only when a view ray
-  /// is parallel to the light. Default 150: rows are uniform in tan(angle), so slices near the edges
-  /// are 1/cos^2(span/2) = 14.9x denser in angle than in the middle at 150 degrees (README "Fallback").
+  /// Fallback threshold on the angular span (degrees) of the lit region seen from the camera and
+  /// projected along the light, in (0, 180]. 180 = no span criterion (only the impossible case).
+  /// Default 150: rows are uniform in tan(angle), so slices near the edges are 1 / cos^2(span / 2) =
+  /// 14.9x denser in angle than in the middle at 150 degrees (README "Fallback").
   double maxSpanDegrees = 150.0;
+  /// Fallback threshold on the angle (degrees, [0, 90)) between the region's view rays and the light
+  /// line through the camera. 0 = no such criterion. Default 5: the slowest ray of a row then has a
+  /// world step per texel at most 1 / sin(5 deg) = 11.5x that of the fastest (Sec. 3.2); it costs 1.3%
+  /// of random light directions for a 60 degree camera (README "Fallback").
+  double minEpipoleAngleDegrees = 5.0;
   /// Reference ray used by Rectification::referenceDistance() and rowReference().
   ReferenceRay referenceRay = ReferenceRay::Bisectrix;
 
@@ -116,14 +132,16 @@ enum class RectifyStatus {
 enum class FallbackReason {
   None,                   ///< projective
   ViewRayParallelToLight, ///< a view ray through the region is a light ray (epipole on screen): impossible
-  NonLinearity,           ///< span >= threshold: possible but too non-linear (rows, columns, step ratios)
+  NonLinearity,           ///< span >= maxSpanDegrees: possible but the rows are too non-linear
+  EpipoleTooClose,        ///< a view ray of the region is within minEpipoleAngleDegrees of the light line
   EmptyRegion,            ///< status Empty
 };
 
-/// Stable token for logs and JSON: "none", "view-ray-parallel-to-light", "non-linearity", "empty-region".
-const char* toString(FallbackReason reason);
+/// Stable token for logs and JSON: "none", "view-ray-parallel-to-light", "non-linearity",
+/// "epipole-too-close", "empty-region".
+const char* reasonToken(FallbackReason reason);
 /// "projective", "fallback", "empty".
-const char* toString(RectifyStatus status);
+const char* statusToken(RectifyStatus status);
 
 /// The rectified light view and the bounds of the lit region in it (see the math at the top).
 struct RectifiedFrame {
@@ -132,6 +150,7 @@ struct RectifiedFrame {
   glm::dvec3 axisY{0, 1, 0};          ///< axisZ x axisX
   glm::dvec3 axisZ{0, 0, 1};          ///< direction light travels at the camera
   double inverseLightDistance = 0.0;  ///< rho = 1 / |camera - light|, 0 for a directional light
+  glm::dvec3 lightPosition{0.0};      ///< L (spot / point light only) = origin - axisZ / rho
   double rowSlopeMin = 0.0, rowSlopeMax = 0.0;     ///< bounds of y = Y / X
   double depthSlopeMin = 0.0, depthSlopeMax = 0.0; ///< bounds of z = Z / X
   double axisMin = 0.0, axisMax = 0.0;             ///< bounds of xh (world units along axisX if directional)
@@ -146,6 +165,7 @@ struct Split {
   /// the camera), NDC y = row, NDC z = depth. Column-major (glm), ready for glUniformMatrix4fv.
   glm::dmat4 rectClipFromWorld{1.0};
   double rangeBegin = 0.0, rangeEnd = 0.0; ///< [x_k, x_k+1] along the projection axis (xh)
+  double zetaBegin = 0.0, zetaEnd = 0.0;   ///< column parameter zeta at its left (near) and right edge
   int layer = 0;                           ///< texture layer (SplitLayout::Layers), else 0
   double columnBegin = 0.0, columnEnd = 1.0; ///< normalized horizontal region of the map it renders into
 };
@@ -195,13 +215,16 @@ struct Rectification {
   RectifyStatus status = RectifyStatus::Fallback;
   FallbackReason reason = FallbackReason::None;
   std::string message; ///< human-readable explanation with the numbers, for logs
-  /// The decision measure: angular span (degrees, [0, 180]) of the lit region's vertices seen from the
-  /// camera, projected along the light (the angle between the two extreme projected directions). 180
-  /// when they do not fit in an open half-plane, i.e. some view ray through the region is a light ray.
+  /// The measure that decided, and its threshold (degrees): epipoleAngle and minEpipoleAngleDegrees for
+  /// reason EpipoleTooClose, else span and maxSpanDegrees.
   double measure = 0.0;
-  double threshold = 0.0; ///< RectifyOptions::maxSpanDegrees
-  /// Diagnostic: angle (degrees, [0, 90]) between the light's axis line through the camera (both
-  /// directions) and the camera's view frustum; 0 when the epipole or anti-epipole is on screen.
+  double threshold = 0.0;
+  /// Angular span (degrees, [0, 180]) of the lit region's vertices seen from the camera and projected
+  /// along the light: the angle between the two extreme projected directions. 180 when they do not fit
+  /// in an open half-plane, i.e. some view ray through the region is a light ray.
+  double span = 0.0;
+  /// Smallest angle (degrees, [0, 90]) between a view ray of the region and the light line through the
+  /// camera (either direction); 0 when the epipole or anti-epipole lies in the region's view.
   double epipoleAngle = 0.0;
 
   RectifiedFrame frame;      ///< valid when Projective
@@ -259,8 +282,9 @@ Rectification rectify(const Camera& camera, const SpotLight& light, const Rectif
 /// An omnidirectional point light as six spot faces (Sec. 3.2 "Local Lights"), in GL cube-map face
 /// order +X, -X, +Y, -Y, +Z, -Z: face i covers the directions within 45 degrees (per axis) of its axis,
 /// from `nearPlane` to `range` along that axis (nearPlane <= 0 means range * 1e-3). Faces that miss the
-/// camera frustum are Empty; the face whose region contains the camera-light line falls back, the
-/// others usually stay projective, even with the light on screen. Add the faces' contributions.
+/// camera frustum are Empty; a face whose region contains the camera-light line falls back, and with
+/// the light on screen (or within minEpipoleAngleDegrees of it) every face lit next to the light
+/// falls back too (EpipoleTooClose). Add the faces' contributions.
 std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::dvec3& position, double range,
                                                const RectifyOptions& options = {}, double nearPlane = -1.0);
 
