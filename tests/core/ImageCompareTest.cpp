@@ -228,7 +228,7 @@ TEST_CASE("compareImages: NaN and Inf are counted, excluded from the sums, and f
   CHECK(contains(why, "no finite samples"));
 }
 
-TEST_CASE("withinTolerance: a single changed channel of a single pixel fails; tolerated noise passes") {
+TEST_CASE("withinTolerance: a single changed channel of a single pixel fails, tolerated noise passes") {
   const Image reference = randomImage(37, 23, 3, 42);
   ImageTolerance tolerance;
   tolerance.maxAbsError = 2e-3;

@@ -119,7 +119,7 @@ TEST_CASE("PNG: the two sRGB segments meet at 0.0031308 and the inverse round-tr
   }
 }
 
-TEST_CASE("PNG: signature, IHDR size and colour type; content and orientation decode correctly") {
+TEST_CASE("PNG: signature, IHDR size and colour type, content and orientation decode correctly") {
   crep::test::TempDir dir;
   const int w = 37, h = 23;
   Image image(w, h, 3);
@@ -152,7 +152,7 @@ TEST_CASE("PNG: signature, IHDR size and colour type; content and orientation de
   CHECK(d.at(1, 1, 0) == 0);
 }
 
-TEST_CASE("PNG: exposure multiplies before encoding; NaN/Inf become 0") {
+TEST_CASE("PNG: exposure multiplies before encoding, NaN and Inf become 0") {
   crep::test::TempDir dir;
   Image image(4, 1, 3, 0.25f);
   image.at(1, 0, 0) = kNan;

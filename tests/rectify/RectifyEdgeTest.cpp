@@ -35,7 +35,7 @@ void checkDirectional(const Camera& cam, const Rectification& r, const glm::dvec
     checkProjective(
         r, cam, rng, [&](const glm::dvec3& p, double t) { return p + t * glm::length(p - c) * l; },
         [](const glm::dvec3&) { return true; }, w);
-  report("edge case", w, 0.0);
+  report("edge case", w, 0.0, false);
 }
 
 /// A direction rotated by `angle` away from `dir` in the plane of dir and `away`.
@@ -287,7 +287,7 @@ TEST_CASE("rectify: layouts, viewports and light rays") {
     CHECK(regions.splits[static_cast<std::size_t>(k)].rectClipFromWorld ==
           layers.splits[static_cast<std::size_t>(k)].rectClipFromWorld);
   }
-  CHECK_THROWS_AS(regions.splitViewport(0, 1000, 512), InvalidArgument); // not a multiple of K
+  CHECK_THROWS_AS(regions.splitViewport(0, 1001, 512), InvalidArgument); // not a multiple of K
   CHECK_THROWS_AS(regions.splitViewport(4, 1024, 512), InvalidArgument);
   CHECK_THROWS_AS(regions.splitViewport(0, 1024, 0), InvalidArgument);
   // Light rays of map positions: every point maps back to the same (column, row).

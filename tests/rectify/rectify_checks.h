@@ -184,8 +184,13 @@ inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19
   }
 }
 
-inline void report(const char* name, const Worst& w, double seconds) {
-  MESSAGE(std::string(name) << ": " << w.projective << " projective, " << w.fallback << " fallback, " << w.empty
+/// Asserts the worst deviations. `tol` is 1e-9 (issue 3) for configurations that pass the default
+/// thresholds; near the degenerate cone the rounding of the input points themselves is amplified by the
+/// conditioning (1 / cos(span / 2) up to 1146 at 179.9 degrees, 1 / sin(epipole angle)), and the sweeps
+/// that go there state 1e-8.
+inline void report(const char* name, const Worst& w, double seconds, bool verbose = true, double tol = 1e-9) {
+  if (verbose)
+    MESSAGE(std::string(name) << ": " << w.projective << " projective, " << w.fallback << " fallback, " << w.empty
                << " empty; " << w.points << " region points; worst: view row/depth " << w.viewRowDepth
                << ", light column/row " << w.lightColumnRow << ", helper vs matrix " << w.helperVsMatrix
                << ", outside cube " << w.outsideCube << ", tightness " << w.tightness << ", gap " << w.gap
@@ -193,12 +198,12 @@ inline void report(const char* name, const Worst& w, double seconds) {
   CHECK(w.nonFinite == 0);
   CHECK(w.notOneSplit == 0);
   CHECK(w.leftToRight == 0);
-  CHECK(w.viewRowDepth < 1e-9);
-  CHECK(w.lightColumnRow < 1e-9);
-  CHECK(w.helperVsMatrix < 1e-9);
-  CHECK(w.outsideCube < 1e-9);
-  CHECK(w.tightness < 1e-9);
-  CHECK(w.gap < 1e-9);
+  CHECK(w.viewRowDepth < tol);
+  CHECK(w.lightColumnRow < tol);
+  CHECK(w.helperVsMatrix < tol);
+  CHECK(w.outsideCube < tol);
+  CHECK(w.tightness < tol);
+  CHECK(w.gap < tol);
   CHECK(w.roundTrip < 1e-12);
   CHECK(w.distance < 1e-12);
 }
