@@ -13,7 +13,8 @@ namespace crep {
 namespace {
 
 std::string vecString(const glm::dvec3& v) {
-  return "(" + detail::formatValue(v.x) + ", " + detail::formatValue(v.y) + ", " + detail::formatValue(v.z) + ")";
+  return "(" + detail::formatValue(v.x) + ", " + detail::formatValue(v.y) + ", " + detail::formatValue(v.z) +
+         ")";
 }
 
 void requireProjective(const Rectification& r) {
@@ -44,7 +45,9 @@ double zetaOfColumn(const Rectification& r, double column) {
 }
 
 /// 1 / X of the point with column parameter zeta on the view ray of depth slope z (> 0 if it exists).
-double inverseX(const RectifiedFrame& f, double zeta, double z) { return zeta - f.inverseLightDistance * z; }
+double inverseX(const RectifiedFrame& f, double zeta, double z) {
+  return zeta - f.inverseLightDistance * z;
+}
 
 } // namespace
 
@@ -66,7 +69,8 @@ RectPoint Rectification::toRectified(const glm::dvec3& world) const {
   // Split k covers zeta in [zetaEnd, zetaBegin]; on a shared boundary take the lower split.
   const int K = splitCount();
   int k = 0;
-  while (k < K - 1 && zeta < splits[static_cast<std::size_t>(k)].zetaEnd) ++k;
+  while (k < K - 1 && zeta < splits[static_cast<std::size_t>(k)].zetaEnd)
+    ++k;
   const Split& s = splits[static_cast<std::size_t>(k)];
   p.split = k;
   p.splitColumn = (s.zetaBegin - zeta) / (s.zetaBegin - s.zetaEnd);
@@ -124,7 +128,9 @@ double Rectification::rayDistance(double row, double depth, double column) const
   return std::sqrt(1.0 + y * y + z * z) / den;
 }
 
-RowReference Rectification::rowReference(double row) const { return rowReference(row, referenceRay); }
+RowReference Rectification::rowReference(double row) const {
+  return rowReference(row, referenceRay);
+}
 
 RowReference Rectification::rowReference(double row, ReferenceRay choice) const {
   requireProjective(*this);
@@ -219,7 +225,8 @@ SplitViewport Rectification::splitViewport(int split, int width, int height) con
   if (split < 0 || split >= K)
     throw InvalidArgument("Rectification.splitViewport.split", detail::formatValue(split),
                           "must be in [0, " + std::to_string(K) + ")");
-  if (width <= 0) throw InvalidArgument("Rectification.splitViewport.width", detail::formatValue(width), "must be > 0");
+  if (width <= 0)
+    throw InvalidArgument("Rectification.splitViewport.width", detail::formatValue(width), "must be > 0");
   if (height <= 0)
     throw InvalidArgument("Rectification.splitViewport.height", detail::formatValue(height), "must be > 0");
   if (layout == SplitLayout::Layers) return {split, 0, 0, width, height};

@@ -20,20 +20,28 @@ using rectify_detail::Pyramid;
 
 const char* reasonToken(FallbackReason reason) {
   switch (reason) {
-  case FallbackReason::None: return "none";
-  case FallbackReason::ViewRayParallelToLight: return "view-ray-parallel-to-light";
-  case FallbackReason::NonLinearity: return "non-linearity";
-  case FallbackReason::EpipoleTooClose: return "epipole-too-close";
-  case FallbackReason::EmptyRegion: return "empty-region";
+  case FallbackReason::None:
+    return "none";
+  case FallbackReason::ViewRayParallelToLight:
+    return "view-ray-parallel-to-light";
+  case FallbackReason::NonLinearity:
+    return "non-linearity";
+  case FallbackReason::EpipoleTooClose:
+    return "epipole-too-close";
+  case FallbackReason::EmptyRegion:
+    return "empty-region";
   }
   return "unknown";
 }
 
 const char* statusToken(RectifyStatus status) {
   switch (status) {
-  case RectifyStatus::Projective: return "projective";
-  case RectifyStatus::Fallback: return "fallback";
-  case RectifyStatus::Empty: return "empty";
+  case RectifyStatus::Projective:
+    return "projective";
+  case RectifyStatus::Fallback:
+    return "fallback";
+  case RectifyStatus::Empty:
+    return "empty";
   }
   return "unknown";
 }
@@ -63,19 +71,22 @@ void validate(const RectifyOptions& o) {
   switch (o.scheme) {
   case SplitScheme::Uniform:
   case SplitScheme::Logarithmic:
-  case SplitScheme::Blend: break;
+  case SplitScheme::Blend:
+    break;
   default:
     throw InvalidArgument("RectifyOptions.scheme", detail::formatValue(static_cast<int>(o.scheme)),
                           "must be Uniform, Logarithmic or Blend");
   }
-  if (!std::isfinite(o.minEpipoleAngleDegrees) || o.minEpipoleAngleDegrees < 0.0 || o.minEpipoleAngleDegrees >= 90.0)
-    throw InvalidArgument("RectifyOptions.minEpipoleAngleDegrees", detail::formatValue(o.minEpipoleAngleDegrees),
-                          "degrees, must be in [0, 90)");
+  if (!std::isfinite(o.minEpipoleAngleDegrees) || o.minEpipoleAngleDegrees < 0.0 ||
+      o.minEpipoleAngleDegrees >= 90.0)
+    throw InvalidArgument("RectifyOptions.minEpipoleAngleDegrees",
+                          detail::formatValue(o.minEpipoleAngleDegrees), "degrees, must be in [0, 90)");
   if (o.layout != SplitLayout::Regions && o.layout != SplitLayout::Layers)
     throw InvalidArgument("RectifyOptions.layout", detail::formatValue(static_cast<int>(o.layout)),
                           "must be Regions or Layers");
   if (o.referenceRay != ReferenceRay::Bisectrix && o.referenceRay != ReferenceRay::Optimal)
-    throw InvalidArgument("RectifyOptions.referenceRay", detail::formatValue(static_cast<int>(o.referenceRay)),
+    throw InvalidArgument("RectifyOptions.referenceRay",
+                          detail::formatValue(static_cast<int>(o.referenceRay)),
                           "must be Bisectrix or Optimal");
 }
 
@@ -91,11 +102,14 @@ std::vector<double> splitPositions(double xmin, double xmax, int splits, SplitSc
   validate(o);
   // x_j = xmin (1 + g_j) with relative offsets g_j, exact at both ends.
   const double q = (xmax - xmin) / xmin, logRatio = std::log1p(q);
-  const double lambda = scheme == SplitScheme::Uniform ? 0.0 : scheme == SplitScheme::Logarithmic ? 1.0 : blend;
+  const double lambda = scheme == SplitScheme::Uniform       ? 0.0
+                        : scheme == SplitScheme::Logarithmic ? 1.0
+                                                             : blend;
   std::vector<double> x(static_cast<std::size_t>(splits) + 1);
   for (int j = 1; j < splits; ++j) {
     const double t = static_cast<double>(j) / splits;
-    x[static_cast<std::size_t>(j)] = xmin * (1.0 + lambda * std::expm1(logRatio * t) + (1.0 - lambda) * q * t);
+    x[static_cast<std::size_t>(j)] =
+        xmin * (1.0 + lambda * std::expm1(logRatio * t) + (1.0 - lambda) * q * t);
   }
   x.front() = xmin;
   x.back() = xmax;
@@ -115,7 +129,8 @@ Pyramid cameraPyramid(const Camera& camera) {
   const glm::dvec3 r = camera.right(), u = camera.up();
   // Same corner order as Camera::frustumCorners: (-x,-y), (+x,-y), (+x,+y), (-x,+y).
   const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
-  for (unsigned i = 0; i < 4; ++i) p.edges[i] = p.axis + sx[i] * tx * r + sy[i] * ty * u;
+  for (unsigned i = 0; i < 4; ++i)
+    p.edges[i] = p.axis + sx[i] * tx * r + sy[i] * ty * u;
   p.near = camera.near();
   p.far = camera.far();
   return p;
@@ -127,7 +142,8 @@ Pyramid lightPyramid(const glm::dvec3& apex, const glm::dvec3& axis, const glm::
   p.apex = apex;
   p.axis = axis;
   const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
-  for (unsigned i = 0; i < 4; ++i) p.edges[i] = axis + sx[i] * tanHalf * right + sy[i] * tanHalf * up;
+  for (unsigned i = 0; i < 4; ++i)
+    p.edges[i] = axis + sx[i] * tanHalf * right + sy[i] * tanHalf * up;
   p.near = near;
   p.far = far;
   return p;
@@ -251,10 +267,11 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
     r.epipoleAngle = 0.0;
     r.status = RectifyStatus::Fallback;
     r.reason = FallbackReason::ViewRayParallelToLight;
-    r.message = pointLike ? "a view ray through the lit region passes through the light (the camera-light line "
-                            "crosses it): projective rectification impossible"
-                          : "a view ray is parallel to the light direction (epipole on screen): projective "
-                            "rectification impossible";
+    r.message = pointLike
+                    ? "a view ray through the lit region passes through the light (the camera-light line "
+                      "crosses it): projective rectification impossible"
+                    : "a view ray is parallel to the light direction (epipole on screen): projective "
+                      "rectification impossible";
     return r;
   }
   r.span = span * kDeg;
@@ -337,7 +354,8 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
   const int K = options.splits;
   const std::vector<double> frac = splitFractions(zetaMax, zetaMin, offset, options);
   std::vector<double> zeta(frac.size());
-  for (std::size_t j = 0; j < frac.size(); ++j) zeta[j] = zetaMax - frac[j] * (zetaMax - zetaMin);
+  for (std::size_t j = 0; j < frac.size(); ++j)
+    zeta[j] = zetaMax - frac[j] * (zetaMax - zetaMin);
   zeta.front() = zetaMax;
   zeta.back() = zetaMin;
   const glm::dmat4 frameFromWorld = f.frameFromWorld();
@@ -428,8 +446,8 @@ std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(position[i]))
       throw InvalidArgument("PointLight.position",
-                            "(" + detail::formatValue(position.x) + ", " + detail::formatValue(position.y) + ", " +
-                                detail::formatValue(position.z) + ")",
+                            "(" + detail::formatValue(position.x) + ", " + detail::formatValue(position.y) +
+                                ", " + detail::formatValue(position.z) + ")",
                             "components must be finite");
   requirePositive("PointLight.range", range);
   const double near = nearPlane <= 0.0 ? range * 1e-3 : nearPlane;

@@ -8,9 +8,12 @@ namespace crep::rectify_detail {
 
 const std::array<std::array<int, 4>, 6>& Pyramid::faces() {
   static const std::array<std::array<int, 4>, 6> f{{
-      {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}, // sides, same order as the side planes
-      {0, 1, 2, 3},                                           // near
-      {4, 5, 6, 7},                                           // far
+      {0, 1, 5, 4},
+      {1, 2, 6, 5},
+      {2, 3, 7, 6},
+      {3, 0, 4, 7}, // sides, same order as the side planes
+      {0, 1, 2, 3}, // near
+      {4, 5, 6, 7}, // far
   }};
   return f;
 }
@@ -26,13 +29,6 @@ std::array<glm::dvec3, 4> Pyramid::sideNormals() const {
   return n;
 }
 
-double Pyramid::planeDistance(int plane, const glm::dvec3& p) const {
-  const glm::dvec3 d = p - apex;
-  if (plane < 4) return glm::dot(sideNormals()[static_cast<unsigned>(plane)], d);
-  const double t = glm::dot(axis, d);
-  return plane == 4 ? t - near : far - t;
-}
-
 namespace {
 
 using Polygon = std::vector<glm::dvec3>;
@@ -44,7 +40,8 @@ Polygon clip(const Polygon& poly, Dist dist) {
   const std::size_t n = poly.size();
   if (n == 0) return out;
   std::vector<double> d(n);
-  for (std::size_t i = 0; i < n; ++i) d[i] = dist(poly[i]);
+  for (std::size_t i = 0; i < n; ++i)
+    d[i] = dist(poly[i]);
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = (i + 1) % n;
     const bool inI = d[i] >= 0.0, inJ = d[j] >= 0.0;
@@ -58,7 +55,7 @@ Polygon clip(const Polygon& poly, Dist dist) {
   return out;
 }
 
-/// Distances to the planes of p computed with precomputed normals (hot loop).
+/// Signed distances (>= 0 inside) to the 6 bounding planes of a pyramid: 0..3 sides, 4 near, 5 far.
 struct PlaneSet {
   std::array<glm::dvec3, 4> normals;
   const Pyramid* pyramid;
@@ -74,7 +71,8 @@ void clipFacesInto(const Pyramid& a, const Pyramid& b, std::vector<glm::dvec3>& 
   const PlaneSet planes{b.sideNormals(), &b};
   for (const auto& face : Pyramid::faces()) {
     Polygon poly;
-    for (int idx : face) poly.push_back(a.corner(idx));
+    for (int idx : face)
+      poly.push_back(a.corner(idx));
     for (int plane = 0; plane < 6 && !poly.empty(); ++plane)
       poly = clip(poly, [&](const glm::dvec3& p) { return planes(plane, p); });
     out.insert(out.end(), poly.begin(), poly.end());
@@ -91,9 +89,8 @@ std::vector<glm::dvec3> intersectionVertices(const Pyramid& a, const Pyramid& b)
 }
 
 std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts) {
-  std::sort(pts.begin(), pts.end(), [](const glm::dvec2& p, const glm::dvec2& q) {
-    return p.x < q.x || (p.x == q.x && p.y < q.y);
-  });
+  std::sort(pts.begin(), pts.end(),
+            [](const glm::dvec2& p, const glm::dvec2& q) { return p.x < q.x || (p.x == q.x && p.y < q.y); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   if (pts.size() < 3) return pts;
   const auto cross = [](const glm::dvec2& o, const glm::dvec2& p, const glm::dvec2& q) {
@@ -102,11 +99,13 @@ std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts) {
   std::vector<glm::dvec2> hull(2 * pts.size());
   std::size_t k = 0;
   for (const auto& p : pts) {
-    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0.0) --k;
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p) <= 0.0)
+      --k;
     hull[k++] = p;
   }
   for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {
-    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0.0) --k;
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0.0)
+      --k;
     hull[k++] = pts[i];
   }
   hull.resize(k - 1);

@@ -19,11 +19,9 @@ struct Pyramid {
   double near = 0.0, far = 0.0;
 
   glm::dvec3 corner(int i) const { return apex + (i < 4 ? near : far) * edges[static_cast<unsigned>(i % 4)]; }
-  /// Signed Euclidean distance of p to bounding plane `plane` (0..3 sides, 4 near, 5 far), >= 0 inside.
-  double planeDistance(int plane, const glm::dvec3& p) const;
-  /// The 6 faces as quads of corner indices.
+  /// The 6 faces as quads of corner indices (sides 0..3, near, far).
   static const std::array<std::array<int, 4>, 6>& faces();
-
+  /// Unit normals of the 4 side planes (through the apex), pointing inside.
   std::array<glm::dvec3, 4> sideNormals() const;
 };
 

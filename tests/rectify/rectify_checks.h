@@ -16,17 +16,17 @@ namespace crep::test {
 
 /// Worst deviations over a sweep (checked once at the end so the sweep stays fast).
 struct Worst {
-  double viewRowDepth = 0;    ///< row / depth spread along one view ray (normalized units)
-  double lightColumnRow = 0;  ///< column / row spread along one light ray
-  double helperVsMatrix = 0;  ///< toRectified vs the split matrix
-  double outsideCube = 0;     ///< how far a region point lands outside the unit cube of its split
-  double tightness = 0;       ///< distance of the extreme region vertices from the cube faces
-  double gap = 0;             ///< mismatch at shared split boundaries
-  double roundTrip = 0;       ///< |toWorld(toRectified(p)) - p| / |p - camera| / column conditioning
-  double distance = 0;        ///< rayDistance vs |p - camera|, relative, / column conditioning
-  int notOneSplit = 0;        ///< region points in no split, or in two that do not share a boundary
-  int nonFinite = 0;          ///< NaN / Inf anywhere
-  int leftToRight = 0;        ///< view rays whose column does not increase with distance
+  double viewRowDepth = 0;   ///< row / depth spread along one view ray (normalized units)
+  double lightColumnRow = 0; ///< column / row spread along one light ray
+  double helperVsMatrix = 0; ///< toRectified vs the split matrix
+  double outsideCube = 0;    ///< how far a region point lands outside the unit cube of its split
+  double tightness = 0;      ///< distance of the extreme region vertices from the cube faces
+  double gap = 0;            ///< mismatch at shared split boundaries
+  double roundTrip = 0;      ///< |toWorld(toRectified(p)) - p| / |p - camera| / column conditioning
+  double distance = 0;       ///< rayDistance vs |p - camera|, relative, / column conditioning
+  int notOneSplit = 0;       ///< region points in no split, or in two that do not share a boundary
+  int nonFinite = 0;         ///< NaN / Inf anywhere
+  int leftToRight = 0;       ///< view rays whose column does not increase with distance
   int projective = 0, fallback = 0, empty = 0;
   int points = 0;
 
@@ -44,7 +44,9 @@ inline bool finite(const glm::dmat4& m) {
       if (!std::isfinite(m[c][r])) return false;
   return true;
 }
-inline bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+inline bool finite(const glm::dvec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 /// Normalized (splitColumn, row, depth) of p under split k's matrix.
 inline glm::dvec3 viaMatrix(const Rectification& r, int k, const glm::dvec3& p) {
@@ -69,20 +71,23 @@ inline glm::dvec3 regionPoint(const Rectification& r, std::mt19937_64& rng) {
 /// point of p's light ray at parameter t (t = 0: p itself); `inRegion` is an independent test of
 /// region membership used for rejection-sampled frustum points.
 inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19937_64& rng,
-                     const std::function<glm::dvec3(const glm::dvec3&, double)>& lightPoint,
-                     const std::function<bool(const glm::dvec3&)>& inRegion, Worst& w) {
+                            const std::function<glm::dvec3(const glm::dvec3&, double)>& lightPoint,
+                            const std::function<bool(const glm::dvec3&)>& inRegion, Worst& w) {
   const glm::dvec3 c = cam.position();
   const int K = r.splitCount();
   bool ok = K >= 1 && finite(r.frame.axisX) && finite(r.frame.axisY) && finite(r.frame.axisZ) &&
-            std::isfinite(r.frame.rowSlopeMin + r.frame.rowSlopeMax + r.frame.depthSlopeMin + r.frame.depthSlopeMax +
-                          r.frame.axisMin + r.frame.axisMax);
-  for (const auto& s : r.splits) ok = ok && finite(s.rectClipFromWorld) && std::isfinite(s.rangeBegin + s.rangeEnd);
+            std::isfinite(r.frame.rowSlopeMin + r.frame.rowSlopeMax + r.frame.depthSlopeMin +
+                          r.frame.depthSlopeMax + r.frame.axisMin + r.frame.axisMax);
+  for (const auto& s : r.splits)
+    ok = ok && finite(s.rectClipFromWorld) && std::isfinite(s.rangeBegin + s.rangeEnd);
   if (!ok) ++w.nonFinite;
 
   // No gaps: ranges are contiguous and cover [axisMin, axisMax]; the matrices agree on the boundary.
-  if (!(r.splits.front().rangeBegin == r.frame.axisMin && r.splits.back().rangeEnd == r.frame.axisMax)) w.gap = 1;
+  if (!(r.splits.front().rangeBegin == r.frame.axisMin && r.splits.back().rangeEnd == r.frame.axisMax))
+    w.gap = 1;
   for (int k = 0; k + 1 < K; ++k) {
-    if (!(r.splits[static_cast<std::size_t>(k)].rangeEnd == r.splits[static_cast<std::size_t>(k) + 1].rangeBegin) ||
+    if (!(r.splits[static_cast<std::size_t>(k)].rangeEnd ==
+          r.splits[static_cast<std::size_t>(k) + 1].rangeBegin) ||
         !(r.splits[static_cast<std::size_t>(k)].rangeEnd > r.splits[static_cast<std::size_t>(k)].rangeBegin))
       w.gap = 1;
     const double row = uniform(rng, 0, 1), depth = uniform(rng, 0, 1);
@@ -94,7 +99,8 @@ inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19
       continue; // spot light: that (column, depth) pair lies beyond the view ray's horizon
     }
     const glm::dvec3 lo = viaMatrix(r, k, p), hi = viaMatrix(r, k + 1, p);
-    w.note(w.gap, std::max({std::abs(lo.x - 1.0), std::abs(hi.x), std::abs(lo.y - hi.y), std::abs(lo.z - hi.z)}));
+    w.note(w.gap,
+           std::max({std::abs(lo.x - 1.0), std::abs(hi.x), std::abs(lo.y - hi.y), std::abs(lo.z - hi.z)}));
   }
 
   // Tight bounds: some region vertex touches each face of the map.
@@ -108,9 +114,8 @@ inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19
     colLo = std::min(colLo, q.column);
     colHi = std::max(colHi, q.column);
   }
-  w.note(w.tightness,
-         std::max({std::abs(rowLo), std::abs(rowHi - 1), std::abs(depLo), std::abs(depHi - 1), std::abs(colLo),
-                   std::abs(colHi - 1)}));
+  w.note(w.tightness, std::max({std::abs(rowLo), std::abs(rowHi - 1), std::abs(depLo), std::abs(depHi - 1),
+                                std::abs(colLo), std::abs(colHi - 1)}));
 
   const auto checkPoint = [&](const glm::dvec3& p) {
     ++w.points;
@@ -149,12 +154,14 @@ inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19
 
   // Region points: vertices, random convex combinations, rejection-sampled frustum points.
   std::vector<glm::dvec3> pts(r.regionVertices.begin(), r.regionVertices.end());
-  for (int i = 0; i < 24; ++i) pts.push_back(regionPoint(r, rng));
+  for (int i = 0; i < 24; ++i)
+    pts.push_back(regionPoint(r, rng));
   for (int i = 0, found = 0; i < 64 && found < 8; ++i) {
     const double t = logUniform(rng, cam.near(), cam.far());
-    const glm::dvec3 p = c + t * (cam.forward() + uniform(rng, -1, 1) * std::tan(0.5 * cam.fovY()) * cam.aspect() *
-                                                       cam.right() +
-                                  uniform(rng, -1, 1) * std::tan(0.5 * cam.fovY()) * cam.up());
+    const glm::dvec3 p =
+        c +
+        t * (cam.forward() + uniform(rng, -1, 1) * std::tan(0.5 * cam.fovY()) * cam.aspect() * cam.right() +
+             uniform(rng, -1, 1) * std::tan(0.5 * cam.fovY()) * cam.up());
     if (inRegion(p)) {
       pts.push_back(p);
       ++found;
@@ -190,11 +197,13 @@ inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19
 /// that go there state 1e-8.
 inline void report(const char* name, const Worst& w, double seconds, bool verbose = true, double tol = 1e-9) {
   if (verbose)
-    MESSAGE(std::string(name) << ": " << w.projective << " projective, " << w.fallback << " fallback, " << w.empty
-               << " empty; " << w.points << " region points; worst: view row/depth " << w.viewRowDepth
-               << ", light column/row " << w.lightColumnRow << ", helper vs matrix " << w.helperVsMatrix
-               << ", outside cube " << w.outsideCube << ", tightness " << w.tightness << ", gap " << w.gap
-               << ", round trip " << w.roundTrip << ", distance " << w.distance << "; " << seconds << " s");
+    MESSAGE(std::string(name) << ": " << w.projective << " projective, " << w.fallback << " fallback, "
+                              << w.empty << " empty; " << w.points << " region points; worst: view row/depth "
+                              << w.viewRowDepth << ", light column/row " << w.lightColumnRow
+                              << ", helper vs matrix " << w.helperVsMatrix << ", outside cube "
+                              << w.outsideCube << ", tightness " << w.tightness << ", gap " << w.gap
+                              << ", round trip " << w.roundTrip << ", distance " << w.distance << "; "
+                              << seconds << " s");
   CHECK(w.nonFinite == 0);
   CHECK(w.notOneSplit == 0);
   CHECK(w.leftToRight == 0);

@@ -7,8 +7,8 @@
 #include <crep/rectify/rectify.h>
 
 #include <algorithm>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <ostream>
@@ -19,8 +19,12 @@
 
 namespace crep {
 // doctest prints enums through operator<<.
-inline std::ostream& operator<<(std::ostream& os, FallbackReason r) { return os << reasonToken(r); }
-inline std::ostream& operator<<(std::ostream& os, RectifyStatus s) { return os << statusToken(s); }
+inline std::ostream& operator<<(std::ostream& os, FallbackReason r) {
+  return os << reasonToken(r);
+}
+inline std::ostream& operator<<(std::ostream& os, RectifyStatus s) {
+  return os << statusToken(s);
+}
 } // namespace crep
 
 namespace crep::test {
@@ -58,7 +62,8 @@ inline Camera randomCamera(std::mt19937_64& rng) {
 inline SpotLight randomSpot(std::mt19937_64& rng, const Camera& cam) {
   const double reach = std::min(cam.far(), 50.0);
   const double ndcX = uniform(rng, -1, 1), ndcY = uniform(rng, -1, 1);
-  const glm::dvec3 target = cam.position() + cam.rayDirection(ndcX, ndcY) * logUniform(rng, cam.near(), reach);
+  const glm::dvec3 target =
+      cam.position() + cam.rayDirection(ndcX, ndcY) * logUniform(rng, cam.near(), reach);
   const double dist = logUniform(rng, 0.1, 40.0);
   const glm::dvec3 pos = target + randomUnit(rng) * dist;
   glm::dvec3 dir = glm::normalize(target - pos);
@@ -164,12 +169,14 @@ inline glm::dvec4 toNdc(const glm::dmat4& clipFromWorld, const glm::dvec3& p) {
 inline bool insideClip(const glm::dmat4& clipFromWorld, const glm::dvec3& p, double tol = 1e-9) {
   const glm::dvec4 c = clipFromWorld * glm::dvec4(p, 1.0);
   if (!(c.w > 0.0)) return false;
-  return std::abs(c.x) <= c.w * (1 + tol) && std::abs(c.y) <= c.w * (1 + tol) && std::abs(c.z) <= c.w * (1 + tol);
+  return std::abs(c.x) <= c.w * (1 + tol) && std::abs(c.y) <= c.w * (1 + tol) &&
+         std::abs(c.z) <= c.w * (1 + tol);
 }
 
 /// Independent: does the line through a and b meet the intersection of two GL frusta? Returns the
 /// signed length of the parameter interval (t in units of |b - a|; > 0 meets, < 0 misses).
-inline double lineMeetsFrusta(const glm::dvec3& a, const glm::dvec3& b, const glm::dmat4& m1, const glm::dmat4& m2) {
+inline double lineMeetsFrusta(const glm::dvec3& a, const glm::dvec3& b, const glm::dmat4& m1,
+                              const glm::dmat4& m2) {
   double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
   for (const glm::dmat4* m : {&m1, &m2}) {
     const glm::dvec4 c0 = *m * glm::dvec4(a, 1.0), c1 = *m * glm::dvec4(b - a, 0.0);
