@@ -7,5 +7,6 @@ namespace crep::tool {
 
 /// Each command takes its arguments (after the command name) and returns the process exit status.
 int renderCommand(const std::vector<std::string>& args);
+int rectifyCommand(const std::vector<std::string>& args);
 
 } // namespace crep::tool

@@ -24,6 +24,14 @@ commands:
             --exposure X        PNG exposure (default 1)
             --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
             --debug-gl          debug GL context; GL errors abort the command
+  rectify   print the projective rectification for a camera and a directional light as JSON:
+            {"status": "projective"|"fallback", "reason", "measure", "threshold",
+             "splits": [{"rectClipFromWorld": [16 numbers, column-major], "range": [a, b]}]}
+            --camera-pos x,y,z --camera-target x,y,z --camera-up x,y,z (default 0,1,0)
+            --fovy-deg F (60) --aspect A (16/9) --near N (0.1) --far F (120)
+            --light-dir x,y,z   direction the light travels
+            --splits K (4) --scheme uniform|logarithmic|blend (logarithmic) --blend L (0.5)
+            (camera and light default to the colonnade scene's)
   help      this text
 
 Exit status: 0 success, 1 runtime error (GL, I/O, invalid parameter), 2 usage error.
@@ -41,6 +49,7 @@ int main(int argc, char** argv) {
   args.erase(args.begin());
   try {
     if (command == "render") return crep::tool::renderCommand(args);
+    if (command == "rectify") return crep::tool::rectifyCommand(args);
     std::fprintf(stderr, "crep: unknown command '%s' (see crep help)\n", command.c_str());
     return 2;
   } catch (const crep::tool::UsageError& e) {

@@ -1,40 +1,20 @@
 // End-to-end tests of the crep tool: run the built binary as a user would.
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
+#include "support/tool_runner.h"
 
 #include <crep/core/exr.h>
 
 #include <doctest/doctest.h>
 
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
-#include <sys/wait.h>
-
-#ifndef CREP_TOOL_PATH
-#error "CREP_TOOL_PATH must be defined by the build"
-#endif
 
 namespace {
-struct RunResult {
-  int status;
-  std::string output; // stdout + stderr
-};
-
-RunResult runCrep(const std::string& args) {
-  const std::string command = std::string("'") + CREP_TOOL_PATH + "' " + args + " 2>&1";
-  RunResult r{-1, {}};
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), static_cast<int>(buf.size()), pipe)) r.output += buf.data();
-  const int raw = pclose(pipe);
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return r;
-}
+using crep::test::runCrep;
+using RunResult = crep::test::ToolResult;
 } // namespace
 
 TEST_CASE("crep render: default scene at test size writes a finite, non-empty EXR and PNG with timings") {
@@ -72,26 +52,6 @@ TEST_CASE("crep render: default scene at test size writes a finite, non-empty EX
   CHECK(minT >= 0.0);
   CHECK(maxT <= 1.0);
   CHECK(maxT > minT);
-}
-
-TEST_CASE("crep: usage errors exit 2 and name the option") {
-  // These fail before any GL work, so they need no context.
-  struct Case {
-    const char* args;
-    const char* mentions;
-  };
-  for (const Case& c : {Case{"render --size 0x90", "--size"}, Case{"render --size abc", "--size"},
-                        Case{"render --map-size -3", "--map-size"}, Case{"render --exposure nan", "--exposure"},
-                        Case{"render --bogus 1", "--bogus"}, Case{"render --steps", "--steps"},
-                        Case{"frobnicate", "frobnicate"}}) {
-    const RunResult r = runCrep(c.args);
-    INFO(c.args << " -> " << r.output);
-    CHECK(r.status == 2);
-    CHECK(r.output.find(c.mentions) != std::string::npos);
-  }
-  const RunResult help = runCrep("help");
-  CHECK(help.status == 0);
-  CHECK(help.output.find("render") != std::string::npos);
 }
 
 TEST_CASE("crep render: unknown scene and oversized map are runtime errors naming the parameter") {

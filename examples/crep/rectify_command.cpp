@@ -1,0 +1,65 @@
+// `crep rectify`: prints the projective rectification (or the fallback decision) for a camera and a
+// directional light as one JSON object (rectify/include/crep/rectify/json.h).
+#include "args.h"
+#include "commands.h"
+
+#include <crep/core/error.h>
+#include <crep/rectify/json.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scenes/scene.h>
+
+#include <cstdio>
+#include <map>
+#include <numbers>
+
+namespace crep::tool {
+
+namespace {
+// Library parameter names -> the command-line options that set them.
+const std::map<std::string, std::string> kOptionOf = {
+    {"Camera.position", "--camera-pos"},       {"Camera.target", "--camera-target"},
+    {"Camera.up", "--camera-up"},              {"Camera.fovY", "--fovy-deg"},
+    {"Camera.aspect", "--aspect"},             {"Camera.near", "--near"},
+    {"Camera.far", "--far"},                   {"DirectionalLight.direction", "--light-dir"},
+    {"RectifyOptions.splits", "--splits"},     {"RectifyOptions.blend", "--blend"},
+    {"Camera.orientation", "--camera-target"},
+};
+} // namespace
+
+int rectifyCommand(const std::vector<std::string>& argv) {
+  const Args args(argv,
+                  {"camera-pos", "camera-target", "camera-up", "fovy-deg", "aspect", "near", "far", "light-dir",
+                   "splits", "scheme", "blend"},
+                  {});
+  // Defaults: the default scene's camera and sun.
+  const scenes::Scene scene = scenes::makeScene("colonnade");
+  const glm::dvec3 defaultTarget = scene.camera.position() + scene.camera.forward();
+  try {
+    const Camera camera = Camera::lookAt(
+        args.vec3("camera-pos", scene.camera.position()), args.vec3("camera-target", defaultTarget),
+        args.vec3("camera-up", {0, 1, 0}), args.number("fovy-deg", 60.0) * std::numbers::pi / 180.0,
+        args.number("aspect", 16.0 / 9.0), args.number("near", 0.1), args.number("far", 120.0));
+    const DirectionalLight light(args.vec3("light-dir", scene.sun.direction()));
+    RectifyOptions options;
+    options.splits = args.integer("splits", options.splits, 1, RectifyOptions::kMaxSplits);
+    const std::string scheme = args.string("scheme", "logarithmic");
+    if (scheme == "uniform")
+      options.scheme = SplitScheme::Uniform;
+    else if (scheme == "logarithmic")
+      options.scheme = SplitScheme::Logarithmic;
+    else if (scheme == "blend")
+      options.scheme = SplitScheme::Blend;
+    else
+      throw UsageError("option --scheme: '" + scheme + "' is not uniform, logarithmic or blend");
+    options.blend = args.number("blend", options.blend);
+    const Rectification r = rectify(camera, light, options);
+    std::printf("%s\n", toJson(r).c_str());
+    return 0;
+  } catch (const InvalidArgument& e) {
+    const auto it = kOptionOf.find(e.parameter());
+    if (it == kOptionOf.end()) throw;
+    throw UsageError("option " + it->second + ": " + e.what());
+  }
+}
+
+} // namespace crep::tool

@@ -1,0 +1,112 @@
+// End-to-end tests of the crep tool that need no GL: usage errors and `crep rectify`.
+#include "support/tool_runner.h"
+
+#include <crep/core/camera.h>
+
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <numbers>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace {
+std::vector<std::vector<double>> splitMatrices(const std::string& json) {
+  std::vector<std::vector<double>> out;
+  const std::regex matrix(R"re("rectClipFromWorld": \[([^\]]*)\])re");
+  for (auto it = std::sregex_iterator(json.begin(), json.end(), matrix); it != std::sregex_iterator(); ++it) {
+    std::vector<double> values;
+    std::string list = (*it)[1];
+    char* p = list.data();
+    while (*p) {
+      char* end = nullptr;
+      values.push_back(std::strtod(p, &end));
+      if (end == p) break;
+      p = end;
+      while (*p == ',' || *p == ' ') ++p;
+    }
+    out.push_back(values);
+  }
+  return out;
+}
+} // namespace
+
+TEST_CASE("crep rectify: JSON splits contain the camera frustum") {
+  const auto r = crep::test::runCrep("rectify --camera-pos 0,1,5 --camera-target 0,1,0 --camera-up 0,1,0 "
+                                     "--fovy-deg 50 --aspect 1.5 --near 0.2 --far 40 --light-dir 1,-1,0.2 --splits 3");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find(R"("status": "projective")") != std::string::npos);
+  const auto matrices = splitMatrices(r.output);
+  REQUIRE(matrices.size() == 3);
+  const crep::Camera camera =
+      crep::Camera::lookAt({0, 1, 5}, {0, 1, 0}, {0, 1, 0}, 50.0 * std::numbers::pi / 180.0, 1.5, 0.2, 40.0);
+  // Every sampled point of the frustum lies in the NDC cube of at least one split (parsed from the
+  // printed column-major numbers).
+  for (int i = 0; i <= 4; ++i)
+    for (int j = 0; j <= 4; ++j)
+      for (double dist : {0.2, 0.5, 3.0, 17.0, 40.0}) {
+        const glm::dvec3 dir = camera.rayDirection(i / 2.0 - 1.0, j / 2.0 - 1.0);
+        const glm::dvec3 p = camera.position() + dir * (dist / glm::dot(dir, camera.forward()));
+        bool inside = false;
+        for (const auto& m : matrices) {
+          REQUIRE(m.size() == 16);
+          glm::dmat4 clip;
+          for (int k = 0; k < 16; ++k) clip[k / 4][k % 4] = m[static_cast<std::size_t>(k)];
+          const glm::dvec4 c = clip * glm::dvec4(p, 1.0);
+          const glm::dvec3 ndc = glm::dvec3(c) / c.w;
+          const double tol = 1e-9;
+          inside = inside || (c.w > 0 && std::abs(ndc.x) <= 1 + tol && std::abs(ndc.y) <= 1 + tol &&
+                              std::abs(ndc.z) <= 1 + tol);
+        }
+        CHECK(inside);
+      }
+}
+
+TEST_CASE("crep rectify: light in view gives a fallback with its reason") {
+  const auto r = crep::test::runCrep("rectify --camera-pos 0,0,0 --camera-target 0,0,-1 --light-dir 0.1,0,1");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find(R"("status": "fallback")") != std::string::npos);
+  CHECK(r.output.find(R"("splits": [])") != std::string::npos);
+}
+
+TEST_CASE("crep rectify: invalid options exit 2 naming the option") {
+  struct Case {
+    const char* args;
+    const char* mentions;
+  };
+  for (const Case& c :
+       {Case{"rectify --near 5 --far 1", "--far"}, Case{"rectify --light-dir 0,0,0", "--light-dir"},
+        Case{"rectify --splits 0", "--splits"}, Case{"rectify --fovy-deg 180", "--fovy-deg"},
+        Case{"rectify --aspect -1", "--aspect"}, Case{"rectify --near nan", "--near"},
+        Case{"rectify --camera-pos 1,2", "--camera-pos"}, Case{"rectify --scheme cubic", "--scheme"},
+        Case{"rectify --camera-target 0,0,0 --camera-pos 0,0,0", "--camera-target"}}) {
+    const auto r = crep::test::runCrep(c.args);
+    INFO(c.args << " -> " << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.mentions) != std::string::npos);
+  }
+}
+
+TEST_CASE("crep: usage errors exit 2 and name the option") {
+  // These fail before any GL work, so they need no context.
+  struct Case {
+    const char* args;
+    const char* mentions;
+  };
+  for (const Case& c : {Case{"render --size 0x90", "--size"}, Case{"render --size abc", "--size"},
+                        Case{"render --map-size -3", "--map-size"}, Case{"render --exposure nan", "--exposure"},
+                        Case{"render --bogus 1", "--bogus"}, Case{"render --steps", "--steps"},
+                        Case{"frobnicate", "frobnicate"}}) {
+    const auto r = crep::test::runCrep(c.args);
+    INFO(c.args << " -> " << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.mentions) != std::string::npos);
+  }
+  const auto help = crep::test::runCrep("help");
+  CHECK(help.status == 0);
+  CHECK(help.output.find("render") != std::string::npos);
+}
+
