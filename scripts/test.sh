@@ -5,8 +5,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 crep_install_packages
 if [ "${CREP_SANITIZE:-0}" = 1 ]; then
   crep_build build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCREP_SANITIZE=ON
-  # Mesa's llvmpipe keeps allocations alive until exit; leak checking is for our code only (see tests/lsan.supp).
-  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp
+  export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   ctest --test-dir build-asan --output-on-failure -j 2 "$@"
 else
