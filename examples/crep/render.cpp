@@ -72,7 +72,8 @@ int renderCommand(const std::vector<std::string>& argv) {
     };
   // The context lives for the whole process, like an application's: destroying the last context
   // unloads Mesa's driver, after which LeakSanitizer cannot attribute the driver's own allocations.
-  GlContext* context = timings.time("gl context", [&] { return new GlContext(contextOptions); });
+  static GlContext* context = nullptr; // reachable until exit, never destroyed
+  context = timings.time("gl context", [&] { return new GlContext(contextOptions); });
   std::fprintf(stderr, "crep render: %s, %s\n", context->renderer().c_str(), context->version().c_str());
 
   const scenes::Scene scene =
