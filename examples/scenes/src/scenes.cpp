@@ -163,7 +163,7 @@ Scene makeScene(std::string_view name, double aspect) {
   if (name == "terrain") {
     Scene s{"terrain", terrainMesh(),
             Camera::lookAt({0.0, 12.0, 40.0}, {0.0, 6.0, -40.0}, {0, 1, 0}, fov, aspect, 0.1, 200.0),
-            DirectionalLight(glm::dvec3(0.6, -0.35, -0.72), glm::dvec3(4.0, 3.5, 2.8)),
+            DirectionalLight(glm::dvec3(0.8, -0.45, 0.2), glm::dvec3(4.0, 3.5, 2.8)),
             Medium(glm::dvec3(0.012, 0.014, 0.018), glm::dvec3(0.002), 0.5, glm::dvec3(0.002, 0.004, 0.008)), {}, {}};
     computeBounds(s);
     return s;

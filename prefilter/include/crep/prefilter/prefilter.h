@@ -1,0 +1,211 @@
+// Prefiltered single scattering on a rectified shadow map, CPU reference (Klehm, Seidel, Eisemann 2014:
+// Sec. 3.1 prefix filtering, Sec. 3.2 weights, Sec. 3.3 regions and normalized storage, Listings 1-4,
+// Appendix A). Double precision, multi-threaded over rows, deterministic (bit-identical output for any
+// thread count). The GPU passes (gpu_*.h) implement the same rules; this header is their contract.
+//
+// ---------------------------------------------------------------------------------------------------
+// Prefilter (prefilter())
+// Prefilter regions: every layout region (split) k is cut into P = regionsPerSplit equal parts, so
+// there are R = K P regions of n = W / R texels; region r = k P + q covers texel columns
+// [r n, (r + 1) n) and its reference-ray profile is layout.referenceProfile(row, k).sub(q / P, (q+1) / P)
+// (referenceProfiles()). Per texel row j (row coordinate (j + 0.5) / H) and region r, left to right:
+//   z_i = texelBasisDepth(depth(i, j), depthMargin)     (fourier.h)
+//   F_i = F_{i-1} + m_i (B(z_i) - F_{i-1}),  F_{-1} = 0, m_i = regionMixFactors(...)   (weights.h)
+// so F_i = sum_{l<=i} w_l B(z_l) / sum_{l<=i} w_l in [-1, 1] (Appendix A), the region's own normalized
+// prefix ending at the right edge of texel i. Stored: e = quantize(0.5 + 0.5 F, format), the same
+// encoding for every format (decode F = 2 e - 1).
+//
+// ---------------------------------------------------------------------------------------------------
+// Evaluation (evaluate()), per camera pixel (x, y) of a w x h depth image (row 0 at the bottom):
+//   ndc = (2 (x + 0.5) / w - 1, 2 (y + 0.5) / h - 1), v = camera.rayDirection(ndc) (unit),
+//   s = linearDepth(depth) / dot(v, forward) (the surface distance, world units); sky: depth >= 1
+//   integrates to the far plane, s = far / dot(v, forward) (the map covers the frustum up to there and
+//   has no information beyond it); p = camera.position() + s v; P = layout.toRectified(p) gives the
+//   ray's row, its depth z_r and the hit's region k_s / column u (-> prefilter region r_s, u_s).
+//   The ray is cut at the region boundaries: t_r = rayDistance(row, z_r, r / R) along the ray itself
+//   (not the reference ray). Region r < r_s contributes on [t_r, t_{r+1}], region r_s on [t_{r_s}, s],
+//   except that region 0 starts at the camera (t = 0; the map starts at X = axisMin, in front of the
+//   near plane): that is the paper's 1 - exp(-s sigma) for one region.
+//   Optional near-plane correction (Sec. 3.1, EvaluateOptions::nearPlaneCorrection): the integral
+//   starts at the near-plane point t_n = near / dot(v, forward) instead, in region r_n (u_n); the part
+//   [t_n, end] of region r_n uses the prefix difference (below); regions before r_n contribute nothing.
+//   Visibility of a region segment [u_a, u_b] of region r (u_a = 0 except with the correction):
+//     (a = fourierCoefficients(zb) then applyRingingFilter(EvaluateOptions::ringing, a), fourier.h)
+//     V = clamp(0.5 + a(zb) . (W_b F(u_b) - W_a F(u_a)) / (W_b - W_a), 0, 1), zb = rayBasisDepth(z_r, m),
+//     W = regionWeightTotal(mode, extinction, profile of the nearest texel row, n, u) (W_a = 0 for
+//     u_a = 0, then V = clamp(0.5 + a . F(u_b), 0, 1)); if W_b - W_a <= 1e-12 W_b, V = clamp(0.5 + a .
+//     F(u_b)).
+//   F(u): the filtered basis sampled at the prefix boundary u of region r: texel-space column
+//     x = clamp(u n - 1, 0, n - 1) (texel i holds the prefix at u = (i + 1) / n), row y = clamp(row H - 0.5,
+//     0, H - 1); Sampling::Bilinear interpolates linearly between floor and floor + 1 in x and y (never
+//     across a region boundary: x stays in [0, n - 1] of its region), Sampling::Nearest takes
+//     floor(x + 0.5), floor(y + 0.5). On the GPU: texture(array, vec3((r n + x + 0.5) / W, (y + 0.5) / H,
+//     layer)) with GL_LINEAR / GL_NEAREST does the same (up to the sampler's 8-bit weight precision).
+//   Radiance per channel c (Eq. 1, 3, 11):
+//     L_c = C_c sum_segments V (exp(-sigma_c t_a) - exp(-sigma_c t_b)) / sigma_c,
+//     computed as exp(-sigma_c t_a) (t_b - t_a) phi(sigma_c (t_b - t_a)) (sigma_c -> 0 limit, weights.h),
+//     C = light.irradiance() * medium.scatteringTimesPhase(dot(light.direction(), -v)) (Mie HG + Rayleigh).
+//   AverageVisibility: one visibility for the whole ray is not what the regions give; the same
+//   per-region formula is used (the stored F are then unweighted means per region).
+//   Output RGBA: RGB = L, A = exp(-weightExtinction(medium) s), the grey transmittance to the surface
+//   (composite: surface * A + L; per-channel transmittance is exp(-sigma_c s)).
+//
+// ---------------------------------------------------------------------------------------------------
+// Reference march (marchReference()): the same rays, start and end rules and output, but the
+// visibility is integrated exactly over the same map: the ray's texel row floor(row H) (clamped), each
+// texel i of the crossed regions lit iff depth(i, j) >= z_r (GL_LESS shadow test, no basis), weighted
+// with the ray's own exact transmittance over the part of the texel it crosses, per channel (the part of
+// region 0 in front of the map, camera to column 0, takes the first texel's test). No Fourier
+// truncation, no reference-ray weights, no quantization, no filtering: the method's own error is
+// evaluate() against marchReference() on the same map.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/image.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/prefilter/fourier.h>
+#include <crep/prefilter/weights.h>
+#include <crep/rectify/rectified_map.h>
+
+namespace crep {
+
+/// How the filtered basis is stored (as the GPU texture array stores it).
+enum class StorageFormat {
+  RGBA8,   ///< GL_RGBA8 (UNORM): quantize(e) = round(clamp(e, 0, 1) 255) / 255, round half up
+  RGBA16F, ///< GL_RGBA16F: e rounded to the nearest binary16 (ties to even)
+  RGBA32F, ///< GL_RGBA32F: e rounded to the nearest float
+};
+/// "rgba8", "rgba16f", "rgba32f".
+const char* storageFormatToken(StorageFormat format);
+
+/// How evaluate() samples the filtered basis.
+enum class Sampling {
+  Nearest,  ///< GL_NEAREST
+  Bilinear, ///< GL_LINEAR: hardware bilinear filtering of the array layer (paper Sec. 5) (default)
+};
+
+struct PrefilterOptions {
+  /// M, even, in [kMinBases, kMaxBases] (fourier.h). Layers = ceil(M / 4).
+  int bases = kDefaultBases;
+  WeightMode weights = WeightMode::Exact;
+  StorageFormat format = StorageFormat::RGBA8;
+  /// P >= 1: prefilter regions per layout region (Sec. 3.3, Table 1); map width must be a multiple of
+  /// regionCount() * P.
+  int regionsPerSplit = 1;
+  /// m in [0, 0.25] of texelBasisDepth / rayBasisDepth (fourier.h). Default 1/16: see prefilter/README.md.
+  double depthMargin = 0.0625;
+  /// GPU pass only (Table 1: bases per invocation, a multiple of 4 in [4, 128]; the last group of a row
+  /// may be partial when it does not divide M); ignored by the CPU.
+  int basesPerInvocation = 8;
+  /// CPU worker threads: 0 = std::thread::hardware_concurrency(). Never changes the result.
+  int threads = 0;
+};
+
+/// Throws InvalidArgument naming the field ("bases", "PrefilterOptions.regionsPerSplit",
+/// "PrefilterOptions.depthMargin", "PrefilterOptions.basesPerInvocation", "PrefilterOptions.threads").
+void validate(const PrefilterOptions& options);
+
+/// Number of RGBA layers for M bases: (M + 3) / 4 (channels beyond M are stored as encoded 0.5, i.e. F = 0).
+inline int layerCount(int bases) {
+  return (bases + 3) / 4;
+}
+
+/// The storage rule of the filtered basis: encode F in [-1, 1] as e = 0.5 + 0.5 F and round it to
+/// `format` (RGBA8: round(clamp(e, 0, 1) * 255) / 255; RGBA16F: nearest binary16, ties to even; RGBA32F:
+/// nearest float). Returns the stored value e as the GPU reads it back.
+float storeFiltered(double filtered, StorageFormat format);
+/// Nearest binary16 value of v (ties to even, subnormals included, +-inf beyond 65504), as a float.
+float roundToHalf(double v);
+
+/// The per-row, per-region reference-ray profiles the prefilter uses (see top): H * R values, index
+/// j * R + r. What the GPU uploads (4 numbers per row and region).
+std::vector<DistanceProfile> referenceProfiles(const RectifiedLayout& layout, int height,
+                                               int regionsPerSplit);
+
+/// The prefiltered ("filtered-basis") texture array and what evaluation needs with it.
+struct FilteredBasis {
+  int width = 0, height = 0; ///< texels, the map's size
+  int bases = 0;             ///< M
+  int layers = 0;            ///< ceil(M / 4)
+  int regions = 0;           ///< R = layout regions * regionsPerSplit
+  int regionsPerSplit = 1;   ///< P
+  StorageFormat format = StorageFormat::RGBA8;
+  WeightMode weights = WeightMode::Exact;
+  double extinction = 0.0;  ///< the scalar weight extinction s (1/world unit)
+  double depthMargin = 0.0; ///< m of fourier.h
+  /// Stored values e (encoded, already rounded to `format`), layers * height * width * 4, index
+  /// ((layer * height + y) * width + x) * 4 + channel; basis j = 4 layer + channel; y = 0 bottom.
+  /// Exactly what glTexSubImage3D of a GL_RGBA / GL_FLOAT array upload would contain.
+  std::vector<float> texels;
+  /// referenceProfiles(): height * regions, index y * regions + r.
+  std::vector<DistanceProfile> profiles;
+  /// The map's layout (shared with the RectifiedMap).
+  std::shared_ptr<const RectifiedLayout> layout;
+
+  int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
+  float stored(int x, int y, int basis) const {
+    return texels[((static_cast<std::size_t>(basis / 4) * static_cast<std::size_t>(height) +
+                    static_cast<std::size_t>(y)) *
+                       static_cast<std::size_t>(width) +
+                   static_cast<std::size_t>(x)) *
+                      4 +
+                  static_cast<std::size_t>(basis % 4)];
+  }
+  /// Decoded F = 2 e - 1 of basis j at texel (x, y).
+  double filtered(int x, int y, int basis) const {
+    return 2.0 * static_cast<double>(stored(x, y, basis)) - 1.0;
+  }
+};
+
+/// The CPU reference prefilter (see top) with the medium's weight extinction (weightExtinction()).
+/// Validates the map and options (InvalidArgument naming them).
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const PrefilterOptions& options = {});
+/// The same with an explicit scalar weight extinction s >= 0 (1/world unit).
+FilteredBasis prefilter(const RectifiedMap& map, double extinction, const PrefilterOptions& options = {});
+
+struct EvaluateOptions {
+  Sampling sampling = Sampling::Bilinear;
+  /// Sec. 3.1: integrate from the near plane instead of the camera (see top).
+  bool nearPlaneCorrection = false;
+  /// Damping of the ray coefficients a (fourier.h). Default None = the paper's Eq. 8: on the built-in
+  /// scenes Lanczos damping is worse (its wider step darkens the texels just before each receiver, which
+  /// lies in the map itself); it is much better for open, unoccluded views (prefilter/README.md).
+  RingingFilter ringing = RingingFilter::None;
+  /// CPU worker threads: 0 = hardware concurrency. Never changes the result.
+  int threads = 0;
+};
+
+/// C of Eq. 1 per channel for a view direction v (unit, from the camera): irradiance *
+/// medium.scatteringTimesPhase(dot(light.direction(), -v)) (radiance per world unit).
+glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
+                              const glm::dvec3& viewDirection);
+
+/// Evaluation (see top): a 4-channel image of cameraDepth's size, RGB = in-scattered radiance, A =
+/// grey transmittance. `cameraDepth`: 1 channel (channel 0 used if more), depth-buffer values of
+/// `camera` in [0, 1] (1 = sky). Throws InvalidArgument ("cameraDepth") for an empty image or a value
+/// NaN / outside [0, 1] (with its pixel), ("FilteredBasis") for an inconsistent basis or no layout.
+/// Pixels whose surface point the layout cannot map (toRectified throws: only when `camera` is not the
+/// rectification's camera) get the unshadowed value (V = 1 on the whole ray), never NaN.
+Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+               const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options = {});
+
+/// The brute-force reference march over the same map (see top), same inputs and output as evaluate().
+Image marchReference(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                     const DirectionalLight& light, const Medium& medium,
+                     const EvaluateOptions& options = {});
+
+/// Closed-form single scattering of the homogeneous medium without occluders (Eq. 1 with V = 1, Eq. 3),
+/// same rays, start/end rules and output as evaluate(): L_c = C_c (exp(-sigma_c t_a) - exp(-sigma_c s))
+/// / sigma_c with t_a = 0 (or the near-plane distance). Ground truth for tests and a no-shadow fallback.
+Image unshadowedScattering(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                           const Medium& medium, const EvaluateOptions& options = {});
+
+} // namespace crep

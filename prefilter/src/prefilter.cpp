@@ -1,0 +1,462 @@
+// CPU reference of prefiltered single scattering: Klehm, Seidel, Eisemann 2014, Sec. 3.1 (prefix
+// filtering of the Fourier basis, Eq. 5-9), Sec. 3.2 (transmittance weights, Eq. 10-11), Sec. 3.3
+// (regions, normalized storage, Listings 1-4), Appendix A (normalized filtered basis), plus a
+// brute-force march and the closed form of the unshadowed medium (Eq. 1, 3) as references. The exact
+// rules (also the GPU's contract) are documented in crep/prefilter/prefilter.h.
+#include <crep/core/error.h>
+#include <crep/prefilter/prefilter.h>
+
+#include "parallel.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+namespace crep {
+
+namespace {
+
+std::string pixelString(int x, int y) {
+  return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+void validateCameraDepth(const Image& depth) {
+  if (depth.empty()) throw InvalidArgument("cameraDepth", "empty", "must be a depth-buffer image");
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const float v = depth.at(x, y, 0);
+      if (!(v >= 0.0f && v <= 1.0f))
+        throw InvalidArgument("cameraDepth", pixelString(x, y) + " = " + detail::formatValue(v),
+                              "depth-buffer values must be in [0, 1]");
+    }
+}
+
+/// The view ray of one camera pixel and its integration range (prefilter.h "Evaluation").
+struct PixelRay {
+  glm::dvec3 direction{0.0}; ///< unit, from the camera
+  double surface = 0.0;      ///< s: distance to the surface (far plane for the sky)
+  double start = 0.0;        ///< 0, or the near-plane distance with the correction
+};
+
+PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y, bool nearPlaneCorrection) {
+  PixelRay r;
+  const double ndcX = 2.0 * (x + 0.5) / depth.width() - 1.0;
+  const double ndcY = 2.0 * (y + 0.5) / depth.height() - 1.0;
+  r.direction = camera.rayDirection(ndcX, ndcY);
+  const double cosForward = glm::dot(r.direction, camera.forward());
+  const double d = depth.at(x, y, 0);
+  const double viewDepth = d >= 1.0 ? camera.far() : camera.linearDepth(d);
+  r.surface = viewDepth / cosForward;
+  r.start = nearPlaneCorrection ? std::min(camera.near() / cosForward, r.surface) : 0.0;
+  return r;
+}
+
+/// exp(-sigma ta) - exp(-sigma tb), divided by sigma (sigma -> 0: tb - ta).
+double transmittanceIntegral(double sigma, double ta, double tb) {
+  const double len = tb - ta;
+  if (!(len > 0.0)) return 0.0;
+  return std::exp(-sigma * ta) * len * oneMinusExpOverX(sigma * len);
+}
+
+glm::dvec3 transmittanceIntegral(const glm::dvec3& sigma, double ta, double tb) {
+  return {transmittanceIntegral(sigma.x, ta, tb), transmittanceIntegral(sigma.y, ta, tb),
+          transmittanceIntegral(sigma.z, ta, tb)};
+}
+
+/// A point of a ray in prefilter-region coordinates: region r of R = K P, u in [0, 1] within it.
+struct RegionPoint {
+  int region = 0;
+  double u = 0.0;
+};
+
+RegionPoint regionPoint(const RectPoint& p, int layoutRegions, int perSplit) {
+  const int k = std::clamp(p.split, 0, layoutRegions - 1);
+  const double uk = std::clamp(p.splitColumn, 0.0, 1.0);
+  const int q = std::min(static_cast<int>(std::floor(uk * perSplit)), perSplit - 1);
+  return {k * perSplit + q, std::clamp(uk * perSplit - q, 0.0, 1.0)};
+}
+
+/// The mapped part of one pixel's ray: row, depth, and the regions from start to surface.
+struct MappedRay {
+  double row = 0.0, depth = 0.0;
+  RegionPoint first, last; ///< where the integration starts (region 0, u 0 without the correction) / ends
+};
+
+/// Maps a pixel ray into the layout; false when the layout cannot map its points.
+bool mapRay(const RectifiedLayout& layout, const glm::dvec3& origin, const PixelRay& ray, int perSplit,
+            bool nearPlaneCorrection, MappedRay& out) {
+  const int K = layout.regionCount();
+  try {
+    const RectPoint hit = layout.toRectified(origin + ray.surface * ray.direction);
+    out.row = hit.row;
+    out.depth = hit.depth;
+    out.last = regionPoint(hit, K, perSplit);
+    out.first = {0, 0.0};
+    if (nearPlaneCorrection) {
+      const RectPoint np = layout.toRectified(origin + ray.start * ray.direction);
+      out.first = regionPoint(np, K, perSplit);
+      if (out.first.region > out.last.region ||
+          (out.first.region == out.last.region && out.first.u > out.last.u))
+        out.first = out.last; // rounding: the surface is at the near plane
+    }
+  } catch (const InvalidArgument&) {
+    return false;
+  }
+  return true;
+}
+
+/// Calls segment(region, ua, ub, ta, tb) for every region the ray crosses from start to surface (world
+/// distances along the ray itself; region 0 starts at the camera without the correction).
+template <class Segment>
+void forEachSegment(const RectifiedLayout& layout, const PixelRay& ray, const MappedRay& m, int regions,
+                    const Segment& segment) {
+  double ta = ray.start;
+  for (int r = m.first.region; r <= m.last.region; ++r) {
+    const double ua = r == m.first.region ? m.first.u : 0.0;
+    const double ub = r == m.last.region ? m.last.u : 1.0;
+    double tb = r == m.last.region ? ray.surface
+                                   : layout.rayDistance(m.row, m.depth, static_cast<double>(r + 1) / regions);
+    tb = std::clamp(tb, ta, ray.surface);
+    segment(r, ua, ub, ta, tb);
+    ta = tb;
+  }
+}
+
+void validateBasis(const FilteredBasis& b) {
+  const auto bad = [](const std::string& what) {
+    throw InvalidArgument("FilteredBasis", what, "must be a consistent result of prefilter()");
+  };
+  if (!b.layout) bad("layout null");
+  validateBases(b.bases);
+  if (b.layers != layerCount(b.bases)) bad("layers " + std::to_string(b.layers));
+  if (b.width <= 0 || b.height <= 0)
+    bad("size " + std::to_string(b.width) + " x " + std::to_string(b.height));
+  if (b.regionsPerSplit < 1 || b.regions != b.layout->regionCount() * b.regionsPerSplit ||
+      b.width % b.regions != 0)
+    bad("regions " + std::to_string(b.regions));
+  if (b.texels.size() != static_cast<std::size_t>(b.layers) * static_cast<std::size_t>(b.height) *
+                             static_cast<std::size_t>(b.width) * 4)
+    bad("texels size " + std::to_string(b.texels.size()));
+  if (b.profiles.size() != static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.regions))
+    bad("profiles size " + std::to_string(b.profiles.size()));
+  if (!(b.extinction >= 0.0) || !std::isfinite(b.extinction))
+    bad("extinction " + detail::formatValue(b.extinction));
+  if (!(b.depthMargin >= 0.0 && b.depthMargin <= 0.25))
+    bad("depthMargin " + detail::formatValue(b.depthMargin));
+}
+
+/// Samples the decoded filtered basis of region r at prefix boundary u and normalized row (see the
+/// header: x = clamp(u n - 1, 0, n - 1), y = clamp(row H - 0.5, 0, H - 1)).
+void sampleFiltered(const FilteredBasis& b, Sampling sampling, int r, double u, double row, double* out) {
+  const int n = b.regionWidth();
+  const double x = std::clamp(u * n - 1.0, 0.0, static_cast<double>(n - 1));
+  const double y = std::clamp(row * b.height - 0.5, 0.0, static_cast<double>(b.height - 1));
+  const int base = r * n;
+  if (sampling == Sampling::Nearest) {
+    const int xi = base + static_cast<int>(std::floor(x + 0.5));
+    const int yi = static_cast<int>(std::floor(y + 0.5));
+    for (int j = 0; j < b.bases; ++j)
+      out[j] = b.filtered(xi, yi, j);
+    return;
+  }
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const int x1 = std::min(x0 + 1, n - 1), y1 = std::min(y0 + 1, b.height - 1);
+  const double fx = x - x0, fy = y - y0;
+  for (int j = 0; j < b.bases; ++j) {
+    const double e00 = b.stored(base + x0, y0, j), e10 = b.stored(base + x1, y0, j);
+    const double e01 = b.stored(base + x0, y1, j), e11 = b.stored(base + x1, y1, j);
+    const double e = (1.0 - fy) * ((1.0 - fx) * e00 + fx * e10) + fy * ((1.0 - fx) * e01 + fx * e11);
+    out[j] = 2.0 * e - 1.0;
+  }
+}
+
+void validateEvaluateOptions(const EvaluateOptions& o) {
+  if (o.threads < 0)
+    throw InvalidArgument("EvaluateOptions.threads", detail::formatValue(o.threads), "must be >= 0");
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------------
+
+const char* storageFormatToken(StorageFormat format) {
+  switch (format) {
+  case StorageFormat::RGBA8:
+    return "rgba8";
+  case StorageFormat::RGBA16F:
+    return "rgba16f";
+  case StorageFormat::RGBA32F:
+    return "rgba32f";
+  }
+  return "unknown";
+}
+
+void validate(const PrefilterOptions& o) {
+  validateBases(o.bases);
+  if (o.regionsPerSplit < 1 || o.regionsPerSplit > 1024)
+    throw InvalidArgument("PrefilterOptions.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
+                          "must be in [1, 1024]");
+  if (!(o.depthMargin >= 0.0 && o.depthMargin <= 0.25))
+    throw InvalidArgument("PrefilterOptions.depthMargin", detail::formatValue(o.depthMargin),
+                          "must be in [0, 0.25]");
+  if (o.basesPerInvocation < 4 || o.basesPerInvocation > kMaxBases || o.basesPerInvocation % 4 != 0)
+    throw InvalidArgument("PrefilterOptions.basesPerInvocation", detail::formatValue(o.basesPerInvocation),
+                          "must be a multiple of 4 in [4, " + std::to_string(kMaxBases) + "]");
+  if (o.threads < 0)
+    throw InvalidArgument("PrefilterOptions.threads", detail::formatValue(o.threads), "must be >= 0");
+}
+
+float roundToHalf(double v) {
+  if (!std::isfinite(v) || v == 0.0) return static_cast<float>(v);
+  const double a = std::abs(v);
+  if (a >= 65520.0) return static_cast<float>(std::copysign(std::numeric_limits<double>::infinity(), v));
+  int e = 0;
+  std::frexp(a, &e); // a = f 2^e, f in [0.5, 1): the leading bit is 2^(e-1)
+  // binary16: 11 significant bits for normals (exponent >= -14), fixed quantum 2^-24 below.
+  const int quantumExp = std::max(e - 11, -24);
+  const double q = std::ldexp(1.0, quantumExp);
+  const double rounded = std::nearbyint(a / q) * q; // default rounding mode: ties to even
+  return static_cast<float>(std::copysign(rounded, v));
+}
+
+float storeFiltered(double filtered, StorageFormat format) {
+  const double e = 0.5 + 0.5 * filtered;
+  switch (format) {
+  case StorageFormat::RGBA8:
+    return static_cast<float>(std::floor(std::clamp(e, 0.0, 1.0) * 255.0 + 0.5) / 255.0);
+  case StorageFormat::RGBA16F:
+    return roundToHalf(e);
+  case StorageFormat::RGBA32F:
+    break;
+  }
+  return static_cast<float>(e);
+}
+
+std::vector<DistanceProfile> referenceProfiles(const RectifiedLayout& layout, int height,
+                                               int regionsPerSplit) {
+  if (height <= 0)
+    throw InvalidArgument("referenceProfiles.height", detail::formatValue(height), "must be > 0");
+  if (regionsPerSplit < 1)
+    throw InvalidArgument("PrefilterOptions.regionsPerSplit", detail::formatValue(regionsPerSplit),
+                          "must be >= 1");
+  const int K = layout.regionCount(), P = regionsPerSplit, R = K * P;
+  std::vector<DistanceProfile> out(static_cast<std::size_t>(height) * static_cast<std::size_t>(R));
+  for (int j = 0; j < height; ++j) {
+    const double row = (j + 0.5) / height;
+    const double depth = layout.referenceDepth(row);
+    for (int k = 0; k < K; ++k) {
+      const DistanceProfile p = layout.rayProfile(row, depth, k);
+      for (int q = 0; q < P; ++q)
+        out[static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(k * P + q)] =
+            P == 1 ? p : p.sub(static_cast<double>(q) / P, static_cast<double>(q + 1) / P);
+    }
+  }
+  return out;
+}
+
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const PrefilterOptions& options) {
+  return prefilter(map, weightExtinction(medium), options);
+}
+
+FilteredBasis prefilter(const RectifiedMap& map, double extinction, const PrefilterOptions& options) {
+  validate(map);
+  validate(options);
+  if (!(extinction >= 0.0) || !std::isfinite(extinction))
+    throw InvalidArgument("extinction", detail::formatValue(extinction), "must be finite and >= 0");
+  const int W = map.width(), H = map.height(), M = options.bases;
+  const int R = map.layout->regionCount() * options.regionsPerSplit;
+  if (W % R != 0)
+    throw InvalidArgument("RectifiedMap.depth", "width " + std::to_string(W),
+                          "must be a multiple of regionCount() * PrefilterOptions.regionsPerSplit = " +
+                              std::to_string(R));
+  FilteredBasis b;
+  b.width = W;
+  b.height = H;
+  b.bases = M;
+  b.layers = layerCount(M);
+  b.regions = R;
+  b.regionsPerSplit = options.regionsPerSplit;
+  b.format = options.format;
+  b.weights = options.weights;
+  b.extinction = extinction;
+  b.depthMargin = options.depthMargin;
+  b.layout = map.layout;
+  b.profiles = referenceProfiles(*map.layout, H, options.regionsPerSplit);
+  b.texels.assign(static_cast<std::size_t>(b.layers) * static_cast<std::size_t>(H) *
+                      static_cast<std::size_t>(W) * 4,
+                  storeFiltered(0.0, options.format));
+
+  const int n = W / R;
+  const std::size_t layerStride = static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 4;
+  detail::parallelRows(H, options.threads, [&](int j) {
+    std::vector<double> mix(static_cast<std::size_t>(n));
+    std::array<double, kMaxBases> F{}, B{};
+    const std::span<double> basisSpan(B.data(), static_cast<std::size_t>(M));
+    for (int r = 0; r < R; ++r) {
+      const DistanceProfile& profile =
+          b.profiles[static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)];
+      regionMixFactors(options.weights, extinction, profile, n, mix);
+      std::fill(F.begin(), F.end(), 0.0);
+      for (int i = 0; i < n; ++i) {
+        const int x = r * n + i;
+        fourierBasis(texelBasisDepth(map.depth.at(x, j), options.depthMargin), basisSpan);
+        const double m = mix[static_cast<std::size_t>(i)];
+        // Listing 2: the normalized weighted prefix, F_i = F_{i-1} + m_i (B_i - F_{i-1}).
+        for (int k = 0; k < M; ++k)
+          F[static_cast<std::size_t>(k)] +=
+              m * (B[static_cast<std::size_t>(k)] - F[static_cast<std::size_t>(k)]);
+        const std::size_t texel =
+            (static_cast<std::size_t>(j) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x)) * 4;
+        for (int k = 0; k < M; ++k)
+          b.texels[static_cast<std::size_t>(k / 4) * layerStride + texel + static_cast<std::size_t>(k % 4)] =
+              storeFiltered(F[static_cast<std::size_t>(k)], options.format);
+      }
+    }
+  });
+  return b;
+}
+
+glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
+                              const glm::dvec3& viewDirection) {
+  return light.irradiance() * medium.scatteringTimesPhase(glm::dot(light.direction(), -viewDirection));
+}
+
+Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+               const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
+  validateBasis(basis);
+  validateCameraDepth(cameraDepth);
+  validateEvaluateOptions(options);
+  const RectifiedLayout& layout = *basis.layout;
+  const int w = cameraDepth.width(), h = cameraDepth.height(), M = basis.bases, R = basis.regions;
+  const int n = basis.regionWidth();
+  const glm::dvec3 sigma = medium.extinction();
+  const double greySigma = weightExtinction(medium);
+  const glm::dvec3 origin = camera.position();
+  Image out(w, h, 4);
+  detail::parallelRows(h, options.threads, [&](int y) {
+    std::array<double, kMaxBases> a{}, Fa{}, Fb{};
+    const std::span<double> aSpan(a.data(), static_cast<std::size_t>(M));
+    for (int x = 0; x < w; ++x) {
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      const glm::dvec3 C = scatteringConstant(light, medium, ray.direction);
+      glm::dvec3 L(0.0);
+      MappedRay m;
+      if (!mapRay(layout, origin, ray, basis.regionsPerSplit, options.nearPlaneCorrection, m)) {
+        L = C * transmittanceIntegral(sigma, ray.start, ray.surface);
+      } else {
+        fourierCoefficients(rayBasisDepth(m.depth, basis.depthMargin), aSpan);
+        applyRingingFilter(options.ringing, aSpan);
+        const int nearestRow =
+            std::clamp(static_cast<int>(std::floor(m.row * basis.height)), 0, basis.height - 1);
+        forEachSegment(layout, ray, m, R, [&](int r, double ua, double ub, double ta, double tb) {
+          sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data());
+          double dot = 0.0;
+          bool plain = ua <= 0.0;
+          if (!plain) {
+            // Near-plane correction: the prefix difference of one region, each prefix restored by its own
+            // weight total (Appendix A), then renormalized by the segment's total.
+            const DistanceProfile& p =
+                basis.profiles[static_cast<std::size_t>(nearestRow) * static_cast<std::size_t>(R) +
+                               static_cast<std::size_t>(r)];
+            const double wa = regionWeightTotal(basis.weights, basis.extinction, p, n, ua);
+            const double wb = regionWeightTotal(basis.weights, basis.extinction, p, n, ub);
+            if (wb - wa > 1e-12 * wb) {
+              sampleFiltered(basis, options.sampling, r, ua, m.row, Fa.data());
+              for (int k = 0; k < M; ++k) {
+                const auto kk = static_cast<std::size_t>(k);
+                dot += a[kk] * (wb * Fb[kk] - wa * Fa[kk]);
+              }
+              dot /= wb - wa;
+            } else {
+              plain = true;
+            }
+          }
+          if (plain)
+            for (int k = 0; k < M; ++k)
+              dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
+          const double V = std::clamp(0.5 + dot, 0.0, 1.0);
+          L += C * V * transmittanceIntegral(sigma, ta, tb);
+        });
+      }
+      out.at(x, y, 0) = static_cast<float>(L.x);
+      out.at(x, y, 1) = static_cast<float>(L.y);
+      out.at(x, y, 2) = static_cast<float>(L.z);
+      out.at(x, y, 3) = static_cast<float>(std::exp(-greySigma * ray.surface));
+    }
+  });
+  return out;
+}
+
+Image marchReference(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                     const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
+  validate(map);
+  validateCameraDepth(cameraDepth);
+  validateEvaluateOptions(options);
+  const RectifiedLayout& layout = *map.layout;
+  const int w = cameraDepth.width(), h = cameraDepth.height();
+  const int W = map.width(), H = map.height(), K = layout.regionCount(), n = W / K;
+  const glm::dvec3 sigma = medium.extinction();
+  const double greySigma = weightExtinction(medium);
+  const glm::dvec3 origin = camera.position();
+  Image out(w, h, 4);
+  detail::parallelRows(h, options.threads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      const glm::dvec3 C = scatteringConstant(light, medium, ray.direction);
+      glm::dvec3 L(0.0);
+      MappedRay m;
+      if (!mapRay(layout, origin, ray, 1, options.nearPlaneCorrection, m)) {
+        L = C * transmittanceIntegral(sigma, ray.start, ray.surface);
+      } else {
+        const int j = std::clamp(static_cast<int>(std::floor(m.row * H)), 0, H - 1);
+        const double zr = m.depth;
+        forEachSegment(layout, ray, m, K, [&](int r, double ua, double ub, double ta, double tb) {
+          const DistanceProfile p = layout.rayProfile(m.row, m.depth, r);
+          const int i0 = std::clamp(static_cast<int>(std::floor(ua * n)), 0, n - 1);
+          const int i1 = std::clamp(static_cast<int>(std::ceil(ub * n)) - 1, i0, n - 1);
+          double t = ta;
+          for (int i = i0; i <= i1; ++i) {
+            // The ray's own distance at the texel's right edge, clipped to the segment; the part of region 0
+            // in front of the map (camera to column 0) takes the first texel's visibility.
+            const double tEnd = i == i1 ? tb : std::clamp(p(static_cast<double>(i + 1) / n), t, tb);
+            const bool lit = map.depth.at(r * n + i, j) >= zr;
+            if (lit) L += C * transmittanceIntegral(sigma, t, tEnd);
+            t = tEnd;
+          }
+        });
+      }
+      out.at(x, y, 0) = static_cast<float>(L.x);
+      out.at(x, y, 1) = static_cast<float>(L.y);
+      out.at(x, y, 2) = static_cast<float>(L.z);
+      out.at(x, y, 3) = static_cast<float>(std::exp(-greySigma * ray.surface));
+    }
+  });
+  return out;
+}
+
+Image unshadowedScattering(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                           const Medium& medium, const EvaluateOptions& options) {
+  validateCameraDepth(cameraDepth);
+  validateEvaluateOptions(options);
+  const int w = cameraDepth.width(), h = cameraDepth.height();
+  const glm::dvec3 sigma = medium.extinction();
+  const double greySigma = weightExtinction(medium);
+  Image out(w, h, 4);
+  detail::parallelRows(h, options.threads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      const glm::dvec3 L = scatteringConstant(light, medium, ray.direction) *
+                           transmittanceIntegral(sigma, ray.start, ray.surface);
+      out.at(x, y, 0) = static_cast<float>(L.x);
+      out.at(x, y, 1) = static_cast<float>(L.y);
+      out.at(x, y, 2) = static_cast<float>(L.z);
+      out.at(x, y, 3) = static_cast<float>(std::exp(-greySigma * ray.surface));
+    }
+  });
+  return out;
+}
+
+} // namespace crep
