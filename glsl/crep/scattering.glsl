@@ -1,0 +1,420 @@
+// crepuscular: prefiltered single scattering on a rectified shadow map (Klehm, Seidel, Eisemann 2014,
+// "Filter-based real-time single scattering using rectified shadow maps", JCGT 3(3)), the per-pixel
+// half: Fourier coefficients (Eq. 8), the constant-time evaluation of a view ray (Listing 4,
+// Appendix A), generalised to prefilter regions exactly as crep::evaluate() (crep/prefilter/prefilter.h,
+// "Evaluation") does it, and the weight and basis helpers the prefilter pass shares with it.
+//
+// Public include (see crep/common.glsl for the conventions). How an engine uses it in its own deferred
+// or forward shader:
+//
+//   #define CREP_SCATTERING_BINDING 3      // uniform buffer binding of CrepScatteringBlock (default 0)
+//   #define CREP_FILTERED_BASIS_UNIT 5     // texture unit of the filtered basis (default 0)
+//   #include "crep/scattering.glsl"
+//   ...
+//   vec4 s = crep_inScattering(cameraPosition, viewDirection, surfaceDistance);
+//   color = surface * s.a + s.rgb;
+//
+// C++ side: bind PrefilterPass::filteredBasisTexture() (GL_TEXTURE_2D_ARRAY; GL_LINEAR filtering and
+// clamp to edge, as the pass sets them) to the unit and a uniform buffer holding the gpu::ScatteringParams
+// of makeScatteringParams() (crep/prefilter/gpu_pass.h) to the binding.
+//
+// Entry points: crep_inScattering(origin, dir, surfaceDistance), crep_inScatteringAt(worldPosition),
+// crep_inScatteringSegment(origin, dir, start, surface). They return vec4(in-scattered radiance,
+// grey transmittance to the surface). Scope as crep::evaluate: a directional light and a projective
+// rectification (the block holds its frame and split zetas).
+//
+// Options (#define before the include; every one has a default):
+//   CREP_SCATTERING_BINDING, CREP_FILTERED_BASIS_UNIT    resources above
+//   CREP_BASES                 M, when known at compile time (loops get constant bounds); must then equal
+//                              the filtered basis's M. Without it M comes from the uniform block.
+//   CREP_NEAR_PLANE_CORRECTION 1: Sec. 3.1's near-plane correction (crep_inScatteringSegment with start > 0);
+//                              also declares the region-weights storage buffer (PrefilterPass::
+//                              regionWeightsBuffer()) at CREP_REGION_WEIGHTS_BINDING (default 1).
+//   CREP_RINGING_LANCZOS       1: damp the ray coefficients with Lanczos sigma factors (crep::RingingFilter::
+//                              Lanczos, fourier.h; not in the paper); default 0 = Eq. 8 as published
+//   CREP_NO_FP64               1: reduce Fourier angles in float (default: in double, see crep_halfTurns)
+//   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
+#ifndef CREP_SCATTERING_GLSL
+#define CREP_SCATTERING_GLSL
+
+#include "common.glsl"
+#include "phase.glsl"
+#include "scattering_structs.glsl"
+
+#ifndef CREP_NEAR_PLANE_CORRECTION
+#define CREP_NEAR_PLANE_CORRECTION 0
+#endif
+#ifndef CREP_NO_FP64
+#define CREP_NO_FP64 0
+#endif
+#ifndef CREP_RINGING_LANCZOS
+#define CREP_RINGING_LANCZOS 0
+#endif
+
+// ---------------------------------------------------------------------------------------------------
+// Fourier basis and coefficients (Eq. 8). Harmonic h = 0, 1, ... is the paper's k = h + 1, with
+// c_k = pi (2k - 1) = pi (2h + 1). Bases are packed four per RGBA texel as crep::fourierBasis orders
+// them: (B_{2k-1}, B_{2k}, B_{2k+1}, B_{2k+2}) = (sin c_k z, cos c_k z, sin c_{k+1} z, cos c_{k+1} z),
+// so layer l holds harmonics 2l and 2l + 1.
+//
+// Accuracy: the highest harmonic reaches (2h + 1) pi ~ 400 rad for M = 128, where a float angle is only
+// good to ~2e-5 rad. Angles are therefore reduced in half turns, exactly in double (x mod 2), and only
+// the reduced value goes to float; sin and cos of pi r come from crep_sincospi, whose reduction is exact
+// too. Harmonics inside a group advance by the angle-addition recurrence (one sin/cos pair per group).
+// Measured against the double CPU prefilter (RGBA32F, llvmpipe): max error of the stored basis 8e-7 for
+// M = 32 and M = 128 with the double reduction, 1.8e-6 / 1.1e-5 with CREP_NO_FP64.
+
+#if CREP_NO_FP64
+#define CREP_REAL float
+#else
+#define CREP_REAL double
+#endif
+
+// x mod 2 in [-1, 1): the angle pi x reduced to one turn (exact in double).
+float crep_halfTurns(CREP_REAL x) {
+  return float(x - CREP_REAL(2.0) * floor(x * CREP_REAL(0.5) + CREP_REAL(0.5)));
+}
+
+// (sin(pi x), cos(pi x)) for |x| < 2^22, within a few ulp: exact reduction to r in [-1/4, 1/4] and the
+// quadrant, then Taylor polynomials of degree 9 / 10 in r (truncation below 1e-8).
+vec2 crep_sincospi(float x) {
+  float k = round(2.0 * x);
+  float r = x - 0.5 * k;
+  float r2 = r * r;
+  float s = r * (3.14159265358979 +
+                 r2 * (-5.16771278004997 + r2 * (2.55016403987735 + r2 * (-0.599264529320792 + r2 * 0.0821458866111282))));
+  float c = 1.0 + r2 * (-4.93480220054468 +
+                        r2 * (4.05871212641677 + r2 * (-1.33526276885459 + r2 * (0.235330630358893 + r2 * -0.0258068913900914))));
+  int q = int(k) & 3;
+  if (q == 0) return vec2(s, c);
+  if (q == 1) return vec2(c, -s);
+  if (q == 2) return vec2(-s, -c);
+  return vec2(-c, s);
+}
+
+// (sin, cos) of c_k z for harmonic h (k = h + 1): the start of a recurrence.
+vec2 crep_harmonic(int h, CREP_REAL z) { return crep_sincospi(crep_halfTurns(CREP_REAL(2 * h + 1) * z)); }
+
+// (sin, cos) of the recurrence step 2 pi z between consecutive harmonics.
+vec2 crep_harmonicStep(CREP_REAL z) { return crep_sincospi(crep_halfTurns(CREP_REAL(2.0) * z)); }
+
+// Angle addition: (sin, cos) of a + b from those of a and b.
+vec2 crep_rotate(vec2 a, vec2 b) { return vec2(a.x * b.y + a.y * b.x, a.y * b.y - a.x * b.x); }
+
+// The depth fed to B for a stored map depth (crep::texelBasisDepth, fourier.h): the exact end values 0
+// (caster clamped in front) and 1 (nothing) stay, the rest moves into [m, 1 - m].
+CREP_REAL crep_texelBasisDepth(float depth, float margin) {
+  if (depth >= 1.0) return CREP_REAL(1.0);
+  if (depth <= 0.0) return CREP_REAL(0.0);
+  return CREP_REAL(margin) + (CREP_REAL(1.0) - CREP_REAL(2.0) * CREP_REAL(margin)) * CREP_REAL(depth);
+}
+
+// The depth fed to a for a view ray (crep::rayBasisDepth): m + (1 - 2m) clamp(depth, 0, 1).
+CREP_REAL crep_rayBasisDepth(float depth, float margin) {
+  return CREP_REAL(margin) + (CREP_REAL(1.0) - CREP_REAL(2.0) * CREP_REAL(margin)) * CREP_REAL(clamp(depth, 0.0, 1.0));
+}
+
+// Eq. 8 coefficients of harmonics h and h + 1 in basis order: (a_{2k-1}, a_{2k}, a_{2k+1}, a_{2k+2}) =
+// (2 cos / c_k, -2 sin / c_k, 2 cos / c_{k+1}, -2 sin / c_{k+1}) from their (sin, cos).
+vec4 crep_coefficients4(int h, vec2 first, vec2 second) {
+  float g0 = 2.0 / (float(CREP_PI) * float(2 * h + 1));
+  float g1 = 2.0 / (float(CREP_PI) * float(2 * h + 3));
+  return vec4(g0 * first.y, -g0 * first.x, g1 * second.y, -g1 * second.x);
+}
+
+// Lanczos sigma factor sin(x) / x, x = pi (2h + 1) / M, of harmonic h (crep::ringingFactor).
+float crep_lanczosFactor(int h, int bases) {
+  float x = float(2 * h + 1) / float(bases);
+  return crep_sincospi(x).x / (float(CREP_PI) * x);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Weights (crep/prefilter/weights.h; Eq. 11 and its variants). s is the scalar weight extinction.
+
+// phi(x) = (1 - exp(-x)) / x for x >= 0, phi(0) = 1, +inf -> 0 (crep::oneMinusExpOverX): the series
+// below 1/4 (truncation < 2e-9) keeps the sigma -> 0 limit exact and free of cancellation.
+float crep_oneMinusExpOverX(float x) {
+  if (x < 0.25)
+    return 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0 - x * (1.0 / 720.0 - x / 5040.0)))));
+  return (1.0 - exp(-x)) / x;
+}
+
+// exp(x) - 1 without cancellation near 0 (series below 1/4, truncation < 1e-8 relative).
+float crep_expm1(float x) {
+  if (abs(x) < 0.25)
+    return x * (1.0 + x * (1.0 / 2.0 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0 + x / 720.0)))));
+  return exp(x) - 1.0;
+}
+
+// Transmittance integral of one segment divided by sigma: (exp(-sigma ta) - exp(-sigma tb)) / sigma,
+// = tb - ta for sigma -> 0 (Eq. 3 per segment), per channel.
+vec3 crep_transmittanceIntegral(vec3 sigma, float ta, float tb) {
+  float len = tb - ta;
+  if (!(len > 0.0)) return vec3(0.0);
+  vec3 x = sigma * len;
+  return exp(-sigma * ta) * len *
+         vec3(crep_oneMinusExpOverX(x.r), crep_oneMinusExpOverX(x.g), crep_oneMinusExpOverX(x.b));
+}
+
+// The weight mode's distance tau from the region's start at fractional texel position x = u n (see
+// gpu::RegionWeights); a negative value stands for +infinity.
+float crep_regionDistance(CrepRegionWeights w, int mode, int n, float x) {
+  if (w.valid == 0) return -1.0;
+  if (mode == CREP_WEIGHTS_EXACT) {
+    float u = x / float(n);
+    float den = w.c + w.d * u;
+    return den > 0.0 ? u * w.scale / den : -1.0;
+  }
+  if (mode == CREP_WEIGHTS_CONSTANT_STEP) return x * w.scale;
+  if (mode == CREP_WEIGHTS_CONSTANT_RATIO) return w.c == 0.0 ? x * w.scale : w.scale * crep_expm1(x * w.c);
+  return x;
+}
+
+// Listing 2's mix factor of texel i of an n-texel region (crep::regionMixFactors): w_i / sum_{j<=i} w_j
+// with w_i = exp(-s tau_i) - exp(-s tau_{i+1}), written with phi so that s = 0 is the length-weighted
+// mean. Texel lengths come without the cancellation of tau_{i+1} - tau_i.
+float crep_mixFactor(CrepRegionWeights w, int mode, float s, int i, int n) {
+  if (mode == CREP_WEIGHTS_AVERAGE_VISIBILITY) return 1.0 / float(i + 1);
+  if (i == 0) return 1.0;
+  if (w.valid == 0) return 0.0;
+  float t0, t1, dt;
+  if (mode == CREP_WEIGHTS_EXACT) {
+    float u0 = float(i) / float(n), u1 = float(i + 1) / float(n);
+    float den0 = w.c + w.d * u0, den1 = w.c + w.d * u1;
+    if (!(den0 > 0.0) || !(den1 > 0.0)) return 0.0; // beyond a spot light's horizon
+    t0 = u0 * w.scale / den0;
+    t1 = u1 * w.scale / den1;
+    dt = w.scale * w.c / (float(n) * den0 * den1);
+  } else if (mode == CREP_WEIGHTS_CONSTANT_STEP) {
+    t0 = float(i) * w.scale;
+    t1 = float(i + 1) * w.scale;
+    dt = w.scale;
+  } else { // CREP_WEIGHTS_CONSTANT_RATIO: tau_i = D0 (r^i - 1) / (r - 1), step D0 r^i
+    if (w.c == 0.0) {
+      t0 = float(i) * w.scale;
+      t1 = float(i + 1) * w.scale;
+      dt = w.scale;
+    } else {
+      t0 = w.scale * crep_expm1(float(i) * w.c);
+      t1 = w.scale * crep_expm1(float(i + 1) * w.c);
+      dt = w.d * exp(float(i) * w.c);
+    }
+  }
+  float num = exp(-s * t0) * crep_oneMinusExpOverX(s * dt) * dt;
+  float den = crep_oneMinusExpOverX(s * t1) * t1;
+  if (!(den > 0.0)) return 1.0 / float(i + 1);
+  float m = num / den;
+  return m >= 0.0 ? min(m, 1.0) : 0.0; // also sends NaN (float overflow far out) to 0
+}
+
+// The weight total of the first u n texels divided by s (crep::regionWeightTotal): tau phi(s tau).
+float crep_regionWeightTotal(CrepRegionWeights w, int mode, float s, int n, float u) {
+  if (mode == CREP_WEIGHTS_AVERAGE_VISIBILITY) return u * float(n);
+  float tau = crep_regionDistance(w, mode, n, u * float(n));
+  if (tau < 0.0) return s > 0.0 ? 1.0 / s : 3.0e38;
+  return tau * crep_oneMinusExpOverX(s * tau);
+}
+
+#ifndef CREP_SCATTERING_NO_EVALUATION
+// ---------------------------------------------------------------------------------------------------
+// Evaluation (Listing 4 + Appendix A, regions as in crep::evaluate).
+
+#ifndef CREP_SCATTERING_BINDING
+#define CREP_SCATTERING_BINDING 0
+#endif
+#ifndef CREP_FILTERED_BASIS_UNIT
+#define CREP_FILTERED_BASIS_UNIT 0
+#endif
+#ifndef CREP_REGION_WEIGHTS_BINDING
+#define CREP_REGION_WEIGHTS_BINDING 1
+#endif
+
+layout(std140, binding = CREP_SCATTERING_BINDING) uniform CrepScatteringBlock { CrepScatteringParams crep_scattering; };
+layout(binding = CREP_FILTERED_BASIS_UNIT) uniform sampler2DArray crep_filteredBasis;
+#if CREP_NEAR_PLANE_CORRECTION
+layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegionWeightsBlock {
+  CrepRegionWeights crep_regionWeights[];
+};
+#endif
+
+#ifdef CREP_BASES
+#define CREP_EVAL_LAYERS ((CREP_BASES + 3) / 4)
+#define CREP_EVAL_HALF (CREP_BASES / 2)
+#define CREP_EVAL_MAX_LAYERS ((CREP_BASES + 3) / 4)
+#else
+#define CREP_EVAL_LAYERS crep_scattering.basisInfo.y
+#define CREP_EVAL_HALF (crep_scattering.basisInfo.x / 2)
+#define CREP_EVAL_MAX_LAYERS 32
+#endif
+
+// A world point in the rectified map (crep::Rectification::toRectified): slopes y = Y / X, z = Z / X,
+// normalized row and depth, split k and the column within it.
+struct CrepRectPoint {
+  float y, z;
+  float row, depth;
+  int split;
+  float splitColumn;
+};
+
+// `offset` = point - frame origin (world). False where the rectification cannot map it (X <= 0).
+bool crep_toRectified(vec3 offset, out CrepRectPoint p) {
+  float X = dot(crep_scattering.frameAxisX.xyz, offset);
+  p = CrepRectPoint(0.0, 0.0, 0.0, 0.0, 0, 0.0);
+  if (!(X > 0.0)) return false;
+  float Y = dot(crep_scattering.frameAxisY.xyz, offset), Z = dot(crep_scattering.frameAxisZ.xyz, offset);
+  p.y = Y / X;
+  p.z = Z / X;
+  p.row = (p.y - crep_scattering.slopes.x) * crep_scattering.slopes.y;
+  p.depth = (p.z - crep_scattering.slopes.z) * crep_scattering.slopes.w;
+  float zeta = (1.0 + crep_scattering.frameAxisX.w * Z) / X;
+  int K = crep_scattering.mapSize.w;
+  int k = 0;
+  while (k < K - 1 && zeta < crep_scattering.splitZeta[k].y) ++k;
+  vec2 range = crep_scattering.splitZeta[k].xy;
+  p.split = k;
+  p.splitColumn = (range.x - zeta) / (range.x - range.y);
+  return true;
+}
+
+// The prefilter region r = k P + q of a mapped point and its column u in [0, 1] inside it.
+void crep_regionPoint(CrepRectPoint p, out int region, out float u) {
+  int K = crep_scattering.mapSize.w, P = crep_scattering.basisInfo.z;
+  int k = clamp(p.split, 0, K - 1);
+  float uk = clamp(p.splitColumn, 0.0, 1.0);
+  int q = min(int(floor(uk * float(P))), P - 1);
+  region = k * P + q;
+  u = clamp(uk * float(P) - float(q), 0.0, 1.0);
+}
+
+// World distance along the view ray of slopes (y, z) to the boundary column b / R of the prefilter
+// regions (crep::Rectification::rayDistance); 3e38 where the ray never gets there.
+float crep_boundaryDistance(float y, float z, int b) {
+  int K = crep_scattering.mapSize.w, P = crep_scattering.basisInfo.z;
+  int k = b / P;
+  float u = float(b - k * P) / float(P);
+  if (k >= K) {
+    k = K - 1;
+    u = 1.0;
+  }
+  vec2 range = crep_scattering.splitZeta[k].xy;
+  float den = range.x + u * (range.y - range.x) - crep_scattering.frameAxisX.w * z;
+  return den > 0.0 ? sqrt(1.0 + y * y + z * z) / den : 3.0e38;
+}
+
+// The decoded filtered basis F = 2 e - 1 of one layer at prefix boundary u of region r and normalized
+// row (crep::evaluate's sampling rule: texel x = clamp(u n - 1, 0, n - 1) of the region, y = clamp(row H
+// - 0.5, 0, H - 1)). The sampler's GL_LINEAR / GL_NEAREST does the filtering; x never leaves the region.
+vec4 crep_filteredBasisAt(int region, float u, float row, int layer) {
+  int W = crep_scattering.mapSize.x, H = crep_scattering.mapSize.y, n = W / crep_scattering.mapSize.z;
+  float x = clamp(u * float(n) - 1.0, 0.0, float(n - 1));
+  float y = clamp(row * float(H) - 0.5, 0.0, float(H - 1));
+  vec3 coord = vec3((float(region * n) + x + 0.5) / float(W), (y + 0.5) / float(H), float(layer));
+  return 2.0 * textureLod(crep_filteredBasis, coord, 0.0) - 1.0;
+}
+
+// C of Eq. 1 for a view direction (unit, from the camera): irradiance * sigma_s * phase, per channel.
+vec3 crep_scatteringConstant(vec3 viewDirection) {
+  float cosTheta = dot(crep_scattering.lightDirection.xyz, -viewDirection);
+  return crep_scattering.lightIrradiance.rgb *
+         (crep_scattering.mieScattering.rgb * crep_henyeyGreenstein(crep_scattering.mieScattering.w, cosTheta) +
+          crep_scattering.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
+}
+
+// In-scattered radiance along the ray origin + t dir, t in [start, surface] (world units; dir unit),
+// and the grey transmittance to the surface: vec4(L.rgb, exp(-mean(sigma_t) surface)).
+// The visibility of each prefilter region the ray crosses is clamp(0.5 + a(z_r) . F, 0, 1) with F the
+// region's normalized filtered basis at the ray's end in it (Appendix A), weighted by the ray's own
+// transmittance integral over that region (Eq. 3, 11). start > 0 needs CREP_NEAR_PLANE_CORRECTION.
+vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface) {
+  vec3 sigma = crep_scattering.extinction.rgb;
+  vec3 C = crep_scatteringConstant(dir);
+  float transmittance = exp(-dot(sigma, vec3(1.0 / 3.0)) * surface);
+  vec3 offset = origin - crep_scattering.frameOrigin.xyz;
+  CrepRectPoint hit;
+  if (!crep_toRectified(offset + surface * dir, hit))
+    return vec4(C * crep_transmittanceIntegral(sigma, start, surface), transmittance);
+  int lastRegion, firstRegion = 0;
+  float lastU, firstU = 0.0;
+  crep_regionPoint(hit, lastRegion, lastU);
+#if CREP_NEAR_PLANE_CORRECTION
+  if (start > 0.0) {
+    CrepRectPoint nearPoint;
+    if (!crep_toRectified(offset + start * dir, nearPoint))
+      return vec4(C * crep_transmittanceIntegral(sigma, start, surface), transmittance);
+    crep_regionPoint(nearPoint, firstRegion, firstU);
+    if (firstRegion > lastRegion || (firstRegion == lastRegion && firstU > lastU)) {
+      firstRegion = lastRegion;
+      firstU = lastU;
+    }
+  }
+#else
+  start = 0.0;
+#endif
+
+  // Eq. 8 coefficients of the ray, by recurrence from one reduced sin/cos pair.
+  float margin = crep_scattering.depthMargin.x;
+  CREP_REAL zr = crep_rayBasisDepth(hit.depth, margin);
+  vec2 stepSC = crep_harmonicStep(zr);
+  vec2 sc = crep_harmonic(0, zr);
+  vec4 a[CREP_EVAL_MAX_LAYERS];
+  for (int l = 0; l < CREP_EVAL_LAYERS; ++l) {
+    vec2 next = crep_rotate(sc, stepSC);
+    a[l] = crep_coefficients4(2 * l, sc, next);
+#if CREP_RINGING_LANCZOS
+    a[l] *= vec4(vec2(crep_lanczosFactor(2 * l, 2 * CREP_EVAL_HALF)), vec2(crep_lanczosFactor(2 * l + 1, 2 * CREP_EVAL_HALF)));
+#endif
+    if (2 * l + 1 >= CREP_EVAL_HALF) a[l].zw = vec2(0.0); // M % 4 == 2: the last layer holds one harmonic
+    sc = crep_rotate(next, stepSC);
+  }
+
+  vec3 L = vec3(0.0);
+  float ta = start;
+#if CREP_NEAR_PLANE_CORRECTION
+  int R = crep_scattering.mapSize.z, n = crep_scattering.mapSize.x / R;
+  int nearestRow = clamp(int(floor(hit.row * float(crep_scattering.mapSize.y))), 0, crep_scattering.mapSize.y - 1);
+  int mode = crep_scattering.basisInfo.w;
+  float s = crep_scattering.extinction.w;
+#endif
+  for (int r = firstRegion; r <= lastRegion; ++r) {
+    float ua = r == firstRegion ? firstU : 0.0;
+    float ub = r == lastRegion ? lastU : 1.0;
+    float tb = r == lastRegion ? surface : crep_boundaryDistance(hit.y, hit.z, r + 1);
+    tb = clamp(tb, ta, surface);
+    float dotF = 0.0;
+    bool plain = true;
+#if CREP_NEAR_PLANE_CORRECTION
+    if (ua > 0.0) {
+      // The prefix difference of one region, each prefix restored by its own weight total.
+      CrepRegionWeights w = crep_regionWeights[nearestRow * R + r];
+      float wa = crep_regionWeightTotal(w, mode, s, n, ua), wb = crep_regionWeightTotal(w, mode, s, n, ub);
+      if (wb - wa > 1e-12 * wb) {
+        plain = false;
+        for (int l = 0; l < CREP_EVAL_LAYERS; ++l)
+          dotF += dot(a[l], wb * crep_filteredBasisAt(r, ub, hit.row, l) - wa * crep_filteredBasisAt(r, ua, hit.row, l));
+        dotF /= wb - wa;
+      }
+    }
+#endif
+    if (plain)
+      for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(r, ub, hit.row, l));
+    float V = clamp(0.5 + dotF, 0.0, 1.0);
+    L += C * V * crep_transmittanceIntegral(sigma, ta, tb);
+    ta = tb;
+  }
+  return vec4(L, transmittance);
+}
+
+// In-scattering from the camera (origin) to the surface at distance `surface` along `dir` (unit):
+// vec4(radiance, grey transmittance). Sky pixels: pass the far-plane distance (the map has no
+// information beyond it); composite as surface * result.a + result.rgb.
+vec4 crep_inScattering(vec3 origin, vec3 dir, float surface) { return crep_inScatteringSegment(origin, dir, 0.0, surface); }
+
+// The same for a world-space surface point seen from the rectification's camera.
+vec4 crep_inScatteringAt(vec3 worldPosition) {
+  vec3 d = worldPosition - crep_scattering.frameOrigin.xyz;
+  float t = length(d);
+  return crep_inScattering(crep_scattering.frameOrigin.xyz, t > 0.0 ? d / t : crep_scattering.frameAxisX.xyz, t);
+}
+
+#endif // CREP_SCATTERING_NO_EVALUATION
+#endif // CREP_SCATTERING_GLSL

@@ -1,0 +1,53 @@
+#version 450 core
+// Evaluation pass of prefiltered single scattering (Klehm, Seidel, Eisemann 2014, Sec. 3.3 "Evaluating a
+// Ray", Listing 4): one invocation per camera pixel reconstructs the view ray from the camera depth
+// buffer and evaluates it with crep_inScatteringSegment (crep/scattering.glsl). Pixel rays, the sky rule
+// and the near-plane start are crep::evaluate()'s (crep/prefilter/prefilter.h, "Evaluation"). Output:
+// RGB in-scattered radiance, A grey transmittance to the surface. Driven by crep::EvaluatePass.
+#ifndef CREP_OUTPUT_FORMAT
+#define CREP_OUTPUT_FORMAT rgba32f // rgba32f or rgba16f
+#endif
+#ifndef CREP_LOCAL_SIZE_X
+#define CREP_LOCAL_SIZE_X 8
+#endif
+#ifndef CREP_LOCAL_SIZE_Y
+#define CREP_LOCAL_SIZE_Y 8
+#endif
+#ifndef CREP_EVALUATE_BINDING
+#define CREP_EVALUATE_BINDING 1 // uniform buffer binding of CrepEvaluateBlock
+#endif
+#ifndef CREP_CAMERA_DEPTH_UNIT
+#define CREP_CAMERA_DEPTH_UNIT 1
+#endif
+#include "crep/scattering.glsl"
+
+layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y) in;
+
+layout(binding = CREP_CAMERA_DEPTH_UNIT) uniform sampler2D crep_cameraDepth; // depth-buffer values in [0, 1]
+layout(binding = 0, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
+layout(std140, binding = CREP_EVALUATE_BINDING) uniform CrepEvaluateBlock { CrepEvaluateParams crep_evaluate; };
+
+// View-space distance of a depth-buffer value (GL perspective, glDepthRange(0, 1)), written as
+// near far / (near + (1 - d)(far - near)): 1 - d is exact for d >= 1/2, so there is no cancellation
+// where crep_linearDepth's (2d - 1) form loses digits (d near 1).
+float crep_viewDepth(float d, float zNear, float zFar) { return zNear * zFar / (zNear + (1.0 - d) * (zFar - zNear)); }
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = crep_evaluate.imageSize.xy;
+  if (any(greaterThanEqual(pixel, size))) return;
+  float zNear = crep_evaluate.cameraPosition.w, zFar = crep_evaluate.cameraForward.w;
+  vec3 forward = crep_evaluate.cameraForward.xyz;
+  vec2 ndc = 2.0 * (vec2(pixel) + 0.5) / vec2(size) - 1.0;
+  vec3 dir = normalize(forward + ndc.x * crep_evaluate.cameraRight.xyz + ndc.y * crep_evaluate.cameraUp.xyz);
+  float cosForward = dot(dir, forward);
+  float d = texelFetch(crep_cameraDepth, pixel, 0).r;
+  // Sky (d >= 1, also NaN): integrate to the far plane; d < 0 is treated as 0 (the near plane).
+  float viewDepth = d < 1.0 ? crep_viewDepth(max(d, 0.0), zNear, zFar) : zFar;
+  float surface = viewDepth / cosForward;
+  float start = 0.0;
+#if CREP_NEAR_PLANE_CORRECTION
+  start = min(zNear / cosForward, surface);
+#endif
+  imageStore(crep_scatteringOut, pixel, crep_inScatteringSegment(crep_evaluate.cameraPosition.xyz, dir, start, surface));
+}

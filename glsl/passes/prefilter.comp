@@ -1,0 +1,96 @@
+#version 450 core
+// Prefilter pass of prefiltered single scattering (Klehm, Seidel, Eisemann 2014, Sec. 3.3): the basis
+// transform fused into the weighted prefix filter (Listing 3 + Listing 2), with the normalized storage
+// of Appendix A. The rules are crep::prefilter()'s (crep/prefilter/prefilter.h, "Prefilter"):
+//   z_i = texelBasisDepth(depth(i, j), m),  F_i = F_{i-1} + m_i (B(z_i) - F_{i-1}),  F_{-1} = 0,
+//   stored e_i = 0.5 + 0.5 F_i  (rounded as the RGBA8 rule says when CREP_BASIS_UNORM8 is 1).
+// One invocation filters one row j (x), one group of CREP_BASES_PER_INVOCATION bases (y) and one
+// prefilter region r (z), left to right over the region's n texels (Table 1's two parallelization
+// factors: bases per invocation, regions per row). Driven by crep::PrefilterPass (gpu_pass.h).
+#define CREP_SCATTERING_NO_EVALUATION
+#include "crep/scattering.glsl"
+
+#ifndef CREP_BASES_PER_INVOCATION
+#define CREP_BASES_PER_INVOCATION 8 // a multiple of 4; the last group of bases may be partial
+#endif
+#ifndef CREP_BASIS_FORMAT
+#define CREP_BASIS_FORMAT rgba8 // image format of the filtered basis: rgba8, rgba16f or rgba32f
+#endif
+#ifndef CREP_BASIS_UNORM8
+#define CREP_BASIS_UNORM8 1 // 1: round to the RGBA8 rule before the store (CREP_BASIS_FORMAT rgba8)
+#endif
+#ifndef CREP_BASIS_HALF
+#define CREP_BASIS_HALF 0 // 1: round to the nearest binary16, ties to even, before the store (rgba16f)
+#endif
+#ifndef CREP_LOCAL_SIZE_X
+#define CREP_LOCAL_SIZE_X 64 // rows per workgroup
+#endif
+#ifndef CREP_LOCAL_SIZE_Y
+#define CREP_LOCAL_SIZE_Y 1 // base groups per workgroup
+#endif
+#ifndef CREP_LOCAL_SIZE_Z
+#define CREP_LOCAL_SIZE_Z 1 // regions per workgroup
+#endif
+
+#define CREP_GROUP_VEC4S (CREP_BASES_PER_INVOCATION / 4)
+
+layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y, local_size_z = CREP_LOCAL_SIZE_Z) in;
+
+layout(binding = 0) uniform sampler2D crep_rectifiedDepth; // W x H depth-buffer values in [0, 1]
+layout(binding = 0, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray crep_filteredBasisOut;
+layout(std140, binding = 0) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
+layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
+
+// The stored value e = 0.5 + 0.5 F, rounded by crep::storeFiltered's rule of the format, so that the
+// store itself is exact (the GL leaves the rounding of float -> unorm / half conversions open; Mesa
+// llvmpipe truncates to half).
+vec4 crep_encodeFiltered(vec4 F) {
+  vec4 e = 0.5 + 0.5 * F;
+#if CREP_BASIS_UNORM8
+  e = floor(clamp(e, 0.0, 1.0) * 255.0 + 0.5) / 255.0; // round half up
+#elif CREP_BASIS_HALF
+  // binary16 keeps 11 significant bits (quantum 2^(exponent - 11)), and a fixed quantum 2^-24 below 2^-14.
+  ivec4 exponent;
+  frexp(e, exponent);
+  vec4 quantum = ldexp(vec4(1.0), max(exponent - 11, ivec4(-24)));
+  e = roundEven(e / quantum) * quantum;
+#endif
+  return e;
+}
+
+void main() {
+  int row = int(gl_GlobalInvocationID.x), group = int(gl_GlobalInvocationID.y), region = int(gl_GlobalInvocationID.z);
+  int H = crep_prefilter.mapSize.y, R = crep_prefilter.mapSize.z, n = crep_prefilter.mapSize.w;
+  int M = crep_prefilter.basisInfo.x, layers = (M + 3) / 4;
+  int groups = (layers + CREP_GROUP_VEC4S - 1) / CREP_GROUP_VEC4S;
+  if (row >= H || group >= groups || region >= R) return;
+
+  int mode = crep_prefilter.basisInfo.z;
+  float s = crep_prefilter.weights.x, margin = crep_prefilter.weights.y;
+  CrepRegionWeights w = crep_regionWeights[row * R + region];
+  int firstHarmonic = group * (CREP_BASES_PER_INVOCATION / 2);
+  int firstLayer = group * CREP_GROUP_VEC4S;
+
+  vec4 F[CREP_GROUP_VEC4S];
+  for (int v = 0; v < CREP_GROUP_VEC4S; ++v) F[v] = vec4(0.0);
+
+  for (int i = 0; i < n; ++i) {
+    int x = region * n + i;
+    // Listing 3: the basis of the texel's depth (Eq. 8), computed here instead of read from a texture.
+    CREP_REAL z = crep_texelBasisDepth(texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r, margin);
+    vec2 stepSC = crep_harmonicStep(z);
+    vec2 sc = crep_harmonic(firstHarmonic, z);
+    // Listing 2: the normalized weighted prefix.
+    float m = crep_mixFactor(w, mode, s, i, n);
+    for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
+      int layer = firstLayer + v;
+      if (layer >= layers) break;
+      vec2 second = crep_rotate(sc, stepSC);
+      // M % 4 == 2: the last layer holds one harmonic; its other channels stay F = 0 (stored 0.5).
+      vec4 B = 2 * layer + 1 < M / 2 ? vec4(sc, second) : vec4(sc, 0.0, 0.0);
+      F[v] += m * (B - F[v]);
+      imageStore(crep_filteredBasisOut, ivec3(x, row, layer), crep_encodeFiltered(F[v]));
+      sc = crep_rotate(second, stepSC);
+    }
+  }
+}

@@ -1,0 +1,178 @@
+// GPU passes of prefiltered single scattering (Klehm, Seidel, Eisemann 2014, Sec. 3.3, Listings 2-4,
+// Appendix A) on OpenGL 4.5 compute shaders: PrefilterPass turns the caller's rectified depth texture
+// into the filtered-basis texture array, EvaluatePass turns the caller's camera depth texture into the
+// scattering image. They implement the rules of crep::prefilter() and crep::evaluate() (prefilter.h,
+// the CPU reference and contract) in float; tests/prefilter/PrefilterGpuGLTest.cpp states how closely.
+//
+// Effect-module conventions (STYLE.md): a CreateInfo fixes sizes, formats and quality once (programs and
+// textures are built in the constructor, owned by RAII and released in the destructor); a Frame carries
+// the per-frame inputs. Inputs are non-owning: GL names of the caller's textures and pointers to CPU
+// objects that must outlive the call. No pass creates, owns or changes the current GL context; each
+// needs one (OpenGL 4.5 core) current on the calling thread for its whole lifetime.
+//
+// GL state: run() binds its own programs, textures, samplers, images and buffers to the units and
+// binding points below and unbinds them (0) before returning; it does not restore the caller's bindings
+// there. It issues glMemoryBarrier so that the results can be sampled / image-loaded afterwards.
+//   PrefilterPass::run: texture unit 0 (+ sampler), image unit 0, uniform buffer 0, storage buffer 0.
+//   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0, uniform buffers 0 and 1,
+//                       storage buffer 1 (near-plane correction).
+// Engines that evaluate in their own shader use crep/scattering.glsl with filteredBasis() and
+// makeScatteringParams() (see that file's header).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <crep/core/camera.h>
+#include <crep/core/gl.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/prefilter/gpu_structs.h>
+#include <crep/prefilter/prefilter.h>
+#include <crep/rectify/rectified_map.h>
+
+namespace crep {
+
+/// A filtered basis on the GPU: the texture array and the parameters it was prefiltered with
+/// (everything evaluation needs besides the layout). Non-owning GL names.
+struct FilteredBasisView {
+  std::uint32_t texture = 0;       ///< GL_TEXTURE_2D_ARRAY, width x height x ceil(bases / 4) layers, RGBA
+  std::uint32_t regionWeights = 0; ///< buffer of height * R gpu::RegionWeights (near-plane correction)
+  int width = 0;                   ///< W, texels
+  int height = 0;                  ///< H, texels
+  int bases = kDefaultBases;       ///< M
+  int layoutRegions = 1;           ///< K, the layout's regionCount()
+  int regionsPerSplit = 1;         ///< P; prefilter regions R = K P
+  WeightMode weights = WeightMode::Exact; ///< weight mode used
+  double extinction = 0.0;                ///< scalar weight extinction s used (1/world unit)
+  double depthMargin = 0.0625;            ///< m of fourier.h used
+
+  int regions() const noexcept { return layoutRegions * regionsPerSplit; } ///< R
+};
+
+/// The GPU per-row data of the weights (gpu::RegionWeights, index row * R + region) from the reference
+/// profiles of referenceProfiles() (height * R of them) for regions of `texelsPerRegion` texels: the
+/// CPU half of the prefilter pass, computed in double. Throws InvalidArgument ("texelsPerRegion") if < 1.
+std::vector<gpu::RegionWeights> gpuRegionWeights(const std::vector<DistanceProfile>& profiles,
+                                                 WeightMode mode, int texelsPerRegion);
+
+/// The uniform block of crep/scattering.glsl for evaluating `basis` on a projective `layout` (the one it
+/// was prefiltered from) with a directional light and a medium. Throws InvalidArgument naming the
+/// parameter ("layout": not a ProjectiveLayout, or its region count differs from basis.layoutRegions or
+/// exceeds gpu::kMaxSplits; "FilteredBasisView": inconsistent sizes).
+gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const RectifiedLayout& layout,
+                                           const DirectionalLight& light, const Medium& medium);
+
+/// The prefilter pass (Listing 3 + 2): one compute dispatch over rows x groups of bases x regions.
+class PrefilterPass {
+public:
+  struct CreateInfo {
+    int width = 1024;          ///< map width W, texels; a multiple of the regions R = K P at run()
+    int height = 1024;         ///< map height H, texels (rows = epipolar slices)
+    int bases = kDefaultBases; ///< M, even, in [4, 128]; ceil(M / 4) RGBA layers
+    StorageFormat format = StorageFormat::RGBA8; ///< texture format of the filtered basis (Sec. 3.3)
+    WeightMode weights = WeightMode::Exact;      ///< filter weights (weights.h)
+    int regionsPerSplit = 1; ///< P, prefilter regions per layout region (Table 1 "regions"), >= 1
+    /// Bases one invocation filters (Table 1): a multiple of 4 in [4, 128] (the last group of a row may be
+    /// partial). On llvmpipe (1024^2 map, M = 32)
+    /// 32 is fastest (28 ms vs 45 ms for 8, 67 ms for 4): more invocations only repeat the depth reads
+    /// and weights on a CPU; GPUs prefer 8 (the paper's choice on an NVIDIA Titan).
+    int basesPerInvocation = 8;
+    double depthMargin = 0.0625; ///< m of fourier.h, in [0, 0.25]
+    int workgroupRows = 64;      ///< local_size_x: rows per workgroup, >= 1
+    int workgroupBaseGroups = 1; ///< local_size_y: groups of bases per workgroup, >= 1
+    int workgroupRegions = 1;    ///< local_size_z: regions per workgroup, >= 1
+
+    /// The CPU options that describe the same prefilter (for crep::prefilter()).
+    PrefilterOptions prefilterOptions() const;
+  };
+
+  struct Frame {
+    /// The caller's rectified map: a GL_TEXTURE_2D of width x height texels (any depth or float
+    /// format; channel r = depth-buffer value in [0, 1]), e.g. rendered with the split matrices and
+    /// SplitLayout::Regions. Read with texelFetch through the pass's own sampler (no compare mode).
+    std::uint32_t rectifiedDepth = 0;
+    const RectifiedLayout* layout = nullptr; ///< the map's layout (reference-ray profiles); not owned
+    const Medium* medium = nullptr;   ///< weight extinction = weightExtinction(*medium), unless overridden
+    double extinctionOverride = -1.0; ///< >= 0: use this weight extinction s instead (1/world unit)
+  };
+
+  /// Validates `info` (InvalidArgument naming the field, e.g. "PrefilterPass::CreateInfo.bases"; GlError
+  /// naming it when a size exceeds GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS or the compute
+  /// workgroup limits), compiles the program and allocates the filtered-basis texture array.
+  explicit PrefilterPass(const CreateInfo& info);
+  ~PrefilterPass();
+  PrefilterPass(PrefilterPass&&) noexcept;
+  PrefilterPass& operator=(PrefilterPass&&) noexcept;
+  PrefilterPass(const PrefilterPass&) = delete;
+  PrefilterPass& operator=(const PrefilterPass&) = delete;
+
+  /// Prefilters the frame's map into filteredBasisTexture(). Computes the per-row weights on the CPU
+  /// (height x R profiles of the layout, double) and uploads them, then dispatches. Throws
+  /// InvalidArgument naming the Frame field (null layout / medium, texture 0 or not a 2D texture of the
+  /// created size, width not a multiple of R, negative extinction).
+  void run(const Frame& frame);
+
+  const CreateInfo& createInfo() const noexcept { return info_; }
+  int layers() const noexcept { return (info_.bases + 3) / 4; }
+  /// GL_TEXTURE_2D_ARRAY of the filtered basis (GL_LINEAR, clamp to edge), valid after run().
+  std::uint32_t filteredBasisTexture() const noexcept { return texture_.get(); }
+  /// GL buffer of gpu::RegionWeights of the last run (for the near-plane correction).
+  std::uint32_t regionWeightsBuffer() const noexcept { return weightsBuffer_.get(); }
+  /// The filtered basis of the last run. Throws Error before the first run().
+  FilteredBasisView filteredBasis() const;
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, texture_, sampler_, paramsBuffer_, weightsBuffer_;
+  std::size_t weightsCapacity_ = 0;
+  bool ran_ = false;
+  int lastLayoutRegions_ = 1;
+  double lastExtinction_ = 0.0;
+};
+
+/// The evaluation pass (Listing 4): the scattering image of a camera depth buffer.
+class EvaluatePass {
+public:
+  struct CreateInfo {
+    int bases = kDefaultBases;              ///< M compiled into the shader; must equal the filtered basis's M
+    Sampling sampling = Sampling::Bilinear; ///< filtering of the filtered basis (GL_LINEAR / GL_NEAREST)
+    bool nearPlaneCorrection = false;       ///< Sec. 3.1: integrate from the near plane (prefilter.h)
+    RingingFilter ringing = RingingFilter::None; ///< damping of the ray coefficients (fourier.h)
+    /// Format of the caller's output texture: RGBA32F (default) or RGBA16F.
+    StorageFormat outputFormat = StorageFormat::RGBA32F;
+    int workgroupWidth = 8;  ///< local_size_x, pixels, >= 1
+    int workgroupHeight = 8; ///< local_size_y, pixels, >= 1
+  };
+
+  struct Frame {
+    std::uint32_t cameraDepth = 0;  ///< caller's GL_TEXTURE_2D, depth-buffer values of `camera` in [0, 1]
+    std::uint32_t output = 0;       ///< caller's GL_TEXTURE_2D of the same size in outputFormat: RGB L, A T
+    const Camera* camera = nullptr; ///< the camera of cameraDepth (normally the rectified one)
+    const DirectionalLight* light = nullptr; ///< the light of the rectification
+    const Medium* medium = nullptr;          ///< the medium (C of Eq. 1, per-channel extinction)
+    const RectifiedLayout* layout = nullptr; ///< the layout the basis was prefiltered from (projective)
+    FilteredBasisView basis;                 ///< e.g. PrefilterPass::filteredBasis()
+  };
+
+  /// Validates `info` (InvalidArgument naming the field, GlError beyond the workgroup limits) and
+  /// compiles the program.
+  explicit EvaluatePass(const CreateInfo& info);
+  ~EvaluatePass();
+  EvaluatePass(EvaluatePass&&) noexcept;
+  EvaluatePass& operator=(EvaluatePass&&) noexcept;
+  EvaluatePass(const EvaluatePass&) = delete;
+  EvaluatePass& operator=(const EvaluatePass&) = delete;
+
+  /// Writes the scattering image into frame.output. Throws InvalidArgument naming the Frame field
+  /// (null pointers, texture 0, wrong target / format / size, bases mismatch, layout not projective).
+  void run(const Frame& frame);
+
+  const CreateInfo& createInfo() const noexcept { return info_; }
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
+};
+
+} // namespace crep

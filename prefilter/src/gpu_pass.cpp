@@ -1,0 +1,542 @@
+// GPU prefilter and evaluation passes of prefiltered single scattering: Klehm, Seidel, Eisemann 2014,
+// Sec. 3.3 (fused basis transform and weighted prefix filter, Listings 2-3; regions and bases per thread,
+// Table 1; normalized storage, Appendix A) and the per-pixel evaluation (Listing 4). The shaders are
+// glsl/passes/prefilter.comp, glsl/passes/evaluate.comp and the public glsl/crep/scattering.glsl; the
+// host side here validates, computes the per-row weight data in double (gpu::RegionWeights), fills the
+// shared blocks (gpu_structs.h) and dispatches. Contract: crep/prefilter/prefilter.h.
+#include <crep/core/error.h>
+#include <crep/core/shader_library.h>
+#include <crep/prefilter/gpu_pass.h>
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <string>
+
+namespace crep {
+
+static_assert(static_cast<int>(WeightMode::AverageVisibility) == 0 &&
+                  static_cast<int>(WeightMode::ConstantStep) == 1 &&
+                  static_cast<int>(WeightMode::ConstantRatio) == 2 &&
+                  static_cast<int>(WeightMode::Exact) == 3,
+              "CREP_WEIGHTS_* of glsl/crep/scattering_structs.glsl");
+static_assert(gpu::kMaxSplits == RectifyOptions::kMaxSplits, "CREP_MAX_SPLITS");
+
+namespace {
+
+// Binding points (see gpu_pass.h and the shaders' defaults).
+constexpr GLuint kScatteringBinding = 0, kEvaluateBinding = 1, kRegionWeightsEvalBinding = 1;
+constexpr GLuint kBasisUnit = 0, kCameraDepthUnit = 1;
+
+std::string str(long long v) {
+  return std::to_string(v);
+}
+
+[[noreturn]] void invalid(const std::string& parameter, const std::string& value,
+                          const std::string& requirement) {
+  throw InvalidArgument(parameter, value, requirement);
+}
+
+int getInteger(GLenum pname) {
+  GLint v = 0;
+  glGetIntegerv(pname, &v);
+  return v;
+}
+
+int getIndexed(GLenum pname, GLuint index) {
+  GLint v = 0;
+  glGetIntegeri_v(pname, index, &v);
+  return v;
+}
+
+int ceilDiv(int a, int b) {
+  return (a + b - 1) / b;
+}
+
+/// Invocations per row and region: groups of basesPerInvocation / 4 layers (the last may be partial).
+int baseGroups(const PrefilterPass::CreateInfo& info) {
+  return ceilDiv(layerCount(info.bases), info.basesPerInvocation / 4);
+}
+
+void requireAtLeast(const char* parameter, int value, int minimum) {
+  if (value < minimum) invalid(parameter, detail::formatValue(value), "must be >= " + str(minimum));
+}
+
+/// Local size and dispatch counts against GL_MAX_COMPUTE_WORK_GROUP_{SIZE,INVOCATIONS,COUNT}.
+void checkWorkgroup(const char* const names[3], const int local[3], const int groups[3]) {
+  long long invocations = 1;
+  for (GLuint axis = 0; axis < 3; ++axis) {
+    const int maxSize = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_SIZE, axis);
+    if (local[axis] > maxSize)
+      throw GlError(std::string(names[axis]) + " = " + str(local[axis]) +
+                    " exceeds GL_MAX_COMPUTE_WORK_GROUP_SIZE[" + str(axis) + "] = " + str(maxSize));
+    const int maxCount = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_COUNT, axis);
+    if (groups[axis] > maxCount)
+      throw GlError(std::string(names[axis]) + " = " + str(local[axis]) + " needs " + str(groups[axis]) +
+                    " workgroups, beyond GL_MAX_COMPUTE_WORK_GROUP_COUNT[" + str(axis) +
+                    "] = " + str(maxCount));
+    invocations *= local[axis];
+  }
+  const int maxInvocations = getInteger(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS);
+  if (invocations > maxInvocations)
+    throw GlError(std::string(names[0]) + " x " + names[1] + " x " + names[2] + " = " + str(invocations) +
+                  " exceeds GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS = " + str(maxInvocations));
+}
+
+void validateBasesField(const char* parameter, int bases) {
+  if (bases < kMinBases || bases > kMaxBases || bases % 2 != 0)
+    invalid(parameter, detail::formatValue(bases),
+            "must be even and in [" + str(kMinBases) + ", " + str(kMaxBases) + "]");
+}
+
+GLenum internalFormat(StorageFormat format) {
+  switch (format) {
+  case StorageFormat::RGBA8:
+    return GL_RGBA8;
+  case StorageFormat::RGBA16F:
+    return GL_RGBA16F;
+  case StorageFormat::RGBA32F:
+    break;
+  }
+  return GL_RGBA32F;
+}
+
+const char* imageFormatQualifier(StorageFormat format) {
+  return storageFormatToken(format);
+}
+
+struct TextureInfo {
+  GLint target = 0, width = 0, height = 0, depth = 0, format = 0;
+};
+
+/// Target, level-0 size and internal format of a caller's texture; InvalidArgument naming `parameter`
+/// if `name` is 0 or not a texture.
+TextureInfo textureInfo(const char* parameter, std::uint32_t name) {
+  if (name == 0 || glIsTexture(name) != GL_TRUE)
+    invalid(parameter, str(name), "must name an existing GL texture");
+  TextureInfo t;
+  glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &t.target);
+  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_WIDTH, &t.width);
+  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_HEIGHT, &t.height);
+  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_DEPTH, &t.depth);
+  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_INTERNAL_FORMAT, &t.format);
+  return t;
+}
+
+std::string sizeString(int w, int h) {
+  return str(w) + " x " + str(h);
+}
+
+gl::Handle createUniformBuffer(std::size_t bytes) {
+  gl::Handle buffer = gl::createBuffer();
+  glNamedBufferStorage(buffer.get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  return buffer;
+}
+
+gl::Handle createSampler(GLenum filter) {
+  gl::Handle sampler = gl::createSampler();
+  glSamplerParameteri(sampler.get(), GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
+  glSamplerParameteri(sampler.get(), GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
+  glSamplerParameteri(sampler.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(sampler.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(sampler.get(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
+  return sampler;
+}
+
+glm::vec4 vec4Of(const glm::dvec3& v, double w = 0.0) {
+  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w)};
+}
+
+/// Eq. 12 parameters as crep::regionMixFactors defines them (weights.h): first texel length D0 and the
+/// log of the step ratio of the first three texel centres.
+void ratioParameters(const DistanceProfile& p, int n, double& first, double& logRatio) {
+  first = p.fromStart(1.0 / n);
+  logRatio = 0.0;
+  if (n >= 3) {
+    const double t0 = p.fromStart(0.5 / n), t1 = p.fromStart(1.5 / n), t2 = p.fromStart(2.5 / n);
+    const double ratio = (t2 - t1) / (t1 - t0);
+    if (std::isfinite(ratio) && ratio > 0.0) logRatio = std::log(ratio);
+  }
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------------
+
+std::vector<gpu::RegionWeights> gpuRegionWeights(const std::vector<DistanceProfile>& profiles,
+                                                 WeightMode mode, int texelsPerRegion) {
+  if (texelsPerRegion < 1) invalid("texelsPerRegion", detail::formatValue(texelsPerRegion), "must be >= 1");
+  const int n = texelsPerRegion;
+  std::vector<gpu::RegionWeights> out(profiles.size());
+  for (std::size_t i = 0; i < profiles.size(); ++i) {
+    const DistanceProfile& p = profiles[i];
+    gpu::RegionWeights& w = out[i];
+    double scale = 0.0, c = 0.0, d = 0.0;
+    bool valid = true;
+    switch (mode) {
+    case WeightMode::Exact:
+      // tau(u) = u (b c - a d) / (c (c + d u)) = u scale / (c + d u) (DistanceProfile::fromStart).
+      valid = p.c > 0.0;
+      scale = valid ? (p.b * p.c - p.a * p.d) / p.c : 0.0;
+      c = p.c;
+      d = p.d;
+      break;
+    case WeightMode::ConstantStep:
+      scale = p.fromStart(1.0) / n;
+      break;
+    case WeightMode::ConstantRatio: {
+      double first = 0.0, logRatio = 0.0;
+      ratioParameters(p, n, first, logRatio);
+      scale = logRatio == 0.0 ? first : first / std::expm1(logRatio);
+      c = logRatio;
+      d = first;
+      break;
+    }
+    case WeightMode::AverageVisibility:
+      break;
+    }
+    valid = valid && std::isfinite(scale) && std::isfinite(c) && std::isfinite(d) &&
+            std::abs(scale) <= std::numeric_limits<float>::max();
+    w.scale = valid ? static_cast<float>(scale) : 0.0f;
+    w.c = valid ? static_cast<float>(c) : 1.0f;
+    w.d = valid ? static_cast<float>(d) : 0.0f;
+    w.valid = valid ? 1 : 0;
+  }
+  return out;
+}
+
+gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const RectifiedLayout& layout,
+                                           const DirectionalLight& light, const Medium& medium) {
+  const auto* projective = dynamic_cast<const ProjectiveLayout*>(&layout);
+  if (projective == nullptr)
+    invalid("layout", "not a ProjectiveLayout",
+            "the GPU evaluation maps world points with a projective rectification");
+  const Rectification& r = projective->rectification();
+  const int K = layout.regionCount();
+  if (K != basis.layoutRegions)
+    invalid("layout", "regionCount() " + str(K),
+            "must equal FilteredBasisView.layoutRegions = " + str(basis.layoutRegions));
+  if (K > gpu::kMaxSplits) invalid("layout", "regionCount() " + str(K), "must be <= " + str(gpu::kMaxSplits));
+  validateBasesField("FilteredBasisView.bases", basis.bases);
+  if (basis.width <= 0 || basis.height <= 0 || basis.regionsPerSplit < 1 ||
+      basis.width % basis.regions() != 0)
+    invalid("FilteredBasisView",
+            "size " + sizeString(basis.width, basis.height) + ", regions " + str(basis.regions()),
+            "width and height must be > 0 and the width a multiple of the regions");
+
+  const RectifiedFrame& f = r.frame;
+  gpu::ScatteringParams p;
+  p.frameOrigin = vec4Of(f.origin);
+  p.frameAxisX = vec4Of(f.axisX, f.inverseLightDistance);
+  p.frameAxisY = vec4Of(f.axisY);
+  p.frameAxisZ = vec4Of(f.axisZ);
+  p.slopes = glm::vec4(
+      static_cast<float>(f.rowSlopeMin), static_cast<float>(1.0 / (f.rowSlopeMax - f.rowSlopeMin)),
+      static_cast<float>(f.depthSlopeMin), static_cast<float>(1.0 / (f.depthSlopeMax - f.depthSlopeMin)));
+  p.extinction = vec4Of(medium.extinction(), basis.extinction);
+  p.mieScattering = vec4Of(medium.mieScattering(), medium.hgG());
+  p.rayleighScattering = vec4Of(medium.rayleighScattering());
+  p.lightIrradiance = vec4Of(light.irradiance());
+  p.lightDirection = vec4Of(light.direction());
+  p.mapSize = glm::ivec4(basis.width, basis.height, basis.regions(), K);
+  p.basisInfo = glm::ivec4(basis.bases, layerCount(basis.bases), basis.regionsPerSplit,
+                           static_cast<int>(basis.weights));
+  p.depthMargin = glm::vec4(static_cast<float>(basis.depthMargin), 0.0f, 0.0f, 0.0f);
+  for (int k = 0; k < K; ++k) {
+    const Split& s = r.splits[static_cast<std::size_t>(k)];
+    p.splitZeta[k] = glm::vec4(static_cast<float>(s.zetaBegin), static_cast<float>(s.zetaEnd), 0.0f, 0.0f);
+  }
+  return p;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// PrefilterPass
+
+PrefilterOptions PrefilterPass::CreateInfo::prefilterOptions() const {
+  PrefilterOptions o;
+  o.bases = bases;
+  o.weights = weights;
+  o.format = format;
+  o.regionsPerSplit = regionsPerSplit;
+  o.depthMargin = depthMargin;
+  o.basesPerInvocation = basesPerInvocation;
+  return o;
+}
+
+PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
+  requireAtLeast("PrefilterPass::CreateInfo.width", info.width, 1);
+  requireAtLeast("PrefilterPass::CreateInfo.height", info.height, 1);
+  validateBasesField("PrefilterPass::CreateInfo.bases", info.bases);
+  if (info.basesPerInvocation < 4 || info.basesPerInvocation > kMaxBases || info.basesPerInvocation % 4 != 0)
+    invalid("PrefilterPass::CreateInfo.basesPerInvocation", detail::formatValue(info.basesPerInvocation),
+            "must be a multiple of 4 in [4, " + str(kMaxBases) + "]");
+  if (info.regionsPerSplit < 1 || info.regionsPerSplit > info.width)
+    invalid("PrefilterPass::CreateInfo.regionsPerSplit", detail::formatValue(info.regionsPerSplit),
+            "must be in [1, width = " + str(info.width) + "]");
+  if (!(info.depthMargin >= 0.0 && info.depthMargin <= 0.25))
+    invalid("PrefilterPass::CreateInfo.depthMargin", detail::formatValue(info.depthMargin),
+            "must be in [0, 0.25]");
+  if (info.format != StorageFormat::RGBA8 && info.format != StorageFormat::RGBA16F &&
+      info.format != StorageFormat::RGBA32F)
+    invalid("PrefilterPass::CreateInfo.format", str(static_cast<int>(info.format)),
+            "must be RGBA8, RGBA16F or RGBA32F");
+  requireAtLeast("PrefilterPass::CreateInfo.workgroupRows", info.workgroupRows, 1);
+  requireAtLeast("PrefilterPass::CreateInfo.workgroupBaseGroups", info.workgroupBaseGroups, 1);
+  requireAtLeast("PrefilterPass::CreateInfo.workgroupRegions", info.workgroupRegions, 1);
+
+  const int maxSize = gl::maxTextureSize();
+  if (info.width > maxSize)
+    throw GlError("PrefilterPass::CreateInfo.width = " + str(info.width) +
+                  " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
+  if (info.height > maxSize)
+    throw GlError("PrefilterPass::CreateInfo.height = " + str(info.height) +
+                  " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
+  const int maxLayers = gl::maxArrayTextureLayers();
+  if (layers() > maxLayers)
+    throw GlError("PrefilterPass::CreateInfo.bases = " + str(info.bases) + " needs " + str(layers()) +
+                  " layers, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
+  {
+    const char* names[3] = {"PrefilterPass::CreateInfo.workgroupRows",
+                            "PrefilterPass::CreateInfo.workgroupBaseGroups",
+                            "PrefilterPass::CreateInfo.workgroupRegions"};
+    const int local[3] = {info.workgroupRows, info.workgroupBaseGroups, info.workgroupRegions};
+    // The most regions a run can have is one per column.
+    const int groups[3] = {ceilDiv(info.height, info.workgroupRows),
+                           ceilDiv(baseGroups(info), info.workgroupBaseGroups),
+                           ceilDiv(info.width, info.workgroupRegions)};
+    checkWorkgroup(names, local, groups);
+  }
+
+  const std::vector<ShaderStageSource> stages = {
+      {ShaderStage::Compute,
+       "passes/prefilter.comp",
+       {{"CREP_BASES", str(info.bases)},
+        {"CREP_BASES_PER_INVOCATION", str(info.basesPerInvocation)},
+        {"CREP_BASIS_FORMAT", imageFormatQualifier(info.format)},
+        {"CREP_BASIS_UNORM8", info.format == StorageFormat::RGBA8 ? "1" : "0"},
+        {"CREP_BASIS_HALF", info.format == StorageFormat::RGBA16F ? "1" : "0"},
+        {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
+        {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
+        {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)}}}};
+  program_ = buildProgram(stages);
+
+  texture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(texture_.get(), 1, internalFormat(info.format), info.width, info.height, layers());
+  glTextureParameteri(texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(texture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl::checkError(
+      "PrefilterPass: filtered-basis texture array (PrefilterPass::CreateInfo width x height x bases)");
+
+  sampler_ = createSampler(GL_NEAREST);
+  paramsBuffer_ = createUniformBuffer(sizeof(gpu::PrefilterParams));
+  gl::checkError("PrefilterPass: buffers");
+}
+
+PrefilterPass::~PrefilterPass() = default;
+PrefilterPass::PrefilterPass(PrefilterPass&&) noexcept = default;
+PrefilterPass& PrefilterPass::operator=(PrefilterPass&&) noexcept = default;
+
+void PrefilterPass::run(const Frame& frame) {
+  if (frame.layout == nullptr)
+    invalid("PrefilterPass::Frame.layout", "null", "must point to the map's layout");
+  const TextureInfo depth = textureInfo("PrefilterPass::Frame.rectifiedDepth", frame.rectifiedDepth);
+  if (depth.target != GL_TEXTURE_2D)
+    invalid("PrefilterPass::Frame.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
+            "must be a GL_TEXTURE_2D");
+  if (depth.width != info_.width || depth.height != info_.height)
+    invalid("PrefilterPass::Frame.rectifiedDepth", sizeString(depth.width, depth.height),
+            "must be the created size " + sizeString(info_.width, info_.height));
+  double s = frame.extinctionOverride;
+  if (s < 0.0) {
+    if (frame.medium == nullptr)
+      invalid("PrefilterPass::Frame.medium", "null", "must be set unless extinctionOverride >= 0");
+    s = weightExtinction(*frame.medium);
+  }
+  if (!std::isfinite(s))
+    invalid("PrefilterPass::Frame.extinctionOverride", detail::formatValue(s), "must be finite");
+
+  const int K = frame.layout->regionCount(), P = info_.regionsPerSplit, R = K * P;
+  const int W = info_.width, H = info_.height;
+  if (K < 1 || W % R != 0)
+    invalid("PrefilterPass::Frame.layout", "regionCount() " + str(K),
+            "regionCount() x regionsPerSplit (" + str(K) + " x " + str(P) + ") must divide the map width " +
+                str(W));
+  const int n = W / R;
+
+  const std::vector<gpu::RegionWeights> weights =
+      gpuRegionWeights(referenceProfiles(*frame.layout, H, P), info_.weights, n);
+  const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
+  if (bytes > weightsCapacity_) {
+    weightsBuffer_ = gl::createBuffer();
+    glNamedBufferStorage(weightsBuffer_.get(), static_cast<GLsizeiptr>(bytes), nullptr,
+                         GL_DYNAMIC_STORAGE_BIT);
+    weightsCapacity_ = bytes;
+  }
+  glNamedBufferSubData(weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes), weights.data());
+
+  gpu::PrefilterParams params;
+  params.mapSize = glm::ivec4(W, H, R, n);
+  params.basisInfo = glm::ivec4(info_.bases, info_.basesPerInvocation, static_cast<int>(info_.weights), 0);
+  params.weights = glm::vec4(static_cast<float>(s), static_cast<float>(info_.depthMargin), 0.0f, 0.0f);
+  glNamedBufferSubData(paramsBuffer_.get(), 0, sizeof params, &params);
+
+  glUseProgram(program_.get());
+  glBindTextureUnit(0, frame.rectifiedDepth);
+  glBindSampler(0, sampler_.get());
+  glBindImageTexture(0, texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, internalFormat(info_.format));
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, paramsBuffer_.get());
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes));
+  glDispatchCompute(static_cast<GLuint>(ceilDiv(H, info_.workgroupRows)),
+                    static_cast<GLuint>(ceilDiv(baseGroups(info_), info_.workgroupBaseGroups)),
+                    static_cast<GLuint>(ceilDiv(R, info_.workgroupRegions)));
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                  GL_TEXTURE_UPDATE_BARRIER_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, 0);
+  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+  glBindSampler(0, 0);
+  glBindTextureUnit(0, 0);
+  glUseProgram(0);
+  gl::checkError("PrefilterPass::run");
+
+  ran_ = true;
+  lastLayoutRegions_ = K;
+  lastExtinction_ = s;
+}
+
+FilteredBasisView PrefilterPass::filteredBasis() const {
+  if (!ran_) throw Error("PrefilterPass::filteredBasis: run() has not been called yet");
+  FilteredBasisView v;
+  v.texture = texture_.get();
+  v.regionWeights = weightsBuffer_.get();
+  v.width = info_.width;
+  v.height = info_.height;
+  v.bases = info_.bases;
+  v.layoutRegions = lastLayoutRegions_;
+  v.regionsPerSplit = info_.regionsPerSplit;
+  v.weights = info_.weights;
+  v.extinction = lastExtinction_;
+  v.depthMargin = info_.depthMargin;
+  return v;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// EvaluatePass
+
+EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
+  validateBasesField("EvaluatePass::CreateInfo.bases", info.bases);
+  if (info.outputFormat != StorageFormat::RGBA32F && info.outputFormat != StorageFormat::RGBA16F)
+    invalid("EvaluatePass::CreateInfo.outputFormat", storageFormatToken(info.outputFormat),
+            "must be RGBA32F or RGBA16F");
+  if (info.sampling != Sampling::Bilinear && info.sampling != Sampling::Nearest)
+    invalid("EvaluatePass::CreateInfo.sampling", str(static_cast<int>(info.sampling)),
+            "must be Bilinear or Nearest");
+  if (info.ringing != RingingFilter::None && info.ringing != RingingFilter::Lanczos)
+    invalid("EvaluatePass::CreateInfo.ringing", str(static_cast<int>(info.ringing)),
+            "must be None or Lanczos");
+  requireAtLeast("EvaluatePass::CreateInfo.workgroupWidth", info.workgroupWidth, 1);
+  requireAtLeast("EvaluatePass::CreateInfo.workgroupHeight", info.workgroupHeight, 1);
+  {
+    const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
+                            "EvaluatePass::CreateInfo.workgroupHeight", "(none)"};
+    const int local[3] = {info.workgroupWidth, info.workgroupHeight, 1};
+    const int groups[3] = {1, 1, 1};
+    checkWorkgroup(names, local, groups);
+  }
+  const std::vector<ShaderStageSource> stages = {
+      {ShaderStage::Compute,
+       "passes/evaluate.comp",
+       {{"CREP_BASES", str(info.bases)},
+        {"CREP_OUTPUT_FORMAT", storageFormatToken(info.outputFormat)},
+        {"CREP_NEAR_PLANE_CORRECTION", info.nearPlaneCorrection ? "1" : "0"},
+        {"CREP_RINGING_LANCZOS", info.ringing == RingingFilter::Lanczos ? "1" : "0"},
+        {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
+        {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)}}}};
+  program_ = buildProgram(stages);
+  basisSampler_ = createSampler(info.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
+  depthSampler_ = createSampler(GL_NEAREST);
+  scatteringBuffer_ = createUniformBuffer(sizeof(gpu::ScatteringParams));
+  evaluateBuffer_ = createUniformBuffer(sizeof(gpu::EvaluateParams));
+  gl::checkError("EvaluatePass: samplers and buffers");
+}
+
+EvaluatePass::~EvaluatePass() = default;
+EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
+EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
+
+void EvaluatePass::run(const Frame& frame) {
+  if (frame.camera == nullptr) invalid("EvaluatePass::Frame.camera", "null", "must be set");
+  if (frame.light == nullptr) invalid("EvaluatePass::Frame.light", "null", "must be set");
+  if (frame.medium == nullptr) invalid("EvaluatePass::Frame.medium", "null", "must be set");
+  if (frame.layout == nullptr) invalid("EvaluatePass::Frame.layout", "null", "must be set");
+  const FilteredBasisView& basis = frame.basis;
+  if (basis.bases != info_.bases)
+    invalid("EvaluatePass::Frame.basis.bases", detail::formatValue(basis.bases),
+            "must equal EvaluatePass::CreateInfo.bases = " + str(info_.bases));
+  const TextureInfo b = textureInfo("EvaluatePass::Frame.basis.texture", basis.texture);
+  if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
+      b.depth < layerCount(basis.bases))
+    invalid("EvaluatePass::Frame.basis.texture", "texture " + str(basis.texture),
+            "must be a GL_TEXTURE_2D_ARRAY of " + sizeString(basis.width, basis.height) + " x " +
+                str(layerCount(basis.bases)) + " layers");
+  if (info_.nearPlaneCorrection && (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
+    invalid("EvaluatePass::Frame.basis.regionWeights", str(basis.regionWeights),
+            "must name the region-weights buffer (near-plane correction)");
+  const TextureInfo depth = textureInfo("EvaluatePass::Frame.cameraDepth", frame.cameraDepth);
+  if (depth.target != GL_TEXTURE_2D)
+    invalid("EvaluatePass::Frame.cameraDepth", "texture " + str(frame.cameraDepth),
+            "must be a GL_TEXTURE_2D");
+  const TextureInfo out = textureInfo("EvaluatePass::Frame.output", frame.output);
+  const GLenum outFormat = internalFormat(info_.outputFormat);
+  if (out.target != GL_TEXTURE_2D || static_cast<GLenum>(out.format) != outFormat)
+    invalid("EvaluatePass::Frame.output", "texture " + str(frame.output),
+            std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info_.outputFormat));
+  if (out.width != depth.width || out.height != depth.height)
+    invalid("EvaluatePass::Frame.output", sizeString(out.width, out.height),
+            "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
+
+  const gpu::ScatteringParams scattering =
+      makeScatteringParams(basis, *frame.layout, *frame.light, *frame.medium);
+  const Camera& cam = *frame.camera;
+  const double ty = std::tan(0.5 * cam.fovY()), tx = ty * cam.aspect();
+  gpu::EvaluateParams params;
+  params.cameraPosition = vec4Of(cam.position(), cam.near());
+  params.cameraForward = vec4Of(cam.forward(), cam.far());
+  params.cameraRight = vec4Of(cam.right() * tx);
+  params.cameraUp = vec4Of(cam.up() * ty);
+  params.imageSize = glm::ivec4(depth.width, depth.height, 0, 0);
+  glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
+  glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
+
+  glUseProgram(program_.get());
+  glBindTextureUnit(kBasisUnit, basis.texture);
+  glBindSampler(kBasisUnit, basisSampler_.get());
+  glBindTextureUnit(kCameraDepthUnit, frame.cameraDepth);
+  glBindSampler(kCameraDepthUnit, depthSampler_.get());
+  glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, evaluateBuffer_.get());
+  if (info_.nearPlaneCorrection)
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, basis.regionWeights);
+  glDispatchCompute(static_cast<GLuint>(ceilDiv(depth.width, info_.workgroupWidth)),
+                    static_cast<GLuint>(ceilDiv(depth.height, info_.workgroupHeight)), 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                  GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+  if (info_.nearPlaneCorrection) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
+  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+  glBindSampler(kCameraDepthUnit, 0);
+  glBindTextureUnit(kCameraDepthUnit, 0);
+  glBindSampler(kBasisUnit, 0);
+  glBindTextureUnit(kBasisUnit, 0);
+  glUseProgram(0);
+  gl::checkError("EvaluatePass::run");
+}
+
+} // namespace crep

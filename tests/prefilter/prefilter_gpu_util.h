@@ -1,0 +1,180 @@
+// Shared helpers of the GPU prefilter tests (tests/prefilter/PrefilterGpu*GLTest.cpp): a rectified map
+// and a camera depth buffer rendered from a built-in scene (one GL texture each, read back for the CPU
+// reference), texture read-back and upload of filtered bases, and basis comparison.
+#pragma once
+
+#include <crep/core/gl.h>
+#include <crep/core/image.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/prefilter/prefilter.h>
+#include <crep/rectify/rectified_map.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <doctest/doctest.h>
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <sstream>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace crep::test {
+
+/// A scene with its rectified map (GL texture + CPU copy) and camera depth (GL texture + CPU copy).
+struct GpuScene {
+  scenes::Scene scene;
+  std::shared_ptr<const ProjectiveLayout> layout;
+  gl::Handle mapTexture;   ///< GL_DEPTH_COMPONENT32F, mapWidth x mapHeight
+  RectifiedMap map;        ///< the same values on the CPU
+  gl::Handle depthTexture; ///< camera depth, GL_DEPTH_COMPONENT32F, screenWidth x screenHeight
+  Image cameraDepth;       ///< the same values on the CPU
+};
+
+/// A CPU filtered basis uploaded to the GPU (texture array in `format`, region-weights buffer), and
+/// the view the evaluation pass takes.
+struct UploadedBasis {
+  gl::Handle texture, weights;
+  FilteredBasisView view;
+};
+
+/// GPU filtered basis against the CPU one (stored values e = 0.5 + 0.5 F).
+struct BasisDifference {
+  double maxAbs = 0.0;            ///< max |gpu - cpu| (NaN counts as the maximum)
+  double meanAbs = 0.0;           ///< mean |gpu - cpu|
+  int x = -1, y = -1, basis = -1; ///< where the maximum is
+  float gpu = 0.0f, cpu = 0.0f;   ///< the values there
+  long long over = 0;             ///< values with |gpu - cpu| > tolerance(cpu) (or NaN)
+};
+
+/// Compares GPU read-back values with FilteredBasis::texels; counts values with |d| > tolerance(cpu).
+template <class Tolerance>
+BasisDifference compareBasis(const std::vector<float>& gpu, const FilteredBasis& cpu,
+                             const Tolerance& tolerance) {
+  BasisDifference d;
+  const std::size_t count = cpu.texels.size();
+  double sum = 0.0;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double e = std::abs(static_cast<double>(gpu[i]) - static_cast<double>(cpu.texels[i]));
+    sum += e;
+    if (!(e <= tolerance(cpu.texels[i]))) ++d.over;
+    if (e > d.maxAbs || e != e) {
+      d.maxAbs = e;
+      const std::size_t texel = i / 4,
+                        plane = static_cast<std::size_t>(cpu.width) * static_cast<std::size_t>(cpu.height);
+      const std::size_t layer = texel / plane, inLayer = texel % plane;
+      d.x = static_cast<int>(inLayer % static_cast<std::size_t>(cpu.width));
+      d.y = static_cast<int>(inLayer / static_cast<std::size_t>(cpu.width));
+      d.basis = static_cast<int>(layer * 4 + i % 4);
+      d.gpu = gpu[i];
+      d.cpu = cpu.texels[i];
+    }
+  }
+  d.meanAbs = count > 0 ? sum / static_cast<double>(count) : 0.0;
+  return d;
+}
+
+/// Renders `sceneName` (built-in scene, camera aspect = screen aspect) into a rectified map with
+/// `splits` logarithmic splits (SplitLayout::Regions, GL_DEPTH_CLAMP) and a camera depth buffer.
+/// Requires a projective rectification (REQUIREs it).
+inline GpuScene renderGpuScene(const std::string& sceneName, int mapWidth, int mapHeight, int splits,
+                               int screenWidth, int screenHeight) {
+  GpuScene s{
+      scenes::makeScene(sceneName, static_cast<double>(screenWidth) / screenHeight), {}, {}, {}, {}, {}};
+  RectifyOptions options;
+  options.splits = splits;
+  Rectification r = rectify(s.scene.camera, s.scene.sun, options);
+  INFO(r.message);
+  REQUIRE(r.projective());
+  s.layout = std::make_shared<const ProjectiveLayout>(std::move(r));
+  scenes::SceneRenderer renderer(s.scene.mesh);
+  s.mapTexture = scenes::createDepthTexture(mapWidth, mapHeight, "rectified map size");
+  for (int k = 0; k < s.layout->regionCount(); ++k) {
+    const SplitViewport v = s.layout->rectification().splitViewport(k, mapWidth, mapHeight);
+    renderer.renderDepth(s.layout->rectification().splits[static_cast<std::size_t>(k)].rectClipFromWorld,
+                         s.mapTexture.get(), v.layer, v.x, v.y, v.width, v.height, {.depthClamp = true});
+  }
+  s.map = makeRectifiedMap(s.layout, scenes::readDepthTexture(s.mapTexture.get(), mapWidth, mapHeight));
+  s.depthTexture = scenes::createDepthTexture(screenWidth, screenHeight, "screen size");
+  renderer.renderDepth(s.scene.camera.clipFromWorld(), s.depthTexture.get(), 0, 0, 0, screenWidth,
+                       screenHeight);
+  s.cameraDepth = scenes::readDepthTexture(s.depthTexture.get(), screenWidth, screenHeight);
+  return s;
+}
+
+/// Every texel of a texture array (layers * height * width * 4 floats, layer-major: the order of
+/// FilteredBasis::texels).
+inline std::vector<float> readTextureArray(std::uint32_t texture, int width, int height, int layers) {
+  std::vector<float> out(static_cast<std::size_t>(layers) * static_cast<std::size_t>(height) *
+                         static_cast<std::size_t>(width) * 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(float)),
+                    out.data());
+  return out;
+}
+
+/// A 4-channel image of an RGBA 2D texture.
+inline Image readRgbaTexture(std::uint32_t texture, int width, int height) {
+  Image image(width, height, 4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(image.byteSize()),
+                    image.data().data());
+  return image;
+}
+
+/// A GL_TEXTURE_2D of `format` (GL enum) with nearest filtering, clamp to edge.
+inline gl::Handle createTexture2D(std::uint32_t format, int width, int height) {
+  gl::Handle tex = gl::createTexture(GL_TEXTURE_2D);
+  glTextureStorage2D(tex.get(), 1, format, width, height);
+  glTextureParameteri(tex.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(tex.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return tex;
+}
+
+inline UploadedBasis uploadBasis(const FilteredBasis& basis, StorageFormat format) {
+  UploadedBasis u;
+  const GLenum internal = format == StorageFormat::RGBA8     ? GL_RGBA8
+                          : format == StorageFormat::RGBA16F ? GL_RGBA16F
+                                                             : GL_RGBA32F;
+  u.texture = gl::createTexture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(u.texture.get(), 1, internal, basis.width, basis.height, basis.layers);
+  glTextureParameteri(u.texture.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(u.texture.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(u.texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(u.texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTextureSubImage3D(u.texture.get(), 0, 0, 0, 0, basis.width, basis.height, basis.layers, GL_RGBA, GL_FLOAT,
+                      basis.texels.data());
+  const std::vector<gpu::RegionWeights> weights =
+      gpuRegionWeights(basis.profiles, basis.weights, basis.regionWidth());
+  u.weights = gl::createBuffer();
+  glNamedBufferStorage(u.weights.get(), static_cast<GLsizeiptr>(weights.size() * sizeof(gpu::RegionWeights)),
+                       weights.data(), 0);
+  u.view.texture = u.texture.get();
+  u.view.regionWeights = u.weights.get();
+  u.view.width = basis.width;
+  u.view.height = basis.height;
+  u.view.bases = basis.bases;
+  u.view.layoutRegions = basis.layout->regionCount();
+  u.view.regionsPerSplit = basis.regionsPerSplit;
+  u.view.weights = basis.weights;
+  u.view.extinction = basis.extinction;
+  u.view.depthMargin = basis.depthMargin;
+  return u;
+}
+
+inline std::string describe(const BasisDifference& d) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "max |gpu - cpu| " << d.maxAbs << " (basis " << d.basis << " at texel (" << d.x << ", " << d.y
+    << "): gpu " << d.gpu << ", cpu " << d.cpu << "), mean " << d.meanAbs << ", " << d.over
+    << " values beyond tolerance";
+  return s.str();
+}
+
+} // namespace crep::test
