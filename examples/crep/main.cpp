@@ -19,8 +19,13 @@ commands:
   render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
             --scene NAME        colonnade (default) | forest | terrain | boxes
             --size WxH          image size (default 1280x720)
-            --map-size N        shadow map size (default 2048)
-            --steps N           ray-march samples per pixel (default 128)
+            --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
+                                against a standard shadow map)
+            --map-size N        shadow map and rectified map size (default 1024)
+            --bases M           Fourier bases, a multiple of 4 in [4, 128] (default 32)
+            --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
+            --splits K          rectification splits (default 4; --map-size must be a multiple)
+            --steps N           reference march samples per pixel (default 256)
             --exposure X        PNG exposure (default 1)
             --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
             --debug-gl          debug GL context; GL errors abort the command

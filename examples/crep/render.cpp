@@ -1,5 +1,6 @@
-// `crep render`: the main job. Renders a built-in scene (shadow pass, lit camera pass), computes
-// single scattering and writes the scattering and composited images to EXR plus a tone-mapped PNG.
+// `crep render`: the main job. Renders a built-in scene (standard shadow pass and lit camera pass),
+// computes single scattering with the chosen method and writes the scattering and composited images
+// to EXR plus a tone-mapped PNG, with a table of per-stage timings.
 #include "args.h"
 #include "commands.h"
 #include "timings.h"
@@ -10,6 +11,9 @@
 #include <crep/core/gl_context.h>
 #include <crep/core/png.h>
 #include <crep/core/shader_library.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/rectify/rectified_map.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 
@@ -17,6 +21,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 
 namespace crep::tool {
@@ -36,7 +41,8 @@ gl::Handle createColorTexture(int width, int height, GLenum format) {
 Image readRgba(GLuint texture, int width, int height) {
   Image image(width, height, 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(image.data().size_bytes()), image.data().data());
+  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(image.data().size_bytes()),
+                    image.data().data());
   gl::checkError("readback");
   return image;
 }
@@ -45,16 +51,46 @@ void setVec3(GLuint program, GLint location, const glm::dvec3& v) {
   glProgramUniform3f(program, location, static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
 }
 
+void setMat4(GLuint program, GLint location, const glm::dmat4& m) {
+  const glm::mat4 f(m);
+  glProgramUniformMatrix4fv(program, location, 1, GL_FALSE, &f[0][0]);
+}
+
+void dispatch2D(int width, int height) {
+  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+}
+
+StorageFormat parseFormat(const std::string& text) {
+  if (text == "rgba8") return StorageFormat::RGBA8;
+  if (text == "rgba16f") return StorageFormat::RGBA16F;
+  if (text == "rgba32f") return StorageFormat::RGBA32F;
+  throw UsageError("option --format: '" + text + "' is not rgba8, rgba16f or rgba32f");
+}
+
 } // namespace
 
 int renderCommand(const std::vector<std::string>& argv) {
-  const Args args(argv, {"scene", "size", "map-size", "steps", "exposure", "out"}, {"debug-gl"});
+  const Args args(argv,
+                  {"scene", "size", "map-size", "steps", "exposure", "out", "method", "bases", "format", "splits"},
+                  {"debug-gl"});
   const std::string sceneName = args.string("scene", "colonnade");
   const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension);
-  const int mapSize = args.integer("map-size", 2048, 1, Image::kMaxDimension);
-  const int steps = args.integer("steps", 128, 1, 65536);
+  const int mapSize = args.integer("map-size", 1024, 1, Image::kMaxDimension);
+  const int steps = args.integer("steps", 256, 1, 65536);
   const double exposure = args.number("exposure", 1.0);
   if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const std::string method = args.string("method", "prefilter");
+  if (method != "prefilter" && method != "reference")
+    throw UsageError("option --method: '" + method + "' is not prefilter or reference");
+  const int bases = args.integer("bases", kDefaultBases, kMinBases, kMaxBases);
+  if (bases % 4 != 0) throw UsageError("option --bases: must be a multiple of 4");
+  const StorageFormat format = parseFormat(args.string("format", "rgba8"));
+  RectifyOptions rectifyOptions;
+  rectifyOptions.splits = args.integer("splits", rectifyOptions.splits, 1, RectifyOptions::kMaxSplits);
+  if (mapSize % rectifyOptions.splits != 0)
+    throw UsageError("option --map-size: " + std::to_string(mapSize) + " must be a multiple of --splits " +
+                     std::to_string(rectifyOptions.splits));
   const std::string out = args.string("out", "crep-" + sceneName);
   if (out.empty()) throw UsageError("option --out: must not be empty");
 
@@ -81,18 +117,27 @@ int renderCommand(const std::vector<std::string>& argv) {
   gl::checkTextureSize("--map-size", mapSize, mapSize);
   gl::checkTextureSize("--size", size.x, size.y);
 
+  // The method actually used: the projective prefilter needs a projective rectification (the
+  // epipolar fallback is not implemented yet; until then a non-projective frame uses the reference).
+  const Rectification rect = timings.time("rectify", [&] { return rectify(scene.camera, scene.sun, rectifyOptions); });
+  std::string used = method;
+  if (method == "prefilter" && !rect.projective()) {
+    std::fprintf(stderr, "crep render: rectification is %s (%s); using the reference march\n",
+                 statusToken(rect.status), rect.message.c_str());
+    used = "reference";
+  }
+
   auto renderer = timings.time("scene upload + shaders", [&] {
     auto r = std::make_unique<scenes::SceneRenderer>(scene.mesh);
     glFinish();
     return r;
   });
-  gl::Handle marchProgram = timings.time("scattering shader", [&] {
-    return buildProgram({{ShaderStage::Compute, "passes/march_world.comp", {{"CREP_MARCH_STEPS", std::to_string(steps)}}}});
-  });
+  gl::Handle compositeProgram = buildProgram({{ShaderStage::Compute, "passes/composite.comp", {}}});
 
+  // Standard shadow map: lit surfaces (and the reference march).
   const glm::dmat4 shadowClipFromWorld = scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
   gl::Handle shadowMap = scenes::createDepthTexture(mapSize, mapSize, "--map-size");
-  timings.time("shadow pass", [&] {
+  timings.time("shadow pass (standard)", [&] {
     renderer->renderDepth(shadowClipFromWorld, shadowMap.get(), 0, 0, 0, mapSize, mapSize, {.depthClamp = true});
     glFinish();
   });
@@ -111,34 +156,90 @@ int renderCommand(const std::vector<std::string>& argv) {
   });
 
   gl::Handle scattering = createColorTexture(size.x, size.y, GL_RGBA32F);
+  if (used == "prefilter") {
+    const auto layout = std::make_shared<ProjectiveLayout>(rect);
+    gl::Handle rectified = scenes::createDepthTexture(mapSize, mapSize, "--map-size");
+    timings.time("shadow pass (rectified)", [&] {
+      renderer->renderRectified(rect, rectified.get(), mapSize, mapSize);
+      glFinish();
+    });
+    PrefilterPass::CreateInfo prefilterInfo;
+    prefilterInfo.width = mapSize;
+    prefilterInfo.height = mapSize;
+    prefilterInfo.bases = bases;
+    prefilterInfo.format = format;
+    auto prefilterPass = timings.time("prefilter setup", [&] { return std::make_unique<PrefilterPass>(prefilterInfo); });
+    EvaluatePass::CreateInfo evaluateInfo;
+    evaluateInfo.bases = bases;
+    auto evaluatePass = timings.time("evaluate setup", [&] { return std::make_unique<EvaluatePass>(evaluateInfo); });
+    timings.time("prefilter", [&] {
+      PrefilterPass::Frame frame;
+      frame.rectifiedDepth = rectified.get();
+      frame.layout = layout.get();
+      frame.medium = &scene.medium;
+      prefilterPass->run(frame);
+      glFinish();
+    });
+    timings.time("evaluate", [&] {
+      EvaluatePass::Frame frame;
+      frame.cameraDepth = depth.get();
+      frame.output = scattering.get();
+      frame.camera = &scene.camera;
+      frame.light = &scene.sun;
+      frame.medium = &scene.medium;
+      frame.layout = layout.get();
+      frame.basis = prefilterPass->filteredBasis();
+      evaluatePass->run(frame);
+      glFinish();
+    });
+  } else {
+    gl::Handle marchProgram = timings.time("march shader", [&] {
+      return buildProgram(
+          {{ShaderStage::Compute, "passes/march_world.comp", {{"CREP_MARCH_STEPS", std::to_string(steps)}}}});
+    });
+    timings.time("reference march", [&] {
+      const GLuint p = marchProgram.get();
+      glUseProgram(p);
+      setMat4(p, 0, glm::inverse(scene.camera.clipFromWorld()));
+      setMat4(p, 1, shadowClipFromWorld);
+      setVec3(p, 2, scene.camera.position());
+      setVec3(p, 3, scene.sun.direction());
+      setVec3(p, 4, scene.sun.irradiance());
+      setVec3(p, 5, scene.medium.mieScattering());
+      setVec3(p, 6, scene.medium.rayleighScattering());
+      setVec3(p, 7, scene.medium.extinction());
+      glProgramUniform1f(p, 8, static_cast<float>(scene.medium.hgG()));
+      glProgramUniform2i(p, 9, size.x, size.y);
+      glProgramUniform1f(p, 10, 2e-4f);
+      glBindTextureUnit(0, depth.get());
+      glBindTextureUnit(1, shadowMap.get());
+      glBindImageTexture(0, scattering.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      dispatch2D(size.x, size.y);
+      glUseProgram(0);
+      glBindTextureUnit(0, 0);
+      glBindTextureUnit(1, 0);
+      glFinish();
+      gl::checkError("reference march");
+    });
+  }
+
   gl::Handle composite = createColorTexture(size.x, size.y, GL_RGBA32F);
-  timings.time("scattering (world march)", [&] {
-    const GLuint p = marchProgram.get();
+  timings.time("composite", [&] {
+    const GLuint p = compositeProgram.get();
     glUseProgram(p);
-    const glm::mat4 worldFromClip(glm::inverse(scene.camera.clipFromWorld()));
-    const glm::mat4 shadow(shadowClipFromWorld);
-    glProgramUniformMatrix4fv(p, 0, 1, GL_FALSE, &worldFromClip[0][0]);
-    glProgramUniformMatrix4fv(p, 1, 1, GL_FALSE, &shadow[0][0]);
-    setVec3(p, 2, scene.camera.position());
-    setVec3(p, 3, scene.sun.direction());
-    setVec3(p, 4, scene.sun.irradiance());
-    setVec3(p, 5, scene.medium.mieScattering());
-    setVec3(p, 6, scene.medium.rayleighScattering());
-    setVec3(p, 7, scene.medium.extinction());
-    glProgramUniform1f(p, 8, static_cast<float>(scene.medium.hgG()));
-    glProgramUniform2i(p, 9, size.x, size.y);
-    glProgramUniform1f(p, 10, 2e-4f);
+    setMat4(p, 0, glm::inverse(scene.camera.clipFromWorld()));
+    setVec3(p, 1, scene.camera.position());
+    setVec3(p, 2, scene.medium.extinction());
+    glProgramUniform2i(p, 3, size.x, size.y);
     glBindTextureUnit(0, depth.get());
-    glBindTextureUnit(1, shadowMap.get());
-    glBindTextureUnit(2, color.get());
-    glBindImageTexture(0, scattering.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, composite.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(static_cast<GLuint>((size.x + 7) / 8), static_cast<GLuint>((size.y + 7) / 8), 1);
-    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glBindTextureUnit(1, color.get());
+    glBindTextureUnit(2, scattering.get());
+    glBindImageTexture(0, composite.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    dispatch2D(size.x, size.y);
     glUseProgram(0);
     for (GLuint unit = 0; unit < 3; ++unit) glBindTextureUnit(unit, 0);
     glFinish();
-    gl::checkError("scattering pass");
+    gl::checkError("composite");
   });
 
   Image scatteringImage, compositeImage;
@@ -151,6 +252,7 @@ int renderCommand(const std::vector<std::string>& argv) {
   // Refuse to write a silently wrong image.
   long long nonFinite = 0;
   for (float v : compositeImage.data()) nonFinite += std::isfinite(v) ? 0 : 1;
+  for (float v : scatteringImage.data()) nonFinite += std::isfinite(v) ? 0 : 1;
   if (nonFinite > 0) throw Error("render produced " + std::to_string(nonFinite) + " non-finite samples");
 
   const std::string exrPath = out + ".exr", pngPath = out + ".png";
@@ -160,8 +262,12 @@ int renderCommand(const std::vector<std::string>& argv) {
   });
   timings.time("write png", [&] { writePng(pngPath, compositeImage, ToneMap{static_cast<float>(exposure)}); });
 
-  std::printf("crep render: scene %s, %dx%d, shadow map %d^2, %d march steps\n", scene.name.c_str(), size.x, size.y,
-              mapSize, steps);
+  std::printf("crep render: scene %s, %dx%d, method %s, map %d^2", scene.name.c_str(), size.x, size.y, used.c_str(),
+              mapSize);
+  if (used == "prefilter")
+    std::printf(", M = %d, %d splits\n", bases, rect.splitCount());
+  else
+    std::printf(", %d march steps\n", steps);
   timings.print(stdout);
   std::printf("wrote %s (layers composite.RGBA, scattering.RGBA) and %s\n", exrPath.c_str(), pngPath.c_str());
   return 0;

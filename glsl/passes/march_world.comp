@@ -14,9 +14,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler2D cameraDepth; // depth-buffer values in [0, 1]
 layout(binding = 1) uniform sampler2D shadowMap;   // depth-buffer values in [0, 1], nearest
-layout(binding = 2) uniform sampler2D surfaceColor; // lit surfaces (radiance leaving the surface)
 layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut; // rgb in-scattering, a transmittance
-layout(binding = 1, rgba32f) uniform writeonly image2D compositeOut;  // surface * T + in-scattering
 
 layout(location = 0) uniform mat4 worldFromClip;
 layout(location = 1) uniform mat4 shadowClipFromWorld;
@@ -59,6 +57,4 @@ void main() {
   vec3 inscatter = sigmaPhase * lightIrradiance * sum * dt;
   vec3 transmittance = exp(-extinction * s);
   imageStore(scatteringOut, pixel, vec4(inscatter, dot(transmittance, vec3(1.0 / 3.0))));
-  vec3 surface = texelFetch(surfaceColor, pixel, 0).rgb;
-  imageStore(compositeOut, pixel, vec4(surface * transmittance + inscatter, 1.0));
 }

@@ -97,6 +97,16 @@ void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t d
   gl::checkError("SceneRenderer::renderDepth");
 }
 
+void SceneRenderer::renderRectified(const Rectification& r, std::uint32_t depthTexture, int width, int height) {
+  if (!r.projective())
+    throw InvalidArgument("Rectification.status", statusToken(r.status), "must be projective to render a rectified map");
+  for (int k = 0; k < r.splitCount(); ++k) {
+    const SplitViewport v = r.splitViewport(k, width, height);
+    renderDepth(r.splits[static_cast<std::size_t>(k)].rectClipFromWorld, depthTexture, v.layer, v.x, v.y, v.width,
+                v.height, {.depthClamp = true});
+  }
+}
+
 void SceneRenderer::renderShaded(const ShadeInputs& in, std::uint32_t colorTexture, std::uint32_t depthTexture,
                                  int width, int height) {
   Impl& d = *impl_;

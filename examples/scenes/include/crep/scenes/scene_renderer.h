@@ -8,6 +8,7 @@
 
 #include <crep/core/gl.h>
 #include <crep/core/image.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
 
 namespace crep::scenes {
@@ -32,6 +33,12 @@ public:
   /// height). Clears that viewport to depth 1 first. Values are depth-buffer values in [0, 1].
   void renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x, int y, int width,
                    int height, const DepthRenderOptions& options = {});
+
+  /// Renders a projective rectified shadow map: every split with its rectClipFromWorld into its
+  /// viewport (Rectification::splitViewport) of the caller's width x height depth texture, with depth
+  /// clamping (what rectify.h asks of an engine). Throws InvalidArgument unless `rectification` is
+  /// projective.
+  void renderRectified(const Rectification& rectification, std::uint32_t depthTexture, int width, int height);
 
   /// Inputs of the lit surface pass: Lambert with a standard shadow map plus a constant ambient term.
   struct ShadeInputs {
