@@ -4,9 +4,9 @@
 // brute-force march and the closed form of the unshadowed medium (Eq. 1, 3) as references. The exact
 // rules (also the GPU's contract) are documented in crep/prefilter/prefilter.h.
 #include <crep/core/error.h>
+#include <crep/core/parallel.h>
 #include <crep/prefilter/prefilter.h>
 
-#include "parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -291,7 +291,7 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
 
   const int n = W / R;
   const std::size_t layerStride = static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 4;
-  detail::parallelRows(H, options.threads, [&](int j) {
+  parallelRows(H, options.threads, [&](int j) {
     std::vector<double> mix(static_cast<std::size_t>(n));
     std::array<double, kMaxBases> F{}, B{};
     const std::span<double> basisSpan(B.data(), static_cast<std::size_t>(M));
@@ -336,7 +336,7 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
   const double greySigma = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
   Image out(w, h, 4);
-  detail::parallelRows(h, options.threads, [&](int y) {
+  parallelRows(h, options.threads, [&](int y) {
     std::array<double, kMaxBases> a{}, Fa{}, Fb{};
     const std::span<double> aSpan(a.data(), static_cast<std::size_t>(M));
     for (int x = 0; x < w; ++x) {
@@ -402,7 +402,7 @@ Image marchReference(const RectifiedMap& map, const Image& cameraDepth, const Ca
   const double greySigma = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
   Image out(w, h, 4);
-  detail::parallelRows(h, options.threads, [&](int y) {
+  parallelRows(h, options.threads, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
       const glm::dvec3 C = scatteringConstant(light, medium, ray.direction);
@@ -445,7 +445,7 @@ Image unshadowedScattering(const Image& cameraDepth, const Camera& camera, const
   const glm::dvec3 sigma = medium.extinction();
   const double greySigma = weightExtinction(medium);
   Image out(w, h, 4);
-  detail::parallelRows(h, options.threads, [&](int y) {
+  parallelRows(h, options.threads, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
       const glm::dvec3 L = scatteringConstant(light, medium, ray.direction) *

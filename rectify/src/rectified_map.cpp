@@ -3,6 +3,7 @@
 // linear in the column within a split, so s is a 1D projective function of that column (Sec. 3.2
 // weights need it per row; Sec. 4.2 splits are the regions).
 #include <crep/core/error.h>
+#include <crep/core/parallel.h>
 #include <crep/rectify/rectified_map.h>
 
 #include <algorithm>
@@ -167,29 +168,7 @@ RectifiedMap castRectifiedMap(std::shared_ptr<const RectifiedLayout> layout, int
         depth.at(i, j) = static_cast<float>(std::clamp(l.toRectified(*hit).depth, 0.0, 1.0));
     }
   };
-  int n = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  n = std::min(n, height);
-  if (n <= 1) {
-    for (int j = 0; j < height; ++j)
-      doRow(j);
-  } else {
-    // Rows interleaved over the workers; every texel is written by exactly one of them.
-    std::vector<std::thread> workers;
-    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
-    for (int t = 0; t < n; ++t)
-      workers.emplace_back([&, t] {
-        try {
-          for (int j = t; j < height; j += n)
-            doRow(j);
-        } catch (...) {
-          errors[static_cast<std::size_t>(t)] = std::current_exception();
-        }
-      });
-    for (auto& w : workers)
-      w.join();
-    for (auto& e : errors)
-      if (e) std::rethrow_exception(e);
-  }
+  parallelRows(height, threads, doRow); // rows interleaved; every texel written by exactly one worker
   return RectifiedMap{std::move(layout), std::move(depth)};
 }
 

@@ -1,5 +1,6 @@
-// Private: deterministic row-parallel loops of the CPU reference (each row is computed by exactly one
-// worker and depends on nothing another worker writes, so the result never depends on the thread count).
+// Deterministic row-parallel loops for the CPU references (prefilter, resampling, marches): each row is
+// computed by exactly one worker and depends on nothing another worker writes, so results never depend
+// on the thread count.
 #pragma once
 
 #include <algorithm>
@@ -7,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-namespace crep::detail {
+namespace crep {
 
 /// Runs body(row) for row in [0, count) on min(threads, count) workers (threads <= 0: hardware
 /// concurrency), rows interleaved. Rethrows the first exception (by worker index) after all joined.
@@ -38,4 +39,4 @@ void parallelRows(int count, int threads, const Body& body) {
     if (e) std::rethrow_exception(e);
 }
 
-} // namespace crep::detail
+} // namespace crep
