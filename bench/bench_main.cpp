@@ -64,8 +64,7 @@ Setup makeSetup(const std::string& sceneName, int screenW, int screenH, int mapW
   s.cameraDepth = crep::scenes::createDepthTexture(screenW, screenH, "--size");
   renderer.renderDepth(s.scene.camera.clipFromWorld(), s.cameraDepth.get(), 0, 0, 0, screenW, screenH);
   s.cameraDepthImage = crep::scenes::readDepthTexture(s.cameraDepth.get(), screenW, screenH);
-  s.scattering = crep::gl::createTexture(GL_TEXTURE_2D);
-  glTextureStorage2D(s.scattering.get(), 1, GL_RGBA32F, screenW, screenH);
+  s.scattering = crep::gl::createTexture2D(GL_RGBA32F, screenW, screenH, "--size");
   glFinish();
   return s;
 }

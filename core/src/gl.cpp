@@ -140,6 +140,28 @@ Handle createQuery(std::uint32_t target) {
   return checked(ObjectType::Query, name, "glCreateQueries", "target=" + hex(target));
 }
 
+Handle createTexture2D(std::uint32_t internalFormat, int width, int height, const char* parameter) {
+  checkTextureSize(parameter, width, height);
+  Handle tex = createTexture(GL_TEXTURE_2D);
+  glTextureStorage2D(tex.get(), 1, internalFormat, width, height);
+  glTextureParameteri(tex.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(tex.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  checkError("createTexture2D");
+  return tex;
+}
+
+Image readTexture(std::uint32_t texture, int width, int height, TexelData data, int layer) {
+  Image image(width, height, data == TexelData::Rgba ? 4 : 1);
+  const GLenum format = data == TexelData::Rgba ? GL_RGBA : data == TexelData::Red ? GL_RED : GL_DEPTH_COMPONENT;
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureSubImage(texture, 0, 0, 0, layer, width, height, 1, format, GL_FLOAT,
+                       static_cast<GLsizei>(image.data().size_bytes()), image.data().data());
+  checkError("readTexture");
+  return image;
+}
+
 Handle createSampler() {
   GLuint name = 0;
   glCreateSamplers(1, &name);

@@ -29,22 +29,11 @@ namespace crep::tool {
 namespace {
 
 gl::Handle createColorTexture(int width, int height, GLenum format) {
-  gl::Handle tex = gl::createTexture(GL_TEXTURE_2D);
-  glTextureStorage2D(tex.get(), 1, format, width, height);
-  glTextureParameteri(tex.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTextureParameteri(tex.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return tex;
+  return gl::createTexture2D(format, width, height, "--size");
 }
 
 Image readRgba(GLuint texture, int width, int height) {
-  Image image(width, height, 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(image.data().size_bytes()),
-                    image.data().data());
-  gl::checkError("readback");
-  return image;
+  return gl::readTexture(texture, width, height, gl::TexelData::Rgba);
 }
 
 void setVec3(GLuint program, GLint location, const glm::dvec3& v) {

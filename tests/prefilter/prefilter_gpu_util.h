@@ -118,22 +118,12 @@ inline std::vector<float> readTextureArray(std::uint32_t texture, int width, int
 
 /// A 4-channel image of an RGBA 2D texture.
 inline Image readRgbaTexture(std::uint32_t texture, int width, int height) {
-  Image image(width, height, 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(image.byteSize()),
-                    image.data().data());
-  return image;
+  return gl::readTexture(texture, width, height, gl::TexelData::Rgba);
 }
 
 /// A GL_TEXTURE_2D of `format` (GL enum) with nearest filtering, clamp to edge.
 inline gl::Handle createTexture2D(std::uint32_t format, int width, int height) {
-  gl::Handle tex = gl::createTexture(GL_TEXTURE_2D);
-  glTextureStorage2D(tex.get(), 1, format, width, height);
-  glTextureParameteri(tex.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTextureParameteri(tex.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return tex;
+  return gl::createTexture2D(format, width, height);
 }
 
 inline UploadedBasis uploadBasis(const FilteredBasis& basis, StorageFormat format) {

@@ -162,25 +162,11 @@ Image SceneRenderer::renderDepthImage(const glm::dmat4& clipFromWorld, int width
 }
 
 gl::Handle createDepthTexture(int width, int height, const char* parameter) {
-  gl::checkTextureSize(parameter, width, height);
-  gl::Handle tex = gl::createTexture(GL_TEXTURE_2D);
-  glTextureStorage2D(tex.get(), 1, GL_DEPTH_COMPONENT32F, width, height);
-  glTextureParameteri(tex.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTextureParameteri(tex.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(tex.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  gl::checkError("createDepthTexture");
-  return tex;
+  return gl::createTexture2D(GL_DEPTH_COMPONENT32F, width, height, parameter);
 }
 
 Image readDepthTexture(std::uint32_t texture, int width, int height, int layer) {
-  Image image(width, height, 1);
-  const auto bytes = static_cast<GLsizei>(image.data().size_bytes());
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureSubImage(texture, 0, 0, 0, layer, width, height, 1, GL_DEPTH_COMPONENT, GL_FLOAT, bytes,
-                       image.data().data());
-  gl::checkError("readDepthTexture");
-  return image;
+  return gl::readTexture(texture, width, height, gl::TexelData::Depth, layer);
 }
 
 } // namespace crep::scenes

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <string>
 
+#include <crep/core/image.h>
+
 namespace crep::gl {
 
 enum class ObjectType { Texture, Buffer, Framebuffer, Renderbuffer, VertexArray, Program, Shader, Query, Sampler };
@@ -38,6 +40,16 @@ Handle createFramebuffer();
 Handle createVertexArray();
 Handle createQuery(std::uint32_t target);
 Handle createSampler();
+
+/// A GL_TEXTURE_2D with one level of `internalFormat` (a GLenum such as GL_RGBA32F or
+/// GL_DEPTH_COMPONENT32F), nearest filtering, clamp to edge. Checks the size first
+/// (checkTextureSize(parameter, ...)).
+Handle createTexture2D(std::uint32_t internalFormat, int width, int height, const char* parameter = "texture size");
+
+/// What readTexture() reads: RGBA (4 channels), the red channel, or depth (1 channel each).
+enum class TexelData { Rgba, Red, Depth };
+/// Reads level 0 of a 2D texture, or layer `layer` of a 2D array, as a float image (row 0 = bottom).
+Image readTexture(std::uint32_t texture, int width, int height, TexelData data, int layer = 0);
 
 /// Implementation limits.
 int maxTextureSize();      ///< GL_MAX_TEXTURE_SIZE
