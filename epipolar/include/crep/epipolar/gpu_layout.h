@@ -1,0 +1,117 @@
+// Blocks shared between the epipolar/ GPU passes (gpu_march.h, resample.h) and their shaders. Each struct
+// has a GLSL twin with the same name prefixed "Crep" in glsl/crep/epipolar.glsl, laid out by std140 (uniform
+// blocks) or std430 (storage buffers): 16-byte vectors and matrices only, int instead of bool, a
+// static_assert on the size. tests/epipolar/GpuLayoutGLTest.cpp compares every member offset with the
+// offsets the driver reports for the linked shaders.
+//
+// A shader of an engine that maps pixels into a rectified map (e.g. to evaluate the prefiltered scattering
+// on the epipolar fallback layout) includes "crep/epipolar.glsl" with CREP_LAYOUT set, and binds a uniform
+// buffer holding makeLayoutParams(layout) at CREP_LAYOUT_BINDING (plus, for the epipolar layout, a storage
+// buffer holding makeEpipolarSlices(layout) at CREP_SLICES_BINDING).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/rectify/rectified_map.h>
+
+namespace crep {
+class EpipolarLayout; // crep/epipolar/epipolar.h
+} // namespace crep
+
+namespace crep::gpu {
+
+/// Largest number of layout regions the layout blocks hold (= RectifyOptions::kMaxSplits).
+inline constexpr int kMaxLayoutRegions = 64;
+
+/// The value of CREP_LAYOUT in glsl/crep/epipolar.glsl.
+enum class LayoutKind : std::int32_t {
+  Projective = 0, ///< crep::ProjectiveLayout
+  Epipolar = 1,   ///< crep::EpipolarLayout
+};
+
+/// std140 block CrepProjectiveLayoutBlock { CrepProjectiveLayoutParams crep_projective; } (CREP_LAYOUT 0).
+struct ProjectiveLayoutParams {
+  glm::vec4 origin{0.0f}; ///< xyz: camera position (world); w: rho = 1 / |camera - light| (0: directional)
+  glm::vec4 axisX{1.0f, 0.0f, 0.0f, 0.0f};  ///< xyz: projection axis (unit); w: 0
+  glm::vec4 axisY{0.0f, 1.0f, 0.0f, 0.0f};  ///< xyz: axisZ x axisX; w: 0
+  glm::vec4 axisZ{0.0f, 0.0f, 1.0f, 0.0f};  ///< xyz: direction light travels at the camera; w: 0
+  glm::vec4 slopes{0.0f, 1.0f, 0.0f, 1.0f}; ///< row slope min, max, depth slope min, max
+  glm::ivec4 counts{1, 0, 0, 0};            ///< x: layout regions (splits) K; yzw: 0
+  glm::vec4 splitZeta[kMaxLayoutRegions]{}; ///< split k < K: x zetaBegin, y zetaEnd (1/world unit); zw 0
+};
+static_assert(sizeof(ProjectiveLayoutParams) == 16 * (6 + kMaxLayoutRegions),
+              "std140 CrepProjectiveLayoutParams");
+
+/// std140 block CrepEpipolarLayoutBlock { CrepEpipolarLayoutParams crep_epipolar; } (CREP_LAYOUT 1): the
+/// geometry of crep::EpipolarLayout (epipolar.h); the per-slice bounds are in the storage buffer below.
+struct EpipolarLayoutParams {
+  glm::vec4 origin{0.0f};                        ///< xyz: camera position (world); w: 0
+  glm::vec4 towardLight{0.0f, 1.0f, 0.0f, 0.0f}; ///< xyz: m = -light direction (unit); w: 0
+  glm::vec4 imageX{
+      1.0f, 0.0f, 0.0f,
+      0.0f}; ///< xyz: camera right / (tan(fovY / 2) aspect): NDC x = dot(w, imageX) / dot(w, forward)
+  glm::vec4 imageY{0.0f, 1.0f, 0.0f, 0.0f};   ///< xyz: camera up / tan(fovY / 2)
+  glm::vec4 forward{0.0f, 0.0f, -1.0f, 0.0f}; ///< xyz: camera forward (unit); w: 0
+  glm::vec4 cameraTan{1.0f};                  ///< x: tan(fovY / 2) aspect, y: tan(fovY / 2); zw: 0
+  glm::vec4 border{0.0f};                     ///< x: screen width, y: height (pixels), z: perimeter P, w: 0
+  glm::vec4 arc{
+      0.0f}; ///< x: arcBegin, y: arcLength (border pixels), z: 1 = exit at the larger psi, 0 = smaller
+  glm::ivec4 counts{0}; ///< x: slices H, y: regions K; zw: 0
+  /// Region boundary f_k (b / bMax, EpipolarLayout::regionFractions()) in element k / 4, component k % 4,
+  /// k = 0..K.
+  glm::vec4 regionFractions[kMaxLayoutRegions / 4 + 1]{};
+};
+static_assert(sizeof(EpipolarLayoutParams) == 16 * (9 + kMaxLayoutRegions / 4 + 1),
+              "std140 CrepEpipolarLayoutParams");
+
+/// std430 element of CrepEpipolarSlicesBlock { CrepEpipolarSlice crep_slices[]; }: one slice (texel row).
+struct EpipolarSlice {
+  glm::vec4 bounds{0.0f}; ///< x: bMax (world units), y: psiMin, z: psiMax (radians), w: 0
+};
+static_assert(sizeof(EpipolarSlice) == 16, "std430 CrepEpipolarSlice");
+
+/// std140 block CrepMarchBlock { CrepMarchParams crep_march; } of the march and resampling passes.
+struct MarchParams {
+  glm::vec4 cameraPosition{0.0f};                    ///< xyz: world; w: near plane distance
+  glm::vec4 cameraForward{0.0f, 0.0f, -1.0f, 0.0f};  ///< xyz: unit view direction; w: far plane distance
+  glm::vec4 cameraRight{1.0f, 0.0f, 0.0f, 0.0f};     ///< xyz: right * tan(fovY / 2) * aspect; w: 0
+  glm::vec4 cameraUp{0.0f, 1.0f, 0.0f, 0.0f};        ///< xyz: up * tan(fovY / 2); w: 0
+  glm::vec4 lightDirection{0.0f, -1.0f, 0.0f, 0.0f}; ///< xyz: direction the light travels; w: 0
+  glm::vec4 lightIrradiance{0.0f};                   ///< rgb: irradiance; w: 0
+  glm::vec4 mieScattering{0.0f};      ///< rgb: sigma_s of the Henyey-Greenstein part (1/world unit); w: g
+  glm::vec4 rayleighScattering{0.0f}; ///< rgb: sigma_s of the Rayleigh part; w: 0
+  glm::vec4 extinction{0.0f};         ///< rgb: sigma_t; w: grey extinction (mean of rgb)
+  /// march: xy camera image (pixels), zw rectified map (texels); world march: zw standard shadow map;
+  /// resampling: xy standard shadow map, zw rectified map
+  glm::ivec4 sizes{0};
+  glm::ivec4 info{0};   ///< march: x tree levels L, y tree row stride; world march: x steps N, y refinements
+  glm::vec4 bias{0.0f}; ///< world march: x shadow bias (depth-buffer units)
+  glm::vec4 block{0.0f, 0.0f, -1.0f, 0.0f}; ///< world march: xy centre, z radius (pixels; < 0: all pixels)
+  glm::ivec4 region{0};               ///< world march: xy first pixel of the dispatch, zw its size (pixels)
+  glm::mat4 lightClipFromWorld{1.0f}; ///< world march / resampling: the standard shadow map's matrix
+};
+static_assert(sizeof(MarchParams) == 16 * 18, "std140 CrepMarchParams");
+
+/// The camera, light and medium part of MarchParams for a w x h camera image and a W x H map.
+MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                            int width, int height, int mapWidth, int mapHeight);
+
+/// The block of a projective layout (regionCount() <= kMaxLayoutRegions, else InvalidArgument
+/// "ProjectiveLayout.regionCount").
+ProjectiveLayoutParams makeProjectiveLayoutParams(const ProjectiveLayout& layout);
+
+/// The block and the slice table of an epipolar layout.
+EpipolarLayoutParams makeEpipolarLayoutParams(const EpipolarLayout& layout);
+std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout);
+
+/// Which GLSL layout implements `layout`: Projective for ProjectiveLayout, Epipolar for EpipolarLayout;
+/// throws InvalidArgument ("layout") for any other RectifiedLayout (no GPU mapping).
+LayoutKind layoutKind(const RectifiedLayout& layout);
+
+} // namespace crep::gpu

@@ -1,0 +1,133 @@
+// GPU passes of the ray marches (OpenGL 4.5 compute shaders): the min/max trees of a rectified map, the
+// tree-accelerated and brute-force marches along its rows, and the world-space reference march against a
+// standard shadow map. They implement the rules of crep/epipolar/march.h in float precision (the CPU
+// functions there are their references).
+//
+// Every pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
+// buffers and sampler (RAII); the textures of FrameAttribs are the caller's (non-owning GL names).
+// Conventions: depth textures hold depth-buffer values in [0, 1] (GL_DEPTH_COMPONENT32F or GL_R32F, read
+// with texelFetch through the pass's own nearest sampler, so the texture's compare mode does not matter);
+// outputs are GL_RGBA32F (scattering: RGB radiance, A grey transmittance) and GL_R32F (steps per pixel).
+// A pass leaves GL state as follows: program 0; texture units 0-1 with no texture and no sampler; image
+// units 0-1, uniform buffer bindings 0-1 and storage buffer bindings 0-1 unbound. It issues the memory
+// barriers its outputs need for texture fetches, image loads, readback and buffer reads.
+// NaN in a GPU input is not checked (it would cost a readback): a NaN camera depth is treated as the sky
+// (far plane), a NaN rectified-map texel as shadowing every ray (every comparison with it is false),
+// a NaN standard shadow-map texel as empty (lit). The CPU functions reject NaN with InvalidArgument.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/gl.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/epipolar/gpu_layout.h>
+#include <crep/rectify/rectified_map.h>
+
+namespace crep {
+
+/// Builds the 1D min/max trees of every row of a W x H rectified map (march.h MinMaxTrees; Yusov 2012
+/// Sec. 6.3) into a storage buffer it owns, in exactly MinMaxTrees' layout (the values are bit-identical).
+class MinMaxTreePass {
+public:
+  struct CreateInfo {
+    int mapWidth = 0;  ///< W texels (> 0, <= GL_MAX_TEXTURE_SIZE)
+    int mapHeight = 0; ///< H texels (> 0, <= GL_MAX_TEXTURE_SIZE)
+  };
+  /// Throws InvalidArgument ("MinMaxTreePass.mapSize") for sizes <= 0, GlError beyond GL_MAX_TEXTURE_SIZE
+  /// or above 2^16 columns (16 tree levels), ShaderError if the shader does not build.
+  explicit MinMaxTreePass(const CreateInfo& info);
+
+  /// Builds the trees of `rectifiedDepth` (the caller's W x H depth texture).
+  void run(std::uint32_t rectifiedDepth);
+
+  std::uint32_t treeBuffer() const noexcept { return buffer_.get(); } ///< GL_SHADER_STORAGE_BUFFER
+  int levels() const noexcept { return levels_; }
+  int rowStride() const noexcept { return rowStride_; }
+  /// Reads the buffer back: 2 floats per node, MinMaxTrees::data()'s layout.
+  std::vector<float> readNodes() const;
+
+private:
+  CreateInfo info_;
+  int levels_ = 0, rowStride_ = 0;
+  gl::Handle program_, buffer_, sampler_;
+};
+
+/// The march of every camera pixel's view ray along its row of a rectified map (march.h "Rectified
+/// marches"), with the map's min/max trees (MinMaxTree) or texel by texel (BruteForce).
+class RectifiedMarchPass {
+public:
+  enum class Mode { MinMaxTree, BruteForce };
+  struct CreateInfo {
+    int mapWidth = 0;  ///< W texels of the maps it will march (> 0, <= GL_MAX_TEXTURE_SIZE)
+    int mapHeight = 0; ///< H texels
+    Mode mode = Mode::MinMaxTree;
+  };
+  /// Per-frame inputs: non-owning.
+  struct FrameAttribs {
+    /// The map's layout: a ProjectiveLayout or an EpipolarLayout (gpu::layoutKind()); not stored.
+    const RectifiedLayout* layout = nullptr;
+    const Camera* camera = nullptr;
+    const DirectionalLight* light = nullptr;
+    const Medium* medium = nullptr;
+    std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
+    int width = 0, height = 0;     ///< camera image size (pixels)
+    std::uint32_t rectifiedDepth =
+        0;                           ///< mapWidth x mapHeight depth texture rendered / resampled for `layout`
+    std::uint32_t minMaxBuffer = 0;  ///< MinMaxTreePass::treeBuffer() of that map (MinMaxTree mode)
+    std::uint32_t scatteringOut = 0; ///< GL_RGBA32F width x height texture
+    std::uint32_t stepsOut = 0;      ///< GL_R32F width x height texture, or 0 (steps not written)
+  };
+  /// Throws InvalidArgument ("RectifiedMarchPass.mapSize") / GlError like MinMaxTreePass.
+  explicit RectifiedMarchPass(const CreateInfo& info);
+  /// Throws InvalidArgument naming the field of FrameAttribs (null pointers, zero names, sizes that do not
+  /// match the textures, wrong output formats, a layout with no GPU mapping or too many regions).
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle programs_[2], params_, layoutBlock_, slices_, sampler_, dummySteps_;
+  int dummyWidth_ = 0, dummyHeight_ = 0;
+};
+
+/// The world-space reference march (march.h) against a standard shadow map; optionally only the pixels
+/// within a radius of a point: the epipole block of seed 003 Fig. 8 (its other pixels are not written).
+class WorldMarchPass {
+public:
+  struct CreateInfo {
+    int steps = 256;      ///< N >= 1 (WorldMarchOptions)
+    int refinements = 16; ///< bisections at each visibility change, [0, 60]
+  };
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    const DirectionalLight* light = nullptr;
+    const Medium* medium = nullptr;
+    std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
+    int width = 0, height = 0;
+    std::uint32_t shadowMap = 0; ///< standard shadow map (depth texture) rendered with lightClipFromWorld
+    int shadowWidth = 0, shadowHeight = 0;
+    glm::dmat4 lightClipFromWorld{1.0};
+    double bias = 0.0;               ///< added to the stored depth (depth-buffer units)
+    std::uint32_t scatteringOut = 0; ///< GL_RGBA32F width x height
+    std::uint32_t stepsOut = 0;      ///< GL_R32F width x height, or 0
+    /// Epipole block: when blockRadius >= 0, only pixels whose centre is within blockRadius pixels of
+    /// blockCenter (pixel coordinates, origin at the bottom-left corner of the image) are marched.
+    glm::dvec2 blockCenter{0.0};
+    double blockRadius = -1.0;
+  };
+  /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
+  explicit WorldMarchPass(const CreateInfo& info);
+  /// Throws InvalidArgument naming the FrameAttribs field.
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, params_, sampler_, dummySteps_;
+  int dummyWidth_ = 0, dummyHeight_ = 0;
+};
+
+} // namespace crep

@@ -1,0 +1,71 @@
+// Resampling of a standard shadow map into a rectified map (Klehm et al. 2014, Sec. 4.1): the epipolar
+// fallback's map, and, with the same code, a projective rectified map for engines that cannot change
+// their shadow pass. CPU reference (double) and GL compute pass.
+//
+// Rule, for texel (i, j) of a W x H map of `layout` (column (i + 0.5) / W, row (j + 0.5) / H):
+//   ray = layout.lightRay(column, row); (x, y) = NDC of ray.origin under lightClipFromWorld (the same for
+//   every point of the ray: the matrix must be an orthographic projection along the light direction);
+//   outside [-1, 1]^2 -> 1 (no information: nothing casts); else d = shadowDepth(floor(u Ws), floor(v Hs))
+//   (nearest texel, "point-resampled"), u = (x + 1) / 2, v = (y + 1) / 2;
+//   d >= 1 -> 1 (nothing on that light ray); else the occluder p = lightClipFromWorld^-1 (x, y, 2 d - 1, 1)
+//   (on the ray), stored depth = clamp(layout.toRectified(p).depth, 0, 1).
+// Blocker clamping (Sec. 4.1): an occluder between the light and the camera frustum has a depth < 0 in the
+// slice's bounds and is clamped to 0, so it still shadows every view ray of the texel (like GL_DEPTH_CLAMP
+// for the projective matrices); one behind the frustum clamps to 1 (lit).
+// For an EpipolarLayout the map height must be its sliceCount(); the width W a multiple of regionCount().
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/gl.h>
+#include <crep/core/image.h>
+#include <crep/rectify/rectified_map.h>
+
+namespace crep {
+
+struct ResampleOptions {
+  int threads = 0; ///< CPU worker threads: 0 = hardware concurrency (never changes the result)
+};
+
+/// Throws InvalidArgument ("lightClipFromWorld") unless the matrix is finite, affine (last row 0 0 0 1)
+/// and projects the light direction to a point (an orthographic shadow matrix looking along it).
+void validateLightMatrix(const glm::dmat4& lightClipFromWorld, const glm::dvec3& lightDirection);
+
+/// The CPU reference (rule at the top). Throws InvalidArgument for a null layout, sizes <= 0 or a width
+/// that is not a multiple of regionCount() ("resampleShadowMap.size"), an EpipolarLayout whose sliceCount()
+/// differs from the height, an empty / multi-channel shadow map or a NaN texel ("shadowDepth"), a bad
+/// light matrix. The light direction is the layout's light ray direction.
+RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, int width, int height,
+                               const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                               const ResampleOptions& options = {});
+
+/// The GL compute pass of the same rule (float precision; a NaN shadow-map texel counts as empty). Owns
+/// its program, buffers and sampler; the textures are the caller's. GL state left as in gpu_march.h.
+class ShadowResamplePass {
+public:
+  struct CreateInfo {
+    int mapWidth = 0;  ///< W texels of the rectified maps it writes (> 0, <= GL_MAX_TEXTURE_SIZE)
+    int mapHeight = 0; ///< H texels (for an EpipolarLayout: its sliceCount())
+  };
+  struct FrameAttribs {
+    const RectifiedLayout* layout = nullptr; ///< ProjectiveLayout or EpipolarLayout (not stored)
+    std::uint32_t shadowMap = 0;             ///< standard shadow map: depth texture (or GL_R32F)
+    int shadowWidth = 0, shadowHeight = 0;
+    glm::dmat4 lightClipFromWorld{1.0}; ///< the matrix it was rendered with (validateLightMatrix)
+    std::uint32_t rectifiedOut = 0;     ///< GL_R32F mapWidth x mapHeight texture (written)
+  };
+  /// Throws InvalidArgument ("ShadowResamplePass.mapSize") for sizes <= 0, GlError beyond
+  /// GL_MAX_TEXTURE_SIZE.
+  explicit ShadowResamplePass(const CreateInfo& info);
+  /// Throws InvalidArgument naming the FrameAttribs field.
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle programs_[2], params_, layoutBlock_, slices_, sampler_;
+};
+
+} // namespace crep

@@ -1,0 +1,428 @@
+// The epipolar fallback layout (crep/epipolar/epipolar.h): Klehm et al. 2014 Sec. 4.1 (angles to the
+// light, per-slice bounds of the angle and of the distance along the reference ray), slices through the
+// screen border in the order of Yusov 2012 (seed 000 Sec. 6.1 exit points, Sec. 6.6 sectors).
+#include <crep/core/error.h>
+#include <crep/core/image.h>
+#include <crep/epipolar/epipolar.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+namespace crep {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Floor of sin(psi) in distances: a ray along the light axis gets a huge finite step (a valid profile).
+constexpr double kMinSinPsi = 1e-12;
+
+std::string vecString(const glm::dvec3& v) {
+  return "(" + detail::formatValue(v.x) + ", " + detail::formatValue(v.y) + ", " + detail::formatValue(v.z) +
+         ")";
+}
+
+/// Intersects [lo, hi] (within [0, pi]) with {psi : A cos psi + B sin psi <= 0}, a closed half-circle
+/// centred at atan2(B, A) + pi.
+void clipHalfCircle(double A, double B, double& lo, double& hi) {
+  if (A == 0.0 && B == 0.0) return;
+  const double mid = 0.5 * (lo + hi);
+  double centre = std::atan2(B, A) + kPi;
+  centre -= 2.0 * kPi * std::round((centre - mid) / (2.0 * kPi));
+  lo = std::max(lo, centre - 0.5 * kPi);
+  hi = std::min(hi, centre + 0.5 * kPi);
+}
+
+} // namespace
+
+void validate(const EpipolarOptions& o) {
+  if (o.slices < 0 || o.slices > kMaxEpipolarSlices)
+    throw InvalidArgument("EpipolarOptions.slices", detail::formatValue(o.slices),
+                          "must be 0 (automatic) or in [1, " + std::to_string(kMaxEpipolarSlices) + "]");
+  if (!(o.slicesPerBorderPixel > 0.0) || !std::isfinite(o.slicesPerBorderPixel))
+    throw InvalidArgument("EpipolarOptions.slicesPerBorderPixel", detail::formatValue(o.slicesPerBorderPixel),
+                          "must be finite and > 0");
+  if (o.regions < 1 || o.regions > RectifyOptions::kMaxSplits)
+    throw InvalidArgument("EpipolarOptions.regions", detail::formatValue(o.regions),
+                          "must be in [1, " + std::to_string(RectifyOptions::kMaxSplits) + "]");
+  if (o.regionScheme == SplitScheme::Blend)
+    throw InvalidArgument("EpipolarOptions.regionScheme", "Blend", "must be Uniform or Logarithmic");
+  if (!(o.epipoleBlockRadius >= 0.0) || !std::isfinite(o.epipoleBlockRadius))
+    throw InvalidArgument("EpipolarOptions.epipoleBlockRadius", detail::formatValue(o.epipoleBlockRadius),
+                          "must be finite and >= 0");
+}
+
+// Sec. 4.1 (Baran-style epipolar coordinates) with Yusov Sec. 6.1: epipole, exit sides, border arc, slice
+// count.
+EpipolarLayout::EpipolarLayout(const Camera& camera, const DirectionalLight& light, int screenWidth,
+                               int screenHeight, const EpipolarOptions& options)
+    : camera_(camera), l_(light.direction()), m_(-light.direction()), width_(screenWidth),
+      height_(screenHeight), options_(options) {
+  if (screenWidth <= 0 || screenHeight <= 0 || screenWidth > Image::kMaxDimension ||
+      screenHeight > Image::kMaxDimension)
+    throw InvalidArgument("EpipolarLayout.screenSize",
+                          std::to_string(screenWidth) + " x " + std::to_string(screenHeight),
+                          "must be in [1, " + std::to_string(Image::kMaxDimension) + "] per side");
+  validate(options);
+  tanY_ = std::tan(0.5 * camera.fovY());
+  tanX_ = tanY_ * camera.aspect();
+
+  // The epipole: the image of the light axis, from the side of it that is in front (V.z >= 0).
+  const glm::dvec3 hm = image(m_);
+  vanishing_ = hm.z >= 0.0 ? hm : -hm;
+  kind_ = hm.z > 0.0 ? EpipoleKind::Epipole : hm.z < 0.0 ? EpipoleKind::AntiEpipole : EpipoleKind::AtInfinity;
+  exitAtHigh_ = hm.z >= 0.0;
+  if (vanishing_.z > 0.0) epipoleNdc_ = glm::dvec2(vanishing_) / vanishing_.z;
+
+  // Exit sides: rays from the epipole leave the screen through the sides whose inner half-plane holds it.
+  const glm::dvec3& V = vanishing_;
+  const bool exits[4] = {V.x > -V.z, V.y > -V.z, V.x < V.z, V.y < V.z}; // left, bottom, right, top
+  const double side[4] = {static_cast<double>(height_), static_cast<double>(width_),
+                          static_cast<double>(height_), static_cast<double>(width_)};
+  const double sideBegin[4] = {0.0, side[0], side[0] + side[1], side[0] + side[1] + side[2]};
+  exitSides_ = 0;
+  for (int s = 0; s < 4; ++s)
+    exitSides_ |= exits[s] ? 1 << s : 0;
+  if (exitSides_ == 15 || exitSides_ == 0) {
+    // All four (epipole on screen), or none (only for a degenerate V): the whole border from the corner.
+    arcBegin_ = 0.0;
+    arcLength_ = perimeter();
+    exitSides_ = 15;
+  } else {
+    int first = 0;
+    while (!(exits[first] && !exits[(first + 3) % 4]))
+      ++first;
+    arcBegin_ = sideBegin[first];
+    arcLength_ = 0.0;
+    for (int s = first; exits[s % 4] && s < first + 4; ++s)
+      arcLength_ += side[s % 4];
+  }
+  const int H = options.slices > 0
+                    ? options.slices
+                    : static_cast<int>(std::ceil(arcLength_ * options.slicesPerBorderPixel - 1e-9));
+  if (H < 1 || H > kMaxEpipolarSlices)
+    throw InvalidArgument(
+        "EpipolarOptions.slicesPerBorderPixel", detail::formatValue(options.slicesPerBorderPixel),
+        "gives " + std::to_string(H) + " slices; must give [1, " + std::to_string(kMaxEpipolarSlices) + "]");
+  slices_.resize(static_cast<std::size_t>(H));
+  buildSlices();
+  const int K = options.regions;
+  fractions_.assign(static_cast<std::size_t>(K) + 1, 1.0);
+  fractions_[0] = 0.0;
+  const double ratio = std::min(camera.near() / camera.far(), 0.5);
+  for (int k = 1; k < K; ++k)
+    fractions_[static_cast<std::size_t>(k)] = options.regionScheme == SplitScheme::Uniform
+                                                  ? static_cast<double>(k) / K
+                                                  : std::pow(ratio, 1.0 - static_cast<double>(k) / K);
+}
+
+glm::dvec3 EpipolarLayout::image(const glm::dvec3& w) const {
+  return {glm::dot(w, camera_.right()) / tanX_, glm::dot(w, camera_.up()) / tanY_,
+          glm::dot(w, camera_.forward())};
+}
+
+bool EpipolarLayout::epipoleOnScreen() const noexcept {
+  return kind_ != EpipoleKind::AtInfinity && std::abs(epipoleNdc_.x) <= 1.0 && std::abs(epipoleNdc_.y) <= 1.0;
+}
+
+std::optional<glm::dvec2> EpipolarLayout::epipolePixel() const {
+  if (kind_ == EpipoleKind::AtInfinity || !(vanishing_.z > 0.0)) return std::nullopt;
+  return glm::dvec2((epipoleNdc_.x + 1.0) * 0.5 * width_, (epipoleNdc_.y + 1.0) * 0.5 * height_);
+}
+
+double EpipolarLayout::epipoleBlockRadiusPixels() const {
+  return options_.epipoleBlockRadius *
+         std::sqrt(static_cast<double>(width_) * width_ + static_cast<double>(height_) * height_);
+}
+
+std::vector<int> EpipolarLayout::epipoleBlockPixels() const {
+  std::vector<int> out;
+  const auto e = epipolePixel();
+  const double r = epipoleBlockRadiusPixels();
+  if (!e || !(r > 0.0) || !std::isfinite(e->x) || !std::isfinite(e->y)) return out;
+  const int y0 = std::max(0, static_cast<int>(std::floor(e->y - r - 1.0)));
+  const int y1 = std::min(height_ - 1, static_cast<int>(std::ceil(e->y + r + 1.0)));
+  const int x0 = std::max(0, static_cast<int>(std::floor(e->x - r - 1.0)));
+  const int x1 = std::min(width_ - 1, static_cast<int>(std::ceil(e->x + r + 1.0)));
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x)
+      if (glm::length(glm::dvec2(x + 0.5, y + 0.5) - *e) <= r) out.push_back(y * width_ + x);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Border parameterization (Yusov's order, in pixels)
+
+glm::dvec2 EpipolarLayout::borderPoint(double sigma) const {
+  const double P = perimeter(), w = width_, h = height_;
+  double s = std::fmod(sigma, P);
+  if (s < 0.0) s += P;
+  if (s < h) return {-1.0, 1.0 - 2.0 * s / h};
+  s -= h;
+  if (s < w) return {-1.0 + 2.0 * s / w, -1.0};
+  s -= w;
+  if (s < h) return {1.0, -1.0 + 2.0 * s / h};
+  s -= h;
+  return {1.0 - 2.0 * std::min(s, w) / w, 1.0};
+}
+
+double EpipolarLayout::borderSigma(const glm::dvec2& ndc) const {
+  const double w = width_, h = height_;
+  const double x = std::clamp(ndc.x, -1.0, 1.0), y = std::clamp(ndc.y, -1.0, 1.0);
+  if (std::abs(x) >= std::abs(y)) {
+    if (x < 0.0) return 0.5 * (1.0 - y) * h; // left, top to bottom
+    return h + w + 0.5 * (y + 1.0) * h;      // right, bottom to top
+  }
+  if (y < 0.0) return h + 0.5 * (x + 1.0) * w; // bottom, left to right
+  return 2.0 * h + w + 0.5 * (1.0 - x) * w;    // top, right to left
+}
+
+double EpipolarLayout::rowSigma(double row) const {
+  return arcBegin_ + row * arcLength_;
+}
+
+double EpipolarLayout::rowOfSigma(double sigma) const {
+  const double P = perimeter();
+  double d = sigma - arcBegin_;
+  if (arcLength_ >= P) {
+    d = std::fmod(d, P);
+    if (d < 0.0) d += P;
+    return d / P;
+  }
+  // Outside the arc (rounding next to its ends): the nearer end.
+  const double gap = P - arcLength_;
+  d = std::fmod(d + 0.5 * gap, P);
+  if (d < 0.0) d += P;
+  return std::clamp((d - 0.5 * gap) / arcLength_, 0.0, 1.0);
+}
+
+glm::dvec3 EpipolarLayout::borderDirection(double sigma) const {
+  const glm::dvec2 p = borderPoint(sigma);
+  return glm::normalize(camera_.forward() + p.x * tanX_ * camera_.right() + p.y * tanY_ * camera_.up());
+}
+
+int EpipolarLayout::sliceIndex(double row) const {
+  const int H = sliceCount();
+  if (!(row == row)) return 0;
+  return std::clamp(static_cast<int>(std::floor(std::clamp(row, -1.0, 2.0) * H)), 0, H - 1);
+}
+
+glm::dvec3 EpipolarLayout::sliceDirection(double row) const {
+  const glm::dvec3 w = borderDirection(rowSigma(row));
+  const glm::dvec3 q = w - glm::dot(w, m_) * m_;
+  const double len = glm::length(q);
+  return len > 0.0 ? q / len : anyOrthogonal(m_);
+}
+
+double EpipolarLayout::columnFraction(double column) const {
+  const int K = regionCount();
+  const int k = std::clamp(static_cast<int>(std::floor(column * K)), 0, K - 1);
+  const double f0 = fractions_[static_cast<std::size_t>(k)], f1 = fractions_[static_cast<std::size_t>(k) + 1];
+  return f0 + (column * K - k) * (f1 - f0);
+}
+
+double EpipolarLayout::fractionColumn(double fraction) const {
+  const int K = regionCount();
+  int k = 0;
+  while (k < K - 1 && fraction >= fractions_[static_cast<std::size_t>(k) + 1])
+    ++k;
+  const double f0 = fractions_[static_cast<std::size_t>(k)], f1 = fractions_[static_cast<std::size_t>(k) + 1];
+  return (k + (fraction - f0) / (f1 - f0)) / K;
+}
+
+double EpipolarLayout::psi(int slice, double depth) const {
+  const Slice& s = slices_[static_cast<std::size_t>(std::clamp(slice, 0, sliceCount() - 1))];
+  return s.psiMin + depth * (s.psiMax - s.psiMin);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Half-planes
+
+// Yusov Sec. 6.1 / 6.6: the entry and exit points of an epipolar line, here as the visible psi interval of
+// the slice's half-plane (exact in 3D, also for an epipole behind the camera or at infinity).
+std::optional<EpipolarLayout::HalfPlaneView> EpipolarLayout::viewOfHalfPlane(const glm::dvec3& n) const {
+  // Directions of the half-plane: w(psi) = cos(psi) m + sin(psi) n, psi in [0, pi]; its image point is
+  // H(psi) = cos(psi) hm + sin(psi) hn. On screen: |H.x| <= H.z, |H.y| <= H.z (which implies H.z >= 0).
+  const glm::dvec3 hm = image(m_), hn = image(n);
+  double lo = 0.0, hi = kPi;
+  clipHalfCircle(hm.x - hm.z, hn.x - hn.z, lo, hi);   // x <= 1
+  clipHalfCircle(-hm.x - hm.z, -hn.x - hn.z, lo, hi); // x >= -1
+  clipHalfCircle(hm.y - hm.z, hn.y - hn.z, lo, hi);   // y <= 1
+  clipHalfCircle(-hm.y - hm.z, -hn.y - hn.z, lo, hi); // y >= -1
+  if (!(lo <= hi)) return std::nullopt;
+  const double psiExit = exitAtHigh_ ? hi : lo;
+  const glm::dvec3 H = std::cos(psiExit) * hm + std::sin(psiExit) * hn;
+  if (!(H.z > 0.0)) return std::nullopt;
+  return HalfPlaneView{lo, hi, borderSigma(glm::dvec2(H) / H.z)};
+}
+
+// Sec. 4.1 bounds: z (psi) from the limiting view rays of each slice row, x (b) from the far-plane points of
+// its limiting rays (and the screen corners inside it).
+void EpipolarLayout::buildSlices() {
+  const int H = sliceCount();
+  const double far = camera_.far();
+  const glm::dvec3 F = camera_.forward();
+  for (auto& s : slices_) {
+    s.bMax = 0.0;
+    s.psiMin = kInf;
+    s.psiMax = -kInf;
+  }
+  // Includes the view ray of angle psi in the half-plane n into slice j's bounds.
+  const auto include = [&](int j, const glm::dvec3& n, double psiValue) {
+    Slice& s = slices_[static_cast<std::size_t>(j)];
+    s.psiMin = std::min(s.psiMin, psiValue);
+    s.psiMax = std::max(s.psiMax, psiValue);
+    const glm::dvec3 w = std::cos(psiValue) * m_ + std::sin(psiValue) * n;
+    const double cosF = glm::dot(w, F);
+    if (cosF > 0.0) s.bMax = std::max(s.bMax, far / cosF * std::sin(psiValue));
+  };
+  const auto includeSlice = [&](int j, double row) {
+    const glm::dvec3 n = sliceDirection(row);
+    if (const auto view = viewOfHalfPlane(n)) {
+      include(j, n, view->psiLo);
+      include(j, n, view->psiHi);
+    }
+  };
+  for (int j = 0; j < H; ++j) {
+    includeSlice(j, static_cast<double>(j) / H);
+    includeSlice(j, (j + 0.5) / H);
+    includeSlice(j, static_cast<double>(j + 1) / H);
+    slices_[static_cast<std::size_t>(j)].direction = sliceDirection((j + 0.5) / H);
+  }
+  // Screen corners inside a slice row's sector are vertices of it too.
+  for (const glm::dvec2 corner :
+       {glm::dvec2(-1, -1), glm::dvec2(1, -1), glm::dvec2(1, 1), glm::dvec2(-1, 1)}) {
+    const glm::dvec3 w =
+        glm::normalize(F + corner.x * tanX_ * camera_.right() + corner.y * tanY_ * camera_.up());
+    const glm::dvec3 q = w - glm::dot(w, m_) * m_;
+    const double b = glm::length(q);
+    if (!(b > 1e-12)) continue;
+    const glm::dvec3 n = q / b;
+    if (const auto view = viewOfHalfPlane(n))
+      include(sliceIndex(rowOfSigma(view->exitSigma)), n, std::atan2(b, glm::dot(w, m_)));
+  }
+  for (auto& s : slices_) {
+    if (!(s.psiMin <=
+          s.psiMax)) { // no visible ray (cannot happen for a row of the exit arc): a harmless default
+      s.psiMin = 0.0;
+      s.psiMax = kPi;
+    }
+    // Degenerate ranges would make the depth undefined; keep a tiny one.
+    const double minRange = 1e-9;
+    if (s.psiMax - s.psiMin < minRange) {
+      const double c = 0.5 * (s.psiMin + s.psiMax);
+      s.psiMin = std::max(0.0, c - minRange);
+      s.psiMax = std::min(kPi, s.psiMin + 2.0 * minRange);
+    }
+    s.bMax = s.bMax > 0.0 ? s.bMax * (1.0 + 1e-12) : far * 1e-9;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// RectifiedLayout
+
+// Sec. 4.1 mapping: y = slice (by its exit point), x = distance along the reference ray (b), z = angle to the
+// light.
+RectPoint EpipolarLayout::toRectified(const glm::dvec3& world) const {
+  const glm::dvec3 q = world - camera_.position();
+  const double a = glm::dot(q, m_);
+  const glm::dvec3 perp = q - a * m_;
+  const double b = glm::length(perp);
+  if (!std::isfinite(a) || !std::isfinite(b))
+    throw InvalidArgument("EpipolarLayout.toRectified.world", vecString(world), "must be finite");
+  if (!(b > 0.0))
+    throw InvalidArgument("EpipolarLayout.toRectified.world", vecString(world),
+                          "lies on the light axis through the camera (no slice)");
+  const glm::dvec3 n = perp / b;
+  const auto view = viewOfHalfPlane(n);
+  if (!view)
+    throw InvalidArgument("EpipolarLayout.toRectified.world", vecString(world),
+                          "its epipolar half-plane is not on screen (no slice)");
+  RectPoint p;
+  p.row = rowOfSigma(view->exitSigma);
+  const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(p.row))];
+  const double fraction = b / s.bMax;
+  p.depth = (std::atan2(b, a) - s.psiMin) / (s.psiMax - s.psiMin);
+  const int K = regionCount();
+  int k = 0;
+  while (k < K - 1 && fraction >= fractions_[static_cast<std::size_t>(k) + 1])
+    ++k;
+  const double f0 = fractions_[static_cast<std::size_t>(k)], f1 = fractions_[static_cast<std::size_t>(k) + 1];
+  p.split = k;
+  p.splitColumn = (fraction - f0) / (f1 - f0);
+  p.column = (k + p.splitColumn) / K;
+  return p;
+}
+
+LightRay EpipolarLayout::lightRay(double column, double row) const {
+  if (!std::isfinite(column) || !std::isfinite(row))
+    throw InvalidArgument("EpipolarLayout.lightRay",
+                          "column " + detail::formatValue(column) + ", row " + detail::formatValue(row),
+                          "must be finite");
+  const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(row))];
+  return {camera_.position() + columnFraction(column) * s.bMax * sliceDirection(row), l_};
+}
+
+glm::dvec3 EpipolarLayout::viewRayDirection(double row, double depth) const {
+  const double angle = psi(sliceIndex(row), depth);
+  return std::cos(angle) * m_ + std::sin(angle) * sliceDirection(row);
+}
+
+double EpipolarLayout::rayDistance(double row, double depth, double column) const {
+  const int j = sliceIndex(row);
+  // A ray along the light axis (sin(psi) = 0) never leaves column 0: the same huge finite step as
+  // rayProfile() keeps the two consistent.
+  const double sinPsi = std::max(std::sin(psi(j, depth)), kMinSinPsi);
+  return columnFraction(column) * slices_[static_cast<std::size_t>(j)].bMax / sinPsi;
+}
+
+// Sec. 3.2: the row's reference ray (bisectrix, or the optimal k_ref = sqrt(k_min k_max)).
+double EpipolarLayout::referenceDepth(double row) const {
+  const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(row))];
+  // k = sin(psi) (Sec. 3.2: the cosine to the slice's direction orthogonal to the light); the ray's world
+  // step per column is proportional to 1 / k. psiA: largest k (smallest step), psiB: smallest k.
+  const double halfPi = 0.5 * kPi;
+  const double psiA = std::clamp(halfPi, s.psiMin, s.psiMax);
+  const double psiB = std::abs(s.psiMin - halfPi) > std::abs(s.psiMax - halfPi) ? s.psiMin : s.psiMax;
+  double psiRef = 0.5 * (psiA + psiB);
+  if (options_.referenceRay == ReferenceRay::Optimal) {
+    const double kMin = std::sin(psiB), kMax = std::sin(psiA);
+    if (kMin > 0.0) {
+      const double k = std::sqrt(kMin * kMax);
+      // The ray between psiA and psiB with sin(psi) = k.
+      psiRef = psiB < halfPi ? std::asin(std::min(1.0, k)) : kPi - std::asin(std::min(1.0, k));
+    }
+  }
+  return (psiRef - s.psiMin) / (s.psiMax - s.psiMin);
+}
+
+double EpipolarLayout::referenceDistance(double row, double column) const {
+  return rayDistance(row, referenceDepth(row), column);
+}
+
+// Sec. 3.2 / Eq. 11: distances along a ray are linear in the column inside a region (constant step).
+DistanceProfile EpipolarLayout::rayProfile(double row, double depth, int region) const {
+  const int K = regionCount();
+  if (region < 0 || region >= K)
+    throw InvalidArgument("EpipolarLayout.region", detail::formatValue(region),
+                          "must be in [0, " + std::to_string(K) + ")");
+  if (!std::isfinite(row) || !std::isfinite(depth))
+    throw InvalidArgument("EpipolarLayout.rayProfile",
+                          "row " + detail::formatValue(row) + ", depth " + detail::formatValue(depth),
+                          "must be finite");
+  const int j = sliceIndex(row);
+  const double sinPsi = std::max(std::sin(psi(j, depth)), kMinSinPsi);
+  const double scale = slices_[static_cast<std::size_t>(j)].bMax / sinPsi;
+  const double f0 = fractions_[static_cast<std::size_t>(region)],
+               f1 = fractions_[static_cast<std::size_t>(region) + 1];
+  return {f0 * scale, (f1 - f0) * scale, 1.0, 0.0};
+}
+
+DistanceProfile EpipolarLayout::referenceProfile(double row, int region) const {
+  return rayProfile(row, referenceDepth(row), region);
+}
+
+} // namespace crep

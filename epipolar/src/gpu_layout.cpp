@@ -1,0 +1,75 @@
+// The GPU layout blocks (crep/epipolar/gpu_layout.h, glsl/crep/epipolar.glsl) and their upload.
+#include <crep/core/error.h>
+#include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/gpu_layout.h>
+
+#include "gpu_common.h"
+
+#include <cmath>
+
+namespace crep {
+
+namespace gpu {
+
+EpipolarLayoutParams makeEpipolarLayoutParams(const EpipolarLayout& layout) {
+  const Camera& c = layout.camera();
+  const double tanY = std::tan(0.5 * c.fovY()), tanX = tanY * c.aspect();
+  EpipolarLayoutParams p;
+  p.origin = glm::vec4(glm::vec3(c.position()), 0.0f);
+  p.towardLight = glm::vec4(glm::vec3(-layout.lightDirection()), 0.0f);
+  p.imageX = glm::vec4(glm::vec3(c.right() / tanX), 0.0f);
+  p.imageY = glm::vec4(glm::vec3(c.up() / tanY), 0.0f);
+  p.forward = glm::vec4(glm::vec3(c.forward()), 0.0f);
+  p.cameraTan = glm::vec4(static_cast<float>(tanX), static_cast<float>(tanY), 0.0f, 0.0f);
+  p.border = glm::vec4(static_cast<float>(layout.screenWidth()), static_cast<float>(layout.screenHeight()),
+                       static_cast<float>(layout.perimeter()), 0.0f);
+  p.arc = glm::vec4(static_cast<float>(layout.arcBegin()), static_cast<float>(layout.arcLength()),
+                    layout.epipoleKind() == EpipoleKind::AntiEpipole ? 0.0f : 1.0f, 0.0f);
+  p.counts = glm::ivec4(layout.sliceCount(), layout.regionCount(), 0, 0);
+  const std::vector<double>& f = layout.regionFractions();
+  for (std::size_t k = 0; k < f.size(); ++k)
+    p.regionFractions[k / 4][static_cast<int>(k % 4)] = static_cast<float>(f[k]);
+  return p;
+}
+
+std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout) {
+  std::vector<EpipolarSlice> out;
+  out.reserve(layout.slices().size());
+  for (const auto& s : layout.slices())
+    out.push_back({glm::vec4(static_cast<float>(s.bMax), static_cast<float>(s.psiMin),
+                             static_cast<float>(s.psiMax), 0.0f)});
+  return out;
+}
+
+} // namespace gpu
+
+namespace epipolar_detail {
+
+void uploadLayout(const RectifiedLayout& layout, gpu::LayoutKind kind, int mapHeight, gl::Handle& block,
+                  gl::Handle& slices) {
+  if (kind == gpu::LayoutKind::Projective) {
+    const gpu::ProjectiveLayoutParams p =
+        gpu::makeProjectiveLayoutParams(dynamic_cast<const ProjectiveLayout&>(layout));
+    glNamedBufferSubData(block.get(), 0, sizeof(p), &p);
+    return;
+  }
+  const auto& e = dynamic_cast<const EpipolarLayout&>(layout);
+  if (e.sliceCount() != mapHeight)
+    throw InvalidArgument("mapHeight", std::to_string(mapHeight),
+                          "must be the EpipolarLayout's slice count " + std::to_string(e.sliceCount()));
+  const gpu::EpipolarLayoutParams p = gpu::makeEpipolarLayoutParams(e);
+  glNamedBufferSubData(block.get(), 0, sizeof(p), &p);
+  const std::vector<gpu::EpipolarSlice> table = gpu::makeEpipolarSlices(e);
+  const auto bytes = static_cast<GLsizeiptr>(table.size() * sizeof(gpu::EpipolarSlice));
+  GLint64 size = 0;
+  if (slices) glGetNamedBufferParameteri64v(slices.get(), GL_BUFFER_SIZE, &size);
+  if (!slices || size < bytes) {
+    slices = gl::createBuffer();
+    glNamedBufferStorage(slices.get(), bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+  }
+  glNamedBufferSubData(slices.get(), 0, bytes, table.data());
+}
+
+} // namespace epipolar_detail
+
+} // namespace crep

@@ -1,0 +1,87 @@
+// Private helpers shared by the CPU marches (march.cpp) and the epipole block: the pixel rays and the
+// integration rule of crep/epipolar/march.h ("Rays and output").
+#pragma once
+
+#include <crep/core/camera.h>
+#include <crep/core/error.h>
+#include <crep/core/image.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace crep::epipolar_detail {
+
+inline std::string pixelString(int x, int y) {
+  return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
+}
+
+/// Throws InvalidArgument ("cameraDepth") unless the image is non-empty with values in [0, 1].
+inline void validateCameraDepth(const Image& depth) {
+  if (depth.empty()) throw InvalidArgument("cameraDepth", "empty", "must be a depth-buffer image");
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const float v = depth.at(x, y, 0);
+      if (!(v >= 0.0f && v <= 1.0f))
+        throw InvalidArgument("cameraDepth", pixelString(x, y) + " = " + detail::formatValue(v),
+                              "depth-buffer values must be in [0, 1]");
+    }
+}
+
+/// The view ray of pixel (x, y) and the distance s to its surface (far plane for the sky).
+struct PixelRay {
+  glm::dvec3 direction{0.0};
+  double surface = 0.0;
+};
+
+inline PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y) {
+  PixelRay r;
+  const double ndcX = 2.0 * (x + 0.5) / depth.width() - 1.0;
+  const double ndcY = 2.0 * (y + 0.5) / depth.height() - 1.0;
+  r.direction = camera.rayDirection(ndcX, ndcY);
+  const double cosForward = glm::dot(r.direction, camera.forward());
+  const double d = depth.at(x, y, 0);
+  r.surface = (d >= 1.0 ? camera.far() : camera.linearDepth(d)) / cosForward;
+  return r;
+}
+
+/// phi(x) = (1 - exp(-x)) / x, phi(0) = 1.
+inline double oneMinusExpOverX(double x) {
+  if (std::abs(x) < 1e-8) return 1.0 - 0.5 * x;
+  return -std::expm1(-x) / x;
+}
+
+/// (exp(-sigma ta) - exp(-sigma tb)) / sigma, finite as sigma -> 0 (seed 003 Eq. 3 on a section).
+inline double sectionIntegral(double sigma, double ta, double tb) {
+  const double len = tb - ta;
+  if (!(len > 0.0)) return 0.0;
+  return std::exp(-sigma * ta) * len * oneMinusExpOverX(sigma * len);
+}
+
+inline glm::dvec3 sectionIntegral(const glm::dvec3& sigma, double ta, double tb) {
+  return {sectionIntegral(sigma.x, ta, tb), sectionIntegral(sigma.y, ta, tb),
+          sectionIntegral(sigma.z, ta, tb)};
+}
+
+/// C of seed 003 Eq. 1 per channel for the unit view direction v (from the camera).
+inline glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
+                                     const glm::dvec3& v) {
+  return light.irradiance() * medium.scatteringTimesPhase(glm::dot(light.direction(), -v));
+}
+
+/// The grey extinction of the alpha channel: the mean of the three extinction channels.
+inline double greyExtinction(const Medium& medium) {
+  const glm::dvec3 s = medium.extinction();
+  return (s.x + s.y + s.z) / 3.0;
+}
+
+inline void storePixel(Image& out, int x, int y, const glm::dvec3& L, double transmittance) {
+  out.at(x, y, 0) = static_cast<float>(L.x);
+  out.at(x, y, 1) = static_cast<float>(L.y);
+  out.at(x, y, 2) = static_cast<float>(L.z);
+  out.at(x, y, 3) = static_cast<float>(transmittance);
+}
+
+} // namespace crep::epipolar_detail

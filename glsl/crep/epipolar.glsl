@@ -1,0 +1,380 @@
+// crepuscular: mapping of world points and view rays into a rectified map, for shaders that march or
+// resample rectified maps (passes/march_rectified.comp, passes/epipolar_resample.comp) or evaluate the
+// prefiltered scattering on the epipolar fallback layout. Two layouts (crep/rectify/rectified_map.h):
+//   CREP_LAYOUT_PROJECTIVE  Klehm et al. 2014 Sec. 4.2 (crep::ProjectiveLayout): frame + split zetas
+//   CREP_LAYOUT_EPIPOLAR    Sec. 4.1 epipolar resampling (crep::EpipolarLayout, crep/epipolar/epipolar.h)
+// The uniform blocks are member for member the structs of crep/epipolar/gpu_layout.h (std140/std430).
+//
+// Public include (conventions in crep/common.glsl). Options (#define before the include):
+//   CREP_LAYOUT           CREP_LAYOUT_PROJECTIVE (default) or CREP_LAYOUT_EPIPOLAR: which block exists
+//   CREP_LAYOUT_BINDING   uniform buffer binding of the layout block (default 1)
+//   CREP_SLICES_BINDING   storage buffer binding of the epipolar per-slice table (default 1)
+//
+// What every layout provides:
+//   bool  crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r)
+//         a view ray (unit dir from the camera, surface distance) -> its texel row, depth z_r and last texel
+//   float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize)
+//         the ray's own world distance at texel boundary i (unclamped; 3e38 = never)
+//   bool  crep_layoutToRectified(vec3 world, out vec4 p)   p = (row, column, depth, region)
+//   CrepLightRay crep_layoutLightRay(float column, float row)
+#ifndef CREP_EPIPOLAR_GLSL
+#define CREP_EPIPOLAR_GLSL
+
+#include "common.glsl"
+
+#define CREP_LAYOUT_PROJECTIVE 0
+#define CREP_LAYOUT_EPIPOLAR 1
+#ifndef CREP_LAYOUT
+#define CREP_LAYOUT CREP_LAYOUT_PROJECTIVE
+#endif
+#ifndef CREP_LAYOUT_BINDING
+#define CREP_LAYOUT_BINDING 1
+#endif
+#ifndef CREP_SLICES_BINDING
+#define CREP_SLICES_BINDING 1
+#endif
+
+// gpu::kMaxLayoutRegions
+#define CREP_MAX_LAYOUT_REGIONS 64
+#define CREP_NEVER 3.0e38
+
+// A view ray mapped onto its row of a rectified map (crep/epipolar/march.h "Rectified marches").
+struct CrepRowRay {
+  float row;    // normalized row of the ray
+  float depth;  // z_r, clamped to [0, 1]
+  int texelRow; // j = clamp(floor(row H), 0, H - 1)
+  int last;     // e: the last texel the ray crosses
+  vec4 dist;    // layout data of crep_rowRayDistance
+};
+
+// A light ray: origin + t direction, t >= 0 in the direction light travels (crep::LightRay).
+struct CrepLightRay {
+  vec3 origin;
+  vec3 direction;
+};
+
+// gpu::MarchParams (std140): the frame attributes of the march and resampling passes.
+struct CrepMarchParams {
+  vec4 cameraPosition;     // xyz world; w near
+  vec4 cameraForward;      // xyz unit view direction; w far
+  vec4 cameraRight;        // xyz right * tan(fovY / 2) * aspect; w 0
+  vec4 cameraUp;           // xyz up * tan(fovY / 2); w 0
+  vec4 lightDirection;     // xyz direction the light travels; w 0
+  vec4 lightIrradiance;    // rgb; w 0
+  vec4 mieScattering;      // rgb; w Henyey-Greenstein g
+  vec4 rayleighScattering; // rgb; w 0
+  vec4 extinction;         // rgb sigma_t; w grey extinction (mean of rgb)
+  ivec4 sizes;             // march: xy camera image, zw map; world march: zw shadow map; resampling: xy shadow map, zw map
+  ivec4 info;              // march: x tree levels L, y tree row stride; world march: x steps N, y refinements
+  vec4 bias;               // world march: x shadow bias (depth-buffer units); yzw 0
+  vec4 block;              // world march: xy centre (pixels), z radius (pixels, < 0: every pixel), w 0
+  ivec4 region;            // world march: xy first pixel of the dispatch, zw its size
+  mat4 lightClipFromWorld; // world march / resampling: the standard shadow map's matrix
+};
+
+// The view ray of pixel p of a w x h camera image and its surface distance (crep/epipolar/march.h: sky
+// pixels end at the far plane). xyz = unit direction, w = distance.
+vec4 crep_pixelRay(CrepMarchParams m, ivec2 p, float depth) {
+  vec2 ndc = 2.0 * (vec2(p) + 0.5) / vec2(m.sizes.xy) - 1.0;
+  vec3 dir = normalize(m.cameraForward.xyz + ndc.x * m.cameraRight.xyz + ndc.y * m.cameraUp.xyz);
+  float viewDepth = depth >= 1.0 || !(depth >= 0.0) ? m.cameraForward.w
+                                                    : crep_linearDepth(depth, m.cameraPosition.w, m.cameraForward.w);
+  return vec4(dir, viewDepth / dot(dir, m.cameraForward.xyz));
+}
+
+// (exp(-sigma ta) - exp(-sigma tb)) / sigma per channel, tb - ta as sigma -> 0 (seed 003 Eq. 3).
+vec3 crep_sectionIntegral(vec3 sigma, float ta, float tb) {
+  float len = max(tb - ta, 0.0);
+  vec3 x = sigma * len;
+  // Series below 0.1 (truncation < 2e-8), where exp(-x) - 1 would cancel in float.
+  vec3 series = 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0))));
+  vec3 phi = mix(-(exp(-x) - 1.0) / max(x, vec3(1e-30)), series, lessThan(x, vec3(0.1)));
+  return exp(-sigma * ta) * len * phi;
+}
+
+// The texel e of a ray ending in region k at column u in [0, 1] of it (n texels per region).
+int crep_lastTexel(int k, float u, int K, int n) {
+  k = clamp(k, 0, K - 1);
+  return k * n + clamp(int(ceil(clamp(u, 0.0, 1.0) * float(n))) - 1, 0, n - 1);
+}
+
+#if CREP_LAYOUT == CREP_LAYOUT_PROJECTIVE
+// ---------------------------------------------------------------------------------------------------
+// Projective layout (rectify.h "The math"): frame coordinates X, Y, Z of p - origin; slopes y = Y / X,
+// z = Z / X; zeta = (1 + rho Z) / X; split k covers zeta in [zetaEnd_k, zetaBegin_k].
+
+// gpu::ProjectiveLayoutParams (std140).
+struct CrepProjectiveLayoutParams {
+  vec4 origin;  // xyz camera position; w rho (0: directional)
+  vec4 axisX;   // xyz; w 0
+  vec4 axisY;   // xyz; w 0
+  vec4 axisZ;   // xyz; w 0
+  vec4 slopes;  // row slope min, row slope max, depth slope min, depth slope max
+  ivec4 counts; // x regions (splits) K
+  vec4 splitZeta[CREP_MAX_LAYOUT_REGIONS]; // x zetaBegin, y zetaEnd
+};
+
+layout(std140, binding = CREP_LAYOUT_BINDING) uniform CrepProjectiveLayoutBlock {
+  CrepProjectiveLayoutParams crep_projective;
+};
+
+bool crep_layoutToRectified(vec3 world, out vec4 p) {
+  vec3 offset = world - crep_projective.origin.xyz;
+  float X = dot(crep_projective.axisX.xyz, offset);
+  p = vec4(0.0);
+  if (!(X > 0.0)) return false;
+  float Y = dot(crep_projective.axisY.xyz, offset), Z = dot(crep_projective.axisZ.xyz, offset);
+  vec4 s = crep_projective.slopes;
+  float zeta = (1.0 + crep_projective.origin.w * Z) / X;
+  int K = crep_projective.counts.x;
+  int k = 0;
+  while (k < K - 1 && zeta < crep_projective.splitZeta[k].y) ++k;
+  vec2 range = crep_projective.splitZeta[k].xy;
+  float u = (range.x - zeta) / (range.x - range.y);
+  p = vec4((Y / X - s.x) / (s.y - s.x), (float(k) + u) / float(K), (Z / X - s.z) / (s.w - s.z), float(k));
+  return true;
+}
+
+// zeta of a normalized column (the end splits extrapolate), as crep::Rectification does.
+float crep_projectiveZeta(float column) {
+  int K = crep_projective.counts.x;
+  float scaled = column * float(K);
+  int k = clamp(int(floor(scaled)), 0, K - 1);
+  vec2 range = crep_projective.splitZeta[k].xy;
+  return range.x + (scaled - float(k)) * (range.y - range.x);
+}
+
+// Directional lights only (rho = 0): the point of the light ray with Z = 0 and the light direction.
+CrepLightRay crep_layoutLightRay(float column, float row) {
+  vec4 s = crep_projective.slopes;
+  float y = s.x + row * (s.y - s.x);
+  float X = 1.0 / crep_projectiveZeta(column);
+  return CrepLightRay(crep_projective.origin.xyz + X * (crep_projective.axisX.xyz + y * crep_projective.axisY.xyz),
+                      crep_projective.axisZ.xyz);
+}
+
+bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
+  r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
+  vec4 p;
+  if (!crep_layoutToRectified(crep_projective.origin.xyz + surface * dir, p)) return false;
+  int K = crep_projective.counts.x, n = mapSize.x / K;
+  int k = int(p.w);
+  float u = p.y * float(K) - float(k);
+  r.row = p.x;
+  r.depth = clamp(p.z, 0.0, 1.0);
+  r.texelRow = clamp(int(floor(p.x * float(mapSize.y))), 0, mapSize.y - 1);
+  r.last = crep_lastTexel(k, u, K, n);
+  // The ray's slopes at its (clamped) depth: s(zeta) = sqrt(1 + y^2 + z^2) / (zeta - rho z).
+  vec4 s = crep_projective.slopes;
+  float y = s.x + p.x * (s.y - s.x), z = s.z + r.depth * (s.w - s.z);
+  r.dist = vec4(sqrt(1.0 + y * y + z * z), crep_projective.origin.w * z, 0.0, 0.0);
+  return true;
+}
+
+float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
+  int K = crep_projective.counts.x, n = mapSize.x / K;
+  int k = i / n, q = i - k * n;
+  if (k >= K) {
+    k = K - 1;
+    q = n;
+  }
+  vec2 range = crep_projective.splitZeta[k].xy;
+  float den = range.x + (float(q) / float(n)) * (range.y - range.x) - r.dist.y;
+  return den > 0.0 ? r.dist.x / den : CREP_NEVER;
+}
+#endif // CREP_LAYOUT_PROJECTIVE
+
+#if CREP_LAYOUT == CREP_LAYOUT_EPIPOLAR
+// ---------------------------------------------------------------------------------------------------
+// Epipolar layout (crep/epipolar/epipolar.h): m = direction toward the light, for a point q = p - camera:
+// a = q.m, b = |q - a m|, psi = atan(b, a); the slice is the half-plane of q around the light axis, named
+// by the border position sigma (pixels, Yusov's order) of its exit point; row = (sigma - arcBegin) /
+// arcLength; column = b / bMax_j, depth = (psi - psiMin_j) / (psiMax_j - psiMin_j) with the bounds of
+// texel row j = floor(row H).
+
+// gpu::EpipolarLayoutParams (std140).
+struct CrepEpipolarLayoutParams {
+  vec4 origin;      // xyz camera position
+  vec4 towardLight; // xyz m
+  vec4 imageX;      // xyz right / tanX
+  vec4 imageY;      // xyz up / tanY
+  vec4 forward;     // xyz
+  vec4 cameraTan;   // x tanX, y tanY
+  vec4 border;      // x width, y height (pixels), z perimeter
+  vec4 arc;         // x arcBegin, y arcLength, z 1 = exit at the larger psi
+  ivec4 counts;     // x slices H, y regions K
+  vec4 regionFractions[CREP_MAX_LAYOUT_REGIONS / 4 + 1]; // f_k in element k / 4, component k % 4
+};
+
+// gpu::EpipolarSlice (std430).
+struct CrepEpipolarSlice {
+  vec4 bounds; // x bMax, y psiMin, z psiMax
+};
+
+layout(std140, binding = CREP_LAYOUT_BINDING) uniform CrepEpipolarLayoutBlock {
+  CrepEpipolarLayoutParams crep_epipolar;
+};
+layout(std430, binding = CREP_SLICES_BINDING) readonly buffer CrepEpipolarSlicesBlock {
+  CrepEpipolarSlice crep_slices[];
+};
+
+// Homogeneous image point of a direction: NDC = xy / z where z > 0.
+vec3 crep_epipolarImage(vec3 w) {
+  return vec3(dot(w, crep_epipolar.imageX.xyz), dot(w, crep_epipolar.imageY.xyz), dot(w, crep_epipolar.forward.xyz));
+}
+
+// [lo, hi] intersected with {psi : A cos psi + B sin psi <= 0} (a half-circle centred at atan(B, A) + pi).
+void crep_clipHalfCircle(float A, float B, inout float lo, inout float hi) {
+  if (A == 0.0 && B == 0.0) return;
+  float mid = 0.5 * (lo + hi);
+  float centre = atan(B, A) + float(CREP_PI);
+  centre -= float(CREP_TWO_PI) * round((centre - mid) / float(CREP_TWO_PI));
+  lo = max(lo, centre - 0.5 * float(CREP_PI));
+  hi = min(hi, centre + 0.5 * float(CREP_PI));
+}
+
+// Border position (pixels) of an NDC point on the border: left top->bottom, bottom left->right, right
+// bottom->top, top right->left, starting at the top-left corner.
+float crep_epipolarBorderSigma(vec2 ndc) {
+  float w = crep_epipolar.border.x, h = crep_epipolar.border.y;
+  vec2 p = clamp(ndc, -1.0, 1.0);
+  if (abs(p.x) >= abs(p.y)) return p.x < 0.0 ? 0.5 * (1.0 - p.y) * h : h + w + 0.5 * (p.y + 1.0) * h;
+  return p.y < 0.0 ? h + 0.5 * (p.x + 1.0) * w : 2.0 * h + w + 0.5 * (1.0 - p.x) * w;
+}
+
+vec2 crep_epipolarBorderPoint(float sigma) {
+  float w = crep_epipolar.border.x, h = crep_epipolar.border.y, P = crep_epipolar.border.z;
+  float s = mod(sigma, P);
+  if (s < h) return vec2(-1.0, 1.0 - 2.0 * s / h);
+  s -= h;
+  if (s < w) return vec2(-1.0 + 2.0 * s / w, -1.0);
+  s -= w;
+  if (s < h) return vec2(1.0, -1.0 + 2.0 * s / h);
+  s -= h;
+  return vec2(1.0 - 2.0 * min(s, w) / w, 1.0);
+}
+
+float crep_epipolarRowOfSigma(float sigma) {
+  float P = crep_epipolar.border.z, begin = crep_epipolar.arc.x, len = crep_epipolar.arc.y;
+  float d = sigma - begin;
+  if (len >= P) return mod(d, P) / P;
+  float gap = P - len;
+  return clamp((mod(d + 0.5 * gap, P) - 0.5 * gap) / len, 0.0, 1.0);
+}
+
+// The exit border position of the half-plane with unit direction n (orthogonal to m); false when no
+// part of it is on screen. psiRange receives its visible psi interval.
+bool crep_epipolarExitSigma(vec3 n, out float sigma, out vec2 psiRange) {
+  vec3 hm = crep_epipolarImage(crep_epipolar.towardLight.xyz), hn = crep_epipolarImage(n);
+  float lo = 0.0, hi = float(CREP_PI);
+  crep_clipHalfCircle(hm.x - hm.z, hn.x - hn.z, lo, hi);
+  crep_clipHalfCircle(-hm.x - hm.z, -hn.x - hn.z, lo, hi);
+  crep_clipHalfCircle(hm.y - hm.z, hn.y - hn.z, lo, hi);
+  crep_clipHalfCircle(-hm.y - hm.z, -hn.y - hn.z, lo, hi);
+  psiRange = vec2(lo, hi);
+  sigma = 0.0;
+  if (!(lo <= hi)) return false;
+  float psiExit = crep_epipolar.arc.z > 0.5 ? hi : lo;
+  vec3 H = cos(psiExit) * hm + sin(psiExit) * hn;
+  if (!(H.z > 0.0)) return false;
+  sigma = crep_epipolarBorderSigma(H.xy / H.z);
+  return true;
+}
+
+// Region boundary f_k (b / bMax) and the piecewise-linear column <-> b / bMax mapping.
+float crep_epipolarFraction(int k) { return crep_epipolar.regionFractions[k >> 2][k & 3]; }
+
+float crep_epipolarColumnFraction(float column) {
+  int K = crep_epipolar.counts.y;
+  int k = clamp(int(floor(column * float(K))), 0, K - 1);
+  float f0 = crep_epipolarFraction(k), f1 = crep_epipolarFraction(k + 1);
+  return f0 + (column * float(K) - float(k)) * (f1 - f0);
+}
+
+// Region k and the column u in it of b / bMax.
+void crep_epipolarFractionRegion(float fraction, out int k, out float u) {
+  int K = crep_epipolar.counts.y;
+  k = 0;
+  while (k < K - 1 && fraction >= crep_epipolarFraction(k + 1)) ++k;
+  float f0 = crep_epipolarFraction(k), f1 = crep_epipolarFraction(k + 1);
+  u = (fraction - f0) / (f1 - f0);
+}
+
+int crep_epipolarSliceIndex(float row) {
+  int H = crep_epipolar.counts.x;
+  return clamp(int(floor(row * float(H))), 0, H - 1);
+}
+
+// Unit direction of the slice at a normalized row, orthogonal to m.
+vec3 crep_epipolarSliceDirection(float row) {
+  vec2 p = crep_epipolarBorderPoint(crep_epipolar.arc.x + row * crep_epipolar.arc.y);
+  vec2 t = crep_epipolar.cameraTan.xy;
+  // imageX * tanX = right, imageY * tanY = up: the view ray through NDC p is forward + p.x tanX right + ...
+  vec3 w = normalize(crep_epipolar.forward.xyz + (p.x * t.x * t.x) * crep_epipolar.imageX.xyz +
+                     (p.y * t.y * t.y) * crep_epipolar.imageY.xyz);
+  vec3 m = crep_epipolar.towardLight.xyz;
+  return normalize(w - dot(w, m) * m);
+}
+
+bool crep_layoutToRectified(vec3 world, out vec4 p) {
+  p = vec4(0.0);
+  vec3 m = crep_epipolar.towardLight.xyz;
+  vec3 q = world - crep_epipolar.origin.xyz;
+  float a = dot(q, m);
+  vec3 perp = q - a * m;
+  float b = length(perp);
+  if (!(b > 0.0)) return false;
+  float sigma;
+  vec2 range;
+  if (!crep_epipolarExitSigma(perp / b, sigma, range)) return false;
+  float row = crep_epipolarRowOfSigma(sigma);
+  vec4 s = crep_slices[crep_epipolarSliceIndex(row)].bounds;
+  int k;
+  float u;
+  crep_epipolarFractionRegion(b / s.x, k, u);
+  p = vec4(row, (float(k) + u) / float(crep_epipolar.counts.y), (atan(b, a) - s.y) / (s.z - s.y), float(k));
+  return true;
+}
+
+CrepLightRay crep_layoutLightRay(float column, float row) {
+  vec4 s = crep_slices[crep_epipolarSliceIndex(row)].bounds;
+  return CrepLightRay(crep_epipolar.origin.xyz + crep_epipolarColumnFraction(column) * s.x *
+                                                     crep_epipolarSliceDirection(row),
+                      -crep_epipolar.towardLight.xyz);
+}
+
+bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
+  r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
+  vec3 m = crep_epipolar.towardLight.xyz;
+  float a = dot(dir, m);
+  vec3 perp = dir - a * m;
+  float sinPsi = length(perp);
+  if (!(sinPsi > 0.0)) return false;
+  float sigma;
+  vec2 range;
+  if (!crep_epipolarExitSigma(perp / sinPsi, sigma, range)) return false;
+  r.row = crep_epipolarRowOfSigma(sigma);
+  r.texelRow = clamp(int(floor(r.row * float(mapSize.y))), 0, mapSize.y - 1);
+  vec4 s = crep_slices[r.texelRow].bounds;
+  r.depth = clamp((atan(sinPsi, a) - s.y) / (s.z - s.y), 0.0, 1.0);
+  // Distances along the ray: T = (b / bMax) bMax / sin(psi), psi at z_r, b / bMax piecewise linear in i.
+  float sinRay = max(sin(s.y + r.depth * (s.z - s.y)), 1e-30);
+  int K = crep_epipolar.counts.y, n = mapSize.x / K;
+  int k;
+  float u;
+  crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
+  r.last = crep_lastTexel(k, u, K, n);
+  r.dist = vec4(s.x / sinRay, 0.0, 0.0, 0.0);
+  return true;
+}
+
+float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
+  int K = crep_epipolar.counts.y, n = mapSize.x / K;
+  int k = i / n, q = i - k * n;
+  if (k >= K) return r.dist.x;
+  float f0 = crep_epipolarFraction(k), f1 = crep_epipolarFraction(k + 1);
+  return (f0 + (f1 - f0) * float(q) / float(n)) * r.dist.x;
+}
+#endif // CREP_LAYOUT_EPIPOLAR
+
+#endif // CREP_EPIPOLAR_GLSL

@@ -1,0 +1,98 @@
+#version 450 core
+// Ray march of each camera pixel's view ray along its row of a rectified map (crep/epipolar/march.h,
+// "Rectified marches"): CREP_MARCH_TREE 1 walks the row's 1D min/max binary tree (Chen et al. 2011;
+// Yusov 2012 Algorithm 2, seed 000 Sec. 4), 0 tests every texel (brute force). Same rays, sections and
+// output as crep::minMaxMarch / crep::bruteForceMarch; float precision.
+//
+// Resources: params block (binding 0), layout block (crep/epipolar.glsl, binding 1), camera depth
+// (unit 0), rectified map depth (unit 1, texelFetch), min/max nodes (storage buffer 0, tree variant),
+// outputs: RGBA32F scattering (image 0), R32F steps (image 1).
+#include "crep/epipolar.glsl"
+#include "crep/phase.glsl"
+
+#ifndef CREP_MARCH_TREE
+#define CREP_MARCH_TREE 1
+#endif
+#define CREP_MAX_TREE_LEVELS 16
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = 0) uniform sampler2D cameraDepth;
+layout(binding = 1) uniform sampler2D rectifiedDepth;
+#if CREP_MARCH_TREE
+layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+#endif
+layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
+layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(pixel, crep_march.sizes.xy))) return;
+  vec4 ray = crep_pixelRay(crep_march, pixel, texelFetch(cameraDepth, pixel, 0).r);
+  vec3 dir = ray.xyz;
+  float s = ray.w;
+  vec3 sigma = crep_march.extinction.rgb;
+  float cosTheta = dot(crep_march.lightDirection.xyz, -dir);
+  vec3 C = crep_march.lightIrradiance.rgb *
+           (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
+            crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
+  ivec2 mapSize = crep_march.sizes.zw;
+  vec3 L = vec3(0.0);
+  int steps = 0;
+  CrepRowRay r;
+  if (!crep_mapRowRay(dir, s, mapSize, r)) {
+    L = crep_sectionIntegral(sigma, 0.0, s);
+  } else {
+    int j = r.texelRow, end = r.last + 1;
+    float z = r.depth;
+#if CREP_MARCH_TREE
+    int levels = crep_march.info.x;
+    int rowBase = j * crep_march.info.y;
+    int offsets[CREP_MAX_TREE_LEVELS + 1];
+    offsets[0] = 0;
+    offsets[1] = 0;
+    for (int l = 1; l < levels && l < CREP_MAX_TREE_LEVELS; ++l)
+      offsets[l + 1] = offsets[l] + ((mapSize.x + (1 << l) - 1) >> l);
+    int i = 0, level = 0;
+    float ta = 0.0;
+    while (i < end) {
+      // Algorithm 2 step 5.1: one level up where the position is aligned to it.
+      if (level < levels && (i & ((2 << level) - 1)) == 0) ++level;
+      bool lit = false;
+      for (;;) {
+        ++steps;
+        vec2 mm;
+        if (level == 0) {
+          mm = vec2(texelFetch(rectifiedDepth, ivec2(i, j), 0).r);
+        } else {
+          mm = crep_minMax[rowBase + offsets[level] + (i >> level)];
+        }
+        if (mm.x >= z) { // every texel of the node is lit
+          lit = true;
+          break;
+        }
+        if (mm.y < z) break; // every texel is shadowed
+        --level;
+      }
+      int next = min(i + (1 << level), end);
+      float tb = next > r.last ? s : min(crep_rowRayDistance(r, next, mapSize), s);
+      tb = max(tb, ta);
+      if (lit) L += crep_sectionIntegral(sigma, ta, tb);
+      ta = tb;
+      i = next;
+    }
+#else
+    float ta = 0.0;
+    for (int i = 0; i < end; ++i) {
+      ++steps;
+      float tb = i + 1 > r.last ? s : min(crep_rowRayDistance(r, i + 1, mapSize), s);
+      tb = max(tb, ta);
+      if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z) L += crep_sectionIntegral(sigma, ta, tb);
+      ta = tb;
+    }
+#endif
+  }
+  imageStore(scatteringOut, pixel, vec4(C * L, exp(-crep_march.extinction.w * s)));
+  imageStore(stepsOut, pixel, vec4(float(steps)));
+}

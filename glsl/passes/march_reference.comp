@@ -1,0 +1,77 @@
+#version 450 core
+// World-space reference march against a standard shadow map (crep/epipolar/march.h "World-space
+// reference march"; seed 003 Eq. 1 and 3, seed 000 Eq. 15-16): N equal sections from the camera to the
+// surface, visibility at their ends, bisection of every section whose ends differ, exact transmittance
+// integral of every lit part. Same rules as crep::worldSpaceMarch; float precision.
+//
+// The dispatch covers the pixel rectangle crep_march.region (origin xy, size zw); with block.z >= 0 only
+// the pixels within block.z pixels of block.xy (pixel centres) are written: the epipole block of seed 003
+// Fig. 8. Resources: params block (binding 0), camera depth (unit 0), shadow map (unit 1, texelFetch),
+// outputs: RGBA32F scattering (image 0), R32F steps (image 1).
+#include "crep/epipolar.glsl"
+#include "crep/phase.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = 0) uniform sampler2D cameraDepth;
+layout(binding = 1) uniform sampler2D shadowMap;
+layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
+layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
+
+int crep_lookups = 0;
+
+// crep::standardShadowLit: nearest texel, outside the map lit, NaN texels lit (documented GPU rule).
+bool crep_lit(vec3 p) {
+  ++crep_lookups;
+  vec4 q = crep_march.lightClipFromWorld * vec4(p, 1.0);
+  vec3 uvd = q.xyz / q.w * 0.5 + 0.5;
+  if (!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0)) return true;
+  ivec2 size = crep_march.sizes.zw;
+  ivec2 texel = min(ivec2(uvd.xy * vec2(size)), size - 1);
+  float stored = texelFetch(shadowMap, texel, 0).r;
+  return !(clamp(uvd.z, 0.0, 1.0) > stored + crep_march.bias.x);
+}
+
+void main() {
+  ivec2 pixel = crep_march.region.xy + ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), crep_march.region.zw)) ||
+      any(greaterThanEqual(pixel, crep_march.sizes.xy)) || any(lessThan(pixel, ivec2(0))))
+    return;
+  if (crep_march.block.z >= 0.0 && distance(vec2(pixel) + 0.5, crep_march.block.xy) > crep_march.block.z) return;
+  vec4 ray = crep_pixelRay(crep_march, pixel, texelFetch(cameraDepth, pixel, 0).r);
+  vec3 dir = ray.xyz, origin = crep_march.cameraPosition.xyz;
+  float s = ray.w;
+  vec3 sigma = crep_march.extinction.rgb;
+  float cosTheta = dot(crep_march.lightDirection.xyz, -dir);
+  vec3 C = crep_march.lightIrradiance.rgb *
+           (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
+            crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
+  int N = crep_march.info.x, refinements = crep_march.info.y;
+  vec3 L = vec3(0.0);
+  float ta = 0.0;
+  bool va = crep_lit(origin);
+  for (int k = 1; k <= N; ++k) {
+    float tb = k == N ? s : s * float(k) / float(N);
+    bool vb = crep_lit(origin + tb * dir);
+    if (va == vb) {
+      if (va) L += crep_sectionIntegral(sigma, ta, tb);
+    } else {
+      float lo = ta, hi = tb;
+      for (int r = 0; r < refinements; ++r) {
+        float mid = 0.5 * (lo + hi);
+        if (crep_lit(origin + mid * dir) == va)
+          lo = mid;
+        else
+          hi = mid;
+      }
+      float change = 0.5 * (lo + hi);
+      if (va) L += crep_sectionIntegral(sigma, ta, change);
+      if (vb) L += crep_sectionIntegral(sigma, change, tb);
+    }
+    ta = tb;
+    va = vb;
+  }
+  imageStore(scatteringOut, pixel, vec4(C * L, exp(-crep_march.extinction.w * s)));
+  imageStore(stepsOut, pixel, vec4(float(crep_lookups)));
+}

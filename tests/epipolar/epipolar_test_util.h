@@ -1,0 +1,184 @@
+// Shared helpers of the epipolar/ tests: the analytic setup (a camera over a ground plane, an infinite
+// plane occluder) with closed-form single scattering that uses none of the code under test, and image
+// metrics helpers.
+#pragma once
+
+#include <crep/core/camera.h>
+#include <crep/core/image.h>
+#include <crep/core/image_compare.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/rectify/rectified_map.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scenes/scene.h>
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace crep::test {
+
+/// 60 degree camera 2 units above the ground plane y = 0, near 0.1, far 80.
+inline Camera groundCamera(int w = 160, int h = 90) {
+  return Camera::lookAt({0, 2, 0}, {0, 1.5, -10}, {0, 1, 0}, glm::radians(60.0), static_cast<double>(w) / h,
+                        0.1, 80.0);
+}
+inline DirectionalLight sideLight() {
+  return DirectionalLight(glm::dvec3(1.0, -1.0, -0.3), glm::dvec3(2.0, 1.8, 1.5));
+}
+inline Medium colouredMedium() {
+  return Medium(glm::dvec3(0.03, 0.04, 0.05), glm::dvec3(0.01), 0.6, glm::dvec3(0.005, 0.01, 0.02));
+}
+
+inline std::shared_ptr<const ProjectiveLayout>
+projectiveLayout(const Camera& camera, const DirectionalLight& light, int splits = 4) {
+  RectifyOptions options;
+  options.splits = splits;
+  Rectification r = rectify(camera, light, options);
+  REQUIRE(r.projective());
+  return std::make_shared<const ProjectiveLayout>(std::move(r));
+}
+
+/// GL depth-buffer value of a view-space distance (glDepthRange(0, 1)).
+inline double depthBufferValue(const Camera& c, double viewDepth) {
+  const double n = c.near(), f = c.far();
+  const double ndc = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * viewDepth);
+  return 0.5 * ndc + 0.5;
+}
+
+/// Camera depth of the ground plane y = 0 (sky = 1 where it is farther than the far plane or missed).
+inline Image groundDepth(const Camera& camera, int w, int h) {
+  Image depth(w, h, 1, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::dvec3 v = camera.rayDirection(2.0 * (x + 0.5) / w - 1.0, 2.0 * (y + 0.5) / h - 1.0);
+      if (v.y >= 0.0) continue;
+      const double t = -camera.position().y / v.y;
+      const double viewDepth = t * glm::dot(v, camera.forward());
+      if (viewDepth < camera.far()) depth.at(x, y) = static_cast<float>(depthBufferValue(camera, viewDepth));
+    }
+  return depth;
+}
+
+/// The half-space occluder: points with dot(normal, x - point) > 0 (the side the light travels toward)
+/// are shadowed.
+struct HalfSpace {
+  glm::dvec3 normal = glm::normalize(glm::dvec3(1.0, 0.5, 0.3));
+  glm::dvec3 point{2.0, 1.0, -10.0};
+};
+
+/// The first hit of a light ray with the half-space's plane (any t: casters before the ray origin too).
+inline std::optional<glm::dvec3> planeHit(const HalfSpace& plane, const LightRay& ray) {
+  const double dn = glm::dot(plane.normal, ray.direction);
+  if (dn == 0.0) return std::nullopt;
+  return ray.origin + glm::dot(plane.normal, plane.point - ray.origin) / dn * ray.direction;
+}
+
+/// The standard shadow map of the half-space occluder for an orthographic light matrix: each texel
+/// stores the depth-buffer value of the plane along the light ray through its centre (clamped like
+/// GL_DEPTH_CLAMP).
+inline Image halfSpaceShadowMap(const HalfSpace& plane, const glm::dmat4& lightClipFromWorld, int size) {
+  const glm::dmat4 worldFromClip = glm::inverse(lightClipFromWorld);
+  Image d(size, size, 1, 1.0f);
+  for (int j = 0; j < size; ++j)
+    for (int i = 0; i < size; ++i) {
+      const double x = 2.0 * (i + 0.5) / size - 1.0, y = 2.0 * (j + 0.5) / size - 1.0;
+      const glm::dvec4 a = worldFromClip * glm::dvec4(x, y, -1.0, 1.0),
+                       b = worldFromClip * glm::dvec4(x, y, 1.0, 1.0);
+      const glm::dvec3 p0 = glm::dvec3(a) / a.w, p1 = glm::dvec3(b) / b.w;
+      const double f0 = glm::dot(plane.normal, p0 - plane.point),
+                   f1 = glm::dot(plane.normal, p1 - plane.point);
+      if (f0 == f1) continue;
+      const double t = f0 / (f0 - f1); // clip z = -1 + 2 t
+      d.at(i, j) = static_cast<float>(std::clamp(t, 0.0, 1.0));
+    }
+  return d;
+}
+
+/// A light matrix around the analytic scene's visible region (camera at y = 2, far 80, looking to -z).
+inline glm::dmat4 analyticLightMatrix(const DirectionalLight& light) {
+  return scenes::standardLightClipFromWorld(light, {-60.0, -1.0, -85.0}, {60.0, 40.0, 5.0});
+}
+
+/// (exp(-sigma a) - exp(-sigma b)) / sigma per channel.
+inline glm::dvec3 segmentIntegral(const glm::dvec3& sigma, double a, double b) {
+  glm::dvec3 r(0.0);
+  if (!(b > a)) return r;
+  for (int c = 0; c < 3; ++c)
+    r[c] = (std::exp(-sigma[c] * a) - std::exp(-sigma[c] * b)) / sigma[c];
+  return r;
+}
+
+/// Closed-form single scattering (seed 003 Eq. 1, 3) with an optional half-space shadow, per pixel of a
+/// camera depth image (sky to the far plane), RGBA like the marches (A = grey transmittance).
+inline Image closedForm(const Image& depth, const Camera& camera, const DirectionalLight& light,
+                        const Medium& medium, const std::optional<HalfSpace>& plane) {
+  Image out(depth.width(), depth.height(), 4);
+  const glm::dvec3 sigma = medium.extinction();
+  const double grey = (sigma.x + sigma.y + sigma.z) / 3.0;
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const glm::dvec3 v =
+          camera.rayDirection(2.0 * (x + 0.5) / depth.width() - 1.0, 2.0 * (y + 0.5) / depth.height() - 1.0);
+      const double cosF = glm::dot(v, camera.forward());
+      const double d = depth.at(x, y);
+      const double s = (d >= 1.0 ? camera.far() : camera.linearDepth(d)) / cosF;
+      double lo = 0.0, hi = s; // lit part
+      if (plane) {
+        const double f0 = glm::dot(plane->normal, camera.position() - plane->point),
+                     fv = glm::dot(plane->normal, v);
+        if (fv > 0.0)
+          hi = std::min(s, -f0 / fv);
+        else if (fv < 0.0)
+          lo = std::max(0.0, -f0 / fv);
+        else if (f0 > 0.0)
+          hi = lo;
+      }
+      const glm::dvec3 C = light.irradiance() * medium.scatteringTimesPhase(glm::dot(light.direction(), -v));
+      const glm::dvec3 L = C * segmentIntegral(sigma, lo, hi);
+      for (int c = 0; c < 3; ++c)
+        out.at(x, y, c) = static_cast<float>(L[c]);
+      out.at(x, y, 3) = static_cast<float>(std::exp(-grey * s));
+    }
+  return out;
+}
+
+/// Metrics over the RGB channels.
+inline ImageMetrics rgbMetrics(const Image& actual, const Image& reference) {
+  CompareOptions o;
+  o.channels = 3;
+  return compareImages(actual, reference, o);
+}
+
+inline void report(const std::string& what, const ImageMetrics& m) {
+  MESSAGE(what << ": relative RMSE " << m.relativeRmse << ", PSNR " << m.psnr << " dB, max abs "
+               << m.maxAbsError << " (peak " << m.peak << ")");
+}
+
+/// The RGB channels of an RGBA image (image checks on the radiance only; A is the same transmittance).
+inline Image rgb(const Image& rgba) {
+  Image out(rgba.width(), rgba.height(), 3);
+  for (int y = 0; y < rgba.height(); ++y)
+    for (int x = 0; x < rgba.width(); ++x)
+      for (int c = 0; c < 3; ++c)
+        out.at(x, y, c) = rgba.at(x, y, c);
+  return out;
+}
+
+/// Largest relative difference |a - b| / max(|b|, floor) over the RGB channels.
+inline double maxRelativeDifference(const Image& a, const Image& b, double floor) {
+  double worst = 0.0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double r = b.at(x, y, c);
+        worst = std::max(worst, std::abs(a.at(x, y, c) - r) / std::max(std::abs(r), floor));
+      }
+  return worst;
+}
+
+} // namespace crep::test
