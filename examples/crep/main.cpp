@@ -1,9 +1,12 @@
 // crep: the command-line tool of crepuscular. See `crep help`.
 #include "args.h"
 #include "commands.h"
+#include "frame.h"
+#include "options.h"
 
 #include <crep/core/error.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -20,15 +23,36 @@ commands:
             --scene NAME        colonnade (default) | forest | terrain | boxes
             --size WxH          image size (default 1280x720)
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
-                                against a standard shadow map)
-            --map-size N        shadow map and rectified map size (default 1024)
-            --bases M           Fourier bases, a multiple of 4 in [4, 128] (default 32)
-            --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
-            --splits K          rectification splits (default 4; --map-size must be a multiple)
-            --steps N           reference march samples per pixel (default 256)
-            --exposure X        PNG exposure (default 1)
+                                against a standard shadow map) | the other methods listed below
+%s            --exposure X        PNG exposure (default 1)
             --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
+            --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
+                                DIR/shadow.exr (float depth-buffer values), DIR/frame.json
             --debug-gl          debug GL context; GL errors abort the command
+  scatter   single scattering for your own data; writes a scattering EXR (RGB in-scattered radiance,
+            A transmittance)
+            --depth FILE.exr    camera depth: OpenGL depth-buffer values in [0, 1] (1 = sky)
+            --shadow FILE.exr   standard shadow map: depth-buffer values of shadowMap.lightClipFromWorld
+            --frame FILE.json   camera, light, shadow matrix and medium (schema: README, example:
+                                examples/data/frame.json)
+            --method M          prefilter (default: the standard map is resampled into the projective
+                                rectification on the CPU) | reference | the other methods below
+            (and --map-size --bases --format --splits --steps as for render)
+            --out FILE.exr      output (default scattering.exr)
+            --png FILE.png      also a tone-mapped preview of the in-scattered radiance
+            --exposure X        PNG exposure (default 1)
+  compare   every method plus the reference on one built-in scene and camera: a contact sheet PNG
+            (images, amplified error heat maps, metrics and timings) and a CSV
+            --scene NAME --size WxH (default 640x360) and the method options of render
+            --steps N           reference march samples per pixel (default 512)
+            --methods A,B       methods to run besides the reference (default: every method)
+            --amplify X         error heat map: |error| / peak of the reference * X (default 20)
+            --tile-width N      width of each image on the sheet (default: min(image width, 400))
+            --out PREFIX        writes PREFIX.png and PREFIX.csv (default crep-compare-<scene>)
+  bench     the benchmark suite of bench/ (as crep_bench): CPU reference vs GPU passes, methods side
+            by side, bandwidth vs a copy, Table 1/2 rows; ratios measured in one run
+            --scene NAME (forest) --size WxH (1920x1080) --map WxH (1024x1024) --bases M (32)
+            --repeat N (5) --quick (one size, no tables)
   rectify   print the projective rectification for a camera and a directional light as JSON:
             {"status": "projective"|"fallback", "reason", "measure", "threshold",
              "splits": [{"rectClipFromWorld": [16 numbers, column-major], "range": [a, b]}]}
@@ -39,21 +63,37 @@ commands:
             (camera and light default to the colonnade scene's)
   help      this text
 
-Exit status: 0 success, 1 runtime error (GL, I/O, invalid parameter), 2 usage error.
+methods (this build):
+%s
+Exit status: 0 success, 1 runtime error (GL, I/O, invalid input data or parameter; the message names
+the file or field), 2 usage error (the message names the option).
 )";
+
+void printUsage(std::FILE* out) {
+  std::string methods;
+  for (const crep::tool::Method& m : crep::tool::methodRegistry()) {
+    std::string name = m.name;
+    name.resize(std::max<std::size_t>(name.size(), 10), ' ');
+    methods += "  " + name + "  " + m.summary + "\n";
+  }
+  std::fprintf(out, kUsage, crep::tool::kMethodOptionsHelp, methods.c_str());
+}
 
 } // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
-    std::fputs(kUsage, args.empty() ? stderr : stdout);
+    printUsage(args.empty() ? stderr : stdout);
     return args.empty() ? 2 : 0;
   }
   const std::string command = args[0];
   args.erase(args.begin());
   try {
     if (command == "render") return crep::tool::renderCommand(args);
+    if (command == "scatter") return crep::tool::scatterCommand(args);
+    if (command == "compare") return crep::tool::compareCommand(args);
+    if (command == "bench") return crep::tool::benchCommand(args);
     if (command == "rectify") return crep::tool::rectifyCommand(args);
     std::fprintf(stderr, "crep: unknown command '%s' (see crep help)\n", command.c_str());
     return 2;

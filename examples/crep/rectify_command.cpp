@@ -17,19 +17,24 @@ namespace crep::tool {
 namespace {
 // Library parameter names -> the command-line options that set them.
 const std::map<std::string, std::string> kOptionOf = {
-    {"Camera.position", "--camera-pos"},       {"Camera.target", "--camera-target"},
-    {"Camera.up", "--camera-up"},              {"Camera.fovY", "--fovy-deg"},
-    {"Camera.aspect", "--aspect"},             {"Camera.near", "--near"},
-    {"Camera.far", "--far"},                   {"DirectionalLight.direction", "--light-dir"},
-    {"RectifyOptions.splits", "--splits"},     {"RectifyOptions.blend", "--blend"},
+    {"Camera.position", "--camera-pos"},
+    {"Camera.target", "--camera-target"},
+    {"Camera.up", "--camera-up"},
+    {"Camera.fovY", "--fovy-deg"},
+    {"Camera.aspect", "--aspect"},
+    {"Camera.near", "--near"},
+    {"Camera.far", "--far"},
+    {"DirectionalLight.direction", "--light-dir"},
+    {"RectifyOptions.splits", "--splits"},
+    {"RectifyOptions.blend", "--blend"},
     {"Camera.orientation", "--camera-target"},
 };
 } // namespace
 
 int rectifyCommand(const std::vector<std::string>& argv) {
   const Args args(argv,
-                  {"camera-pos", "camera-target", "camera-up", "fovy-deg", "aspect", "near", "far", "light-dir",
-                   "splits", "scheme", "blend"},
+                  {"camera-pos", "camera-target", "camera-up", "fovy-deg", "aspect", "near", "far",
+                   "light-dir", "splits", "scheme", "blend"},
                   {});
   // Defaults: the default scene's camera and sun.
   const scenes::Scene scene = scenes::makeScene("colonnade");

@@ -42,7 +42,8 @@ TEST_CASE("crep render: default scene at test size writes a finite, non-empty EX
   }
   for (int y = 0; y < 90; ++y)
     for (int x = 0; x < 160; ++x) {
-      for (int c = 0; c < 3; ++c) scatterSum += scattering.at(x, y, c);
+      for (int c = 0; c < 3; ++c)
+        scatterSum += scattering.at(x, y, c);
       minT = std::min(minT, double(scattering.at(x, y, 3)));
       maxT = std::max(maxT, double(scattering.at(x, y, 3)));
     }
@@ -60,7 +61,8 @@ TEST_CASE("crep render: prefiltered and reference methods agree on every built-i
   crep::ExrReadOptions scatteringLayer;
   scatteringLayer.layer = "scattering";
   for (const char* scene : {"colonnade", "forest", "terrain", "boxes"}) {
-    std::string common = std::string("render --scene ") + scene + " --size 160x90 --map-size 512 --steps 512 --out '";
+    std::string common =
+        std::string("render --scene ") + scene + " --size 160x90 --map-size 512 --steps 512 --out '";
     const RunResult pre = runCrep(common + (dir.path() / "pre").string() + "' --method prefilter");
     const RunResult ref = runCrep(common + (dir.path() / "ref").string() + "' --method reference");
     INFO(std::string(scene) << "\n" << pre.output << "\n" << ref.output);
@@ -74,7 +76,7 @@ TEST_CASE("crep render: prefiltered and reference methods agree on every built-i
     const crep::ImageMetrics m = crep::compareImages(a, b, options);
     MESSAGE(std::string(scene) << ": prefilter vs world-space reference march: " << crep::describe(m));
     // Two independent pipelines (rectified map + Fourier prefilter vs a 512-step march against a
-    // X
+    // standard 512^2 shadow map): measured 0.54% (terrain) to 2.1% (colonnade), README "Measured figures".
     CHECK(m.nanCount == 0);
     CHECK(m.relativeRmse < 0.04);
   }

@@ -24,7 +24,8 @@ std::vector<std::vector<double>> splitMatrices(const std::string& json) {
       values.push_back(std::strtod(p, &end));
       if (end == p) break;
       p = end;
-      while (*p == ',' || *p == ' ') ++p;
+      while (*p == ',' || *p == ' ')
+        ++p;
     }
     out.push_back(values);
   }
@@ -33,8 +34,9 @@ std::vector<std::vector<double>> splitMatrices(const std::string& json) {
 } // namespace
 
 TEST_CASE("crep rectify: JSON splits contain the camera frustum") {
-  const auto r = crep::test::runCrep("rectify --camera-pos 0,1,5 --camera-target 0,1,0 --camera-up 0,1,0 "
-                                     "--fovy-deg 50 --aspect 1.5 --near 0.2 --far 40 --light-dir 1,-1,0.2 --splits 3");
+  const auto r =
+      crep::test::runCrep("rectify --camera-pos 0,1,5 --camera-target 0,1,0 --camera-up 0,1,0 "
+                          "--fovy-deg 50 --aspect 1.5 --near 0.2 --far 40 --light-dir 1,-1,0.2 --splits 3");
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find(R"("status": "projective")") != std::string::npos);
@@ -53,7 +55,8 @@ TEST_CASE("crep rectify: JSON splits contain the camera frustum") {
         for (const auto& m : matrices) {
           REQUIRE(m.size() == 16);
           glm::dmat4 clip;
-          for (int k = 0; k < 16; ++k) clip[k / 4][k % 4] = m[static_cast<std::size_t>(k)];
+          for (int k = 0; k < 16; ++k)
+            clip[k / 4][k % 4] = m[static_cast<std::size_t>(k)];
           const glm::dvec4 c = clip * glm::dvec4(p, 1.0);
           const glm::dvec3 ndc = glm::dvec3(c) / c.w;
           const double tol = 1e-9;
@@ -96,10 +99,15 @@ TEST_CASE("crep: usage errors exit 2 and name the option") {
     const char* args;
     const char* mentions;
   };
-  for (const Case& c : {Case{"render --size 0x90", "--size"}, Case{"render --size abc", "--size"},
-                        Case{"render --map-size -3", "--map-size"}, Case{"render --exposure nan", "--exposure"},
-                        Case{"render --bogus 1", "--bogus"}, Case{"render --steps", "--steps"},
-                        Case{"frobnicate", "frobnicate"}}) {
+  for (const Case& c :
+       {Case{"render --size 0x90", "--size"}, Case{"render --size abc", "--size"},
+        Case{"render --map-size -3", "--map-size"}, Case{"render --exposure nan", "--exposure"},
+        Case{"render --bogus 1", "--bogus"}, Case{"render --steps", "--steps"},
+        Case{"render --export-frame ''", "--export-frame"}, Case{"render --method bogus", "--method"},
+        Case{"scatter", "--depth"}, Case{"compare --amplify 0", "--amplify"},
+        Case{"compare --size 8x", "--size"}, Case{"compare --methods prefilter,bogus", "--methods"},
+        Case{"bench --repeat 0", "--repeat"}, Case{"bench --map 12", "--map"},
+        Case{"frobnicate", "frobnicate"}}) {
     const auto r = crep::test::runCrep(c.args);
     INFO(c.args << " -> " << r.output);
     CHECK(r.status == 2);
@@ -109,4 +117,3 @@ TEST_CASE("crep: usage errors exit 2 and name the option") {
   CHECK(help.status == 0);
   CHECK(help.output.find("render") != std::string::npos);
 }
-

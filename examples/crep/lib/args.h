@@ -22,12 +22,13 @@ class Args {
 public:
   /// `flags` are options that take no value. Throws UsageError for an unknown option (anything not
   /// in `valued` or `flags`), a missing value or a repeated option.
-  Args(const std::vector<std::string>& argv, const std::set<std::string>& valued, const std::set<std::string>& flags);
+  Args(const std::vector<std::string>& argv, const std::set<std::string>& valued,
+       const std::set<std::string>& flags);
 
   bool has(const std::string& name) const { return values_.count(name) != 0; }
   std::string string(const std::string& name, const std::string& fallback) const;
   int integer(const std::string& name, int fallback, int min, int max) const;
-  double number(const std::string& name, double fallback) const; ///< finite
+  double number(const std::string& name, double fallback) const;              ///< finite
   glm::dvec3 vec3(const std::string& name, const glm::dvec3& fallback) const; ///< "x,y,z", finite
   /// "WxH" with both in [1, max].
   glm::ivec2 size(const std::string& name, glm::ivec2 fallback, int max) const;

@@ -5,17 +5,30 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace crep::tool {
 
 class StageTimings {
 public:
+  struct Row {
+    std::string stage;
+    double ms;
+  };
+
+  /// Progress: when set, each timed stage is announced on stderr as "<prefix>: <stage> ..." before it
+  /// runs (the commands enable it when stderr is a terminal).
+  void setProgress(std::string prefix) { progress_ = std::move(prefix); }
+
   void add(std::string stage, double milliseconds) { rows_.push_back({std::move(stage), milliseconds}); }
+  void append(const std::vector<Row>& rows) { rows_.insert(rows_.end(), rows.begin(), rows.end()); }
 
   /// Runs `f`, records its wall time under `stage` and returns its result.
   template <class F>
   auto time(std::string stage, F&& f) {
+    if (!progress_.empty()) std::fprintf(stderr, "%s: %s ...\n", progress_.c_str(), stage.c_str());
     const auto start = std::chrono::steady_clock::now();
     if constexpr (std::is_void_v<decltype(f())>) {
       f();
@@ -27,19 +40,19 @@ public:
     }
   }
 
-  void print(std::FILE* out) const {
-    double total = 0;
-    std::fprintf(out, "%-28s %12s\n", "stage", "ms");
-    for (const auto& r : rows_) {
-      std::fprintf(out, "%-28s %12.3f\n", r.stage.c_str(), r.ms);
-      total += r.ms;
-    }
-    std::fprintf(out, "%-28s %12.3f\n", "total", total);
+  double total() const {
+    double sum = 0;
+    for (const auto& r : rows_)
+      sum += r.ms;
+    return sum;
   }
-  struct Row {
-    std::string stage;
-    double ms;
-  };
+
+  void print(std::FILE* out) const {
+    std::fprintf(out, "%-32s %12s\n", "stage", "ms");
+    for (const auto& r : rows_)
+      std::fprintf(out, "%-32s %12.3f\n", r.stage.c_str(), r.ms);
+    std::fprintf(out, "%-32s %12.3f\n", "total", total());
+  }
   const std::vector<Row>& rows() const { return rows_; }
 
 private:
@@ -47,6 +60,7 @@ private:
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
   std::vector<Row> rows_;
+  std::string progress_;
 };
 
 } // namespace crep::tool

@@ -88,7 +88,8 @@ glm::ivec2 Args::size(const std::string& name, glm::ivec2 fallback, int max) con
   const auto it = values_.find(name);
   if (it == values_.end()) return fallback;
   const auto x = it->second.find('x');
-  if (x == std::string::npos) throw UsageError("option --" + name + ": '" + it->second + "' is not WIDTHxHEIGHT");
+  if (x == std::string::npos)
+    throw UsageError("option --" + name + ": '" + it->second + "' is not WIDTHxHEIGHT");
   glm::ivec2 s;
   for (int i = 0; i < 2; ++i) {
     const std::string part = i == 0 ? it->second.substr(0, x) : it->second.substr(x + 1);

@@ -1,0 +1,316 @@
+#include "bench_suite.h"
+
+#include "args.h"
+#include "frame.h"
+#include "timings.h"
+
+#include <crep/core/error.h>
+#include <crep/core/gl.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/prefilter/prefilter.h>
+#include <crep/rectify/rectified_map.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace crep::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// Median wall time in ms of `repeat` runs of f (GPU work is finished inside f with glFinish).
+double medianMs(int repeat, const std::function<void()>& f) {
+  std::vector<double> t;
+  for (int i = 0; i < repeat; ++i) {
+    const auto start = Clock::now();
+    f();
+    t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+struct Setup {
+  scenes::Scene scene;
+  Rectification rect;
+  std::shared_ptr<ProjectiveLayout> layout;
+  gl::Handle rectified, cameraDepth, scattering;
+  Image rectifiedImage, cameraDepthImage;
+  int mapW, mapH, screenW, screenH;
+};
+
+Setup makeSetup(const std::string& sceneName, int screenW, int screenH, int mapW, int mapH) {
+  Setup s{scenes::makeScene(sceneName, double(screenW) / screenH),
+          {},
+          {},
+          {},
+          {},
+          {},
+          {},
+          {},
+          mapW,
+          mapH,
+          screenW,
+          screenH};
+  s.rect = rectify(s.scene.camera, s.scene.sun);
+  if (!s.rect.projective()) throw Error("scene " + sceneName + " is not projective: " + s.rect.message);
+  s.layout = std::make_shared<ProjectiveLayout>(s.rect);
+  scenes::SceneRenderer renderer(s.scene.mesh);
+  s.rectified = scenes::createDepthTexture(mapW, mapH, "--map");
+  renderer.renderRectified(s.rect, s.rectified.get(), mapW, mapH);
+  s.rectifiedImage = scenes::readDepthTexture(s.rectified.get(), mapW, mapH);
+  s.cameraDepth = scenes::createDepthTexture(screenW, screenH, "--size");
+  renderer.renderDepth(s.scene.camera.clipFromWorld(), s.cameraDepth.get(), 0, 0, 0, screenW, screenH);
+  s.cameraDepthImage = scenes::readDepthTexture(s.cameraDepth.get(), screenW, screenH);
+  s.scattering = gl::createTexture2D(GL_RGBA32F, screenW, screenH, "--size");
+  glFinish();
+  return s;
+}
+
+struct GpuTimes {
+  double prefilter, evaluate;
+};
+
+GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat, int regionsPerSplit = 1,
+                 int basesPerInvocation = 8) {
+  PrefilterPass::CreateInfo info;
+  info.width = s.mapW;
+  info.height = s.mapH;
+  info.bases = bases;
+  info.format = format;
+  info.regionsPerSplit = regionsPerSplit;
+  info.basesPerInvocation = std::min(basesPerInvocation, bases);
+  PrefilterPass prefilter(info);
+  EvaluatePass::CreateInfo evalInfo;
+  evalInfo.bases = bases;
+  EvaluatePass evaluate(evalInfo);
+  PrefilterPass::Frame frame;
+  frame.rectifiedDepth = s.rectified.get();
+  frame.layout = s.layout.get();
+  frame.medium = &s.scene.medium;
+  prefilter.run(frame); // warm-up (shader specialization on first dispatch)
+  glFinish();
+  GpuTimes t{};
+  t.prefilter = medianMs(repeat, [&] {
+    prefilter.run(frame);
+    glFinish();
+  });
+  EvaluatePass::Frame ev;
+  ev.cameraDepth = s.cameraDepth.get();
+  ev.output = s.scattering.get();
+  ev.camera = &s.scene.camera;
+  ev.light = &s.scene.sun;
+  ev.medium = &s.scene.medium;
+  ev.layout = s.layout.get();
+  ev.basis = prefilter.filteredBasis();
+  evaluate.run(ev);
+  glFinish();
+  t.evaluate = medianMs(repeat, [&] {
+    evaluate.run(ev);
+    glFinish();
+  });
+  return t;
+}
+
+/// Stages of a method run that are per-frame work (not one-time set-up: shader builds, pass creation,
+/// or the rectified map, which every rectified method shares and which is reported on its own).
+bool perFrameStage(const std::string& stage) {
+  for (const char* skip : {"setup", "shader", "rectify", "shadow pass", "resample", "upload"})
+    if (stage.find(skip) != std::string::npos) return false;
+  return true;
+}
+
+/// Every method of the registry on the same frame: median per-frame milliseconds and the ratio to the
+/// prefiltered method.
+void methodsSideBySide(const BenchOptions& o) {
+  tool::StageTimings setupTimings;
+  tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, setupTimings);
+  tool::MethodSettings settings;
+  settings.mapSize = o.mapWidth;
+  settings.bases = o.bases;
+  if (o.mapWidth != o.mapHeight || o.mapWidth % settings.rectify.splits != 0) {
+    std::printf("\nmethods side by side: skipped (needs a square map whose size is a multiple of %d)\n",
+                settings.rectify.splits);
+    return;
+  }
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  struct Row {
+    std::string name, used;
+    double ms;
+    std::string stages;
+  };
+  std::vector<Row> rows;
+  double mapMs = 0.0;
+  for (const tool::Method& m : tool::methodRegistry()) {
+    std::map<std::string, std::vector<double>> stageMs;
+    std::vector<std::string> order;
+    std::string used;
+    for (int i = 0; i < repeat + 1; ++i) { // first run: warm-up (shader compilation, map)
+      tool::MethodOutput out = m.run(*s.frame, settings);
+      used = out.used;
+      if (i == 0) {
+        for (const auto& r : out.timings.rows())
+          if (r.stage.find("shadow pass (rectified)") != std::string::npos) mapMs = r.ms;
+        continue;
+      }
+      for (const auto& r : out.timings.rows()) {
+        if (!perFrameStage(r.stage)) continue;
+        if (!stageMs.count(r.stage)) order.push_back(r.stage);
+        stageMs[r.stage].push_back(r.ms);
+      }
+    }
+    Row row{m.name, used, 0.0, ""};
+    for (const auto& stage : order) {
+      const double ms = median(stageMs[stage]);
+      row.ms += ms;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s %.2f", row.stages.empty() ? "" : ", ", stage.c_str(), ms);
+      row.stages += buf;
+    }
+    rows.push_back(row);
+  }
+  double prefilterMs = 0.0;
+  for (const Row& r : rows)
+    if (r.name == "prefilter") prefilterMs = r.ms;
+  std::printf(
+      "\nmethods side by side (scene %s, %dx%d, map %d^2, M = %d, reference %d steps; per-frame ms = sum of\n"
+      "the median per-frame stages of %d runs after a warm-up; the rectified shadow pass, %.2f ms, is "
+      "shared):\n",
+      o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.bases, settings.steps, repeat, mapMs);
+  std::printf("%-12s %12s %14s   %s\n", "method", "frame ms", "vs prefilter", "stages (ms)");
+  for (const Row& r : rows)
+    std::printf("%-12s %12.2f %14.2f   %s%s\n", r.name.c_str(), r.ms,
+                prefilterMs > 0 ? r.ms / prefilterMs : 0.0, r.stages.c_str(),
+                r.used != r.name ? ("  [ran " + r.used + "]").c_str() : "");
+}
+
+} // namespace
+
+BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
+  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat"}, {"quick"});
+  BenchOptions o;
+  o.scene = args.string("scene", o.scene);
+  const glm::ivec2 size = args.size("size", {o.screenWidth, o.screenHeight}, Image::kMaxDimension);
+  const glm::ivec2 map = args.size("map", {o.mapWidth, o.mapHeight}, Image::kMaxDimension);
+  o.screenWidth = size.x;
+  o.screenHeight = size.y;
+  o.mapWidth = map.x;
+  o.mapHeight = map.y;
+  o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
+  if (o.bases % 4 != 0) throw tool::UsageError("option --bases: must be a multiple of 4");
+  o.repeat = args.integer("repeat", o.repeat, 1, 1000);
+  o.quick = args.has("quick");
+  return o;
+}
+
+void runBenchSuite(const BenchOptions& o) {
+  tool::StageTimings contextTimings;
+  tool::ensureGlContext("bench", false, contextTimings);
+  const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases, repeat = o.repeat;
+  std::printf("crep bench: scene %s | screen %dx%d | map %dx%d | M = %d | median of %d runs\n",
+              o.scene.c_str(), o.screenWidth, o.screenHeight, mapW, mapH, bases, repeat);
+  const Setup s = makeSetup(o.scene, o.screenWidth, o.screenHeight, mapW, mapH);
+
+  // Memory copy baselines over the bytes the prefilter writes (W x H x M/4 RGBA8 texels).
+  const std::size_t outBytes = std::size_t(mapW) * mapH * std::size_t(bases); // RGBA8: 1 byte per basis
+  std::vector<unsigned char> src(outBytes, 1), dst(outBytes);
+  const double memcpyMs = medianMs(repeat, [&] { std::memcpy(dst.data(), src.data(), outBytes); });
+  gl::Handle a = gl::createTexture(GL_TEXTURE_2D_ARRAY), b = gl::createTexture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(a.get(), 1, GL_RGBA8, mapW, mapH, bases / 4);
+  glTextureStorage3D(b.get(), 1, GL_RGBA8, mapW, mapH, bases / 4);
+  const double gpuCopyMs = medianMs(repeat, [&] {
+    glCopyImageSubData(a.get(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, b.get(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
+                       mapW, mapH, bases / 4);
+    glFinish();
+  });
+
+  // CPU reference (all cores) vs GPU pass, same inputs.
+  PrefilterOptions options;
+  options.bases = bases;
+  const RectifiedMap map = makeRectifiedMap(s.layout, s.rectifiedImage);
+  FilteredBasis basis;
+  const int cpuRepeat = o.quick ? 1 : std::max(1, repeat / 2);
+  const double cpuPrefilterMs = medianMs(cpuRepeat, [&] { basis = prefilter(map, s.scene.medium, options); });
+  const double cpuEvaluateMs = medianMs(cpuRepeat, [&] {
+    const Image img = evaluate(basis, s.cameraDepthImage, s.scene.camera, s.scene.sun, s.scene.medium);
+    (void)img;
+  });
+  const GpuTimes gpu = timeGpu(s, bases, StorageFormat::RGBA8, repeat);
+
+  std::printf("\n%-34s %12s %12s %10s\n", "stage", "CPU ms", "GPU ms", "CPU/GPU");
+  std::printf("%-34s %12.2f %12.2f %10.2f\n", "prefilter", cpuPrefilterMs, gpu.prefilter,
+              cpuPrefilterMs / gpu.prefilter);
+  std::printf("%-34s %12.2f %12.2f %10.2f\n", "evaluate", cpuEvaluateMs, gpu.evaluate,
+              cpuEvaluateMs / gpu.evaluate);
+  const double mib = double(outBytes) / (1024.0 * 1024.0);
+  std::printf("\nbandwidth over the %.1f MiB the prefilter writes (RGBA8):\n", mib);
+  std::printf("  memcpy (CPU)          %8.2f ms  %8.0f MiB/s\n", memcpyMs, mib / (memcpyMs / 1000.0));
+  std::printf("  glCopyImageSubData    %8.2f ms  %8.0f MiB/s\n", gpuCopyMs, mib / (gpuCopyMs / 1000.0));
+  std::printf("  GPU prefilter         %8.2f ms  %8.0f MiB/s  (%.1f%% of the GPU copy)\n", gpu.prefilter,
+              mib / (gpu.prefilter / 1000.0), 100.0 * gpuCopyMs / gpu.prefilter);
+  std::printf("  CPU prefilter         %8.2f ms  %8.0f MiB/s  (%.1f%% of memcpy)\n", cpuPrefilterMs,
+              mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
+
+  methodsSideBySide(o);
+
+  if (!o.quick) {
+    // Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8).
+    std::printf("\nscaling (GPU pass, RGBA8; ratio = time / time of the %dx%d, M = %d row):\n", mapW, mapH,
+                bases);
+    std::printf("%-18s %6s %12s %12s %8s\n", "map", "M", "prefilter ms", "evaluate ms", "ratio");
+    const double base = gpu.prefilter + gpu.evaluate;
+    struct Row {
+      int w, h, m;
+    };
+    const Row rows[] = {{mapW / 2, mapH, bases}, {mapW * 2, mapH, bases}, {mapW, mapH / 2, bases},
+                        {mapW, mapH * 2, bases}, {mapW, mapH, 16},        {mapW, mapH, 64}};
+    for (const Row& r : rows) {
+      std::optional<Setup> resized;
+      if (r.w != mapW || r.h != mapH)
+        resized.emplace(makeSetup(o.scene, o.screenWidth, o.screenHeight, r.w, r.h));
+      const Setup& use = resized ? *resized : s;
+      const GpuTimes t = timeGpu(use, r.m, StorageFormat::RGBA8, repeat);
+      std::printf("%6dx%-11d %6d %12.2f %12.2f %8.2f\n", r.w, r.h, r.m, t.prefilter, t.evaluate,
+                  (t.prefilter + t.evaluate) / base);
+    }
+    // Table 1's study: regions per split x bases per invocation.
+    std::printf("\nparallelization (Table 1; GPU prefilter ms):\n%-10s", "regions");
+    for (int bpi : {4, 8, 16, 32})
+      std::printf(" %8d", bpi);
+    std::printf("   <- bases per invocation\n");
+    for (int p : {1, 2, 4}) {
+      std::printf("%-10d", p);
+      for (int bpi : {4, 8, 16, 32}) {
+        if (bpi > bases || bases % bpi != 0) {
+          std::printf(" %8s", "-");
+          continue;
+        }
+        std::printf(" %8.2f", timeGpu(s, bases, StorageFormat::RGBA8, repeat, p, bpi).prefilter);
+      }
+      std::printf("\n");
+    }
+  }
+  std::printf(
+      "\nhow measured: wall-clock median of %d runs, each ending with glFinish (GPU) or on return (CPU);\n"
+      "llvmpipe runs the GPU passes on the CPU cores, so CPU/GPU compares two CPU implementations here.\n",
+      repeat);
+}
+
+} // namespace crep::bench

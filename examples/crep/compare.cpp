@@ -1,0 +1,207 @@
+// `crep compare`: one built-in scene and camera, every method of the registry plus the reference.
+// Writes a contact sheet PNG (each method's composited image, an amplified error heat map against the
+// reference, metrics and timings printed on the sheet) and a CSV (relative RMSE, PSNR, max and mean
+// absolute error of the in-scattered radiance against the reference, milliseconds per stage).
+#include "args.h"
+#include "commands.h"
+#include "contact_sheet.h"
+#include "frame.h"
+#include "options.h"
+#include "timings.h"
+
+#include <crep/core/error.h>
+#include <crep/core/image_compare.h>
+#include <crep/core/png.h>
+#include <crep/scenes/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+
+namespace crep::tool {
+
+namespace {
+
+struct Result {
+  std::string name, used, detail;
+  Image scattering, composite;
+  ImageMetrics metrics;
+  StageTimings timings;
+};
+
+std::string fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+std::string number(double v) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s)
+    q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+std::vector<std::string> selectedMethods(const Args& args) {
+  std::vector<std::string> names;
+  for (const Method& m : methodRegistry())
+    if (m.reference) names.push_back(m.name);
+  if (!args.has("methods")) {
+    for (const Method& m : methodRegistry())
+      if (!m.reference) names.push_back(m.name);
+    return names;
+  }
+  std::stringstream list(args.string("methods", ""));
+  std::string name;
+  while (std::getline(list, name, ',')) {
+    const Method& m = findMethod(name, "--methods");
+    if (std::find(names.begin(), names.end(), m.name) == names.end()) names.push_back(m.name);
+  }
+  return names;
+}
+
+} // namespace
+
+int compareCommand(const std::vector<std::string>& argv) {
+  std::set<std::string> valued = {"scene", "size", "out", "exposure", "amplify", "tile-width", "methods"};
+  valued.insert(kMethodOptions.begin(), kMethodOptions.end());
+  valued.erase("method");
+  const Args args(argv, valued, {"debug-gl"});
+  const std::string sceneName = args.string("scene", "colonnade");
+  const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension);
+  MethodSettings settings = methodSettings(args);
+  if (!args.has("steps")) settings.steps = 512;
+  const double exposure = args.number("exposure", 1.0);
+  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const double amplify = args.number("amplify", 20.0);
+  if (!(amplify > 0.0)) throw UsageError("option --amplify: must be > 0");
+  const int tileWidth = args.integer("tile-width", std::min(size.x, 400), 16, 4096);
+  const std::vector<std::string> names = selectedMethods(args);
+  const std::string out = args.string("out", "crep-compare-" + sceneName);
+  if (out.empty()) throw UsageError("option --out: must not be empty");
+
+  StageTimings timings;
+  if (isatty(2)) timings.setProgress("crep compare");
+  ensureGlContext("compare", args.has("debug-gl"), timings);
+  SceneFrame s = makeSceneFrame(sceneName, size.x, size.y, settings.mapSize, timings);
+  Frame& frame = *s.frame;
+
+  std::vector<Result> results;
+  for (const std::string& name : names) {
+    if (isatty(2)) std::fprintf(stderr, "crep compare: method %s ...\n", name.c_str());
+    MethodOutput o = runMethod(name, frame, settings);
+    gl::Handle composite = compositeImage(frame, s.color.get(), o.scattering.get());
+    Result r{name,
+             o.used,
+             o.detail,
+             readRgba(o.scattering.get(), size.x, size.y),
+             readRgba(composite.get(), size.x, size.y),
+             {},
+             o.timings};
+    checkGlErrors(name.c_str());
+    requireFinite(r.scattering, "the scattering image of " + name);
+    results.push_back(std::move(r));
+  }
+  const Image& reference = results.front().scattering;
+  CompareOptions compareOptions;
+  compareOptions.channels = 3;
+  for (Result& r : results)
+    r.metrics = compareImages(r.scattering, reference, compareOptions);
+  const double peak = results.front().metrics.peak;
+
+  // CSV: one row per method; a column per stage any method has (empty where it has none).
+  std::vector<std::string> stages;
+  for (const Result& r : results)
+    for (const auto& row : r.timings.rows())
+      if (std::find(stages.begin(), stages.end(), row.stage) == stages.end()) stages.push_back(row.stage);
+  std::ostringstream csv;
+  csv << "scene,width,height,method,ran,relative_rmse,psnr_db,max_abs_error,mean_abs_error";
+  for (const std::string& st : stages)
+    csv << "," << csvField("ms " + st);
+  csv << ",ms total\n";
+  for (const Result& r : results) {
+    csv << sceneName << "," << size.x << "," << size.y << "," << r.name << "," << r.used << ","
+        << number(r.metrics.relativeRmse) << "," << number(r.metrics.psnr) << ","
+        << number(r.metrics.maxAbsError) << "," << number(r.metrics.meanAbsError);
+    for (const std::string& st : stages) {
+      csv << ",";
+      double ms = 0.0;
+      bool found = false;
+      for (const auto& row : r.timings.rows())
+        if (row.stage == st) {
+          ms += row.ms;
+          found = true;
+        }
+      if (found) csv << fixed(ms, 3);
+    }
+    csv << "," << fixed(r.timings.total(), 3) << "\n";
+  }
+  const std::string csvPath = out + ".csv", pngPath = out + ".png";
+  {
+    std::ofstream file(csvPath, std::ios::binary);
+    file << csv.str();
+    file.close();
+    if (!file) throw IoError("cannot write '" + csvPath + "'");
+  }
+
+  // Contact sheet.
+  std::vector<SheetColumn> columns;
+  const std::size_t maxChars = static_cast<std::size_t>(std::max(8, tileWidth / 6));
+  auto clip = [&](std::string line) {
+    if (line.size() > maxChars) line = line.substr(0, maxChars - 3) + "...";
+    return line;
+  };
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const Result& r = results[i];
+    SheetColumn c;
+    c.title = r.name + (r.used != r.name ? " (ran " + r.used + ")" : "");
+    c.image = r.composite;
+    if (i > 0) c.heat = heatMap(r.scattering, reference, peak, amplify);
+    c.lines.push_back(clip(r.detail));
+    if (i > 0) {
+      c.lines.push_back(clip("rel RMSE " + fixed(100.0 * r.metrics.relativeRmse, 2) + "%   PSNR " +
+                             fixed(r.metrics.psnr, 1) + " dB"));
+      c.lines.push_back(
+          clip("max |error| " + number(r.metrics.maxAbsError) + " (peak " + number(peak) + ")"));
+    } else {
+      c.lines.push_back(clip("the reference of the error maps"));
+      c.lines.push_back(clip("in-scattering peak " + number(peak)));
+    }
+    for (const auto& row : r.timings.rows())
+      c.lines.push_back(clip(row.stage + ": " + fixed(row.ms, 1) + " ms"));
+    c.lines.push_back(clip("total: " + fixed(r.timings.total(), 1) + " ms"));
+    columns.push_back(std::move(c));
+  }
+  const std::string header = "crep compare: scene " + sceneName + ", " + std::to_string(size.x) + "x" +
+                             std::to_string(size.y) + ", map " + std::to_string(settings.mapSize) +
+                             "^2, M = " + std::to_string(settings.bases) +
+                             ", reference = world-space march, " + std::to_string(settings.steps) +
+                             " steps; GL renderer: " + glRenderer();
+  const Image sheet = composeSheet(header, columns, tileWidth, exposure, amplify);
+  writePng(pngPath, sheet);
+
+  std::printf("crep compare: scene %s, %dx%d, map %d^2, reference %d march steps\n", sceneName.c_str(),
+              size.x, size.y, settings.mapSize, settings.steps);
+  std::printf("%-12s %-12s %10s %10s %12s %12s\n", "method", "ran", "rel RMSE", "PSNR dB", "max error",
+              "total ms");
+  for (const Result& r : results)
+    std::printf("%-12s %-12s %9.3f%% %10s %12s %12.1f\n", r.name.c_str(), r.used.c_str(),
+                100.0 * r.metrics.relativeRmse, number(r.metrics.psnr).c_str(),
+                number(r.metrics.maxAbsError).c_str(), r.timings.total());
+  std::printf("wrote %s (contact sheet) and %s\n", pngPath.c_str(), csvPath.c_str());
+  return 0;
+}
+
+} // namespace crep::tool

@@ -1,0 +1,234 @@
+#include "contact_sheet.h"
+
+#include <crep/core/png.h>
+
+#include <stb_easy_font.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace crep::tool {
+
+namespace {
+
+/// Heat ramp stops in sRGB (black, purple, orange-red, yellow, pale yellow), like "inferno".
+const std::array<glm::vec3, 5> kRamp = {glm::vec3(0.0f, 0.0f, 0.02f), glm::vec3(0.34f, 0.06f, 0.43f),
+                                        glm::vec3(0.85f, 0.26f, 0.19f), glm::vec3(0.99f, 0.75f, 0.15f),
+                                        glm::vec3(0.99f, 1.0f, 0.75f)};
+
+glm::vec3 ramp(double t) {
+  t = std::clamp(t, 0.0, 1.0) * double(kRamp.size() - 1);
+  const int i = std::min(static_cast<int>(t), static_cast<int>(kRamp.size()) - 2);
+  const float f = static_cast<float>(t - i);
+  const glm::vec3 srgb =
+      kRamp[static_cast<std::size_t>(i)] * (1.0f - f) + kRamp[static_cast<std::size_t>(i) + 1] * f;
+  return {srgbToLinear(srgb.x), srgbToLinear(srgb.y), srgbToLinear(srgb.z)};
+}
+
+void setTopDown(Image& image, int x, int y, const glm::vec3& rgb) {
+  if (x < 0 || y < 0 || x >= image.width() || y >= image.height()) return;
+  const int row = image.height() - 1 - y;
+  for (int c = 0; c < 3; ++c)
+    image.at(x, row, c) = rgb[c];
+}
+
+/// Copies `tile` (RGB(A), row 0 bottom) with its top-left corner at (x0, y0) from the top, with values
+/// multiplied by exposure and clamped to [0, 1] (non-finite -> magenta).
+void blit(Image& sheet, const Image& tile, int x0, int y0, double exposure) {
+  for (int y = 0; y < tile.height(); ++y)
+    for (int x = 0; x < tile.width(); ++x) {
+      glm::vec3 v;
+      bool finite = true;
+      for (int c = 0; c < 3; ++c) {
+        const float s = tile.at(x, y, std::min(c, tile.channels() - 1));
+        finite = finite && std::isfinite(s);
+        v[c] = static_cast<float>(std::clamp(double(s) * exposure, 0.0, 1.0));
+      }
+      setTopDown(sheet, x0 + x, y0 + (tile.height() - 1 - y), finite ? v : glm::vec3(1, 0, 1));
+    }
+}
+
+} // namespace
+
+Image heatMap(const Image& actual, const Image& reference, double peak, double amplification) {
+  Image out(actual.width(), actual.height(), 3);
+  const double scale = amplification / (peak > 0.0 ? peak : 1.0);
+  for (int y = 0; y < actual.height(); ++y)
+    for (int x = 0; x < actual.width(); ++x) {
+      double e = 0.0;
+      bool finite = true;
+      for (int c = 0; c < 3; ++c) {
+        const double a = actual.at(x, y, c), r = reference.at(x, y, c);
+        finite = finite && std::isfinite(a) && std::isfinite(r);
+        e = std::max(e, std::abs(a - r));
+      }
+      const glm::vec3 v = finite ? ramp(e * scale) : glm::vec3(1, 0, 1);
+      for (int c = 0; c < 3; ++c)
+        out.at(x, y, c) = v[c];
+    }
+  return out;
+}
+
+Image resizeImage(const Image& image, int width, int height) {
+  if (width == image.width() && height == image.height()) return image;
+  Image out(width, height, image.channels());
+  const double sx = double(image.width()) / width, sy = double(image.height()) / height;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      // Box filter over the source footprint (at least the nearest source pixel).
+      const int x0 = static_cast<int>(std::floor(x * sx)), y0 = static_cast<int>(std::floor(y * sy));
+      const int x1 = std::max(x0 + 1, static_cast<int>(std::ceil((x + 1) * sx)));
+      const int y1 = std::max(y0 + 1, static_cast<int>(std::ceil((y + 1) * sy)));
+      for (int c = 0; c < image.channels(); ++c) {
+        double sum = 0.0;
+        int n = 0;
+        for (int v = y0; v < std::min(y1, image.height()); ++v)
+          for (int u = x0; u < std::min(x1, image.width()); ++u, ++n)
+            sum += image.at(u, v, c);
+        out.at(x, y, c) = static_cast<float>(n ? sum / n : 0.0);
+      }
+    }
+  return out;
+}
+
+namespace {
+/// Printable ASCII only (the font's range); anything else becomes '?'.
+std::string printable(const std::string& text) {
+  std::string s = text;
+  for (char& c : s)
+    if (c < 32 || c > 126) c = '?';
+  return s;
+}
+} // namespace
+
+int textWidth(const std::string& text, int scale) {
+  std::string copy = printable(text);
+  return stb_easy_font_width(copy.data()) * scale;
+}
+
+int drawText(Image& image, int x, int y, const std::string& text, int scale, const glm::vec3& rgb) {
+  std::vector<char> buffer(text.size() * 400 + 1024);
+  std::string copy = printable(text);
+  const int quads =
+      stb_easy_font_print(0.0f, 0.0f, copy.data(), nullptr, buffer.data(), static_cast<int>(buffer.size()));
+  struct Vertex {
+    float x, y, z;
+    unsigned char color[4];
+  };
+  static_assert(sizeof(Vertex) == 16, "stb_easy_font vertex layout");
+  std::vector<Vertex> vertices(static_cast<std::size_t>(quads) * 4);
+  std::copy_n(buffer.data(), vertices.size() * sizeof(Vertex), reinterpret_cast<char*>(vertices.data()));
+  for (int q = 0; q < quads; ++q) {
+    float minX = 1e9f, minY = 1e9f, maxX = -1e9f, maxY = -1e9f;
+    for (int k = 0; k < 4; ++k) {
+      const Vertex& v = vertices[static_cast<std::size_t>(4 * q + k)];
+      minX = std::min(minX, v.x);
+      maxX = std::max(maxX, v.x);
+      minY = std::min(minY, v.y);
+      maxY = std::max(maxY, v.y);
+    }
+    for (int py = static_cast<int>(std::lround(minY * scale));
+         py < static_cast<int>(std::lround(maxY * scale)); ++py)
+      for (int px = static_cast<int>(std::lround(minX * scale));
+           px < static_cast<int>(std::lround(maxX * scale)); ++px)
+        setTopDown(image, x + px, y + py, rgb);
+  }
+  return stb_easy_font_width(copy.data()) * scale;
+}
+
+namespace {
+/// Greedy word wrap of `text` into lines at most `width` pixels wide at scale 1.
+std::vector<std::string> wrap(const std::string& text, int width) {
+  std::vector<std::string> lines;
+  std::string line, word;
+  auto flush = [&] {
+    if (word.empty()) return;
+    const std::string candidate = line.empty() ? word : line + " " + word;
+    if (!line.empty() && textWidth(candidate, 1) > width) {
+      lines.push_back(line);
+      line = word;
+    } else {
+      line = candidate;
+    }
+    word.clear();
+  };
+  for (char c : text) {
+    if (c == ' ')
+      flush();
+    else
+      word += c;
+  }
+  flush();
+  if (!line.empty()) lines.push_back(line);
+  return lines;
+}
+} // namespace
+
+Image composeSheet(const std::string& header, const std::vector<SheetColumn>& columns, int tileWidth,
+                   double exposure, double amplification) {
+  const int margin = 8, lineHeight = 10, titleHeight = 20;
+  const Image& first = columns.front().image;
+  const int tileHeight =
+      std::max(1, static_cast<int>(std::lround(double(tileWidth) * first.height() / first.width())));
+  std::size_t maxLines = 0;
+  for (const SheetColumn& c : columns)
+    maxLines = std::max(maxLines, c.lines.size());
+  const int columnsCount = static_cast<int>(columns.size());
+  const int width = margin + columnsCount * (tileWidth + margin);
+  const std::vector<std::string> headerLines = wrap(header, width - 2 * margin);
+  const std::vector<std::string> legendLines =
+      wrap("top: composited image (exposure " + std::to_string(exposure).substr(0, 4) +
+               "); middle: |error| of the in-scattering against the reference (max over RGB) / its peak x " +
+               std::to_string(static_cast<int>(std::lround(amplification))) +
+               "; bottom: metrics of the in-scattering, milliseconds per stage (wall clock, glFinish)",
+           width - 2 * margin);
+  const int headerHeight =
+      2 * margin + static_cast<int>(headerLines.size() + legendLines.size()) * lineHeight;
+  const int textHeight = titleHeight + static_cast<int>(maxLines) * lineHeight + margin;
+  const int height = headerHeight + 2 * tileHeight + margin + textHeight + margin;
+  Image sheet(width, height, 3, srgbToLinear(0.12f));
+  const glm::vec3 white(1.0f), grey(srgbToLinear(0.7f));
+  int headerY = margin;
+  for (const std::string& line : headerLines) {
+    drawText(sheet, margin, headerY, line, 1, white);
+    headerY += lineHeight;
+  }
+  for (const std::string& line : legendLines) {
+    drawText(sheet, margin, headerY, line, 1, grey);
+    headerY += lineHeight;
+  }
+  for (int i = 0; i < columnsCount; ++i) {
+    const SheetColumn& col = columns[static_cast<std::size_t>(i)];
+    const int x0 = margin + i * (tileWidth + margin);
+    int y = headerHeight;
+    blit(sheet, resizeImage(col.image, tileWidth, tileHeight), x0, y, exposure);
+    y += tileHeight + margin / 2;
+    if (!col.heat.empty()) {
+      blit(sheet, resizeImage(col.heat, tileWidth, tileHeight), x0, y, 1.0);
+    } else {
+      // Legend: the ramp from 0 to a peak / amplification.
+      const int barTop = y + tileHeight / 2 - 8;
+      for (int x = 0; x < tileWidth; ++x) {
+        const glm::vec3 v = ramp(double(x) / (tileWidth - 1));
+        for (int dy = 0; dy < 16; ++dy)
+          setTopDown(sheet, x0 + x, barTop + dy, v);
+      }
+      drawText(sheet, x0, barTop - 14, "error scale (reference: no error)", 1, white);
+      drawText(sheet, x0, barTop + 20, "0", 1, white);
+      const std::string right = ">= peak / " + std::to_string(static_cast<int>(std::lround(amplification)));
+      drawText(sheet, x0 + tileWidth - textWidth(right, 1), barTop + 20, right, 1, white);
+    }
+    y += tileHeight + margin / 2;
+    drawText(sheet, x0, y + 2, col.title, 2, white);
+    y += titleHeight;
+    for (const std::string& line : col.lines) {
+      drawText(sheet, x0, y, line, 1, grey);
+      y += lineHeight;
+    }
+  }
+  return sheet;
+}
+
+} // namespace crep::tool

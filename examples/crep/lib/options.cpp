@@ -1,0 +1,36 @@
+#include "options.h"
+
+namespace crep::tool {
+
+const std::set<std::string> kMethodOptions = {"method", "map-size", "bases", "format", "splits", "steps"};
+
+const char* const kMethodOptionsHelp =
+    R"(            --map-size N        shadow map and rectified map size (default 1024)
+            --bases M           Fourier bases, a multiple of 4 in [4, 128] (default 32)
+            --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
+            --splits K          rectification splits (default 4; --map-size must be a multiple)
+            --steps N           reference march samples per pixel (default 256)
+)";
+
+StorageFormat parseFormat(const std::string& text) {
+  if (text == "rgba8") return StorageFormat::RGBA8;
+  if (text == "rgba16f") return StorageFormat::RGBA16F;
+  if (text == "rgba32f") return StorageFormat::RGBA32F;
+  throw UsageError("option --format: '" + text + "' is not rgba8, rgba16f or rgba32f");
+}
+
+MethodSettings methodSettings(const Args& args) {
+  MethodSettings s;
+  s.mapSize = args.integer("map-size", s.mapSize, 1, Image::kMaxDimension);
+  s.steps = args.integer("steps", s.steps, 1, 65536);
+  s.bases = args.integer("bases", s.bases, kMinBases, kMaxBases);
+  if (s.bases % 4 != 0) throw UsageError("option --bases: must be a multiple of 4");
+  s.format = parseFormat(args.string("format", "rgba8"));
+  s.rectify.splits = args.integer("splits", s.rectify.splits, 1, RectifyOptions::kMaxSplits);
+  if (s.mapSize % s.rectify.splits != 0)
+    throw UsageError("option --map-size: " + std::to_string(s.mapSize) + " must be a multiple of --splits " +
+                     std::to_string(s.rectify.splits));
+  return s;
+}
+
+} // namespace crep::tool

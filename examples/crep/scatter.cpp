@@ -1,0 +1,139 @@
+// `crep scatter`: single scattering for users' own data. Inputs: a camera depth EXR (GL depth-buffer
+// values in [0, 1]), a standard shadow map EXR (depth-buffer values of an orthographic light matrix)
+// and a JSON frame description (lib/frame_json.h; README "crep scatter"). Output: a scattering EXR,
+// RGB in-scattered radiance and A transmittance.
+//
+// Methods (lib/frame.h registry): `reference` marches every view ray against the user's standard
+// shadow map; `prefilter` builds the projective rectification of the JSON camera and light, point-
+// resamples the standard map into it on the CPU (lib/resample.h; Sec. 4.1's rule on the projective
+// layout) and runs the GPU prefilter and evaluation passes on it.
+#include "args.h"
+#include "commands.h"
+#include "frame.h"
+#include "frame_json.h"
+#include "options.h"
+#include "resample.h"
+#include "timings.h"
+
+#include <crep/core/error.h>
+#include <crep/core/exr.h>
+#include <crep/core/png.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <unistd.h>
+
+namespace crep::tool {
+
+namespace {
+
+/// Reads a depth EXR (channel 0) and checks every value is a depth-buffer value in [0, 1].
+Image readDepthExr(const std::string& option, const std::string& path, const char* what) {
+  Image image;
+  try {
+    image = readExr(path);
+  } catch (const IoError& e) {
+    throw IoError(option + " (" + what + "): " + e.what());
+  } catch (const FormatError& e) {
+    throw FormatError(option + " (" + what + "): " + e.what());
+  }
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const float d = image.at(x, y, 0);
+      if (!(d >= 0.0f && d <= 1.0f))
+        // Report the pixel as a viewer shows it: row 0 at the top.
+        throw FormatError(option + " (" + what + "): '" + path + "': pixel (" + std::to_string(x) + ", " +
+                          std::to_string(image.height() - 1 - y) + ") from the top-left is " +
+                          std::to_string(d) + (std::isnan(d) ? " (NaN)" : "") +
+                          "; expected OpenGL depth-buffer values in [0, 1] (1 = nothing / sky)");
+    }
+  return image;
+}
+
+std::string sizeText(int w, int h) {
+  return std::to_string(w) + "x" + std::to_string(h);
+}
+
+} // namespace
+
+int scatterCommand(const std::vector<std::string>& argv) {
+  std::set<std::string> valued = {"depth", "shadow", "frame", "out", "png", "exposure"};
+  valued.insert(kMethodOptions.begin(), kMethodOptions.end());
+  const Args args(argv, valued, {"debug-gl"});
+  for (const char* required : {"depth", "shadow", "frame"})
+    if (!args.has(required))
+      throw UsageError(std::string("option --") + required + " is required (see crep help)");
+  const std::string depthPath = args.string("depth", ""), shadowPath = args.string("shadow", "");
+  const std::string framePath = args.string("frame", "");
+  const std::string method = args.string("method", "prefilter");
+  findMethod(method);
+  const MethodSettings settings = methodSettings(args);
+  const std::string out = args.string("out", "scattering.exr");
+  if (out.empty()) throw UsageError("option --out: must not be empty");
+  const double exposure = args.number("exposure", 1.0);
+  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+
+  StageTimings timings;
+  if (isatty(2)) timings.setProgress("crep scatter");
+  // Everything about the inputs is checked before any GL work.
+  const FrameDescription desc =
+      timings.time("read frame json", [&] { return readFrameDescription(framePath); });
+  const Camera camera = cameraOf(desc, framePath);
+  const DirectionalLight light = lightOf(desc, framePath);
+  const Medium medium = mediumOf(desc, framePath);
+  checkLightMatrix(desc.lightClipFromWorld, light.direction(), framePath + ": shadowMap.lightClipFromWorld");
+  const Image depth =
+      timings.time("read depth exr", [&] { return readDepthExr("--depth", depthPath, "camera depth"); });
+  const Image shadow =
+      timings.time("read shadow exr", [&] { return readDepthExr("--shadow", shadowPath, "shadow map"); });
+  if (desc.cameraSize && (desc.cameraSize->x != depth.width() || desc.cameraSize->y != depth.height()))
+    throw FormatError(framePath + ": camera.size " + sizeText(desc.cameraSize->x, desc.cameraSize->y) +
+                      " does not match the depth image '" + depthPath + "' (" +
+                      sizeText(depth.width(), depth.height()) + ")");
+  if (desc.shadowSize && (desc.shadowSize->x != shadow.width() || desc.shadowSize->y != shadow.height()))
+    throw FormatError(framePath + ": shadowMap.size " + sizeText(desc.shadowSize->x, desc.shadowSize->y) +
+                      " does not match the shadow map '" + shadowPath + "' (" +
+                      sizeText(shadow.width(), shadow.height()) + ")");
+  const double imageAspect = double(depth.width()) / double(depth.height());
+  if (std::abs(camera.aspect() / imageAspect - 1.0) > 0.01)
+    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " +
+                      std::to_string(camera.aspect()) + ", which does not match the depth image '" +
+                      depthPath + "' (" + sizeText(depth.width(), depth.height()) + ", aspect " +
+                      std::to_string(imageAspect) + ")");
+
+  ensureGlContext("scatter", args.has("debug-gl"), timings);
+  Frame frame(camera, light, medium);
+  frame.width = depth.width();
+  frame.height = depth.height();
+  timings.time("upload", [&] {
+    frame.cameraDepth = uploadR32F(depth, "--depth");
+    frame.shadowMap = uploadR32F(shadow, "--shadow");
+  });
+  frame.shadowWidth = shadow.width();
+  frame.shadowHeight = shadow.height();
+  frame.lightClipFromWorld = desc.lightClipFromWorld;
+  frame.shadowBias = desc.shadowBias;
+  frame.shadowImage = shadow;
+
+  MethodOutput result = runMethod(method, frame, settings);
+  timings.append(result.timings.rows());
+  const Image scattering =
+      timings.time("readback", [&] { return readRgba(result.scattering.get(), frame.width, frame.height); });
+  checkGlErrors("scattering");
+  requireFinite(scattering, "the scattering image");
+  timings.time("write exr", [&] { writeExr(out, scattering, ExrPixelType::Float); });
+  if (args.has("png"))
+    timings.time("write png", [&] {
+      writePng(args.string("png", ""), scattering, ToneMap{static_cast<float>(exposure)});
+    });
+
+  std::printf("crep scatter: %s, %dx%d, method %s (%s)\n", framePath.c_str(), frame.width, frame.height,
+              result.used.c_str(), result.detail.c_str());
+  timings.print(stdout);
+  std::printf("wrote %s (RGB in-scattered radiance, A transmittance)%s%s\n", out.c_str(),
+              args.has("png") ? " and " : "", args.has("png") ? args.string("png", "").c_str() : "");
+  return 0;
+}
+
+} // namespace crep::tool

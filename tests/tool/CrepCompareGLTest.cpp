@@ -1,0 +1,134 @@
+// `crep compare` and `crep bench` end to end at test sizes.
+#include "support/gl_fixture.h"
+#include "support/image_check.h"
+#include "support/tool_runner.h"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted) {
+      fields.push_back(field);
+      field.clear();
+    } else
+      field += c;
+  }
+  fields.push_back(field);
+  return fields;
+}
+
+/// The CSV as one map column -> value per data row.
+std::vector<std::map<std::string, std::string>> readCsv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = splitCsv(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> f = splitCsv(line);
+    REQUIRE(f.size() == header.size());
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < f.size(); ++i)
+      row[header[i]] = f[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+/// Width and height from a PNG's IHDR chunk (0, 0 if it is not a PNG).
+std::pair<int, int> pngSize(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char b[24] = {};
+  in.read(reinterpret_cast<char*>(b), 24);
+  if (!in || b[1] != 'P' || b[2] != 'N' || b[3] != 'G') return {0, 0};
+  auto be = [&](int o) { return (b[o] << 24) | (b[o + 1] << 16) | (b[o + 2] << 8) | b[o + 3]; };
+  return {be(16), be(20)};
+}
+
+} // namespace
+
+TEST_CASE("crep compare: contact sheet and CSV with every method against the reference") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir("crep-compare");
+  const std::string prefix = (dir / "cmp").string();
+  const auto r = crep::test::runCrep(
+      "compare --scene boxes --size 160x90 --map-size 256 --steps 256 --out '" + prefix + "'");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const auto rows = readCsv(prefix + ".csv");
+  REQUIRE(rows.size() >= 2); // the reference and at least the prefiltered method
+  std::map<std::string, std::map<std::string, std::string>> byMethod;
+  for (const auto& row : rows)
+    byMethod[row.at("method")] = row;
+  REQUIRE(byMethod.count("reference") == 1);
+  REQUIRE(byMethod.count("prefilter") == 1);
+  for (const auto& row : rows) {
+    for (const char* column :
+         {"scene", "relative_rmse", "psnr_db", "max_abs_error", "mean_abs_error", "ms total"})
+      CHECK(!row.at(column).empty());
+    CHECK(row.at("scene") == "boxes");
+    CHECK(std::strtod(row.at("ms total").c_str(), nullptr) > 0.0);
+  }
+  CHECK(byMethod["reference"]["relative_rmse"] == "0");
+  CHECK(byMethod["reference"]["psnr_db"] == "inf");
+  CHECK(!byMethod["reference"]["ms reference march"].empty());
+  const double rel = std::strtod(byMethod["prefilter"]["relative_rmse"].c_str(), nullptr);
+  CHECK(rel > 0.0);
+  CHECK(rel < 0.04); // prefiltered vs world-space march (CrepToolGLTest: 0.89% on boxes at 512^2)
+  CHECK(std::isfinite(std::strtod(byMethod["prefilter"]["psnr_db"].c_str(), nullptr)));
+  CHECK(!byMethod["prefilter"]["ms prefilter"].empty());
+  CHECK(!byMethod["prefilter"]["ms evaluate"].empty());
+  CHECK(byMethod["prefilter"]["ms reference march"].empty());
+
+  // Sheet: one column per method, each 160 wide (margins 8), images and heat maps stacked.
+  const auto [w, h] = pngSize(prefix + ".png");
+  CHECK(w == 8 + static_cast<int>(rows.size()) * (160 + 8));
+  CHECK(h > 2 * 90);
+  // The printed table names every method and the files.
+  CHECK(r.output.find("prefilter") != std::string::npos);
+  CHECK(r.output.find("cmp.csv") != std::string::npos);
+}
+
+TEST_CASE("crep compare: --methods selects methods and always adds the reference") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir("crep-compare");
+  const std::string prefix = (dir / "one").string();
+  const auto r = crep::test::runCrep(
+      "compare --size 160x90 --map-size 128 --steps 64 --methods prefilter --tile-width 80 --out '" + prefix +
+      "'");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const auto rows = readCsv(prefix + ".csv");
+  REQUIRE(rows.size() == 2);
+  CHECK(rows[0].at("method") == "reference");
+  CHECK(rows[1].at("method") == "prefilter");
+  CHECK(pngSize(prefix + ".png").first == 8 + 2 * (80 + 8));
+}
+
+TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
+  CREP_REQUIRE_GL();
+  const auto r = crep::test::runCrep("bench --quick --size 160x90 --map 128x128 --repeat 1");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  for (const char* text : {"CPU/GPU", "prefilter", "evaluate", "bandwidth", "methods side by side",
+                           "reference", "vs prefilter", "how measured"})
+    CHECK(r.output.find(text) != std::string::npos);
+  CHECK(r.output.find("Table 1") == std::string::npos); // --quick: no tables
+}
