@@ -17,7 +17,7 @@ namespace crep {
 
 using epipolar_detail::PixelRay;
 using epipolar_detail::pixelRay;
-using epipolar_detail::scatteringConstant;
+// scatteringConstant: crep::scatteringConstant (prefilter.h).
 using epipolar_detail::sectionIntegral;
 
 // ---------------------------------------------------------------------------------------------------

@@ -7,6 +7,8 @@
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/prefilter/prefilter.h>
+#include <crep/prefilter/weights.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,12 +49,6 @@ inline PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y)
   return r;
 }
 
-/// phi(x) = (1 - exp(-x)) / x, phi(0) = 1.
-inline double oneMinusExpOverX(double x) {
-  if (std::abs(x) < 1e-8) return 1.0 - 0.5 * x;
-  return -std::expm1(-x) / x;
-}
-
 /// (exp(-sigma ta) - exp(-sigma tb)) / sigma, finite as sigma -> 0 (seed 003 Eq. 3 on a section).
 inline double sectionIntegral(double sigma, double ta, double tb) {
   const double len = tb - ta;
@@ -65,17 +61,9 @@ inline glm::dvec3 sectionIntegral(const glm::dvec3& sigma, double ta, double tb)
           sectionIntegral(sigma.z, ta, tb)};
 }
 
-/// C of seed 003 Eq. 1 per channel for the unit view direction v (from the camera).
-inline glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
-                                     const glm::dvec3& v) {
-  return light.irradiance() * medium.scatteringTimesPhase(glm::dot(light.direction(), -v));
-}
-
-/// The grey extinction of the alpha channel: the mean of the three extinction channels.
-inline double greyExtinction(const Medium& medium) {
-  const glm::dvec3 s = medium.extinction();
-  return (s.x + s.y + s.z) / 3.0;
-}
+// C of Eq. 1 (crep::scatteringConstant), phi(x) (crep::oneMinusExpOverX) and the grey extinction of
+// the alpha channel (crep::weightExtinction) come from prefilter/, so both methods integrate alike.
+inline double greyExtinction(const Medium& medium) { return weightExtinction(medium); }
 
 inline void storePixel(Image& out, int x, int y, const glm::dvec3& L, double transmittance) {
   out.at(x, y, 0) = static_cast<float>(L.x);
