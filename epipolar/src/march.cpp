@@ -193,7 +193,7 @@ MarchResult marchRows(const RectifiedMap& map, const Image& cameraDepth, const C
                       const DirectionalLight& light, const Medium& medium, const MarchOptions& options,
                       const Walk& walk) {
   validate(map);
-  epipolar_detail::validateCameraDepth(cameraDepth);
+  validateCameraDepth(cameraDepth);
   validateOptions(options);
   const RectifiedLayout& layout = *map.layout;
   const int w = cameraDepth.width(), h = cameraDepth.height(), W = map.width(), H = map.height();
@@ -378,7 +378,7 @@ MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightCli
                             const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
                             const Medium& medium, const WorldMarchOptions& options) {
   validateShadowMap(shadowDepth, lightClipFromWorld);
-  epipolar_detail::validateCameraDepth(cameraDepth);
+  validateCameraDepth(cameraDepth);
   validate(options);
   const int w = cameraDepth.width(), h = cameraDepth.height();
   MarchResult out{Image(w, h, 4), Image(w, h, 1)};
@@ -403,7 +403,7 @@ void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClip
                            const Medium& medium, std::span<const int> pixels, Image& scattering, Image* steps,
                            const WorldMarchOptions& options) {
   validateShadowMap(shadowDepth, lightClipFromWorld);
-  epipolar_detail::validateCameraDepth(cameraDepth);
+  validateCameraDepth(cameraDepth);
   validate(options);
   const int w = cameraDepth.width(), h = cameraDepth.height();
   if (scattering.width() != w || scattering.height() != h || scattering.channels() != 4)

@@ -16,21 +16,7 @@
 
 namespace crep::epipolar_detail {
 
-inline std::string pixelString(int x, int y) {
-  return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
-}
-
-/// Throws InvalidArgument ("cameraDepth") unless the image is non-empty with values in [0, 1].
-inline void validateCameraDepth(const Image& depth) {
-  if (depth.empty()) throw InvalidArgument("cameraDepth", "empty", "must be a depth-buffer image");
-  for (int y = 0; y < depth.height(); ++y)
-    for (int x = 0; x < depth.width(); ++x) {
-      const float v = depth.at(x, y, 0);
-      if (!(v >= 0.0f && v <= 1.0f))
-        throw InvalidArgument("cameraDepth", pixelString(x, y) + " = " + detail::formatValue(v),
-                              "depth-buffer values must be in [0, 1]");
-    }
-}
+// validateCameraDepth: crep::validateCameraDepth (prefilter.h), the same rule for every CPU path.
 
 /// The view ray of pixel (x, y) and the distance s to its surface (far plane for the sky).
 struct PixelRay {
@@ -63,7 +49,9 @@ inline glm::dvec3 sectionIntegral(const glm::dvec3& sigma, double ta, double tb)
 
 // C of Eq. 1 (crep::scatteringConstant), phi(x) (crep::oneMinusExpOverX) and the grey extinction of
 // the alpha channel (crep::weightExtinction) come from prefilter/, so both methods integrate alike.
-inline double greyExtinction(const Medium& medium) { return weightExtinction(medium); }
+inline double greyExtinction(const Medium& medium) {
+  return weightExtinction(medium);
+}
 
 inline void storePixel(Image& out, int x, int y, const glm::dvec3& L, double transmittance) {
   out.at(x, y, 0) = static_cast<float>(L.x);

@@ -7,7 +7,6 @@
 #include <crep/core/parallel.h>
 #include <crep/prefilter/prefilter.h>
 
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,17 +20,6 @@ namespace {
 
 std::string pixelString(int x, int y) {
   return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
-}
-
-void validateCameraDepth(const Image& depth) {
-  if (depth.empty()) throw InvalidArgument("cameraDepth", "empty", "must be a depth-buffer image");
-  for (int y = 0; y < depth.height(); ++y)
-    for (int x = 0; x < depth.width(); ++x) {
-      const float v = depth.at(x, y, 0);
-      if (!(v >= 0.0f && v <= 1.0f))
-        throw InvalidArgument("cameraDepth", pixelString(x, y) + " = " + detail::formatValue(v),
-                              "depth-buffer values must be in [0, 1]");
-    }
 }
 
 /// The view ray of one camera pixel and its integration range (prefilter.h "Evaluation").
@@ -179,6 +167,17 @@ void validateEvaluateOptions(const EvaluateOptions& o) {
 }
 
 } // namespace
+
+void validateCameraDepth(const Image& depth) {
+  if (depth.empty()) throw InvalidArgument("cameraDepth", "empty", "must be a depth-buffer image");
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const float v = depth.at(x, y, 0);
+      if (!(v >= 0.0f && v <= 1.0f))
+        throw InvalidArgument("cameraDepth", pixelString(x, y) + " = " + detail::formatValue(v),
+                              "depth-buffer values must be in [0, 1]");
+    }
+}
 
 // ---------------------------------------------------------------------------------------------------
 

@@ -9,6 +9,7 @@
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
 
+#include "support/analytic_scene.h"
 #include "support/image_check.h"
 
 #include <doctest/doctest.h>
@@ -28,61 +29,12 @@ namespace {
 // The analytic setup: a 60 degree camera 2 units above a ground plane y = 0, near 0.1, far 80, light
 // from the side and above; a coloured medium (optical depth ~5 along the far plane distance).
 
-Camera testCamera(int w = 160, int h = 90) {
-  return Camera::lookAt({0, 2, 0}, {0, 1.5, -10}, {0, 1, 0}, glm::radians(60.0), static_cast<double>(w) / h,
-                        0.1, 80.0);
-}
-DirectionalLight testLight() {
-  return DirectionalLight(glm::dvec3(1.0, -1.0, -0.3), glm::dvec3(2.0, 1.8, 1.5));
-}
-Medium testMedium() {
-  return Medium(glm::dvec3(0.03, 0.04, 0.05), glm::dvec3(0.01), 0.6, glm::dvec3(0.005, 0.01, 0.02));
-}
-
-std::shared_ptr<const ProjectiveLayout> testLayout(const Camera& camera, const DirectionalLight& light,
-                                                   int splits = 4) {
-  RectifyOptions options;
-  options.splits = splits;
-  Rectification r = rectify(camera, light, options);
-  REQUIRE(r.projective());
-  return std::make_shared<const ProjectiveLayout>(std::move(r));
-}
-
-/// GL depth-buffer value of a view-space distance (glDepthRange(0, 1)).
-double depthBufferValue(const Camera& c, double viewDepth) {
-  const double n = c.near(), f = c.far();
-  const double ndc = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * viewDepth);
-  return 0.5 * ndc + 0.5;
-}
-
-/// Camera depth of the ground plane y = 0 (sky = 1 where it is farther than the far plane or missed).
-Image groundDepth(const Camera& camera, int w, int h) {
-  Image depth(w, h, 1, 1.0f);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const glm::dvec3 v = camera.rayDirection(2.0 * (x + 0.5) / w - 1.0, 2.0 * (y + 0.5) / h - 1.0);
-      if (v.y >= 0.0) continue;
-      const double t = -camera.position().y / v.y;
-      const double viewDepth = t * glm::dot(v, camera.forward());
-      if (viewDepth < camera.far()) depth.at(x, y) = static_cast<float>(depthBufferValue(camera, viewDepth));
-    }
-  return depth;
-}
-
-/// The half-space occluder: points with dot(n, x - p0) > 0 (the side the light travels toward) are shadowed.
-struct HalfSpace {
-  glm::dvec3 normal = glm::normalize(glm::dvec3(1.0, 0.5, 0.3));
-  glm::dvec3 point{2.0, 1.0, -10.0};
-};
+using test::groundDepth;
+using test::HalfSpace;
 
 RectifiedMap halfSpaceMap(std::shared_ptr<const ProjectiveLayout> layout, const HalfSpace& plane, int W,
                           int H) {
-  return castRectifiedMap(layout, W, H, [&](const LightRay& ray) -> std::optional<glm::dvec3> {
-    const double dn = glm::dot(plane.normal, ray.direction);
-    if (dn == 0.0) return std::nullopt;
-    const double t = glm::dot(plane.normal, plane.point - ray.origin) / dn; // any t: casters before Z = 0 too
-    return ray.origin + t * ray.direction;
-  });
+  return castRectifiedMap(layout, W, H, [&](const LightRay& ray) { return test::planeHit(plane, ray); });
 }
 
 /// exp(-sigma a) - exp(-sigma b), over sigma, per channel.
@@ -169,8 +121,8 @@ TEST_CASE("prefilter: stored values follow the GPU's storage rules") {
 }
 
 TEST_CASE("prefilter: the filtered basis is the normalized weighted prefix of each region (Appendix A)") {
-  const Camera camera = testCamera();
-  const auto layout = testLayout(camera, testLight(), 2);
+  const Camera camera = test::groundCamera();
+  const auto layout = test::projectiveLayout(camera, test::sideLight(), 2);
   const int W = 48, H = 5, M = 6; // M not a multiple of 4: the second layer is half used
   Image depth(W, H, 1);
   std::mt19937_64 rng(1);
@@ -225,10 +177,10 @@ TEST_CASE("prefilter: the filtered basis is the normalized weighted prefix of ea
 }
 
 TEST_CASE("prefilter: output is bit-identical for any thread count") {
-  const Camera camera = testCamera(64, 36);
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera(64, 36);
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const RectifiedMap map = halfSpaceMap(layout, HalfSpace{}, 128, 37);
   const Image depth = groundDepth(camera, 64, 36);
   PrefilterOptions o;
@@ -264,10 +216,10 @@ TEST_CASE("prefilter: ground truth (a) no occluder equals the closed form of the
   // PSNR 50.3 dB, max abs 6.0e-3 (peak 0.134); with Lanczos damping 3.3e-4 / 78.6 dB / 2.7e-4. The march
   // over the same (empty) map is exact. The residual is the ringing of the series against empty texels
   // near the depth margin (fourier.h); without the margin it is 2.5e-2.
-  const Camera camera = testCamera();
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera();
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const RectifiedMap map = castRectifiedMap(layout, 512, 256, [](const LightRay&) { return std::nullopt; });
   const Image depth = groundDepth(camera, 160, 90);
   const Image truth = unshadowedScattering(depth, camera, light, medium);
@@ -305,10 +257,10 @@ TEST_CASE("prefilter: ground truth (b) half-space shadow equals the closed form 
   // 4.2e-3 (peak 0.122); Lanczos 7.5e-3 / 53.4 dB / 4.0e-3; nearest sampling 9.8e-3. The march over the
   // same map: 3.7e-3 (the map's own discretization); prefiltered vs march 9.7e-3. Of that, ~0.35% is the
   // grey weight extinction for this coloured medium (a grey medium gives 5.7e-3 against the closed form).
-  const Camera camera = testCamera();
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera();
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const HalfSpace plane;
   const RectifiedMap map = halfSpaceMap(layout, plane, 512, 256);
   const Image depth = groundDepth(camera, 160, 90);
@@ -350,10 +302,10 @@ TEST_CASE("prefilter: ground truth (b) half-space shadow equals the closed form 
 }
 
 TEST_CASE("prefilter: storage formats differ from RGBA32F only by their quantization") {
-  const Camera camera = testCamera();
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera();
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const RectifiedMap map = halfSpaceMap(layout, HalfSpace{}, 256, 128);
   const Image depth = groundDepth(camera, 160, 90);
   PrefilterOptions o;
@@ -379,10 +331,10 @@ TEST_CASE("prefilter: storage formats differ from RGBA32F only by their quantiza
 }
 
 TEST_CASE("prefilter: near-plane correction integrates from the near plane (Sec. 3.1)") {
-  const Camera camera = testCamera(80, 45);
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera(80, 45);
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const HalfSpace plane;
   const RectifiedMap map = halfSpaceMap(layout, plane, 512, 256);
   const Image depth = groundDepth(camera, 80, 45);
@@ -410,10 +362,10 @@ TEST_CASE("prefilter: near-plane correction integrates from the near plane (Sec.
 }
 
 TEST_CASE("prefilter: sky pixels integrate to the far plane") {
-  const Camera camera = testCamera(64, 36);
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera(64, 36);
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const RectifiedMap empty = castRectifiedMap(layout, 256, 128, [](const LightRay&) { return std::nullopt; });
   const Image sky(64, 36, 1, 1.0f);
   const Image ours = evaluate(prefilter(empty, medium), sky, camera, light, medium);
@@ -433,10 +385,10 @@ TEST_CASE("prefilter: sky pixels integrate to the far plane") {
 }
 
 TEST_CASE("prefilter: clamped visibility keeps 0 <= L <= unshadowed for arbitrary maps") {
-  const Camera camera = testCamera(48, 27);
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera(48, 27);
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   std::mt19937_64 rng(9);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   Image random(128, 64, 1);
@@ -466,10 +418,10 @@ TEST_CASE("prefilter: clamped visibility keeps 0 <= L <= unshadowed for arbitrar
 }
 
 TEST_CASE("prefilter: sigma -> 0 gives the linear limit without NaN") {
-  const Camera camera = testCamera(64, 36);
-  const DirectionalLight light = testLight();
+  const Camera camera = test::groundCamera(64, 36);
+  const DirectionalLight light = test::sideLight();
   const Medium thin(glm::dvec3(1e-14), glm::dvec3(0.0), 0.3);
-  const auto layout = testLayout(camera, light);
+  const auto layout = test::projectiveLayout(camera, light);
   const RectifiedMap empty = castRectifiedMap(layout, 256, 128, [](const LightRay&) { return std::nullopt; });
   const Image depth = groundDepth(camera, 64, 36);
   const FilteredBasis basis = prefilter(empty, thin);
@@ -488,10 +440,10 @@ TEST_CASE("prefilter: sigma -> 0 gives the linear limit without NaN") {
 }
 
 TEST_CASE("prefilter: more prefilter regions per split (Sec. 3.3) keep the ground truth") {
-  const Camera camera = testCamera();
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera();
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const HalfSpace plane;
   const RectifiedMap map = halfSpaceMap(layout, plane, 768, 256);
   const Image depth = groundDepth(camera, 160, 90);
@@ -511,10 +463,10 @@ TEST_CASE("prefilter: more prefilter regions per split (Sec. 3.3) keep the groun
 }
 
 TEST_CASE("prefilter: bad input gets a named InvalidArgument") {
-  const Camera camera = testCamera(16, 9);
-  const DirectionalLight light = testLight();
-  const Medium medium = testMedium();
-  const auto layout = testLayout(camera, light);
+  const Camera camera = test::groundCamera(16, 9);
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const auto layout = test::projectiveLayout(camera, light);
   const auto parameterOf = [](const auto& f) -> std::string {
     try {
       f();

@@ -188,6 +188,11 @@ struct EvaluateOptions {
 glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
                               const glm::dvec3& viewDirection);
 
+/// Throws InvalidArgument ("cameraDepth", naming the pixel and value) unless `depth` is non-empty and
+/// every value of its first channel is a depth-buffer value in [0, 1] (NaN included). Shared by every
+/// CPU path that reads a camera depth image (evaluate, the marches of epipolar/).
+void validateCameraDepth(const Image& depth);
+
 /// Evaluation (see top): a 4-channel image of cameraDepth's size, RGB = in-scattered radiance, A =
 /// grey transmittance. `cameraDepth`: 1 channel (channel 0 used if more), depth-buffer values of
 /// `camera` in [0, 1] (1 = sky). Throws InvalidArgument ("cameraDepth") for an empty image or a value
