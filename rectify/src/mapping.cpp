@@ -1,6 +1,6 @@
 // Mapping helpers of a projective rectification: world <-> (split, column, row, depth), light and view
-// rays, world distances along view rays (closed form), reference rays of Sec. 3.2 and the Eq. 12 step
-// factor. Formulas at the top of crep/rectify/rectify.h.
+// rays, world distances along view rays (closed form), reference rays (Klehm et al. 2014, Sec. 3.2) and
+// the Eq. 12 step factor. Formulas at the top of crep/rectify/rectify.h.
 #include <crep/core/error.h>
 #include <crep/rectify/rectify.h>
 

@@ -1,7 +1,7 @@
 // The RectifiedMap contract and the projective layout (rectified_map.h). Distances along view rays are
 // the closed form of rectify.h ("The math"): s = sqrt(1 + y^2 + z^2) / (zeta - rho z), and zeta is
-// linear in the column within a split, so s is a 1D projective function of that column (Sec. 3.2
-// weights need it per row; Sec. 4.2 splits are the regions).
+// linear in the column within a split, so s is a 1D projective function of that column (the weights of
+// Klehm et al. 2014, Sec. 3.2, need it per row; the Sec. 4.2 splits are the regions).
 #include <crep/core/error.h>
 #include <crep/core/parallel.h>
 #include <crep/rectify/rectified_map.h>

@@ -210,35 +210,64 @@ std::vector<double> splitFractions(double zetaMax, double zetaMin, double offset
   return f;
 }
 
-/// The common construction. `region` are the vertices of the convex region to cover, `lightDir` the
-/// direction light travels at the camera (unit), `rho` = 1 / |camera - light| (0: directional) and
-/// `lightPos` the light's position (point-like lights only).
-Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region, const glm::dvec3& lightDir,
-                    double rho, const glm::dvec3& lightPos, const RectifyOptions& options, bool pointLike) {
+/// The region's angles (degrees) known when a result is made: see Rectification::span and epipoleAngle.
+struct RegionAngles {
+  double span = 0.0;
+  double epipoleAngle = 0.0;
+};
+
+/// The fields every result carries: the region, the options' layout and reference ray, and
+/// maxSpanDegrees as the threshold.
+Rectification baseResult(const std::vector<glm::dvec3>& region, const RectifyOptions& options) {
   Rectification r;
   r.threshold = options.maxSpanDegrees;
   r.layout = options.layout;
   r.referenceRay = options.referenceRay;
   r.regionVertices = region;
-  const glm::dvec3 c = camera.position();
+  return r;
+}
 
-  if (region.empty()) {
-    r.status = RectifyStatus::Empty;
-    r.reason = FallbackReason::EmptyRegion;
-    r.message = "the light's frustum does not intersect the camera frustum: nothing is lit";
-    return r;
-  }
+/// The one constructor of non-projective results: status Empty for FallbackReason::EmptyRegion, else
+/// Fallback, with the measure that decided, its threshold, the message and the angles known so far;
+/// frame, splits and slope hull stay empty.
+Rectification fallbackResult(FallbackReason reason, double measure, double threshold, std::string message,
+                             RegionAngles angles, const std::vector<glm::dvec3>& region,
+                             const RectifyOptions& options) {
+  Rectification r = baseResult(region, options);
+  r.status = reason == FallbackReason::EmptyRegion ? RectifyStatus::Empty : RectifyStatus::Fallback;
+  r.reason = reason;
+  r.message = std::move(message);
+  r.measure = measure;
+  r.threshold = threshold;
+  r.span = angles.span;
+  r.epipoleAngle = angles.epipoleAngle;
+  return r;
+}
 
-  // 2D directions of the region's vertices seen from the camera, projected along the light (Sec. 4.2
-  // "find the 2D vectors ... that span the biggest angle"). Any basis of the plane will do: the
-  // bisectrix found below does not depend on it, so the result is continuous in the light direction.
-  const glm::dvec3 b1 = anyOrthogonal(lightDir), b2 = glm::cross(lightDir, b1);
+/// The directions of the region's vertices seen from the camera and projected along the light, and the
+/// smallest sector holding them (Klehm et al. 2014, Sec. 4.2: "find the 2D vectors ... that span the
+/// biggest angle"). Angles are in radians in the basis (b1, b2) of the plane orthogonal to the light.
+struct ProjectedSector {
+  glm::dvec3 b1{0.0}, b2{0.0};
+  double start = 0.0, span = 0.0; ///< the sector [start, start + span]
+  /// Not inside an open half-plane (up to rounding): some view ray through the region is a light ray.
+  bool impossible = false;
+};
+
+/// Klehm et al. 2014, Sec. 4.2: the sector of the region's projected view directions. Any basis of
+/// the plane will do: the bisectrix does not depend on it, so the result is continuous in the light
+/// direction.
+ProjectedSector projectedSector(const glm::dvec3& c, const std::vector<glm::dvec3>& region,
+                                const glm::dvec3& lightDir) {
+  ProjectedSector s;
+  s.b1 = anyOrthogonal(lightDir);
+  s.b2 = glm::cross(lightDir, s.b1);
   std::vector<double> angles;
   angles.reserve(region.size());
   bool onLightLine = false;
   for (const auto& v : region) {
     const glm::dvec3 d = v - c;
-    const double q1 = glm::dot(d, b1), q2 = glm::dot(d, b2);
+    const double q1 = glm::dot(d, s.b1), q2 = glm::dot(d, s.b2);
     // A vertex on the camera's light line: its view ray is a light ray (relative 1e-12 ~ rounding).
     if (!(std::hypot(q1, q2) > 1e-12 * glm::length(d))) {
       onLightLine = true;
@@ -246,134 +275,123 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
     }
     angles.push_back(std::atan2(q2, q1));
   }
-  double span = kPi, start = 0.0;
+  s.span = kPi;
+  s.start = 0.0;
   if (!onLightLine) {
     std::sort(angles.begin(), angles.end());
     // The largest circular gap between consecutive directions; the span is its complement.
     double gap = angles.front() + 2.0 * kPi - angles.back();
-    start = angles.front();
+    s.start = angles.front();
     for (std::size_t i = 1; i < angles.size(); ++i) {
       const double g = angles[i] - angles[i - 1];
       if (g > gap) {
         gap = g;
-        start = angles[i];
+        s.start = angles[i];
       }
     }
-    span = 2.0 * kPi - gap;
+    s.span = 2.0 * kPi - gap;
   }
-  // Not inside an open half-plane (up to rounding): some view ray through the region is a light ray.
-  if (onLightLine || span >= kPi * (1.0 - 1e-12)) {
-    r.span = r.measure = 180.0;
-    r.epipoleAngle = 0.0;
-    r.status = RectifyStatus::Fallback;
-    r.reason = FallbackReason::ViewRayParallelToLight;
-    r.message = pointLike
-                    ? "a view ray through the lit region passes through the light (the camera-light line "
-                      "crosses it): projective rectification impossible"
-                    : "a view ray is parallel to the light direction (epipole on screen): projective "
-                      "rectification impossible";
-    return r;
-  }
-  r.span = span * kDeg;
+  s.impossible = onLightLine || s.span >= kPi * (1.0 - 1e-12);
+  return s;
+}
 
-  // Frame: X along the bisectrix (orthogonal to the light), Z along the light, Y = Z x X.
-  const double mid = start + 0.5 * span;
+/// Klehm et al. 2014, Sec. 4.2: the rectified light view, X along the sector's bisectrix (orthogonal
+/// to the light), Z along the light, Y = Z x X; its bounds are set later (frameBounds).
+RectifiedFrame bisectrixFrame(const glm::dvec3& c, const glm::dvec3& lightDir, const ProjectedSector& sector,
+                              double rho, const glm::dvec3& lightPos) {
+  const double mid = sector.start + 0.5 * sector.span;
   RectifiedFrame f;
   f.origin = c;
   f.axisZ = lightDir;
-  f.axisX = glm::normalize(std::cos(mid) * b1 + std::sin(mid) * b2);
+  f.axisX = glm::normalize(std::cos(mid) * sector.b1 + std::sin(mid) * sector.b2);
   f.axisY = glm::cross(f.axisZ, f.axisX);
   f.inverseLightDistance = rho;
   f.lightPosition = lightPos;
+  return f;
+}
 
-  // Bounds from the *slopes* of the vertices (the camera is the centre of projection), and of zeta.
-  const double inf = std::numeric_limits<double>::infinity();
-  double yMin = inf, yMax = -inf, zMin = inf, zMax = -inf, zetaMin = inf, zetaMax = -inf;
+/// Bounds of the row slope y, the depth slope z and the column parameter zeta over the region's
+/// vertices, and their (y, z) slopes.
+struct SlopeBounds {
+  double yMin, yMax, zMin, zMax, zetaMin, zetaMax;
   std::vector<glm::dvec2> slopes;
-  slopes.reserve(region.size());
+};
+
+/// The region's bounds in the frame from the *slopes* of its vertices (the camera is the centre of
+/// projection, Klehm et al. 2014, Sec. 4.2), and of zeta.
+SlopeBounds slopeBounds(const RectifiedFrame& f, const std::vector<glm::dvec3>& region) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double rho = f.inverseLightDistance;
+  SlopeBounds b{inf, -inf, inf, -inf, inf, -inf, {}};
+  b.slopes.reserve(region.size());
   for (const auto& v : region) {
-    const glm::dvec3 d = v - c;
+    const glm::dvec3 d = v - f.origin;
     const double X = glm::dot(f.axisX, d), Y = glm::dot(f.axisY, d), Z = glm::dot(f.axisZ, d);
     const double y = Y / X, z = Z / X;
     // 1 + rho Z = rho dot(axisZ, p - L), evaluated from L for precision next to the light.
-    const double zeta = rho == 0.0 ? 1.0 / X : rho * glm::dot(f.axisZ, v - lightPos) / X;
-    slopes.emplace_back(y, z);
-    yMin = std::min(yMin, y);
-    yMax = std::max(yMax, y);
-    zMin = std::min(zMin, z);
-    zMax = std::max(zMax, z);
-    zetaMin = std::min(zetaMin, zeta);
-    zetaMax = std::max(zetaMax, zeta);
+    const double zeta = rho == 0.0 ? 1.0 / X : rho * glm::dot(f.axisZ, v - f.lightPosition) / X;
+    b.slopes.emplace_back(y, z);
+    b.yMin = std::min(b.yMin, y);
+    b.yMax = std::max(b.yMax, y);
+    b.zMin = std::min(b.zMin, z);
+    b.zMax = std::max(b.zMax, z);
+    b.zetaMin = std::min(b.zetaMin, zeta);
+    b.zetaMax = std::max(b.zetaMax, zeta);
   }
-  const double yScale = 1.0 + std::max(std::abs(yMin), std::abs(yMax));
-  const double zScale = 1.0 + std::max(std::abs(zMin), std::abs(zMax));
-  const double zetaScale = std::max(std::abs(zetaMin), std::abs(zetaMax));
-  if (!(yMax - yMin > 1e-12 * yScale) || !(zMax - zMin > 1e-12 * zScale) ||
-      !(zetaMax - zetaMin > 1e-12 * zetaScale)) {
-    // Only a spot/point region can be flat (the frusta touch along a face, an edge or a point).
-    r.status = RectifyStatus::Empty;
-    r.reason = FallbackReason::EmptyRegion;
-    r.message = "the lit part of the camera frustum is flat (the frusta only touch): nothing is lit";
-    return r;
-  }
-  std::vector<glm::dvec2> hull = rectify_detail::convexHull(slopes);
-  r.epipoleAngle = epipoleAngle(hull) * kDeg;
+  return b;
+}
 
-  if (r.span >= options.maxSpanDegrees) {
-    r.status = RectifyStatus::Fallback;
-    r.reason = FallbackReason::NonLinearity;
-    r.measure = r.span;
-    r.message = fmt("angular span of the lit region around the light axis %.6g deg >= threshold %.6g deg: "
-                    "rectification too non-linear",
-                    r.span, options.maxSpanDegrees);
-    return r;
-  }
-  if (r.epipoleAngle < options.minEpipoleAngleDegrees) {
-    r.status = RectifyStatus::Fallback;
-    r.reason = FallbackReason::EpipoleTooClose;
-    r.measure = r.epipoleAngle;
-    r.threshold = options.minEpipoleAngleDegrees;
-    r.message = fmt("a view ray of the lit region is %.6g deg from the light line < threshold %.6g deg: "
-                    "step ratios too large",
-                    r.epipoleAngle, options.minEpipoleAngleDegrees);
-    return r;
-  }
-  r.measure = r.span;
+/// True when the region is flat in y, z or zeta up to rounding. Only a spot/point region can be flat
+/// (the frusta touch along a face, an edge or a point).
+bool isFlat(const SlopeBounds& b) {
+  const double yScale = 1.0 + std::max(std::abs(b.yMin), std::abs(b.yMax));
+  const double zScale = 1.0 + std::max(std::abs(b.zMin), std::abs(b.zMax));
+  const double zetaScale = std::max(std::abs(b.zetaMin), std::abs(b.zetaMax));
+  return !(b.yMax - b.yMin > 1e-12 * yScale) || !(b.zMax - b.zMin > 1e-12 * zScale) ||
+         !(b.zetaMax - b.zetaMin > 1e-12 * zetaScale);
+}
 
-  f.rowSlopeMin = yMin;
-  f.rowSlopeMax = yMax;
-  f.depthSlopeMin = zMin;
-  f.depthSlopeMax = zMax;
-  const double offset = -rho * zMin; // xh = 1 / (zeta + offset) > 0 on the region
-  f.axisMin = 1.0 / (zetaMax + offset);
-  f.axisMax = 1.0 / (zetaMin + offset);
-  r.frame = f;
-  r.slopeHull = std::move(hull);
+/// Stores the bounds in the frame and returns the offset -rho zMin of xh = 1 / (zeta + offset), which
+/// is > 0 on the region.
+double frameBounds(RectifiedFrame& f, const SlopeBounds& b) {
+  f.rowSlopeMin = b.yMin;
+  f.rowSlopeMax = b.yMax;
+  f.depthSlopeMin = b.zMin;
+  f.depthSlopeMax = b.zMax;
+  const double offset = -f.inverseLightDistance * b.zMin;
+  f.axisMin = 1.0 / (b.zetaMax + offset);
+  f.axisMax = 1.0 / (b.zetaMin + offset);
+  return offset;
+}
 
-  // Splits (Sec. 4.2 "Non-linearity"): shared row and depth slopes, one column projection each.
+/// Klehm et al. 2014, Sec. 4.2 "Non-linearity": the K splits of a bounded frame, sharing the row and
+/// depth slopes, each with its own column projection.
+std::vector<Split> splitProjections(const RectifiedFrame& f, const SlopeBounds& b, double offset,
+                                    const RectifyOptions& options) {
   const int K = options.splits;
-  const std::vector<double> frac = splitFractions(zetaMax, zetaMin, offset, options);
+  const double rho = f.inverseLightDistance;
+  const std::vector<double> frac = splitFractions(b.zetaMax, b.zetaMin, offset, options);
   std::vector<double> zeta(frac.size());
   for (std::size_t j = 0; j < frac.size(); ++j)
-    zeta[j] = zetaMax - frac[j] * (zetaMax - zetaMin);
-  zeta.front() = zetaMax;
-  zeta.back() = zetaMin;
+    zeta[j] = b.zetaMax - frac[j] * (b.zetaMax - b.zetaMin);
+  zeta.front() = b.zetaMax;
+  zeta.back() = b.zetaMin;
   const glm::dmat4 frameFromWorld = f.frameFromWorld();
-  const double alpha = 2.0 / (yMax - yMin), beta = -1.0 - alpha * yMin;
-  const double gamma = 2.0 / (zMax - zMin), delta = -1.0 - gamma * zMin;
-  r.splits.resize(static_cast<std::size_t>(K));
+  const double alpha = 2.0 / (b.yMax - b.yMin), beta = -1.0 - alpha * b.yMin;
+  const double gamma = 2.0 / (b.zMax - b.zMin), delta = -1.0 - gamma * b.zMin;
+  std::vector<Split> splits(static_cast<std::size_t>(K));
   for (int k = 0; k < K; ++k) {
     const auto ku = static_cast<std::size_t>(k);
-    Split& s = r.splits[ku];
+    Split& s = splits[ku];
     s.zetaBegin = zeta[ku];
     s.zetaEnd = zeta[ku + 1];
-    s.rangeBegin = k == 0 ? f.axisMin : r.splits[ku - 1].rangeEnd;
+    s.rangeBegin = k == 0 ? f.axisMin : splits[ku - 1].rangeEnd;
     s.rangeEnd = k == K - 1 ? f.axisMax : 1.0 / (s.zetaEnd + offset);
-    const double b = 2.0 / (s.zetaEnd - s.zetaBegin), a = -1.0 - b * s.zetaBegin; // ndc.x = a + b zeta
+    const double bz = 2.0 / (s.zetaEnd - s.zetaBegin), a = -1.0 - bz * s.zetaBegin; // ndc.x = a + bz zeta
     glm::dmat4 S(0.0); // frame (X, Y, Z, 1) -> clip; S[column][row]
     S[0][0] = a;
-    S[2][0] = b * rho;
-    S[3][0] = b;
+    S[2][0] = bz * rho;
+    S[3][0] = bz;
     S[0][1] = beta;
     S[1][1] = alpha;
     S[0][2] = delta;
@@ -390,13 +408,74 @@ Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region,
       s.columnEnd = 1.0;
     }
   }
+  return splits;
+}
+
+/// The common construction (Klehm et al. 2014, Sec. 4.2). `region` are the vertices of the convex
+/// region to cover, `lightDir` the direction light travels at the camera (unit), `rho` =
+/// 1 / |camera - light| (0: directional) and `lightPos` the light's position (point-like lights only).
+/// Decides in this order (crep/rectify/rectify.h, "Fallback decision"): empty, impossible, flat, too
+/// non-linear, epipole too close.
+Rectification build(const Camera& camera, const std::vector<glm::dvec3>& region, const glm::dvec3& lightDir,
+                    double rho, const glm::dvec3& lightPos, const RectifyOptions& options, bool pointLike) {
+  if (region.empty())
+    return fallbackResult(FallbackReason::EmptyRegion, 0.0, options.maxSpanDegrees,
+                          "the light's frustum does not intersect the camera frustum: nothing is lit", {},
+                          region, options);
+
+  const ProjectedSector sector = projectedSector(camera.position(), region, lightDir);
+  if (sector.impossible)
+    return fallbackResult(FallbackReason::ViewRayParallelToLight, 180.0, options.maxSpanDegrees,
+                          pointLike ? "a view ray through the lit region passes through the light (the "
+                                      "camera-light line crosses it): projective rectification impossible"
+                                    : "a view ray is parallel to the light direction (epipole on screen): "
+                                      "projective rectification impossible",
+                          {180.0, 0.0}, region, options);
+  RegionAngles angles{sector.span * kDeg, 0.0};
+
+  RectifiedFrame f = bisectrixFrame(camera.position(), lightDir, sector, rho, lightPos);
+  const SlopeBounds bounds = slopeBounds(f, region);
+  if (isFlat(bounds))
+    return fallbackResult(
+        FallbackReason::EmptyRegion, 0.0, options.maxSpanDegrees,
+        "the lit part of the camera frustum is flat (the frusta only touch): nothing is lit", angles, region,
+        options);
+  std::vector<glm::dvec2> hull = rectify_detail::convexHull(bounds.slopes);
+  angles.epipoleAngle = epipoleAngle(hull) * kDeg;
+
+  if (angles.span >= options.maxSpanDegrees)
+    return fallbackResult(
+        FallbackReason::NonLinearity, angles.span, options.maxSpanDegrees,
+        fmt("angular span of the lit region around the light axis %.6g deg >= threshold %.6g deg: "
+            "rectification too non-linear",
+            angles.span, options.maxSpanDegrees),
+        angles, region, options);
+  if (angles.epipoleAngle < options.minEpipoleAngleDegrees)
+    return fallbackResult(
+        FallbackReason::EpipoleTooClose, angles.epipoleAngle, options.minEpipoleAngleDegrees,
+        fmt("a view ray of the lit region is %.6g deg from the light line < threshold %.6g deg: "
+            "step ratios too large",
+            angles.epipoleAngle, options.minEpipoleAngleDegrees),
+        angles, region, options);
+
+  const double offset = frameBounds(f, bounds);
+  Rectification r = baseResult(region, options);
   r.status = RectifyStatus::Projective;
   r.reason = FallbackReason::None;
-  r.message = fmt("projective: angular span %.6g deg < %.6g deg", r.span, options.maxSpanDegrees) +
-              fmt(", epipole angle %.6g deg >= %.6g deg", r.epipoleAngle, options.minEpipoleAngleDegrees);
+  r.message =
+      fmt("projective: angular span %.6g deg < %.6g deg", angles.span, options.maxSpanDegrees) +
+      fmt(", epipole angle %.6g deg >= %.6g deg", angles.epipoleAngle, options.minEpipoleAngleDegrees);
+  r.measure = angles.span;
+  r.span = angles.span;
+  r.epipoleAngle = angles.epipoleAngle;
+  r.frame = f;
+  r.splits = splitProjections(f, bounds, offset, options);
+  r.slopeHull = std::move(hull);
   return r;
 }
 
+/// Klehm et al. 2014, Sec. 3.2: a spot light or point-light face, over the camera frustum intersected
+/// with the light's frustum, in the perspective space centred at the light.
 Rectification buildPointLike(const Camera& camera, const glm::dvec3& lightPos, const Pyramid& lightFrustum,
                              const RectifyOptions& options) {
   const Pyramid cam = cameraPyramid(camera);
@@ -404,18 +483,10 @@ Rectification buildPointLike(const Camera& camera, const glm::dvec3& lightPos, c
   const glm::dvec3 toCamera = camera.position() - lightPos;
   const double dist = glm::length(toCamera);
   const double scale = std::max({1.0, glm::length(camera.position()), glm::length(lightPos)});
-  if (!region.empty() && !(dist > 1e-12 * scale)) {
-    Rectification r;
-    r.threshold = options.maxSpanDegrees;
-    r.layout = options.layout;
-    r.referenceRay = options.referenceRay;
-    r.regionVertices = region;
-    r.span = r.measure = 180.0;
-    r.status = RectifyStatus::Fallback;
-    r.reason = FallbackReason::ViewRayParallelToLight;
-    r.message = "the camera is at the light position: every view ray is a light ray";
-    return r;
-  }
+  if (!region.empty() && !(dist > 1e-12 * scale))
+    return fallbackResult(FallbackReason::ViewRayParallelToLight, 180.0, options.maxSpanDegrees,
+                          "the camera is at the light position: every view ray is a light ray", {180.0, 0.0},
+                          region, options);
   const glm::dvec3 lightDir = dist > 0.0 ? toCamera / dist : lightFrustum.axis;
   return build(camera, region, lightDir, dist > 0.0 ? 1.0 / dist : 0.0, lightPos, options, true);
 }

@@ -1,5 +1,5 @@
-// The RectifiedMap contract (DESIGN.md "Data flow"): what both rectifications (the projective one of
-// Sec. 4.2 and the epipolar resampling fallback of Sec. 4.1) hand to every consumer (prefilter, min/max
+// The RectifiedMap contract: what both rectifications (the projective one of Klehm et al. 2014,
+// Sec. 4.2, and the epipolar resampling fallback of Sec. 4.1) hand to every consumer (prefilter, min/max
 // trees, ray marches, evaluation), so those are written once.
 //
 // A rectified map is a W x H depth image plus a layout:
