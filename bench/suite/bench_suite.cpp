@@ -1,7 +1,9 @@
 #include "bench_suite.h"
 
 #include "args.h"
-#include "frame.h"
+#include "gl_session.h"
+#include "methods.h"
+#include "scene_frame.h"
 #include "timings.h"
 
 #include <crep/core/error.h>
@@ -93,15 +95,15 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat, in
   PrefilterPass::CreateInfo info;
   info.width = s.mapW;
   info.height = s.mapH;
-  info.bases = bases;
-  info.format = format;
-  info.regionsPerSplit = regionsPerSplit;
-  info.basesPerInvocation = std::min(basesPerInvocation, bases);
+  info.options.bases = bases;
+  info.options.format = format;
+  info.options.regionsPerSplit = regionsPerSplit;
+  info.options.basesPerInvocation = std::min(basesPerInvocation, bases);
   PrefilterPass prefilter(info);
   EvaluatePass::CreateInfo evalInfo;
   evalInfo.bases = bases;
   EvaluatePass evaluate(evalInfo);
-  PrefilterPass::Frame frame;
+  PrefilterPass::FrameAttribs frame;
   frame.rectifiedDepth = s.rectified.get();
   frame.layout = s.layout.get();
   frame.medium = &s.scene.medium;
@@ -112,7 +114,7 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat, in
     prefilter.run(frame);
     glFinish();
   });
-  EvaluatePass::Frame ev;
+  EvaluatePass::FrameAttribs ev;
   ev.cameraDepth = s.cameraDepth.get();
   ev.output = s.scattering.get();
   ev.camera = &s.scene.camera;
@@ -144,7 +146,7 @@ void methodsSideBySide(const BenchOptions& o) {
   tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, setupTimings);
   tool::MethodSettings settings;
   settings.mapSize = o.mapWidth;
-  settings.bases = o.bases;
+  settings.prefilter.bases = o.bases;
   if (o.mapWidth != o.mapHeight || o.mapWidth % settings.rectify.splits != 0) {
     std::printf("\nmethods side by side: skipped (needs a square map whose size is a multiple of %d)\n",
                 settings.rectify.splits);
@@ -214,7 +216,7 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.mapWidth = map.x;
   o.mapHeight = map.y;
   o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
-  if (o.bases % 4 != 0) throw tool::UsageError("option --bases: must be a multiple of 4");
+  if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
   o.repeat = args.integer("repeat", o.repeat, 1, 1000);
   o.quick = args.has("quick");
   return o;
@@ -228,16 +230,16 @@ void runBenchSuite(const BenchOptions& o) {
               o.scene.c_str(), o.screenWidth, o.screenHeight, mapW, mapH, bases, repeat);
   const Setup s = makeSetup(o.scene, o.screenWidth, o.screenHeight, mapW, mapH);
 
-  // Memory copy baselines over the bytes the prefilter writes (W x H x M/4 RGBA8 texels).
-  const std::size_t outBytes = std::size_t(mapW) * mapH * std::size_t(bases); // RGBA8: 1 byte per basis
+  // Memory copy baselines over the bytes the prefilter writes (W x H x ceil(M / 4) RGBA8 texels).
+  const std::size_t outBytes = std::size_t(mapW) * mapH * std::size_t(layerCount(bases)) * 4;
   std::vector<unsigned char> src(outBytes, 1), dst(outBytes);
   const double memcpyMs = medianMs(repeat, [&] { std::memcpy(dst.data(), src.data(), outBytes); });
   gl::Handle a = gl::createTexture(GL_TEXTURE_2D_ARRAY), b = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(a.get(), 1, GL_RGBA8, mapW, mapH, bases / 4);
-  glTextureStorage3D(b.get(), 1, GL_RGBA8, mapW, mapH, bases / 4);
+  glTextureStorage3D(a.get(), 1, GL_RGBA8, mapW, mapH, layerCount(bases));
+  glTextureStorage3D(b.get(), 1, GL_RGBA8, mapW, mapH, layerCount(bases));
   const double gpuCopyMs = medianMs(repeat, [&] {
     glCopyImageSubData(a.get(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, b.get(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
-                       mapW, mapH, bases / 4);
+                       mapW, mapH, layerCount(bases));
     glFinish();
   });
 

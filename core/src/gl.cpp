@@ -3,6 +3,7 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -154,7 +155,9 @@ Handle createTexture2D(std::uint32_t internalFormat, int width, int height, cons
 
 Image readTexture(std::uint32_t texture, int width, int height, TexelData data, int layer) {
   Image image(width, height, data == TexelData::Rgba ? 4 : 1);
-  const GLenum format = data == TexelData::Rgba ? GL_RGBA : data == TexelData::Red ? GL_RED : GL_DEPTH_COMPONENT;
+  const GLenum format = data == TexelData::Rgba  ? GL_RGBA
+                        : data == TexelData::Red ? GL_RED
+                                                 : GL_DEPTH_COMPONENT;
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glGetTextureSubImage(texture, 0, 0, 0, layer, width, height, 1, format, GL_FLOAT,
                        static_cast<GLsizei>(image.data().size_bytes()), image.data().data());
@@ -215,6 +218,72 @@ double GpuTimer::milliseconds() {
   GLuint64 nanoseconds = 0;
   glGetQueryObjectui64v(query_.get(), GL_QUERY_RESULT, &nanoseconds);
   return static_cast<double>(nanoseconds) * 1e-6;
+}
+
+Handle createClampSampler(std::uint32_t filter) {
+  Handle s = createSampler();
+  glSamplerParameteri(s.get(), GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
+  glSamplerParameteri(s.get(), GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
+  glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(s.get(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
+  return s;
+}
+
+Handle createDynamicBuffer(std::size_t bytes) {
+  Handle b = createBuffer();
+  glNamedBufferStorage(b.get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  return b;
+}
+
+std::uint32_t scratchTexture2D(Handle& texture, int& w, int& h, std::uint32_t internalFormat, int width,
+                               int height) {
+  if (!texture || w < width || h < height) {
+    w = std::max(w, width);
+    h = std::max(h, height);
+    texture = createTexture(GL_TEXTURE_2D);
+    glTextureStorage2D(texture.get(), 1, internalFormat, w, h);
+  }
+  return texture.get();
+}
+
+void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
+                      std::uint32_t format) {
+  if (width <= 0 || height <= 0)
+    throw InvalidArgument(parameter, std::to_string(width) + " x " + std::to_string(height),
+                          "size must be > 0");
+  if (texture == 0 || !glIsTexture(texture))
+    throw InvalidArgument(parameter, std::to_string(texture), "must be the name of an existing texture");
+  GLint w = 0, h = 0, f = 0;
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_WIDTH, &w);
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_HEIGHT, &h);
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &f);
+  if (w != width || h != height)
+    throw InvalidArgument(parameter, "texture of " + std::to_string(w) + " x " + std::to_string(h),
+                          "must be " + std::to_string(width) + " x " + std::to_string(height));
+  if (format != 0 && static_cast<GLenum>(f) != format)
+    throw InvalidArgument(parameter, "internal format " + hex(static_cast<std::uint32_t>(f)),
+                          "must be " + hex(format) +
+                              (format == GL_RGBA32F ? " (GL_RGBA32F)"
+                               : format == GL_R32F  ? " (GL_R32F)"
+                                                    : ""));
+}
+
+void unbindPassState(int units) {
+  glUseProgram(0);
+  for (GLuint unit = 0; unit < static_cast<GLuint>(units); ++unit) {
+    glBindTextureUnit(unit, 0);
+    glBindSampler(unit, 0);
+    glBindImageTexture(unit, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+    glBindBufferBase(GL_UNIFORM_BUFFER, unit, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, unit, 0);
+  }
+}
+
+void passOutputBarrier() {
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                  GL_TEXTURE_UPDATE_BARRIER_BIT | GL_PIXEL_BUFFER_BARRIER_BIT |
+                  GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
 } // namespace crep::gl

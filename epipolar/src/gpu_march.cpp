@@ -20,24 +20,6 @@ namespace crep {
 
 namespace gpu {
 
-MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
-                            int width, int height, int mapWidth, int mapHeight) {
-  MarchParams p;
-  const double ty = std::tan(0.5 * camera.fovY()), tx = ty * camera.aspect();
-  p.cameraPosition = glm::vec4(glm::vec3(camera.position()), static_cast<float>(camera.near()));
-  p.cameraForward = glm::vec4(glm::vec3(camera.forward()), static_cast<float>(camera.far()));
-  p.cameraRight = glm::vec4(glm::vec3(camera.right() * tx), 0.0f);
-  p.cameraUp = glm::vec4(glm::vec3(camera.up() * ty), 0.0f);
-  p.lightDirection = glm::vec4(glm::vec3(light.direction()), 0.0f);
-  p.lightIrradiance = glm::vec4(glm::vec3(light.irradiance()), 0.0f);
-  p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));
-  p.rayleighScattering = glm::vec4(glm::vec3(medium.rayleighScattering()), 0.0f);
-  const glm::dvec3 sigma = medium.extinction();
-  p.extinction = glm::vec4(glm::vec3(sigma), static_cast<float>((sigma.x + sigma.y + sigma.z) / 3.0));
-  p.sizes = glm::ivec4(width, height, mapWidth, mapHeight);
-  return p;
-}
-
 ProjectiveLayoutParams makeProjectiveLayoutParams(const ProjectiveLayout& layout) {
   const Rectification& r = layout.rectification();
   const int K = r.splitCount();
@@ -83,13 +65,12 @@ MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
   buffer_ = gl::createBuffer();
   const long long bytes = static_cast<long long>(std::max(rowStride_, 1)) * info.mapHeight * 8;
   glNamedBufferStorage(buffer_.get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  sampler_ = epipolar_detail::createNearestSampler();
+  sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("MinMaxTreePass");
 }
 
 void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
-  epipolar_detail::requireTexture("MinMaxTreePass.rectifiedDepth", rectifiedDepth, info_.mapWidth,
-                                  info_.mapHeight);
+  gl::requireTexture2D("MinMaxTreePass.rectifiedDepth", rectifiedDepth, info_.mapWidth, info_.mapHeight);
   const GLuint p = program_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
@@ -123,14 +104,13 @@ RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
   if (MinMaxTrees::levelCount(info.mapWidth) > 16)
     throw GlError("crep: RectifiedMarchPass.mapSize width " + std::to_string(info.mapWidth) +
                   " needs more than 16 tree levels");
-  params_ = epipolar_detail::createUniformBuffer(sizeof(gpu::MarchParams));
-  layoutBlock_ = epipolar_detail::createUniformBuffer(epipolar_detail::kLayoutBlockSize);
-  sampler_ = epipolar_detail::createNearestSampler();
+  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
+  layoutBlock_ = gl::createDynamicBuffer(epipolar_detail::kLayoutBlockSize);
+  sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("RectifiedMarchPass");
 }
 
 void RectifiedMarchPass::run(const FrameAttribs& f) {
-  using epipolar_detail::requireTexture;
   if (!f.layout) throw InvalidArgument("RectifiedMarchPass.FrameAttribs.layout", "null", "must be set");
   if (!f.camera || !f.light || !f.medium)
     throw InvalidArgument("RectifiedMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
@@ -143,12 +123,12 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
     throw InvalidArgument("RectifiedMarchPass.mapSize", "height " + std::to_string(H),
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
-  requireTexture("RectifiedMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
-  requireTexture("RectifiedMarchPass.FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-  requireTexture("RectifiedMarchPass.FrameAttribs.scatteringOut", f.scatteringOut, f.width, f.height,
-                 GL_RGBA32F);
+  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
+  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
+  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.scatteringOut", f.scatteringOut, f.width, f.height,
+                       GL_RGBA32F);
   if (f.stepsOut != 0)
-    requireTexture("RectifiedMarchPass.FrameAttribs.stepsOut", f.stepsOut, f.width, f.height, GL_R32F);
+    gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.stepsOut", f.stepsOut, f.width, f.height, GL_R32F);
   const bool tree = info_.mode == Mode::MinMaxTree;
   if (tree && (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer)))
     throw InvalidArgument("RectifiedMarchPass.FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
@@ -175,9 +155,9 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
   epipolar_detail::uploadLayout(*f.layout, kind, H, layoutBlock_, slices_);
 
-  const GLuint steps =
-      f.stepsOut != 0 ? f.stepsOut
-                      : epipolar_detail::dummyR32F(dummySteps_, dummyWidth_, dummyHeight_, f.width, f.height);
+  const GLuint steps = f.stepsOut != 0 ? f.stepsOut
+                                       : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
+                                                              f.width, f.height);
   glUseProgram(program.get());
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
   glBindBufferBase(GL_UNIFORM_BUFFER, 1, layoutBlock_.get());
@@ -190,80 +170,9 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   glBindImageTexture(0, f.scatteringOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glDispatchCompute(static_cast<GLuint>((f.width + 7) / 8), static_cast<GLuint>((f.height + 7) / 8), 1);
-  epipolar_detail::outputBarrier();
-  epipolar_detail::unbindAll();
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
   gl::checkError("RectifiedMarchPass::run");
-}
-
-// ---------------------------------------------------------------------------------------------------
-// WorldMarchPass
-
-WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
-  WorldMarchOptions o;
-  o.steps = info.steps;
-  o.refinements = info.refinements;
-  validate(o);
-  program_ = buildProgram({{ShaderStage::Compute, "passes/march_reference.comp", {}}});
-  params_ = epipolar_detail::createUniformBuffer(sizeof(gpu::MarchParams));
-  sampler_ = epipolar_detail::createNearestSampler();
-  gl::checkError("WorldMarchPass");
-}
-
-void WorldMarchPass::run(const FrameAttribs& f) {
-  using epipolar_detail::requireTexture;
-  if (!f.camera || !f.light || !f.medium)
-    throw InvalidArgument("WorldMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
-  requireTexture("WorldMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
-  requireTexture("WorldMarchPass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth, f.shadowHeight);
-  requireTexture("WorldMarchPass.FrameAttribs.scatteringOut", f.scatteringOut, f.width, f.height, GL_RGBA32F);
-  if (f.stepsOut != 0)
-    requireTexture("WorldMarchPass.FrameAttribs.stepsOut", f.stepsOut, f.width, f.height, GL_R32F);
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(f.lightClipFromWorld[c][r]))
-        throw InvalidArgument("WorldMarchPass.FrameAttribs.lightClipFromWorld",
-                              detail::formatValue(f.lightClipFromWorld[c][r]), "must be finite");
-  if (!std::isfinite(f.bias))
-    throw InvalidArgument("WorldMarchPass.FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
-  if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
-    throw InvalidArgument("WorldMarchPass.FrameAttribs.blockCenter/blockRadius",
-                          detail::formatValue(f.blockRadius), "must be finite");
-
-  gpu::MarchParams params =
-      gpu::makeMarchParams(*f.camera, *f.light, *f.medium, f.width, f.height, f.shadowWidth, f.shadowHeight);
-  params.info = glm::ivec4(info_.steps, info_.refinements, 0, 0);
-  params.bias = glm::vec4(static_cast<float>(f.bias), 0.0f, 0.0f, 0.0f);
-  params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
-  // The dispatch: the whole image, or the block's bounding box clipped to it.
-  glm::ivec4 region(0, 0, f.width, f.height);
-  if (f.blockRadius >= 0.0) {
-    const auto lo = glm::max(glm::floor(f.blockCenter - f.blockRadius - 1.0), glm::dvec2(0.0));
-    const auto hi = glm::min(glm::ceil(f.blockCenter + f.blockRadius + 1.0), glm::dvec2(f.width, f.height));
-    region =
-        glm::ivec4(static_cast<int>(lo.x), static_cast<int>(lo.y), std::max(0, static_cast<int>(hi.x - lo.x)),
-                   std::max(0, static_cast<int>(hi.y - lo.y)));
-    params.block = glm::vec4(static_cast<float>(f.blockCenter.x), static_cast<float>(f.blockCenter.y),
-                             static_cast<float>(f.blockRadius), 0.0f);
-  }
-  params.region = region;
-  if (region.z == 0 || region.w == 0) return; // the block misses the image
-  glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-
-  const GLuint steps =
-      f.stepsOut != 0 ? f.stepsOut
-                      : epipolar_detail::dummyR32F(dummySteps_, dummyWidth_, dummyHeight_, f.width, f.height);
-  glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindTextureUnit(1, f.shadowMap);
-  glBindSampler(0, sampler_.get());
-  glBindSampler(1, sampler_.get());
-  glBindImageTexture(0, f.scatteringOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(static_cast<GLuint>((region.z + 7) / 8), static_cast<GLuint>((region.w + 7) / 8), 1);
-  epipolar_detail::outputBarrier();
-  epipolar_detail::unbindAll();
-  gl::checkError("WorldMarchPass::run");
 }
 
 } // namespace crep

@@ -25,14 +25,19 @@ void validateLightMatrix(const glm::dmat4& M, const glm::dvec3& lightDirection) 
   if (M[0][3] != 0.0 || M[1][3] != 0.0 || M[2][3] != 0.0 || M[3][3] == 0.0)
     throw InvalidArgument("lightClipFromWorld", "a perspective matrix",
                           "must be affine (an orthographic shadow matrix: last row 0 0 0 w)");
+  if (std::abs(glm::determinant(M)) < 1e-300)
+    throw InvalidArgument("lightClipFromWorld", "a singular matrix", "must be invertible");
+  // The light direction must map to a pure depth increase: every light ray is one texel, and the depth
+  // buffer keeps the occluder nearest to the light. The tolerance admits matrices stored in float (an
+  // engine's): 1e-3 of the matrix scale moves a point 1e-3 texel-space units per unit of depth at most.
   const glm::dvec4 d = M * glm::dvec4(lightDirection, 0.0);
   const double scale =
       std::max({glm::length(glm::dvec3(M[0])), glm::length(glm::dvec3(M[1])), glm::length(glm::dvec3(M[2]))});
-  if (!(std::abs(d.x) <= 1e-9 * scale && std::abs(d.y) <= 1e-9 * scale) || !(std::abs(d.z) > 0.0))
+  if (!(std::hypot(d.x, d.y) <= 1e-3 * scale) || !(d.z > 0.0))
     throw InvalidArgument("lightClipFromWorld",
-                          "light direction maps to (" + detail::formatValue(d.x) + ", " +
-                              detail::formatValue(d.y) + ")",
-                          "must look along the light direction (x and y constant along a light ray)");
+                          "light direction maps to clip (" + detail::formatValue(d.x) + ", " +
+                              detail::formatValue(d.y) + ", " + detail::formatValue(d.z) + ")",
+                          "must look along the light direction: (0, 0, > 0) expected");
 }
 
 // Sec. 4.1: point resampling over the texels of the rectified map, blockers clamped to the slice's range.
@@ -94,14 +99,13 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
 
 ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("ShadowResamplePass.mapSize", info.mapWidth, info.mapHeight);
-  params_ = epipolar_detail::createUniformBuffer(sizeof(gpu::MarchParams));
-  layoutBlock_ = epipolar_detail::createUniformBuffer(epipolar_detail::kLayoutBlockSize);
-  sampler_ = epipolar_detail::createNearestSampler();
+  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
+  layoutBlock_ = gl::createDynamicBuffer(epipolar_detail::kLayoutBlockSize);
+  sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("ShadowResamplePass");
 }
 
 void ShadowResamplePass::run(const FrameAttribs& f) {
-  using epipolar_detail::requireTexture;
   if (!f.layout) throw InvalidArgument("ShadowResamplePass.FrameAttribs.layout", "null", "must be set");
   const gpu::LayoutKind kind = gpu::layoutKind(*f.layout);
   const int W = info_.mapWidth, H = info_.mapHeight;
@@ -112,8 +116,9 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
     throw InvalidArgument("ShadowResamplePass.mapSize", "height " + std::to_string(H),
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
-  requireTexture("ShadowResamplePass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth, f.shadowHeight);
-  requireTexture("ShadowResamplePass.FrameAttribs.rectifiedOut", f.rectifiedOut, W, H, GL_R32F);
+  gl::requireTexture2D("ShadowResamplePass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth,
+                       f.shadowHeight);
+  gl::requireTexture2D("ShadowResamplePass.FrameAttribs.rectifiedOut", f.rectifiedOut, W, H, GL_R32F);
   validateLightMatrix(f.lightClipFromWorld, f.layout->lightRay(0.5, 0.5).direction);
 
   gl::Handle& program = programs_[static_cast<int>(kind)];
@@ -138,8 +143,8 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   glBindSampler(0, sampler_.get());
   glBindImageTexture(0, f.rectifiedOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
-  epipolar_detail::outputBarrier();
-  epipolar_detail::unbindAll();
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
   gl::checkError("ShadowResamplePass::run");
 }
 

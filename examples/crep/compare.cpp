@@ -5,8 +5,10 @@
 #include "args.h"
 #include "commands.h"
 #include "contact_sheet.h"
-#include "frame.h"
+#include "gl_session.h"
+#include "methods.h"
 #include "options.h"
+#include "scene_frame.h"
 #include "timings.h"
 
 #include <crep/core/error.h>
@@ -186,7 +188,7 @@ int compareCommand(const std::vector<std::string>& argv) {
   }
   const std::string header = "crep compare: scene " + sceneName + ", " + std::to_string(size.x) + "x" +
                              std::to_string(size.y) + ", map " + std::to_string(settings.mapSize) +
-                             "^2, M = " + std::to_string(settings.bases) +
+                             "^2, M = " + std::to_string(settings.prefilter.bases) +
                              ", reference = world-space march, " + std::to_string(settings.steps) +
                              " steps; GL renderer: " + glRenderer();
   const Image sheet = composeSheet(header, columns, tileWidth, exposure, amplify);

@@ -1,7 +1,7 @@
 // crep: the command-line tool of crepuscular. See `crep help`.
 #include "args.h"
 #include "commands.h"
-#include "frame.h"
+#include "methods.h"
 #include "options.h"
 
 #include <crep/core/error.h>

@@ -5,9 +5,11 @@
 // DIR/shadow.exr (float depth-buffer values) and DIR/frame.json.
 #include "args.h"
 #include "commands.h"
-#include "frame.h"
 #include "frame_json.h"
+#include "gl_session.h"
+#include "methods.h"
 #include "options.h"
+#include "scene_frame.h"
 #include "timings.h"
 
 #include <crep/core/error.h>

@@ -9,11 +9,13 @@
 // layout) and runs the GPU prefilter and evaluation passes on it.
 #include "args.h"
 #include "commands.h"
-#include "frame.h"
+#include "gl_session.h"
+#include "methods.h"
+
 #include "frame_json.h"
 #include "options.h"
-#include "resample.h"
 #include "timings.h"
+#include <crep/epipolar/resample.h>
 
 #include <crep/core/error.h>
 #include <crep/core/exr.h>
@@ -82,7 +84,14 @@ int scatterCommand(const std::vector<std::string>& argv) {
   const Camera camera = cameraOf(desc, framePath);
   const DirectionalLight light = lightOf(desc, framePath);
   const Medium medium = mediumOf(desc, framePath);
-  checkLightMatrix(desc.lightClipFromWorld, light.direction(), framePath + ": shadowMap.lightClipFromWorld");
+  try {
+    validateLightMatrix(desc.lightClipFromWorld, light.direction());
+  } catch (const InvalidArgument& e) {
+    std::string what = e.what(); // "crep: invalid lightClipFromWorld = <value> (<requirement>)"
+    const std::string prefix = "crep: invalid lightClipFromWorld = ";
+    if (what.starts_with(prefix)) what = what.substr(prefix.size());
+    throw FormatError(framePath + ": shadowMap.lightClipFromWorld: " + what);
+  }
   const Image depth =
       timings.time("read depth exr", [&] { return readDepthExr("--depth", depthPath, "camera depth"); });
   const Image shadow =

@@ -20,7 +20,7 @@
 #ifndef CREP_EPIPOLAR_GLSL
 #define CREP_EPIPOLAR_GLSL
 
-#include "common.glsl"
+#include "march.glsl"
 
 #define CREP_LAYOUT_PROJECTIVE 0
 #define CREP_LAYOUT_EPIPOLAR 1
@@ -38,7 +38,7 @@
 #define CREP_MAX_LAYOUT_REGIONS 64
 #define CREP_NEVER 3.0e38
 
-// A view ray mapped onto its row of a rectified map (crep/epipolar/march.h "Rectified marches").
+// A view ray mapped onto its row of a rectified map (crep/scatter/rectified_march.h).
 struct CrepRowRay {
   float row;    // normalized row of the ray
   float depth;  // z_r, clamped to [0, 1]
@@ -52,45 +52,6 @@ struct CrepLightRay {
   vec3 origin;
   vec3 direction;
 };
-
-// gpu::MarchParams (std140): the frame attributes of the march and resampling passes.
-struct CrepMarchParams {
-  vec4 cameraPosition;     // xyz world; w near
-  vec4 cameraForward;      // xyz unit view direction; w far
-  vec4 cameraRight;        // xyz right * tan(fovY / 2) * aspect; w 0
-  vec4 cameraUp;           // xyz up * tan(fovY / 2); w 0
-  vec4 lightDirection;     // xyz direction the light travels; w 0
-  vec4 lightIrradiance;    // rgb; w 0
-  vec4 mieScattering;      // rgb; w Henyey-Greenstein g
-  vec4 rayleighScattering; // rgb; w 0
-  vec4 extinction;         // rgb sigma_t; w grey extinction (mean of rgb)
-  ivec4 sizes;             // march: xy camera image, zw map; world march: zw shadow map; resampling: xy shadow map, zw map
-  ivec4 info;              // march: x tree levels L, y tree row stride; world march: x steps N, y refinements
-  vec4 bias;               // world march: x shadow bias (depth-buffer units); yzw 0
-  vec4 block;              // world march: xy centre (pixels), z radius (pixels, < 0: every pixel), w 0
-  ivec4 region;            // world march: xy first pixel of the dispatch, zw its size
-  mat4 lightClipFromWorld; // world march / resampling: the standard shadow map's matrix
-};
-
-// The view ray of pixel p of a w x h camera image and its surface distance (crep/epipolar/march.h: sky
-// pixels end at the far plane). xyz = unit direction, w = distance.
-vec4 crep_pixelRay(CrepMarchParams m, ivec2 p, float depth) {
-  vec2 ndc = 2.0 * (vec2(p) + 0.5) / vec2(m.sizes.xy) - 1.0;
-  vec3 dir = normalize(m.cameraForward.xyz + ndc.x * m.cameraRight.xyz + ndc.y * m.cameraUp.xyz);
-  float viewDepth = depth >= 1.0 || !(depth >= 0.0) ? m.cameraForward.w
-                                                    : crep_linearDepth(depth, m.cameraPosition.w, m.cameraForward.w);
-  return vec4(dir, viewDepth / dot(dir, m.cameraForward.xyz));
-}
-
-// (exp(-sigma ta) - exp(-sigma tb)) / sigma per channel, tb - ta as sigma -> 0 (seed 003 Eq. 3).
-vec3 crep_sectionIntegral(vec3 sigma, float ta, float tb) {
-  float len = max(tb - ta, 0.0);
-  vec3 x = sigma * len;
-  // Series below 0.1 (truncation < 2e-8), where exp(-x) - 1 would cancel in float.
-  vec3 series = 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0))));
-  vec3 phi = mix(-(exp(-x) - 1.0) / max(x, vec3(1e-30)), series, lessThan(x, vec3(0.1)));
-  return exp(-sigma * ta) * len * phi;
-}
 
 // The texel e of a ray ending in region k at column u in [0, 1] of it (n texels per region).
 int crep_lastTexel(int k, float u, int K, int n) {

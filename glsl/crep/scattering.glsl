@@ -39,6 +39,7 @@
 
 #include "common.glsl"
 #include "phase.glsl"
+#include "ray.glsl"
 #include "scattering_structs.glsl"
 
 #ifndef CREP_NEAR_PLANE_CORRECTION
@@ -131,29 +132,11 @@ float crep_lanczosFactor(int h, int bases) {
 // ---------------------------------------------------------------------------------------------------
 // Weights (crep/prefilter/weights.h; Eq. 11 and its variants). s is the scalar weight extinction.
 
-// phi(x) = (1 - exp(-x)) / x for x >= 0, phi(0) = 1, +inf -> 0 (crep::oneMinusExpOverX): the series
-// below 1/4 (truncation < 2e-9) keeps the sigma -> 0 limit exact and free of cancellation.
-float crep_oneMinusExpOverX(float x) {
-  if (x < 0.25)
-    return 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0 - x * (1.0 / 720.0 - x / 5040.0)))));
-  return (1.0 - exp(-x)) / x;
-}
-
 // exp(x) - 1 without cancellation near 0 (series below 1/4, truncation < 1e-8 relative).
 float crep_expm1(float x) {
   if (abs(x) < 0.25)
     return x * (1.0 + x * (1.0 / 2.0 + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0 + x / 720.0)))));
   return exp(x) - 1.0;
-}
-
-// Transmittance integral of one segment divided by sigma: (exp(-sigma ta) - exp(-sigma tb)) / sigma,
-// = tb - ta for sigma -> 0 (Eq. 3 per segment), per channel.
-vec3 crep_transmittanceIntegral(vec3 sigma, float ta, float tb) {
-  float len = tb - ta;
-  if (!(len > 0.0)) return vec3(0.0);
-  vec3 x = sigma * len;
-  return exp(-sigma * ta) * len *
-         vec3(crep_oneMinusExpOverX(x.r), crep_oneMinusExpOverX(x.g), crep_oneMinusExpOverX(x.b));
 }
 
 // The weight mode's distance tau from the region's start at fractional texel position x = u n (see

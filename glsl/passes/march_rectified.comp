@@ -42,7 +42,7 @@ void main() {
   int steps = 0;
   CrepRowRay r;
   if (!crep_mapRowRay(dir, s, mapSize, r)) {
-    L = crep_sectionIntegral(sigma, 0.0, s);
+    L = crep_transmittanceIntegral(sigma, 0.0, s);
   } else {
     int j = r.texelRow, end = r.last + 1;
     float z = r.depth;
@@ -78,7 +78,7 @@ void main() {
       int next = min(i + (1 << level), end);
       float tb = next > r.last ? s : min(crep_rowRayDistance(r, next, mapSize), s);
       tb = max(tb, ta);
-      if (lit) L += crep_sectionIntegral(sigma, ta, tb);
+      if (lit) L += crep_transmittanceIntegral(sigma, ta, tb);
       ta = tb;
       i = next;
     }
@@ -88,7 +88,7 @@ void main() {
       ++steps;
       float tb = i + 1 > r.last ? s : min(crep_rowRayDistance(r, i + 1, mapSize), s);
       tb = max(tb, ta);
-      if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z) L += crep_sectionIntegral(sigma, ta, tb);
+      if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z) L += crep_transmittanceIntegral(sigma, ta, tb);
       ta = tb;
     }
 #endif

@@ -1,14 +1,14 @@
 #version 450 core
-// World-space reference march against a standard shadow map (crep/epipolar/march.h "World-space
-// reference march"; seed 003 Eq. 1 and 3, seed 000 Eq. 15-16): N equal sections from the camera to the
+// World-space reference march against a standard shadow map (crep/scatter/world_march.h; Klehm et al.
+// 2014, Eq. 1 and 3, Yusov 2012, Eq. 15-16): N equal sections from the camera to the
 // surface, visibility at their ends, bisection of every section whose ends differ, exact transmittance
 // integral of every lit part. Same rules as crep::worldSpaceMarch; float precision.
 //
 // The dispatch covers the pixel rectangle crep_march.region (origin xy, size zw); with block.z >= 0 only
-// the pixels within block.z pixels of block.xy (pixel centres) are written: the epipole block of seed 003
-// Fig. 8. Resources: params block (binding 0), camera depth (unit 0), shadow map (unit 1, texelFetch),
+// the pixels within block.z pixels of block.xy (pixel centres) are written: the epipole block of Klehm
+// et al. 2014, Fig. 8. Resources: params block (binding 0), camera depth (unit 0), shadow map (unit 1, texelFetch),
 // outputs: RGBA32F scattering (image 0), R32F steps (image 1).
-#include "crep/epipolar.glsl"
+#include "crep/march.glsl"
 #include "crep/phase.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -55,7 +55,7 @@ void main() {
     float tb = k == N ? s : s * float(k) / float(N);
     bool vb = crep_lit(origin + tb * dir);
     if (va == vb) {
-      if (va) L += crep_sectionIntegral(sigma, ta, tb);
+      if (va) L += crep_transmittanceIntegral(sigma, ta, tb);
     } else {
       float lo = ta, hi = tb;
       for (int r = 0; r < refinements; ++r) {
@@ -66,8 +66,8 @@ void main() {
           hi = mid;
       }
       float change = 0.5 * (lo + hi);
-      if (va) L += crep_sectionIntegral(sigma, ta, change);
-      if (vb) L += crep_sectionIntegral(sigma, change, tb);
+      if (va) L += crep_transmittanceIntegral(sigma, ta, change);
+      if (vb) L += crep_transmittanceIntegral(sigma, change, tb);
     }
     ta = tb;
     va = vb;

@@ -62,9 +62,9 @@ void basis(T z, std::span<T> b) {
 
 } // namespace
 
-void validateBases(int bases) {
+void validateBases(int bases, std::string_view parameter) {
   if (bases < kMinBases || bases > kMaxBases || bases % 2 != 0)
-    throw InvalidArgument("bases", detail::formatValue(bases),
+    throw InvalidArgument(std::string(parameter), detail::formatValue(bases),
                           "must be even and in [" + std::to_string(kMinBases) + ", " +
                               std::to_string(kMaxBases) + "]");
 }

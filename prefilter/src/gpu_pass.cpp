@@ -58,7 +58,7 @@ int ceilDiv(int a, int b) {
 
 /// Invocations per row and region: groups of basesPerInvocation / 4 layers (the last may be partial).
 int baseGroups(const PrefilterPass::CreateInfo& info) {
-  return ceilDiv(layerCount(info.bases), info.basesPerInvocation / 4);
+  return ceilDiv(layerCount(info.options.bases), info.options.basesPerInvocation / 4);
 }
 
 void requireAtLeast(const char* parameter, int value, int minimum) {
@@ -84,12 +84,6 @@ void checkWorkgroup(const char* const names[3], const int local[3], const int gr
   if (invocations > maxInvocations)
     throw GlError(std::string(names[0]) + " x " + names[1] + " x " + names[2] + " = " + str(invocations) +
                   " exceeds GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS = " + str(maxInvocations));
-}
-
-void validateBasesField(const char* parameter, int bases) {
-  if (bases < kMinBases || bases > kMaxBases || bases % 2 != 0)
-    invalid(parameter, detail::formatValue(bases),
-            "must be even and in [" + str(kMinBases) + ", " + str(kMaxBases) + "]");
 }
 
 GLenum internalFormat(StorageFormat format) {
@@ -128,22 +122,6 @@ TextureInfo textureInfo(const char* parameter, std::uint32_t name) {
 
 std::string sizeString(int w, int h) {
   return str(w) + " x " + str(h);
-}
-
-gl::Handle createUniformBuffer(std::size_t bytes) {
-  gl::Handle buffer = gl::createBuffer();
-  glNamedBufferStorage(buffer.get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  return buffer;
-}
-
-gl::Handle createSampler(GLenum filter) {
-  gl::Handle sampler = gl::createSampler();
-  glSamplerParameteri(sampler.get(), GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
-  glSamplerParameteri(sampler.get(), GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
-  glSamplerParameteri(sampler.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glSamplerParameteri(sampler.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glSamplerParameteri(sampler.get(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
-  return sampler;
 }
 
 glm::vec4 vec4Of(const glm::dvec3& v, double w = 0.0) {
@@ -220,7 +198,7 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
     invalid("layout", "regionCount() " + str(K),
             "must equal FilteredBasisView.layoutRegions = " + str(basis.layoutRegions));
   if (K > gpu::kMaxSplits) invalid("layout", "regionCount() " + str(K), "must be <= " + str(gpu::kMaxSplits));
-  validateBasesField("FilteredBasisView.bases", basis.bases);
+  validateBases(basis.bases, "FilteredBasisView.bases");
   if (basis.width <= 0 || basis.height <= 0 || basis.regionsPerSplit < 1 ||
       basis.width % basis.regions() != 0)
     invalid("FilteredBasisView",
@@ -255,34 +233,14 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 // ---------------------------------------------------------------------------------------------------
 // PrefilterPass
 
-PrefilterOptions PrefilterPass::CreateInfo::prefilterOptions() const {
-  PrefilterOptions o;
-  o.bases = bases;
-  o.weights = weights;
-  o.format = format;
-  o.regionsPerSplit = regionsPerSplit;
-  o.depthMargin = depthMargin;
-  o.basesPerInvocation = basesPerInvocation;
-  return o;
-}
-
 PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.width", info.width, 1);
   requireAtLeast("PrefilterPass::CreateInfo.height", info.height, 1);
-  validateBasesField("PrefilterPass::CreateInfo.bases", info.bases);
-  if (info.basesPerInvocation < 4 || info.basesPerInvocation > kMaxBases || info.basesPerInvocation % 4 != 0)
-    invalid("PrefilterPass::CreateInfo.basesPerInvocation", detail::formatValue(info.basesPerInvocation),
-            "must be a multiple of 4 in [4, " + str(kMaxBases) + "]");
-  if (info.regionsPerSplit < 1 || info.regionsPerSplit > info.width)
-    invalid("PrefilterPass::CreateInfo.regionsPerSplit", detail::formatValue(info.regionsPerSplit),
+  const PrefilterOptions& o = info.options;
+  validate(o, "PrefilterPass::CreateInfo.options");
+  if (o.regionsPerSplit > info.width)
+    invalid("PrefilterPass::CreateInfo.options.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
             "must be in [1, width = " + str(info.width) + "]");
-  if (!(info.depthMargin >= 0.0 && info.depthMargin <= 0.25))
-    invalid("PrefilterPass::CreateInfo.depthMargin", detail::formatValue(info.depthMargin),
-            "must be in [0, 0.25]");
-  if (info.format != StorageFormat::RGBA8 && info.format != StorageFormat::RGBA16F &&
-      info.format != StorageFormat::RGBA32F)
-    invalid("PrefilterPass::CreateInfo.format", str(static_cast<int>(info.format)),
-            "must be RGBA8, RGBA16F or RGBA32F");
   requireAtLeast("PrefilterPass::CreateInfo.workgroupRows", info.workgroupRows, 1);
   requireAtLeast("PrefilterPass::CreateInfo.workgroupBaseGroups", info.workgroupBaseGroups, 1);
   requireAtLeast("PrefilterPass::CreateInfo.workgroupRegions", info.workgroupRegions, 1);
@@ -296,7 +254,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
                   " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
   const int maxLayers = gl::maxArrayTextureLayers();
   if (layers() > maxLayers)
-    throw GlError("PrefilterPass::CreateInfo.bases = " + str(info.bases) + " needs " + str(layers()) +
+    throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(o.bases) + " needs " + str(layers()) +
                   " layers, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
   {
     const char* names[3] = {"PrefilterPass::CreateInfo.workgroupRows",
@@ -313,18 +271,17 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   const std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/prefilter.comp",
-       {{"CREP_BASES", str(info.bases)},
-        {"CREP_BASES_PER_INVOCATION", str(info.basesPerInvocation)},
-        {"CREP_BASIS_FORMAT", imageFormatQualifier(info.format)},
-        {"CREP_BASIS_UNORM8", info.format == StorageFormat::RGBA8 ? "1" : "0"},
-        {"CREP_BASIS_HALF", info.format == StorageFormat::RGBA16F ? "1" : "0"},
+       {{"CREP_BASES_PER_INVOCATION", str(o.basesPerInvocation)},
+        {"CREP_BASIS_FORMAT", imageFormatQualifier(o.format)},
+        {"CREP_BASIS_UNORM8", o.format == StorageFormat::RGBA8 ? "1" : "0"},
+        {"CREP_BASIS_HALF", o.format == StorageFormat::RGBA16F ? "1" : "0"},
         {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
         {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
         {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)}}}};
   program_ = buildProgram(stages);
 
   texture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(texture_.get(), 1, internalFormat(info.format), info.width, info.height, layers());
+  glTextureStorage3D(texture_.get(), 1, internalFormat(o.format), info.width, info.height, layers());
   glTextureParameteri(texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTextureParameteri(texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -332,8 +289,8 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   gl::checkError(
       "PrefilterPass: filtered-basis texture array (PrefilterPass::CreateInfo width x height x bases)");
 
-  sampler_ = createSampler(GL_NEAREST);
-  paramsBuffer_ = createUniformBuffer(sizeof(gpu::PrefilterParams));
+  sampler_ = gl::createClampSampler(GL_NEAREST);
+  paramsBuffer_ = gl::createDynamicBuffer(sizeof(gpu::PrefilterParams));
   gl::checkError("PrefilterPass: buffers");
 }
 
@@ -341,35 +298,35 @@ PrefilterPass::~PrefilterPass() = default;
 PrefilterPass::PrefilterPass(PrefilterPass&&) noexcept = default;
 PrefilterPass& PrefilterPass::operator=(PrefilterPass&&) noexcept = default;
 
-void PrefilterPass::run(const Frame& frame) {
+void PrefilterPass::run(const FrameAttribs& frame) {
   if (frame.layout == nullptr)
-    invalid("PrefilterPass::Frame.layout", "null", "must point to the map's layout");
-  const TextureInfo depth = textureInfo("PrefilterPass::Frame.rectifiedDepth", frame.rectifiedDepth);
+    invalid("PrefilterPass::FrameAttribs.layout", "null", "must point to the map's layout");
+  const TextureInfo depth = textureInfo("PrefilterPass::FrameAttribs.rectifiedDepth", frame.rectifiedDepth);
   if (depth.target != GL_TEXTURE_2D)
-    invalid("PrefilterPass::Frame.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
+    invalid("PrefilterPass::FrameAttribs.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
             "must be a GL_TEXTURE_2D");
   if (depth.width != info_.width || depth.height != info_.height)
-    invalid("PrefilterPass::Frame.rectifiedDepth", sizeString(depth.width, depth.height),
+    invalid("PrefilterPass::FrameAttribs.rectifiedDepth", sizeString(depth.width, depth.height),
             "must be the created size " + sizeString(info_.width, info_.height));
   double s = frame.extinctionOverride;
   if (s < 0.0) {
     if (frame.medium == nullptr)
-      invalid("PrefilterPass::Frame.medium", "null", "must be set unless extinctionOverride >= 0");
+      invalid("PrefilterPass::FrameAttribs.medium", "null", "must be set unless extinctionOverride >= 0");
     s = weightExtinction(*frame.medium);
   }
   if (!std::isfinite(s))
-    invalid("PrefilterPass::Frame.extinctionOverride", detail::formatValue(s), "must be finite");
+    invalid("PrefilterPass::FrameAttribs.extinctionOverride", detail::formatValue(s), "must be finite");
 
-  const int K = frame.layout->regionCount(), P = info_.regionsPerSplit, R = K * P;
+  const int K = frame.layout->regionCount(), P = info_.options.regionsPerSplit, R = K * P;
   const int W = info_.width, H = info_.height;
   if (K < 1 || W % R != 0)
-    invalid("PrefilterPass::Frame.layout", "regionCount() " + str(K),
+    invalid("PrefilterPass::FrameAttribs.layout", "regionCount() " + str(K),
             "regionCount() x regionsPerSplit (" + str(K) + " x " + str(P) + ") must divide the map width " +
                 str(W));
   const int n = W / R;
 
   const std::vector<gpu::RegionWeights> weights =
-      gpuRegionWeights(referenceProfiles(*frame.layout, H, P), info_.weights, n);
+      gpuRegionWeights(referenceProfiles(*frame.layout, H, P), info_.options.weights, n);
   const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
   if (bytes > weightsCapacity_) {
     weightsBuffer_ = gl::createBuffer();
@@ -381,14 +338,16 @@ void PrefilterPass::run(const Frame& frame) {
 
   gpu::PrefilterParams params;
   params.mapSize = glm::ivec4(W, H, R, n);
-  params.basisInfo = glm::ivec4(info_.bases, info_.basesPerInvocation, static_cast<int>(info_.weights), 0);
-  params.weights = glm::vec4(static_cast<float>(s), static_cast<float>(info_.depthMargin), 0.0f, 0.0f);
+  params.basisInfo = glm::ivec4(info_.options.bases, info_.options.basesPerInvocation,
+                                static_cast<int>(info_.options.weights), 0);
+  params.weights =
+      glm::vec4(static_cast<float>(s), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
   glNamedBufferSubData(paramsBuffer_.get(), 0, sizeof params, &params);
 
   glUseProgram(program_.get());
   glBindTextureUnit(0, frame.rectifiedDepth);
   glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, internalFormat(info_.format));
+  glBindImageTexture(0, texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, internalFormat(info_.options.format));
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, paramsBuffer_.get());
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes));
   glDispatchCompute(static_cast<GLuint>(ceilDiv(H, info_.workgroupRows)),
@@ -416,12 +375,12 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
   v.regionWeights = weightsBuffer_.get();
   v.width = info_.width;
   v.height = info_.height;
-  v.bases = info_.bases;
+  v.bases = info_.options.bases;
   v.layoutRegions = lastLayoutRegions_;
-  v.regionsPerSplit = info_.regionsPerSplit;
-  v.weights = info_.weights;
+  v.regionsPerSplit = info_.options.regionsPerSplit;
+  v.weights = info_.options.weights;
   v.extinction = lastExtinction_;
-  v.depthMargin = info_.depthMargin;
+  v.depthMargin = info_.options.depthMargin;
   return v;
 }
 
@@ -429,16 +388,11 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
 // EvaluatePass
 
 EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
-  validateBasesField("EvaluatePass::CreateInfo.bases", info.bases);
+  validateBases(info.bases, "EvaluatePass::CreateInfo.bases");
+  validate(info.options, "EvaluatePass::CreateInfo.options");
   if (info.outputFormat != StorageFormat::RGBA32F && info.outputFormat != StorageFormat::RGBA16F)
     invalid("EvaluatePass::CreateInfo.outputFormat", storageFormatToken(info.outputFormat),
             "must be RGBA32F or RGBA16F");
-  if (info.sampling != Sampling::Bilinear && info.sampling != Sampling::Nearest)
-    invalid("EvaluatePass::CreateInfo.sampling", str(static_cast<int>(info.sampling)),
-            "must be Bilinear or Nearest");
-  if (info.ringing != RingingFilter::None && info.ringing != RingingFilter::Lanczos)
-    invalid("EvaluatePass::CreateInfo.ringing", str(static_cast<int>(info.ringing)),
-            "must be None or Lanczos");
   requireAtLeast("EvaluatePass::CreateInfo.workgroupWidth", info.workgroupWidth, 1);
   requireAtLeast("EvaluatePass::CreateInfo.workgroupHeight", info.workgroupHeight, 1);
   {
@@ -453,15 +407,16 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
        "passes/evaluate.comp",
        {{"CREP_BASES", str(info.bases)},
         {"CREP_OUTPUT_FORMAT", storageFormatToken(info.outputFormat)},
-        {"CREP_NEAR_PLANE_CORRECTION", info.nearPlaneCorrection ? "1" : "0"},
-        {"CREP_RINGING_LANCZOS", info.ringing == RingingFilter::Lanczos ? "1" : "0"},
+        {"CREP_NEAR_PLANE_CORRECTION", info.options.nearPlaneCorrection ? "1" : "0"},
+        {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
         {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
         {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)}}}};
   program_ = buildProgram(stages);
-  basisSampler_ = createSampler(info.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
-  depthSampler_ = createSampler(GL_NEAREST);
-  scatteringBuffer_ = createUniformBuffer(sizeof(gpu::ScatteringParams));
-  evaluateBuffer_ = createUniformBuffer(sizeof(gpu::EvaluateParams));
+  basisSampler_ =
+      gl::createClampSampler(info.options.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
+  depthSampler_ = gl::createClampSampler(GL_NEAREST);
+  scatteringBuffer_ = gl::createDynamicBuffer(sizeof(gpu::ScatteringParams));
+  evaluateBuffer_ = gl::createDynamicBuffer(sizeof(gpu::EvaluateParams));
   gl::checkError("EvaluatePass: samplers and buffers");
 }
 
@@ -469,35 +424,36 @@ EvaluatePass::~EvaluatePass() = default;
 EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
 
-void EvaluatePass::run(const Frame& frame) {
-  if (frame.camera == nullptr) invalid("EvaluatePass::Frame.camera", "null", "must be set");
-  if (frame.light == nullptr) invalid("EvaluatePass::Frame.light", "null", "must be set");
-  if (frame.medium == nullptr) invalid("EvaluatePass::Frame.medium", "null", "must be set");
-  if (frame.layout == nullptr) invalid("EvaluatePass::Frame.layout", "null", "must be set");
+void EvaluatePass::run(const FrameAttribs& frame) {
+  if (frame.camera == nullptr) invalid("EvaluatePass::FrameAttribs.camera", "null", "must be set");
+  if (frame.light == nullptr) invalid("EvaluatePass::FrameAttribs.light", "null", "must be set");
+  if (frame.medium == nullptr) invalid("EvaluatePass::FrameAttribs.medium", "null", "must be set");
+  if (frame.layout == nullptr) invalid("EvaluatePass::FrameAttribs.layout", "null", "must be set");
   const FilteredBasisView& basis = frame.basis;
   if (basis.bases != info_.bases)
-    invalid("EvaluatePass::Frame.basis.bases", detail::formatValue(basis.bases),
+    invalid("EvaluatePass::FrameAttribs.basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info_.bases));
-  const TextureInfo b = textureInfo("EvaluatePass::Frame.basis.texture", basis.texture);
+  const TextureInfo b = textureInfo("EvaluatePass::FrameAttribs.basis.texture", basis.texture);
   if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
       b.depth < layerCount(basis.bases))
-    invalid("EvaluatePass::Frame.basis.texture", "texture " + str(basis.texture),
+    invalid("EvaluatePass::FrameAttribs.basis.texture", "texture " + str(basis.texture),
             "must be a GL_TEXTURE_2D_ARRAY of " + sizeString(basis.width, basis.height) + " x " +
                 str(layerCount(basis.bases)) + " layers");
-  if (info_.nearPlaneCorrection && (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
-    invalid("EvaluatePass::Frame.basis.regionWeights", str(basis.regionWeights),
+  if (info_.options.nearPlaneCorrection &&
+      (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
+    invalid("EvaluatePass::FrameAttribs.basis.regionWeights", str(basis.regionWeights),
             "must name the region-weights buffer (near-plane correction)");
-  const TextureInfo depth = textureInfo("EvaluatePass::Frame.cameraDepth", frame.cameraDepth);
+  const TextureInfo depth = textureInfo("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
   if (depth.target != GL_TEXTURE_2D)
-    invalid("EvaluatePass::Frame.cameraDepth", "texture " + str(frame.cameraDepth),
+    invalid("EvaluatePass::FrameAttribs.cameraDepth", "texture " + str(frame.cameraDepth),
             "must be a GL_TEXTURE_2D");
-  const TextureInfo out = textureInfo("EvaluatePass::Frame.output", frame.output);
+  const TextureInfo out = textureInfo("EvaluatePass::FrameAttribs.output", frame.output);
   const GLenum outFormat = internalFormat(info_.outputFormat);
   if (out.target != GL_TEXTURE_2D || static_cast<GLenum>(out.format) != outFormat)
-    invalid("EvaluatePass::Frame.output", "texture " + str(frame.output),
+    invalid("EvaluatePass::FrameAttribs.output", "texture " + str(frame.output),
             std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info_.outputFormat));
   if (out.width != depth.width || out.height != depth.height)
-    invalid("EvaluatePass::Frame.output", sizeString(out.width, out.height),
+    invalid("EvaluatePass::FrameAttribs.output", sizeString(out.width, out.height),
             "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
 
   const gpu::ScatteringParams scattering =
@@ -521,13 +477,14 @@ void EvaluatePass::run(const Frame& frame) {
   glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, evaluateBuffer_.get());
-  if (info_.nearPlaneCorrection)
+  if (info_.options.nearPlaneCorrection)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, basis.regionWeights);
   glDispatchCompute(static_cast<GLuint>(ceilDiv(depth.width, info_.workgroupWidth)),
                     static_cast<GLuint>(ceilDiv(depth.height, info_.workgroupHeight)), 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
-  if (info_.nearPlaneCorrection) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
+  if (info_.options.nearPlaneCorrection)
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
   glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);

@@ -1,8 +1,8 @@
 // CPU reference of prefiltered single scattering: Klehm, Seidel, Eisemann 2014, Sec. 3.1 (prefix
 // filtering of the Fourier basis, Eq. 5-9), Sec. 3.2 (transmittance weights, Eq. 10-11), Sec. 3.3
-// (regions, normalized storage, Listings 1-4), Appendix A (normalized filtered basis), plus a
-// brute-force march and the closed form of the unshadowed medium (Eq. 1, 3) as references. The exact
-// rules (also the GPU's contract) are documented in crep/prefilter/prefilter.h.
+// (regions, normalized storage, Listings 1-4), Appendix A (normalized filtered basis). The exact rules
+// (also the GPU's contract) are documented in crep/prefilter/prefilter.h; the rays and the integration
+// rule are crep/scatter/ray.h's.
 #include <crep/core/error.h>
 #include <crep/core/parallel.h>
 #include <crep/prefilter/prefilter.h>
@@ -17,42 +17,6 @@
 namespace crep {
 
 namespace {
-
-std::string pixelString(int x, int y) {
-  return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")";
-}
-
-/// The view ray of one camera pixel and its integration range (prefilter.h "Evaluation").
-struct PixelRay {
-  glm::dvec3 direction{0.0}; ///< unit, from the camera
-  double surface = 0.0;      ///< s: distance to the surface (far plane for the sky)
-  double start = 0.0;        ///< 0, or the near-plane distance with the correction
-};
-
-PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y, bool nearPlaneCorrection) {
-  PixelRay r;
-  const double ndcX = 2.0 * (x + 0.5) / depth.width() - 1.0;
-  const double ndcY = 2.0 * (y + 0.5) / depth.height() - 1.0;
-  r.direction = camera.rayDirection(ndcX, ndcY);
-  const double cosForward = glm::dot(r.direction, camera.forward());
-  const double d = depth.at(x, y, 0);
-  const double viewDepth = d >= 1.0 ? camera.far() : camera.linearDepth(d);
-  r.surface = viewDepth / cosForward;
-  r.start = nearPlaneCorrection ? std::min(camera.near() / cosForward, r.surface) : 0.0;
-  return r;
-}
-
-/// exp(-sigma ta) - exp(-sigma tb), divided by sigma (sigma -> 0: tb - ta).
-double transmittanceIntegral(double sigma, double ta, double tb) {
-  const double len = tb - ta;
-  if (!(len > 0.0)) return 0.0;
-  return std::exp(-sigma * ta) * len * oneMinusExpOverX(sigma * len);
-}
-
-glm::dvec3 transmittanceIntegral(const glm::dvec3& sigma, double ta, double tb) {
-  return {transmittanceIntegral(sigma.x, ta, tb), transmittanceIntegral(sigma.y, ta, tb),
-          transmittanceIntegral(sigma.z, ta, tb)};
-}
 
 /// A point of a ray in prefilter-region coordinates: region r of R = K P, u in [0, 1] within it.
 struct RegionPoint {
@@ -161,23 +125,7 @@ void sampleFiltered(const FilteredBasis& b, Sampling sampling, int r, double u, 
   }
 }
 
-void validateEvaluateOptions(const EvaluateOptions& o) {
-  if (o.threads < 0)
-    throw InvalidArgument("EvaluateOptions.threads", detail::formatValue(o.threads), "must be >= 0");
-}
-
 } // namespace
-
-void validateCameraDepth(const Image& depth) {
-  if (depth.empty()) throw InvalidArgument("cameraDepth", "empty", "must be a depth-buffer image");
-  for (int y = 0; y < depth.height(); ++y)
-    for (int x = 0; x < depth.width(); ++x) {
-      const float v = depth.at(x, y, 0);
-      if (!(v >= 0.0f && v <= 1.0f))
-        throw InvalidArgument("cameraDepth", pixelString(x, y) + " = " + detail::formatValue(v),
-                              "depth-buffer values must be in [0, 1]");
-    }
-}
 
 // ---------------------------------------------------------------------------------------------------
 
@@ -193,19 +141,37 @@ const char* storageFormatToken(StorageFormat format) {
   return "unknown";
 }
 
-void validate(const PrefilterOptions& o) {
-  validateBases(o.bases);
+void validate(const PrefilterOptions& o, std::string_view owner) {
+  const auto field = [&](const char* name) { return std::string(owner) + "." + name; };
+  validateBases(o.bases, field("bases"));
+  if (o.format != StorageFormat::RGBA8 && o.format != StorageFormat::RGBA16F &&
+      o.format != StorageFormat::RGBA32F)
+    throw InvalidArgument(field("format"), detail::formatValue(static_cast<int>(o.format)),
+                          "must be RGBA8, RGBA16F or RGBA32F");
+  if (o.weights != WeightMode::AverageVisibility && o.weights != WeightMode::ConstantStep &&
+      o.weights != WeightMode::ConstantRatio && o.weights != WeightMode::Exact)
+    throw InvalidArgument(field("weights"), detail::formatValue(static_cast<int>(o.weights)),
+                          "must be a WeightMode enumerator");
   if (o.regionsPerSplit < 1 || o.regionsPerSplit > 1024)
-    throw InvalidArgument("PrefilterOptions.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
+    throw InvalidArgument(field("regionsPerSplit"), detail::formatValue(o.regionsPerSplit),
                           "must be in [1, 1024]");
   if (!(o.depthMargin >= 0.0 && o.depthMargin <= 0.25))
-    throw InvalidArgument("PrefilterOptions.depthMargin", detail::formatValue(o.depthMargin),
-                          "must be in [0, 0.25]");
+    throw InvalidArgument(field("depthMargin"), detail::formatValue(o.depthMargin), "must be in [0, 0.25]");
   if (o.basesPerInvocation < 4 || o.basesPerInvocation > kMaxBases || o.basesPerInvocation % 4 != 0)
-    throw InvalidArgument("PrefilterOptions.basesPerInvocation", detail::formatValue(o.basesPerInvocation),
+    throw InvalidArgument(field("basesPerInvocation"), detail::formatValue(o.basesPerInvocation),
                           "must be a multiple of 4 in [4, " + std::to_string(kMaxBases) + "]");
-  if (o.threads < 0)
-    throw InvalidArgument("PrefilterOptions.threads", detail::formatValue(o.threads), "must be >= 0");
+  if (o.threads < 0) throw InvalidArgument(field("threads"), detail::formatValue(o.threads), "must be >= 0");
+}
+
+void validate(const EvaluateOptions& o, std::string_view owner) {
+  const auto field = [&](const char* name) { return std::string(owner) + "." + name; };
+  if (o.sampling != Sampling::Bilinear && o.sampling != Sampling::Nearest)
+    throw InvalidArgument(field("sampling"), detail::formatValue(static_cast<int>(o.sampling)),
+                          "must be Bilinear or Nearest");
+  if (o.ringing != RingingFilter::None && o.ringing != RingingFilter::Lanczos)
+    throw InvalidArgument(field("ringing"), detail::formatValue(static_cast<int>(o.ringing)),
+                          "must be None or Lanczos");
+  if (o.threads < 0) throw InvalidArgument(field("threads"), detail::formatValue(o.threads), "must be >= 0");
 }
 
 float roundToHalf(double v) {
@@ -318,16 +284,11 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
   return b;
 }
 
-glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
-                              const glm::dvec3& viewDirection) {
-  return light.irradiance() * medium.scatteringTimesPhase(glm::dot(light.direction(), -viewDirection));
-}
-
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
                const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
   validateBasis(basis);
   validateCameraDepth(cameraDepth);
-  validateEvaluateOptions(options);
+  validate(options);
   const RectifiedLayout& layout = *basis.layout;
   const int w = cameraDepth.width(), h = cameraDepth.height(), M = basis.bases, R = basis.regions;
   const int n = basis.regionWidth();
@@ -380,79 +341,7 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
           L += C * V * transmittanceIntegral(sigma, ta, tb);
         });
       }
-      out.at(x, y, 0) = static_cast<float>(L.x);
-      out.at(x, y, 1) = static_cast<float>(L.y);
-      out.at(x, y, 2) = static_cast<float>(L.z);
-      out.at(x, y, 3) = static_cast<float>(std::exp(-greySigma * ray.surface));
-    }
-  });
-  return out;
-}
-
-Image marchReference(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                     const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
-  validate(map);
-  validateCameraDepth(cameraDepth);
-  validateEvaluateOptions(options);
-  const RectifiedLayout& layout = *map.layout;
-  const int w = cameraDepth.width(), h = cameraDepth.height();
-  const int W = map.width(), H = map.height(), K = layout.regionCount(), n = W / K;
-  const glm::dvec3 sigma = medium.extinction();
-  const double greySigma = weightExtinction(medium);
-  const glm::dvec3 origin = camera.position();
-  Image out(w, h, 4);
-  parallelRows(h, options.threads, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
-      const glm::dvec3 C = scatteringConstant(light, medium, ray.direction);
-      glm::dvec3 L(0.0);
-      MappedRay m;
-      if (!mapRay(layout, origin, ray, 1, options.nearPlaneCorrection, m)) {
-        L = C * transmittanceIntegral(sigma, ray.start, ray.surface);
-      } else {
-        const int j = std::clamp(static_cast<int>(std::floor(m.row * H)), 0, H - 1);
-        const double zr = m.depth;
-        forEachSegment(layout, ray, m, K, [&](int r, double ua, double ub, double ta, double tb) {
-          const DistanceProfile p = layout.rayProfile(m.row, m.depth, r);
-          const int i0 = std::clamp(static_cast<int>(std::floor(ua * n)), 0, n - 1);
-          const int i1 = std::clamp(static_cast<int>(std::ceil(ub * n)) - 1, i0, n - 1);
-          double t = ta;
-          for (int i = i0; i <= i1; ++i) {
-            // The ray's own distance at the texel's right edge, clipped to the segment; the part of region 0
-            // in front of the map (camera to column 0) takes the first texel's visibility.
-            const double tEnd = i == i1 ? tb : std::clamp(p(static_cast<double>(i + 1) / n), t, tb);
-            const bool lit = map.depth.at(r * n + i, j) >= zr;
-            if (lit) L += C * transmittanceIntegral(sigma, t, tEnd);
-            t = tEnd;
-          }
-        });
-      }
-      out.at(x, y, 0) = static_cast<float>(L.x);
-      out.at(x, y, 1) = static_cast<float>(L.y);
-      out.at(x, y, 2) = static_cast<float>(L.z);
-      out.at(x, y, 3) = static_cast<float>(std::exp(-greySigma * ray.surface));
-    }
-  });
-  return out;
-}
-
-Image unshadowedScattering(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
-                           const Medium& medium, const EvaluateOptions& options) {
-  validateCameraDepth(cameraDepth);
-  validateEvaluateOptions(options);
-  const int w = cameraDepth.width(), h = cameraDepth.height();
-  const glm::dvec3 sigma = medium.extinction();
-  const double greySigma = weightExtinction(medium);
-  Image out(w, h, 4);
-  parallelRows(h, options.threads, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
-      const glm::dvec3 L = scatteringConstant(light, medium, ray.direction) *
-                           transmittanceIntegral(sigma, ray.start, ray.surface);
-      out.at(x, y, 0) = static_cast<float>(L.x);
-      out.at(x, y, 1) = static_cast<float>(L.y);
-      out.at(x, y, 2) = static_cast<float>(L.z);
-      out.at(x, y, 3) = static_cast<float>(std::exp(-greySigma * ray.surface));
+      storeScattering(out, x, y, L, std::exp(-greySigma * ray.surface));
     }
   });
   return out;

@@ -80,17 +80,6 @@ const char* weightModeToken(WeightMode mode) {
   return "unknown";
 }
 
-double weightExtinction(const Medium& medium) {
-  const glm::dvec3 e = medium.extinction();
-  return (e.x + e.y + e.z) / 3.0;
-}
-
-double oneMinusExpOverX(double x) {
-  if (x == std::numeric_limits<double>::infinity()) return 0.0;
-  if (std::abs(x) < 1e-5) return 1.0 - x * (0.5 - x / 6.0); // error < x^3 / 24 < 1e-16
-  return -std::expm1(-x) / x;
-}
-
 void regionDistances(WeightMode mode, const DistanceProfile& profile, int texels, std::span<double> tau) {
   requireTexels(texels, tau.size(), static_cast<std::size_t>(texels) + 1);
   const RatioParams ratio = mode == WeightMode::ConstantRatio ? ratioParams(profile, texels) : RatioParams{};

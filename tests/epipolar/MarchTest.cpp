@@ -1,7 +1,7 @@
-// CPU references of the ray marches (crep/epipolar/march.h): min/max trees, the tree march against the
-// brute-force march of the same rows (seed 000 Algorithm 2), both against closed forms (seed 003 Eq. 1, 3)
-// and against prefilter's brute-force marchReference(); the world-space reference march against the
-// closed forms of an empty medium and of a half-space shadow.
+// CPU references of the ray marches (crep/epipolar/march.h, crep/scatter/rectified_march.h,
+// crep/scatter/world_march.h): min/max trees, the tree march against the brute-force march of the same
+// rows (Yusov 2012, Algorithm 2), both against closed forms (Klehm et al. 2014, Eq. 1, 3); the world-space
+// reference march against the closed forms of an empty medium and of a half-space shadow.
 #include "epipolar_test_util.h"
 #include "support/image_check.h"
 
@@ -95,21 +95,6 @@ TEST_CASE("epipolar march: the min/max march equals the brute-force march of the
       CHECK(tree.scattering.at(10, 10, 3) == brute.scattering.at(10, 10, 3));
     }
   }
-}
-
-TEST_CASE("epipolar march: brute-force march agrees with prefilter's marchReference on the same map") {
-  const Camera camera = groundCamera(80, 45);
-  const DirectionalLight light = sideLight();
-  const Medium medium = colouredMedium();
-  const Image depth = groundDepth(camera, 80, 45);
-  const auto layout = projectiveLayout(camera, light, 4);
-  const RectifiedMap map =
-      castRectifiedMap(layout, 256, 128, [](const LightRay& r) { return planeHit(HalfSpace{}, r); });
-  const MarchResult ours = bruteForceMarch(map, depth, camera, light, medium);
-  const Image theirs = marchReference(map, depth, camera, light, medium);
-  const double rel = maxRelativeDifference(ours.scattering, theirs, 1e-6);
-  MESSAGE("max relative difference to prefilter's marchReference: " << rel);
-  CHECK(rel < 1e-6);
 }
 
 TEST_CASE("epipolar march: closed forms (no occluder, half-space shadow) on a projective map") {

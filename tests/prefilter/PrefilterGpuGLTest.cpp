@@ -81,7 +81,7 @@ struct FormatTolerance {
 PrefilterPass runPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& info,
                            double extinctionOverride = -1.0, std::uint32_t mapTexture = 0) {
   PrefilterPass pass(info);
-  PrefilterPass::Frame frame;
+  PrefilterPass::FrameAttribs frame;
   frame.rectifiedDepth = mapTexture != 0 ? mapTexture : s.mapTexture.get();
   frame.layout = s.layout.get();
   frame.medium = &s.scene.medium;
@@ -93,8 +93,8 @@ PrefilterPass runPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& i
 FilteredBasis cpuPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& info,
                            double extinctionOverride = -1.0, const RectifiedMap* map = nullptr) {
   const RectifiedMap& m = map != nullptr ? *map : s.map;
-  return extinctionOverride >= 0.0 ? prefilter(m, extinctionOverride, info.prefilterOptions())
-                                   : prefilter(m, s.scene.medium, info.prefilterOptions());
+  return extinctionOverride >= 0.0 ? prefilter(m, extinctionOverride, info.options)
+                                   : prefilter(m, s.scene.medium, info.options);
 }
 
 /// Checks the GPU basis against the CPU one with the format's tolerance; returns the difference.
@@ -103,14 +103,14 @@ BasisDifference checkBasis(const PrefilterPass& pass, const FilteredBasis& cpu, 
   const std::vector<float> gpu =
       readTextureArray(pass.filteredBasisTexture(), info.width, info.height, pass.layers());
   REQUIRE(gpu.size() == cpu.texels.size());
-  const FormatTolerance tolerance{info.format};
+  const FormatTolerance tolerance{info.options.format};
   const BasisDifference d = compareBasis(gpu, cpu, tolerance);
   // Values that differ at all (beyond float noise) for the quantized formats.
   const BasisDifference changed = compareBasis(gpu, cpu, [](float) { return 1e-6; });
   MESSAGE(what << ": " << describe(d) << "; " << changed.over << " of " << cpu.texels.size()
                << " differ by > 1e-6");
   CHECK(d.over == 0);
-  if (info.format != StorageFormat::RGBA32F)
+  if (info.options.format != StorageFormat::RGBA32F)
     CHECK(static_cast<double>(changed.over) <= 1e-3 * static_cast<double>(cpu.texels.size()));
   return d;
 }
@@ -132,7 +132,7 @@ gl::Handle runEvaluate(const GpuScene& s, const EvaluatePass::CreateInfo& info,
   EvaluatePass pass(info);
   gl::Handle out = createTexture2D(info.outputFormat == StorageFormat::RGBA16F ? GL_RGBA16F : GL_RGBA32F,
                                    kScreenW, kScreenH);
-  EvaluatePass::Frame frame;
+  EvaluatePass::FrameAttribs frame;
   frame.cameraDepth = s.depthTexture.get();
   frame.output = out.get();
   frame.camera = &s.scene.camera;
@@ -166,9 +166,9 @@ ImageMetrics checkEvaluation(const Image& gpu, const Image& cpu, const EvalToler
 
 Image cpuEvaluate(const GpuScene& s, const FilteredBasis& basis, const EvaluatePass::CreateInfo& info) {
   EvaluateOptions o;
-  o.sampling = info.sampling;
-  o.nearPlaneCorrection = info.nearPlaneCorrection;
-  o.ringing = info.ringing;
+  o.sampling = info.options.sampling;
+  o.nearPlaneCorrection = info.options.nearPlaneCorrection;
+  o.ringing = info.options.ringing;
   return evaluate(basis, s.cameraDepth, s.scene.camera, s.scene.sun, s.scene.medium, o);
 }
 
@@ -186,7 +186,7 @@ TEST_CASE("prefilter GPU: the filtered basis equals the CPU reference in every s
   const GpuScene& s = boxesScene();
   for (const StorageFormat format : {StorageFormat::RGBA32F, StorageFormat::RGBA16F, StorageFormat::RGBA8}) {
     PrefilterPass::CreateInfo info = baseInfo();
-    info.format = format;
+    info.options.format = format;
     const PrefilterPass pass = runPrefilter(s, info);
     checkBasis(pass, cpuPrefilter(s, info), std::string("M = 32, ") + storageFormatToken(format));
   }
@@ -206,9 +206,9 @@ TEST_CASE("prefilter GPU: bases 4, 6, 30 and 128, partial base groups, odd and p
     CAPTURE(bases);
     CAPTURE(c.perInvocation);
     PrefilterPass::CreateInfo info = baseInfo();
-    info.format = StorageFormat::RGBA32F;
-    info.bases = bases;
-    info.basesPerInvocation = c.perInvocation;
+    info.options.format = StorageFormat::RGBA32F;
+    info.options.bases = bases;
+    info.options.basesPerInvocation = c.perInvocation;
     info.workgroupRows = 7;
     info.workgroupBaseGroups = c.baseGroupsPerWorkgroup;
     const PrefilterPass pass = runPrefilter(s, info);
@@ -222,7 +222,7 @@ TEST_CASE("prefilter GPU: bases 4, 6, 30 and 128, partial base groups, odd and p
     e.workgroupHeight = 3;
     const gl::Handle out = runEvaluate(s, e, pass.filteredBasis());
     checkEvaluation(readRgbaTexture(out.get(), kScreenW, kScreenH), cpuEvaluate(s, cpu, e),
-                    evalTolerance(info.format, e.sampling),
+                    evalTolerance(info.options.format, e.options.sampling),
                     "prefilter_gpu_eval_M" + std::to_string(bases) + "_b" + std::to_string(c.perInvocation));
   }
 }
@@ -235,9 +235,9 @@ TEST_CASE("prefilter GPU: every regionsPerSplit x basesPerInvocation configurati
     Image first;
     for (const int perInvocation : {4, 8, 16, 32}) {
       PrefilterPass::CreateInfo info = baseInfo();
-      info.format = StorageFormat::RGBA32F;
-      info.regionsPerSplit = perSplit;
-      info.basesPerInvocation = perInvocation;
+      info.options.format = StorageFormat::RGBA32F;
+      info.options.regionsPerSplit = perSplit;
+      info.options.basesPerInvocation = perInvocation;
       info.workgroupRows = perInvocation == 8 ? 64 : 16;
       info.workgroupBaseGroups = perInvocation == 4 ? 2 : 1;
       info.workgroupRegions = perSplit == 5 ? 3 : 1;
@@ -250,7 +250,7 @@ TEST_CASE("prefilter GPU: every regionsPerSplit x basesPerInvocation configurati
       EvaluatePass::CreateInfo e;
       const gl::Handle out = runEvaluate(s, e, pass.filteredBasis());
       const Image gpu = readRgbaTexture(out.get(), kScreenW, kScreenH);
-      checkEvaluation(gpu, cpuEvaluate(s, cpu, e), evalTolerance(info.format, e.sampling),
+      checkEvaluation(gpu, cpuEvaluate(s, cpu, e), evalTolerance(info.options.format, e.options.sampling),
                       "prefilter_gpu_eval_P" + std::to_string(perSplit) + "_b" +
                           std::to_string(perInvocation));
       // The bases per invocation only change how the work is split: the same image to float noise.
@@ -274,9 +274,9 @@ TEST_CASE("prefilter GPU: every weight mode, the sigma -> 0 limit and a thick me
   for (const double extinction : {-1.0, 0.0, 0.4}) {
     for (const WeightMode mode : modes) {
       PrefilterPass::CreateInfo info = baseInfo();
-      info.format = StorageFormat::RGBA32F;
-      info.weights = mode;
-      info.regionsPerSplit = 5;
+      info.options.format = StorageFormat::RGBA32F;
+      info.options.weights = mode;
+      info.options.regionsPerSplit = 5;
       const std::string name = std::string(weightModeToken(mode)) + ", extinction " +
                                (extinction < 0.0 ? std::string("of the medium") : std::to_string(extinction));
       CAPTURE(name);
@@ -284,10 +284,10 @@ TEST_CASE("prefilter GPU: every weight mode, the sigma -> 0 limit and a thick me
       const FilteredBasis cpu = cpuPrefilter(s, info, extinction);
       checkBasis(pass, cpu, name);
       EvaluatePass::CreateInfo e;
-      e.nearPlaneCorrection = true; // uses the weight totals of the mode
+      e.options.nearPlaneCorrection = true; // uses the weight totals of the mode
       const gl::Handle out = runEvaluate(s, e, pass.filteredBasis());
       checkEvaluation(readRgbaTexture(out.get(), kScreenW, kScreenH), cpuEvaluate(s, cpu, e),
-                      evalTolerance(info.format, e.sampling),
+                      evalTolerance(info.options.format, e.options.sampling),
                       std::string("prefilter_gpu_eval_") + weightModeToken(mode) + "_" +
                           std::to_string(extinction));
     }
@@ -299,8 +299,8 @@ TEST_CASE("prefilter GPU: evaluation equals the CPU evaluation for every format,
   const GpuScene& s = boxesScene();
   for (const StorageFormat format : {StorageFormat::RGBA32F, StorageFormat::RGBA16F, StorageFormat::RGBA8}) {
     PrefilterPass::CreateInfo info = baseInfo();
-    info.format = format;
-    info.regionsPerSplit = 5;
+    info.options.format = format;
+    info.options.regionsPerSplit = 5;
     const FilteredBasis cpu = cpuPrefilter(s, info);
     const PrefilterPass pass = runPrefilter(s, info);
     // The CPU basis uploaded as it is: only the evaluation differs.
@@ -308,9 +308,9 @@ TEST_CASE("prefilter GPU: evaluation equals the CPU evaluation for every format,
     for (const Sampling sampling : {Sampling::Bilinear, Sampling::Nearest})
       for (const int option : {0, 1, 2}) {
         EvaluatePass::CreateInfo e;
-        e.sampling = sampling;
-        e.nearPlaneCorrection = option == 1;
-        e.ringing = option == 2 ? RingingFilter::Lanczos : RingingFilter::None;
+        e.options.sampling = sampling;
+        e.options.nearPlaneCorrection = option == 1;
+        e.options.ringing = option == 2 ? RingingFilter::Lanczos : RingingFilter::None;
         e.outputFormat = option == 2 ? StorageFormat::RGBA16F : StorageFormat::RGBA32F;
         const std::string name = std::string("prefilter_gpu_eval_") + storageFormatToken(format) +
                                  (sampling == Sampling::Nearest ? "_nearest" : "_bilinear") +
@@ -356,8 +356,8 @@ TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random conte
   glTextureSubImage2D(texture.get(), 0, 0, 0, kMapW, kMapH, GL_RED, GL_FLOAT, depth.data().data());
   const RectifiedMap map = makeRectifiedMap(s.layout, depth);
   PrefilterPass::CreateInfo info = baseInfo();
-  info.format = StorageFormat::RGBA32F;
-  info.regionsPerSplit = 5;
+  info.options.format = StorageFormat::RGBA32F;
+  info.options.regionsPerSplit = 5;
   checkBasis(runPrefilter(s, info, -1.0, texture.get()), cpuPrefilter(s, info, -1.0, &map),
              "random R32F map");
 
@@ -367,13 +367,13 @@ TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random conte
     PrefilterPass::CreateInfo o;
     o.width = 136;
     o.height = 45;
-    o.regionsPerSplit = 2;
+    o.options.regionsPerSplit = 2;
     const PrefilterPass pass = runPrefilter(other, o);
     const FilteredBasis cpu = cpuPrefilter(other, o);
     checkBasis(pass, cpu, std::string(name) + ", RGBA8");
     EvaluatePass e({});
     const gl::Handle out = createTexture2D(GL_RGBA32F, 97, 61);
-    EvaluatePass::Frame frame;
+    EvaluatePass::FrameAttribs frame;
     frame.cameraDepth = other.depthTexture.get();
     frame.output = out.get();
     frame.camera = &other.scene.camera;
@@ -382,7 +382,7 @@ TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random conte
     frame.layout = other.layout.get();
     frame.basis = pass.filteredBasis();
     e.run(frame);
-    EvalTolerance t = evalTolerance(o.format, Sampling::Bilinear);
+    EvalTolerance t = evalTolerance(o.options.format, Sampling::Bilinear);
     t.fractionOver = 5e-3; // one stored value one step off (see the basis test) moves a few pixels
     checkEvaluation(readRgbaTexture(out.get(), 97, 61),
                     evaluate(cpu, other.cameraDepth, other.scene.camera, other.scene.sun, other.scene.medium),
@@ -430,26 +430,30 @@ TEST_CASE("prefilter GPU: invalid create infos throw errors naming the parameter
   CHECK(invalidParameter(prefilterWith([](Info& i) { i.width = 0; })) == "PrefilterPass::CreateInfo.width");
   CHECK(invalidParameter(prefilterWith([](Info& i) { i.height = -3; })) ==
         "PrefilterPass::CreateInfo.height");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.bases = 0; })) == "PrefilterPass::CreateInfo.bases");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.bases = 31; })) == "PrefilterPass::CreateInfo.bases");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.bases = 130; })) == "PrefilterPass::CreateInfo.bases");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.bases = 256; })) == "PrefilterPass::CreateInfo.bases");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.basesPerInvocation = 6; })) ==
-        "PrefilterPass::CreateInfo.basesPerInvocation");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.basesPerInvocation = 132; })) ==
-        "PrefilterPass::CreateInfo.basesPerInvocation");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.basesPerInvocation = 2; })) ==
-        "PrefilterPass::CreateInfo.basesPerInvocation");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.regionsPerSplit = 0; })) ==
-        "PrefilterPass::CreateInfo.regionsPerSplit");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.depthMargin = 0.3; })) ==
-        "PrefilterPass::CreateInfo.depthMargin");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.depthMargin = std::nan(""); })) ==
-        "PrefilterPass::CreateInfo.depthMargin");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.bases = 0; })) ==
+        "PrefilterPass::CreateInfo.options.bases");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.bases = 31; })) ==
+        "PrefilterPass::CreateInfo.options.bases");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.bases = 130; })) ==
+        "PrefilterPass::CreateInfo.options.bases");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.bases = 256; })) ==
+        "PrefilterPass::CreateInfo.options.bases");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.basesPerInvocation = 6; })) ==
+        "PrefilterPass::CreateInfo.options.basesPerInvocation");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.basesPerInvocation = 132; })) ==
+        "PrefilterPass::CreateInfo.options.basesPerInvocation");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.basesPerInvocation = 2; })) ==
+        "PrefilterPass::CreateInfo.options.basesPerInvocation");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.regionsPerSplit = 0; })) ==
+        "PrefilterPass::CreateInfo.options.regionsPerSplit");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.depthMargin = 0.3; })) ==
+        "PrefilterPass::CreateInfo.options.depthMargin");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.depthMargin = std::nan(""); })) ==
+        "PrefilterPass::CreateInfo.options.depthMargin");
   CHECK(invalidParameter(prefilterWith([](Info& i) { i.workgroupRows = 0; })) ==
         "PrefilterPass::CreateInfo.workgroupRows");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.format = static_cast<StorageFormat>(7); })) ==
-        "PrefilterPass::CreateInfo.format");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.format = static_cast<StorageFormat>(7); })) ==
+        "PrefilterPass::CreateInfo.options.format");
 
   // Implementation limits: the message names the parameter and the limit.
   const int maxSize = gl::maxTextureSize();
@@ -494,7 +498,7 @@ TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
   CHECK_THROWS_AS(pass.filteredBasis(), Error);
   const auto runWith = [&](auto change) {
     return [&, change] {
-      PrefilterPass::Frame f;
+      PrefilterPass::FrameAttribs f;
       f.rectifiedDepth = s.mapTexture.get();
       f.layout = s.layout.get();
       f.medium = &s.scene.medium;
@@ -502,26 +506,28 @@ TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
       pass.run(f);
     };
   };
-  using Frame = PrefilterPass::Frame;
-  CHECK(invalidParameter(runWith([](Frame& f) { f.layout = nullptr; })) == "PrefilterPass::Frame.layout");
-  CHECK(invalidParameter(runWith([](Frame& f) { f.medium = nullptr; })) == "PrefilterPass::Frame.medium");
+  using Frame = PrefilterPass::FrameAttribs;
+  CHECK(invalidParameter(runWith([](Frame& f) { f.layout = nullptr; })) ==
+        "PrefilterPass::FrameAttribs.layout");
+  CHECK(invalidParameter(runWith([](Frame& f) { f.medium = nullptr; })) ==
+        "PrefilterPass::FrameAttribs.medium");
   CHECK(invalidParameter(runWith([](Frame& f) { f.rectifiedDepth = 0; })) ==
-        "PrefilterPass::Frame.rectifiedDepth");
+        "PrefilterPass::FrameAttribs.rectifiedDepth");
   CHECK(invalidParameter(runWith([](Frame& f) { f.rectifiedDepth = 123456; })) ==
-        "PrefilterPass::Frame.rectifiedDepth");
+        "PrefilterPass::FrameAttribs.rectifiedDepth");
   const gl::Handle wrongSize = createTexture2D(GL_R32F, kMapW + 1, kMapH);
   CHECK(invalidParameter(runWith([&](Frame& f) { f.rectifiedDepth = wrongSize.get(); })) ==
-        "PrefilterPass::Frame.rectifiedDepth");
+        "PrefilterPass::FrameAttribs.rectifiedDepth");
   {
     // K = 2 splits x P = 3 regions do not divide 250 columns.
     PrefilterPass::CreateInfo info = baseInfo();
-    info.regionsPerSplit = 3;
+    info.options.regionsPerSplit = 3;
     PrefilterPass three(info);
-    PrefilterPass::Frame f;
+    PrefilterPass::FrameAttribs f;
     f.rectifiedDepth = s.mapTexture.get();
     f.layout = s.layout.get();
     f.medium = &s.scene.medium;
-    CHECK(invalidParameter([&] { three.run(f); }) == "PrefilterPass::Frame.layout");
+    CHECK(invalidParameter([&] { three.run(f); }) == "PrefilterPass::FrameAttribs.layout");
   }
   CHECK_NOTHROW(runWith([](Frame&) {})());
 
@@ -531,7 +537,7 @@ TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
   const gl::Handle small = createTexture2D(GL_RGBA32F, kScreenW - 1, kScreenH);
   const auto evalWith = [&](auto change) {
     return [&, change] {
-      EvaluatePass::Frame f;
+      EvaluatePass::FrameAttribs f;
       f.cameraDepth = s.depthTexture.get();
       f.output = out.get();
       f.camera = &s.scene.camera;
@@ -543,19 +549,21 @@ TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
       eval.run(f);
     };
   };
-  using EFrame = EvaluatePass::Frame;
-  CHECK(invalidParameter(evalWith([](EFrame& f) { f.camera = nullptr; })) == "EvaluatePass::Frame.camera");
-  CHECK(invalidParameter(evalWith([](EFrame& f) { f.layout = nullptr; })) == "EvaluatePass::Frame.layout");
+  using EFrame = EvaluatePass::FrameAttribs;
+  CHECK(invalidParameter(evalWith([](EFrame& f) { f.camera = nullptr; })) ==
+        "EvaluatePass::FrameAttribs.camera");
+  CHECK(invalidParameter(evalWith([](EFrame& f) { f.layout = nullptr; })) ==
+        "EvaluatePass::FrameAttribs.layout");
   CHECK(invalidParameter(evalWith([&](EFrame& f) { f.output = out8.get(); })) ==
-        "EvaluatePass::Frame.output");
+        "EvaluatePass::FrameAttribs.output");
   CHECK(invalidParameter(evalWith([&](EFrame& f) { f.output = small.get(); })) ==
-        "EvaluatePass::Frame.output");
+        "EvaluatePass::FrameAttribs.output");
   CHECK(invalidParameter(evalWith([&](EFrame& f) { f.cameraDepth = 0; })) ==
-        "EvaluatePass::Frame.cameraDepth");
+        "EvaluatePass::FrameAttribs.cameraDepth");
   CHECK(invalidParameter(evalWith([&](EFrame& f) { f.basis.bases = 16; })) ==
-        "EvaluatePass::Frame.basis.bases");
+        "EvaluatePass::FrameAttribs.basis.bases");
   CHECK(invalidParameter(evalWith([&](EFrame& f) { f.basis.texture = s.mapTexture.get(); })) ==
-        "EvaluatePass::Frame.basis.texture");
+        "EvaluatePass::FrameAttribs.basis.texture");
   CHECK(invalidParameter(evalWith([&](EFrame& f) { f.basis.layoutRegions = 3; })) == "layout");
   CHECK_NOTHROW(evalWith([](EFrame&) {})());
 }

@@ -256,14 +256,14 @@ void main() {
   info.width = W;
   info.height = H;
   PrefilterPass prefilterPass(info);
-  PrefilterPass::Frame pf;
+  PrefilterPass::FrameAttribs pf;
   pf.rectifiedDepth = s.mapTexture.get();
   pf.layout = s.layout.get();
   pf.medium = &s.scene.medium;
   prefilterPass.run(pf);
   EvaluatePass evaluatePass({});
   const gl::Handle reference = createTexture2D(GL_RGBA32F, w, h);
-  EvaluatePass::Frame ef;
+  EvaluatePass::FrameAttribs ef;
   ef.cameraDepth = s.depthTexture.get();
   ef.output = reference.get();
   ef.camera = &s.scene.camera;

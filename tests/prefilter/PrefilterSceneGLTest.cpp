@@ -2,7 +2,8 @@
 // matrices (as an engine does: one depth texture, one viewport per split, GL_DEPTH_CLAMP; see
 // tests/rectify/RectifyGLTest.cpp) and the camera depth rasterized too; the CPU reference prefilter +
 // evaluation (Klehm et al. 2014, Sec. 3) against a brute-force march over the same rectified map with
-// exact per-ray transmittance (prefilter.h marchReference). Small sizes: 160 x 90 screen, 256 x 128 map.
+// exact per-ray transmittance (crep/scatter/rectified_march.h bruteForceMarch). Small sizes: 160 x 90 screen,
+// 256 x 128 map.
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 
@@ -10,6 +11,7 @@
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/rectified_march.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 
@@ -48,7 +50,7 @@ void checkScene(const std::string& name, double maxRelativeRmse, double minPsnr)
   const RectifiedMap map = makeRectifiedMap(layout, readDepthTexture(texture.get(), kMapW, kMapH));
   const Image cameraDepth = renderer.renderDepthImage(scene.camera.clipFromWorld(), kScreenW, kScreenH);
 
-  const Image march = marchReference(map, cameraDepth, scene.camera, scene.sun, scene.medium);
+  const Image march = bruteForceMarch(map, cameraDepth, scene.camera, scene.sun, scene.medium).scattering;
   const FilteredBasis basis = prefilter(map, scene.medium);
   const Image ours = evaluate(basis, cameraDepth, scene.camera, scene.sun, scene.medium);
   EvaluateOptions damped;

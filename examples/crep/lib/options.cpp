@@ -6,7 +6,7 @@ const std::set<std::string> kMethodOptions = {"method", "map-size", "bases", "fo
 
 const char* const kMethodOptionsHelp =
     R"(            --map-size N        shadow map and rectified map size (default 1024)
-            --bases M           Fourier bases, a multiple of 4 in [4, 128] (default 32)
+            --bases M           Fourier bases, even, in [4, 128] (default 32)
             --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
             --splits K          rectification splits (default 4; --map-size must be a multiple)
             --steps N           reference march samples per pixel (default 256)
@@ -23,9 +23,9 @@ MethodSettings methodSettings(const Args& args) {
   MethodSettings s;
   s.mapSize = args.integer("map-size", s.mapSize, 1, Image::kMaxDimension);
   s.steps = args.integer("steps", s.steps, 1, 65536);
-  s.bases = args.integer("bases", s.bases, kMinBases, kMaxBases);
-  if (s.bases % 4 != 0) throw UsageError("option --bases: must be a multiple of 4");
-  s.format = parseFormat(args.string("format", "rgba8"));
+  s.prefilter.bases = args.integer("bases", s.prefilter.bases, kMinBases, kMaxBases);
+  if (s.prefilter.bases % 2 != 0) throw UsageError("option --bases: must be even");
+  s.prefilter.format = parseFormat(args.string("format", "rgba8"));
   s.rectify.splits = args.integer("splits", s.rectify.splits, 1, RectifyOptions::kMaxSplits);
   if (s.mapSize % s.rectify.splits != 0)
     throw UsageError("option --map-size: " + std::to_string(s.mapSize) + " must be a multiple of --splits " +

@@ -3,6 +3,7 @@
 
 #include "args.h"
 #include "frame.h"
+#include "methods.h"
 
 #include <set>
 #include <string>

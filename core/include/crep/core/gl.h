@@ -3,6 +3,7 @@
 // requires a current OpenGL 4.5 context (the caller's or GlContext).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -10,7 +11,17 @@
 
 namespace crep::gl {
 
-enum class ObjectType { Texture, Buffer, Framebuffer, Renderbuffer, VertexArray, Program, Shader, Query, Sampler };
+enum class ObjectType {
+  Texture,
+  Buffer,
+  Framebuffer,
+  Renderbuffer,
+  VertexArray,
+  Program,
+  Shader,
+  Query,
+  Sampler
+};
 
 /// Move-only owner of one GL object name; deletes it with the matching glDelete* on destruction.
 class Handle {
@@ -44,7 +55,30 @@ Handle createSampler();
 /// A GL_TEXTURE_2D with one level of `internalFormat` (a GLenum such as GL_RGBA32F or
 /// GL_DEPTH_COMPONENT32F), nearest filtering, clamp to edge. Checks the size first
 /// (checkTextureSize(parameter, ...)).
-Handle createTexture2D(std::uint32_t internalFormat, int width, int height, const char* parameter = "texture size");
+Handle createTexture2D(std::uint32_t internalFormat, int width, int height,
+                       const char* parameter = "texture size");
+
+/// A sampler with `filter` (GL_NEAREST or GL_LINEAR) for minification and magnification, clamp to edge,
+/// no depth comparison: texelFetch / texture read the raw values whatever the texture's compare mode.
+Handle createClampSampler(std::uint32_t filter);
+/// A buffer of `bytes` bytes with GL_DYNAMIC_STORAGE_BIT (filled with glNamedBufferSubData).
+Handle createDynamicBuffer(std::size_t bytes);
+/// An owned texture of at least width x height in `internalFormat`, (re)allocated when smaller: scratch
+/// output for a pass whose caller does not want that output. `capacityWidth/Height` track its size.
+std::uint32_t scratchTexture2D(Handle& texture, int& capacityWidth, int& capacityHeight,
+                               std::uint32_t internalFormat, int width, int height);
+
+/// Throws InvalidArgument naming `parameter` unless `texture` names an existing texture whose level 0 is
+/// width x height (sizes > 0) and, when `internalFormat` is not 0, of that internal format.
+void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
+                      std::uint32_t internalFormat = 0);
+
+/// The state the compute passes of the library leave behind: program 0; texture units, samplers, image
+/// units, uniform and storage buffer bindings 0 .. units - 1 unbound.
+void unbindPassState(int units);
+/// glMemoryBarrier for every way a pass output is read afterwards: texture fetches, image loads,
+/// texture and buffer updates and readback, storage buffer reads.
+void passOutputBarrier();
 
 /// What readTexture() reads: RGBA (4 channels), the red channel, or depth (1 channel each).
 enum class TexelData { Rgba, Red, Depth };
@@ -52,7 +86,7 @@ enum class TexelData { Rgba, Red, Depth };
 Image readTexture(std::uint32_t texture, int width, int height, TexelData data, int layer = 0);
 
 /// Implementation limits.
-int maxTextureSize();      ///< GL_MAX_TEXTURE_SIZE
+int maxTextureSize();        ///< GL_MAX_TEXTURE_SIZE
 int maxArrayTextureLayers(); ///< GL_MAX_ARRAY_TEXTURE_LAYERS
 
 /// Throws InvalidArgument naming `parameter` when width/height are <= 0, and GlError when they

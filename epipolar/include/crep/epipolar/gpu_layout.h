@@ -19,6 +19,7 @@
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/gpu_world_march.h>
 
 namespace crep {
 class EpipolarLayout; // crep/epipolar/epipolar.h
@@ -75,32 +76,6 @@ struct EpipolarSlice {
   glm::vec4 bounds{0.0f}; ///< x: bMax (world units), y: psiMin, z: psiMax (radians), w: 0
 };
 static_assert(sizeof(EpipolarSlice) == 16, "std430 CrepEpipolarSlice");
-
-/// std140 block CrepMarchBlock { CrepMarchParams crep_march; } of the march and resampling passes.
-struct MarchParams {
-  glm::vec4 cameraPosition{0.0f};                    ///< xyz: world; w: near plane distance
-  glm::vec4 cameraForward{0.0f, 0.0f, -1.0f, 0.0f};  ///< xyz: unit view direction; w: far plane distance
-  glm::vec4 cameraRight{1.0f, 0.0f, 0.0f, 0.0f};     ///< xyz: right * tan(fovY / 2) * aspect; w: 0
-  glm::vec4 cameraUp{0.0f, 1.0f, 0.0f, 0.0f};        ///< xyz: up * tan(fovY / 2); w: 0
-  glm::vec4 lightDirection{0.0f, -1.0f, 0.0f, 0.0f}; ///< xyz: direction the light travels; w: 0
-  glm::vec4 lightIrradiance{0.0f};                   ///< rgb: irradiance; w: 0
-  glm::vec4 mieScattering{0.0f};      ///< rgb: sigma_s of the Henyey-Greenstein part (1/world unit); w: g
-  glm::vec4 rayleighScattering{0.0f}; ///< rgb: sigma_s of the Rayleigh part; w: 0
-  glm::vec4 extinction{0.0f};         ///< rgb: sigma_t; w: grey extinction (mean of rgb)
-  /// march: xy camera image (pixels), zw rectified map (texels); world march: zw standard shadow map;
-  /// resampling: xy standard shadow map, zw rectified map
-  glm::ivec4 sizes{0};
-  glm::ivec4 info{0};   ///< march: x tree levels L, y tree row stride; world march: x steps N, y refinements
-  glm::vec4 bias{0.0f}; ///< world march: x shadow bias (depth-buffer units)
-  glm::vec4 block{0.0f, 0.0f, -1.0f, 0.0f}; ///< world march: xy centre, z radius (pixels; < 0: all pixels)
-  glm::ivec4 region{0};               ///< world march: xy first pixel of the dispatch, zw its size (pixels)
-  glm::mat4 lightClipFromWorld{1.0f}; ///< world march / resampling: the standard shadow map's matrix
-};
-static_assert(sizeof(MarchParams) == 16 * 18, "std140 CrepMarchParams");
-
-/// The camera, light and medium part of MarchParams for a w x h camera image and a W x H map.
-MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
-                            int width, int height, int mapWidth, int mapHeight);
 
 /// The block of a projective layout (regionCount() <= kMaxLayoutRegions, else InvalidArgument
 /// "ProjectiveLayout.regionCount").

@@ -1,7 +1,8 @@
-// GPU passes of the ray marches (OpenGL 4.5 compute shaders): the min/max trees of a rectified map, the
-// tree-accelerated and brute-force marches along its rows, and the world-space reference march against a
-// standard shadow map. They implement the rules of crep/epipolar/march.h in float precision (the CPU
-// functions there are their references).
+// GPU passes of the rectified marches (OpenGL 4.5 compute shaders): the min/max trees of a rectified map
+// and the tree-accelerated and brute-force marches along its rows. They implement the rules of
+// crep/epipolar/march.h and crep/scatter/rectified_march.h in float precision (the CPU functions there are
+// their references). The world-space reference march on the GPU is WorldMarchPass
+// (crep/scatter/gpu_world_march.h).
 //
 // Every pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
 // buffers and sampler (RAII); the textures of FrameAttribs are the caller's (non-owning GL names).
@@ -27,6 +28,7 @@
 #include <crep/core/medium.h>
 #include <crep/epipolar/gpu_layout.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/gpu_world_march.h>
 
 namespace crep {
 
@@ -91,42 +93,6 @@ public:
 private:
   CreateInfo info_;
   gl::Handle programs_[2], params_, layoutBlock_, slices_, sampler_, dummySteps_;
-  int dummyWidth_ = 0, dummyHeight_ = 0;
-};
-
-/// The world-space reference march (march.h) against a standard shadow map; optionally only the pixels
-/// within a radius of a point: the epipole block of seed 003 Fig. 8 (its other pixels are not written).
-class WorldMarchPass {
-public:
-  struct CreateInfo {
-    int steps = 256;      ///< N >= 1 (WorldMarchOptions)
-    int refinements = 16; ///< bisections at each visibility change, [0, 60]
-  };
-  struct FrameAttribs {
-    const Camera* camera = nullptr;
-    const DirectionalLight* light = nullptr;
-    const Medium* medium = nullptr;
-    std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
-    int width = 0, height = 0;
-    std::uint32_t shadowMap = 0; ///< standard shadow map (depth texture) rendered with lightClipFromWorld
-    int shadowWidth = 0, shadowHeight = 0;
-    glm::dmat4 lightClipFromWorld{1.0};
-    double bias = 0.0;               ///< added to the stored depth (depth-buffer units)
-    std::uint32_t scatteringOut = 0; ///< GL_RGBA32F width x height
-    std::uint32_t stepsOut = 0;      ///< GL_R32F width x height, or 0
-    /// Epipole block: when blockRadius >= 0, only pixels whose centre is within blockRadius pixels of
-    /// blockCenter (pixel coordinates, origin at the bottom-left corner of the image) are marched.
-    glm::dvec2 blockCenter{0.0};
-    double blockRadius = -1.0;
-  };
-  /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
-  explicit WorldMarchPass(const CreateInfo& info);
-  /// Throws InvalidArgument naming the FrameAttribs field.
-  void run(const FrameAttribs& frame);
-
-private:
-  CreateInfo info_;
-  gl::Handle program_, params_, sampler_, dummySteps_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 

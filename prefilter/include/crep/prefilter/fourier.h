@@ -22,6 +22,7 @@
 #pragma once
 
 #include <span>
+#include <string_view>
 
 namespace crep {
 
@@ -31,7 +32,7 @@ inline constexpr int kMinBases = 4;
 inline constexpr int kMaxBases = 128;
 
 /// Throws InvalidArgument (parameter "bases") unless M is even and in [kMinBases, kMaxBases].
-void validateBases(int bases);
+void validateBases(int bases, std::string_view parameter = "bases");
 
 /// Eq. 8 ray coefficients a_1..a_M at depth z, into a.size() = M values (M validated as above).
 /// All values from one sin/cos of pi z by the angle-addition recurrence (relative error ~M eps).

@@ -4,11 +4,11 @@
 // scattering image. They implement the rules of crep::prefilter() and crep::evaluate() (prefilter.h,
 // the CPU reference and contract) in float; tests/prefilter/PrefilterGpuGLTest.cpp states how closely.
 //
-// Effect-module conventions (STYLE.md): a CreateInfo fixes sizes, formats and quality once (programs and
-// textures are built in the constructor, owned by RAII and released in the destructor); a Frame carries
-// the per-frame inputs. Inputs are non-owning: GL names of the caller's textures and pointers to CPU
-// objects that must outlive the call. No pass creates, owns or changes the current GL context; each
-// needs one (OpenGL 4.5 core) current on the calling thread for its whole lifetime.
+// Effect-module conventions (docs/ARCHITECTURE.md): a CreateInfo fixes sizes, formats and quality once
+// (programs and textures are built in the constructor, owned by RAII and released in the destructor); a
+// FrameAttribs carries the per-frame inputs. Inputs are non-owning: GL names of the caller's textures and
+// pointers to CPU objects that must outlive the call. No pass creates, owns or changes the current GL
+// context; each needs one (OpenGL 4.5 core) current on the calling thread for its whole lifetime.
 //
 // GL state: run() binds its own programs, textures, samplers, images and buffers to the units and
 // binding points below and unbinds them (0) before returning; it does not restore the caller's bindings
@@ -67,27 +67,20 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 class PrefilterPass {
 public:
   struct CreateInfo {
-    int width = 1024;          ///< map width W, texels; a multiple of the regions R = K P at run()
-    int height = 1024;         ///< map height H, texels (rows = epipolar slices)
-    int bases = kDefaultBases; ///< M, even, in [4, 128]; ceil(M / 4) RGBA layers
-    StorageFormat format = StorageFormat::RGBA8; ///< texture format of the filtered basis (Sec. 3.3)
-    WeightMode weights = WeightMode::Exact;      ///< filter weights (weights.h)
-    int regionsPerSplit = 1; ///< P, prefilter regions per layout region (Table 1 "regions"), >= 1
-    /// Bases one invocation filters (Table 1): a multiple of 4 in [4, 128] (the last group of a row may be
-    /// partial). On llvmpipe (1024^2 map, M = 32)
-    /// 32 is fastest (28 ms vs 45 ms for 8, 67 ms for 4): more invocations only repeat the depth reads
-    /// and weights on a CPU; GPUs prefer 8 (the paper's choice on an NVIDIA Titan).
-    int basesPerInvocation = 8;
-    double depthMargin = 0.0625; ///< m of fourier.h, in [0, 0.25]
+    int width = 1024;  ///< map width W, texels; a multiple of the regions R = K P at run()
+    int height = 1024; ///< map height H, texels (rows = epipolar slices)
+    /// The prefilter it runs: M (ceil(M / 4) RGBA layers), storage format (Sec. 3.3), weights
+    /// (weights.h), regions per split P (Table 1 "regions", <= width), depth margin, bases per invocation
+    /// (Table 1). The same options give the CPU reference crep::prefilter(); `threads` is not used.
+    /// basesPerInvocation: on llvmpipe 32 is fastest (more invocations only repeat the depth reads and
+    /// weights on a CPU); GPUs prefer 8 (the paper's choice on an NVIDIA Titan), the default.
+    PrefilterOptions options;
     int workgroupRows = 64;      ///< local_size_x: rows per workgroup, >= 1
     int workgroupBaseGroups = 1; ///< local_size_y: groups of bases per workgroup, >= 1
     int workgroupRegions = 1;    ///< local_size_z: regions per workgroup, >= 1
-
-    /// The CPU options that describe the same prefilter (for crep::prefilter()).
-    PrefilterOptions prefilterOptions() const;
   };
 
-  struct Frame {
+  struct FrameAttribs {
     /// The caller's rectified map: a GL_TEXTURE_2D of width x height texels (any depth or float
     /// format; channel r = depth-buffer value in [0, 1]), e.g. rendered with the split matrices and
     /// SplitLayout::Regions. Read with texelFetch through the pass's own sampler (no compare mode).
@@ -97,8 +90,8 @@ public:
     double extinctionOverride = -1.0; ///< >= 0: use this weight extinction s instead (1/world unit)
   };
 
-  /// Validates `info` (InvalidArgument naming the field, e.g. "PrefilterPass::CreateInfo.bases"; GlError
-  /// naming it when a size exceeds GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS or the compute
+  /// Validates `info` (InvalidArgument naming the field, e.g. "PrefilterPass::CreateInfo.options.bases";
+  /// GlError naming it when a size exceeds GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS or the compute
   /// workgroup limits), compiles the program and allocates the filtered-basis texture array.
   explicit PrefilterPass(const CreateInfo& info);
   ~PrefilterPass();
@@ -109,12 +102,12 @@ public:
 
   /// Prefilters the frame's map into filteredBasisTexture(). Computes the per-row weights on the CPU
   /// (height x R profiles of the layout, double) and uploads them, then dispatches. Throws
-  /// InvalidArgument naming the Frame field (null layout / medium, texture 0 or not a 2D texture of the
-  /// created size, width not a multiple of R, negative extinction).
-  void run(const Frame& frame);
+  /// InvalidArgument naming the FrameAttribs field (null layout / medium, texture 0 or not a 2D texture of
+  /// the created size, width not a multiple of R, negative extinction).
+  void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
-  int layers() const noexcept { return (info_.bases + 3) / 4; }
+  int layers() const noexcept { return layerCount(info_.options.bases); }
   /// GL_TEXTURE_2D_ARRAY of the filtered basis (GL_LINEAR, clamp to edge), valid after run().
   std::uint32_t filteredBasisTexture() const noexcept { return texture_.get(); }
   /// GL buffer of gpu::RegionWeights of the last run (for the near-plane correction).
@@ -135,17 +128,17 @@ private:
 class EvaluatePass {
 public:
   struct CreateInfo {
-    int bases = kDefaultBases;              ///< M compiled into the shader; must equal the filtered basis's M
-    Sampling sampling = Sampling::Bilinear; ///< filtering of the filtered basis (GL_LINEAR / GL_NEAREST)
-    bool nearPlaneCorrection = false;       ///< Sec. 3.1: integrate from the near plane (prefilter.h)
-    RingingFilter ringing = RingingFilter::None; ///< damping of the ray coefficients (fourier.h)
+    int bases = kDefaultBases; ///< M compiled into the shader; must equal the filtered basis's M
+    /// Sampling of the filtered basis (GL_LINEAR / GL_NEAREST), near-plane correction (Sec. 3.1) and
+    /// ringing filter: the same options give the CPU reference crep::evaluate(); `threads` is not used.
+    EvaluateOptions options;
     /// Format of the caller's output texture: RGBA32F (default) or RGBA16F.
     StorageFormat outputFormat = StorageFormat::RGBA32F;
     int workgroupWidth = 8;  ///< local_size_x, pixels, >= 1
     int workgroupHeight = 8; ///< local_size_y, pixels, >= 1
   };
 
-  struct Frame {
+  struct FrameAttribs {
     std::uint32_t cameraDepth = 0;  ///< caller's GL_TEXTURE_2D, depth-buffer values of `camera` in [0, 1]
     std::uint32_t output = 0;       ///< caller's GL_TEXTURE_2D of the same size in outputFormat: RGB L, A T
     const Camera* camera = nullptr; ///< the camera of cameraDepth (normally the rectified one)
@@ -164,9 +157,9 @@ public:
   EvaluatePass(const EvaluatePass&) = delete;
   EvaluatePass& operator=(const EvaluatePass&) = delete;
 
-  /// Writes the scattering image into frame.output. Throws InvalidArgument naming the Frame field
+  /// Writes the scattering image into frame.output. Throws InvalidArgument naming the FrameAttribs field
   /// (null pointers, texture 0, wrong target / format / size, bases mismatch, layout not projective).
-  void run(const Frame& frame);
+  void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
 

@@ -51,18 +51,17 @@
 //   (composite: surface * A + L; per-channel transmittance is exp(-sigma_c s)).
 //
 // ---------------------------------------------------------------------------------------------------
-// Reference march (marchReference()): the same rays, start and end rules and output, but the
-// visibility is integrated exactly over the same map: the ray's texel row floor(row H) (clamped), each
-// texel i of the crossed regions lit iff depth(i, j) >= z_r (GL_LESS shadow test, no basis), weighted
-// with the ray's own exact transmittance over the part of the texel it crosses, per channel (the part of
-// region 0 in front of the map, camera to column 0, takes the first texel's test). No Fourier
-// truncation, no reference-ray weights, no quantization, no filtering: the method's own error is
-// evaluate() against marchReference() on the same map.
+// References. The method's own error is evaluate() against bruteForceMarch() (crep/scatter/
+// rectified_march.h) on the same map: the same rays, start and end rules and output, but the visibility
+// integrated exactly per texel (no Fourier truncation, no reference-ray weights, no quantization, no
+// filtering). Ground truth without any map: unshadowedScattering() (crep/scatter/ray.h) for an empty
+// scene, worldSpaceMarch() (crep/scatter/world_march.h) against a standard shadow map.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -74,6 +73,7 @@
 #include <crep/prefilter/fourier.h>
 #include <crep/prefilter/weights.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/ray.h>
 
 namespace crep {
 
@@ -109,9 +109,11 @@ struct PrefilterOptions {
   int threads = 0;
 };
 
-/// Throws InvalidArgument naming the field ("bases", "PrefilterOptions.regionsPerSplit",
-/// "PrefilterOptions.depthMargin", "PrefilterOptions.basesPerInvocation", "PrefilterOptions.threads").
-void validate(const PrefilterOptions& options);
+/// The one validation of the prefilter's parameters, for the CPU reference and the GPU pass: throws
+/// InvalidArgument naming the field as `<owner>.bases`, `<owner>.format`, `<owner>.weights`,
+/// `<owner>.regionsPerSplit`, `<owner>.depthMargin`, `<owner>.basesPerInvocation`, `<owner>.threads`
+/// (owner e.g. "PrefilterOptions" or "PrefilterPass::CreateInfo.options").
+void validate(const PrefilterOptions& options, std::string_view owner = "PrefilterOptions");
 
 /// Number of RGBA layers for M bases: (M + 3) / 4 (channels beyond M are stored as encoded 0.5, i.e. F = 0).
 inline int layerCount(int bases) {
@@ -183,15 +185,8 @@ struct EvaluateOptions {
   int threads = 0;
 };
 
-/// C of Eq. 1 per channel for a view direction v (unit, from the camera): irradiance *
-/// medium.scatteringTimesPhase(dot(light.direction(), -v)) (radiance per world unit).
-glm::dvec3 scatteringConstant(const DirectionalLight& light, const Medium& medium,
-                              const glm::dvec3& viewDirection);
-
-/// Throws InvalidArgument ("cameraDepth", naming the pixel and value) unless `depth` is non-empty and
-/// every value of its first channel is a depth-buffer value in [0, 1] (NaN included). Shared by every
-/// CPU path that reads a camera depth image (evaluate, the marches of epipolar/).
-void validateCameraDepth(const Image& depth);
+/// Throws InvalidArgument naming the field as `<owner>.sampling`, `<owner>.ringing`, `<owner>.threads`.
+void validate(const EvaluateOptions& options, std::string_view owner = "EvaluateOptions");
 
 /// Evaluation (see top): a 4-channel image of cameraDepth's size, RGB = in-scattered radiance, A =
 /// grey transmittance. `cameraDepth`: 1 channel (channel 0 used if more), depth-buffer values of
@@ -201,16 +196,5 @@ void validateCameraDepth(const Image& depth);
 /// rectification's camera) get the unshadowed value (V = 1 on the whole ray), never NaN.
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
                const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options = {});
-
-/// The brute-force reference march over the same map (see top), same inputs and output as evaluate().
-Image marchReference(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                     const DirectionalLight& light, const Medium& medium,
-                     const EvaluateOptions& options = {});
-
-/// Closed-form single scattering of the homogeneous medium without occluders (Eq. 1 with V = 1, Eq. 3),
-/// same rays, start/end rules and output as evaluate(): L_c = C_c (exp(-sigma_c t_a) - exp(-sigma_c s))
-/// / sigma_c with t_a = 0 (or the near-plane distance). Ground truth for tests and a no-shadow fallback.
-Image unshadowedScattering(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
-                           const Medium& medium, const EvaluateOptions& options = {});
 
 } // namespace crep

@@ -30,6 +30,7 @@
 
 #include <crep/core/medium.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/ray.h>
 
 namespace crep {
 
@@ -43,11 +44,8 @@ enum class WeightMode {
 /// Stable token: "average-visibility", "constant-step", "constant-ratio", "exact".
 const char* weightModeToken(WeightMode mode);
 
-/// The scalar extinction of the weights: the mean of medium.extinction() over R, G, B (1/world unit).
-double weightExtinction(const Medium& medium);
-
-/// phi(x) = (1 - exp(-x)) / x for x >= 0, phi(0) = 1 (series below 1e-5). +inf -> 0.
-double oneMinusExpOverX(double x);
+// The scalar extinction of the weights is weightExtinction(medium) and phi is oneMinusExpOverX, both in
+// crep/scatter/ray.h (the same grey extinction is the alpha channel of every method's output).
 
 /// The boundary distances tau_0..tau_n (size n + 1, n >= 1) of `mode` (see top; AverageVisibility:
 /// tau_i = i, in texels). Throws InvalidArgument ("texels") for n < 1 or a size mismatch.

@@ -129,6 +129,8 @@ struct RectifyOptions {
   ReferenceRay referenceRay = ReferenceRay::Bisectrix;
 
   static constexpr int kMaxSplits = 64;
+
+  bool operator==(const RectifyOptions&) const = default;
 };
 
 enum class RectifyStatus {

@@ -1,0 +1,268 @@
+// The tool's methods, each built from the library's passes: the world-space reference march
+// (WorldMarchPass), Klehm et al. 2014's prefiltered scattering (PrefilterPass + EvaluatePass), and the
+// min/max tree and brute-force marches over the rectified rows (MinMaxTreePass, RectifiedMarchPass), with
+// the epipolar resampling fallback (EpipolarLayout + ShadowResamplePass + the epipole block) for frames
+// whose rectification is not projective.
+#include "methods.h"
+
+#include "args.h"
+
+#include <crep/core/error.h>
+#include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/gpu_march.h>
+#include <crep/epipolar/resample.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/scatter/gpu_world_march.h>
+
+#include <epoxy/gl.h>
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+namespace crep::tool {
+
+namespace {
+
+gl::Handle newScatteringTexture(const Frame& frame) {
+  return gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "--size");
+}
+
+/// WorldMarchPass on `pixels` of the frame (all, or the block around `blockCenter`).
+void runWorldMarch(const Frame& frame, const MethodSettings& settings, std::uint32_t scattering,
+                   const glm::dvec2& blockCenter = glm::dvec2(0.0), double blockRadius = -1.0) {
+  WorldMarchPass::CreateInfo info;
+  info.options.steps = settings.steps;
+  WorldMarchPass pass(info);
+  WorldMarchPass::FrameAttribs a;
+  a.camera = &frame.camera;
+  a.light = &frame.light;
+  a.medium = &frame.medium;
+  a.cameraDepth = frame.cameraDepth.get();
+  a.width = frame.width;
+  a.height = frame.height;
+  a.shadowMap = frame.shadowMap.get();
+  a.shadowWidth = frame.shadowWidth;
+  a.shadowHeight = frame.shadowHeight;
+  a.lightClipFromWorld = frame.lightClipFromWorld;
+  a.bias = frame.shadowBias;
+  a.scatteringOut = scattering;
+  a.blockCenter = blockCenter;
+  a.blockRadius = blockRadius;
+  pass.run(a);
+  glFinish();
+}
+
+/// The world-space reference: every pixel's view ray marched against the standard shadow map
+/// (crep/scatter/world_march.h), independent of any rectification.
+MethodOutput runReference(Frame& frame, const MethodSettings& settings) {
+  MethodOutput out;
+  out.used = "reference";
+  out.detail = std::to_string(settings.steps) + " march steps, standard map " +
+               std::to_string(frame.shadowWidth) + "x" + std::to_string(frame.shadowHeight);
+  out.scattering = newScatteringTexture(frame);
+  out.timings.time("reference march", [&] { runWorldMarch(frame, settings, out.scattering.get()); });
+  return out;
+}
+
+/// The epipolar fallback map of a frame: the layout of Klehm et al. 2014, Sec. 4.1 for the frame's
+/// camera, light and screen, and the standard shadow map resampled into it on the GPU.
+struct EpipolarMap {
+  std::shared_ptr<EpipolarLayout> layout;
+  gl::Handle texture; ///< R32F, width x sliceCount
+  int width = 0, height = 0;
+};
+
+EpipolarMap makeEpipolarMap(const Frame& frame, const MethodSettings& settings, StageTimings& timings) {
+  EpipolarMap m;
+  EpipolarOptions options;
+  options.regions = settings.rectify.splits;
+  m.layout = timings.time("epipolar layout", [&] {
+    return std::make_shared<EpipolarLayout>(frame.camera, frame.light, frame.width, frame.height, options);
+  });
+  m.width = settings.mapSize;
+  m.height = m.layout->sliceCount();
+  m.texture = gl::createTexture2D(GL_R32F, m.width, m.height, "--map-size");
+  timings.time("resample (epipolar)", [&] {
+    ShadowResamplePass pass({m.width, m.height});
+    ShadowResamplePass::FrameAttribs a;
+    a.layout = m.layout.get();
+    a.shadowMap = frame.shadowMap.get();
+    a.shadowWidth = frame.shadowWidth;
+    a.shadowHeight = frame.shadowHeight;
+    a.lightClipFromWorld = frame.lightClipFromWorld;
+    a.rectifiedOut = m.texture.get();
+    pass.run(a);
+    glFinish();
+  });
+  return m;
+}
+
+/// The world-space march of the pixels around the epipole (Klehm et al. 2014, Fig. 8), over `scattering`.
+void marchEpipoleBlock(const Frame& frame, const MethodSettings& settings, const EpipolarLayout& layout,
+                       std::uint32_t scattering, StageTimings& timings) {
+  const auto centre = layout.epipolePixel();
+  if (!centre || layout.epipoleBlockRadiusPixels() <= 0.0) return;
+  timings.time("epipole block march", [&] {
+    runWorldMarch(frame, settings, scattering, *centre, layout.epipoleBlockRadiusPixels());
+  });
+}
+
+/// The min/max tree (tree = true) or brute-force march of every pixel's view ray along its row of the
+/// rectified map (projective), or of the epipolar fallback map (plus the epipole block).
+MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, bool tree, const char* caller) {
+  MethodOutput out;
+  out.used = tree ? "minmax" : "brute";
+  Rectification rect;
+  const RectifiedGpuMap* map = frame.rectified(settings, out.timings, &rect);
+  std::optional<EpipolarMap> epipolar;
+  const RectifiedLayout* layout = nullptr;
+  std::uint32_t texture = 0;
+  int width = 0, height = 0;
+  if (map) {
+    layout = map->layout.get();
+    texture = map->texture.get();
+    width = height = map->size;
+    out.detail = std::to_string(map->rect.splitCount()) + " splits, map " + std::to_string(map->size) +
+                 "^2 " + map->source;
+  } else {
+    std::fprintf(stderr,
+                 "crep: %s: rectification is %s (%s); using the epipolar resampling fallback (%s march)\n",
+                 caller, statusToken(rect.status), rect.message.c_str(), tree ? "min/max" : "brute-force");
+    epipolar = makeEpipolarMap(frame, settings, out.timings);
+    layout = epipolar->layout.get();
+    texture = epipolar->texture.get();
+    width = epipolar->width;
+    height = epipolar->height;
+    out.used += " (epipolar)";
+    out.detail = "epipolar fallback, map " + std::to_string(width) + "x" + std::to_string(height);
+  }
+  const RectifiedMarchPass::Mode mode =
+      tree ? RectifiedMarchPass::Mode::MinMaxTree : RectifiedMarchPass::Mode::BruteForce;
+  auto pass = out.timings.time("march setup", [&] {
+    return std::make_unique<RectifiedMarchPass>(RectifiedMarchPass::CreateInfo{width, height, mode});
+  });
+  std::unique_ptr<MinMaxTreePass> trees;
+  if (tree) {
+    trees = out.timings.time("min/max setup", [&] {
+      return std::make_unique<MinMaxTreePass>(MinMaxTreePass::CreateInfo{width, height});
+    });
+    out.timings.time("min/max trees", [&] {
+      trees->run(texture);
+      glFinish();
+    });
+  }
+  out.scattering = newScatteringTexture(frame);
+  out.timings.time(tree ? "min/max march" : "brute-force march", [&] {
+    RectifiedMarchPass::FrameAttribs a;
+    a.layout = layout;
+    a.camera = &frame.camera;
+    a.light = &frame.light;
+    a.medium = &frame.medium;
+    a.cameraDepth = frame.cameraDepth.get();
+    a.width = frame.width;
+    a.height = frame.height;
+    a.rectifiedDepth = texture;
+    a.minMaxBuffer = trees ? trees->treeBuffer() : 0;
+    a.scatteringOut = out.scattering.get();
+    pass->run(a);
+    glFinish();
+  });
+  if (epipolar) marchEpipoleBlock(frame, settings, *epipolar->layout, out.scattering.get(), out.timings);
+  return out;
+}
+
+MethodOutput runMinMax(Frame& frame, const MethodSettings& settings) {
+  return runRectifiedMarch(frame, settings, true, "minmax");
+}
+MethodOutput runBrute(Frame& frame, const MethodSettings& settings) {
+  return runRectifiedMarch(frame, settings, false, "brute");
+}
+
+/// Klehm et al. 2014: GPU prefilter of the rectified map (Fourier basis, transmittance-weighted prefix
+/// filter per row) and the constant-time evaluation per pixel.
+MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
+  StageTimings timings;
+  const RectifiedGpuMap* map = frame.rectified(settings, timings);
+  if (!map) {
+    // The prefiltered evaluation pass needs a projective layout (gpu_pass.h); on the epipolar layout the
+    // min/max march over the resampled map stands in for it (it announces the fallback on stderr).
+    MethodOutput fallback = runRectifiedMarch(frame, settings, true, "prefilter");
+    timings.append(fallback.timings.rows());
+    fallback.timings = timings;
+    return fallback;
+  }
+  const PrefilterOptions& options = settings.prefilter;
+  MethodOutput out;
+  out.used = "prefilter";
+  out.detail = "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format) + ", " +
+               std::to_string(map->rect.splitCount()) + " splits, map " + std::to_string(map->size) + "^2 " +
+               map->source;
+  out.timings = timings;
+  PrefilterPass::CreateInfo prefilterInfo;
+  prefilterInfo.width = map->size;
+  prefilterInfo.height = map->size;
+  prefilterInfo.options = options;
+  auto prefilter =
+      out.timings.time("prefilter setup", [&] { return std::make_unique<PrefilterPass>(prefilterInfo); });
+  EvaluatePass::CreateInfo evaluateInfo;
+  evaluateInfo.bases = options.bases;
+  auto evaluate =
+      out.timings.time("evaluate setup", [&] { return std::make_unique<EvaluatePass>(evaluateInfo); });
+  out.timings.time("prefilter", [&] {
+    PrefilterPass::FrameAttribs f;
+    f.rectifiedDepth = map->texture.get();
+    f.layout = map->layout.get();
+    f.medium = &frame.medium;
+    prefilter->run(f);
+    glFinish();
+  });
+  out.scattering = newScatteringTexture(frame);
+  out.timings.time("evaluate", [&] {
+    EvaluatePass::FrameAttribs f;
+    f.cameraDepth = frame.cameraDepth.get();
+    f.output = out.scattering.get();
+    f.camera = &frame.camera;
+    f.light = &frame.light;
+    f.medium = &frame.medium;
+    f.layout = map->layout.get();
+    f.basis = prefilter->filteredBasis();
+    evaluate->run(f);
+    glFinish();
+  });
+  return out;
+}
+
+} // namespace
+
+const std::vector<Method>& methodRegistry() {
+  static const std::vector<Method> registry = {
+      {"reference", "world-space march of every view ray against the standard shadow map", true,
+       runReference},
+      {"prefilter", "Klehm et al. 2014: prefiltered Fourier basis on the rectified map (GPU)", false,
+       runPrefilter},
+      {"minmax", "1D min/max tree march over the rectified rows (Chen et al. 2011, Yusov 2012)", false,
+       runMinMax},
+      {"brute", "brute-force march over the rectified rows, texel by texel", false, runBrute},
+  };
+  return registry;
+}
+
+std::string methodNames() {
+  std::string names;
+  for (const Method& m : methodRegistry())
+    names += (names.empty() ? "" : " | ") + m.name;
+  return names;
+}
+
+const Method& findMethod(const std::string& name, const std::string& option) {
+  for (const Method& m : methodRegistry())
+    if (m.name == name) return m;
+  throw UsageError("option " + option + ": '" + name + "' is not a method (" + methodNames() + ")");
+}
+
+MethodOutput runMethod(const std::string& name, Frame& frame, const MethodSettings& settings) {
+  return findMethod(name).run(frame, settings);
+}
+
+} // namespace crep::tool

@@ -1,0 +1,44 @@
+// The tool's registry of scattering methods: each a function that runs on one Frame and reports its
+// stages. Adding a method is one entry in methodRegistry() (methods.cpp): a name, a one-line summary and
+// a function Frame -> MethodOutput built from the library's passes.
+#pragma once
+
+#include "frame.h"
+#include "timings.h"
+
+#include <crep/core/gl.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace crep::tool {
+
+/// What one method produced.
+struct MethodOutput {
+  gl::Handle scattering; ///< GL_RGBA32F width x height: RGB in-scattered radiance, A grey transmittance
+  std::string used;      ///< the method actually run (a fallback may differ from the one asked)
+  std::string detail;    ///< its parameters, for the report
+  StageTimings timings;  ///< its stages (wall clock, each ends with glFinish)
+};
+
+/// One registry entry.
+struct Method {
+  std::string name;
+  std::string summary;
+  bool reference = false; ///< the reference of `crep compare`
+  std::function<MethodOutput(Frame&, const MethodSettings&)> run;
+};
+
+/// Every method available in this build, the reference first.
+const std::vector<Method>& methodRegistry();
+/// The entry called `name`; throws UsageError naming `option` and listing the names otherwise.
+const Method& findMethod(const std::string& name, const std::string& option = "--method");
+/// "prefilter | reference | ..." for help texts and errors.
+std::string methodNames();
+
+/// Runs `name` and, when the rectification is not projective and the method needs it, the fallback
+/// (announced on stderr by the method).
+MethodOutput runMethod(const std::string& name, Frame& frame, const MethodSettings& settings);
+
+} // namespace crep::tool

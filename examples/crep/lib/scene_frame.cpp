@@ -1,0 +1,59 @@
+#include "scene_frame.h"
+
+#include <crep/core/error.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <epoxy/gl.h>
+
+namespace crep::tool {
+
+SceneFrame::SceneFrame() = default;
+SceneFrame::~SceneFrame() = default;
+SceneFrame::SceneFrame(SceneFrame&&) noexcept = default;
+SceneFrame& SceneFrame::operator=(SceneFrame&&) noexcept = default;
+
+SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,
+                          StageTimings& timings) {
+  SceneFrame s;
+  s.scene = timings.time("scene build", [&] {
+    return std::make_unique<scenes::Scene>(scenes::makeScene(name, double(width) / double(height)));
+  });
+  gl::checkTextureSize("--map-size", shadowMapSize, shadowMapSize);
+  gl::checkTextureSize("--size", width, height);
+  const scenes::Scene& scene = *s.scene;
+  s.renderer = timings.time("scene upload + shaders", [&] {
+    auto r = std::make_unique<scenes::SceneRenderer>(scene.mesh);
+    glFinish();
+    return r;
+  });
+  s.frame = std::make_unique<Frame>(scene.camera, scene.sun, scene.medium);
+  Frame& f = *s.frame;
+  f.width = width;
+  f.height = height;
+  f.renderer = s.renderer.get();
+  // Standard shadow map: lit surfaces and the reference march.
+  f.lightClipFromWorld = scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
+  f.shadowWidth = f.shadowHeight = shadowMapSize;
+  f.shadowMap = scenes::createDepthTexture(shadowMapSize, shadowMapSize, "--map-size");
+  timings.time("shadow pass (standard)", [&] {
+    s.renderer->renderDepth(f.lightClipFromWorld, f.shadowMap.get(), 0, 0, 0, shadowMapSize, shadowMapSize,
+                            {.depthClamp = true});
+    glFinish();
+  });
+  s.color = gl::createTexture2D(GL_RGBA32F, width, height, "--size");
+  f.cameraDepth = scenes::createDepthTexture(width, height, "--size");
+  timings.time("camera pass", [&] {
+    scenes::SceneRenderer::ShadeInputs in;
+    in.clipFromWorld = scene.camera.clipFromWorld();
+    in.shadowClipFromWorld = f.lightClipFromWorld;
+    in.shadowMap = f.shadowMap.get();
+    in.lightDirection = scene.sun.direction();
+    in.lightIrradiance = scene.sun.irradiance();
+    s.renderer->renderShaded(in, s.color.get(), f.cameraDepth.get(), width, height);
+    glFinish();
+  });
+  return s;
+}
+
+} // namespace crep::tool

@@ -1,0 +1,34 @@
+// A built-in scene (crep/scenes) rendered into a Frame: the standard shadow pass and the lit camera pass.
+#pragma once
+
+#include "frame.h"
+#include "timings.h"
+
+#include <crep/core/gl.h>
+
+#include <memory>
+#include <string>
+
+namespace crep::scenes {
+class SceneRenderer;
+struct Scene;
+} // namespace crep::scenes
+
+namespace crep::tool {
+
+struct SceneFrame {
+  std::unique_ptr<scenes::Scene> scene;
+  std::unique_ptr<scenes::SceneRenderer> renderer;
+  std::unique_ptr<Frame> frame;
+  gl::Handle color; ///< lit surfaces, RGBA32F width x height
+  SceneFrame();
+  ~SceneFrame();
+  SceneFrame(SceneFrame&&) noexcept;
+  SceneFrame& operator=(SceneFrame&&) noexcept;
+};
+
+/// Builds scene `name` for a width x height camera and renders its passes (stages to `timings`).
+SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,
+                          StageTimings& timings);
+
+} // namespace crep::tool

@@ -1,0 +1,40 @@
+// crepuscular: the frame block of the march and resampling passes and the camera pixel rays they march
+// (GLSL twin of gpu::MarchParams in crep/scatter/gpu_world_march.h; the rays of crep/scatter/ray.h).
+//
+// Public include (conventions in crep/common.glsl).
+#ifndef CREP_MARCH_GLSL
+#define CREP_MARCH_GLSL
+
+#include "common.glsl"
+#include "ray.glsl"
+
+// gpu::MarchParams (std140): the frame attributes of the march and resampling passes.
+struct CrepMarchParams {
+  vec4 cameraPosition;     // xyz world; w near
+  vec4 cameraForward;      // xyz unit view direction; w far
+  vec4 cameraRight;        // xyz right * tan(fovY / 2) * aspect; w 0
+  vec4 cameraUp;           // xyz up * tan(fovY / 2); w 0
+  vec4 lightDirection;     // xyz direction the light travels; w 0
+  vec4 lightIrradiance;    // rgb; w 0
+  vec4 mieScattering;      // rgb; w Henyey-Greenstein g
+  vec4 rayleighScattering; // rgb; w 0
+  vec4 extinction;         // rgb sigma_t; w grey extinction (mean of rgb)
+  ivec4 sizes;             // march: xy camera image, zw map; world march: zw shadow map; resampling: xy shadow map, zw map
+  ivec4 info;              // march: x tree levels L, y tree row stride; world march: x steps N, y refinements
+  vec4 bias;               // world march: x shadow bias (depth-buffer units); yzw 0
+  vec4 block;              // world march: xy centre (pixels), z radius (pixels, < 0: every pixel), w 0
+  ivec4 region;            // world march: xy first pixel of the dispatch, zw its size
+  mat4 lightClipFromWorld; // world march / resampling: the standard shadow map's matrix
+};
+
+// The view ray of pixel p of a w x h camera image and its surface distance (crep/scatter/ray.h: sky
+// pixels end at the far plane). xyz = unit direction, w = distance.
+vec4 crep_pixelRay(CrepMarchParams m, ivec2 p, float depth) {
+  vec2 ndc = 2.0 * (vec2(p) + 0.5) / vec2(m.sizes.xy) - 1.0;
+  vec3 dir = normalize(m.cameraForward.xyz + ndc.x * m.cameraRight.xyz + ndc.y * m.cameraUp.xyz);
+  float viewDepth = depth >= 1.0 || !(depth >= 0.0) ? m.cameraForward.w
+                                                    : crep_linearDepth(depth, m.cameraPosition.w, m.cameraForward.w);
+  return vec4(dir, viewDepth / dot(dir, m.cameraForward.xyz));
+}
+
+#endif // CREP_MARCH_GLSL

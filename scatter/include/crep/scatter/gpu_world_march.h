@@ -1,0 +1,99 @@
+// The GL pass of the world-space reference march (crep/scatter/world_march.h: its CPU reference and
+// rule) and the std140 block MarchParams shared by every march and resampling pass of the library
+// (this one, the rectified marches and the resampling of epipolar/). Float precision.
+//
+// The block has a GLSL twin with the same name prefixed "Crep" in glsl/crep/march.glsl: 16-byte vectors
+// and matrices only, int instead of bool, a static_assert on the size; the GL tests compare every member
+// offset with the offsets the driver reports.
+//
+// The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its program,
+// buffer and sampler (RAII); the textures of FrameAttribs are the caller's (non-owning GL names). Depth
+// textures hold depth-buffer values in [0, 1] (GL_DEPTH_COMPONENT32F or GL_R32F, read with texelFetch
+// through the pass's own nearest sampler, so their compare mode does not matter); outputs are
+// GL_RGBA32F (scattering: RGB radiance, A grey transmittance) and GL_R32F (steps per pixel). It leaves
+// program 0, texture units 0-1 with no texture and no sampler, image units 0-1, uniform and storage
+// buffer bindings 0-1 unbound (gl::unbindPassState), and issues gl::passOutputBarrier(). A NaN camera
+// depth is treated as the sky (far plane), a NaN shadow-map texel as empty (lit): checking would cost a
+// readback. The CPU reference rejects NaN with InvalidArgument.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/gl.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/scatter/world_march.h>
+
+namespace crep {
+namespace gpu {
+
+/// std140 block CrepMarchBlock { CrepMarchParams crep_march; } of the march and resampling passes.
+struct MarchParams {
+  glm::vec4 cameraPosition{0.0f};                    ///< xyz: world; w: near plane distance
+  glm::vec4 cameraForward{0.0f, 0.0f, -1.0f, 0.0f};  ///< xyz: unit view direction; w: far plane distance
+  glm::vec4 cameraRight{1.0f, 0.0f, 0.0f, 0.0f};     ///< xyz: right * tan(fovY / 2) * aspect; w: 0
+  glm::vec4 cameraUp{0.0f, 1.0f, 0.0f, 0.0f};        ///< xyz: up * tan(fovY / 2); w: 0
+  glm::vec4 lightDirection{0.0f, -1.0f, 0.0f, 0.0f}; ///< xyz: direction the light travels; w: 0
+  glm::vec4 lightIrradiance{0.0f};                   ///< rgb: irradiance; w: 0
+  glm::vec4 mieScattering{0.0f};      ///< rgb: sigma_s of the Henyey-Greenstein part (1/world unit); w: g
+  glm::vec4 rayleighScattering{0.0f}; ///< rgb: sigma_s of the Rayleigh part; w: 0
+  glm::vec4 extinction{0.0f};         ///< rgb: sigma_t; w: grey extinction (weightExtinction)
+  /// march: xy camera image (pixels), zw rectified map (texels); world march: zw standard shadow map;
+  /// resampling: xy standard shadow map, zw rectified map
+  glm::ivec4 sizes{0};
+  glm::ivec4 info{0};   ///< march: x tree levels L, y tree row stride; world march: x steps N, y refinements
+  glm::vec4 bias{0.0f}; ///< world march: x shadow bias (depth-buffer units)
+  glm::vec4 block{0.0f, 0.0f, -1.0f, 0.0f}; ///< world march: xy centre, z radius (pixels; < 0: all pixels)
+  glm::ivec4 region{0};               ///< world march: xy first pixel of the dispatch, zw its size (pixels)
+  glm::mat4 lightClipFromWorld{1.0f}; ///< world march / resampling: the standard shadow map's matrix
+};
+static_assert(sizeof(MarchParams) == 16 * 18, "std140 CrepMarchParams");
+
+/// The camera, light and medium part of MarchParams for a w x h camera image and a W x H map.
+MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                            int width, int height, int mapWidth, int mapHeight);
+
+} // namespace gpu
+
+/// The world-space reference march (world_march.h) against a standard shadow map; optionally only the
+/// pixels within a radius of a point: the epipole block of Klehm et al. 2014, Fig. 8 (its other pixels
+/// are not written).
+class WorldMarchPass {
+public:
+  struct CreateInfo {
+    /// steps and refinements are compiled in; bias and threads are not used by the pass (bias is a
+    /// per-frame attribute, FrameAttribs::bias).
+    WorldMarchOptions options;
+  };
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    const DirectionalLight* light = nullptr;
+    const Medium* medium = nullptr;
+    std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
+    int width = 0, height = 0;
+    std::uint32_t shadowMap = 0; ///< standard shadow map (depth texture) rendered with lightClipFromWorld
+    int shadowWidth = 0, shadowHeight = 0;
+    glm::dmat4 lightClipFromWorld{1.0};
+    double bias = 0.0;               ///< added to the stored depth (depth-buffer units)
+    std::uint32_t scatteringOut = 0; ///< GL_RGBA32F width x height
+    std::uint32_t stepsOut = 0;      ///< GL_R32F width x height, or 0
+    /// Epipole block: when blockRadius >= 0, only pixels whose centre is within blockRadius pixels of
+    /// blockCenter (pixel coordinates, origin at the bottom-left corner of the image) are marched.
+    glm::dvec2 blockCenter{0.0};
+    double blockRadius = -1.0;
+  };
+  /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
+  explicit WorldMarchPass(const CreateInfo& info);
+  /// Throws InvalidArgument naming the FrameAttribs field.
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, params_, sampler_, dummySteps_;
+  int dummyWidth_ = 0, dummyHeight_ = 0;
+};
+
+} // namespace crep

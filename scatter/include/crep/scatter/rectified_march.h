@@ -1,0 +1,111 @@
+// Marches of camera view rays along the rows of a rectified map (Klehm et al. 2014, Sec. 2.2: in a
+// rectified map every view ray is one texel row at constant depth), on the rays and with the output of
+// crep/scatter/ray.h. The brute-force march here is the reference every rectified method is measured
+// against on the same map (the prefiltered evaluation, the min/max tree march of epipolar/); the
+// scaffolding (marchRectifiedRows) is shared with the tree march so both integrate identical sections.
+//
+// ---------------------------------------------------------------------------------------------------
+// Rule. P = layout.toRectified(camera.position() + s v) gives the ray's row, its depth z_r (clamped to
+// [0, 1]: 1 is "behind every stored occluder") and the region k and column u of its end. Texel row
+// j = clamp(floor(row H), 0, H - 1); the ray crosses texels 0..e of that row, e = k n + clamp(ceil(u n) - 1,
+// 0, n - 1) (K regions of n = W / K texels). Texel i is lit iff depth(i, j) >= z_r (the GL_LESS shadow
+// test). Its section of the ray is [T(i), T(i + 1)] with the ray's own world distances (the layout's
+// DistanceProfile, exact):
+//   T(0) = 0 (region 0 starts at the camera: the part in front of the map takes the first texel's test),
+//   T(e + 1) = s,
+//   T(r n) = clamp(layout.rayDistance(row, z_r, r / K), T((r - 1) n), s) at region boundaries,
+//   T(r n + q) = clamp(layout.rayProfile(row, z_r, r)(q / n), T(r n), T((r + 1) n)) inside region r.
+// With the near-plane correction every section is clipped to [t_n, s] (texels in front of the near plane
+// contribute nothing). Pixels whose end point the layout cannot map (toRectified throws) are unshadowed.
+// Steps (MarchResult::steps) of the brute-force march: texels visited (e + 1); unmapped pixels: 0.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/image.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/core/parallel.h>
+#include <crep/rectify/rectified_map.h>
+#include <crep/scatter/ray.h>
+
+namespace crep {
+
+/// One pixel's ray mapped onto its row (rule at the top).
+struct RowRay {
+  double row = 0.0;   ///< normalized row of the ray
+  double depth = 0.0; ///< z_r, clamped to [0, 1]
+  int texelRow = 0;   ///< j
+  int last = 0;       ///< e: the last texel crossed
+};
+
+/// Maps `ray` (from `origin`) into a W x H map of `layout`; false when the layout cannot map its end.
+bool mapRowRay(const RectifiedLayout& layout, const glm::dvec3& origin, const PixelRay& ray, int width,
+               int height, RowRay& out);
+
+/// T(i) of the rule at the top: the ray's own world distance at texel boundary i.
+class RowDistances {
+public:
+  RowDistances(const RectifiedLayout& layout, const RowRay& ray, int width, double surface);
+  double at(int i) const;
+
+private:
+  int n_, last_;
+  double surface_;
+  std::vector<double> bounds_;
+  std::vector<DistanceProfile> profiles_;
+};
+
+/// The per-pixel scaffolding of the rectified marches: validates the inputs (map, "cameraDepth",
+/// options), maps every pixel's ray and calls walk(const RowRay&, const RowDistances&, litSection, int&
+/// steps), where litSection(ta, tb) adds the lit section [ta, tb] (clipped to the integration range).
+/// Unmapped pixels are unshadowed. Rows of the camera image run in parallel.
+template <class Walk>
+MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                               const DirectionalLight& light, const Medium& medium,
+                               const MarchOptions& options, const Walk& walk) {
+  validate(map);
+  validateCameraDepth(cameraDepth);
+  validate(options);
+  const RectifiedLayout& layout = *map.layout;
+  const int w = cameraDepth.width(), h = cameraDepth.height(), W = map.width(), H = map.height();
+  const glm::dvec3 sigma = medium.extinction();
+  const double grey = weightExtinction(medium);
+  const glm::dvec3 origin = camera.position();
+  MarchResult out{Image(w, h, 4), Image(w, h, 1)};
+  parallelRows(h, options.threads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      glm::dvec3 L(0.0);
+      int steps = 0;
+      RowRay r;
+      if (!mapRowRay(layout, origin, ray, W, H, r)) {
+        L = transmittanceIntegral(sigma, ray.start, ray.surface);
+      } else {
+        const RowDistances T(layout, r, W, ray.surface);
+        walk(
+            r, T,
+            [&](double ta, double tb) { L += transmittanceIntegral(sigma, std::max(ta, ray.start), tb); },
+            steps);
+      }
+      storeScattering(out.scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
+                      std::exp(-grey * ray.surface));
+      out.steps.at(x, y) = static_cast<float>(steps);
+    }
+  });
+  return out;
+}
+
+/// The brute-force march (rule at the top), texel by texel: the reference of every method on the same map.
+/// Throws InvalidArgument for an invalid map (validate(RectifiedMap)), camera depth ("cameraDepth") or
+/// options.
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const DirectionalLight& light, const Medium& medium,
+                            const MarchOptions& options = {});
+
+} // namespace crep

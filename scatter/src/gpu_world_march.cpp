@@ -1,0 +1,102 @@
+// The GL pass of the world-space reference march (crep/scatter/gpu_world_march.h; Klehm et al. 2014,
+// Eq. 1 and 3) and the shared march block. Shader: passes/march_reference.comp, crep/march.glsl.
+#include <crep/core/error.h>
+#include <crep/core/shader_library.h>
+#include <crep/scatter/gpu_world_march.h>
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace crep {
+
+namespace gpu {
+
+MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                            int width, int height, int mapWidth, int mapHeight) {
+  MarchParams p;
+  const double ty = std::tan(0.5 * camera.fovY()), tx = ty * camera.aspect();
+  p.cameraPosition = glm::vec4(glm::vec3(camera.position()), static_cast<float>(camera.near()));
+  p.cameraForward = glm::vec4(glm::vec3(camera.forward()), static_cast<float>(camera.far()));
+  p.cameraRight = glm::vec4(glm::vec3(camera.right() * tx), 0.0f);
+  p.cameraUp = glm::vec4(glm::vec3(camera.up() * ty), 0.0f);
+  p.lightDirection = glm::vec4(glm::vec3(light.direction()), 0.0f);
+  p.lightIrradiance = glm::vec4(glm::vec3(light.irradiance()), 0.0f);
+  p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));
+  p.rayleighScattering = glm::vec4(glm::vec3(medium.rayleighScattering()), 0.0f);
+  const glm::dvec3 sigma = medium.extinction();
+  p.extinction = glm::vec4(glm::vec3(sigma), static_cast<float>(weightExtinction(medium)));
+  p.sizes = glm::ivec4(width, height, mapWidth, mapHeight);
+  return p;
+}
+
+} // namespace gpu
+
+WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
+  validate(info.options);
+  program_ = buildProgram({{ShaderStage::Compute, "passes/march_reference.comp", {}}});
+  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
+  sampler_ = gl::createClampSampler(GL_NEAREST);
+  gl::checkError("WorldMarchPass");
+}
+
+void WorldMarchPass::run(const FrameAttribs& f) {
+  if (!f.camera || !f.light || !f.medium)
+    throw InvalidArgument("WorldMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
+  gl::requireTexture2D("WorldMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
+  gl::requireTexture2D("WorldMarchPass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth, f.shadowHeight);
+  gl::requireTexture2D("WorldMarchPass.FrameAttribs.scatteringOut", f.scatteringOut, f.width, f.height,
+                       GL_RGBA32F);
+  if (f.stepsOut != 0)
+    gl::requireTexture2D("WorldMarchPass.FrameAttribs.stepsOut", f.stepsOut, f.width, f.height, GL_R32F);
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(f.lightClipFromWorld[c][r]))
+        throw InvalidArgument("WorldMarchPass.FrameAttribs.lightClipFromWorld",
+                              detail::formatValue(f.lightClipFromWorld[c][r]), "must be finite");
+  if (!std::isfinite(f.bias))
+    throw InvalidArgument("WorldMarchPass.FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
+  if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
+    throw InvalidArgument("WorldMarchPass.FrameAttribs.blockCenter/blockRadius",
+                          detail::formatValue(f.blockRadius), "must be finite");
+
+  gpu::MarchParams params =
+      gpu::makeMarchParams(*f.camera, *f.light, *f.medium, f.width, f.height, f.shadowWidth, f.shadowHeight);
+  params.info = glm::ivec4(info_.options.steps, info_.options.refinements, 0, 0);
+  params.bias = glm::vec4(static_cast<float>(f.bias), 0.0f, 0.0f, 0.0f);
+  params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
+  // The dispatch: the whole image, or the block's bounding box clipped to it.
+  glm::ivec4 region(0, 0, f.width, f.height);
+  if (f.blockRadius >= 0.0) {
+    const auto lo = glm::max(glm::floor(f.blockCenter - f.blockRadius - 1.0), glm::dvec2(0.0));
+    const auto hi = glm::min(glm::ceil(f.blockCenter + f.blockRadius + 1.0), glm::dvec2(f.width, f.height));
+    region =
+        glm::ivec4(static_cast<int>(lo.x), static_cast<int>(lo.y), std::max(0, static_cast<int>(hi.x - lo.x)),
+                   std::max(0, static_cast<int>(hi.y - lo.y)));
+    params.block = glm::vec4(static_cast<float>(f.blockCenter.x), static_cast<float>(f.blockCenter.y),
+                             static_cast<float>(f.blockRadius), 0.0f);
+  }
+  params.region = region;
+  if (region.z == 0 || region.w == 0) return; // the block misses the image
+  glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
+
+  const GLuint steps = f.stepsOut != 0 ? f.stepsOut
+                                       : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
+                                                              f.width, f.height);
+  glUseProgram(program_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindTextureUnit(0, f.cameraDepth);
+  glBindTextureUnit(1, f.shadowMap);
+  glBindSampler(0, sampler_.get());
+  glBindSampler(1, sampler_.get());
+  glBindImageTexture(0, f.scatteringOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glDispatchCompute(static_cast<GLuint>((region.z + 7) / 8), static_cast<GLuint>((region.w + 7) / 8), 1);
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+  gl::checkError("WorldMarchPass::run");
+}
+
+} // namespace crep

@@ -1,0 +1,152 @@
+// The world-space reference march against a standard shadow map (Klehm et al. 2014, Eq. 1 and 3;
+// Yusov 2012, Eq. 15-16). Rules at the top of crep/scatter/world_march.h.
+#include <crep/core/error.h>
+#include <crep/core/parallel.h>
+#include <crep/scatter/world_march.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace crep {
+
+void validate(const WorldMarchOptions& o) {
+  if (o.steps < 1 || o.steps > (1 << 24))
+    throw InvalidArgument("WorldMarchOptions.steps", detail::formatValue(o.steps), "must be in [1, 2^24]");
+  if (o.refinements < 0 || o.refinements > 60)
+    throw InvalidArgument("WorldMarchOptions.refinements", detail::formatValue(o.refinements),
+                          "must be in [0, 60]");
+  if (!std::isfinite(o.bias))
+    throw InvalidArgument("WorldMarchOptions.bias", detail::formatValue(o.bias), "must be finite");
+  if (o.threads < 0)
+    throw InvalidArgument("WorldMarchOptions.threads", detail::formatValue(o.threads), "must be >= 0");
+}
+
+bool standardShadowLit(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld, const glm::dvec3& p,
+                       double bias) {
+  const glm::dvec4 q = lightClipFromWorld * glm::dvec4(p, 1.0);
+  const glm::dvec3 uvd = glm::dvec3(q) / q.w * 0.5 + 0.5;
+  if (!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0)) return true;
+  const int W = shadowDepth.width(), H = shadowDepth.height();
+  const int i = std::min(static_cast<int>(uvd.x * W), W - 1),
+            j = std::min(static_cast<int>(uvd.y * H), H - 1);
+  return std::clamp(uvd.z, 0.0, 1.0) <= static_cast<double>(shadowDepth.at(i, j)) + bias;
+}
+
+namespace {
+
+void validateShadowMap(const Image& shadowDepth, const glm::dmat4& m) {
+  if (shadowDepth.empty())
+    throw InvalidArgument("shadowDepth", "empty", "must be a W x H 1-channel depth image");
+  if (shadowDepth.channels() != 1)
+    throw InvalidArgument("shadowDepth", std::to_string(shadowDepth.channels()) + " channels",
+                          "must have 1 channel");
+  for (int j = 0; j < shadowDepth.height(); ++j)
+    for (int i = 0; i < shadowDepth.width(); ++i)
+      if (std::isnan(shadowDepth.at(i, j)))
+        throw InvalidArgument("shadowDepth",
+                              "texel (" + std::to_string(i) + ", " + std::to_string(j) + ") = NaN",
+                              "depth-buffer values must not be NaN");
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r]))
+        throw InvalidArgument("lightClipFromWorld", detail::formatValue(m[c][r]), "must be finite");
+}
+
+/// One pixel of the world-space march; returns the lookups.
+int worldMarchPixel(const Image& shadowDepth, const glm::dmat4& M, const glm::dvec3& origin,
+                    const PixelRay& ray, const glm::dvec3& sigma, const WorldMarchOptions& o, glm::dvec3& L) {
+  const double s = ray.surface;
+  int lookups = 0;
+  const auto lit = [&](double t) {
+    ++lookups;
+    return standardShadowLit(shadowDepth, M, origin + t * ray.direction, o.bias);
+  };
+  L = glm::dvec3(0.0);
+  double ta = 0.0;
+  bool va = lit(0.0);
+  for (int k = 1; k <= o.steps; ++k) {
+    const double tb = k == o.steps ? s : s * k / o.steps;
+    const bool vb = lit(tb);
+    if (va == vb) {
+      if (va) L += transmittanceIntegral(sigma, ta, tb);
+    } else {
+      // Bisect for the change: [lo, hi] keeps va at lo and vb at hi.
+      double lo = ta, hi = tb;
+      for (int r = 0; r < o.refinements; ++r) {
+        const double mid = 0.5 * (lo + hi);
+        (lit(mid) == va ? lo : hi) = mid;
+      }
+      const double change = 0.5 * (lo + hi);
+      if (va) L += transmittanceIntegral(sigma, ta, change);
+      if (vb) L += transmittanceIntegral(sigma, change, tb);
+    }
+    ta = tb;
+    va = vb;
+  }
+  return lookups;
+}
+
+} // namespace
+
+// Klehm et al. 2014, Eq. 1 and 3 (Yusov 2012, Eq. 15-16) against a standard shadow map: the
+// rectification-free reference.
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                            const Medium& medium, const WorldMarchOptions& options) {
+  validateShadowMap(shadowDepth, lightClipFromWorld);
+  validateCameraDepth(cameraDepth);
+  validate(options);
+  const int w = cameraDepth.width(), h = cameraDepth.height();
+  MarchResult out{Image(w, h, 4), Image(w, h, 1)};
+  const glm::dvec3 sigma = medium.extinction();
+  const double grey = weightExtinction(medium);
+  parallelRows(h, options.threads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
+      glm::dvec3 L;
+      const int lookups =
+          worldMarchPixel(shadowDepth, lightClipFromWorld, camera.position(), ray, sigma, options, L);
+      storeScattering(out.scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
+                      std::exp(-grey * ray.surface));
+      out.steps.at(x, y) = static_cast<float>(lookups);
+    }
+  });
+  return out;
+}
+
+void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                           const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                           const Medium& medium, std::span<const int> pixels, Image& scattering, Image* steps,
+                           const WorldMarchOptions& options) {
+  validateShadowMap(shadowDepth, lightClipFromWorld);
+  validateCameraDepth(cameraDepth);
+  validate(options);
+  const int w = cameraDepth.width(), h = cameraDepth.height();
+  if (scattering.width() != w || scattering.height() != h || scattering.channels() != 4)
+    throw InvalidArgument("scattering",
+                          std::to_string(scattering.width()) + " x " + std::to_string(scattering.height()),
+                          "must be an RGBA image of cameraDepth's size");
+  if (steps && (steps->width() != w || steps->height() != h || steps->channels() != 1))
+    throw InvalidArgument("steps", std::to_string(steps->width()) + " x " + std::to_string(steps->height()),
+                          "must be a 1-channel image of cameraDepth's size");
+  for (int p : pixels)
+    if (p < 0 || p >= w * h)
+      throw InvalidArgument("pixels", detail::formatValue(p),
+                            "must be in [0, " + std::to_string(w * h) + ")");
+  const glm::dvec3 sigma = medium.extinction();
+  const double grey = weightExtinction(medium);
+  const int count = static_cast<int>(pixels.size());
+  parallelRows(count, options.threads, [&](int k) {
+    const int p = pixels[static_cast<std::size_t>(k)], x = p % w, y = p / w;
+    const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
+    glm::dvec3 L;
+    const int lookups =
+        worldMarchPixel(shadowDepth, lightClipFromWorld, camera.position(), ray, sigma, options, L);
+    storeScattering(scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
+                    std::exp(-grey * ray.surface));
+    if (steps) steps->at(x, y) = static_cast<float>(lookups);
+  });
+}
+
+} // namespace crep
