@@ -1,6 +1,6 @@
 // The epipolar fallback layout (crep/epipolar/epipolar.h): Klehm et al. 2014 Sec. 4.1 (angles to the
 // light, per-slice bounds of the angle and of the distance along the reference ray), slices through the
-// screen border in the order of Yusov 2012 (seed 000 Sec. 6.1 exit points, Sec. 6.6 sectors).
+// screen border in the order of Yusov 2012 (Sec. 6.1 exit points, Sec. 6.6 sectors).
 #include <crep/core/error.h>
 #include <crep/core/image.h>
 #include <crep/epipolar/epipolar.h>

@@ -1,6 +1,6 @@
 // GPU passes of the marches (crep/epipolar/gpu_march.h) and the shared blocks (gpu_layout.h): min/max
 // trees (Yusov 2012 Sec. 6.3), tree / brute-force march along rectified rows (Algorithm 2), world-space
-// reference march (seed 003 Eq. 1, 3). Shaders: passes/minmax_build.comp, passes/march_rectified.comp,
+// reference march (Klehm et al. 2014, Eq. 1, 3). Shaders: passes/minmax_build.comp, passes/march_rectified.comp,
 // passes/march_reference.comp, crep/epipolar.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>

@@ -3,10 +3,10 @@
 // and a JSON frame description (lib/frame_json.h; README "crep scatter"). Output: a scattering EXR,
 // RGB in-scattered radiance and A transmittance.
 //
-// Methods (lib/frame.h registry): `reference` marches every view ray against the user's standard
+// Methods (lib/methods.h registry): `reference` marches every view ray against the user's standard
 // shadow map; `prefilter` builds the projective rectification of the JSON camera and light, point-
-// resamples the standard map into it on the CPU (lib/resample.h; Sec. 4.1's rule on the projective
-// layout) and runs the GPU prefilter and evaluation passes on it.
+// resamples the standard map into it on the CPU (crep::resampleShadowMap; Klehm et al. 2014, Sec. 4.1's
+// rule on the projective layout) and runs the GPU prefilter and evaluation passes on it.
 #include "args.h"
 #include "commands.h"
 #include "gl_session.h"

@@ -1,7 +1,7 @@
 #version 450 core
 // Ray march of each camera pixel's view ray along its row of a rectified map (crep/epipolar/march.h,
 // "Rectified marches"): CREP_MARCH_TREE 1 walks the row's 1D min/max binary tree (Chen et al. 2011;
-// Yusov 2012 Algorithm 2, seed 000 Sec. 4), 0 tests every texel (brute force). Same rays, sections and
+// Yusov 2012, Algorithm 2 and Sec. 4), 0 tests every texel (brute force). Same rays, sections and
 // output as crep::minMaxMarch / crep::bruteForceMarch; float precision.
 //
 // Resources: params block (binding 0), layout block (crep/epipolar.glsl, binding 1), camera depth

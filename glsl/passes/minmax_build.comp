@@ -1,5 +1,5 @@
 #version 450 core
-// The 1D min/max binary tree of every row of a rectified map (Chen et al. 2011; Yusov 2012 seed 000
+// The 1D min/max binary tree of every row of a rectified map (Chen et al. 2011; Yusov 2012,
 // Sec. 6.3: level 1 from pairs of texels, level l from pairs of nodes of level l - 1), in the storage
 // layout of crep::MinMaxTrees (crep/epipolar/march.h): per row, levels 1..L one after the other, level l
 // with ceil(W / 2^l) nodes (min, max). One work group per row; the levels are built in turn.

@@ -1,6 +1,6 @@
 // Prefilter weights: Klehm, Seidel, Eisemann 2014, Sec. 3.1 (average visibility, Eq. 5), Sec. 3.2
 // (transmittance weights w_i of Eq. 11 with a reference ray), Sec. 4.2 (Eq. 12, constant step ratio),
-// plus exact weights from the reference ray's closed-form distances (DESIGN.md "Weights"). Definitions
+// plus exact weights from the reference ray's closed-form distances (crep/prefilter/weights.h). Definitions
 // and the sigma -> 0 handling are in crep/prefilter/weights.h.
 #include <crep/core/error.h>
 #include <crep/prefilter/weights.h>

@@ -59,7 +59,7 @@ inline glm::dvec3 segmentIntegral(const glm::dvec3& sigma, double a, double b) {
   return r;
 }
 
-/// Closed-form single scattering (seed 003 Eq. 1, 3) with an optional half-space shadow, per pixel of a
+/// Closed-form single scattering (Klehm et al. 2014, Eq. 1, 3) with an optional half-space shadow, per pixel of a
 /// camera depth image (sky to the far plane), RGBA like the marches (A = grey transmittance).
 inline Image closedForm(const Image& depth, const Camera& camera, const DirectionalLight& light,
                         const Medium& medium, const std::optional<HalfSpace>& plane) {

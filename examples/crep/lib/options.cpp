@@ -9,7 +9,7 @@ const char* const kMethodOptionsHelp =
             --bases M           Fourier bases, even, in [4, 128] (default 32)
             --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
             --splits K          rectification splits (default 4; --map-size must be a multiple)
-            --steps N           reference march samples per pixel (default 256)
+            --steps N           reference march: sections per view ray, changes bisected (default 256)
 )";
 
 StorageFormat parseFormat(const std::string& text) {

@@ -1,6 +1,6 @@
 // Epipolar rectification, the fallback when the projective rectification cannot be built (Klehm, Seidel,
 // Eisemann 2014, Sec. 4.1 after Baran et al. 2010; slices through the screen border after Yusov 2012,
-// seed 000 Sec. 6.1, 6.6). CPU, double precision.
+// Sec. 6.1, 6.6). CPU, double precision.
 //
 // ---------------------------------------------------------------------------------------------------
 // Geometry (directional light). m = -light.direction(): the direction toward the light. For a point p,

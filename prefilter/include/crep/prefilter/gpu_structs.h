@@ -6,7 +6,7 @@
 // reports for the linked shaders (glGetProgramResourceiv).
 //
 // An engine that evaluates the scattering in its own shader (#include "crep/scattering.glsl") fills a
-// ScatteringParams with PrefilterPass::scatteringParams() and uploads it to a uniform buffer bound at
+// ScatteringParams with makeScatteringParams() (gpu_pass.h) and uploads it to a uniform buffer bound at
 // CREP_SCATTERING_BINDING.
 #pragma once
 
