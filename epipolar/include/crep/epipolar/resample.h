@@ -30,8 +30,9 @@ struct ResampleOptions {
   int threads = 0; ///< CPU worker threads: 0 = hardware concurrency (never changes the result)
 };
 
-/// Throws InvalidArgument ("lightClipFromWorld") unless the matrix is finite, affine (last row 0 0 0 1)
-/// and projects the light direction to a point (an orthographic shadow matrix looking along it).
+/// Throws InvalidArgument ("lightClipFromWorld") unless the matrix is finite, affine (last row 0 0 0 w),
+/// invertible, and maps the light direction to a pure depth increase (clip (0, 0, > 0), up to 1e-3 of the
+/// matrix scale so that matrices stored in float pass): an orthographic shadow matrix looking along it.
 void validateLightMatrix(const glm::dmat4& lightClipFromWorld, const glm::dvec3& lightDirection);
 
 /// The CPU reference (rule at the top). Throws InvalidArgument for a null layout, sizes <= 0 or a width
