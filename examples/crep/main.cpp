@@ -5,6 +5,7 @@
 #include "options.h"
 
 #include <crep/core/error.h>
+#include <crep/scenes/shaders.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -90,6 +91,8 @@ int main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   try {
+    // The tool's own shaders (reference march, compositing, scene rasterization) next to the library's.
+    crep::scenes::registerShaders();
     if (command == "render") return crep::tool::renderCommand(args);
     if (command == "scatter") return crep::tool::scatterCommand(args);
     if (command == "compare") return crep::tool::compareCommand(args);

@@ -5,12 +5,12 @@
 #include "support/tool_runner.h"
 
 #include <crep/core/camera.h>
-#include <crep/core/exr.h>
-#include <crep/core/image_compare.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/scenes/scene.h>
+#include <crep/support/exr.h>
+#include <crep/support/image_compare.h>
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
@@ -113,8 +113,8 @@ TEST_CASE("crep scatter: the example frame over a ground plane without casters m
     // corner); measured 0.98% over the image.
     CHECK(rgb.relativeRmse < (reference ? 1e-3 : 0.02));
     // Prefilter: A = exp(-mean(sigma_t) s), exact (measured 1.8e-7). The reference march
-    // (glsl/passes/march_world.comp) writes the mean of the per-channel transmittances instead, which
-    // differs by up to 2.4e-3 for this medium.
+    // (examples/glsl/passes/march_world.comp) writes the mean of the per-channel transmittances instead,
+    // which differs by up to 2.4e-3 for this medium.
     CHECK(alpha.maxAbsError < (reference ? 4e-3 : 1e-4));
   }
 }

@@ -5,11 +5,11 @@
 #include "resample.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl_context.h>
 #include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
+#include <crep/support/gl_context.h>
 
 #include <epoxy/gl.h>
 

@@ -124,7 +124,7 @@ void checkGlErrors(const char* what);
 gl::Handle uploadR32F(const Image& image, const char* parameter);
 /// Reads an RGBA texture back (row 0 = bottom).
 Image readRgba(std::uint32_t texture, int width, int height);
-/// surface * exp(-sigma_t s) + in-scattering (glsl/passes/composite.comp), a new RGBA32F texture.
+/// surface * exp(-sigma_t s) + in-scattering (examples/glsl/passes/composite.comp), a new RGBA32F texture.
 gl::Handle compositeImage(const Frame& frame, std::uint32_t surfaceColor, std::uint32_t scattering);
 
 /// Throws crep::Error when `image` holds NaN or infinity (refuse to write a silently wrong image).
