@@ -1,5 +1,8 @@
-# Installs headers, the library, the public GLSL includes, an exported CMake package and a
-# pkg-config file. A consumer does find_package(crepuscular) and links crep::crepuscular.
+# Installs the two libraries with their headers, the public GLSL includes, one exported CMake package
+# with a component per library, and a pkg-config file per library:
+#   find_package(crepuscular)                      -> crep::crepuscular (component runtime, the default)
+#   find_package(crepuscular COMPONENTS support)   -> crep::support too (EXR, PNG, compare, EGL context)
+#   pkg-config crepuscular / crepuscular-support
 include(CMakePackageConfigHelpers)
 
 foreach(module IN LISTS CREP_MODULES)
@@ -7,33 +10,46 @@ foreach(module IN LISTS CREP_MODULES)
     install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${module}/include/crep DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   endif()
 endforeach()
+install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/support/include/crep DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # Public GLSL includes an engine can #include in its own shaders.
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/glsl/crep DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/glsl)
 
-install(TARGETS crepuscular EXPORT crepuscularTargets
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
-  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(EXPORT crepuscularTargets NAMESPACE crep:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular)
+set(CREP_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular)
+foreach(component runtime support)
+  if(component STREQUAL "runtime")
+    set(target crepuscular)
+  else()
+    set(target crepuscular_support)
+  endif()
+  install(TARGETS ${target} EXPORT crepuscular-${component}-targets
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
+    INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(EXPORT crepuscular-${component}-targets NAMESPACE crep:: DESTINATION ${CREP_CMAKE_DIR})
+  # A static archive carries its private dependencies to the consumer: the config must find them.
+  get_target_property(type ${target} TYPE)
+  string(TOUPPER ${component} upper)
+  if(type STREQUAL "STATIC_LIBRARY")
+    set(CREP_${upper}_STATIC ON)
+  else()
+    set(CREP_${upper}_STATIC OFF)
+  endif()
+endforeach()
 
-get_target_property(crep_library_type crepuscular TYPE)
-if(crep_library_type STREQUAL "STATIC_LIBRARY")
-  set(CREP_CONFIG_STATIC ON)
-else()
-  set(CREP_CONFIG_STATIC OFF)
-endif()
 configure_package_config_file(${CMAKE_CURRENT_SOURCE_DIR}/cmake/crepuscularConfig.cmake.in
   ${CMAKE_CURRENT_BINARY_DIR}/crepuscularConfig.cmake
-  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular
+  INSTALL_DESTINATION ${CREP_CMAKE_DIR}
   PATH_VARS CMAKE_INSTALL_DATADIR)
 write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/crepuscularConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/crepuscularConfig.cmake
               ${CMAKE_CURRENT_BINARY_DIR}/crepuscularConfigVersion.cmake
-        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular)
+        DESTINATION ${CREP_CMAKE_DIR})
 
 # Relocatable: the prefix is found relative to the .pc file, so `cmake --install --prefix` works.
 file(RELATIVE_PATH CREP_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
-configure_file(${CMAKE_CURRENT_SOURCE_DIR}/cmake/crepuscular.pc.in ${CMAKE_CURRENT_BINARY_DIR}/crepuscular.pc @ONLY)
-install(FILES ${CMAKE_CURRENT_BINARY_DIR}/crepuscular.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+foreach(pc crepuscular crepuscular-support)
+  configure_file(${CMAKE_CURRENT_SOURCE_DIR}/cmake/${pc}.pc.in ${CMAKE_CURRENT_BINARY_DIR}/${pc}.pc @ONLY)
+  install(FILES ${CMAKE_CURRENT_BINARY_DIR}/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endforeach()

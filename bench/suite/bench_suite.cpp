@@ -14,6 +14,7 @@
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
+#include <crep/scenes/shaders.h>
 
 #include <epoxy/gl.h>
 
@@ -223,6 +224,7 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
 }
 
 void runBenchSuite(const BenchOptions& o) {
+  scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
   tool::StageTimings contextTimings;
   tool::ensureGlContext("bench", false, contextTimings);
   const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases, repeat = o.repeat;

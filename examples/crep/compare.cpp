@@ -12,9 +12,9 @@
 #include "timings.h"
 
 #include <crep/core/error.h>
-#include <crep/core/image_compare.h>
-#include <crep/core/png.h>
 #include <crep/scenes/scene.h>
+#include <crep/support/image_compare.h>
+#include <crep/support/png.h>
 
 #include <algorithm>
 #include <cmath>

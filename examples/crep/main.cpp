@@ -1,10 +1,12 @@
 // crep: the command-line tool of crepuscular. See `crep help`.
 #include "args.h"
+#include "command_registry.h"
 #include "commands.h"
 #include "methods.h"
 #include "options.h"
 
 #include <crep/core/error.h>
+#include <crep/scenes/shaders.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -49,11 +51,7 @@ commands:
             --amplify X         error heat map: |error| / peak of the reference * X (default 20)
             --tile-width N      width of each image on the sheet (default: min(image width, 400))
             --out PREFIX        writes PREFIX.png and PREFIX.csv (default crep-compare-<scene>)
-  bench     the benchmark suite of bench/ (as crep_bench): CPU reference vs GPU passes, methods side
-            by side, bandwidth vs a copy, Table 1/2 rows; ratios measured in one run
-            --scene NAME (forest) --size WxH (1920x1080) --map WxH (1024x1024) --bases M (32)
-            --repeat N (5) --quick (one size, no tables)
-  rectify   print the projective rectification for a camera and a directional light as JSON:
+%s  rectify   print the projective rectification for a camera and a directional light as JSON:
             {"status": "projective"|"fallback", "reason", "measure", "threshold",
              "splits": [{"rectClipFromWorld": [16 numbers, column-major], "range": [a, b]}]}
             --camera-pos x,y,z --camera-target x,y,z --camera-up x,y,z (default 0,1,0)
@@ -69,14 +67,20 @@ Exit status: 0 success, 1 runtime error (GL, I/O, invalid input data or paramete
 the file or field), 2 usage error (the message names the option).
 )";
 
+std::string paddedName(std::string name) {
+  name.resize(std::max<std::size_t>(name.size(), 10), ' ');
+  return name;
+}
+
 void printUsage(std::FILE* out) {
+  // Commands registered by other parts of the build (bench/ adds `crep bench`), after compare.
+  std::string registered;
+  for (const crep::tool::Command& c : crep::tool::registeredCommands())
+    registered += "  " + paddedName(c.name) + c.help;
   std::string methods;
-  for (const crep::tool::Method& m : crep::tool::methodRegistry()) {
-    std::string name = m.name;
-    name.resize(std::max<std::size_t>(name.size(), 10), ' ');
-    methods += "  " + name + "  " + m.summary + "\n";
-  }
-  std::fprintf(out, kUsage, crep::tool::kMethodOptionsHelp, methods.c_str());
+  for (const crep::tool::Method& m : crep::tool::methodRegistry())
+    methods += "  " + paddedName(m.name) + "  " + m.summary + "\n";
+  std::fprintf(out, kUsage, crep::tool::kMethodOptionsHelp, registered.c_str(), methods.c_str());
 }
 
 } // namespace
@@ -90,11 +94,14 @@ int main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   try {
+    // The tool's own shaders (reference march, compositing, scene rasterization) next to the library's.
+    crep::scenes::registerShaders();
     if (command == "render") return crep::tool::renderCommand(args);
     if (command == "scatter") return crep::tool::scatterCommand(args);
     if (command == "compare") return crep::tool::compareCommand(args);
-    if (command == "bench") return crep::tool::benchCommand(args);
     if (command == "rectify") return crep::tool::rectifyCommand(args);
+    if (const crep::tool::Command* registered = crep::tool::findCommand(command))
+      return registered->run(args);
     std::fprintf(stderr, "crep: unknown command '%s' (see crep help)\n", command.c_str());
     return 2;
   } catch (const crep::tool::UsageError& e) {

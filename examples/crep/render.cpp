@@ -13,10 +13,10 @@
 #include "timings.h"
 
 #include <crep/core/error.h>
-#include <crep/core/exr.h>
-#include <crep/core/png.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
+#include <crep/support/exr.h>
+#include <crep/support/png.h>
 
 #include <cstdio>
 #include <filesystem>

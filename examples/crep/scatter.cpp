@@ -18,8 +18,8 @@
 #include <crep/epipolar/resample.h>
 
 #include <crep/core/error.h>
-#include <crep/core/exr.h>
-#include <crep/core/png.h>
+#include <crep/support/exr.h>
+#include <crep/support/png.h>
 
 #include <cmath>
 #include <cstdio>

@@ -4,8 +4,8 @@
 #include "support/image_check.h"
 
 #include <crep/core/error.h>
-#include <crep/core/exr.h>
 #include <crep/core/image.h>
+#include <crep/support/exr.h>
 
 #include <doctest/doctest.h>
 

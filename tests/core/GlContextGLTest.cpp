@@ -1,9 +1,9 @@
-// The headless context and the GL helpers (crep/core/gl_context.h, crep/core/gl.h).
+// The headless context and the GL helpers (crep/support/gl_context.h, crep/core/gl.h).
 #include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
-#include <crep/core/gl_context.h>
+#include <crep/support/gl_context.h>
 
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>

@@ -3,9 +3,9 @@
 #include "support/image_check.h"
 
 #include <crep/core/error.h>
-#include <crep/core/exr.h>
 #include <crep/core/image.h>
-#include <crep/core/image_compare.h>
+#include <crep/support/exr.h>
+#include <crep/support/image_compare.h>
 
 #include <doctest/doctest.h>
 

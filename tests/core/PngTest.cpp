@@ -4,7 +4,7 @@
 
 #include <crep/core/error.h>
 #include <crep/core/image.h>
-#include <crep/core/png.h>
+#include <crep/support/png.h>
 
 #include <doctest/doctest.h>
 

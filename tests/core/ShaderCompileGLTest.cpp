@@ -28,7 +28,8 @@ bool contains(std::string_view haystack, std::string_view needle) {
   return haystack.find(needle) != std::string_view::npos;
 }
 
-/// Shaders of the library proper: glsl/test/ holds test fixtures only.
+/// Shaders of the library (glsl/) and of examples/ (examples/glsl/, registered by test_main.cpp);
+/// the "test/" files are the fixtures of tests/glsl/.
 bool isLibraryFile(std::string_view path) {
   return !path.starts_with("test/");
 }
@@ -155,13 +156,13 @@ TEST_CASE("buildProgram: errors name the file, the included file and the line") 
   }
   SUBCASE("link error") {
     try {
-      crep::buildProgram({{ShaderStage::Compute, "passes/test_fill.comp", {}},
+      crep::buildProgram({{ShaderStage::Compute, "test/test_fill.comp", {}},
                           {ShaderStage::Vertex, "passes/fullscreen.vert", {}}});
       FAIL("no ShaderError");
     } catch (const crep::ShaderError& e) {
       MESSAGE(std::string(e.what()));
       CHECK(contains(e.what(), "cannot link"));
-      CHECK(contains(e.what(), "\"passes/test_fill.comp\", \"passes/fullscreen.vert\""));
+      CHECK(contains(e.what(), "\"test/test_fill.comp\", \"passes/fullscreen.vert\""));
     }
   }
   SUBCASE("missing file, no stages") {
@@ -185,7 +186,7 @@ TEST_CASE("test_fill.comp: define variants, a dispatch that is not a multiple of
     const float clear = -1.0f;
     glClearTexImage(texture.get(), 0, GL_RED, GL_FLOAT, &clear);
     const crep::gl::Handle program =
-        crep::buildProgram({{ShaderStage::Compute, "passes/test_fill.comp", defines}});
+        crep::buildProgram({{ShaderStage::Compute, "test/test_fill.comp", defines}});
     glUseProgram(program.get());
     glUniform2i(0, extentX, extentY);
     glBindImageTexture(0, texture.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);

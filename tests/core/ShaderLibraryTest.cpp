@@ -38,7 +38,8 @@ bool contains(std::string_view haystack, std::string_view needle) {
   return haystack.find(needle) != std::string_view::npos;
 }
 
-/// Shaders of the library proper: glsl/test/ holds test fixtures only.
+/// Shaders of the library (glsl/) and of examples/ (examples/glsl/, registered by test_main.cpp);
+/// the "test/" files are the fixtures of tests/glsl/.
 bool isLibraryFile(std::string_view path) {
   return !path.starts_with("test/");
 }
@@ -109,17 +110,61 @@ TEST_CASE("ShaderLibrary: files are embedded, sorted and unique") {
   CHECK(has("crep/common.glsl"));
   CHECK(has("crep/phase.glsl"));
   CHECK(has("passes/fullscreen.vert"));
-  CHECK(has("passes/test_fill.comp"));
-  CHECK(contains(ShaderLibrary::source("passes/test_fill.comp"), "CREP_FILL_VALUE"));
+  CHECK(has("test/test_fill.comp"));
+  CHECK(contains(ShaderLibrary::source("test/test_fill.comp"), "CREP_FILL_VALUE"));
   CHECK_THROWS_AS(ShaderLibrary::source("passes/no_such_file.comp"), crep::ShaderError);
   CHECK(contains(errorOf("passes/no_such_file.comp"), "passes/no_such_file.comp"));
+}
+
+TEST_CASE("ShaderLibrary::addFiles: extra sets include library files, never shadow them") {
+  // What examples/ and tests/ do with their generated sets (cmake/EmbedGlsl.cmake), by hand.
+  static constexpr ShaderLibrary::File kExtra[] = {
+      {"test/added/main.comp", "#version 450 core\n#include \"crep/phase.glsl\"\n#include \"helper.glsl\"\n"
+                               "layout(local_size_x = 1) in;\nvoid main() {}\n"},
+      {"test/added/helper.glsl", "const int crep_test_helper = 1;\n"}};
+  const auto before = ShaderLibrary::files();
+  const std::size_t countBefore = before.size();
+  ShaderLibrary::addFiles(kExtra);
+  ShaderLibrary::addFiles(kExtra); // the same set again: nothing changes
+  const auto after = ShaderLibrary::files();
+  CHECK(after.size() == countBefore + 2);
+  CHECK(before.size() == countBefore); // a span taken earlier stays valid and unchanged
+  CHECK(std::none_of(before.begin(), before.end(),
+                     [](const auto& f) { return f.path.starts_with("test/added/"); }));
+  for (std::size_t i = 1; i < after.size(); ++i)
+    CHECK(after[i - 1].path < after[i].path);
+  // Relative includes resolve inside the set, root includes reach the library's files.
+  const ExpandedShader e = ShaderLibrary::expand("test/added/main.comp");
+  CHECK(e.files == std::vector<std::string>{"test/added/main.comp", "crep/phase.glsl", "crep/common.glsl",
+                                            "test/added/helper.glsl"});
+
+  // Another source under a registered path is refused, and nothing of that set is added.
+  static constexpr ShaderLibrary::File kShadow[] = {{"test/added/other.glsl", "// fine on its own\n"},
+                                                    {"crep/common.glsl", "// not the library's\n"}};
+  try {
+    ShaderLibrary::addFiles(kShadow);
+    FAIL("addFiles accepted a file that shadows crep/common.glsl");
+  } catch (const crep::ShaderError& error) {
+    CHECK(contains(error.what(), "\"crep/common.glsl\" is already registered"));
+  }
+  CHECK(ShaderLibrary::files().size() == countBefore + 2);
+  CHECK(contains(ShaderLibrary::source("crep/common.glsl"), "crepuscular"));
+  // Paths must be what include resolution produces; a set must not repeat a path.
+  for (const char* path : {"", "/abs.glsl", "a/../b.glsl", "./a.glsl", "a//b.glsl", "dir/", "a\"b.glsl"}) {
+    const ShaderLibrary::File bad[] = {{path, "\n"}};
+    CAPTURE(path);
+    CHECK_THROWS_AS(ShaderLibrary::addFiles(bad), crep::ShaderError);
+  }
+  static constexpr ShaderLibrary::File kTwice[] = {{"test/added/twice.glsl", "\n"},
+                                                   {"test/added/twice.glsl", "\n"}};
+  CHECK_THROWS_AS(ShaderLibrary::addFiles(kTwice), crep::ShaderError);
 }
 
 TEST_CASE("ShaderLibrary: expand resolves includes with #line markers and a files table") {
   const std::vector<ShaderDefine> defines = {{"CREP_A", "1"}, {"CREP_B", ""}};
   const ExpandedShader e = ShaderLibrary::expand("test/include_main.comp", defines);
   // Relative to the including file first (include_a.glsl, sub/include_b.glsl, and test/shadowed.glsl
-  // from test/sub/), else the glsl/ root (test/shadowed.glsl from test/); include_a.glsl only once;
+  // from test/sub/), else the root of the paths (test/shadowed.glsl from test/); include_a.glsl only once;
   // the #include inside a block comment is left alone; the #version line becomes an empty line.
   // Line k of the n-th file is numbered n * 100000 + k (kLineStride).
   const std::string expected =
@@ -158,11 +203,11 @@ TEST_CASE("ShaderLibrary: expand resolves includes with #line markers and a file
 TEST_CASE("ShaderLibrary: #version first, then the defines, then the body") {
   SUBCASE("the file's own #version") {
     const std::vector<ShaderDefine> defines = {{"CREP_FILL_VALUE", "2.5"}};
-    const ExpandedShader e = ShaderLibrary::expand("passes/test_fill.comp", defines);
+    const ExpandedShader e = ShaderLibrary::expand("test/test_fill.comp", defines);
     CHECK(e.text.starts_with("#version 450 core\n#define CREP_FILL_VALUE 2.5\n#line 1 0\n"));
     // The #version line of the body is gone (exactly one #version).
     CHECK(e.text.find("#version") == e.text.rfind("#version"));
-    CHECK(e.files == std::vector<std::string>{"passes/test_fill.comp"});
+    CHECK(e.files == std::vector<std::string>{"test/test_fill.comp"});
   }
   SUBCASE("no #version: 450 core") {
     const ExpandedShader e = ShaderLibrary::expand("crep/common.glsl");
@@ -175,10 +220,10 @@ TEST_CASE("ShaderLibrary: #version first, then the defines, then the body") {
   SUBCASE("bad define names and values") {
     for (const char* name : {"", "1ABC", "A B", "A-B", "A\nB"}) {
       const std::vector<ShaderDefine> defines = {{name, "1"}};
-      CHECK_THROWS_AS(ShaderLibrary::expand("passes/test_fill.comp", defines), crep::InvalidArgument);
+      CHECK_THROWS_AS(ShaderLibrary::expand("test/test_fill.comp", defines), crep::InvalidArgument);
     }
     const std::vector<ShaderDefine> defines = {{"A", "1\n#error"}};
-    CHECK_THROWS_AS(ShaderLibrary::expand("passes/test_fill.comp", defines), crep::InvalidArgument);
+    CHECK_THROWS_AS(ShaderLibrary::expand("test/test_fill.comp", defines), crep::InvalidArgument);
   }
 }
 

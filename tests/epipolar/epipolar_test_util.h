@@ -5,12 +5,12 @@
 
 #include <crep/core/camera.h>
 #include <crep/core/image.h>
-#include <crep/core/image_compare.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
+#include <crep/support/image_compare.h>
 
 #include "support/analytic_scene.h"
 

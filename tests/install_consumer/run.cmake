@@ -1,26 +1,61 @@
 cmake_minimum_required(VERSION 3.25)
-# Script mode: installs the build tree into WORK_DIR/prefix, then configures, builds and runs the
-# consumer project against it with find_package(crepuscular), and checks the pkg-config file.
+# Script mode: installs the build tree into WORK_DIR/prefix, then configures, builds and runs two
+# consumer projects against it and checks the pkg-config files:
+#   runtime/  an engine: find_package(crepuscular) (runtime only), its own EGL context, the prefilter
+#             and evaluation passes on it; its link line must not mention OpenEXR or stb
+#   support/  a tool: find_package(crepuscular COMPONENTS support), an EXR round trip
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
+  if(rc EQUAL 77)
+    message(FATAL_ERROR "no GL context (exit 77): ${ARGN}\n${out}\n${err}\n"
+                        "This test needs OpenGL 4.5 through EGL (Mesa llvmpipe); it is not skipped.")
+  elseif(NOT rc EQUAL 0)
     message(FATAL_ERROR "command failed (${rc}): ${ARGN}\n${out}\n${err}")
   endif()
   message(STATUS "${out}")
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
-run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
-    -DCMAKE_BUILD_TYPE=Release)
-run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
-run(${WORK_DIR}/build/consumer)
-# pkg-config: the .pc file resolves and names the library.
+
+foreach(consumer runtime support)
+  set(build ${WORK_DIR}/${consumer})
+  run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE}/${consumer} -B ${build} -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
+      -DCMAKE_BUILD_TYPE=Release)
+  run(${CMAKE_COMMAND} --build ${build})
+  file(READ ${build}/CMakeFiles/consumer.dir/link.txt link_line)
+  string(STRIP "${link_line}" link_line)
+  message(STATUS "${consumer} consumer link line: ${link_line}")
+  set(link_${consumer} "${link_line}")
+  run(${build}/consumer ${build})
+endforeach()
+# An engine linking only the runtime library gets neither OpenEXR (nor Imath / Iex) nor stb.
+if(link_runtime MATCHES "[Oo]pen[Ee][Xx][Rr]|Imath|Iex|stb")
+  message(FATAL_ERROR "the runtime consumer's link line mentions OpenEXR or stb (${CMAKE_MATCH_0}):\n${link_runtime}")
+endif()
+if(NOT link_runtime MATCHES "libcrepuscular\\.(a|so)" OR link_runtime MATCHES "crepuscular_support")
+  message(FATAL_ERROR "the runtime consumer must link libcrepuscular and not the support library:\n${link_runtime}")
+endif()
+if(NOT link_support MATCHES "libcrepuscular_support\\.(a|so)")
+  message(FATAL_ERROR "the support consumer does not link libcrepuscular_support:\n${link_support}")
+endif()
+
+# pkg-config: both files resolve; the runtime one names no OpenEXR, even with --static.
 find_program(PKG_CONFIG pkg-config REQUIRED)
 file(GLOB_RECURSE pc ${WORK_DIR}/prefix/*/crepuscular.pc)
 get_filename_component(pcdir "${pc}" DIRECTORY)
 set(ENV{PKG_CONFIG_PATH} "${pcdir}")
-execute_process(COMMAND ${PKG_CONFIG} --libs --cflags crepuscular RESULT_VARIABLE rc OUTPUT_VARIABLE flags)
-if(NOT rc EQUAL 0 OR NOT flags MATCHES "-lcrepuscular")
-  message(FATAL_ERROR "pkg-config crepuscular failed: ${flags}")
-endif()
-message(STATUS "pkg-config crepuscular: ${flags}")
+foreach(args "--libs;--cflags;crepuscular" "--libs;--static;crepuscular" "--libs;--cflags;crepuscular-support")
+  execute_process(COMMAND ${PKG_CONFIG} ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE flags ERROR_VARIABLE err)
+  string(STRIP "${flags}" flags)
+  string(REPLACE ";" " " shown "${args}")
+  if(NOT rc EQUAL 0 OR NOT flags MATCHES "-lcrepuscular")
+    message(FATAL_ERROR "pkg-config ${shown} failed: ${flags}\n${err}")
+  endif()
+  message(STATUS "pkg-config ${shown}: ${flags}")
+  if(shown MATCHES "crepuscular$" AND flags MATCHES "OpenEXR|Imath|Iex|stb")
+    message(FATAL_ERROR "pkg-config ${shown} mentions OpenEXR or stb: ${flags}")
+  endif()
+  if(shown MATCHES "crepuscular-support$" AND NOT flags MATCHES "-lcrepuscular_support")
+    message(FATAL_ERROR "pkg-config ${shown} does not name the support library: ${flags}")
+  endif()
+endforeach()

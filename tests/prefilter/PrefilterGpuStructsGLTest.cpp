@@ -8,10 +8,10 @@
 #include "prefilter_gpu_util.h"
 
 #include <crep/core/error.h>
-#include <crep/core/image_compare.h>
 #include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/gpu_structs.h>
+#include <crep/support/image_compare.h>
 
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>

@@ -7,13 +7,13 @@
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 
-#include <crep/core/image_compare.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scatter/rectified_march.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
+#include <crep/support/image_compare.h>
 
 #include <doctest/doctest.h>
 

@@ -4,11 +4,11 @@
 // (b) one infinite plane occluder (half-space shadow): the closed form along each ray, with the
 // rectified map made on the CPU by intersecting each texel's light ray with the plane.
 #include <crep/core/error.h>
-#include <crep/core/image_compare.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scatter/rectified_march.h>
+#include <crep/support/image_compare.h>
 
 #include "support/analytic_scene.h"
 #include "support/image_check.h"

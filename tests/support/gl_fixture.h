@@ -12,7 +12,7 @@
 // purpose installs its own callback with ScopedGlDebugCallback.
 #pragma once
 
-#include <crep/core/gl_context.h>
+#include <crep/support/gl_context.h>
 
 #include <functional>
 #include <string>

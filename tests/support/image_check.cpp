@@ -1,8 +1,8 @@
 #include "support/image_check.h"
 
 #include <crep/core/error.h>
-#include <crep/core/exr.h>
-#include <crep/core/png.h>
+#include <crep/support/exr.h>
+#include <crep/support/png.h>
 
 #include <doctest/doctest.h>
 

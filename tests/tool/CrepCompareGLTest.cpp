@@ -122,6 +122,7 @@ TEST_CASE("crep compare: --methods selects methods and always adds the reference
   CHECK(pngSize(prefix + ".png").first == 8 + 2 * (80 + 8));
 }
 
+#if CREP_TOOL_HAS_BENCH // bench/ built: it adds `crep bench`
 TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
   CREP_REQUIRE_GL();
   const auto r = crep::test::runCrep("bench --quick --size 160x90 --map 128x128 --repeat 1");
@@ -132,3 +133,4 @@ TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
     CHECK(r.output.find(text) != std::string::npos);
   CHECK(r.output.find("Table 1") == std::string::npos); // --quick: no tables
 }
+#endif

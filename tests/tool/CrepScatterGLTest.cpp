@@ -5,12 +5,12 @@
 #include "support/tool_runner.h"
 
 #include <crep/core/camera.h>
-#include <crep/core/exr.h>
-#include <crep/core/image_compare.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/scenes/scene.h>
+#include <crep/support/exr.h>
+#include <crep/support/image_compare.h>
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>

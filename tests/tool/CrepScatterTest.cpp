@@ -4,8 +4,8 @@
 #include "support/image_check.h"
 #include "support/tool_runner.h"
 
-#include <crep/core/exr.h>
 #include <crep/core/image.h>
+#include <crep/support/exr.h>
 
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>

@@ -3,7 +3,7 @@
 #include "support/image_check.h"
 #include "support/tool_runner.h"
 
-#include <crep/core/exr.h>
+#include <crep/support/exr.h>
 
 #include <doctest/doctest.h>
 

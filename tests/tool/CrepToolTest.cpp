@@ -99,15 +99,22 @@ TEST_CASE("crep: usage errors exit 2 and name the option") {
     const char* args;
     const char* mentions;
   };
-  for (const Case& c :
-       {Case{"render --size 0x90", "--size"}, Case{"render --size abc", "--size"},
-        Case{"render --map-size -3", "--map-size"}, Case{"render --exposure nan", "--exposure"},
-        Case{"render --bogus 1", "--bogus"}, Case{"render --steps", "--steps"},
-        Case{"render --export-frame ''", "--export-frame"}, Case{"render --method bogus", "--method"},
-        Case{"scatter", "--depth"}, Case{"compare --amplify 0", "--amplify"},
-        Case{"compare --size 8x", "--size"}, Case{"compare --methods prefilter,bogus", "--methods"},
-        Case{"bench --repeat 0", "--repeat"}, Case{"bench --map 12", "--map"},
-        Case{"frobnicate", "frobnicate"}}) {
+  std::vector<Case> cases = {Case{"render --size 0x90", "--size"},
+                             Case{"render --size abc", "--size"},
+                             Case{"render --map-size -3", "--map-size"},
+                             Case{"render --exposure nan", "--exposure"},
+                             Case{"render --bogus 1", "--bogus"},
+                             Case{"render --steps", "--steps"},
+                             Case{"render --export-frame ''", "--export-frame"},
+                             Case{"render --method bogus", "--method"},
+                             Case{"scatter", "--depth"},
+                             Case{"compare --amplify 0", "--amplify"},
+                             Case{"compare --size 8x", "--size"},
+                             Case{"compare --methods prefilter,bogus", "--methods"},
+                             Case{"frobnicate", "frobnicate"}};
+  if (CREP_TOOL_HAS_BENCH) // `crep bench` exists when bench/ is built
+    cases.insert(cases.end(), {Case{"bench --repeat 0", "--repeat"}, Case{"bench --map 12", "--map"}});
+  for (const Case& c : cases) {
     const auto r = crep::test::runCrep(c.args);
     INFO(c.args << " -> " << r.output);
     CHECK(r.status == 2);
@@ -116,4 +123,7 @@ TEST_CASE("crep: usage errors exit 2 and name the option") {
   const auto help = crep::test::runCrep("help");
   CHECK(help.status == 0);
   CHECK(help.output.find("render") != std::string::npos);
+  // bench/ registers `crep bench` with the tool's command registry (examples/ does not know bench/).
+  CHECK((help.output.find("\n  bench     the benchmark suite") != std::string::npos) ==
+        (CREP_TOOL_HAS_BENCH != 0));
 }

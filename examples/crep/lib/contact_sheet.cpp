@@ -1,6 +1,6 @@
 #include "contact_sheet.h"
 
-#include <crep/core/png.h>
+#include <crep/support/png.h>
 
 #include <stb_easy_font.h>
 

@@ -5,7 +5,7 @@
 #pragma once
 
 #include <crep/core/image.h>
-#include <crep/core/image_compare.h>
+#include <crep/support/image_compare.h>
 
 #include <glm/glm.hpp>
 

@@ -3,7 +3,7 @@
 #include "frame.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl_context.h>
+#include <crep/support/gl_context.h>
 #include <crep/core/shader_library.h>
 
 #include <epoxy/gl.h>

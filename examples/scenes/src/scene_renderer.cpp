@@ -1,6 +1,7 @@
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/scenes/scene_renderer.h>
+#include <crep/scenes/shaders.h>
 
 #include <epoxy/gl.h>
 
@@ -12,7 +13,8 @@ void setMatrix(GLuint program, GLint location, const glm::dmat4& m) {
   glProgramUniformMatrix4fv(program, location, 1, GL_FALSE, &f[0][0]);
 }
 void setVec3(GLuint program, GLint location, const glm::dvec3& v) {
-  glProgramUniform3f(program, location, static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z));
+  glProgramUniform3f(program, location, static_cast<float>(v.x), static_cast<float>(v.y),
+                     static_cast<float>(v.z));
 }
 } // namespace
 
@@ -46,6 +48,7 @@ SceneRenderer::SceneRenderer(const Mesh& mesh) : impl_(std::make_unique<Impl>())
     glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, a, a);
   }
+  registerShaders();
   d.depthProgram = buildProgram({{ShaderStage::Vertex, "passes/scene.vert", {}},
                                  {ShaderStage::Fragment, "passes/scene_depth.frag", {}}});
   d.shadeProgram = buildProgram({{ShaderStage::Vertex, "passes/scene.vert", {}},
@@ -56,8 +59,8 @@ SceneRenderer::SceneRenderer(const Mesh& mesh) : impl_(std::make_unique<Impl>())
 
 SceneRenderer::~SceneRenderer() = default;
 
-void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x, int y,
-                                int width, int height, const DepthRenderOptions& options) {
+void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x,
+                                int y, int width, int height, const DepthRenderOptions& options) {
   Impl& d = *impl_;
   const GLuint fb = d.framebuffer.get();
   GLint target = 0;
@@ -97,18 +100,20 @@ void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t d
   gl::checkError("SceneRenderer::renderDepth");
 }
 
-void SceneRenderer::renderRectified(const Rectification& r, std::uint32_t depthTexture, int width, int height) {
+void SceneRenderer::renderRectified(const Rectification& r, std::uint32_t depthTexture, int width,
+                                    int height) {
   if (!r.projective())
-    throw InvalidArgument("Rectification.status", statusToken(r.status), "must be projective to render a rectified map");
+    throw InvalidArgument("Rectification.status", statusToken(r.status),
+                          "must be projective to render a rectified map");
   for (int k = 0; k < r.splitCount(); ++k) {
     const SplitViewport v = r.splitViewport(k, width, height);
-    renderDepth(r.splits[static_cast<std::size_t>(k)].rectClipFromWorld, depthTexture, v.layer, v.x, v.y, v.width,
-                v.height, {.depthClamp = true});
+    renderDepth(r.splits[static_cast<std::size_t>(k)].rectClipFromWorld, depthTexture, v.layer, v.x, v.y,
+                v.width, v.height, {.depthClamp = true});
   }
 }
 
-void SceneRenderer::renderShaded(const ShadeInputs& in, std::uint32_t colorTexture, std::uint32_t depthTexture,
-                                 int width, int height) {
+void SceneRenderer::renderShaded(const ShadeInputs& in, std::uint32_t colorTexture,
+                                 std::uint32_t depthTexture, int width, int height) {
   Impl& d = *impl_;
   const GLuint fb = d.framebuffer.get();
   glNamedFramebufferTexture(fb, GL_COLOR_ATTACHMENT0, colorTexture, 0);

@@ -1,8 +1,10 @@
-// The shader library: every file of glsl/ is embedded into the library at build time (no file is
-// read at run time). `#include "path"` directives are resolved here, relative to the including file
-// first and then to the glsl/ root; each file is included once per expansion. `#line` markers keep
-// compiler messages pointing at the real file and line; variants are made by prepended #defines
-// (shaders give defaults with #ifndef).
+// The shader library: shader sources embedded into the binaries at build time (no file is read at run
+// time). The runtime library serves its own files (glsl/: the public includes crep/*.glsl and the
+// passes of its modules); a program adds its own embedded sets with addFiles() (cmake/EmbedGlsl.cmake
+// generates them), and every registered file can include every other one. `#include "path"`
+// directives are resolved here, relative to the including file first and then to the root of the
+// paths; each file is included once per expansion. `#line` markers keep compiler messages pointing at
+// the real file and line; variants are made by prepended #defines (shaders give defaults with #ifndef).
 #pragma once
 
 #include <cstdint>
@@ -29,7 +31,7 @@ struct ExpandedShader {
 
   std::string text;
   /// Source-string numbers used in the `#line <line> <number>` markers: files[number] is the
-  /// path (relative to glsl/) of that file. Number 0 is the top-level file.
+  /// path of that file in the shader library. Number 0 is the top-level file.
   std::vector<std::string> files;
   /// Rewrites a driver log ("0:12(3): error ..." or "ERROR: 0:12: ...") into "path:12(3): error ...".
   std::string translateLog(std::string_view log) const;
@@ -38,11 +40,21 @@ struct ExpandedShader {
 class ShaderLibrary {
 public:
   struct File {
-    std::string_view path; ///< relative to glsl/, e.g. "crep/common.glsl"
+    std::string_view path; ///< relative to its set's root, e.g. "crep/common.glsl" (glsl/crep/common.glsl)
     std::string_view source;
   };
-  /// Every embedded file, sorted by path.
+  /// Every registered file (the library's own and those added with addFiles()), sorted by path. The
+  /// span stays valid for the life of the process, even after a later addFiles() (which makes a new
+  /// table; files() then returns the new one).
   static std::span<const File> files();
+  /// Registers more embedded files, e.g. an application's own shaders (cmake/EmbedGlsl.cmake). The
+  /// views must stay valid for the life of the process (static storage, as generated). Paths are
+  /// relative ("passes/scene.vert"), without "." or ".." segments; their includes may name any
+  /// registered file, e.g. "crep/common.glsl". Registering a file again (same path, same source
+  /// storage) does nothing, so a set may be registered by every user. Throws ShaderError for an
+  /// invalid path or a path already registered with another source (files never shadow each other).
+  /// Thread-safe.
+  static void addFiles(std::span<const File> files);
   /// Source of one file. Throws ShaderError for an unknown path.
   static std::string_view source(std::string_view path);
   /// Expands `path`: `#version` line (the file's own, or "#version 450 core"), then `defines`, then
@@ -54,11 +66,11 @@ enum class ShaderStage : std::uint32_t { Vertex, Fragment, Compute };
 
 struct ShaderStageSource {
   ShaderStage stage;
-  std::string path; ///< embedded file, relative to glsl/
+  std::string path; ///< registered file of the ShaderLibrary, e.g. "passes/prefilter.comp"
   std::vector<ShaderDefine> defines;
 };
 
-/// Compiles and links a program from embedded files (current context required). Throws ShaderError
+/// Compiles and links a program from registered files (current context required). Throws ShaderError
 /// whose message holds the translated compile or link log.
 gl::Handle buildProgram(std::initializer_list<ShaderStageSource> stages);
 gl::Handle buildProgram(std::span<const ShaderStageSource> stages);

@@ -5,7 +5,7 @@
 // size and truncated pixel data is detected independently of OpenEXR's behaviour. Pixels are then
 // decoded by OpenEXR (Imf::MultiPartInputFile / Imf::InputPart) without chunk table
 // reconstruction; every OpenEXR exception becomes a crep::FormatError naming the file.
-#include <crep/core/exr.h>
+#include <crep/support/exr.h>
 
 #include <crep/core/error.h>
 

@@ -1,4 +1,4 @@
-#include <crep/core/png.h>
+#include <crep/support/png.h>
 
 #include <crep/core/error.h>
 

@@ -1,4 +1,4 @@
-#include <crep/core/image_compare.h>
+#include <crep/support/image_compare.h>
 
 #include <crep/core/error.h>
 

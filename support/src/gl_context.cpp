@@ -1,7 +1,7 @@
 // Headless OpenGL context through EGL's surfaceless platform (EGL_MESA_platform_surfaceless): no
 // window system, no config, no surface. Every step that can fail throws GlUnavailable naming it.
 #include <crep/core/error.h>
-#include <crep/core/gl_context.h>
+#include <crep/support/gl_context.h>
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>

@@ -1,0 +1,161 @@
+// An engine-side consumer of the installed runtime library (crep::crepuscular only). Like an engine, it
+// owns the GL context (a headless EGL context on Mesa's surfaceless platform, created with libEGL in
+// engine_context.cpp) and its GL loader (libepoxy); the library's passes run on that context. It rectifies a
+// camera and a sun, fills a rectified depth map and a camera depth buffer with ramps, runs
+// crep::PrefilterPass and crep::EvaluatePass and checks the scattering image.
+//
+// Exit status: 0 success, 1 failure, 77 no GL context (the install test treats that as a failure too:
+// llvmpipe is expected wherever the tests run).
+#include <crep/core/camera.h>
+#include <crep/core/error.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/core/shader_library.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/rectify/rectified_map.h>
+#include <crep/rectify/rectify.h>
+
+#include "engine_context.h"
+
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string_view>
+#include <vector>
+
+namespace {
+
+constexpr int kNoGl = 77;
+
+/// A depth texture as an engine's depth pass would leave it, filled from `values` (row 0 at the bottom).
+GLuint depthTexture(int width, int height, const std::vector<float>& values) {
+  GLuint texture = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+  glTextureStorage2D(texture, 1, GL_DEPTH_COMPONENT32F, width, height);
+  glTextureSubImage2D(texture, 0, 0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, values.data());
+  return texture;
+}
+
+int checks() {
+  // Only the library's shaders are shipped: no tool, scene or test shader.
+  for (const crep::ShaderLibrary::File& f : crep::ShaderLibrary::files()) {
+    const std::string_view p = f.path;
+    if (!p.starts_with("crep/") && !p.starts_with("passes/")) {
+      std::fprintf(stderr, "consumer: unexpected embedded shader %.*s\n", int(p.size()), p.data());
+      return 1;
+    }
+    for (const std::string_view tool :
+         {"passes/fullscreen", "passes/scene", "passes/composite", "passes/march_world", "passes/test_fill"})
+      if (p.starts_with(tool)) {
+        std::fprintf(stderr, "consumer: tool or test shader %.*s in the runtime library\n", int(p.size()),
+                     p.data());
+        return 1;
+      }
+  }
+  if (!std::filesystem::is_regular_file(std::filesystem::path(CREP_GLSL_DIR) / "crep" / "scattering.glsl")) {
+    std::fprintf(stderr, "consumer: no crep/scattering.glsl in %s\n", CREP_GLSL_DIR);
+    return 1;
+  }
+  try {
+    crep::Camera::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1.0, 1.0, 1.0, 0.5);
+    std::fprintf(stderr, "consumer: near >= far must throw\n");
+    return 1;
+  } catch (const crep::InvalidArgument& e) {
+    std::printf("expected error: %s\n", e.what());
+  }
+  return 0;
+}
+
+} // namespace
+
+int main() {
+  if (const int status = checks(); status != 0) return status;
+
+  EngineContext engine;
+  if (!engine.create()) return kNoGl;
+  std::printf("engine context: %s, %s\n", reinterpret_cast<const char*>(glGetString(GL_VERSION)),
+              reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
+  try {
+    // The frame: a camera and a sun from the side, so the rectification is projective.
+    constexpr int kCameraWidth = 48, kCameraHeight = 32, kMapSize = 64;
+    const crep::Camera camera = crep::Camera::lookAt({0, 2, 8}, {0, 1, 0}, {0, 1, 0}, glm::radians(60.0),
+                                                     double(kCameraWidth) / kCameraHeight, 0.1, 50.0);
+    const crep::DirectionalLight sun({1.0, -0.6, -0.3}, glm::dvec3(3.0));
+    const crep::Medium medium({0.05, 0.05, 0.05}, {0.01, 0.01, 0.01}, 0.5);
+    const crep::Rectification rect = crep::rectify(camera, sun);
+    if (!rect.projective()) {
+      std::fprintf(stderr, "consumer: the rectification is not projective: %s\n", rect.message.c_str());
+      return 1;
+    }
+    const crep::ProjectiveLayout layout(rect);
+    std::printf("rectification: %d splits, span %.1f degrees\n", rect.splitCount(), rect.span);
+
+    // The rectified shadow map (an occluder ramp: nearer the light toward the top rows and to the
+    // right, nothing in the bottom quarter) and the camera depth buffer (a ramp, sky in the top rows).
+    std::vector<float> map(std::size_t(kMapSize) * kMapSize);
+    for (int y = 0; y < kMapSize; ++y)
+      for (int x = 0; x < kMapSize; ++x)
+        map[std::size_t(y) * kMapSize + x] =
+            y < kMapSize / 4 ? 1.0f : 0.2f + 0.6f * float(x + y) / float(2 * (kMapSize - 1));
+    std::vector<float> depth(std::size_t(kCameraWidth) * kCameraHeight);
+    for (int y = 0; y < kCameraHeight; ++y)
+      for (int x = 0; x < kCameraWidth; ++x)
+        depth[std::size_t(y) * kCameraWidth + x] =
+            y >= kCameraHeight - 4 ? 1.0f : 0.9f + 0.099f * float(x) / float(kCameraWidth - 1);
+    const GLuint rectifiedDepth = depthTexture(kMapSize, kMapSize, map);
+    const GLuint cameraDepth = depthTexture(kCameraWidth, kCameraHeight, depth);
+    GLuint output = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &output);
+    glTextureStorage2D(output, 1, GL_RGBA32F, kCameraWidth, kCameraHeight);
+
+    // The library's passes on the engine's context.
+    crep::PrefilterPass prefilter({.width = kMapSize, .height = kMapSize});
+    crep::EvaluatePass evaluate({});
+    prefilter.run({.rectifiedDepth = rectifiedDepth, .layout = &layout, .medium = &medium});
+    evaluate.run({.cameraDepth = cameraDepth,
+                  .output = output,
+                  .camera = &camera,
+                  .light = &sun,
+                  .medium = &medium,
+                  .layout = &layout,
+                  .basis = prefilter.filteredBasis()});
+
+    std::vector<float> pixels(std::size_t(kCameraWidth) * kCameraHeight * 4);
+    glGetTextureImage(output, 0, GL_RGBA, GL_FLOAT, GLsizei(pixels.size() * sizeof(float)), pixels.data());
+    if (const GLenum error = glGetError(); error != GL_NO_ERROR) {
+      std::fprintf(stderr, "consumer: GL error 0x%x\n", error);
+      return 1;
+    }
+    double maxRadiance = 0.0, minTransmittance = 1.0;
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      if (!std::isfinite(pixels[i]) || pixels[i] < 0.0f) {
+        std::fprintf(stderr, "consumer: scattering value %g at pixel %zu channel %zu\n", double(pixels[i]),
+                     i / 4, i % 4);
+        return 1;
+      }
+      if (i % 4 == 3)
+        minTransmittance = std::fmin(minTransmittance, pixels[i]);
+      else
+        maxRadiance = std::fmax(maxRadiance, pixels[i]);
+    }
+    if (!(maxRadiance > 0.0) || !(minTransmittance < 1.0)) {
+      std::fprintf(stderr, "consumer: no scattering (max radiance %g, min transmittance %g)\n", maxRadiance,
+                   minTransmittance);
+      return 1;
+    }
+    glDeleteTextures(1, &output);
+    glDeleteTextures(1, &cameraDepth);
+    glDeleteTextures(1, &rectifiedDepth);
+    std::printf("consumer ok: %zu embedded shader files; %dx%d scattering image, max in-scattered %.4g, "
+                "min transmittance %.4g\n",
+                crep::ShaderLibrary::files().size(), kCameraWidth, kCameraHeight, maxRadiance,
+                minTransmittance);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "consumer: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
