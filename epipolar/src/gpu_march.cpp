@@ -1,7 +1,7 @@
 // GPU passes of the marches (crep/epipolar/gpu_march.h) and the shared blocks (gpu_layout.h): min/max
 // trees (Yusov 2012 Sec. 6.3), tree / brute-force march along rectified rows (Algorithm 2), world-space
-// reference march (Klehm et al. 2014, Eq. 1, 3). Shaders: passes/minmax_build.comp, passes/march_rectified.comp,
-// passes/march_reference.comp, crep/epipolar.glsl.
+// reference march (Klehm et al. 2014, Eq. 1, 3). Shaders: passes/minmax_build.comp,
+// passes/march_rectified.comp, passes/march_reference.comp, crep/epipolar.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
@@ -158,21 +158,12 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   const GLuint steps = f.stepsOut != 0 ? f.stepsOut
                                        : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
                                                               f.width, f.height);
-  glUseProgram(program.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  gpu::bindMarchResources(program.get(), params_.get(), f.cameraDepth, f.rectifiedDepth, sampler_.get(),
+                          f.scatteringOut, steps);
   glBindBufferBase(GL_UNIFORM_BUFFER, 1, layoutBlock_.get());
   if (kind == gpu::LayoutKind::Epipolar) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, slices_.get());
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindTextureUnit(1, f.rectifiedDepth);
-  glBindSampler(0, sampler_.get());
-  glBindSampler(1, sampler_.get());
-  glBindImageTexture(0, f.scatteringOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(static_cast<GLuint>((f.width + 7) / 8), static_cast<GLuint>((f.height + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError("RectifiedMarchPass::run");
+  gpu::dispatchMarch(f.width, f.height, "RectifiedMarchPass::run");
 }
 
 } // namespace crep

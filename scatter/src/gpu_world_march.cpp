@@ -32,6 +32,28 @@ MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light,
   return p;
 }
 
+void bindMarchResources(std::uint32_t program, std::uint32_t params, std::uint32_t cameraDepth,
+                        std::uint32_t map, std::uint32_t sampler, std::uint32_t scattering,
+                        std::uint32_t steps) {
+  glUseProgram(program);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params);
+  glBindTextureUnit(0, cameraDepth);
+  glBindTextureUnit(1, map);
+  glBindSampler(0, sampler);
+  glBindSampler(1, sampler);
+  glBindImageTexture(0, scattering, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+}
+
+void dispatchMarch(int width, int height, const char* what) {
+  // 8 x 8 pixels per workgroup: 64 invocations, a multiple of every GPU's SIMD width (32 / 64); the
+  // rectified marches of neighbouring pixels read neighbouring rows of the map.
+  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+  gl::checkError(what);
+}
+
 } // namespace gpu
 
 WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
@@ -85,18 +107,9 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   const GLuint steps = f.stepsOut != 0 ? f.stepsOut
                                        : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
                                                               f.width, f.height);
-  glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindTextureUnit(1, f.shadowMap);
-  glBindSampler(0, sampler_.get());
-  glBindSampler(1, sampler_.get());
-  glBindImageTexture(0, f.scatteringOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(static_cast<GLuint>((region.z + 7) / 8), static_cast<GLuint>((region.w + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError("WorldMarchPass::run");
+  gpu::bindMarchResources(program_.get(), params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(),
+                          f.scatteringOut, steps);
+  gpu::dispatchMarch(region.z, region.w, "WorldMarchPass::run");
 }
 
 } // namespace crep

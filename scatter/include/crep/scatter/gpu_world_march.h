@@ -56,6 +56,17 @@ static_assert(sizeof(MarchParams) == 16 * 18, "std140 CrepMarchParams");
 MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
                             int width, int height, int mapWidth, int mapHeight);
 
+/// The resources of every march pass's shader (this module's and epipolar/'s): `program` current,
+/// MarchParams buffer `params` at uniform binding 0, the camera depth at texture unit 0 and the map it
+/// marches at unit 1 (both through `sampler`), the scattering output (GL_RGBA32F) at image unit 0 and
+/// the steps output (GL_R32F) at image unit 1. The caller binds its own extra blocks after this.
+void bindMarchResources(std::uint32_t program, std::uint32_t params, std::uint32_t cameraDepth,
+                        std::uint32_t map, std::uint32_t sampler, std::uint32_t scattering,
+                        std::uint32_t steps);
+/// Dispatches 8 x 8 workgroups over width x height pixels (local size of the march shaders), then issues
+/// gl::passOutputBarrier(), unbinds (gl::unbindPassState(2)) and checks GL errors under `what`.
+void dispatchMarch(int width, int height, const char* what);
+
 } // namespace gpu
 
 /// The world-space reference march (world_march.h) against a standard shadow map; optionally only the
