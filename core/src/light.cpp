@@ -3,6 +3,7 @@
 
 #include "validate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -12,11 +13,14 @@ namespace crep {
 
 namespace {
 using detail::formatVec3;
+/// v / |v| for any finite non-zero v: scaled by its largest component first, so neither tiny (1e-300)
+/// nor huge (1e300) vectors under- or overflow in the length.
 glm::dvec3 unitDirection(const char* parameter, const glm::dvec3& v) {
-  const double len = glm::length(v);
-  if (!std::isfinite(len) || !(len > 0.0))
+  const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !(largest > 0.0))
     throw InvalidArgument(parameter, formatVec3(v), "must be a finite, non-zero vector");
-  return v / len;
+  const glm::dvec3 scaled = v / largest;
+  return scaled / glm::length(scaled);
 }
 void requireColor(const char* parameter, const glm::dvec3& c) {
   detail::requireNonNegativeVec3(parameter, c, "components must be finite and >= 0");
@@ -42,7 +46,8 @@ SpotLight::SpotLight(const glm::dvec3& position, const glm::dvec3& direction, do
       range_(range), near_(nearPlane), intensity_(intensity) {
   detail::requireFiniteVec3("SpotLight.position", position);
   if (!std::isfinite(coneAngle) || !(coneAngle > 0.0) || !(coneAngle < 0.5 * std::numbers::pi))
-    throw InvalidArgument("SpotLight.coneAngle", detail::formatValue(coneAngle), "half angle in radians, must be in (0, pi/2)");
+    throw InvalidArgument("SpotLight.coneAngle", detail::formatValue(coneAngle),
+                          "half angle in radians, must be in (0, pi/2)");
   requirePositive("SpotLight.range", range);
   if (nearPlane == -1.0) near_ = range * 1e-3;
   if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range))

@@ -29,10 +29,22 @@ double sphereIntegral(P&& p) {
   const int n = 20000;
   const double h = 2.0 / n;
   double sum = p(-1.0) + p(1.0);
-  for (int i = 1; i < n; ++i) sum += (i % 2 ? 4.0 : 2.0) * p(-1.0 + i * h);
+  for (int i = 1; i < n; ++i)
+    sum += (i % 2 ? 4.0 : 2.0) * p(-1.0 + i * h);
   return 2.0 * std::numbers::pi * sum * h / 3.0;
 }
 } // namespace
+
+TEST_CASE("DirectionalLight: directions of any finite non-zero length normalise without under/overflow") {
+  // |(1e-300, 0, 0)|^2 underflows and |(1e300, 1e300, 0)|^2 overflows in double: both are valid directions.
+  const crep::DirectionalLight tiny({1e-300, 0, 0}, {1, 1, 1});
+  CHECK(tiny.direction() == glm::dvec3(1, 0, 0));
+  const crep::DirectionalLight huge({1e300, -1e300, 0}, {1, 1, 1});
+  CHECK(huge.direction().x == doctest::Approx(std::sqrt(0.5)).epsilon(1e-15));
+  CHECK(huge.direction().y == doctest::Approx(-std::sqrt(0.5)).epsilon(1e-15));
+  const crep::DirectionalLight subnormal({0, 0, -4.9e-324}, {1, 1, 1});
+  CHECK(subnormal.direction() == glm::dvec3(0, 0, -1));
+}
 
 TEST_CASE("DirectionalLight: direction normalized, invalid input named") {
   const crep::DirectionalLight light({0, -3, 4}, {1, 2, 3});
@@ -75,7 +87,9 @@ TEST_CASE("SpotLight: cone maps to the NDC square, invalid input named") {
   expectInvalid("SpotLight.range", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 0.0); });
   expectInvalid("SpotLight.direction", [] { crep::SpotLight({0, 0, 0}, {0, 0, 0}, 0.5, 10.0); });
   expectInvalid("SpotLight.position", [] { crep::SpotLight({kNan, 0, 0}, {0, -1, 0}, 0.5, 10.0); });
-  expectInvalid("SpotLight.nearPlane", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 10.0, {1, 1, 1}, 20.0); });
+  expectInvalid("SpotLight.nearPlane", [] {
+    crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 10.0, {1, 1, 1}, 20.0);
+  });
 }
 
 TEST_CASE("Phase functions are normalized over the sphere") {
@@ -89,7 +103,8 @@ TEST_CASE("Phase functions are normalized over the sphere") {
           doctest::Approx(g).epsilon(1e-6).scale(1.0));
   }
   CHECK(crep::henyeyGreenstein(0.0, 0.3) == doctest::Approx(1.0 / (4.0 * std::numbers::pi)).epsilon(1e-15));
-  CHECK(sphereIntegral([](double mu) { return crep::rayleighPhase(mu); }) == doctest::Approx(1.0).epsilon(1e-10));
+  CHECK(sphereIntegral([](double mu) { return crep::rayleighPhase(mu); }) ==
+        doctest::Approx(1.0).epsilon(1e-10));
   CHECK(crep::rayleighPhase(1.0) == doctest::Approx(2.0 * crep::rayleighPhase(0.0)));
 }
 
@@ -106,7 +121,9 @@ TEST_CASE("Medium: invalid coefficients are named") {
   expectInvalid("Medium.mieScattering", [] { crep::Medium({-0.1, 0.1, 0.1}); });
   expectInvalid("Medium.mieScattering", [] { crep::Medium({kNan, 0.1, 0.1}); });
   expectInvalid("Medium.absorption", [] { crep::Medium({0.1, 0.1, 0.1}, {0, -1e-3, 0}); });
-  expectInvalid("Medium.rayleighScattering", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 0.0, {0, 0, -1}); });
+  expectInvalid("Medium.rayleighScattering", [] {
+    crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 0.0, {0, 0, -1});
+  });
   expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 1.0); });
   expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, kNan); });
   expectInvalid("Medium.extinction.g", [] { crep::Medium({0.1, 0.0, 0.1}); });

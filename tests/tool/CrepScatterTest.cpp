@@ -213,3 +213,121 @@ TEST_CASE("crep scatter: malformed frame descriptions exit 1 naming the field") 
     expectFailure(crep::test::runCrep(in.args()), 1, {"frame.json", c.mentions});
   }
 }
+
+TEST_CASE("crep scatter: numbers out of range are refused where they come in, naming the JSON path") {
+  const Inputs in;
+  struct Case {
+    const char* name;
+    std::function<void(Json&)> edit;
+    const char* mentions;
+  };
+  const Case cases[] = {
+      {"intensity 1e38", [](Json& j) { j["light"]["intensity"] = 1e38; }, "light.intensity"},
+      {"intensity 1e300", [](Json& j) { j["light"]["intensity"] = 1e300; }, "light.intensity"},
+      {"colour 1e308", [](Json& j) { j["light"]["color"][0] = 1e308; }, "light.color[0]"},
+      {"absorption 1e300",
+       [](Json& j) {
+         j["medium"]["absorption"] = Json::array({1e300, 0, 0});
+       },
+       "medium.absorption[0]"},
+      {"mie + rayleigh 1e308",
+       [](Json& j) {
+         j["medium"]["mieScattering"] = Json::array({1e308, 1e308, 1e308});
+         j["medium"]["rayleighScattering"] = Json::array({1e308, 1e308, 1e308});
+       },
+       "medium.mieScattering[0]"},
+      // Each factor in range, the product not: 1e20 x 1e20.
+      {"colour x intensity",
+       [](Json& j) {
+         j["light"]["color"] = Json::array({1e20, 1e20, 1e20});
+         j["light"]["intensity"] = 1e20;
+       },
+       "light.intensity: color * intensity"},
+      // In range, but the radiance bound (irradiance x scattering x phase x path) is not.
+      {"radiance bound",
+       [](Json& j) {
+         j["light"]["intensity"] = 1e28;
+         j["medium"]["hgG"] = 0.999;
+       },
+       "light.intensity: with this medium the in-scattered radiance can reach"},
+      {"camera translated by 1e30", [](Json& j) { j["camera"]["viewFromWorld"][12] = 1e30; },
+       "camera.viewFromWorld: camera position at distance"},
+      {"camera translated by 1e20", [](Json& j) { j["camera"]["viewFromWorld"][12] = 1e20; },
+       "camera.viewFromWorld: camera position at distance"},
+      {"near plane 1e-300",
+       [](Json& j) {
+         const double n = 1e-300, f = 120.0;
+         j["camera"]["clipFromView"][10] = -(f + n) / (f - n);
+         j["camera"]["clipFromView"][14] = -2.0 * f * n / (f - n);
+       },
+       "camera.clipFromView: near / far below 1e-12"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.name);
+    in.editJson(c.edit);
+    const crep::test::ToolResult r = crep::test::runCrep(in.args());
+    expectFailure(r, 1, {"frame.json", c.mentions});
+    CHECK(r.output.find("non-finite") == std::string::npos); // refused up front, not after the work
+    CHECK_FALSE(std::filesystem::exists(in.dir / "out.exr"));
+  }
+}
+
+TEST_CASE("crep scatter: JSON text problems name the path: overflow, duplicate keys, nesting, size") {
+  const Inputs in;
+  const std::string example = readText(kExample);
+  const auto runWith = [&](const std::string& text) {
+    writeText(in.dir / "frame.json", text);
+    return crep::test::runCrep(in.args());
+  };
+  // 1e309 is valid JSON grammar but overflows a double: named with its field, line and column.
+  {
+    Json j = Json::parse(example);
+    j["light"]["intensity"] = 12345.0;
+    std::string text = j.dump(2);
+    text.replace(text.find("12345.0"), 7, "1e309");
+    const crep::test::ToolResult r = runWith(text);
+    expectFailure(r, 1,
+                  {"frame.json", "light.intensity: number '1e309' is beyond the range of a double", "line"});
+    CHECK(r.output.find("json.exception") == std::string::npos);
+  }
+  // A key given twice in one object.
+  {
+    std::string text = example;
+    const auto at = text.find("\"light\"");
+    REQUIRE(at != std::string::npos);
+    text.insert(text.find('{', at) + 1, "\"intensity\": 2, ");
+    expectFailure(runWith(text), 1, {"frame.json", "light.intensity: duplicate key"});
+  }
+  // Deep nesting (destroying a deeply nested document recurses): refused while parsing.
+  expectFailure(runWith(std::string(100000, '[') + std::string(100000, ']')), 1,
+                {"frame.json", "nested deeper than 32 levels"});
+  // Over the documented size limit (1 MiB): refused before it is parsed.
+  {
+    std::string text = example;
+    text.insert(text.rfind('}'), ", \"comment\": \"" + std::string(1 << 20, 'x') + "\"");
+    expectFailure(runWith(text), 1, {"frame.json", "at most 1048576 bytes"});
+  }
+  // A directory instead of a file.
+  {
+    std::filesystem::create_directory(in.dir / "frame.dir");
+    const std::string args = "scatter --depth '" + in.path("depth.exr") + "' --shadow '" +
+                             in.path("shadow.exr") + "' --frame '" + in.path("frame.dir") + "' --out '" +
+                             in.path("out.exr") + "'";
+    expectFailure(crep::test::runCrep(args), 1, {"frame.dir", "is a directory"});
+  }
+  CHECK_FALSE(std::filesystem::exists(in.dir / "out.exr"));
+}
+
+TEST_CASE("crep scatter: a light direction of tiny or huge length is normalised, not called zero") {
+  // [1e-300, 0, 0] and [1e300, 0, 0] are the direction +x: not "zero", and the checks that follow see +x
+  // (here the example's shadow matrix, which does not look along +x, is what is refused).
+  const Inputs in;
+  for (const double scale : {1e-300, 1e-30, 1e30}) {
+    INFO(scale);
+    in.editJson([&](Json& j) { j["light"]["direction"] = Json::array({scale, 0.0, 0.0}); });
+    const crep::test::ToolResult r = crep::test::runCrep(in.args());
+    INFO(r.output);
+    CHECK(r.output.find("zero") == std::string::npos);
+    CHECK(r.output.find("shadowMap.lightClipFromWorld") != std::string::npos);
+  }
+}

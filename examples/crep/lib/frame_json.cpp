@@ -7,11 +7,16 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
+#include <numbers>
+#include <set>
 #include <sstream>
+#include <vector>
 
 namespace crep::tool {
 
@@ -22,6 +27,13 @@ using Json = nlohmann::json;
 const char* typeName(const Json& j) {
   return j.type_name();
 }
+
+/// Largest magnitude of any number of a frame description (frame_json.h).
+constexpr double kMaxMagnitude = 1e30;
+/// Largest in-scattered radiance the inputs may produce (frame_json.h "Ranges").
+constexpr double kMaxRadiance = 1e30;
+/// Deepest nesting of arrays and objects accepted (the schema needs 3).
+constexpr int kMaxDepth = 32;
 
 /// Field access with messages "<source>: <path>: <problem>".
 class Reader {
@@ -63,6 +75,9 @@ public:
     if (!j.is_number()) fail(path, std::string("expected a number, got ") + typeName(j));
     const double v = j.get<double>();
     if (!std::isfinite(v)) fail(path, "not a finite number");
+    if (std::abs(v) > kMaxMagnitude)
+      fail(path, format(v) + " is beyond +-" + format(kMaxMagnitude) +
+                     " (the GPU passes compute in float: results must stay far below 3.4e38)");
     return v;
   }
 
@@ -117,6 +132,90 @@ private:
   std::string source_;
 };
 
+/// A SAX pass over the text before the DOM parse: it knows the JSON path of every token, so a number
+/// that overflows a double, a duplicate key, nesting beyond kMaxDepth and syntax errors are reported with
+/// the path (and line and column) instead of the parser's internal message.
+class PathChecker final : public nlohmann::json_sax<Json> {
+public:
+  PathChecker(const std::string& text, const std::string& source) : text_(text), source_(source) {}
+
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override { return open(false); }
+  bool start_array(std::size_t) override { return open(true); }
+  bool end_object() override { return close(); }
+  bool end_array() override { return close(); }
+  bool key(string_t& k) override {
+    Level& l = stack_.back();
+    if (!l.keys.insert(k).second)
+      throw FormatError(source_ + ": " + join(path(stack_.size() - 1), k) +
+                        ": duplicate key (each field may appear once)");
+    l.key = k;
+    return true;
+  }
+  bool parse_error(std::size_t position, const std::string& token,
+                   const nlohmann::detail::exception& e) override {
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i + 1 < position && i < text_.size(); ++i) {
+      if (text_[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    const std::string where = path().empty() ? "(top level)" : path();
+    const std::string at = " (line " + std::to_string(line) + ", column " + std::to_string(column) + ")";
+    if (e.id == 406) // number overflow
+      throw FormatError(source_ + ": " + where + ": number '" + token + "' is beyond the range of a double" +
+                        at);
+    throw FormatError(source_ + ": not valid JSON at " + where + at + ": " + e.what());
+  }
+
+private:
+  struct Level {
+    bool array = false;
+    std::size_t index = 0;
+    std::string key;
+    std::set<std::string> keys;
+  };
+
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
+  /// The path of the current position through the outermost `levels` levels (all by default).
+  std::string path(std::size_t levels = std::numeric_limits<std::size_t>::max()) const {
+    std::string p;
+    for (std::size_t i = 0; i < stack_.size() && i < levels; ++i)
+      p = stack_[i].array ? p + "[" + std::to_string(stack_[i].index) + "]" : join(p, stack_[i].key);
+    return p;
+  }
+  bool value() {
+    if (!stack_.empty() && stack_.back().array) ++stack_.back().index;
+    return true;
+  }
+  bool open(bool array) {
+    if (static_cast<int>(stack_.size()) >= kMaxDepth)
+      throw FormatError(source_ + ": " + (path().empty() ? "(top level)" : path()) + ": nested deeper than " +
+                        std::to_string(kMaxDepth) + " levels");
+    stack_.push_back({array, 0, {}, {}});
+    return true;
+  }
+  bool close() {
+    stack_.pop_back();
+    return value();
+  }
+
+  const std::string& text_;
+  const std::string& source_;
+  std::vector<Level> stack_;
+};
+
 std::string formatVec(const glm::dvec3& v) {
   return "[" + Reader::format(v.x) + ", " + Reader::format(v.y) + ", " + Reader::format(v.z) + "]";
 }
@@ -132,9 +231,11 @@ std::string formatMat(const glm::dmat4& m) {
 FrameDescription parseFrameDescription(const std::string& text, const std::string& source) {
   const Reader r(source);
   Json root;
+  PathChecker checker(text, source);
+  Json::sax_parse(text, &checker); // throws FormatError with the path; otherwise the text is valid JSON
   try {
     root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
     throw FormatError(source + ": not valid JSON: " + e.what());
   }
   r.requireObject(root, "", {"version", "camera", "light", "shadowMap", "medium"});
@@ -154,10 +255,14 @@ FrameDescription parseFrameDescription(const std::string& text, const std::strin
       r.vec3(r.get(light, "light", "direction"), "light.direction", "x, y, z: the direction light travels");
   f.lightColor = r.vec3(r.get(light, "light", "color"), "light.color", "linear r, g, b");
   f.lightIntensity = r.number(r.get(light, "light", "intensity"), "light.intensity");
-  if (glm::length(f.lightDirection) == 0.0) r.fail("light.direction", "must not be zero");
+  if (f.lightDirection == glm::dvec3(0.0)) r.fail("light.direction", "must not be zero");
   for (int c = 0; c < 3; ++c)
     if (f.lightColor[c] < 0.0) r.fail("light.color", "components must be >= 0");
   if (f.lightIntensity < 0.0) r.fail("light.intensity", "must be >= 0");
+  for (int c = 0; c < 3; ++c)
+    if (f.lightColor[c] * f.lightIntensity > kMaxMagnitude)
+      r.fail("light.intensity", "color * intensity = " + Reader::format(f.lightColor[c] * f.lightIntensity) +
+                                    " is beyond " + Reader::format(kMaxMagnitude));
 
   const Json& shadow = r.get(root, "", "shadowMap");
   r.requireObject(shadow, "shadowMap", {"lightClipFromWorld", "size", "bias"});
@@ -179,12 +284,25 @@ FrameDescription parseFrameDescription(const std::string& text, const std::strin
 }
 
 FrameDescription readFrameDescription(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw IoError("cannot read frame description '" + path.string() + "': it is a directory");
+  const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxFrameBytes)
+    throw FormatError(path.string() + ": " + std::to_string(bytes) +
+                      " bytes; a frame description is at most " + std::to_string(kMaxFrameBytes) +
+                      " bytes (1 MiB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError("cannot open frame description '" + path.string() + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Bounded read: also for files whose size the file system does not report (pipes).
+  std::string text(kMaxFrameBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw IoError("cannot read frame description '" + path.string() + "'");
-  return parseFrameDescription(text.str(), path.string());
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxFrameBytes)
+    throw FormatError(path.string() + ": a frame description is at most " + std::to_string(kMaxFrameBytes) +
+                      " bytes (1 MiB)");
+  return parseFrameDescription(text, path.string());
 }
 
 std::string toJson(const FrameDescription& f) {
@@ -250,16 +368,27 @@ Camera cameraOf(const FrameDescription& f, const std::string& source) {
            "element 11 (column 2, row 3) must be -1 (OpenGL perspective), got " + Reader::format(p[2][3]));
   if (!(p[0][0] > 0.0) || !(p[1][1] > 0.0))
     r.fail("camera.clipFromView", "elements 0 and 5 (focal lengths) must be > 0");
-  if (std::abs(a + 1.0) < 1e-12)
-    r.fail("camera.clipFromView",
-           "infinite far plane (element 10 = -1) is not supported: the map covers the frustum up "
-           "to a finite far plane");
   const double near = b / (a - 1.0), far = b / (a + 1.0);
+  // near / far = (a + 1) / (a - 1): element 10 rounds to -1 for an infinite far plane and for a near plane
+  // too small against the far one; the matrix cannot tell them apart, the message names both.
+  if (std::abs(a + 1.0) < 1e-12)
+    r.fail(
+        "camera.clipFromView",
+        "near / far below 1e-12 (element 10 = " + Reader::format(a) + ", near = " + Reader::format(near) +
+            "): an infinite far plane or a near plane too small for the depth buffer; neither is supported "
+            "(the map covers the frustum up to a finite far plane)");
   if (!(near > 0.0) || !(far > near) || !std::isfinite(far))
     r.fail("camera.clipFromView",
            "near " + Reader::format(near) + " and far " + Reader::format(far) +
                " (from elements 10 and 14) must satisfy 0 < near < far: OpenGL depth conventions "
                "(NDC z in [-1, 1]; reversed Z is not supported)");
+  // World coordinates must resolve the near plane: beyond |position| = 1e12 near, double precision no
+  // longer separates the frustum corners from the camera (and float GPU math failed long before).
+  if (!(glm::length(position) < 1e12 * near))
+    r.fail("camera.viewFromWorld",
+           "camera position at distance " + Reader::format(glm::length(position)) +
+               " from the origin is not representable against the near plane " + Reader::format(near) +
+               " (|position| must be < 1e12 near): use camera-relative world coordinates");
   const double fovY = 2.0 * std::atan(1.0 / p[1][1]);
   const double aspect = p[1][1] / p[0][0];
   try {
@@ -278,9 +407,44 @@ DirectionalLight lightOf(const FrameDescription& f, const std::string& source) {
   }
 }
 
+namespace {
+
+/// Upper bound of the in-scattered radiance of any pixel (Klehm et al. 2014, Eq. 1 with V = 1 and the
+/// largest phase value): E_c (sigma_mie,c HG_max + sigma_rayleigh,c 3 / (8 pi)) min(s_max, 1 / sigma_t,c).
+double radianceBound(const FrameDescription& f, const Medium& m) {
+  const double g = std::abs(f.hgG);
+  const double hgMax = (1.0 + g) / (4.0 * std::numbers::pi * (1.0 - g) * (1.0 - g));
+  const double rayleighMax = 3.0 / (8.0 * std::numbers::pi);
+  // Longest view ray: the far plane at the frustum corner (from clipFromView; infinite if not finite).
+  const glm::dmat4& p = f.clipFromView;
+  const double far = p[3][2] / (p[2][2] + 1.0);
+  const double corner = std::sqrt(1.0 + 1.0 / (p[0][0] * p[0][0]) + 1.0 / (p[1][1] * p[1][1]));
+  const double sMax =
+      std::isfinite(far) && far > 0.0 ? far * corner : std::numeric_limits<double>::infinity();
+  const glm::dvec3 sigma = m.extinction();
+  double bound = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double C = f.lightColor[c] * f.lightIntensity *
+                     (f.mieScattering[c] * hgMax + f.rayleighScattering[c] * rayleighMax);
+    const double length = sigma[c] > 0.0 ? std::min(sMax, 1.0 / sigma[c]) : sMax;
+    if (C > 0.0) bound = std::max(bound, C * length);
+  }
+  return bound;
+}
+
+} // namespace
+
 Medium mediumOf(const FrameDescription& f, const std::string& source) {
   try {
-    return Medium(f.mieScattering, f.absorption, f.hgG, f.rayleighScattering);
+    Medium m(f.mieScattering, f.absorption, f.hgG, f.rayleighScattering);
+    const double bound = radianceBound(f, m);
+    if (!(bound <= kMaxRadiance))
+      Reader(source).fail("light.intensity",
+                          "with this medium the in-scattered radiance can reach " + Reader::format(bound) +
+                              " (irradiance x scattering x phase x path length), beyond " +
+                              Reader::format(kMaxRadiance) +
+                              ": lower light.intensity / light.color or medium.mieScattering / hgG");
+    return m;
   } catch (const InvalidArgument& e) {
     std::string field = "medium (extinction = mieScattering + rayleighScattering + absorption)";
     const std::string& p = e.parameter();

@@ -27,6 +27,12 @@
 //     }
 //   }
 //
+// Ranges: every number is finite and at most 1e30 in magnitude, and so is light.color * light.intensity;
+// the inputs must keep the in-scattered radiance below 1e30 (irradiance x scattering x the largest phase
+// value x the longest path, 1 / extinction or the far-plane corner distance): the GPU passes compute in
+// float. A frame description file is at most 1 MiB; a key may appear once per object; nesting is at most
+// 32 levels. Errors name the JSON path (e.g. "light.intensity", "camera.viewFromWorld[12]").
+//
 // Matrices are 16 numbers in column-major order (as GLSL and glm store them, and as `crep rectify`
 // prints them): element k is column k / 4, row k % 4. Unknown fields are errors (a typo must not be
 // silently ignored); a field named "comment" is allowed in every object.
@@ -38,11 +44,15 @@
 
 #include <glm/glm.hpp>
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 
 namespace crep::tool {
+
+/// Largest frame description file readFrameDescription() accepts.
+inline constexpr std::uintmax_t kMaxFrameBytes = 1u << 20;
 
 struct FrameDescription {
   glm::dmat4 viewFromWorld{1.0};
