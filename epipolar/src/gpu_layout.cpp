@@ -1,11 +1,10 @@
-// The GPU layout blocks (crep/epipolar/gpu_layout.h, glsl/crep/epipolar.glsl) and their upload.
+// The epipolar layout's GPU block and slice table (crep/epipolar/gpu_layout.h, glsl/crep/epipolar.glsl).
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
 
-#include "gpu_common.h"
-
 #include <cmath>
+#include <cstring>
 
 namespace crep {
 
@@ -43,33 +42,18 @@ std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout) {
 
 } // namespace gpu
 
-namespace epipolar_detail {
-
-void uploadLayout(const RectifiedLayout& layout, gpu::LayoutKind kind, int mapHeight, gl::Handle& block,
-                  gl::Handle& slices) {
-  if (kind == gpu::LayoutKind::Projective) {
-    const gpu::ProjectiveLayoutParams p =
-        gpu::makeProjectiveLayoutParams(dynamic_cast<const ProjectiveLayout&>(layout));
-    glNamedBufferSubData(block.get(), 0, sizeof(p), &p);
-    return;
-  }
-  const auto& e = dynamic_cast<const EpipolarLayout&>(layout);
-  if (e.sliceCount() != mapHeight)
-    throw InvalidArgument("mapHeight", std::to_string(mapHeight),
-                          "must be the EpipolarLayout's slice count " + std::to_string(e.sliceCount()));
-  const gpu::EpipolarLayoutParams p = gpu::makeEpipolarLayoutParams(e);
-  glNamedBufferSubData(block.get(), 0, sizeof(p), &p);
-  const std::vector<gpu::EpipolarSlice> table = gpu::makeEpipolarSlices(e);
-  const auto bytes = static_cast<GLsizeiptr>(table.size() * sizeof(gpu::EpipolarSlice));
-  GLint64 size = 0;
-  if (slices) glGetNamedBufferParameteri64v(slices.get(), GL_BUFFER_SIZE, &size);
-  if (!slices || size < bytes) {
-    slices = gl::createBuffer();
-    glNamedBufferStorage(slices.get(), bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
-  }
-  glNamedBufferSubData(slices.get(), 0, bytes, table.data());
+std::optional<GpuLayoutData> EpipolarLayout::gpuLayoutData() const {
+  const gpu::EpipolarLayoutParams p = gpu::makeEpipolarLayoutParams(*this);
+  const std::vector<gpu::EpipolarSlice> table = gpu::makeEpipolarSlices(*this);
+  GpuLayoutData d;
+  d.kind = gpu::LayoutKind::Epipolar;
+  d.block.resize(sizeof(p));
+  std::memcpy(d.block.data(), &p, sizeof(p));
+  d.rows.resize(table.size() * sizeof(gpu::EpipolarSlice));
+  std::memcpy(d.rows.data(), table.data(), d.rows.size());
+  d.rowCount = sliceCount();
+  d.regionCount = regionCount();
+  return d;
 }
-
-} // namespace epipolar_detail
 
 } // namespace crep

@@ -8,7 +8,7 @@
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 
-#include "gpu_common.h"
+#include <crep/scatter/gpu_layout_buffers.h>
 
 #include <epoxy/gl.h>
 
@@ -20,33 +20,12 @@ namespace crep {
 
 namespace gpu {
 
-ProjectiveLayoutParams makeProjectiveLayoutParams(const ProjectiveLayout& layout) {
-  const Rectification& r = layout.rectification();
-  const int K = r.splitCount();
-  if (K > kMaxLayoutRegions)
-    throw InvalidArgument("ProjectiveLayout.regionCount", detail::formatValue(K),
-                          "must be <= " + std::to_string(kMaxLayoutRegions) + " on the GPU");
-  const RectifiedFrame& f = r.frame;
-  ProjectiveLayoutParams p;
-  p.origin = glm::vec4(glm::vec3(f.origin), static_cast<float>(f.inverseLightDistance));
-  p.axisX = glm::vec4(glm::vec3(f.axisX), 0.0f);
-  p.axisY = glm::vec4(glm::vec3(f.axisY), 0.0f);
-  p.axisZ = glm::vec4(glm::vec3(f.axisZ), 0.0f);
-  p.slopes = glm::vec4(static_cast<float>(f.rowSlopeMin), static_cast<float>(f.rowSlopeMax),
-                       static_cast<float>(f.depthSlopeMin), static_cast<float>(f.depthSlopeMax));
-  p.counts = glm::ivec4(K, 0, 0, 0);
-  for (int k = 0; k < K; ++k) {
-    const Split& s = r.splits[static_cast<std::size_t>(k)];
-    p.splitZeta[k] = glm::vec4(static_cast<float>(s.zetaBegin), static_cast<float>(s.zetaEnd), 0.0f, 0.0f);
-  }
-  return p;
-}
-
 LayoutKind layoutKind(const RectifiedLayout& layout) {
-  if (dynamic_cast<const ProjectiveLayout*>(&layout)) return LayoutKind::Projective;
-  if (dynamic_cast<const EpipolarLayout*>(&layout)) return LayoutKind::Epipolar;
-  throw InvalidArgument("layout", "a RectifiedLayout without GPU mapping",
-                        "must be a ProjectiveLayout or an EpipolarLayout");
+  const std::optional<GpuLayoutData> data = layout.gpuLayoutData();
+  if (!data)
+    throw InvalidArgument("layout", "a RectifiedLayout without GPU mapping",
+                          "must be a ProjectiveLayout or an EpipolarLayout");
+  return data->kind;
 }
 
 } // namespace gpu
@@ -105,7 +84,6 @@ RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
     throw GlError("crep: RectifiedMarchPass.mapSize width " + std::to_string(info.mapWidth) +
                   " needs more than 16 tree levels");
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  layoutBlock_ = gl::createDynamicBuffer(epipolar_detail::kLayoutBlockSize);
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("RectifiedMarchPass");
 }
@@ -153,15 +131,14 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   gpu::MarchParams params = gpu::makeMarchParams(*f.camera, *f.light, *f.medium, f.width, f.height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-  epipolar_detail::uploadLayout(*f.layout, kind, H, layoutBlock_, slices_);
+  layoutBuffers_.upload(*f.layout, H);
 
   const GLuint steps = f.stepsOut != 0 ? f.stepsOut
                                        : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
                                                               f.width, f.height);
   gpu::bindMarchResources(program.get(), params_.get(), f.cameraDepth, f.rectifiedDepth, sampler_.get(),
                           f.scatteringOut, steps);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 1, layoutBlock_.get());
-  if (kind == gpu::LayoutKind::Epipolar) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, slices_.get());
+  layoutBuffers_.bind(1, 1);
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
   gpu::dispatchMarch(f.width, f.height, "RectifiedMarchPass::run");
 }

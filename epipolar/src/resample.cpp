@@ -7,7 +7,7 @@
 #include <crep/epipolar/gpu_layout.h>
 #include <crep/epipolar/resample.h>
 
-#include "gpu_common.h"
+#include <crep/scatter/gpu_layout_buffers.h>
 
 #include <epoxy/gl.h>
 
@@ -100,14 +100,12 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
 ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("ShadowResamplePass.mapSize", info.mapWidth, info.mapHeight);
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  layoutBlock_ = gl::createDynamicBuffer(epipolar_detail::kLayoutBlockSize);
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("ShadowResamplePass");
 }
 
 void ShadowResamplePass::run(const FrameAttribs& f) {
   if (!f.layout) throw InvalidArgument("ShadowResamplePass.FrameAttribs.layout", "null", "must be set");
-  const gpu::LayoutKind kind = gpu::layoutKind(*f.layout);
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (W % f.layout->regionCount() != 0)
     throw InvalidArgument("ShadowResamplePass.mapSize", std::to_string(W),
@@ -121,6 +119,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   gl::requireTexture2D("ShadowResamplePass.FrameAttribs.rectifiedOut", f.rectifiedOut, W, H, GL_R32F);
   validateLightMatrix(f.lightClipFromWorld, f.layout->lightRay(0.5, 0.5).direction);
 
+  const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
   gl::Handle& program = programs_[static_cast<int>(kind)];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
@@ -130,15 +129,13 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   params.sizes = glm::ivec4(f.shadowWidth, f.shadowHeight, W, H);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-  epipolar_detail::uploadLayout(*f.layout, kind, H, layoutBlock_, slices_);
   const glm::mat4 worldFromClip(glm::inverse(f.lightClipFromWorld));
 
   const GLuint p = program.get();
   glUseProgram(p);
   glProgramUniformMatrix4fv(p, 0, 1, GL_FALSE, &worldFromClip[0][0]);
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 1, layoutBlock_.get());
-  if (kind == gpu::LayoutKind::Epipolar) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, slices_.get());
+  layoutBuffers_.bind(1, 1);
   glBindTextureUnit(0, f.shadowMap);
   glBindSampler(0, sampler_.get());
   glBindImageTexture(0, f.rectifiedOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);

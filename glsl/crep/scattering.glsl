@@ -34,6 +34,12 @@
 //                              Lanczos, fourier.h; not in the paper); default 0 = Eq. 8 as published
 //   CREP_NO_FP64               1: reduce Fourier angles in float (default: in double, see crep_halfTurns)
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
+//   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
+//                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
+//                              CREP_LAYOUT_EPIPOLAR (1, the fallback of Klehm et al. 2014, Sec. 4.1). Bind
+//                              the layout block at CREP_LAYOUT_BINDING and, for the epipolar layout, the
+//                              slice table at CREP_SLICES_BINDING (gpu::LayoutBuffers of any layout). The
+//                              entry points and the integration rule are the same on both layouts.
 #ifndef CREP_SCATTERING_GLSL
 #define CREP_SCATTERING_GLSL
 
@@ -230,6 +236,11 @@ layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegion
 #define CREP_EVAL_MAX_LAYERS 32
 #endif
 
+#ifdef CREP_EVAL_LAYOUT
+#define CREP_LAYOUT CREP_EVAL_LAYOUT
+#include "epipolar.glsl"
+#endif
+
 // A world point in the rectified map (crep::Rectification::toRectified): slopes y = Y / X, z = Z / X,
 // normalized row and depth, split k and the column within it.
 struct CrepRectPoint {
@@ -284,6 +295,52 @@ float crep_boundaryDistance(float y, float z, int b) {
   return den > 0.0 ? sqrt(1.0 + y * y + z * z) / den : 3.0e38;
 }
 
+// A view ray mapped for the evaluation: its normalized row and depth z_r, the prefilter region and column
+// of its end, and what crep_evalBoundary needs (the projective frame's slopes, or a layout's row ray).
+struct CrepEvalRay {
+  float row, depth;
+  int region;
+  float u;
+  vec4 data;     // projective frame: (y, z, 0, 0)
+#ifdef CREP_EVAL_LAYOUT
+  CrepRowRay rr; // layout: the row ray of crep/epipolar.glsl
+#endif
+};
+
+// Maps the point origin + t dir (t = surface) of a ray from the camera; false where the layout cannot.
+bool crep_evalMap(vec3 origin, vec3 dir, float t, out CrepEvalRay e) {
+#ifdef CREP_EVAL_LAYOUT
+  e = CrepEvalRay(0.0, 0.0, 0, 0.0, vec4(0.0), CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0)));
+  vec4 p; // (row, column, depth, layout region)
+  if (!crep_layoutToRectified(origin + t * dir, p)) return false;
+  if (!crep_mapRowRay(dir, t, crep_scattering.mapSize.xy, e.rr)) return false;
+  CrepRectPoint hit = CrepRectPoint(0.0, 0.0, p.x, p.z, int(p.w), p.y * float(crep_scattering.mapSize.w) - p.w);
+  crep_regionPoint(hit, e.region, e.u);
+  e.row = p.x;
+  e.depth = p.z;
+  return true;
+#else
+  e = CrepEvalRay(0.0, 0.0, 0, 0.0, vec4(0.0));
+  CrepRectPoint hit;
+  if (!crep_toRectified(origin - crep_scattering.frameOrigin.xyz + t * dir, hit)) return false;
+  crep_regionPoint(hit, e.region, e.u);
+  e.row = hit.row;
+  e.depth = hit.depth;
+  e.data = vec4(hit.y, hit.z, 0.0, 0.0);
+  return true;
+#endif
+}
+
+// World distance along the mapped ray to the boundary column b / R of the prefilter regions.
+float crep_evalBoundary(CrepEvalRay e, int b) {
+#ifdef CREP_EVAL_LAYOUT
+  int n = crep_scattering.mapSize.x / crep_scattering.mapSize.z; // texels per prefilter region
+  return crep_rowRayDistance(e.rr, b * n, crep_scattering.mapSize.xy);
+#else
+  return crep_boundaryDistance(e.data.x, e.data.y, b);
+#endif
+}
+
 // The decoded filtered basis F = 2 e - 1 of one layer at prefix boundary u of region r and normalized
 // row (crep::evaluate's sampling rule: texel x = clamp(u n - 1, 0, n - 1) of the region, y = clamp(row H
 // - 0.5, 0, H - 1)). The sampler's GL_LINEAR / GL_NEAREST does the filtering; x never leaves the region.
@@ -312,19 +369,18 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
   vec3 sigma = crep_scattering.extinction.rgb;
   vec3 C = crep_scatteringConstant(dir);
   float transmittance = exp(-dot(sigma, vec3(1.0 / 3.0)) * surface);
-  vec3 offset = origin - crep_scattering.frameOrigin.xyz;
-  CrepRectPoint hit;
-  if (!crep_toRectified(offset + surface * dir, hit))
+  CrepEvalRay hit;
+  if (!crep_evalMap(origin, dir, surface, hit))
     return vec4(C * crep_transmittanceIntegral(sigma, start, surface), transmittance);
-  int lastRegion, firstRegion = 0;
-  float lastU, firstU = 0.0;
-  crep_regionPoint(hit, lastRegion, lastU);
+  int lastRegion = hit.region, firstRegion = 0;
+  float lastU = hit.u, firstU = 0.0;
 #if CREP_NEAR_PLANE_CORRECTION
   if (start > 0.0) {
-    CrepRectPoint nearPoint;
-    if (!crep_toRectified(offset + start * dir, nearPoint))
+    CrepEvalRay nearPoint;
+    if (!crep_evalMap(origin, dir, start, nearPoint))
       return vec4(C * crep_transmittanceIntegral(sigma, start, surface), transmittance);
-    crep_regionPoint(nearPoint, firstRegion, firstU);
+    firstRegion = nearPoint.region;
+    firstU = nearPoint.u;
     if (firstRegion > lastRegion || (firstRegion == lastRegion && firstU > lastU)) {
       firstRegion = lastRegion;
       firstU = lastU;
@@ -361,7 +417,7 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
   for (int r = firstRegion; r <= lastRegion; ++r) {
     float ua = r == firstRegion ? firstU : 0.0;
     float ub = r == lastRegion ? lastU : 1.0;
-    float tb = r == lastRegion ? surface : crep_boundaryDistance(hit.y, hit.z, r + 1);
+    float tb = r == lastRegion ? surface : crep_evalBoundary(hit, r + 1);
     tb = clamp(tb, ta, surface);
     float dotF = 0.0;
     bool plain = true;

@@ -30,6 +30,8 @@ namespace {
 // Binding points (see gpu_pass.h and the shaders' defaults).
 constexpr GLuint kScatteringBinding = 0, kEvaluateBinding = 1, kRegionWeightsEvalBinding = 1;
 constexpr GLuint kBasisUnit = 0, kCameraDepthUnit = 1;
+// Layouts other than projective: their block (gpu::LayoutBuffers) next to the scattering and evaluate blocks.
+constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 
 std::string str(long long v) {
   return std::to_string(v);
@@ -189,10 +191,9 @@ std::vector<gpu::RegionWeights> gpuRegionWeights(const std::vector<DistanceProfi
 gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const RectifiedLayout& layout,
                                            const DirectionalLight& light, const Medium& medium) {
   const auto* projective = dynamic_cast<const ProjectiveLayout*>(&layout);
-  if (projective == nullptr)
-    invalid("layout", "not a ProjectiveLayout",
-            "the GPU evaluation maps world points with a projective rectification");
-  const Rectification& r = projective->rectification();
+  if (projective == nullptr && !layout.gpuLayoutData())
+    invalid("layout", "a RectifiedLayout without GPU mapping",
+            "must be a ProjectiveLayout or an EpipolarLayout");
   const int K = layout.regionCount();
   if (K != basis.layoutRegions)
     invalid("layout", "regionCount() " + str(K),
@@ -205,15 +206,24 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
             "size " + sizeString(basis.width, basis.height) + ", regions " + str(basis.regions()),
             "width and height must be > 0 and the width a multiple of the regions");
 
-  const RectifiedFrame& f = r.frame;
   gpu::ScatteringParams p;
-  p.frameOrigin = vec4Of(f.origin);
-  p.frameAxisX = vec4Of(f.axisX, f.inverseLightDistance);
-  p.frameAxisY = vec4Of(f.axisY);
-  p.frameAxisZ = vec4Of(f.axisZ);
-  p.slopes = glm::vec4(
-      static_cast<float>(f.rowSlopeMin), static_cast<float>(1.0 / (f.rowSlopeMax - f.rowSlopeMin)),
-      static_cast<float>(f.depthSlopeMin), static_cast<float>(1.0 / (f.depthSlopeMax - f.depthSlopeMin)));
+  p.frameOrigin = vec4Of(layout.origin());
+  if (projective) {
+    // The projective frame (Klehm et al. 2014, Sec. 4.2); other layouts are mapped by their own block
+    // (CREP_EVAL_LAYOUT, gpu::LayoutBuffers).
+    const RectifiedFrame& f = projective->rectification().frame;
+    p.frameOrigin = vec4Of(f.origin);
+    p.frameAxisX = vec4Of(f.axisX, f.inverseLightDistance);
+    p.frameAxisY = vec4Of(f.axisY);
+    p.frameAxisZ = vec4Of(f.axisZ);
+    p.slopes = glm::vec4(
+        static_cast<float>(f.rowSlopeMin), static_cast<float>(1.0 / (f.rowSlopeMax - f.rowSlopeMin)),
+        static_cast<float>(f.depthSlopeMin), static_cast<float>(1.0 / (f.depthSlopeMax - f.depthSlopeMin)));
+    for (int k = 0; k < K; ++k) {
+      const Split& s = projective->rectification().splits[static_cast<std::size_t>(k)];
+      p.splitZeta[k] = glm::vec4(static_cast<float>(s.zetaBegin), static_cast<float>(s.zetaEnd), 0.0f, 0.0f);
+    }
+  }
   p.extinction = vec4Of(medium.extinction(), basis.extinction);
   p.mieScattering = vec4Of(medium.mieScattering(), medium.hgG());
   p.rayleighScattering = vec4Of(medium.rayleighScattering());
@@ -223,10 +233,6 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
   p.basisInfo = glm::ivec4(basis.bases, layerCount(basis.bases), basis.regionsPerSplit,
                            static_cast<int>(basis.weights));
   p.depthMargin = glm::vec4(static_cast<float>(basis.depthMargin), 0.0f, 0.0f, 0.0f);
-  for (int k = 0; k < K; ++k) {
-    const Split& s = r.splits[static_cast<std::size_t>(k)];
-    p.splitZeta[k] = glm::vec4(static_cast<float>(s.zetaBegin), static_cast<float>(s.zetaEnd), 0.0f, 0.0f);
-  }
   return p;
 }
 
@@ -387,6 +393,29 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
 // ---------------------------------------------------------------------------------------------------
 // EvaluatePass
 
+namespace {
+/// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
+/// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
+std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind) {
+  std::vector<ShaderStageSource> stages = {
+      {ShaderStage::Compute,
+       "passes/evaluate.comp",
+       {{"CREP_BASES", str(info.bases)},
+        {"CREP_OUTPUT_FORMAT", storageFormatToken(info.outputFormat)},
+        {"CREP_NEAR_PLANE_CORRECTION", info.options.nearPlaneCorrection ? "1" : "0"},
+        {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
+        {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
+        {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)}}}};
+  if (layoutKind >= 0) {
+    std::vector<ShaderDefine>& d = stages[0].defines;
+    d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
+    d.push_back({"CREP_LAYOUT_BINDING", str(kLayoutBinding)});
+    d.push_back({"CREP_SLICES_BINDING", str(kLayoutRowsBinding)});
+  }
+  return stages;
+}
+} // namespace
+
 EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   validateBases(info.bases, "EvaluatePass::CreateInfo.bases");
   validate(info.options, "EvaluatePass::CreateInfo.options");
@@ -402,16 +431,7 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
     const int groups[3] = {1, 1, 1};
     checkWorkgroup(names, local, groups);
   }
-  const std::vector<ShaderStageSource> stages = {
-      {ShaderStage::Compute,
-       "passes/evaluate.comp",
-       {{"CREP_BASES", str(info.bases)},
-        {"CREP_OUTPUT_FORMAT", storageFormatToken(info.outputFormat)},
-        {"CREP_NEAR_PLANE_CORRECTION", info.options.nearPlaneCorrection ? "1" : "0"},
-        {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
-        {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
-        {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)}}}};
-  program_ = buildProgram(stages);
+  program_ = buildProgram(evaluateStages(info, -1));
   basisSampler_ =
       gl::createClampSampler(info.options.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
   depthSampler_ = gl::createClampSampler(GL_NEAREST);
@@ -419,6 +439,7 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   evaluateBuffer_ = gl::createDynamicBuffer(sizeof(gpu::EvaluateParams));
   gl::checkError("EvaluatePass: samplers and buffers");
 }
+
 
 EvaluatePass::~EvaluatePass() = default;
 EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
@@ -458,6 +479,17 @@ void EvaluatePass::run(const FrameAttribs& frame) {
 
   const gpu::ScatteringParams scattering =
       makeScatteringParams(basis, *frame.layout, *frame.light, *frame.medium);
+  // A projective layout is evaluated from the scattering block's frame (the default program); any other
+  // layout with a GPU mapping through its own block (Klehm et al. 2014, Sec. 4.1 for the epipolar one).
+  GLuint program = program_.get();
+  const bool projective = dynamic_cast<const ProjectiveLayout*>(frame.layout) != nullptr;
+  if (!projective) {
+    const gpu::LayoutKind kind =
+        layoutBuffers_.upload(*frame.layout, basis.height, "EvaluatePass::FrameAttribs.layout");
+    gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
+    if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
+    program = variant.get();
+  }
   const Camera& cam = *frame.camera;
   const double ty = std::tan(0.5 * cam.fovY()), tx = ty * cam.aspect();
   gpu::EvaluateParams params;
@@ -469,7 +501,8 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
 
-  glUseProgram(program_.get());
+  glUseProgram(program);
+  if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
   glBindTextureUnit(kBasisUnit, basis.texture);
   glBindSampler(kBasisUnit, basisSampler_.get());
   glBindTextureUnit(kCameraDepthUnit, frame.cameraDepth);
@@ -487,6 +520,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
+  if (!projective) {
+    glBindBufferBase(GL_UNIFORM_BUFFER, kLayoutBinding, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLayoutRowsBinding, 0);
+  }
   glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
   glBindSampler(kCameraDepthUnit, 0);
   glBindTextureUnit(kCameraDepthUnit, 0);

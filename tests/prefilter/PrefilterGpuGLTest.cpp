@@ -54,29 +54,6 @@ const GpuScene& boxesScene() {
   return scene;
 }
 
-double ulpHalf(double e) {
-  if (e < std::ldexp(1.0, -14)) return std::ldexp(1.0, -24);
-  int exponent = 0;
-  std::frexp(e, &exponent);
-  return std::ldexp(1.0, exponent - 11);
-}
-
-/// The per-value tolerance of a storage format (see the top of the file).
-struct FormatTolerance {
-  StorageFormat format;
-  double operator()(float cpu) const {
-    switch (format) {
-    case StorageFormat::RGBA8:
-      return 1.0 / 255.0 + 1e-6;
-    case StorageFormat::RGBA16F:
-      return ulpHalf(cpu) + 1e-6;
-    case StorageFormat::RGBA32F:
-      break;
-    }
-    return 4e-6;
-  }
-};
-
 /// Runs the GPU prefilter on the scene's map texture; returns the pass (its texture holds the result).
 PrefilterPass runPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& info,
                            double extinctionOverride = -1.0, std::uint32_t mapTexture = 0) {

@@ -50,6 +50,30 @@ struct BasisDifference {
   long long over = 0;             ///< values with |gpu - cpu| > tolerance(cpu) (or NaN)
 };
 
+inline double ulpHalf(double e) {
+  if (e < std::ldexp(1.0, -14)) return std::ldexp(1.0, -24);
+  int exponent = 0;
+  std::frexp(e, &exponent);
+  return std::ldexp(1.0, exponent - 11);
+}
+
+/// The per-value tolerance of a storage format for GPU vs CPU basis values (PrefilterGpuGLTest.cpp says
+/// how it was measured): one RGBA8 step, one binary16 ulp, 4e-6 for RGBA32F.
+struct FormatTolerance {
+  StorageFormat format;
+  double operator()(float cpu) const {
+    switch (format) {
+    case StorageFormat::RGBA8:
+      return 1.0 / 255.0 + 1e-6;
+    case StorageFormat::RGBA16F:
+      return ulpHalf(cpu) + 1e-6;
+    case StorageFormat::RGBA32F:
+      break;
+    }
+    return 4e-6;
+  }
+};
+
 /// Compares GPU read-back values with FilteredBasis::texels; counts values with |d| > tolerance(cpu).
 template <class Tolerance>
 BasisDifference compareBasis(const std::vector<float>& gpu, const FilteredBasis& cpu,

@@ -164,6 +164,7 @@ public:
   double referenceDepth(double row) const override;
   DistanceProfile rayProfile(double row, double depth, int region) const override;
   DistanceProfile referenceProfile(double row, int region) const override;
+  std::optional<GpuLayoutData> gpuLayoutData() const override;
 
   /// The visible psi interval of the half-plane with unit in-plane direction n (orthogonal to the light)
   /// and the border sigma of its exit point; nullopt when no part of it is on screen.

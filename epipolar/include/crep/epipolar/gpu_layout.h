@@ -18,6 +18,7 @@
 #include <crep/core/camera.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/rectify/gpu_layout.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -26,28 +27,6 @@ class EpipolarLayout; // crep/epipolar/epipolar.h
 } // namespace crep
 
 namespace crep::gpu {
-
-/// Largest number of layout regions the layout blocks hold (= RectifyOptions::kMaxSplits).
-inline constexpr int kMaxLayoutRegions = 64;
-
-/// The value of CREP_LAYOUT in glsl/crep/epipolar.glsl.
-enum class LayoutKind : std::int32_t {
-  Projective = 0, ///< crep::ProjectiveLayout
-  Epipolar = 1,   ///< crep::EpipolarLayout
-};
-
-/// std140 block CrepProjectiveLayoutBlock { CrepProjectiveLayoutParams crep_projective; } (CREP_LAYOUT 0).
-struct ProjectiveLayoutParams {
-  glm::vec4 origin{0.0f}; ///< xyz: camera position (world); w: rho = 1 / |camera - light| (0: directional)
-  glm::vec4 axisX{1.0f, 0.0f, 0.0f, 0.0f};  ///< xyz: projection axis (unit); w: 0
-  glm::vec4 axisY{0.0f, 1.0f, 0.0f, 0.0f};  ///< xyz: axisZ x axisX; w: 0
-  glm::vec4 axisZ{0.0f, 0.0f, 1.0f, 0.0f};  ///< xyz: direction light travels at the camera; w: 0
-  glm::vec4 slopes{0.0f, 1.0f, 0.0f, 1.0f}; ///< row slope min, max, depth slope min, max
-  glm::ivec4 counts{1, 0, 0, 0};            ///< x: layout regions (splits) K; yzw: 0
-  glm::vec4 splitZeta[kMaxLayoutRegions]{}; ///< split k < K: x zetaBegin, y zetaEnd (1/world unit); zw 0
-};
-static_assert(sizeof(ProjectiveLayoutParams) == 16 * (6 + kMaxLayoutRegions),
-              "std140 CrepProjectiveLayoutParams");
 
 /// std140 block CrepEpipolarLayoutBlock { CrepEpipolarLayoutParams crep_epipolar; } (CREP_LAYOUT 1): the
 /// geometry of crep::EpipolarLayout (epipolar.h); the per-slice bounds are in the storage buffer below.
@@ -77,16 +56,12 @@ struct EpipolarSlice {
 };
 static_assert(sizeof(EpipolarSlice) == 16, "std430 CrepEpipolarSlice");
 
-/// The block of a projective layout (regionCount() <= kMaxLayoutRegions, else InvalidArgument
-/// "ProjectiveLayout.regionCount").
-ProjectiveLayoutParams makeProjectiveLayoutParams(const ProjectiveLayout& layout);
-
 /// The block and the slice table of an epipolar layout.
 EpipolarLayoutParams makeEpipolarLayoutParams(const EpipolarLayout& layout);
 std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout);
 
-/// Which GLSL layout implements `layout`: Projective for ProjectiveLayout, Epipolar for EpipolarLayout;
-/// throws InvalidArgument ("layout") for any other RectifiedLayout (no GPU mapping).
+/// Which GLSL layout implements `layout` (its gpuLayoutData().kind); throws InvalidArgument ("layout") for
+/// a RectifiedLayout without GPU mapping.
 LayoutKind layoutKind(const RectifiedLayout& layout);
 
 } // namespace crep::gpu

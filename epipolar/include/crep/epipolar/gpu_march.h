@@ -28,6 +28,7 @@
 #include <crep/core/medium.h>
 #include <crep/epipolar/gpu_layout.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/gpu_layout_buffers.h>
 #include <crep/scatter/gpu_world_march.h>
 
 namespace crep {
@@ -92,7 +93,8 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle programs_[2], params_, layoutBlock_, slices_, sampler_, dummySteps_;
+  gpu::LayoutBuffers layoutBuffers_;
+  gl::Handle programs_[2], params_, sampler_, dummySteps_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 

@@ -23,6 +23,7 @@
 #include <crep/core/gl.h>
 #include <crep/core/image.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/gpu_layout_buffers.h>
 
 namespace crep {
 
@@ -66,7 +67,8 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle programs_[2], params_, layoutBlock_, slices_, sampler_;
+  gpu::LayoutBuffers layoutBuffers_;
+  gl::Handle programs_[2], params_, sampler_;
 };
 
 } // namespace crep

@@ -15,7 +15,8 @@
 // there. It issues glMemoryBarrier so that the results can be sampled / image-loaded afterwards.
 //   PrefilterPass::run: texture unit 0 (+ sampler), image unit 0, uniform buffer 0, storage buffer 0.
 //   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0, uniform buffers 0 and 1,
-//                       storage buffer 1 (near-plane correction).
+//                       storage buffer 1 (near-plane correction); for a non-projective layout also
+//                       uniform buffer 2 and storage buffer 2 (its layout block and row table).
 // Engines that evaluate in their own shader use crep/scattering.glsl with filteredBasis() and
 // makeScatteringParams() (see that file's header).
 #pragma once
@@ -30,6 +31,7 @@
 #include <crep/prefilter/gpu_structs.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/gpu_layout_buffers.h>
 
 namespace crep {
 
@@ -56,10 +58,11 @@ struct FilteredBasisView {
 std::vector<gpu::RegionWeights> gpuRegionWeights(const std::vector<DistanceProfile>& profiles,
                                                  WeightMode mode, int texelsPerRegion);
 
-/// The uniform block of crep/scattering.glsl for evaluating `basis` on a projective `layout` (the one it
-/// was prefiltered from) with a directional light and a medium. Throws InvalidArgument naming the
-/// parameter ("layout": not a ProjectiveLayout, or its region count differs from basis.layoutRegions or
-/// exceeds gpu::kMaxSplits; "FilteredBasisView": inconsistent sizes).
+/// The uniform block of crep/scattering.glsl for evaluating `basis` on `layout` (the one it was
+/// prefiltered from; a non-projective layout also needs its own block, gpu::LayoutBuffers + CREP_EVAL_LAYOUT)
+/// with a directional light and a medium. Throws InvalidArgument naming the parameter ("layout": no GPU
+/// mapping, or its region count differs from basis.layoutRegions or exceeds gpu::kMaxSplits;
+/// "FilteredBasisView": inconsistent sizes).
 gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const RectifiedLayout& layout,
                                            const DirectionalLight& light, const Medium& medium);
 
@@ -144,8 +147,10 @@ public:
     const Camera* camera = nullptr; ///< the camera of cameraDepth (normally the rectified one)
     const DirectionalLight* light = nullptr; ///< the light of the rectification
     const Medium* medium = nullptr;          ///< the medium (C of Eq. 1, per-channel extinction)
-    const RectifiedLayout* layout = nullptr; ///< the layout the basis was prefiltered from (projective)
-    FilteredBasisView basis;                 ///< e.g. PrefilterPass::filteredBasis()
+    /// The layout the basis was prefiltered from: a ProjectiveLayout, or any layout with a GPU mapping
+    /// (an EpipolarLayout: the fallback of Klehm et al. 2014, Sec. 4.1), evaluated through its layout block.
+    const RectifiedLayout* layout = nullptr;
+    FilteredBasisView basis; ///< e.g. PrefilterPass::filteredBasis()
   };
 
   /// Validates `info` (InvalidArgument naming the field, GlError beyond the workgroup limits) and
@@ -166,6 +171,8 @@ public:
 private:
   CreateInfo info_;
   gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
+  gl::Handle layoutPrograms_[2]; ///< per gpu::LayoutKind, built on first use (non-projective layouts)
+  gpu::LayoutBuffers layoutBuffers_;
 };
 
 } // namespace crep

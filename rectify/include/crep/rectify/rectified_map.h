@@ -24,6 +24,7 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/image.h>
+#include <crep/rectify/gpu_layout.h>
 #include <crep/rectify/rectify.h>
 
 namespace crep {
@@ -79,6 +80,9 @@ public:
   virtual DistanceProfile rayProfile(double row, double depth, int region) const = 0;
   /// referenceDistance(row, (region + u) / K) as a DistanceProfile of u (exact).
   virtual DistanceProfile referenceProfile(double row, int region) const = 0;
+  /// The layout serialized for the GPU (crep/rectify/gpu_layout.h), or nullopt when the GLSL has no
+  /// mapping for it. Throws InvalidArgument when the layout exceeds what the GPU blocks hold.
+  virtual std::optional<GpuLayoutData> gpuLayoutData() const { return std::nullopt; }
 };
 
 /// The projective rectification (Sec. 4.2) as a RectifiedLayout: regions = splits.
@@ -100,6 +104,7 @@ public:
   double referenceDepth(double row) const override;
   DistanceProfile rayProfile(double row, double depth, int region) const override;
   DistanceProfile referenceProfile(double row, int region) const override;
+  std::optional<GpuLayoutData> gpuLayoutData() const override;
 
 private:
   Rectification rect_;

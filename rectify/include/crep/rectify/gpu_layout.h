@@ -1,0 +1,62 @@
+// The GPU description of a rectified layout: what the GLSL of glsl/crep/epipolar.glsl needs to map world
+// points and view rays into a rectified map (CREP_LAYOUT = LayoutKind). Every RectifiedLayout with a GPU
+// mapping serializes itself into a GpuLayoutData (RectifiedLayout::gpuLayoutData()): a std140 layout
+// block and, for layouts with per-row data, a std430 table of rows. A pass uploads the bytes without
+// knowing the concrete layout (gpu::LayoutBuffers, crep/scatter/gpu_layout_buffers.h), so every module
+// above rectify/ can evaluate or march on any layout.
+//
+// The projective block lives here; the epipolar block with EpipolarLayout (crep/epipolar/gpu_layout.h).
+// Each struct has a GLSL twin with the same name prefixed "Crep" in glsl/crep/epipolar.glsl (std140:
+// 16-byte vectors only, int instead of bool, a static_assert on the size; GL tests compare the offsets).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace crep {
+
+class ProjectiveLayout; // crep/rectify/rectified_map.h
+
+namespace gpu {
+
+/// Largest number of layout regions the layout blocks hold (= RectifyOptions::kMaxSplits).
+inline constexpr int kMaxLayoutRegions = 64;
+
+/// The value of CREP_LAYOUT in glsl/crep/epipolar.glsl.
+enum class LayoutKind : std::int32_t {
+  Projective = 0, ///< crep::ProjectiveLayout
+  Epipolar = 1,   ///< crep::EpipolarLayout
+};
+
+/// std140 block CrepProjectiveLayoutBlock { CrepProjectiveLayoutParams crep_projective; } (CREP_LAYOUT 0).
+struct ProjectiveLayoutParams {
+  glm::vec4 origin{0.0f}; ///< xyz: camera position (world); w: rho = 1 / |camera - light| (0: directional)
+  glm::vec4 axisX{1.0f, 0.0f, 0.0f, 0.0f};  ///< xyz: projection axis (unit); w: 0
+  glm::vec4 axisY{0.0f, 1.0f, 0.0f, 0.0f};  ///< xyz: axisZ x axisX; w: 0
+  glm::vec4 axisZ{0.0f, 0.0f, 1.0f, 0.0f};  ///< xyz: direction light travels at the camera; w: 0
+  glm::vec4 slopes{0.0f, 1.0f, 0.0f, 1.0f}; ///< row slope min, max, depth slope min, max
+  glm::ivec4 counts{1, 0, 0, 0};            ///< x: layout regions (splits) K; yzw: 0
+  glm::vec4 splitZeta[kMaxLayoutRegions]{}; ///< split k < K: x zetaBegin, y zetaEnd (1/world unit); zw 0
+};
+static_assert(sizeof(ProjectiveLayoutParams) == 16 * (6 + kMaxLayoutRegions),
+              "std140 CrepProjectiveLayoutParams");
+
+/// The block of a projective layout (regionCount() <= kMaxLayoutRegions, else InvalidArgument
+/// "ProjectiveLayout.regionCount").
+ProjectiveLayoutParams makeProjectiveLayoutParams(const ProjectiveLayout& layout);
+
+} // namespace gpu
+
+/// A layout serialized for the GPU (see the top).
+struct GpuLayoutData {
+  gpu::LayoutKind kind = gpu::LayoutKind::Projective;
+  std::vector<std::byte> block; ///< the std140 layout block (CREP_LAYOUT_BINDING)
+  std::vector<std::byte> rows;  ///< std430 per-row table (CREP_SLICES_BINDING), empty if the layout has none
+  int rowCount = 0;             ///< rows of the table: the map height the layout requires, 0 = any
+  int regionCount = 0;          ///< the layout's regionCount()
+};
+
+} // namespace crep

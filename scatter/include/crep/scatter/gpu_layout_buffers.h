@@ -1,0 +1,32 @@
+// Upload of any rectified layout's GPU description (crep/rectify/gpu_layout.h) into GL buffers, for the
+// passes that map pixels into a rectified map on the GPU (the marches and resampling of epipolar/, the
+// evaluation of prefilter/). Requires a current OpenGL 4.5 context; owns its two buffers (RAII).
+#pragma once
+
+#include <cstdint>
+
+#include <crep/core/gl.h>
+#include <crep/rectify/rectified_map.h>
+
+namespace crep::gpu {
+
+class LayoutBuffers {
+public:
+  /// Uploads `layout`'s block and row table for a map of `mapHeight` rows. Throws InvalidArgument naming
+  /// `parameter` when the layout has no GPU mapping, has more than kMaxLayoutRegions regions, or needs a
+  /// different map height (an EpipolarLayout: one row per slice). Returns the layout's kind (the value of
+  /// CREP_LAYOUT for the shader).
+  LayoutKind upload(const RectifiedLayout& layout, int mapHeight, const char* parameter = "layout");
+  /// Binds the block at uniform buffer `blockBinding` and, for layouts with a row table, the table at
+  /// storage buffer `rowsBinding` (the defaults of glsl/crep/epipolar.glsl are 1 and 1).
+  void bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const;
+  LayoutKind kind() const noexcept { return kind_; }
+
+private:
+  LayoutKind kind_ = LayoutKind::Projective;
+  bool hasRows_ = false;
+  gl::Handle block_, rows_;
+  std::size_t rowsCapacity_ = 0;
+};
+
+} // namespace crep::gpu
