@@ -72,7 +72,9 @@ void checkEpipolarEvaluation(const EpipolarCase& c, StorageFormat format) {
       readTextureArray(prefilterPass.filteredBasisTexture(), W, H, prefilterPass.layers());
   const FormatTolerance basisTolerance{format};
   const BasisDifference d = compareBasis(gpuBasis, cpu, basisTolerance);
-  MESSAGE(std::string(c.name) + " " + storageFormatToken(format) + ", basis: " + describe(d));
+  const std::string basisReport =
+      std::string(c.name) + " " + storageFormatToken(format) + ", basis: " + describe(d);
+  MESSAGE(basisReport);
   CHECK(d.over == 0);
 
   EvaluatePass evaluatePass({});
