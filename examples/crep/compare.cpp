@@ -89,8 +89,19 @@ int compareCommand(const std::vector<std::string>& argv) {
   if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
   const double amplify = args.number("amplify", 20.0);
   if (!(amplify > 0.0)) throw UsageError("option --amplify: must be > 0");
-  const int tileWidth = args.integer("tile-width", std::min(size.x, 400), 16, 4096);
+  // Default: the image width within the accepted tile widths (a 1-pixel wide image is shown 16 wide).
+  const int tileWidth =
+      args.integer("tile-width", std::clamp(size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);
   const std::vector<std::string> names = selectedMethods(args);
+  const glm::ivec2 sheetBound = sheetSizeBound(tileWidth, size, static_cast<int>(names.size()));
+  if (sheetBound.y > Image::kMaxDimension ||
+      static_cast<long long>(sheetBound.x) * sheetBound.y > Image::kMaxPixels)
+    throw UsageError(
+        "option --tile-width: tiles " + std::to_string(tileWidth) + " wide for --size " +
+        std::to_string(size.x) + "x" + std::to_string(size.y) + " make a contact sheet of up to " +
+        std::to_string(sheetBound.x) + "x" + std::to_string(sheetBound.y) +
+        " pixels, beyond the image limits (" + std::to_string(Image::kMaxDimension) + " per side, " +
+        std::to_string(Image::kMaxPixels) + " pixels): use a smaller --tile-width or a wider --size");
   const std::string out = args.string("out", "crep-compare-" + sceneName);
   if (out.empty()) throw UsageError("option --out: must not be empty");
 

@@ -1,4 +1,5 @@
 // End-to-end tests of the crep tool that need no GL: usage errors and `crep rectify`.
+#include "support/image_check.h"
 #include "support/tool_runner.h"
 
 #include <crep/core/camera.h>
@@ -6,6 +7,8 @@
 #include <doctest/doctest.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <regex>
 #include <string>
@@ -126,4 +129,37 @@ TEST_CASE("crep: usage errors exit 2 and name the option") {
   // bench/ registers `crep bench` with the tool's command registry (examples/ does not know bench/).
   CHECK((help.output.find("\n  bench     the benchmark suite") != std::string::npos) ==
         (CREP_TOOL_HAS_BENCH != 0));
+}
+
+namespace {
+/// Runs crep and checks a failure: exit status, every mention in the output, no internal names.
+crep::test::ToolResult expectFailure(const std::string& args, int status,
+                                     std::initializer_list<const char*> mentions) {
+  const auto r = crep::test::runCrep(args);
+  INFO(args << " -> " << r.output);
+  CHECK(r.status == status);
+  for (const char* m : mentions)
+    CHECK(r.output.find(m) != std::string::npos);
+  CHECK(r.output.find("unexpected error") == std::string::npos);
+  return r;
+}
+
+/// Files in `dir` (none should be written by a command that failed validation).
+std::size_t fileCount(const crep::test::TempDir& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    ++n;
+  return n;
+}
+} // namespace
+
+TEST_CASE("crep compare: a contact sheet beyond the image limits is a usage error naming --tile-width") {
+  // --size 1x1 used to crash (a 1-pixel default tile); now the default tile is at least 16 wide
+  // (CrepCompareGLTest), and a sheet that would exceed the image limits is refused before any work.
+  crep::test::TempDir dir;
+  const std::string out = " --out '" + (dir / "sheet").string() + "'";
+  expectFailure("compare --size 1x32768" + out, 2, {"--tile-width", "--size", "1x32768"});
+  expectFailure("compare --size 100x1000 --tile-width 4096" + out, 2, {"--tile-width", "4096"});
+  expectFailure("compare --tile-width 15" + out, 2, {"--tile-width", "[16, 4096]"});
+  CHECK(fileCount(dir) == 0);
 }
