@@ -82,13 +82,14 @@ int compareCommand(const std::vector<std::string>& argv) {
   valued.erase("method");
   const Args args(argv, valued, {"debug-gl"});
   const std::string sceneName = args.string("scene", "colonnade");
-  const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension);
+  const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension, Image::kMaxPixels);
   MethodSettings settings = methodSettings(args);
   if (!args.has("steps")) settings.steps = 512;
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const double exposure = exposureOption(args);
   const double amplify = args.number("amplify", 20.0);
-  if (!(amplify > 0.0)) throw UsageError("option --amplify: must be > 0");
+  // Bounded so that the legend prints a plain number; at 1e6 float rounding of the images (relative
+  // 6e-8) already fills 6% of the heat map's scale.
+  if (!(amplify > 0.0 && amplify <= 1e6)) throw UsageError("option --amplify: must be in (0, 1e6]");
   // Default: the image width within the accepted tile widths (a 1-pixel wide image is shown 16 wide).
   const int tileWidth =
       args.integer("tile-width", std::clamp(size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);

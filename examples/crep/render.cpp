@@ -68,9 +68,8 @@ int renderCommand(const std::vector<std::string>& argv) {
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
   const Args args(argv, valued, {"debug-gl"});
   const std::string sceneName = args.string("scene", "colonnade");
-  const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension);
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension, Image::kMaxPixels);
+  const double exposure = exposureOption(args);
   const std::string method = args.string("method", "prefilter");
   findMethod(method); // usage error before any GL work
   const MethodSettings settings = methodSettings(args);

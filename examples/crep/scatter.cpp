@@ -73,8 +73,7 @@ int scatterCommand(const std::vector<std::string>& argv) {
   const MethodSettings settings = methodSettings(args);
   const std::string out = args.string("out", "scattering.exr");
   if (out.empty()) throw UsageError("option --out: must not be empty");
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const double exposure = exposureOption(args);
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep scatter");

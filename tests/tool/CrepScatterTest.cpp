@@ -213,3 +213,14 @@ TEST_CASE("crep scatter: malformed frame descriptions exit 1 naming the field") 
     expectFailure(crep::test::runCrep(in.args()), 1, {"frame.json", c.mentions});
   }
 }
+
+TEST_CASE("crep scatter: --map-size and --exposure out of range are usage errors naming the option") {
+  const Inputs in;
+  // --map-size 32768 used to fail inside the CPU resampling, naming Image.width*height.
+  const auto big = crep::test::runCrep(in.args("--map-size 32768"));
+  expectFailure(big, 2, {"--map-size", "16384"});
+  CHECK(big.output.find("Image.") == std::string::npos);
+  expectFailure(crep::test::runCrep(in.args("--exposure 1e39")), 2, {"--exposure", "1e30"});
+  expectFailure(crep::test::runCrep(in.args("--exposure 0")), 2, {"--exposure"});
+  CHECK(!std::filesystem::exists(in.dir / "out.exr"));
+}

@@ -163,3 +163,58 @@ TEST_CASE("crep compare: a contact sheet beyond the image limits is a usage erro
   expectFailure("compare --tile-width 15" + out, 2, {"--tile-width", "[16, 4096]"});
   CHECK(fileCount(dir) == 0);
 }
+
+TEST_CASE("crep: out-of-range numbers are usage errors naming the option, before any output") {
+  crep::test::TempDir dir;
+  const std::string out = " --out '" + (dir / "x").string() + "'";
+  // --exposure 1e39 used to write the EXR, then fail naming ToneMap.exposure with exit 1.
+  expectFailure("render --size 16x9 --exposure 1e39" + out, 2, {"--exposure", "[1e-30, 1e30]"});
+  expectFailure("render --size 16x9 --exposure 1e-31" + out, 2, {"--exposure"});
+  expectFailure("render --size 16x9 --exposure 1e999" + out, 2, {"--exposure", "out of range"});
+  expectFailure("compare --size 16x9 --exposure 1e39" + out, 2, {"--exposure"});
+  expectFailure("compare --size 16x9 --amplify 1e300" + out, 2, {"--amplify"});
+  expectFailure("render --size 16x9 --map-size 32768" + out, 2, {"--map-size", "16384"});
+  expectFailure("render --size 32768x32768" + out, 2, {"--size", "pixels"});
+  expectFailure("compare --size 16x9 --map-size 16385" + out, 2, {"--map-size"});
+  if (CREP_TOOL_HAS_BENCH) {
+    // Used to fail inside the rectification, naming Rectification.splitViewport.width.
+    for (const char* map : {"1x1", "4x4", "24x24"}) {
+      const auto r = expectFailure(std::string("bench --map ") + map, 2, {"--map", "multiple of 16"});
+      CHECK(r.output.find("Rectification") == std::string::npos);
+    }
+    expectFailure("bench --quick --map 2x2", 2, {"--map", "multiple of 4"});
+    expectFailure("bench --map 16x1", 2, {"--map", "height"});
+    expectFailure("bench --map 32768x16", 2, {"--map"});
+  }
+  CHECK(fileCount(dir) == 0);
+}
+
+TEST_CASE("crep: numbers and sizes are parsed strictly (decimal, no spaces, no '+', no hex)") {
+  struct Case {
+    const char* args;
+    const char* mentions;
+  };
+  for (const Case& c :
+       {Case{"render --size ' 160x90'", "--size"}, Case{"render --size '160x90 '", "--size"},
+        Case{"render --size +160x+90", "--size"}, Case{"render --size 0x10x90", "--size"},
+        Case{"render --size 160x-90", "--size"}, Case{"render --exposure 0x10", "--exposure"},
+        Case{"render --exposure ' 1'", "--exposure"}, Case{"render --exposure '1 '", "--exposure"},
+        Case{"render --exposure +1", "--exposure"}, Case{"render --exposure inf", "--exposure"},
+        Case{"render --exposure 1e", "--exposure"}, Case{"render --exposure .", "--exposure"},
+        Case{"render --steps +5", "--steps"}, Case{"render --steps ' 5'", "--steps"},
+        Case{"render --steps 5.0", "--steps"}, Case{"render --steps 0x10", "--steps"},
+        Case{"render --map-size 99999999999999999999", "--map-size"},
+        Case{"rectify --camera-pos '0, 1, 5'", "--camera-pos"}, Case{"rectify --aspect 0x1p1", "--aspect"}}) {
+    const auto r = crep::test::runCrep(c.args);
+    INFO(c.args << " -> " << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.mentions) != std::string::npos);
+  }
+  // What the grammar accepts (args.h): fractions, exponents, a leading '-'.
+  for (const char* ok : {"rectify --aspect 1.5", "rectify --aspect .5e1", "rectify --aspect 2.",
+                         "rectify --aspect 15E-1", "rectify --light-dir -1,-1e0,0.25 --fovy-deg 6e1"}) {
+    const auto r = crep::test::runCrep(ok);
+    INFO(ok << " -> " << r.output);
+    CHECK(r.status == 0);
+  }
+}
