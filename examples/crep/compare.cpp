@@ -8,6 +8,7 @@
 #include "gl_session.h"
 #include "methods.h"
 #include "options.h"
+#include "paths.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -104,7 +105,10 @@ int compareCommand(const std::vector<std::string>& argv) {
         " pixels, beyond the image limits (" + std::to_string(Image::kMaxDimension) + " per side, " +
         std::to_string(Image::kMaxPixels) + " pixels): use a smaller --tile-width or a wider --size");
   const std::string out = args.string("out", "crep-compare-" + sceneName);
-  if (out.empty()) throw UsageError("option --out: must not be empty");
+  requireOutputPrefix({"--out", out});
+  const std::string csvPath = out + ".csv", pngPath = out + ".png";
+  requireOutputFile({"--out", pngPath});
+  requireOutputFile({"--out", csvPath});
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep compare");
@@ -162,7 +166,6 @@ int compareCommand(const std::vector<std::string>& argv) {
     }
     csv << "," << fixed(r.timings.total(), 3) << "\n";
   }
-  const std::string csvPath = out + ".csv", pngPath = out + ".png";
   {
     std::ofstream file(csvPath, std::ios::binary);
     file << csv.str();

@@ -9,6 +9,7 @@
 #include "gl_session.h"
 #include "methods.h"
 #include "options.h"
+#include "paths.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -23,6 +24,7 @@
 #include <fstream>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 namespace crep::tool {
 
@@ -74,9 +76,19 @@ int renderCommand(const std::vector<std::string>& argv) {
   findMethod(method); // usage error before any GL work
   const MethodSettings settings = methodSettings(args);
   const std::string out = args.string("out", "crep-" + sceneName);
-  if (out.empty()) throw UsageError("option --out: must not be empty");
-  if (args.has("export-frame") && args.string("export-frame", "").empty())
-    throw UsageError("option --export-frame: must not be empty");
+  requireOutputPrefix({"--out", out});
+  const std::string exportDir = args.string("export-frame", "");
+  // Every file this command writes, checked before any work: usage errors first, then the file system.
+  std::vector<PathOption> outputs = {{"--out", out + ".exr"}, {"--out", out + ".png"}};
+  if (args.has("export-frame")) {
+    requireNonEmpty({"--export-frame", exportDir});
+    for (const char* name : {"depth.exr", "shadow.exr", "frame.json"})
+      outputs.push_back({"--export-frame", (std::filesystem::path(exportDir) / name).string()});
+  }
+  requireDistinctFiles(outputs);
+  requireOutputFile(outputs[0]);
+  requireOutputFile(outputs[1]);
+  if (args.has("export-frame")) requireOutputDirectory({"--export-frame", exportDir});
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep render");
@@ -104,7 +116,7 @@ int renderCommand(const std::vector<std::string>& argv) {
     writeExrLayers(exrPath, layers);
   });
   timings.time("write png", [&] { writePng(pngPath, compositeImg, ToneMap{static_cast<float>(exposure)}); });
-  if (args.has("export-frame")) exportFrame(args.string("export-frame", ""), s, timings);
+  if (args.has("export-frame")) exportFrame(exportDir, s, timings);
 
   std::printf("crep render: scene %s, %dx%d, method %s (%s)\n", s.scene->name.c_str(), size.x, size.y,
               result.used.c_str(), result.detail.c_str());
@@ -112,7 +124,7 @@ int renderCommand(const std::vector<std::string>& argv) {
   std::printf("wrote %s (layers composite.RGBA, scattering.RGBA) and %s\n", exrPath.c_str(), pngPath.c_str());
   if (args.has("export-frame"))
     std::printf("exported the frame for crep scatter: %s/{depth.exr, shadow.exr, frame.json}\n",
-                args.string("export-frame", "").c_str());
+                exportDir.c_str());
   return 0;
 }
 

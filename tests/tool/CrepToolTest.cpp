@@ -218,3 +218,24 @@ TEST_CASE("crep: numbers and sizes are parsed strictly (decimal, no spaces, no '
     CHECK(r.status == 0);
   }
 }
+
+TEST_CASE("crep render and compare: outputs that collide or cannot be written fail before any work") {
+  crep::test::TempDir dir;
+  std::filesystem::create_directory(dir / "frame");
+  std::ofstream(dir / "file.txt") << "not a directory";
+  const std::string d = dir.path().string();
+  // PREFIX.exr would be the exported depth.exr.
+  expectFailure("render --size 16x9 --out '" + d + "/frame/depth' --export-frame '" + d + "/frame'", 2,
+                {"--export-frame", "--out", "depth.exr"});
+  expectFailure("render --size 16x9 --out '" + d + "/frame/'", 2, {"--out", "directory"});
+  expectFailure("render --size 16x9 --out ''", 2, {"--out", "empty"});
+  expectFailure("render --size 16x9 --out '" + d + "/missing/x'", 1, {"--out", "missing", "does not exist"});
+  expectFailure("render --size 16x9 --out '" + d + "/x' --export-frame '" + d + "/file.txt'", 1,
+                {"--export-frame", "file.txt", "not a directory"});
+  expectFailure("render --size 16x9 --out '" + d + "/x' --export-frame '" + d + "/file.txt/sub'", 1,
+                {"--export-frame", "file.txt", "not a directory"});
+  expectFailure("compare --size 16x9 --out '" + d + "/missing/x'", 1, {"--out", "missing", "does not exist"});
+  expectFailure("compare --size 16x9 --out '" + d + "/'", 2, {"--out", "directory"});
+  CHECK(fileCount(dir) == 2); // frame/ and file.txt, nothing else
+  CHECK(std::filesystem::is_empty(dir / "frame"));
+}
