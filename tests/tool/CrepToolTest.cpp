@@ -219,6 +219,50 @@ TEST_CASE("crep: numbers and sizes are parsed strictly (decimal, no spaces, no '
   }
 }
 
+TEST_CASE("crep rectify: a field of view below 0.001 degrees is a usage error, help and README list the "
+          "empty status") {
+  // --fovy-deg 1e-300 used to print the undocumented status "empty".
+  for (const char* fovy : {"1e-300", "1e-12", "0.0009", "180", "0"})
+    expectFailure(std::string("rectify --fovy-deg ") + fovy, 2, {"--fovy-deg", "[0.001, 180)"});
+  const auto smallest = crep::test::runCrep("rectify --fovy-deg 0.001");
+  INFO(smallest.output);
+  CHECK(smallest.status == 0);
+  CHECK(smallest.output.find(R"("status": "projective")") != std::string::npos);
+  // "empty" remains a status of the library (spot and point lights), so both documents list it.
+  const auto help = crep::test::runCrep("help");
+  CHECK(help.output.find(R"("projective"|"fallback"|"empty")") != std::string::npos);
+  std::ifstream readme(std::string(CREP_SOURCE_DIR) + "/README.md");
+  const std::string text((std::istreambuf_iterator<char>(readme)), std::istreambuf_iterator<char>());
+  CHECK(text.find(R"("status": "projective" | "fallback" | "empty")") != std::string::npos);
+}
+
+TEST_CASE("crep: every command answers --help with its own section on stdout, --version prints the version") {
+  std::vector<std::string> commands = {"render", "scatter", "compare", "rectify"};
+  if (CREP_TOOL_HAS_BENCH) commands.push_back("bench");
+  for (const std::string& command : commands)
+    for (const std::string& form : {command + " --help", command + " --size 8x8 --help", "help " + command}) {
+      // stderr to /dev/null: the help text must be on stdout.
+      const auto r = crep::test::runCrep(form + " 2>/dev/null; exit $?");
+      INFO(form << " -> " << r.output);
+      CHECK(r.status == 0);
+      CHECK(r.output.starts_with("usage: crep " + command + " [options]\n"));
+      CHECK(r.output.find("\n  " + command + " ") != std::string::npos);
+      CHECK(r.output.find("Exit status") != std::string::npos);
+      for (const std::string& other : commands)
+        if (other != command) CHECK(r.output.find("\n  " + other + " ") == std::string::npos);
+    }
+  const auto render = crep::test::runCrep("render --help");
+  CHECK(render.output.find("--export-frame") != std::string::npos);
+  CHECK(render.output.find("--tile-width") == std::string::npos);
+  CHECK(render.output.find("unknown option") == std::string::npos);
+
+  const auto version = crep::test::runCrep("--version 2>/dev/null; exit $?");
+  INFO(version.output);
+  CHECK(version.status == 0);
+  CHECK(std::regex_match(version.output, std::regex(R"(crep \d+\.\d+\.\d+\n)")));
+  expectFailure("help frobnicate", 2, {"frobnicate"});
+}
+
 TEST_CASE("crep render and compare: outputs that collide or cannot be written fail before any work") {
   crep::test::TempDir dir;
   std::filesystem::create_directory(dir / "frame");
