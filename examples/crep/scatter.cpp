@@ -14,6 +14,7 @@
 
 #include "frame_json.h"
 #include "options.h"
+#include "paths.h"
 #include "timings.h"
 #include <crep/epipolar/resample.h>
 
@@ -72,9 +73,22 @@ int scatterCommand(const std::vector<std::string>& argv) {
   findMethod(method);
   const MethodSettings settings = methodSettings(args);
   const std::string out = args.string("out", "scattering.exr");
-  if (out.empty()) throw UsageError("option --out: must not be empty");
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const double exposure = exposureOption(args);
+  // Files: inputs that are directories, outputs that cannot be written or would overwrite an input fail
+  // here, before anything is read or written.
+  const std::vector<PathOption> inputs = {
+      {"--depth", depthPath}, {"--shadow", shadowPath}, {"--frame", framePath}};
+  std::vector<PathOption> outputs = {{"--out", out}};
+  if (args.has("png")) outputs.push_back({"--png", args.string("png", "")});
+  for (const PathOption& p : inputs)
+    requireNonEmpty(p);
+  for (const PathOption& p : outputs)
+    requireNonEmpty(p);
+  requireDistinctFiles(outputs, inputs); // usage errors above, file system below
+  for (const PathOption& p : outputs)
+    requireOutputFile(p);
+  for (const PathOption& p : inputs)
+    requireInputFile(p);
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep scatter");
