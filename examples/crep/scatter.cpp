@@ -22,6 +22,7 @@
 #include <crep/support/exr.h>
 #include <crep/support/png.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -30,6 +31,15 @@
 namespace crep::tool {
 
 namespace {
+
+/// The shortest text that reads back as exactly `v` (std::to_chars): 1.0000001f is "1.0000001", not the
+/// "1.000000" of std::to_string.
+template <class T>
+std::string shortest(T v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
 
 /// Reads a depth EXR (channel 0) and checks every value is a depth-buffer value in [0, 1].
 Image readDepthExr(const std::string& option, const std::string& path, const char* what) {
@@ -47,8 +57,8 @@ Image readDepthExr(const std::string& option, const std::string& path, const cha
       if (!(d >= 0.0f && d <= 1.0f))
         // Report the pixel as a viewer shows it: row 0 at the top.
         throw FormatError(option + " (" + what + "): '" + path + "': pixel (" + std::to_string(x) + ", " +
-                          std::to_string(image.height() - 1 - y) + ") from the top-left is " +
-                          std::to_string(d) + (std::isnan(d) ? " (NaN)" : "") +
+                          std::to_string(image.height() - 1 - y) + ") from the top-left is " + shortest(d) +
+                          (std::isnan(d) ? " (NaN)" : "") +
                           "; expected OpenGL depth-buffer values in [0, 1] (1 = nothing / sky)");
     }
   return image;
@@ -120,10 +130,9 @@ int scatterCommand(const std::vector<std::string>& argv) {
                       sizeText(shadow.width(), shadow.height()) + ")");
   const double imageAspect = double(depth.width()) / double(depth.height());
   if (std::abs(camera.aspect() / imageAspect - 1.0) > 0.01)
-    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " +
-                      std::to_string(camera.aspect()) + ", which does not match the depth image '" +
-                      depthPath + "' (" + sizeText(depth.width(), depth.height()) + ", aspect " +
-                      std::to_string(imageAspect) + ")");
+    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " + shortest(camera.aspect()) +
+                      ", which does not match the depth image '" + depthPath + "' (" +
+                      sizeText(depth.width(), depth.height()) + ", aspect " + shortest(imageAspect) + ")");
 
   ensureGlContext("scatter", args.has("debug-gl"), timings);
   Frame frame(camera, light, medium);

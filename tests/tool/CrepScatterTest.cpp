@@ -331,6 +331,7 @@ TEST_CASE("crep scatter: a light direction of tiny or huge length is normalised,
     CHECK(r.output.find("zero") == std::string::npos);
     CHECK(r.output.find("shadowMap.lightClipFromWorld") != std::string::npos);
   }
+}
 
 TEST_CASE("crep scatter: a directory as --frame, --depth or --shadow is an I/O error naming the option") {
   // A directory given as --frame used to be read as an empty JSON text ("unexpected end of input").
@@ -406,4 +407,15 @@ TEST_CASE("crep scatter: --map-size and --exposure out of range are usage errors
   expectFailure(crep::test::runCrep(in.args("--exposure 1e39")), 2, {"--exposure", "1e30"});
   expectFailure(crep::test::runCrep(in.args("--exposure 0")), 2, {"--exposure"});
   CHECK(!std::filesystem::exists(in.dir / "out.exr"));
+}
+
+TEST_CASE("crep scatter: an out-of-range depth is printed with the digits that tell it from 1") {
+  // 1.0000001f printed with %f reads "1.000000", which looks valid; the message must show the value.
+  const Inputs in;
+  crep::Image depth(160, 90, 1, 0.9f);
+  depth.at(3, 89) = std::nextafter(1.0f, 2.0f); // 1.00000012, top-left row
+  crep::writeExr(in.dir / "depth.exr", depth, crep::ExrPixelType::Float);
+  const crep::test::ToolResult r = crep::test::runCrep(in.args());
+  expectFailure(r, 1, {"depth.exr", "pixel (3, 0) from the top-left is 1.0000001", "[0, 1]"});
+  CHECK_FALSE(std::filesystem::exists(in.dir / "out.exr"));
 }
