@@ -33,6 +33,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// The most regions per split of the parallelization rows (Table 1).
+constexpr int kMaxRegionsPerSplit = 4;
+
 /// Median wall time in ms of `repeat` runs of f (GPU work is finished inside f with glFinish).
 double medianMs(int repeat, const std::function<void()>& f) {
   std::vector<double> t;
@@ -210,8 +213,29 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat"}, {"quick"});
   BenchOptions o;
   o.scene = args.string("scene", o.scene);
-  const glm::ivec2 size = args.size("size", {o.screenWidth, o.screenHeight}, Image::kMaxDimension);
-  const glm::ivec2 map = args.size("map", {o.mapWidth, o.mapHeight}, Image::kMaxDimension);
+  o.quick = args.has("quick");
+  const glm::ivec2 size =
+      args.size("size", {o.screenWidth, o.screenHeight}, Image::kMaxDimension, Image::kMaxPixels);
+  // The map is read back as an image; without --quick the scaling rows also use twice its width and
+  // twice its height, and half its width.
+  const int scale = o.quick ? 1 : 2;
+  const glm::ivec2 map =
+      args.size("map", {o.mapWidth, o.mapHeight}, Image::kMaxDimension / scale, Image::kMaxPixels / scale);
+  // The rectification's splits lie side by side in the map (SplitLayout::Regions); without --quick the
+  // parallelization rows split each into up to kMaxRegionsPerSplit regions and the scaling rows halve
+  // the width (a multiple of splits * kMaxRegionsPerSplit halves to a multiple of splits).
+  const int splits = RectifyOptions{}.splits;
+  const int multiple = o.quick ? splits : splits * kMaxRegionsPerSplit;
+  if (map.x % multiple != 0)
+    throw tool::UsageError("option --map: width " + std::to_string(map.x) + " must be a multiple of " +
+                           std::to_string(multiple) + " (the rectification's " + std::to_string(splits) +
+                           " splits side by side" +
+                           (o.quick ? std::string(")")
+                                    : std::string(", each in up to ") + std::to_string(kMaxRegionsPerSplit) +
+                                          " regions in the parallelization rows; --quick omits them)"));
+  if (map.y < scale)
+    throw tool::UsageError("option --map: height " + std::to_string(map.y) +
+                           " must be at least 2 (halved by the scaling rows; --quick omits them)");
   o.screenWidth = size.x;
   o.screenHeight = size.y;
   o.mapWidth = map.x;
@@ -219,7 +243,6 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
   if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
   o.repeat = args.integer("repeat", o.repeat, 1, 1000);
-  o.quick = args.has("quick");
   return o;
 }
 
@@ -299,7 +322,7 @@ void runBenchSuite(const BenchOptions& o) {
     for (int bpi : {4, 8, 16, 32})
       std::printf(" %8d", bpi);
     std::printf("   <- bases per invocation\n");
-    for (int p : {1, 2, 4}) {
+    for (int p : {1, 2, kMaxRegionsPerSplit}) {
       std::printf("%-10d", p);
       for (int bpi : {4, 8, 16, 32}) {
         if (bpi > bases || bases % bpi != 0) {

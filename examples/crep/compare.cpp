@@ -8,6 +8,7 @@
 #include "gl_session.h"
 #include "methods.h"
 #include "options.h"
+#include "paths.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -82,17 +83,32 @@ int compareCommand(const std::vector<std::string>& argv) {
   valued.erase("method");
   const Args args(argv, valued, {"debug-gl"});
   const std::string sceneName = args.string("scene", "colonnade");
-  const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension);
+  const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension, Image::kMaxPixels);
   MethodSettings settings = methodSettings(args);
   if (!args.has("steps")) settings.steps = 512;
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const double exposure = exposureOption(args);
   const double amplify = args.number("amplify", 20.0);
-  if (!(amplify > 0.0)) throw UsageError("option --amplify: must be > 0");
-  const int tileWidth = args.integer("tile-width", std::min(size.x, 400), 16, 4096);
+  // Bounded so that the legend prints a plain number; at 1e6 float rounding of the images (relative
+  // 6e-8) already fills 6% of the heat map's scale.
+  if (!(amplify > 0.0 && amplify <= 1e6)) throw UsageError("option --amplify: must be in (0, 1e6]");
+  // Default: the image width within the accepted tile widths (a 1-pixel wide image is shown 16 wide).
+  const int tileWidth =
+      args.integer("tile-width", std::clamp(size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);
   const std::vector<std::string> names = selectedMethods(args);
+  const glm::ivec2 sheetBound = sheetSizeBound(tileWidth, size, static_cast<int>(names.size()));
+  if (sheetBound.y > Image::kMaxDimension ||
+      static_cast<long long>(sheetBound.x) * sheetBound.y > Image::kMaxPixels)
+    throw UsageError(
+        "option --tile-width: tiles " + std::to_string(tileWidth) + " wide for --size " +
+        std::to_string(size.x) + "x" + std::to_string(size.y) + " make a contact sheet of up to " +
+        std::to_string(sheetBound.x) + "x" + std::to_string(sheetBound.y) +
+        " pixels, beyond the image limits (" + std::to_string(Image::kMaxDimension) + " per side, " +
+        std::to_string(Image::kMaxPixels) + " pixels): use a smaller --tile-width or a wider --size");
   const std::string out = args.string("out", "crep-compare-" + sceneName);
-  if (out.empty()) throw UsageError("option --out: must not be empty");
+  requireOutputPrefix({"--out", out});
+  const std::string csvPath = out + ".csv", pngPath = out + ".png";
+  requireOutputFile({"--out", pngPath});
+  requireOutputFile({"--out", csvPath});
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep compare");
@@ -150,7 +166,6 @@ int compareCommand(const std::vector<std::string>& argv) {
     }
     csv << "," << fixed(r.timings.total(), 3) << "\n";
   }
-  const std::string csvPath = out + ".csv", pngPath = out + ".png";
   {
     std::ofstream file(csvPath, std::ios::binary);
     file << csv.str();

@@ -14,24 +14,36 @@
 #include <string>
 #include <vector>
 
+#ifndef CREP_VERSION
+#error "CREP_VERSION (the project version) must be defined by the build"
+#endif
+
 namespace {
 
-const char* kUsage = R"(crep - single scattering from rectified shadow maps
+const char* const kIntro = R"(crep - single scattering from rectified shadow maps
 
 usage: crep <command> [options]
+       crep <command> --help     that command's options
+       crep --version
 
 commands:
-  render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
+)";
+
+const char* const kRender =
+    R"(  render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
             --scene NAME        colonnade (default) | forest | terrain | boxes
             --size WxH          image size (default 1280x720)
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
                                 against a standard shadow map) | the other methods listed below
-%s            --exposure X        PNG exposure (default 1)
+@METHOD_OPTIONS@            --exposure X        PNG exposure in [1e-30, 1e30] (default 1)
             --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
             --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
                                 DIR/shadow.exr (float depth-buffer values), DIR/frame.json
             --debug-gl          debug GL context; GL errors abort the command
-  scatter   single scattering for your own data; writes a scattering EXR (RGB in-scattered radiance,
+)";
+
+const char* const kScatter =
+    R"(  scatter   single scattering for your own data; writes a scattering EXR (RGB in-scattered radiance,
             A transmittance)
             --depth FILE.exr    camera depth: OpenGL depth-buffer values in [0, 1] (1 = sky)
             --shadow FILE.exr   standard shadow map: depth-buffer values of shadowMap.lightClipFromWorld
@@ -39,60 +51,136 @@ commands:
                                 examples/data/frame.json)
             --method M          prefilter (default: the standard map is resampled into the projective
                                 rectification on the CPU) | reference | the other methods below
-            (and --map-size --bases --format --splits --steps as for render)
-            --out FILE.exr      output (default scattering.exr)
+@METHOD_OPTIONS@            --out FILE.exr      output (default scattering.exr); never one of the inputs
             --png FILE.png      also a tone-mapped preview of the in-scattered radiance
-            --exposure X        PNG exposure (default 1)
-  compare   every method plus the reference on one built-in scene and camera: a contact sheet PNG
+            --exposure X        PNG exposure in [1e-30, 1e30] (default 1)
+            --debug-gl          debug GL context; GL errors abort the command
+)";
+
+const char* const kCompare =
+    R"(  compare   every method plus the reference on one built-in scene and camera: a contact sheet PNG
             (images, amplified error heat maps, metrics and timings) and a CSV
-            --scene NAME --size WxH (default 640x360) and the method options of render
-            --steps N           reference march samples per pixel (default 512)
+            --scene NAME --size WxH (default 640x360) as for render
+@METHOD_OPTIONS@            (--steps: reference march samples per pixel, default 512 here)
             --methods A,B       methods to run besides the reference (default: every method)
-            --amplify X         error heat map: |error| / peak of the reference * X (default 20)
-            --tile-width N      width of each image on the sheet (default: min(image width, 400))
+            --exposure X        exposure of the images on the sheet in [1e-30, 1e30] (default 1)
+            --amplify X         error heat map: |error| / peak of the reference * X, in (0, 1e6]
+                                (default 20)
+            --tile-width N      width of each image on the sheet in [16, 4096] (default: the image
+                                width within [16, 400])
             --out PREFIX        writes PREFIX.png and PREFIX.csv (default crep-compare-<scene>)
-%s  rectify   print the projective rectification for a camera and a directional light as JSON:
-            {"status": "projective"|"fallback", "reason", "measure", "threshold",
+            --debug-gl          debug GL context; GL errors abort the command
+)";
+
+const char* const kRectify =
+    R"(  rectify   print the projective rectification for a camera and a directional light as JSON:
+            {"status": "projective"|"fallback"|"empty", "reason", "measure", "threshold",
              "splits": [{"rectClipFromWorld": [16 numbers, column-major], "range": [a, b]}]}
+            ("empty": the lit part of the camera frustum is empty or flat, nothing is lit)
             --camera-pos x,y,z --camera-target x,y,z --camera-up x,y,z (default 0,1,0)
-            --fovy-deg F (60) --aspect A (16/9) --near N (0.1) --far F (120)
+            --fovy-deg F (60, in [0.001, 180)) --aspect A (16/9) --near N (0.1) --far F (120)
             --light-dir x,y,z   direction the light travels
             --splits K (4) --scheme uniform|logarithmic|blend (logarithmic) --blend L (0.5)
             (camera and light default to the colonnade scene's)
-  help      this text
-
-methods (this build):
-%s
-Exit status: 0 success, 1 runtime error (GL, I/O, invalid input data or parameter; the message names
-the file or field), 2 usage error (the message names the option).
 )";
+
+const char* const kHelp = R"(  help      this text (crep help <command>: that command's section)
+)";
+
+const char* const kFooter = R"(
+Numbers: decimal only, no spaces or '+' (12, -0.5, 2e-3); sizes WIDTHxHEIGHT in digits (640x360).
+Exit status: 0 success, 1 runtime error (GL, I/O, invalid input data or parameter; the message names
+the file or field), 2 usage error (the message names the option; nothing has been written).
+)";
+
+/// `text` with its "@METHOD_OPTIONS@" replaced by the help lines of the method options.
+std::string withMethodOptions(std::string text) {
+  const std::string marker = "@METHOD_OPTIONS@";
+  if (const auto at = text.find(marker); at != std::string::npos)
+    text.replace(at, marker.size(), crep::tool::kMethodOptionsHelp);
+  return text;
+}
 
 std::string paddedName(std::string name) {
   name.resize(std::max<std::size_t>(name.size(), 10), ' ');
   return name;
 }
 
-void printUsage(std::FILE* out) {
-  // Commands registered by other parts of the build (bench/ adds `crep bench`), after compare.
-  std::string registered;
+/// The `crep help` section of each command, in the order of `crep help`: the built-in commands, the
+/// registered ones (bench/ adds `crep bench`) after compare.
+struct Section {
+  std::string name, text;
+  bool methods = false; ///< takes --method / --methods: help lists the methods of this build
+};
+
+std::vector<Section> sections() {
+  std::vector<Section> s = {{"render", withMethodOptions(kRender), true},
+                            {"scatter", withMethodOptions(kScatter), true},
+                            {"compare", withMethodOptions(kCompare), true}};
   for (const crep::tool::Command& c : crep::tool::registeredCommands())
-    registered += "  " + paddedName(c.name) + c.help;
-  std::string methods;
+    s.push_back({c.name, "  " + paddedName(c.name) + c.help, false});
+  s.push_back({"rectify", kRectify, false});
+  s.push_back({"help", kHelp, false});
+  return s;
+}
+
+std::string methodList() {
+  std::string methods = "\nmethods (this build):\n";
   for (const crep::tool::Method& m : crep::tool::methodRegistry())
     methods += "  " + paddedName(m.name) + "  " + m.summary + "\n";
-  std::fprintf(out, kUsage, crep::tool::kMethodOptionsHelp, registered.c_str(), methods.c_str());
+  return methods;
+}
+
+void printUsage(std::FILE* out) {
+  std::string text = kIntro;
+  for (const Section& s : sections())
+    text += s.text;
+  text += methodList() + kFooter;
+  std::fputs(text.c_str(), out);
+}
+
+/// `crep <command> --help`: that command's section (stdout). False if there is no such command.
+bool printCommandHelp(const std::string& command) {
+  for (const Section& s : sections())
+    if (s.name == command) {
+      std::string text = "usage: crep " + command + " [options]\n\n" + s.text;
+      if (s.methods) text += methodList();
+      text += kFooter;
+      std::fputs(text.c_str(), stdout);
+      return true;
+    }
+  return false;
+}
+
+bool isHelp(const std::string& arg) {
+  return arg == "--help" || arg == "-h";
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
-    printUsage(args.empty() ? stderr : stdout);
-    return args.empty() ? 2 : 0;
+  if (args.empty()) {
+    printUsage(stderr);
+    return 2;
+  }
+  if (args[0] == "--version") {
+    std::printf("crep %s\n", CREP_VERSION);
+    return 0;
+  }
+  if (args[0] == "help" || isHelp(args[0])) {
+    if (args.size() == 1) {
+      printUsage(stdout);
+      return 0;
+    }
+    if (args.size() == 2 && printCommandHelp(args[1])) return 0;
+    std::fprintf(stderr, "crep help: unknown command '%s' (see crep help)\n", args[1].c_str());
+    return 2;
   }
   const std::string command = args[0];
   args.erase(args.begin());
+  // Every command answers --help (anywhere among its options) with its section of the usage text.
+  if (std::any_of(args.begin(), args.end(), isHelp) && printCommandHelp(command)) return 0;
   try {
     // The tool's own shaders (reference march, compositing, scene rasterization) next to the library's.
     crep::scenes::registerShaders();

@@ -1,5 +1,6 @@
 // `crep rectify`: prints the projective rectification (or the fallback decision) for a camera and a
-// directional light as one JSON object (rectify/include/crep/rectify/json.h).
+// directional light as one JSON object (rectify/include/crep/rectify/json.h). Status "projective",
+// "fallback" or "empty" (the lit part of the camera frustum is empty or flat; rectify.h).
 #include "args.h"
 #include "commands.h"
 
@@ -15,6 +16,8 @@
 namespace crep::tool {
 
 namespace {
+constexpr double kMinFovyDeg = 1e-3;
+
 // Library parameter names -> the command-line options that set them.
 const std::map<std::string, std::string> kOptionOf = {
     {"Camera.position", "--camera-pos"},
@@ -39,10 +42,16 @@ int rectifyCommand(const std::vector<std::string>& argv) {
   // Defaults: the default scene's camera and sun.
   const scenes::Scene scene = scenes::makeScene("colonnade");
   const glm::dvec3 defaultTarget = scene.camera.position() + scene.camera.forward();
+  // Below a thousandth of a degree the frustum is numerically a line (at 1e-12 degrees the lit region
+  // collapses and the status is "empty"): such a camera is a typo, not a request.
+  const double fovyDeg = args.number("fovy-deg", 60.0);
+  if (!(fovyDeg >= kMinFovyDeg && fovyDeg < 180.0))
+    throw UsageError("option --fovy-deg: " + args.string("fovy-deg", "") +
+                     " is outside [0.001, 180) degrees");
   try {
     const Camera camera = Camera::lookAt(
         args.vec3("camera-pos", scene.camera.position()), args.vec3("camera-target", defaultTarget),
-        args.vec3("camera-up", {0, 1, 0}), args.number("fovy-deg", 60.0) * std::numbers::pi / 180.0,
+        args.vec3("camera-up", {0, 1, 0}), fovyDeg * std::numbers::pi / 180.0,
         args.number("aspect", 16.0 / 9.0), args.number("near", 0.1), args.number("far", 120.0));
     const DirectionalLight light(args.vec3("light-dir", scene.sun.direction()));
     RectifyOptions options;

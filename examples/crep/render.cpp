@@ -9,6 +9,7 @@
 #include "gl_session.h"
 #include "methods.h"
 #include "options.h"
+#include "paths.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -23,6 +24,7 @@
 #include <fstream>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 namespace crep::tool {
 
@@ -68,16 +70,25 @@ int renderCommand(const std::vector<std::string>& argv) {
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
   const Args args(argv, valued, {"debug-gl"});
   const std::string sceneName = args.string("scene", "colonnade");
-  const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension);
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension, Image::kMaxPixels);
+  const double exposure = exposureOption(args);
   const std::string method = args.string("method", "prefilter");
   findMethod(method); // usage error before any GL work
   const MethodSettings settings = methodSettings(args);
   const std::string out = args.string("out", "crep-" + sceneName);
-  if (out.empty()) throw UsageError("option --out: must not be empty");
-  if (args.has("export-frame") && args.string("export-frame", "").empty())
-    throw UsageError("option --export-frame: must not be empty");
+  requireOutputPrefix({"--out", out});
+  const std::string exportDir = args.string("export-frame", "");
+  // Every file this command writes, checked before any work: usage errors first, then the file system.
+  std::vector<PathOption> outputs = {{"--out", out + ".exr"}, {"--out", out + ".png"}};
+  if (args.has("export-frame")) {
+    requireNonEmpty({"--export-frame", exportDir});
+    for (const char* name : {"depth.exr", "shadow.exr", "frame.json"})
+      outputs.push_back({"--export-frame", (std::filesystem::path(exportDir) / name).string()});
+  }
+  requireDistinctFiles(outputs);
+  requireOutputFile(outputs[0]);
+  requireOutputFile(outputs[1]);
+  if (args.has("export-frame")) requireOutputDirectory({"--export-frame", exportDir});
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep render");
@@ -105,7 +116,7 @@ int renderCommand(const std::vector<std::string>& argv) {
     writeExrLayers(exrPath, layers);
   });
   timings.time("write png", [&] { writePng(pngPath, compositeImg, ToneMap{static_cast<float>(exposure)}); });
-  if (args.has("export-frame")) exportFrame(args.string("export-frame", ""), s, timings);
+  if (args.has("export-frame")) exportFrame(exportDir, s, timings);
 
   std::printf("crep render: scene %s, %dx%d, method %s (%s)\n", s.scene->name.c_str(), size.x, size.y,
               result.used.c_str(), result.detail.c_str());
@@ -113,7 +124,7 @@ int renderCommand(const std::vector<std::string>& argv) {
   std::printf("wrote %s (layers composite.RGBA, scattering.RGBA) and %s\n", exrPath.c_str(), pngPath.c_str());
   if (args.has("export-frame"))
     std::printf("exported the frame for crep scatter: %s/{depth.exr, shadow.exr, frame.json}\n",
-                args.string("export-frame", "").c_str());
+                exportDir.c_str());
   return 0;
 }
 

@@ -14,6 +14,7 @@
 
 #include "frame_json.h"
 #include "options.h"
+#include "paths.h"
 #include "timings.h"
 #include <crep/epipolar/resample.h>
 
@@ -21,6 +22,7 @@
 #include <crep/support/exr.h>
 #include <crep/support/png.h>
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -29,6 +31,15 @@
 namespace crep::tool {
 
 namespace {
+
+/// The shortest text that reads back as exactly `v` (std::to_chars): 1.0000001f is "1.0000001", not the
+/// "1.000000" of std::to_string.
+template <class T>
+std::string shortest(T v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
 
 /// Reads a depth EXR (channel 0) and checks every value is a depth-buffer value in [0, 1].
 Image readDepthExr(const std::string& option, const std::string& path, const char* what) {
@@ -46,8 +57,8 @@ Image readDepthExr(const std::string& option, const std::string& path, const cha
       if (!(d >= 0.0f && d <= 1.0f))
         // Report the pixel as a viewer shows it: row 0 at the top.
         throw FormatError(option + " (" + what + "): '" + path + "': pixel (" + std::to_string(x) + ", " +
-                          std::to_string(image.height() - 1 - y) + ") from the top-left is " +
-                          std::to_string(d) + (std::isnan(d) ? " (NaN)" : "") +
+                          std::to_string(image.height() - 1 - y) + ") from the top-left is " + shortest(d) +
+                          (std::isnan(d) ? " (NaN)" : "") +
                           "; expected OpenGL depth-buffer values in [0, 1] (1 = nothing / sky)");
     }
   return image;
@@ -72,9 +83,22 @@ int scatterCommand(const std::vector<std::string>& argv) {
   findMethod(method);
   const MethodSettings settings = methodSettings(args);
   const std::string out = args.string("out", "scattering.exr");
-  if (out.empty()) throw UsageError("option --out: must not be empty");
-  const double exposure = args.number("exposure", 1.0);
-  if (!(exposure > 0.0)) throw UsageError("option --exposure: must be > 0");
+  const double exposure = exposureOption(args);
+  // Files: inputs that are directories, outputs that cannot be written or would overwrite an input fail
+  // here, before anything is read or written.
+  const std::vector<PathOption> inputs = {
+      {"--depth", depthPath}, {"--shadow", shadowPath}, {"--frame", framePath}};
+  std::vector<PathOption> outputs = {{"--out", out}};
+  if (args.has("png")) outputs.push_back({"--png", args.string("png", "")});
+  for (const PathOption& p : inputs)
+    requireNonEmpty(p);
+  for (const PathOption& p : outputs)
+    requireNonEmpty(p);
+  requireDistinctFiles(outputs, inputs); // usage errors above, file system below
+  for (const PathOption& p : outputs)
+    requireOutputFile(p);
+  for (const PathOption& p : inputs)
+    requireInputFile(p);
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep scatter");
@@ -106,10 +130,9 @@ int scatterCommand(const std::vector<std::string>& argv) {
                       sizeText(shadow.width(), shadow.height()) + ")");
   const double imageAspect = double(depth.width()) / double(depth.height());
   if (std::abs(camera.aspect() / imageAspect - 1.0) > 0.01)
-    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " +
-                      std::to_string(camera.aspect()) + ", which does not match the depth image '" +
-                      depthPath + "' (" + sizeText(depth.width(), depth.height()) + ", aspect " +
-                      std::to_string(imageAspect) + ")");
+    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " + shortest(camera.aspect()) +
+                      ", which does not match the depth image '" + depthPath + "' (" +
+                      sizeText(depth.width(), depth.height()) + ", aspect " + shortest(imageAspect) + ")");
 
   ensureGlContext("scatter", args.has("debug-gl"), timings);
   Frame frame(camera, light, medium);

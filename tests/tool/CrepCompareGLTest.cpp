@@ -122,6 +122,25 @@ TEST_CASE("crep compare: --methods selects methods and always adds the reference
   CHECK(pngSize(prefix + ".png").first == 8 + 2 * (80 + 8));
 }
 
+TEST_CASE("crep compare: images 1 pixel wide (--size 1x1, 1x2, 1x90) make a sheet of 16-pixel tiles") {
+  // These used to crash: the default tile width min(width, 400) = 1 skipped the [16, 4096] check and
+  // the legend's ramp divided 0 by 0 and indexed out of bounds (UBSan).
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir("crep-compare");
+  for (const char* size : {"1x1", "1x2", "1x90", "7x1"}) {
+    const std::string prefix = (dir / (std::string("s") + size)).string();
+    const auto r =
+        crep::test::runCrep(std::string("compare --size ") + size +
+                            " --map-size 64 --steps 16 --methods prefilter --out '" + prefix + "'");
+    INFO(size << " -> " << r.output);
+    REQUIRE(r.status == 0);
+    const auto [w, h] = pngSize(prefix + ".png");
+    CHECK(w == 8 + 2 * (16 + 8)); // reference + prefilter, each 16 wide
+    CHECK(h > 0);
+    CHECK(readCsv(prefix + ".csv").size() == 2);
+  }
+}
+
 #if CREP_TOOL_HAS_BENCH // bench/ built: it adds `crep bench`
 TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
   CREP_REQUIRE_GL();

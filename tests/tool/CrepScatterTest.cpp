@@ -17,6 +17,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -330,4 +331,91 @@ TEST_CASE("crep scatter: a light direction of tiny or huge length is normalised,
     CHECK(r.output.find("zero") == std::string::npos);
     CHECK(r.output.find("shadowMap.lightClipFromWorld") != std::string::npos);
   }
+}
+
+TEST_CASE("crep scatter: a directory as --frame, --depth or --shadow is an I/O error naming the option") {
+  // A directory given as --frame used to be read as an empty JSON text ("unexpected end of input").
+  for (const char* option : {"frame", "depth", "shadow"}) {
+    const Inputs in;
+    const std::string file = std::string(option) + (std::string(option) == "frame" ? ".json" : ".exr");
+    std::filesystem::remove(in.dir / file);
+    std::filesystem::create_directory(in.dir / file);
+    const auto r = crep::test::runCrep(in.args());
+    INFO(option);
+    expectFailure(r, 1, {("--" + std::string(option)).c_str(), file.c_str(), "is a directory"});
+    CHECK(r.output.find("unexpected end of input") == std::string::npos);
+    CHECK(!std::filesystem::exists(in.dir / "out.exr"));
+  }
+}
+
+TEST_CASE("crep scatter: --out or --png naming an input or each other is refused, the input untouched") {
+  const Inputs in;
+  const std::string depth = readText(in.path("depth.exr")), frame = readText(in.path("frame.json"));
+  const std::string inputs = "scatter --depth '" + in.path("depth.exr") + "' --shadow '" +
+                             in.path("shadow.exr") + "' --frame '" + in.path("frame.json") + "' ";
+  // The same file spelled differently ("dir/../dir/x") is still the same file.
+  const std::string viaParent = (in.dir / ".." / in.dir.path().filename() / "depth.exr").string();
+  struct Case {
+    std::string extra;
+    std::vector<std::string> mentions;
+  };
+  const Case cases[] = {
+      {"--out '" + in.path("depth.exr") + "'", {"--out", "--depth", "depth.exr"}},
+      {"--out '" + viaParent + "'", {"--out", "--depth"}},
+      {"--out '" + in.path("x.exr") + "' --png '" + in.path("frame.json") + "'", {"--png", "--frame"}},
+      {"--out '" + in.path("x.exr") + "' --png '" + in.path("x.exr") + "'", {"--png", "--out", "x.exr"}},
+  };
+  for (const Case& c : cases) {
+    const auto r = crep::test::runCrep(inputs + c.extra);
+    INFO(c.extra);
+    expectFailure(r, 2, {"refus"});
+    for (const std::string& m : c.mentions)
+      CHECK(r.output.find(m) != std::string::npos);
+  }
+  CHECK(readText(in.path("depth.exr")) == depth);
+  CHECK(readText(in.path("frame.json")) == frame);
+  CHECK(!std::filesystem::exists(in.dir / "x.exr"));
+}
+
+TEST_CASE("crep scatter: unusable output paths fail before anything is written") {
+  const Inputs in;
+  std::filesystem::create_directory(in.dir / "sub");
+  // --png '' used to fail after the EXR was written.
+  expectFailure(crep::test::runCrep(in.args("--png ''")), 2, {"--png", "must not be empty"});
+  expectFailure(crep::test::runCrep(in.args("--png '" + in.path("sub") + "'")), 1,
+                {"--png", "sub", "is a directory"});
+  expectFailure(crep::test::runCrep(in.args("--png '" + in.path("missing/preview.png") + "'")), 1,
+                {"--png", "missing", "does not exist"});
+  // Inputs::args() gives --out out.exr; these give their own.
+  const std::string inputs = "scatter --depth '" + in.path("depth.exr") + "' --shadow '" +
+                             in.path("shadow.exr") + "' --frame '" + in.path("frame.json") + "' ";
+  expectFailure(crep::test::runCrep(inputs + "--out '" + in.path("sub") + "/'"), 1,
+                {"--out", "is a directory"});
+  expectFailure(crep::test::runCrep(inputs + "--out '" + in.path("sub") + "'"), 1,
+                {"--out", "is a directory"});
+  expectFailure(crep::test::runCrep(inputs + "--out ''"), 2, {"--out", "must not be empty"});
+  CHECK(!std::filesystem::exists(in.dir / "out.exr"));
+  CHECK(std::filesystem::is_empty(in.dir / "sub"));
+}
+
+TEST_CASE("crep scatter: --map-size and --exposure out of range are usage errors naming the option") {
+  const Inputs in;
+  // --map-size 32768 used to fail inside the CPU resampling, naming Image.width*height.
+  const auto big = crep::test::runCrep(in.args("--map-size 32768"));
+  expectFailure(big, 2, {"--map-size", "16384"});
+  CHECK(big.output.find("Image.") == std::string::npos);
+  expectFailure(crep::test::runCrep(in.args("--exposure 1e39")), 2, {"--exposure", "1e30"});
+  expectFailure(crep::test::runCrep(in.args("--exposure 0")), 2, {"--exposure"});
+  CHECK(!std::filesystem::exists(in.dir / "out.exr"));
+}
+
+TEST_CASE("crep scatter: an out-of-range depth is printed with the digits that tell it from 1") {
+  // 1.0000001f printed with %f reads "1.000000", which looks valid; the message must show the value.
+  const Inputs in;
+  crep::Image depth(160, 90, 1, 0.9f);
+  depth.at(3, 89) = std::nextafter(1.0f, 2.0f); // 1.00000012, top-left row
+  crep::writeExr(in.dir / "depth.exr", depth, crep::ExrPixelType::Float);
+  const crep::test::ToolResult r = crep::test::runCrep(in.args());
+  expectFailure(r, 1, {"depth.exr", "pixel (3, 0) from the top-left is 1.0000001", "[0, 1]"});
+  CHECK_FALSE(std::filesystem::exists(in.dir / "out.exr"));
 }

@@ -1,4 +1,5 @@
 // End-to-end tests of the crep tool that need no GL: usage errors and `crep rectify`.
+#include "support/image_check.h"
 #include "support/tool_runner.h"
 
 #include <crep/core/camera.h>
@@ -6,6 +7,8 @@
 #include <doctest/doctest.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <regex>
 #include <string>
@@ -126,4 +129,157 @@ TEST_CASE("crep: usage errors exit 2 and name the option") {
   // bench/ registers `crep bench` with the tool's command registry (examples/ does not know bench/).
   CHECK((help.output.find("\n  bench     the benchmark suite") != std::string::npos) ==
         (CREP_TOOL_HAS_BENCH != 0));
+}
+
+namespace {
+/// Runs crep and checks a failure: exit status, every mention in the output, no internal names.
+crep::test::ToolResult expectFailure(const std::string& args, int status,
+                                     std::initializer_list<const char*> mentions) {
+  const auto r = crep::test::runCrep(args);
+  INFO(args << " -> " << r.output);
+  CHECK(r.status == status);
+  for (const char* m : mentions)
+    CHECK(r.output.find(m) != std::string::npos);
+  CHECK(r.output.find("unexpected error") == std::string::npos);
+  return r;
+}
+
+/// Files in `dir` (none should be written by a command that failed validation).
+std::size_t fileCount(const crep::test::TempDir& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    ++n;
+  return n;
+}
+} // namespace
+
+TEST_CASE("crep compare: a contact sheet beyond the image limits is a usage error naming --tile-width") {
+  // --size 1x1 used to crash (a 1-pixel default tile); now the default tile is at least 16 wide
+  // (CrepCompareGLTest), and a sheet that would exceed the image limits is refused before any work.
+  crep::test::TempDir dir;
+  const std::string out = " --out '" + (dir / "sheet").string() + "'";
+  expectFailure("compare --size 1x32768" + out, 2, {"--tile-width", "--size", "1x32768"});
+  expectFailure("compare --size 100x1000 --tile-width 4096" + out, 2, {"--tile-width", "4096"});
+  expectFailure("compare --tile-width 15" + out, 2, {"--tile-width", "[16, 4096]"});
+  CHECK(fileCount(dir) == 0);
+}
+
+TEST_CASE("crep: out-of-range numbers are usage errors naming the option, before any output") {
+  crep::test::TempDir dir;
+  const std::string out = " --out '" + (dir / "x").string() + "'";
+  // --exposure 1e39 used to write the EXR, then fail naming ToneMap.exposure with exit 1.
+  expectFailure("render --size 16x9 --exposure 1e39" + out, 2, {"--exposure", "[1e-30, 1e30]"});
+  expectFailure("render --size 16x9 --exposure 1e-31" + out, 2, {"--exposure"});
+  expectFailure("render --size 16x9 --exposure 1e999" + out, 2, {"--exposure", "out of range"});
+  expectFailure("compare --size 16x9 --exposure 1e39" + out, 2, {"--exposure"});
+  expectFailure("compare --size 16x9 --amplify 1e300" + out, 2, {"--amplify"});
+  expectFailure("render --size 16x9 --map-size 32768" + out, 2, {"--map-size", "16384"});
+  expectFailure("render --size 32768x32768" + out, 2, {"--size", "pixels"});
+  expectFailure("compare --size 16x9 --map-size 16385" + out, 2, {"--map-size"});
+  if (CREP_TOOL_HAS_BENCH) {
+    // Used to fail inside the rectification, naming Rectification.splitViewport.width.
+    for (const char* map : {"1x1", "4x4", "24x24"}) {
+      const auto r = expectFailure(std::string("bench --map ") + map, 2, {"--map", "multiple of 16"});
+      CHECK(r.output.find("Rectification") == std::string::npos);
+    }
+    expectFailure("bench --quick --map 2x2", 2, {"--map", "multiple of 4"});
+    expectFailure("bench --map 16x1", 2, {"--map", "height"});
+    expectFailure("bench --map 32768x16", 2, {"--map"});
+  }
+  CHECK(fileCount(dir) == 0);
+}
+
+TEST_CASE("crep: numbers and sizes are parsed strictly (decimal, no spaces, no '+', no hex)") {
+  struct Case {
+    const char* args;
+    const char* mentions;
+  };
+  for (const Case& c :
+       {Case{"render --size ' 160x90'", "--size"}, Case{"render --size '160x90 '", "--size"},
+        Case{"render --size +160x+90", "--size"}, Case{"render --size 0x10x90", "--size"},
+        Case{"render --size 160x-90", "--size"}, Case{"render --exposure 0x10", "--exposure"},
+        Case{"render --exposure ' 1'", "--exposure"}, Case{"render --exposure '1 '", "--exposure"},
+        Case{"render --exposure +1", "--exposure"}, Case{"render --exposure inf", "--exposure"},
+        Case{"render --exposure 1e", "--exposure"}, Case{"render --exposure .", "--exposure"},
+        Case{"render --steps +5", "--steps"}, Case{"render --steps ' 5'", "--steps"},
+        Case{"render --steps 5.0", "--steps"}, Case{"render --steps 0x10", "--steps"},
+        Case{"render --map-size 99999999999999999999", "--map-size"},
+        Case{"rectify --camera-pos '0, 1, 5'", "--camera-pos"}, Case{"rectify --aspect 0x1p1", "--aspect"}}) {
+    const auto r = crep::test::runCrep(c.args);
+    INFO(c.args << " -> " << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find(c.mentions) != std::string::npos);
+  }
+  // What the grammar accepts (args.h): fractions, exponents, a leading '-'.
+  for (const char* ok : {"rectify --aspect 1.5", "rectify --aspect .5e1", "rectify --aspect 2.",
+                         "rectify --aspect 15E-1", "rectify --light-dir -1,-1e0,0.25 --fovy-deg 6e1"}) {
+    const auto r = crep::test::runCrep(ok);
+    INFO(ok << " -> " << r.output);
+    CHECK(r.status == 0);
+  }
+}
+
+TEST_CASE("crep rectify: a field of view below 0.001 degrees is a usage error, help and README list the "
+          "empty status") {
+  // --fovy-deg 1e-300 used to print the undocumented status "empty".
+  for (const char* fovy : {"1e-300", "1e-12", "0.0009", "180", "0"})
+    expectFailure(std::string("rectify --fovy-deg ") + fovy, 2, {"--fovy-deg", "[0.001, 180)"});
+  const auto smallest = crep::test::runCrep("rectify --fovy-deg 0.001");
+  INFO(smallest.output);
+  CHECK(smallest.status == 0);
+  CHECK(smallest.output.find(R"("status": "projective")") != std::string::npos);
+  // "empty" remains a status of the library (spot and point lights), so both documents list it.
+  const auto help = crep::test::runCrep("help");
+  CHECK(help.output.find(R"("projective"|"fallback"|"empty")") != std::string::npos);
+  std::ifstream readme(std::string(CREP_SOURCE_DIR) + "/README.md");
+  const std::string text((std::istreambuf_iterator<char>(readme)), std::istreambuf_iterator<char>());
+  CHECK(text.find(R"("status": "projective" | "fallback" | "empty")") != std::string::npos);
+}
+
+TEST_CASE("crep: every command answers --help with its own section on stdout, --version prints the version") {
+  std::vector<std::string> commands = {"render", "scatter", "compare", "rectify"};
+  if (CREP_TOOL_HAS_BENCH) commands.push_back("bench");
+  for (const std::string& command : commands)
+    for (const std::string& form : {command + " --help", command + " --size 8x8 --help", "help " + command}) {
+      // stderr to /dev/null: the help text must be on stdout.
+      const auto r = crep::test::runCrep(form + " 2>/dev/null; exit $?");
+      INFO(form << " -> " << r.output);
+      CHECK(r.status == 0);
+      CHECK(r.output.starts_with("usage: crep " + command + " [options]\n"));
+      CHECK(r.output.find("\n  " + command + " ") != std::string::npos);
+      CHECK(r.output.find("Exit status") != std::string::npos);
+      for (const std::string& other : commands)
+        if (other != command) CHECK(r.output.find("\n  " + other + " ") == std::string::npos);
+    }
+  const auto render = crep::test::runCrep("render --help");
+  CHECK(render.output.find("--export-frame") != std::string::npos);
+  CHECK(render.output.find("--tile-width") == std::string::npos);
+  CHECK(render.output.find("unknown option") == std::string::npos);
+
+  const auto version = crep::test::runCrep("--version 2>/dev/null; exit $?");
+  INFO(version.output);
+  CHECK(version.status == 0);
+  CHECK(std::regex_match(version.output, std::regex(R"(crep \d+\.\d+\.\d+\n)")));
+  expectFailure("help frobnicate", 2, {"frobnicate"});
+}
+
+TEST_CASE("crep render and compare: outputs that collide or cannot be written fail before any work") {
+  crep::test::TempDir dir;
+  std::filesystem::create_directory(dir / "frame");
+  std::ofstream(dir / "file.txt") << "not a directory";
+  const std::string d = dir.path().string();
+  // PREFIX.exr would be the exported depth.exr.
+  expectFailure("render --size 16x9 --out '" + d + "/frame/depth' --export-frame '" + d + "/frame'", 2,
+                {"--export-frame", "--out", "depth.exr"});
+  expectFailure("render --size 16x9 --out '" + d + "/frame/'", 2, {"--out", "directory"});
+  expectFailure("render --size 16x9 --out ''", 2, {"--out", "empty"});
+  expectFailure("render --size 16x9 --out '" + d + "/missing/x'", 1, {"--out", "missing", "does not exist"});
+  expectFailure("render --size 16x9 --out '" + d + "/x' --export-frame '" + d + "/file.txt'", 1,
+                {"--export-frame", "file.txt", "not a directory"});
+  expectFailure("render --size 16x9 --out '" + d + "/x' --export-frame '" + d + "/file.txt/sub'", 1,
+                {"--export-frame", "file.txt", "not a directory"});
+  expectFailure("compare --size 16x9 --out '" + d + "/missing/x'", 1, {"--out", "missing", "does not exist"});
+  expectFailure("compare --size 16x9 --out '" + d + "/'", 2, {"--out", "directory"});
+  CHECK(fileCount(dir) == 2); // frame/ and file.txt, nothing else
+  CHECK(std::filesystem::is_empty(dir / "frame"));
 }

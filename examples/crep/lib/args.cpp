@@ -1,8 +1,10 @@
 #include "args.h"
 
-#include <cerrno>
+#include <cctype>
+#include <charconv>
 #include <cmath>
-#include <cstdlib>
+#include <cstdio>
+#include <system_error>
 
 namespace crep::tool {
 
@@ -40,33 +42,93 @@ std::string Args::string(const std::string& name, const std::string& fallback) c
 }
 
 namespace {
+
+bool isDigit(char c) {
+  return std::isdigit(static_cast<unsigned char>(c)) != 0;
+}
+
+/// Skips decimal digits from `i`; returns how many.
+std::size_t digits(const std::string& s, std::size_t& i) {
+  const std::size_t start = i;
+  while (i < s.size() && isDigit(s[i]))
+    ++i;
+  return i - start;
+}
+
+/// '-'? digits (args.h).
+bool isStrictInteger(const std::string& s) {
+  std::size_t i = s.starts_with('-') ? 1 : 0;
+  return digits(s, i) > 0 && i == s.size();
+}
+
+/// '-'? (digits ('.' digits?)? | '.' digits) ([eE] [+-]? digits)? (args.h).
+bool isStrictNumber(const std::string& s) {
+  std::size_t i = s.starts_with('-') ? 1 : 0;
+  std::size_t mantissa = digits(s, i);
+  if (i < s.size() && s[i] == '.') {
+    ++i;
+    mantissa += digits(s, i);
+  }
+  if (mantissa == 0) return false;
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    ++i;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    if (digits(s, i) == 0) return false;
+  }
+  return i == s.size();
+}
+
+/// "0.001", "1e30" (as the help texts write them).
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  std::string s = buf;
+  if (const auto e = s.find("e+"); e != std::string::npos) s.erase(e + 1, 1);
+  return s;
+}
+
 double parseDouble(const std::string& option, const std::string& text) {
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v))
-    throw UsageError("option --" + option + ": '" + text + "' is not a finite number");
+  double v = 0.0;
+  if (!isStrictNumber(text))
+    throw UsageError(
+        "option --" + option + ": '" + text +
+        "' is not a decimal number (digits, optional '-', fraction and exponent: e.g. 0.5, 2e-3)");
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec == std::errc::result_out_of_range || end != text.data() + text.size() || !std::isfinite(v))
+    throw UsageError("option --" + option + ": '" + text + "' is out of range (beyond what a double holds)");
   return v;
 }
+
 } // namespace
 
 int Args::integer(const std::string& name, int fallback, int min, int max) const {
   const auto it = values_.find(name);
   if (it == values_.end()) return fallback;
-  errno = 0;
-  char* end = nullptr;
-  const long v = std::strtol(it->second.c_str(), &end, 10);
-  if (it->second.empty() || end != it->second.c_str() + it->second.size() || errno == ERANGE)
-    throw UsageError("option --" + name + ": '" + it->second + "' is not an integer");
-  if (v < min || v > max)
-    throw UsageError("option --" + name + ": " + it->second + " is outside [" + std::to_string(min) + ", " +
-                     std::to_string(max) + "]");
+  const std::string& text = it->second;
+  const std::string range = "[" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  if (!isStrictInteger(text))
+    throw UsageError("option --" + name + ": '" + text + "' is not an integer (decimal digits, in " + range +
+                     ")");
+  long long v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec == std::errc::result_out_of_range || end != text.data() + text.size() || v < min || v > max)
+    throw UsageError("option --" + name + ": " + text + " is outside " + range);
   return static_cast<int>(v);
 }
 
 double Args::number(const std::string& name, double fallback) const {
   const auto it = values_.find(name);
   return it == values_.end() ? fallback : parseDouble(name, it->second);
+}
+
+double Args::number(const std::string& name, double fallback, double min, double max) const {
+  const auto it = values_.find(name);
+  if (it == values_.end()) return fallback;
+  const double v = parseDouble(name, it->second);
+  if (!(v >= min && v <= max))
+    throw UsageError("option --" + name + ": " + it->second + " is outside [" + shortNumber(min) + ", " +
+                     shortNumber(max) + "]");
+  return v;
 }
 
 glm::dvec3 Args::vec3(const std::string& name, const glm::dvec3& fallback) const {
@@ -84,23 +146,29 @@ glm::dvec3 Args::vec3(const std::string& name, const glm::dvec3& fallback) const
   return v;
 }
 
-glm::ivec2 Args::size(const std::string& name, glm::ivec2 fallback, int max) const {
+glm::ivec2 Args::size(const std::string& name, glm::ivec2 fallback, int max, long long maxPixels) const {
   const auto it = values_.find(name);
   if (it == values_.end()) return fallback;
-  const auto x = it->second.find('x');
-  if (x == std::string::npos)
-    throw UsageError("option --" + name + ": '" + it->second + "' is not WIDTHxHEIGHT");
+  const std::string& text = it->second;
+  const std::string needs = "option --" + name + ": '" + text +
+                            "' needs WIDTHxHEIGHT (decimal digits, e.g. " + "640x360) with each in [1, " +
+                            std::to_string(max) + "]";
+  const auto x = text.find('x');
+  if (x == std::string::npos) throw UsageError(needs);
   glm::ivec2 s;
   for (int i = 0; i < 2; ++i) {
-    const std::string part = i == 0 ? it->second.substr(0, x) : it->second.substr(x + 1);
-    errno = 0;
-    char* end = nullptr;
-    const long v = std::strtol(part.c_str(), &end, 10);
-    if (part.empty() || end != part.c_str() + part.size() || errno == ERANGE || v < 1 || v > max)
-      throw UsageError("option --" + name + ": '" + it->second + "' needs WIDTHxHEIGHT with each in [1, " +
-                       std::to_string(max) + "]");
+    const std::string part = i == 0 ? text.substr(0, x) : text.substr(x + 1);
+    std::size_t end = 0;
+    if (digits(part, end) == 0 || end != part.size()) throw UsageError(needs);
+    long long v = 0;
+    const auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (ec != std::errc() || ptr != part.data() + part.size() || v < 1 || v > max) throw UsageError(needs);
     s[i] = static_cast<int>(v);
   }
+  if (static_cast<long long>(s.x) * s.y > maxPixels)
+    throw UsageError("option --" + name + ": " + text + " has " +
+                     std::to_string(static_cast<long long>(s.x) * s.y) + " pixels, more than " +
+                     std::to_string(maxPixels));
   return s;
 }
 

@@ -1,5 +1,6 @@
 #include "contact_sheet.h"
 
+#include <crep/core/error.h>
 #include <crep/support/png.h>
 
 #include <stb_easy_font.h>
@@ -7,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 namespace crep::tool {
@@ -18,9 +21,10 @@ const std::array<glm::vec3, 5> kRamp = {glm::vec3(0.0f, 0.0f, 0.02f), glm::vec3(
                                         glm::vec3(0.85f, 0.26f, 0.19f), glm::vec3(0.99f, 0.75f, 0.15f),
                                         glm::vec3(0.99f, 1.0f, 0.75f)};
 
+/// The ramp at t in [0, 1] (clamped; NaN -> 0).
 glm::vec3 ramp(double t) {
-  t = std::clamp(t, 0.0, 1.0) * double(kRamp.size() - 1);
-  const int i = std::min(static_cast<int>(t), static_cast<int>(kRamp.size()) - 2);
+  t = (t > 0.0 ? std::min(t, 1.0) : 0.0) * double(kRamp.size() - 1);
+  const int i = std::clamp(static_cast<int>(t), 0, static_cast<int>(kRamp.size()) - 2);
   const float f = static_cast<float>(t - i);
   const glm::vec3 srgb =
       kRamp[static_cast<std::size_t>(i)] * (1.0f - f) + kRamp[static_cast<std::size_t>(i) + 1] * f;
@@ -166,12 +170,36 @@ std::vector<std::string> wrap(const std::string& text, int width) {
 }
 } // namespace
 
+namespace {
+constexpr int kMargin = 8;
+
+/// "20", "0.5", "1e+06": the amplification as the legend shows it.
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+} // namespace
+
+int sheetTileHeight(int tileWidth, glm::ivec2 imageSize) {
+  const double h = std::round(double(tileWidth) * imageSize.y / std::max(1, imageSize.x));
+  return static_cast<int>(std::clamp(h, 1.0, 1e9));
+}
+
+glm::ivec2 sheetSizeBound(int tileWidth, glm::ivec2 imageSize, int columns) {
+  const long long width = kMargin + static_cast<long long>(columns) * (tileWidth + kMargin);
+  const long long height = 2LL * sheetTileHeight(tileWidth, imageSize) + kSheetTextBound;
+  return {static_cast<int>(std::min(width, 1LL << 30)), static_cast<int>(std::min(height, 1LL << 30))};
+}
+
 Image composeSheet(const std::string& header, const std::vector<SheetColumn>& columns, int tileWidth,
                    double exposure, double amplification) {
-  const int margin = 8, lineHeight = 10, titleHeight = 20;
+  if (columns.empty()) throw InvalidArgument("composeSheet.columns", "none", "must not be empty");
+  if (tileWidth < 1)
+    throw InvalidArgument("composeSheet.tileWidth", std::to_string(tileWidth), "must be >= 1");
+  const int margin = kMargin, lineHeight = 10, titleHeight = 20;
   const Image& first = columns.front().image;
-  const int tileHeight =
-      std::max(1, static_cast<int>(std::lround(double(tileWidth) * first.height() / first.width())));
+  const int tileHeight = sheetTileHeight(tileWidth, {first.width(), first.height()});
   std::size_t maxLines = 0;
   for (const SheetColumn& c : columns)
     maxLines = std::max(maxLines, c.lines.size());
@@ -179,9 +207,9 @@ Image composeSheet(const std::string& header, const std::vector<SheetColumn>& co
   const int width = margin + columnsCount * (tileWidth + margin);
   const std::vector<std::string> headerLines = wrap(header, width - 2 * margin);
   const std::vector<std::string> legendLines =
-      wrap("top: composited image (exposure " + std::to_string(exposure).substr(0, 4) +
+      wrap("top: composited image (exposure " + shortNumber(exposure) +
                "); middle: |error| of the in-scattering against the reference (max over RGB) / its peak x " +
-               std::to_string(static_cast<int>(std::lround(amplification))) +
+               shortNumber(amplification) +
                "; bottom: metrics of the in-scattering, milliseconds per stage (wall clock, glFinish)",
            width - 2 * margin);
   const int headerHeight =
@@ -211,13 +239,13 @@ Image composeSheet(const std::string& header, const std::vector<SheetColumn>& co
       // Legend: the ramp from 0 to a peak / amplification.
       const int barTop = y + tileHeight / 2 - 8;
       for (int x = 0; x < tileWidth; ++x) {
-        const glm::vec3 v = ramp(double(x) / (tileWidth - 1));
+        const glm::vec3 v = ramp(tileWidth > 1 ? double(x) / (tileWidth - 1) : 0.0);
         for (int dy = 0; dy < 16; ++dy)
           setTopDown(sheet, x0 + x, barTop + dy, v);
       }
       drawText(sheet, x0, barTop - 14, "error scale (reference: no error)", 1, white);
       drawText(sheet, x0, barTop + 20, "0", 1, white);
-      const std::string right = ">= peak / " + std::to_string(static_cast<int>(std::lround(amplification)));
+      const std::string right = ">= peak / " + shortNumber(amplification);
       drawText(sheet, x0 + tileWidth - textWidth(right, 1), barTop + 20, right, 1, white);
     }
     y += tileHeight + margin / 2;

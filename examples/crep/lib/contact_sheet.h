@@ -37,8 +37,23 @@ int drawText(Image& image, int x, int y, const std::string& text, int scale, con
 /// Width in pixels of `text` drawn at `scale`.
 int textWidth(const std::string& text, int scale);
 
+/// Tile widths a sheet accepts (`crep compare --tile-width`).
+constexpr int kMinTileWidth = 16, kMaxTileWidth = 4096;
+
+/// Height of the image tiles of a sheet whose tiles are tileWidth wide, for images of imageSize (aspect
+/// ratio kept, at least 1).
+int sheetTileHeight(int tileWidth, glm::ivec2 imageSize);
+
+/// The width of a sheet of `columns` columns of tiles tileWidth wide, and an upper bound of its height
+/// (two tiles per column plus the text rows; the text is bounded by kSheetTextBound pixels for the
+/// header, legend and a column's lines of `crep compare`).
+glm::ivec2 sheetSizeBound(int tileWidth, glm::ivec2 imageSize, int columns);
+constexpr int kSheetTextBound = 2048;
+
 /// The sheet: a header line on top, then the columns (each tileWidth wide, images resized keeping the
-/// aspect ratio), the heat map legend in the reference column's heat slot. RGB linear.
+/// aspect ratio), the heat map legend in the reference column's heat slot. RGB linear. Throws
+/// InvalidArgument for no columns or tileWidth < 1 (any tileWidth >= 1 works; the tool asks for at
+/// least kMinTileWidth so that the text fits).
 Image composeSheet(const std::string& header, const std::vector<SheetColumn>& columns, int tileWidth,
                    double exposure, double amplification);
 

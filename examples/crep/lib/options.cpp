@@ -2,10 +2,12 @@
 
 namespace crep::tool {
 
+static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
+
 const std::set<std::string> kMethodOptions = {"method", "map-size", "bases", "format", "splits", "steps"};
 
 const char* const kMethodOptionsHelp =
-    R"(            --map-size N        shadow map and rectified map size (default 1024)
+    R"(            --map-size N        shadow map and rectified map size (default 1024, at most 16384)
             --bases M           Fourier bases, even, in [4, 128] (default 32)
             --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
             --splits K          rectification splits (default 4; --map-size must be a multiple)
@@ -19,9 +21,13 @@ StorageFormat parseFormat(const std::string& text) {
   throw UsageError("option --format: '" + text + "' is not rgba8, rgba16f or rgba32f");
 }
 
+double exposureOption(const Args& args) {
+  return args.number("exposure", 1.0, kMinExposure, kMaxExposure);
+}
+
 MethodSettings methodSettings(const Args& args) {
   MethodSettings s;
-  s.mapSize = args.integer("map-size", s.mapSize, 1, Image::kMaxDimension);
+  s.mapSize = args.integer("map-size", s.mapSize, 1, kMaxMapSize);
   s.steps = args.integer("steps", s.steps, 1, 65536);
   s.prefilter.bases = args.integer("bases", s.prefilter.bases, kMinBases, kMaxBases);
   if (s.prefilter.bases % 2 != 0) throw UsageError("option --bases: must be even");
