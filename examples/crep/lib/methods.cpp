@@ -179,40 +179,25 @@ MethodOutput runBrute(Frame& frame, const MethodSettings& settings) {
   return runRectifiedMarch(frame, settings, false, "brute");
 }
 
-/// Klehm et al. 2014: GPU prefilter of the rectified map (Fourier basis, transmittance-weighted prefix
-/// filter per row) and the constant-time evaluation per pixel.
-MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
-  StageTimings timings;
-  const RectifiedGpuMap* map = frame.rectified(settings, timings);
-  if (!map) {
-    // The prefiltered evaluation pass needs a projective layout (gpu_pass.h); on the epipolar layout the
-    // min/max march over the resampled map stands in for it (it announces the fallback on stderr).
-    MethodOutput fallback = runRectifiedMarch(frame, settings, true, "prefilter");
-    timings.append(fallback.timings.rows());
-    fallback.timings = timings;
-    return fallback;
-  }
-  const PrefilterOptions& options = settings.prefilter;
-  MethodOutput out;
-  out.used = "prefilter";
-  out.detail = "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format) + ", " +
-               std::to_string(map->rect.splitCount()) + " splits, map " + std::to_string(map->size) + "^2 " +
-               map->source;
-  out.timings = timings;
+/// The prefiltered method on one rectified map on the GPU (Klehm et al. 2014): prefilter (Fourier basis,
+/// transmittance-weighted prefix filter per row) and the constant-time evaluation per pixel, on either
+/// layout (projective, or the epipolar fallback through its layout block).
+void prefilterAndEvaluate(const Frame& frame, const MethodSettings& settings, const RectifiedLayout& layout,
+                          std::uint32_t map, int width, int height, MethodOutput& out) {
   PrefilterPass::CreateInfo prefilterInfo;
-  prefilterInfo.width = map->size;
-  prefilterInfo.height = map->size;
-  prefilterInfo.options = options;
+  prefilterInfo.width = width;
+  prefilterInfo.height = height;
+  prefilterInfo.options = settings.prefilter;
   auto prefilter =
       out.timings.time("prefilter setup", [&] { return std::make_unique<PrefilterPass>(prefilterInfo); });
   EvaluatePass::CreateInfo evaluateInfo;
-  evaluateInfo.bases = options.bases;
+  evaluateInfo.bases = settings.prefilter.bases;
   auto evaluate =
       out.timings.time("evaluate setup", [&] { return std::make_unique<EvaluatePass>(evaluateInfo); });
   out.timings.time("prefilter", [&] {
     PrefilterPass::FrameAttribs f;
-    f.rectifiedDepth = map->texture.get();
-    f.layout = map->layout.get();
+    f.rectifiedDepth = map;
+    f.layout = &layout;
     f.medium = &frame.medium;
     prefilter->run(f);
     glFinish();
@@ -225,11 +210,41 @@ MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
     f.camera = &frame.camera;
     f.light = &frame.light;
     f.medium = &frame.medium;
-    f.layout = map->layout.get();
+    f.layout = &layout;
     f.basis = prefilter->filteredBasis();
     evaluate->run(f);
     glFinish();
   });
+}
+
+/// Klehm et al. 2014 on every frame: the rectified map when the rectification is projective, else the
+/// standard shadow map resampled into the epipolar layout (Sec. 4.1) and the pixels next to the epipole
+/// marched in world space (Fig. 8).
+MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
+  MethodOutput out;
+  out.used = "prefilter";
+  const PrefilterOptions& options = settings.prefilter;
+  const std::string basis =
+      "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
+  Rectification rect;
+  if (const RectifiedGpuMap* map = frame.rectified(settings, out.timings, &rect)) {
+    out.detail = "projective layout, " + basis + ", " + std::to_string(map->rect.splitCount()) +
+                 " splits, map " + std::to_string(map->size) + "^2 " + map->source;
+    prefilterAndEvaluate(frame, settings, *map->layout, map->texture.get(), map->size, map->size, out);
+    return out;
+  }
+  std::fprintf(stderr, "crep: prefilter: rectification is %s (%s); using the epipolar resampling fallback\n",
+               statusToken(rect.status), rect.message.c_str());
+  const EpipolarMap epipolar = makeEpipolarMap(frame, settings, out.timings);
+  const double block = epipolar.layout->epipolePixel() ? epipolar.layout->epipoleBlockRadiusPixels() : 0.0;
+  char blockText[32];
+  std::snprintf(blockText, sizeof blockText, "%.1f", block);
+  out.detail = std::string("epipolar layout (") + reasonToken(rect.reason) + "), epipole block radius " +
+               blockText + " px, " + basis + ", map " + std::to_string(epipolar.width) + "x" +
+               std::to_string(epipolar.height);
+  prefilterAndEvaluate(frame, settings, *epipolar.layout, epipolar.texture.get(), epipolar.width,
+                       epipolar.height, out);
+  marchEpipoleBlock(frame, settings, *epipolar.layout, out.scattering.get(), out.timings);
   return out;
 }
 
