@@ -18,6 +18,9 @@
 #include <ImfPartType.h>
 #include <half.h>
 
+#define ZLIB_CONST
+#include <zlib.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -27,6 +30,8 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
+#include <new>
 #include <numeric>
 #include <set>
 #include <string>
@@ -749,6 +754,104 @@ CheckedPart validateLayout(FileReader& reader, const FileLayout& layout, int par
   return checked;
 }
 
+// Size of the output of an RLE chunk as OpenEXR decodes it (a signed count byte c < 0: -c literal
+// bytes follow; c >= 0: the next byte repeated c + 1 times), or -1 if the stream is malformed.
+// Counting stops once the output exceeds `limit`.
+long long rleDecodedSize(const std::vector<std::uint8_t>& in, std::uint64_t limit) {
+  std::uint64_t out = 0;
+  std::size_t at = 0;
+  while (at < in.size() && out <= limit) {
+    const int count = static_cast<std::int8_t>(in[at++]);
+    if (count < 0) {
+      const std::size_t literal = static_cast<std::size_t>(-count);
+      if (in.size() - at < literal) return -1;
+      at += literal;
+      out += literal;
+    } else {
+      if (at == in.size()) return -1;
+      ++at;
+      out += static_cast<std::uint64_t>(count) + 1;
+    }
+  }
+  return static_cast<long long>(out);
+}
+
+// Inflates with bounded memory to learn the decoded size of a zlib stream (ZIP, ZIPS), or -1 if it is
+// not a complete zlib stream. Bytes after the end of the stream are ignored, as OpenEXR does.
+// Inflating stops once the output exceeds `limit`.
+class ZlibSizer {
+public:
+  ZlibSizer() {
+    if (inflateInit_(&stream_, ZLIB_VERSION, static_cast<int>(sizeof(z_stream))) != Z_OK)
+      throw std::bad_alloc();
+  }
+  ~ZlibSizer() { inflateEnd(&stream_); }
+  ZlibSizer(const ZlibSizer&) = delete;
+  ZlibSizer& operator=(const ZlibSizer&) = delete;
+
+  long long decodedSize(const std::vector<std::uint8_t>& in, std::uint64_t limit) {
+    if (inflateReset(&stream_) != Z_OK) return -1;
+    stream_.next_in = in.data();
+    stream_.avail_in = static_cast<uInt>(in.size());
+    std::uint64_t out = 0;
+    for (;;) {
+      stream_.next_out = scratch_.data();
+      stream_.avail_out = static_cast<uInt>(scratch_.size());
+      const int result = inflate(&stream_, Z_NO_FLUSH);
+      out += scratch_.size() - stream_.avail_out;
+      if (result == Z_STREAM_END || (result == Z_OK && out > limit)) return static_cast<long long>(out);
+      if (result != Z_OK) return -1; // corrupt, or the input ended before the stream did
+    }
+  }
+
+private:
+  z_stream stream_{};
+  std::array<Bytef, 1 << 16> scratch_{};
+};
+
+// OpenEXR 3.1 does not check that an RLE, ZIPS or ZIP chunk decodes to its full raw size: it converts
+// the whole chunk from its decompression buffer, whose end then holds stale or uninitialised memory
+// (PIZ, PXR24, B44 and DWA check their decoded size themselves). The chunks of these codecs that
+// OpenEXR will decompress (those smaller than their raw size) are decoded here first, with bounded
+// memory, and must yield exactly the raw size. Runs after the plausibility check of the image size,
+// so the work is bounded by the pixel memory the caller accepted.
+void verifyDecodedSizes(FileReader& reader, const CheckedPart& checked, const fs::path& path) {
+  const int compression = checked.part->compression;
+  if (compression < 1 || compression > 3) return;
+  std::vector<std::uint8_t> table(static_cast<std::size_t>(checked.chunkCount) * 8);
+  if (!reader.readAt(checked.tableOffset, table.data(), table.size()))
+    throwFormat(path, "truncated file (chunk offset table)");
+  std::unique_ptr<ZlibSizer> zlib;
+  std::vector<std::uint8_t> packed;
+  forEachChunk(*checked.part, checked.tiled, [&](long long i, const ExpectedChunk& expected) {
+    const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
+    std::array<std::uint8_t, 4> sizeField{};
+    if (!reader.readAt(offset + checked.chunkHeaderBytes - 4, sizeField.data(), sizeField.size()))
+      throwFormat(path, "truncated file (chunk " + std::to_string(i) + ")");
+    const std::uint64_t dataSize = FileReader::decode32(sizeField.data()); // validated: <= raw size
+    if (dataSize == 0 || dataSize >= expected.rawBytes) return;            // stored uncompressed
+    packed.resize(static_cast<std::size_t>(dataSize));
+    if (!reader.readAt(offset + checked.chunkHeaderBytes, packed.data(), packed.size()))
+      throwFormat(path, "truncated file (chunk " + std::to_string(i) + ")");
+    long long decoded = 0;
+    if (compression == 1) {
+      decoded = rleDecodedSize(packed, expected.rawBytes);
+    } else {
+      if (!zlib) zlib = std::make_unique<ZlibSizer>();
+      decoded = zlib->decodedSize(packed, expected.rawBytes);
+    }
+    const std::string chunk = "corrupt chunk " + std::to_string(i) + " (" + describe(expected) + "): its " +
+                              compressionName(compression) + " data ";
+    if (decoded < 0) throwFormat(path, chunk + "cannot be decoded");
+    if (static_cast<std::uint64_t>(decoded) != expected.rawBytes)
+      throwFormat(path, chunk + "decodes to " +
+                            (static_cast<std::uint64_t>(decoded) > expected.rawBytes ? "more than " : "") +
+                            std::to_string(std::min<std::uint64_t>(static_cast<std::uint64_t>(decoded),
+                                                                   expected.rawBytes)) +
+                            " bytes, expected " + std::to_string(expected.rawBytes));
+  });
+}
+
 // ------------------------------------------------------------------------------------------------
 // Channel selection
 
@@ -856,6 +959,7 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
     if (!dwa && imageBytes > 4096.0 * static_cast<double>(reader.size()) + 16.0 * 1024 * 1024)
       throwFormat(path, "data window " + std::to_string(width) + "x" + std::to_string(height) +
                             " is implausibly large for a " + std::to_string(reader.size()) + "-byte file");
+    verifyDecodedSizes(reader, checked, path);
 
     Imf::InputPart input(file, options.part);
     if (!input.isComplete()) throwFormat(path, "incomplete file (missing pixel data)");

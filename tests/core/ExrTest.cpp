@@ -194,6 +194,29 @@ struct Writer {
   }
 };
 
+// A zlib stream holding `data` in one stored (uncompressed) deflate block.
+Bytes zlibStored(const Bytes& data) {
+  REQUIRE(data.size() < 65536);
+  const auto n = static_cast<std::uint16_t>(data.size());
+  Writer z;
+  z.u8(0x78); // deflate, 32 KiB window
+  z.u8(0x01); // no preset dictionary, check bits
+  z.u8(0x01); // final block, stored
+  z.u16(n);
+  z.u16(static_cast<std::uint16_t>(~n));
+  for (const std::uint8_t byte : data)
+    z.u8(byte);
+  std::uint32_t a = 1, b = 0; // Adler-32, stored big-endian
+  for (const std::uint8_t byte : data) {
+    a = (a + byte) % 65521;
+    b = (b + a) % 65521;
+  }
+  const std::uint32_t adler = (b << 16) | a;
+  for (int shift = 24; shift >= 0; shift -= 8)
+    z.u8(static_cast<std::uint8_t>(adler >> shift));
+  return z.b;
+}
+
 enum : int { kUint = 0, kHalf = 1, kFloat = 2 };
 
 struct RawChannel {
@@ -210,6 +233,7 @@ struct RawPart {
   std::string type;        // explicit type attribute (multi-part files always get one)
   int compression = 0;     // attribute value only: the data written is always uncompressed...
   int fakeChunkBytes = -1; // ...unless >= 0: then every chunk holds this many zero bytes
+  Bytes fakeChunk;         // ...or, if not empty, these bytes (scanline parts)
 };
 
 // The value stored for channel c of part p at EXR coordinates (x, y): an integer in [0, 1024),
@@ -316,7 +340,12 @@ bool sampled(int v, int sampling) {
 std::vector<Bytes> partChunks(const RawPart& part, int p) {
   std::vector<Bytes> chunks;
   if (part.tileWidth == 0) {
-    for (int y = part.minY; y <= part.maxY; ++y) {
+    // Fake chunks cover as many lines as the compression puts in a chunk; real data is written
+    // uncompressed, one line per chunk.
+    const bool fake = part.fakeChunkBytes >= 0 || !part.fakeChunk.empty();
+    const int linesPerChunk[10] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+    const int step = fake ? linesPerChunk[part.compression] : 1;
+    for (int y = part.minY; y <= part.maxY; y += step) {
       Writer data;
       for (std::size_t c = 0; c < part.channels.size(); ++c) {
         const RawChannel& ch = part.channels[c];
@@ -325,6 +354,7 @@ std::vector<Bytes> partChunks(const RawPart& part, int p) {
           if (sampled(x, ch.xSampling)) sample(data, ch.type, rawValue(p, static_cast<int>(c), x, y));
       }
       if (part.fakeChunkBytes >= 0) data.b.assign(static_cast<std::size_t>(part.fakeChunkBytes), 0);
+      if (!part.fakeChunk.empty()) data.b = part.fakeChunk;
       Writer chunk;
       chunk.i32(y);
       chunk.i32(static_cast<std::int32_t>(data.b.size()));
@@ -792,6 +822,37 @@ TEST_CASE(
     put32(b, chunks[1] + 4, 8 * 2 + 2 * 4 * 2);
     writeFile(dir / "yc.exr", b);
     CHECK(contains(expectThrows<crep::FormatError>(dir / "yc.exr"), "expected exactly 16"));
+  }
+  SUBCASE("RLE and ZIP chunks must decode to their full size (OpenEXR 3.1 does not check it)") {
+    RawPart rle = scanlinePart({{"Y", kFloat}}, 160, 4);
+    rle.compression = 1;
+    rle.fakeChunk = {11, 0x80}; // a run of 12 bytes, for 640-byte lines
+    writeFile(dir / "rle.exr", buildExr({rle}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "rle.exr"),
+                   "chunk 0 (scanline 0): its RLE data decodes to 12 bytes, expected 640"));
+    rle.fakeChunk.clear();
+    for (int run = 0; run < 6; ++run) // 6 runs of 128 bytes: more than a line
+      rle.fakeChunk.insert(rle.fakeChunk.end(), {127, 0x80});
+    writeFile(dir / "rle.exr", buildExr({rle}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "rle.exr"), "decodes to more than 640 bytes"));
+    rle.fakeChunk = {0x85, 1, 2}; // a literal run of 123 bytes with 2 present
+    writeFile(dir / "rle.exr", buildExr({rle}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "rle.exr"), "its RLE data cannot be decoded"));
+
+    RawPart zip = scanlinePart({{"Y", kFloat}}, 160, 20);
+    zip.compression = 3; // 16 lines per chunk
+    zip.fakeChunk = zlibStored(Bytes(12, 0x80));
+    writeFile(dir / "zip.exr", buildExr({zip}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "zip.exr"),
+                   "chunk 0 (scanlines 0-15): its ZIP data decodes to 12 bytes, expected 10240"));
+    const Bytes stream = zlibStored(Bytes(12, 0x80));
+    zip.fakeChunk.assign(stream.begin(), stream.begin() + 11); // no Adler-32: the stream is incomplete
+    writeFile(dir / "zip.exr", buildExr({zip}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "zip.exr"), "its ZIP data cannot be decoded"));
+    zip.compression = 2; // ZIPS: one line per chunk
+    zip.fakeChunk = zlibStored(Bytes(600, 0x80));
+    writeFile(dir / "zip.exr", buildExr({zip}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "zip.exr"), "its ZIPS data decodes to 600 bytes"));
   }
 }
 

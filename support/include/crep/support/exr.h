@@ -100,7 +100,8 @@ void writeExrLayers(const std::filesystem::path& path, std::span<const ExrLayer>
 /// times 2 or 4 bytes), compressed ones from 1 byte up to that size (never more: OpenEXR stores a
 /// chunk uncompressed when compression does not make it smaller). The image size must be plausible
 /// for the file size (at most 4096 bytes of float output per byte of file, plus 16 MiB; not applied
-/// to DWAA/DWAB, whose ratio on constant images is unbounded in practice). Every sample of the image
+/// to DWAA/DWAB, whose ratio on constant images is unbounded in practice), and the RLE, ZIPS and ZIP
+/// chunks of the part read must decode to exactly their uncompressed size. Every sample of the image
 /// is checked to have been written by the decoder (see detail::kExrUnwrittenSampleBits).
 /// Throws IoError if the file is missing or unreadable; FormatError naming the file if it is not an
 /// EXR file, is corrupt or truncated (the message names the chunk: its index, line or tile, size
