@@ -18,13 +18,21 @@
 #include <ImfPartType.h>
 #include <half.h>
 
+#define ZLIB_CONST
+#include <zlib.h>
+
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <cstring>
 #include <exception>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <memory>
+#include <new>
+#include <numeric>
 #include <set>
 #include <string>
 #include <system_error>
@@ -283,7 +291,17 @@ private:
   std::uint64_t position_ = 0;
 };
 
+// One entry of a part's channel list: pixel type (0 UINT, 1 HALF, 2 FLOAT) and sampling.
+struct ChannelLayout {
+  std::string name;
+  int type = 0;
+  std::int32_t xSampling = 1, ySampling = 1;
+  int bytes() const { return type == 1 ? 2 : 4; }
+};
+
 struct PartLayout {
+  bool hasChannels = false;
+  std::vector<ChannelLayout> channels;
   bool hasDataWindow = false;
   std::int32_t minX = 0, minY = 0, maxX = -1, maxY = -1;
   int compression = -1;
@@ -308,6 +326,40 @@ struct FileLayout {
   std::vector<PartLayout> parts;
   std::uint64_t tablesStart = 0; // first byte after the headers
 };
+
+const char* compressionName(int compression) {
+  static const char* const kNames[] = {"NONE",  "RLE", "ZIPS", "ZIP",  "PIZ",
+                                       "PXR24", "B44", "B44A", "DWAA", "DWAB"};
+  return compression >= 0 && compression < 10 ? kNames[compression] : "unknown";
+}
+
+// The channel list attribute ("chlist"): entries name\0, int32 pixel type, uint8 pLinear, 3 reserved
+// bytes, int32 xSampling, int32 ySampling; terminated by an empty name.
+std::vector<ChannelLayout> parseChannelList(const std::vector<std::uint8_t>& value, const fs::path& path) {
+  std::vector<ChannelLayout> channels;
+  std::size_t at = 0;
+  for (;;) {
+    if (at >= value.size()) throwFormat(path, "invalid channel list (not terminated)");
+    if (value[at] == 0) return channels;
+    ChannelLayout channel;
+    while (at < value.size() && value[at] != 0)
+      channel.name.push_back(static_cast<char>(value[at++]));
+    if (channel.name.size() > 255 || value.size() - at < 17)
+      throwFormat(path, "invalid channel list (truncated entry)");
+    ++at;
+    const std::int32_t type = FileReader::toSigned(FileReader::decode32(value.data() + at));
+    channel.xSampling = FileReader::toSigned(FileReader::decode32(value.data() + at + 8));
+    channel.ySampling = FileReader::toSigned(FileReader::decode32(value.data() + at + 12));
+    at += 16;
+    if (type < 0 || type > 2)
+      throwFormat(path, "channel '" + channel.name + "' has an unknown pixel type " + std::to_string(type));
+    if (channel.xSampling < 1 || channel.ySampling < 1)
+      throwFormat(path, "channel '" + channel.name + "' has an invalid sampling " +
+                            std::to_string(channel.xSampling) + "x" + std::to_string(channel.ySampling));
+    channel.type = type;
+    channels.push_back(std::move(channel));
+  }
+}
 
 int linesPerChunk(int compression) {
   switch (compression) {
@@ -370,6 +422,11 @@ FileLayout scanHeaders(FileReader& reader, const fs::path& path) {
         part.minY = FileReader::toSigned(reader.u32("dataWindow"));
         part.maxX = FileReader::toSigned(reader.u32("dataWindow"));
         part.maxY = FileReader::toSigned(reader.u32("dataWindow"));
+      } else if (name == "channels" && typeName == "chlist") {
+        std::vector<std::uint8_t> value(static_cast<std::size_t>(size));
+        reader.read(value.data(), value.size(), "channels");
+        part.channels = parseChannelList(value, path);
+        part.hasChannels = true;
       } else if (name == "compression" && typeName == "compression" && size == 1) {
         part.compression = reader.u8("compression");
       } else if (name == "tiles" && typeName == "tiledesc" && size == 9) {
@@ -439,16 +496,144 @@ long long tiledChunkCount(const PartLayout& part, long long w, long long h) {
   }
 }
 
+long long floorDiv(long long a, long long b) { // b > 0
+  return a >= 0 ? a / b : -((-a + b - 1) / b);
+}
+
+// Number of multiples of s in [a, b]: the sampled lines or columns of a channel with sampling s.
+long long sampleCount(long long s, long long a, long long b) {
+  return b < a ? 0 : floorDiv(b, s) - floorDiv(a - 1, s);
+}
+
+// What a chunk of a part must hold, from its place in the offset table.
+struct ExpectedChunk {
+  bool tiled = false;
+  std::int32_t y0 = 0, y1 = 0;                 // scanline chunk: lines y0..y1
+  std::int32_t dx = 0, dy = 0, lx = 0, ly = 0; // tiled chunk: tile and level
+  long long width = 0, height = 0;             // pixels covered
+  std::uint64_t rawBytes = 0;                  // size of its uncompressed pixel data
+};
+
+std::string describe(const ExpectedChunk& c) {
+  if (c.tiled)
+    return "tile (" + std::to_string(c.dx) + ", " + std::to_string(c.dy) + ") of level (" +
+           std::to_string(c.lx) + ", " + std::to_string(c.ly) + ")";
+  return c.y0 == c.y1 ? "scanline " + std::to_string(c.y0)
+                      : "scanlines " + std::to_string(c.y0) + "-" + std::to_string(c.y1);
+}
+
+// Calls f(index, expected) for every chunk of a flat (not deep) part, in offset table order:
+// scanline chunks top to bottom; tiles level by level (mip levels 0, 1, ...; rip levels with ly
+// outer and lx inner), each level row by row. Its raw size is what OpenEXR's readers compute: per
+// line, every channel sampled on it contributes its sampled columns times its sample size.
+// The part's size and chunk count must have been validated. The work is one call per table entry
+// after O(channels + height * log(height)) to sum the line sizes.
+template <class F>
+void forEachChunk(const PartLayout& part, bool tiled, F&& f) {
+  const long long w = part.width(), h = part.height();
+  long long index = 0;
+  if (!tiled) {
+    // Bytes of the lines before line minY + k, from the channels grouped by their y sampling.
+    std::map<long long, std::uint64_t> bytesBySampling;
+    for (const ChannelLayout& channel : part.channels)
+      bytesBySampling[channel.ySampling] +=
+          static_cast<std::uint64_t>(sampleCount(channel.xSampling, part.minX, part.maxX) * channel.bytes());
+    std::vector<std::uint64_t> before(static_cast<std::size_t>(h) + 1, 0);
+    for (const auto& [sampling, bytes] : bytesBySampling)
+      for (long long y = floorDiv(part.minY + sampling - 1, sampling) * sampling; y <= part.maxY;
+           y += sampling)
+        before[static_cast<std::size_t>(y - part.minY) + 1] += bytes;
+    std::partial_sum(before.begin(), before.end(), before.begin());
+    const int lines = linesPerChunk(part.compression);
+    for (long long y0 = part.minY; y0 <= part.maxY; y0 += lines) {
+      ExpectedChunk c;
+      c.y0 = static_cast<std::int32_t>(y0);
+      c.y1 = static_cast<std::int32_t>(std::min<long long>(y0 + lines - 1, part.maxY));
+      c.width = w;
+      c.height = static_cast<long long>(c.y1) - c.y0 + 1;
+      c.rawBytes = before[static_cast<std::size_t>(c.y1 - part.minY) + 1] -
+                   before[static_cast<std::size_t>(c.y0 - part.minY)];
+      f(index++, c);
+    }
+    return;
+  }
+  std::uint64_t pixelBytes = 0; // tiled parts have no subsampled channels (checked)
+  for (const ChannelLayout& channel : part.channels)
+    pixelBytes += static_cast<std::uint64_t>(channel.bytes());
+  const auto level = [&](int lx, int ly) {
+    const long long lw = levelSize(w, lx, part.roundingMode), lh = levelSize(h, ly, part.roundingMode);
+    for (long long ty = 0; ty * part.tileHeight < lh; ++ty)
+      for (long long tx = 0; tx * part.tileWidth < lw; ++tx) {
+        ExpectedChunk c;
+        c.tiled = true;
+        c.dx = static_cast<std::int32_t>(tx);
+        c.dy = static_cast<std::int32_t>(ty);
+        c.lx = lx;
+        c.ly = ly;
+        c.width = std::min<long long>(part.tileWidth, lw - tx * part.tileWidth);
+        c.height = std::min<long long>(part.tileHeight, lh - ty * part.tileHeight);
+        c.rawBytes = static_cast<std::uint64_t>(c.width * c.height) * pixelBytes;
+        f(index++, c);
+      }
+  };
+  if (part.levelMode == 0) {
+    level(0, 0);
+  } else if (part.levelMode == 1) {
+    const int levels = roundedLog2(std::max(w, h), part.roundingMode) + 1;
+    for (int l = 0; l < levels; ++l)
+      level(l, l);
+  } else {
+    const int levelsX = roundedLog2(w, part.roundingMode) + 1,
+              levelsY = roundedLog2(h, part.roundingMode) + 1;
+    for (int ly = 0; ly < levelsY; ++ly)
+      for (int lx = 0; lx < levelsX; ++lx)
+        level(lx, ly);
+  }
+}
+
+// The rule for a chunk's data size field. Uncompressed data must be exactly the raw size. Compressed
+// data is never larger than the raw data and is empty only if that is: OpenEXR's writers store a
+// chunk uncompressed when its codec does not make it smaller, and its readers decode a chunk only if
+// it is smaller than the raw size (a chunk of exactly the raw size is read as uncompressed data).
+bool validDataSize(int compression, std::int32_t stated, std::uint64_t raw) {
+  if (stated < 0) return false;
+  const std::uint64_t size = static_cast<std::uint64_t>(stated);
+  if (compression == 0) return size == raw;
+  return size <= raw && (size > 0 || raw == 0);
+}
+
+std::string expectedDataSize(int compression, const ExpectedChunk& c) {
+  const std::string pixels = std::to_string(c.width) + "x" + std::to_string(c.height) + " pixels";
+  if (compression == 0)
+    return "exactly " + std::to_string(c.rawBytes) + " (the uncompressed data of " + pixels + ")";
+  return (c.rawBytes == 0 ? std::string("0") : "1 to " + std::to_string(c.rawBytes)) + " (" +
+         compressionName(compression) + " data of " + pixels + ", never larger than uncompressed)";
+}
+
+// The part readExr decodes, with where its offset table is.
+struct CheckedPart {
+  const PartLayout* part = nullptr;
+  bool tiled = false;
+  std::uint64_t tableOffset = 0;
+  long long chunkCount = 0;
+  std::uint64_t chunkHeaderBytes = 0; // bytes before the pixel data of each chunk
+};
+
 // Checks, before OpenEXR sees the file:
 // - every part's data window against the size limits (OpenEXR sets up every part),
+// - every flat part's channel list (pixel types, sampling; no subsampling in tiled parts),
 // - the tile description and the chunk count of every part,
 // - that the offset tables fit in the file,
 // - that every chunk of every part starts after the tables and, with its size field, ends inside
-//   the file (this is what detects truncated pixel data).
+//   the file (this is what detects truncated pixel data),
+// - for flat parts, that every chunk header names the line or tile of its table entry and that its
+//   data size is possible for its compression and pixel count (validDataSize). OpenEXR 3.1 trusts
+//   this size: it converts a whole line or tile from its line buffer even when the chunk supplied
+//   fewer bytes, so the rest of the pixels would come from stale or uninitialised memory. This also
+//   bounds the pixel memory by the file: uncompressed pixel data must be present byte for byte.
 // The work is bounded by the file size: a table entry takes 8 bytes of the file.
-// Returns the layout of part `partIndex`.
-const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, int partIndex,
-                                 long long maxPixels, const fs::path& path) {
+CheckedPart validateLayout(FileReader& reader, const FileLayout& layout, int partIndex, long long maxPixels,
+                           const fs::path& path) {
   const bool multiPart = (layout.flags & kFlagMultiPart) != 0;
   if (partIndex >= static_cast<int>(layout.parts.size()))
     throwFormat(path, "part " + std::to_string(partIndex) + " requested but the file has " +
@@ -472,7 +657,9 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
       throwFormat(path, which + "data window " + std::to_string(w) + "x" + std::to_string(h) +
                             " is too large (limits: " + std::to_string(Image::kMaxDimension) + " per side, " +
                             std::to_string(pixelLimit) + " pixels)");
-    if (selected && part.deep(layout.flags)) throwFormat(path, which + "deep images are not supported");
+    const bool deep = part.deep(layout.flags);
+    if (selected && deep) throwFormat(path, which + "deep images are not supported");
+    if (!deep && !part.hasChannels) throwFormat(path, which + "missing channels attribute");
     long long count = 0;
     if (part.tiled(layout.flags)) {
       if (!part.hasTiles) throwFormat(path, which + "tiled part without a valid tiles attribute");
@@ -484,6 +671,9 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
       if (part.roundingMode > 1) throwFormat(path, which + "invalid tile rounding mode");
       count = tiledChunkCount(part, w, h);
       if (count < 0) throwFormat(path, which + "invalid tile level mode " + std::to_string(part.levelMode));
+      for (const ChannelLayout& channel : part.channels)
+        if (!deep && (channel.xSampling != 1 || channel.ySampling != 1))
+          throwFormat(path, which + "channel '" + channel.name + "' of a tiled part is subsampled");
     } else {
       const int lines = linesPerChunk(part.compression);
       if (lines == 0)
@@ -501,6 +691,7 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
   }
 
   // Pass 2: every chunk of every part.
+  CheckedPart checked;
   std::uint64_t tableOffset = layout.tablesStart;
   std::vector<std::uint8_t> table;
   for (std::size_t p = 0; p < layout.parts.size(); ++p) {
@@ -509,15 +700,18 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
     const long long count = counts[p];
     // Deep chunks have a different header; only their position and part number are checked.
     const bool deep = part.deep(layout.flags);
-    const std::uint64_t headerBytes =
-        (multiPart ? 4u : 0u) + (deep ? 0u : (part.tiled(layout.flags) ? 20u : 8u));
+    const bool tiled = part.tiled(layout.flags);
+    const std::uint64_t headerBytes = (multiPart ? 4u : 0u) + (deep ? 0u : (tiled ? 20u : 8u));
     table.resize(static_cast<std::size_t>(count) * 8);
     if (!reader.readAt(tableOffset, table.data(), table.size()))
       throwFormat(path, which + "truncated file (chunk offset table)");
+    if (static_cast<int>(p) == partIndex) checked = {&part, tiled, tableOffset, count, headerBytes};
     tableOffset += table.size();
-    for (long long i = 0; i < count; ++i) {
+
+    // Reads the header of chunk i after checking its position and part number; returns its offset.
+    std::array<std::uint8_t, 24> chunkHeader{};
+    const auto locate = [&](long long i) {
       const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
-      std::array<std::uint8_t, 24> chunkHeader{};
       if (offset == 0)
         throwFormat(path, which + "incomplete file (chunk " + std::to_string(i) + " is missing)");
       if (offset < tablesEnd || offset >= reader.size() ||
@@ -527,16 +721,135 @@ const PartLayout& validateLayout(FileReader& reader, const FileLayout& layout, i
                               std::to_string(reader.size()) + "-byte file)");
       if (multiPart && FileReader::decode32(chunkHeader.data()) != static_cast<std::uint32_t>(p))
         throwFormat(path, which + "corrupt chunk " + std::to_string(i) + " (wrong part number)");
-      if (deep) continue;
-      const std::int32_t dataSize =
-          FileReader::toSigned(FileReader::decode32(chunkHeader.data() + headerBytes - 4));
-      if (dataSize < 0 || static_cast<std::uint64_t>(dataSize) > reader.size() - offset - headerBytes)
+      return offset;
+    };
+    if (deep) {
+      for (long long i = 0; i < count; ++i)
+        locate(i);
+      continue;
+    }
+    forEachChunk(part, tiled, [&](long long i, const ExpectedChunk& expected) {
+      const std::uint64_t offset = locate(i);
+      const std::uint8_t* fields = chunkHeader.data() + (multiPart ? 4 : 0);
+      const auto field = [&](int k) { return FileReader::toSigned(FileReader::decode32(fields + 4 * k)); };
+      const std::string chunk =
+          which + "corrupt chunk " + std::to_string(i) + " (" + describe(expected) + ")";
+      if (tiled && (field(0) != expected.dx || field(1) != expected.dy || field(2) != expected.lx ||
+                    field(3) != expected.ly))
+        throwFormat(path, chunk + ": its header names tile (" + std::to_string(field(0)) + ", " +
+                              std::to_string(field(1)) + ") of level (" + std::to_string(field(2)) + ", " +
+                              std::to_string(field(3)) + ")");
+      if (!tiled && field(0) != expected.y0)
+        throwFormat(path, chunk + ": its header names scanline " + std::to_string(field(0)));
+      const std::int32_t dataSize = field(tiled ? 4 : 1);
+      if (!validDataSize(part.compression, dataSize, expected.rawBytes))
+        throwFormat(path, chunk + ": data size " + std::to_string(dataSize) + " bytes, expected " +
+                              expectedDataSize(part.compression, expected));
+      if (static_cast<std::uint64_t>(dataSize) > reader.size() - offset - headerBytes)
         throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " of " +
                               std::to_string(dataSize) + " bytes at offset " + std::to_string(offset) +
                               " ends beyond the " + std::to_string(reader.size()) + "-byte file)");
+    });
+  }
+  return checked;
+}
+
+// Size of the output of an RLE chunk as OpenEXR decodes it (a signed count byte c < 0: -c literal
+// bytes follow; c >= 0: the next byte repeated c + 1 times), or -1 if the stream is malformed.
+// Counting stops once the output exceeds `limit`.
+long long rleDecodedSize(const std::vector<std::uint8_t>& in, std::uint64_t limit) {
+  std::uint64_t out = 0;
+  std::size_t at = 0;
+  while (at < in.size() && out <= limit) {
+    const int count = static_cast<std::int8_t>(in[at++]);
+    if (count < 0) {
+      const std::size_t literal = static_cast<std::size_t>(-count);
+      if (in.size() - at < literal) return -1;
+      at += literal;
+      out += literal;
+    } else {
+      if (at == in.size()) return -1;
+      ++at;
+      out += static_cast<std::uint64_t>(count) + 1;
     }
   }
-  return layout.parts[static_cast<std::size_t>(partIndex)];
+  return static_cast<long long>(out);
+}
+
+// Inflates with bounded memory to learn the decoded size of a zlib stream (ZIP, ZIPS), or -1 if it is
+// not a complete zlib stream. Bytes after the end of the stream are ignored, as OpenEXR does.
+// Inflating stops once the output exceeds `limit`.
+class ZlibSizer {
+public:
+  ZlibSizer() {
+    if (inflateInit_(&stream_, ZLIB_VERSION, static_cast<int>(sizeof(z_stream))) != Z_OK)
+      throw std::bad_alloc();
+  }
+  ~ZlibSizer() { inflateEnd(&stream_); }
+  ZlibSizer(const ZlibSizer&) = delete;
+  ZlibSizer& operator=(const ZlibSizer&) = delete;
+
+  long long decodedSize(const std::vector<std::uint8_t>& in, std::uint64_t limit) {
+    if (inflateReset(&stream_) != Z_OK) return -1;
+    stream_.next_in = in.data();
+    stream_.avail_in = static_cast<uInt>(in.size());
+    std::uint64_t out = 0;
+    for (;;) {
+      stream_.next_out = scratch_.data();
+      stream_.avail_out = static_cast<uInt>(scratch_.size());
+      const int result = inflate(&stream_, Z_NO_FLUSH);
+      out += scratch_.size() - stream_.avail_out;
+      if (result == Z_STREAM_END || (result == Z_OK && out > limit)) return static_cast<long long>(out);
+      if (result != Z_OK) return -1; // corrupt, or the input ended before the stream did
+    }
+  }
+
+private:
+  z_stream stream_{};
+  std::array<Bytef, 1 << 16> scratch_{};
+};
+
+// OpenEXR 3.1 does not check that an RLE, ZIPS or ZIP chunk decodes to its full raw size: it converts
+// the whole chunk from its decompression buffer, whose end then holds stale or uninitialised memory
+// (PIZ, PXR24, B44 and DWA check their decoded size themselves). The chunks of these codecs that
+// OpenEXR will decompress (those smaller than their raw size) are decoded here first, with bounded
+// memory, and must yield exactly the raw size. Runs after the plausibility check of the image size,
+// so the work is bounded by the pixel memory the caller accepted.
+void verifyDecodedSizes(FileReader& reader, const CheckedPart& checked, const fs::path& path) {
+  const int compression = checked.part->compression;
+  if (compression < 1 || compression > 3) return;
+  std::vector<std::uint8_t> table(static_cast<std::size_t>(checked.chunkCount) * 8);
+  if (!reader.readAt(checked.tableOffset, table.data(), table.size()))
+    throwFormat(path, "truncated file (chunk offset table)");
+  std::unique_ptr<ZlibSizer> zlib;
+  std::vector<std::uint8_t> packed;
+  forEachChunk(*checked.part, checked.tiled, [&](long long i, const ExpectedChunk& expected) {
+    const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
+    std::array<std::uint8_t, 4> sizeField{};
+    if (!reader.readAt(offset + checked.chunkHeaderBytes - 4, sizeField.data(), sizeField.size()))
+      throwFormat(path, "truncated file (chunk " + std::to_string(i) + ")");
+    const std::uint64_t dataSize = FileReader::decode32(sizeField.data()); // validated: <= raw size
+    if (dataSize == 0 || dataSize >= expected.rawBytes) return;            // stored uncompressed
+    packed.resize(static_cast<std::size_t>(dataSize));
+    if (!reader.readAt(offset + checked.chunkHeaderBytes, packed.data(), packed.size()))
+      throwFormat(path, "truncated file (chunk " + std::to_string(i) + ")");
+    long long decoded = 0;
+    if (compression == 1) {
+      decoded = rleDecodedSize(packed, expected.rawBytes);
+    } else {
+      if (!zlib) zlib = std::make_unique<ZlibSizer>();
+      decoded = zlib->decodedSize(packed, expected.rawBytes);
+    }
+    const std::string chunk = "corrupt chunk " + std::to_string(i) + " (" + describe(expected) + "): its " +
+                              compressionName(compression) + " data ";
+    if (decoded < 0) throwFormat(path, chunk + "cannot be decoded");
+    if (static_cast<std::uint64_t>(decoded) != expected.rawBytes)
+      throwFormat(path, chunk + "decodes to " +
+                            (static_cast<std::uint64_t>(decoded) > expected.rawBytes ? "more than " : "") +
+                            std::to_string(std::min<std::uint64_t>(static_cast<std::uint64_t>(decoded),
+                                                                   expected.rawBytes)) +
+                            " bytes, expected " + std::to_string(expected.rawBytes));
+  });
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -611,7 +924,8 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
 
   FileReader reader(path);
   const FileLayout layout = scanHeaders(reader, path);
-  const PartLayout& part = validateLayout(reader, layout, options.part, options.maxPixels, path);
+  const CheckedPart checked = validateLayout(reader, layout, options.part, options.maxPixels, path);
+  const PartLayout& part = *checked.part;
   const int width = static_cast<int>(part.width());
   const int height = static_cast<int>(part.height());
 
@@ -634,22 +948,33 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
         throwFormat(path, "channel '" + name + "' is subsampled, which is not supported");
     }
 
-    // The codecs other than DWA cannot shrink pixel data by much more than zlib's ~1032:1 (half
-    // samples, 2 bytes, become 4-byte floats: 2064:1): a header promising far more pixels than the
-    // file can hold is rejected before the image is allocated. DWAA/DWAB (zlib over RLE or DCT
-    // coefficients) can legitimately exceed this on constant images and are only size-limited.
+    // Uncompressed pixel data is present byte for byte (validateLayout). The codecs other than DWA
+    // cannot shrink pixel data by much more than zlib's ~1032:1 (half samples, 2 bytes, become 4-byte
+    // floats: 2064:1): a header promising far more pixels than the file can hold is rejected before
+    // the image is allocated. DWAA/DWAB (zlib over RLE or DCT coefficients) can legitimately exceed
+    // this on constant images and are only size-limited.
     const bool dwa = part.compression == 8 || part.compression == 9;
     const double imageBytes =
         static_cast<double>(width) * height * static_cast<double>(selected.size()) * 4.0;
     if (!dwa && imageBytes > 4096.0 * static_cast<double>(reader.size()) + 16.0 * 1024 * 1024)
       throwFormat(path, "data window " + std::to_string(width) + "x" + std::to_string(height) +
                             " is implausibly large for a " + std::to_string(reader.size()) + "-byte file");
+    verifyDecodedSizes(reader, checked, path);
 
     Imf::InputPart input(file, options.part);
     if (!input.isComplete()) throwFormat(path, "incomplete file (missing pixel data)");
 
-    Image image(width, height, static_cast<int>(selected.size()));
+    // No sample may be returned that the decoder did not write. The image is filled with a NaN bit
+    // pattern, kExrUnwrittenSampleBits, before decoding and checked after it. No HALF or UINT sample
+    // converts to it (UINT values are never NaN; a half NaN becomes a float whose 13 low mantissa bits
+    // are zero, and the pattern's are not), but a FLOAT channel may hold any bit pattern. So where the
+    // pattern survives, those samples are set to a second pattern and the pixels decoded again: a
+    // sample the decoder writes gets the same value both times, an unwritten one keeps the second
+    // pattern. Exact for every file, and the second decode only happens for files that contain the
+    // pattern themselves (or are incomplete).
     const std::size_t channels = selected.size();
+    Image image(width, height, static_cast<int>(channels),
+                std::bit_cast<float>(detail::kExrUnwrittenSampleBits));
     const std::size_t xStride = channels * sizeof(float);
     const std::size_t yStride = static_cast<std::size_t>(width) * xStride;
     Imf::FrameBuffer frameBuffer;
@@ -659,8 +984,31 @@ Image readExr(const std::filesystem::path& path, const ExrReadOptions& options) 
     input.setFrameBuffer(frameBuffer);
     input.readPixels(dataWindow.min.y, dataWindow.max.y);
 
-    // The rows were read top first; the Image wants the bottom row first.
     const std::span<float> data = image.data();
+    const auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+    std::size_t survivors = 0; // a vectorisable count first: usually 0
+    for (const float v : data)
+      survivors += bits(v) == detail::kExrUnwrittenSampleBits ? 1 : 0;
+    if (survivors != 0) {
+      std::vector<std::size_t> suspects;
+      suspects.reserve(survivors);
+      for (std::size_t i = 0; i < data.size(); ++i)
+        if (bits(data[i]) == detail::kExrUnwrittenSampleBits) suspects.push_back(i);
+      for (const std::size_t i : suspects)
+        data[i] = std::bit_cast<float>(detail::kExrUnwrittenSampleRetryBits);
+      input.readPixels(dataWindow.min.y, dataWindow.max.y);
+      for (const std::size_t i : suspects)
+        if (bits(data[i]) != detail::kExrUnwrittenSampleBits) {
+          const std::size_t row = i / (static_cast<std::size_t>(width) * channels);
+          const std::size_t column = i / channels % static_cast<std::size_t>(width);
+          throwFormat(path, "incomplete pixel data (sample (" +
+                                std::to_string(part.minX + static_cast<long long>(column)) + ", " +
+                                std::to_string(part.minY + static_cast<long long>(row)) + ") of channel '" +
+                                selected[i % channels] + "' was not decoded)");
+        }
+    }
+
+    // The rows were read top first; the Image wants the bottom row first.
     const std::size_t rowFloats = static_cast<std::size_t>(width) * channels;
     for (int y = 0; y < height / 2; ++y) {
       auto top = data.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(y) * rowFloats);
@@ -680,7 +1028,7 @@ ExrFileInfo readExrInfo(const std::filesystem::path& path, int part) {
   if (part < 0) throw InvalidArgument("part", detail::formatValue(part), "must be >= 0");
   FileReader reader(path);
   const FileLayout layout = scanHeaders(reader, path);
-  const PartLayout& selected = validateLayout(reader, layout, part, Image::kMaxPixels, path);
+  const PartLayout& selected = *validateLayout(reader, layout, part, Image::kMaxPixels, path).part;
   try {
     Imf::MultiPartInputFile file(path.c_str(), 0, /*reconstructChunkOffsetTable=*/false);
     const Imf::Header& header = file.header(part);

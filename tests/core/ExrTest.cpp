@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+
 using crep::Image;
 namespace fs = std::filesystem;
 
@@ -72,6 +74,47 @@ void put32(Bytes& b, std::size_t at, std::uint32_t v) {
     b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
+std::uint32_t bitsOf(float v) {
+  std::uint32_t bits = 0;
+  std::memcpy(&bits, &v, 4);
+  return bits;
+}
+float floatOf(std::uint32_t bits) {
+  float v = 0;
+  std::memcpy(&v, &bits, 4);
+  return v;
+}
+
+// IEEE half to float, independent of Imath.
+float halfToFloat(std::uint16_t h) {
+  const int exponent = (h >> 10) & 31, mantissa = h & 1023;
+  float v = 0;
+  if (exponent == 0)
+    v = std::ldexp(static_cast<float>(mantissa), -24);
+  else if (exponent == 31)
+    v = mantissa != 0 ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+  else
+    v = std::ldexp(static_cast<float>(mantissa + 1024), exponent - 25);
+  return (h & 0x8000) != 0 ? -v : v;
+}
+
+// Samples of `image` that come from memory nobody wrote: the reader's sentinel patterns (what its
+// frame buffer holds before decoding) or AddressSanitizer's malloc fill byte 0xBE as a float or as a
+// half converted to float (what OpenEXR's own, uninitialised, line buffers hold under ASan: its
+// default max_malloc_fill_size fills the first 4096 bytes of every allocation, so the test images
+// keep a chunk's raw data below that). Test images never hold these values.
+int unwrittenSamples(const Image& image) {
+  const std::uint32_t asanHalf = bitsOf(halfToFloat(0xBEBE));
+  int count = 0;
+  for (const float v : image.data()) {
+    const std::uint32_t bits = bitsOf(v);
+    if (bits == crep::detail::kExrUnwrittenSampleBits || bits == crep::detail::kExrUnwrittenSampleRetryBits ||
+        bits == 0xBEBEBEBEu || bits == asanHalf)
+      ++count;
+  }
+  return count;
+}
+
 // Position of the value of header attribute `name` (single-part files), or 0.
 std::size_t findAttribute(const Bytes& b, const std::string& name, const std::string& type) {
   std::string key = name;
@@ -98,6 +141,19 @@ std::size_t headerEnd(const Bytes& b) {
     const std::uint32_t size = get32(b, at);
     at += 4 + size;
   }
+}
+
+// The chunk offset table of a single-part scanline file whose chunks follow the table (as OpenEXR
+// writes them): the offset of every chunk.
+std::vector<std::size_t> chunkOffsets(const Bytes& b) {
+  const std::size_t tableStart = headerEnd(b);
+  const std::size_t first = static_cast<std::size_t>(get64(b, tableStart));
+  REQUIRE(first > tableStart);
+  REQUIRE((first - tableStart) % 8 == 0);
+  std::vector<std::size_t> offsets;
+  for (std::size_t i = 0; i < (first - tableStart) / 8; ++i)
+    offsets.push_back(static_cast<std::size_t>(get64(b, tableStart + i * 8)));
+  return offsets;
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -138,6 +194,29 @@ struct Writer {
   }
 };
 
+// A zlib stream holding `data` in one stored (uncompressed) deflate block.
+Bytes zlibStored(const Bytes& data) {
+  REQUIRE(data.size() < 65536);
+  const auto n = static_cast<std::uint16_t>(data.size());
+  Writer z;
+  z.u8(0x78); // deflate, 32 KiB window
+  z.u8(0x01); // no preset dictionary, check bits
+  z.u8(0x01); // final block, stored
+  z.u16(n);
+  z.u16(static_cast<std::uint16_t>(~n));
+  for (const std::uint8_t byte : data)
+    z.u8(byte);
+  std::uint32_t a = 1, b = 0; // Adler-32, stored big-endian
+  for (const std::uint8_t byte : data) {
+    a = (a + byte) % 65521;
+    b = (b + a) % 65521;
+  }
+  const std::uint32_t adler = (b << 16) | a;
+  for (int shift = 24; shift >= 0; shift -= 8)
+    z.u8(static_cast<std::uint8_t>(adler >> shift));
+  return z.b;
+}
+
 enum : int { kUint = 0, kHalf = 1, kFloat = 2 };
 
 struct RawChannel {
@@ -154,6 +233,7 @@ struct RawPart {
   std::string type;        // explicit type attribute (multi-part files always get one)
   int compression = 0;     // attribute value only: the data written is always uncompressed...
   int fakeChunkBytes = -1; // ...unless >= 0: then every chunk holds this many zero bytes
+  Bytes fakeChunk;         // ...or, if not empty, these bytes (scanline parts)
 };
 
 // The value stored for channel c of part p at EXR coordinates (x, y): an integer in [0, 1024),
@@ -260,7 +340,12 @@ bool sampled(int v, int sampling) {
 std::vector<Bytes> partChunks(const RawPart& part, int p) {
   std::vector<Bytes> chunks;
   if (part.tileWidth == 0) {
-    for (int y = part.minY; y <= part.maxY; ++y) {
+    // Fake chunks cover as many lines as the compression puts in a chunk; real data is written
+    // uncompressed, one line per chunk.
+    const bool fake = part.fakeChunkBytes >= 0 || !part.fakeChunk.empty();
+    const int linesPerChunk[10] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+    const int step = fake ? linesPerChunk[part.compression] : 1;
+    for (int y = part.minY; y <= part.maxY; y += step) {
       Writer data;
       for (std::size_t c = 0; c < part.channels.size(); ++c) {
         const RawChannel& ch = part.channels[c];
@@ -269,6 +354,7 @@ std::vector<Bytes> partChunks(const RawPart& part, int p) {
           if (sampled(x, ch.xSampling)) sample(data, ch.type, rawValue(p, static_cast<int>(c), x, y));
       }
       if (part.fakeChunkBytes >= 0) data.b.assign(static_cast<std::size_t>(part.fakeChunkBytes), 0);
+      if (!part.fakeChunk.empty()) data.b = part.fakeChunk;
       Writer chunk;
       chunk.i32(y);
       chunk.i32(static_cast<std::int32_t>(data.b.size()));
@@ -639,6 +725,235 @@ TEST_CASE("EXR: deep and subsampled files are rejected with a clear message") {
   CHECK(contains(expectThrows<crep::FormatError>(dir / "sub.exr"), "subsampled"));
 }
 
+TEST_CASE(
+    "EXR: a chunk whose data size does not fit its compression and width is a FormatError naming the chunk") {
+  crep::test::TempDir dir;
+  SUBCASE(
+      "uncompressed 160-pixel float rows in 12-byte chunks (OpenEXR would fill the rows from stale memory)") {
+    RawPart part = scanlinePart({{"Y", kFloat}}, 160, 90);
+    part.fakeChunkBytes = 12;
+    writeFile(dir / "short.exr", buildExr({part}));
+    const std::string what = expectThrows<crep::FormatError>(dir / "short.exr");
+    INFO(what);
+    CHECK(contains(what, (dir / "short.exr").string()));
+    CHECK(contains(what, "chunk 0 (scanline 0)"));
+    CHECK(contains(what, "data size 12 bytes"));
+    CHECK(contains(what, "expected exactly 640"));
+    CHECK_THROWS_AS((void)crep::readExrInfo(dir / "short.exr"), crep::FormatError);
+  }
+  SUBCASE("size fields of a file written by OpenEXR patched: smaller, larger, zero, negative") {
+    crep::writeExr(dir / "ok.exr", Image(160, 90, 1, 0.5f),
+                   crep::ExrWriteOptions(crep::ExrPixelType::Float, crep::ExrCompression::None));
+    const Bytes original = readFile(dir / "ok.exr");
+    const std::vector<std::size_t> chunks = chunkOffsets(original);
+    REQUIRE(chunks.size() == 90);
+    Bytes all = original;
+    for (const std::size_t chunk : chunks)
+      put32(all, chunk + 4, 12);
+    writeFile(dir / "patched.exr", all);
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "patched.exr"),
+                   "chunk 0 (scanline 0): data size 12 bytes, expected exactly 640"));
+    for (const std::int32_t size : {12, 639, 641, 0, -1}) {
+      CAPTURE(size);
+      Bytes b = original;
+      put32(b, chunks[7] + 4, static_cast<std::uint32_t>(size));
+      writeFile(dir / "patched.exr", b);
+      const std::string what = expectThrows<crep::FormatError>(dir / "patched.exr");
+      INFO(what);
+      CHECK(contains(what, "patched.exr"));
+      CHECK(contains(what, "chunk 7 (scanline 7): data size " + std::to_string(size) + " bytes"));
+    }
+  }
+  SUBCASE("compressed chunks: empty, or larger than the uncompressed data") {
+    crep::writeExr(dir / "ok.exr", patternImage(37, 40, 3),
+                   crep::ExrWriteOptions(crep::ExrPixelType::Half, crep::ExrCompression::Zip));
+    const Bytes original = readFile(dir / "ok.exr");
+    const std::vector<std::size_t> chunks = chunkOffsets(original);
+    REQUIRE(chunks.size() == 3); // 16 lines per chunk
+    for (const std::uint32_t size : {0u, 16u * 37 * 3 * 2 + 1, 0x7FFFFFFFu}) {
+      CAPTURE(size);
+      Bytes b = original;
+      put32(b, chunks[1] + 4, size);
+      writeFile(dir / "patched.exr", b);
+      const std::string what = expectThrows<crep::FormatError>(dir / "patched.exr");
+      INFO(what);
+      CHECK(contains(what, "chunk 1 (scanlines 16-31)"));
+      CHECK(contains(what, "expected 1 to 3552 (ZIP data of 37x16 pixels"));
+    }
+  }
+  SUBCASE("a chunk header naming another line or tile") {
+    crep::writeExr(dir / "ok.exr", Image(16, 8, 1, 0.5f),
+                   crep::ExrWriteOptions(crep::ExrPixelType::Float, crep::ExrCompression::None));
+    Bytes b = readFile(dir / "ok.exr");
+    put32(b, chunkOffsets(b)[3], 2);
+    writeFile(dir / "line.exr", b);
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "line.exr"),
+                   "chunk 3 (scanline 3): its header names scanline 2"));
+
+    RawPart tiled = scanlinePart({{"G", kHalf}, {"R", kFloat}}, 13, 11);
+    tiled.tileWidth = 4;
+    tiled.tileHeight = 4;
+    const Bytes tiledBytes = buildExr({tiled});
+    const std::size_t tableStart = headerEnd(tiledBytes);
+    const std::size_t tile5 = static_cast<std::size_t>(get64(tiledBytes, tableStart + 5 * 8)); // tile (1, 1)
+    b = tiledBytes;
+    put32(b, tile5, 2);
+    writeFile(dir / "tile.exr", b);
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "tile.exr"),
+                   "chunk 5 (tile (1, 1) of level (0, 0)): its header names tile (2, 1)"));
+    b = tiledBytes;
+    put32(b, tile5 + 16, 4 * 4 * 6 - 2); // 4x4 pixels of half + float
+    writeFile(dir / "tile.exr", b);
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "tile.exr"),
+                   "chunk 5 (tile (1, 1) of level (0, 0)): data size 94 bytes, expected exactly 96"));
+    // The clipped edge tile (3, 2) holds 1x3 pixels.
+    const std::size_t edge = static_cast<std::size_t>(get64(tiledBytes, tableStart + 11 * 8));
+    CHECK(get32(tiledBytes, edge + 16) == 3 * 6);
+  }
+  SUBCASE("chunk sizes of subsampled (chroma) channels follow their sampling") {
+    // Luminance/chroma layout: full-resolution Y, BY and RY on every second line and column.
+    const RawPart part = scanlinePart({{"BY", kHalf, 2, 2}, {"RY", kHalf, 2, 2}, {"Y", kHalf}}, 8, 6);
+    writeFile(dir / "yc.exr", buildExr({part}));
+    checkRawContent(crep::readExr(dir / "yc.exr"), part, 0, {2});
+    Bytes b = readFile(dir / "yc.exr");
+    const std::vector<std::size_t> chunks = chunkOffsets(b);
+    CHECK(get32(b, chunks[0] + 4) == 8 * 2 + 2 * 4 * 2); // Y, then BY and RY at 4 columns
+    CHECK(get32(b, chunks[1] + 4) == 8 * 2);             // odd line: Y only
+    put32(b, chunks[1] + 4, 8 * 2 + 2 * 4 * 2);
+    writeFile(dir / "yc.exr", b);
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "yc.exr"), "expected exactly 16"));
+  }
+  SUBCASE("RLE and ZIP chunks must decode to their full size (OpenEXR 3.1 does not check it)") {
+    RawPart rle = scanlinePart({{"Y", kFloat}}, 160, 4);
+    rle.compression = 1;
+    rle.fakeChunk = {11, 0x80}; // a run of 12 bytes, for 640-byte lines
+    writeFile(dir / "rle.exr", buildExr({rle}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "rle.exr"),
+                   "chunk 0 (scanline 0): its RLE data decodes to 12 bytes, expected 640"));
+    rle.fakeChunk.clear();
+    for (int run = 0; run < 6; ++run) // 6 runs of 128 bytes: more than a line
+      rle.fakeChunk.insert(rle.fakeChunk.end(), {127, 0x80});
+    writeFile(dir / "rle.exr", buildExr({rle}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "rle.exr"), "decodes to more than 640 bytes"));
+    rle.fakeChunk = {0x85, 1, 2}; // a literal run of 123 bytes with 2 present
+    writeFile(dir / "rle.exr", buildExr({rle}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "rle.exr"), "its RLE data cannot be decoded"));
+
+    RawPart zip = scanlinePart({{"Y", kFloat}}, 160, 20);
+    zip.compression = 3; // 16 lines per chunk
+    zip.fakeChunk = zlibStored(Bytes(12, 0x80));
+    writeFile(dir / "zip.exr", buildExr({zip}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "zip.exr"),
+                   "chunk 0 (scanlines 0-15): its ZIP data decodes to 12 bytes, expected 10240"));
+    const Bytes stream = zlibStored(Bytes(12, 0x80));
+    zip.fakeChunk.assign(stream.begin(), stream.begin() + 11); // no Adler-32: the stream is incomplete
+    writeFile(dir / "zip.exr", buildExr({zip}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "zip.exr"), "its ZIP data cannot be decoded"));
+    zip.compression = 2; // ZIPS: one line per chunk
+    zip.fakeChunk = zlibStored(Bytes(600, 0x80));
+    writeFile(dir / "zip.exr", buildExr({zip}));
+    CHECK(contains(expectThrows<crep::FormatError>(dir / "zip.exr"), "its ZIPS data decodes to 600 bytes"));
+  }
+}
+
+TEST_CASE("EXR: a 16384x16384 header over 64-byte chunks fails fast, before allocating the image") {
+  crep::test::TempDir dir;
+  const auto peakKiB = [] {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<long long>(usage.ru_maxrss);
+  };
+  struct Case {
+    int compression, lines;
+    const char* mentions;
+  };
+  const Case cases[] = {{0, 1, "chunk 0 (scanline 0): data size 64 bytes, expected exactly 65536"},
+                        {3, 16, "implausibly large"},
+                        {4, 32, "implausibly large"}};
+  for (const Case& c : cases) {
+    CAPTURE(c.compression);
+    RawPart part = scanlinePart({{"Y", kFloat}}, 16384, 16384);
+    part.compression = c.compression;
+    // Built directly: buildExr would encode 1 GiB of pixels first.
+    Writer w;
+    w.u32(20000630);
+    w.u32(2);
+    w.append(partHeader(part, false, 0, part));
+    const int chunks = 16384 / c.lines;
+    const std::uint64_t first = w.b.size() + static_cast<std::uint64_t>(chunks) * 8;
+    for (int i = 0; i < chunks; ++i)
+      w.u64(first + static_cast<std::uint64_t>(i) * 72);
+    for (int i = 0; i < chunks; ++i) {
+      w.i32(i * c.lines);
+      w.i32(64);
+      w.append(Bytes(64, 0));
+    }
+    writeFile(dir / "huge.exr", w.b);
+    const long long before = peakKiB();
+    const auto start = std::chrono::steady_clock::now();
+    const std::string what = expectThrows<crep::FormatError>(dir / "huge.exr");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    INFO(what);
+    CHECK(contains(what, "huge.exr"));
+    CHECK(contains(what, c.mentions));
+    CHECK_MESSAGE(seconds < 1.0, "took " << seconds << " s");
+    // The image would be 1 GiB of floats; the peak resident size must not have grown by 64 MiB.
+    CHECK(peakKiB() - before < 64 * 1024);
+  }
+}
+
+TEST_CASE("EXR: FLOAT samples holding the reader's sentinel bit patterns read back bit-exact") {
+  crep::test::TempDir dir;
+  Image image = patternImage(37, 23, 3);
+  std::size_t i = 0;
+  for (float& v : image.data()) {
+    if (i % 5 == 0) v = floatOf(crep::detail::kExrUnwrittenSampleBits);
+    if (i % 7 == 0) v = floatOf(crep::detail::kExrUnwrittenSampleRetryBits);
+    ++i;
+  }
+  for (crep::ExrCompression compression :
+       {crep::ExrCompression::None, crep::ExrCompression::Zip, crep::ExrCompression::Piz}) {
+    CAPTURE(static_cast<int>(compression));
+    crep::writeExr(dir / "sentinel.exr", image,
+                   crep::ExrWriteOptions(crep::ExrPixelType::Float, compression));
+    const Image back = crep::readExr(dir / "sentinel.exr");
+    REQUIRE(back.sameShape(image));
+    int bad = 0;
+    for (std::size_t k = 0; k < image.data().size(); ++k)
+      if (bitsOf(back.data()[k]) != bitsOf(image.data()[k]) && bad++ < 5)
+        FAIL_CHECK("sample " << k << ": bits " << bitsOf(back.data()[k])
+                             << " != " << bitsOf(image.data()[k]));
+    CHECK(bad == 0);
+  }
+}
+
+TEST_CASE("EXR: chunks OpenEXR stores uncompressed because compression does not help are read") {
+  // Random bits do not compress: OpenEXR's writer then stores the chunk raw, with a size equal to the
+  // uncompressed size, which the reader must accept for every codec.
+  crep::test::TempDir dir;
+  std::mt19937 random(77);
+  Image image(37, 40, 3);
+  for (float& v : image.data())
+    v = floatOf(static_cast<std::uint32_t>(random()) & 0xBF7FFFFFu); // finite: exponent bit 30 clear
+  for (crep::ExrCompression compression : {crep::ExrCompression::Zip, crep::ExrCompression::Piz}) {
+    CAPTURE(static_cast<int>(compression));
+    const int lines = compression == crep::ExrCompression::Zip ? 16 : 32;
+    crep::writeExr(dir / "noise.exr", image, crep::ExrWriteOptions(crep::ExrPixelType::Float, compression));
+    const Bytes b = readFile(dir / "noise.exr");
+    int stored = 0;
+    for (const std::size_t chunk : chunkOffsets(b)) {
+      const int y = static_cast<int>(get32(b, chunk));
+      const std::uint32_t raw = static_cast<std::uint32_t>(std::min(lines, 40 - y) * 37 * 3 * 4);
+      CHECK(get32(b, chunk + 4) <= raw);
+      stored += get32(b, chunk + 4) == raw ? 1 : 0;
+    }
+    CHECK(stored > 0);
+    const Image back = crep::readExr(dir / "noise.exr");
+    REQUIRE(back.sameShape(image));
+    CHECK(std::memcmp(back.data().data(), image.data().data(), image.byteSize()) == 0);
+  }
+}
+
 TEST_CASE("EXR: writeExrLayers round trip, channel naming and validation") {
   crep::test::TempDir dir;
   const Image beauty = patternImage(37, 23, 4);
@@ -847,6 +1162,66 @@ TEST_CASE("EXR: every truncation of a valid file is a FormatError, never a crash
   CHECK_MESSAGE(seconds < 60.0, "truncation sweep took " << seconds << " s");
 }
 
+namespace {
+
+// The image an uncompressed half RGB file written by writeExr holds according to its bytes: chunk y at
+// the offset its table gives, [y][size] then the B, G and R halves of the line.
+Image decodeUncompressedHalfRgb(const Bytes& b, int width, int height) {
+  Image image(width, height, 3);
+  const std::size_t tableStart = headerEnd(b);
+  for (int y = 0; y < height; ++y) {
+    const std::size_t data =
+        static_cast<std::size_t>(get64(b, tableStart + static_cast<std::size_t>(y) * 8)) + 8;
+    for (int fileChannel = 0; fileChannel < 3; ++fileChannel) // B, G, R
+      for (int x = 0; x < width; ++x) {
+        const std::size_t at = data + static_cast<std::size_t>(fileChannel * width + x) * 2;
+        REQUIRE(at + 2 <= b.size());
+        const auto half = static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
+        image.at(x, height - 1 - y, 2 - fileChannel) = halfToFloat(half);
+      }
+  }
+  return image;
+}
+
+// Same samples, NaN matching any NaN.
+int differingSamples(const Image& actual, const Image& expected) {
+  REQUIRE(actual.sameShape(expected));
+  int bad = 0;
+  for (std::size_t i = 0; i < actual.data().size(); ++i) {
+    const float a = actual.data()[i], e = expected.data()[i];
+    if (!(std::isnan(a) && std::isnan(e)) && bitsOf(a) != bitsOf(e)) ++bad;
+  }
+  return bad;
+}
+
+// Rebuilds a single-part scanline file whose chunks follow its table, with the pixel data of chunk i
+// cut to keep[i] bytes where keep[i] >= 0 (its size field to match), the later chunks moved up and
+// the offset table updated. Bytes after the last chunk are kept.
+Bytes withShortChunks(const Bytes& b, const std::vector<std::size_t>& chunks,
+                      const std::vector<std::int64_t>& keep) {
+  const std::size_t tableStart = headerEnd(b);
+  Writer out;
+  for (std::size_t k = 0; k < chunks.front(); ++k)
+    out.u8(b[k]); // header and table
+  std::size_t end = 0;
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    const std::size_t size = get32(b, chunks[i] + 4);
+    const std::size_t kept = keep[i] >= 0 ? static_cast<std::size_t>(keep[i]) : size;
+    put32(out.b, tableStart + i * 8, static_cast<std::uint32_t>(out.b.size()));
+    put32(out.b, tableStart + i * 8 + 4, 0);
+    out.u32(get32(b, chunks[i])); // y
+    out.u32(static_cast<std::uint32_t>(kept));
+    for (std::size_t k = 0; k < kept; ++k)
+      out.u8(b[chunks[i] + 8 + k]);
+    end = chunks[i] + 8 + size;
+  }
+  for (std::size_t k = end; k < b.size(); ++k)
+    out.u8(b[k]);
+  return out.b;
+}
+
+} // namespace
+
 TEST_CASE("EXR: corrupted bytes give an image or a FormatError, never a crash or another exception") {
   crep::test::TempDir dir;
   const auto start = std::chrono::steady_clock::now();
@@ -857,21 +1232,35 @@ TEST_CASE("EXR: corrupted bytes give an image or a FormatError, never a crash or
                    crep::ExrWriteOptions(crep::ExrPixelType::Half, compression));
     originals.push_back(readFile(dir / "ok.exr"));
   }
+  // Where the pixel data of the uncompressed file starts (its header and offset table end).
+  const std::size_t uncompressedPixels = chunkOffsets(originals[2]).front();
   std::mt19937 random(20240601);
-  int formatErrors = 0, successes = 0;
+  int formatErrors = 0, successes = 0, checkedAgainstBytes = 0;
   for (int iteration = 0; iteration < 600; ++iteration) {
-    Bytes b = originals[static_cast<std::size_t>(iteration) % originals.size()];
+    const std::size_t variant = static_cast<std::size_t>(iteration) % originals.size();
+    Bytes b = originals[variant];
     const int flips = 1 + static_cast<int>(random() % 8);
     // Half the mutations hit the header, where they are most dangerous.
     const std::size_t region = iteration % 2 == 0 ? std::min<std::size_t>(b.size(), 400) : b.size();
+    std::size_t lowest = b.size();
     for (int f = 0; f < flips; ++f) {
       const std::size_t at = random() % region;
+      lowest = std::min(lowest, at);
       b[at] = random() % 3 == 0 ? static_cast<std::uint8_t>(0xFF) : static_cast<std::uint8_t>(random());
     }
     writeFile(dir / "fuzz.exr", b);
     try {
       const Image image = crep::readExr(dir / "fuzz.exr");
       CHECK(image.pixelCount() <= static_cast<std::size_t>(Image::kMaxPixels));
+      // No sample of an accepted file comes from unwritten memory...
+      if (const int unwritten = unwrittenSamples(image); unwritten != 0)
+        FAIL_CHECK("iteration " << iteration << ": " << unwritten << " samples from unwritten memory");
+      // ...and an uncompressed file with an intact header and offset table holds exactly its bytes.
+      if (variant == 2 && lowest >= uncompressedPixels) {
+        ++checkedAgainstBytes;
+        if (const int bad = differingSamples(image, decodeUncompressedHalfRgb(b, 37, 23)); bad != 0)
+          FAIL_CHECK("iteration " << iteration << ": " << bad << " samples differ from the file's bytes");
+      }
       ++successes;
     } catch (const crep::FormatError&) {
       ++formatErrors;
@@ -879,9 +1268,132 @@ TEST_CASE("EXR: corrupted bytes give an image or a FormatError, never a crash or
       FAIL_CHECK("iteration " << iteration << ": unexpected exception type: " << e.what());
     }
   }
+  MESSAGE(formatErrors << " rejected, " << successes << " accepted (" << checkedAgainstBytes
+                       << " checked against the file's bytes)");
   // Both outcomes occur (e.g. a changed pixel value of an uncompressed file is still a valid file).
   CHECK(formatErrors > 0);
   CHECK(successes > 0);
+  CHECK(checkedAgainstBytes > 0);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   CHECK_MESSAGE(seconds < 60.0, "corruption sweep took " << seconds << " s");
+}
+
+TEST_CASE(
+    "EXR: corrupted chunk sizes (NONE, ZIP, PIZ) are rejected or read in full, never from unwritten memory") {
+  crep::test::TempDir dir;
+  // A smooth image (values 1 + k/64, exact in half, in a narrow range of half bit patterns), so that
+  // ZIP and PIZ shrink every chunk; 20 pixels wide, so that a chunk's raw data (<= 32 lines x 20 x 3
+  // x 2 bytes) stays below ASan's fill limit.
+  Image image(20, 70, 3);
+  for (int y = 0; y < 70; ++y)
+    for (int x = 0; x < 20; ++x)
+      for (int c = 0; c < 3; ++c)
+        image.at(x, y, c) = 1.0f + static_cast<float>((x + 2 * y + 5 * c) % 64) / 64.0f;
+  struct Variant {
+    crep::ExrCompression compression;
+    int lines;
+    Bytes bytes;
+    std::vector<std::size_t> chunks;
+    std::vector<std::uint32_t> sizes, raw;
+  };
+  std::vector<Variant> variants = {
+      {crep::ExrCompression::None, 1, {}, {}, {}, {}},
+      {crep::ExrCompression::Zip, 16, {}, {}, {}, {}},
+      {crep::ExrCompression::Piz, 32, {}, {}, {}, {}},
+  };
+  for (Variant& v : variants) {
+    crep::writeExr(dir / "ok.exr", image, crep::ExrWriteOptions(crep::ExrPixelType::Half, v.compression));
+    v.bytes = readFile(dir / "ok.exr");
+    // Trailing bytes, so that the last chunk can grow inside the file. (OpenEXR reads the chunks of a
+    // single-part file one after the other, so an earlier chunk that grows misplaces the next one.)
+    v.bytes.resize(v.bytes.size() + 1024, 0);
+    writeFile(dir / "ok.exr", v.bytes);
+    v.chunks = chunkOffsets(v.bytes);
+    REQUIRE(v.chunks.size() == static_cast<std::size_t>((70 + v.lines - 1) / v.lines));
+    for (std::size_t i = 0; i < v.chunks.size(); ++i) {
+      v.sizes.push_back(get32(v.bytes, v.chunks[i] + 4));
+      v.raw.push_back(
+          static_cast<std::uint32_t>(std::min(v.lines, 70 - static_cast<int>(i) * v.lines) * 20 * 3 * 2));
+      CAPTURE(i);
+      if (v.compression == crep::ExrCompression::None)
+        REQUIRE(v.sizes.back() == v.raw.back());
+      else
+        REQUIRE(v.sizes.back() < v.raw.back()); // really compressed
+    }
+    requireIdentical(crep::readExr(dir / "ok.exr"), image);
+  }
+
+  std::mt19937 random(20240602);
+  int rejected = 0, rejectedCut = 0, accepted = 0, acceptedRaw = 0, acceptedCut = 0, acceptedChanged = 0;
+  for (int iteration = 0; iteration < 360; ++iteration) {
+    const Variant& v = variants[static_cast<std::size_t>(iteration) % variants.size()];
+    Bytes b = v.bytes;
+    // A quarter of the files get every chunk's size replaced, the others one chunk's, half of the
+    // time the last one's.
+    const bool all = random() % 4 == 0;
+    const std::size_t one = random() % 2 == 0 ? v.chunks.size() - 1 : random() % v.chunks.size();
+    const int kind = static_cast<int>(random() % 14);
+    // A third of the smaller sizes also cut the chunk's data to match, and the file is laid out
+    // again around it: a consistent file whose chunks are short (as in the report that led to the
+    // size checks), which OpenEXR reads to the end, converting whole lines from its buffers.
+    const bool cut = random() % 3 == 0;
+    std::vector<std::int64_t> keep(v.chunks.size(), -1);
+    bool changed = false, storedRaw = false, payloadCut = false;
+    for (std::size_t i = 0; i < v.chunks.size(); ++i) {
+      if (!all && i != one) continue;
+      const std::int64_t size = v.sizes[i], raw = v.raw[i];
+      const std::int64_t replacements[14] = {size - 1,
+                                             size / 2,
+                                             12,
+                                             1,
+                                             0,
+                                             -1,
+                                             std::numeric_limits<std::int32_t>::min(),
+                                             std::numeric_limits<std::int32_t>::max(),
+                                             size + 1,
+                                             size * 2,
+                                             raw - 1,
+                                             raw,
+                                             raw + 1,
+                                             static_cast<std::int32_t>(random())};
+      const auto replacement = static_cast<std::uint32_t>(replacements[kind]);
+      if (cut && replacements[kind] >= 0 && replacements[kind] < size) {
+        keep[i] = replacements[kind];
+        payloadCut = true;
+      }
+      put32(b, v.chunks[i] + 4, replacement);
+      changed = changed || replacement != static_cast<std::uint32_t>(size);
+      // A compressed chunk of exactly the raw size is read as uncompressed data.
+      storedRaw = storedRaw || (v.compression != crep::ExrCompression::None && replacement == raw);
+    }
+    if (payloadCut) b = withShortChunks(v.bytes, v.chunks, keep);
+    writeFile(dir / "sizes.exr", b);
+    CAPTURE(iteration);
+    try {
+      const Image back = crep::readExr(dir / "sizes.exr");
+      ++accepted;
+      CHECK(unwrittenSamples(back) == 0);
+      if (v.compression == crep::ExrCompression::None) CHECK_FALSE(changed); // exact sizes only
+      if (payloadCut) {
+        ++acceptedCut; // a compressed stream that still decodes once cut: whatever it holds
+      } else if (storedRaw) {
+        ++acceptedRaw; // its pixels are the file's bytes, whatever they mean
+      } else {
+        // The pixel data itself is intact: an accepted file is the original image.
+        CHECK(differingSamples(back, image) == 0);
+        acceptedChanged += changed ? 1 : 0;
+      }
+    } catch (const crep::FormatError& e) {
+      ++rejected;
+      rejectedCut += payloadCut ? 1 : 0;
+      CHECK(contains(e.what(), "sizes.exr"));
+    } catch (const std::exception& e) {
+      FAIL_CHECK("unexpected exception type: " << e.what());
+    }
+  }
+  MESSAGE(rejected << " rejected (" << rejectedCut << " with cut data), " << accepted << " accepted ("
+                   << acceptedChanged << " with a changed size, " << acceptedRaw << " read as stored raw, "
+                   << acceptedCut << " with cut data)");
+  CHECK(rejected > 0);
+  CHECK(accepted > 0);
 }

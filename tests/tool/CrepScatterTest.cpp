@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -57,6 +58,40 @@ struct Inputs {
     writeText(dir / "frame.json", j.dump(2));
   }
 };
+
+/// Rewrites an uncompressed single-part scanline EXR so that every chunk holds only the first `keep`
+/// bytes of its line, with its size field and the offset table to match: a structurally consistent
+/// file whose chunks are too short for its rows.
+void shortenChunks(const std::filesystem::path& path, std::uint32_t keep) {
+  const std::string in = readText(path.string());
+  const auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i)
+      v = (v << 8) | static_cast<unsigned char>(in.at(at + static_cast<std::size_t>(i)));
+    return v;
+  };
+  const auto put = [](std::string& out, std::uint64_t v, int bytes) {
+    for (int i = 0; i < bytes; ++i)
+      out.push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
+  };
+  std::size_t at = 8; // after magic and version: attributes name\0 type\0 size value, then \0
+  while (in.at(at) != 0) {
+    at = in.find('\0', in.find('\0', at) + 1) + 1;
+    at += 4 + u32(at);
+  }
+  const std::size_t tableStart = at + 1;
+  const std::size_t chunks = (u32(tableStart) - tableStart) / 8; // chunks follow the table
+  std::string out = in.substr(0, tableStart);
+  for (std::size_t i = 0; i < chunks; ++i)
+    put(out, tableStart + chunks * 8 + i * (8 + keep), 8);
+  for (std::size_t i = 0; i < chunks; ++i) {
+    const std::size_t chunk = u32(tableStart + i * 8); // files here are far below 4 GiB
+    out += in.substr(chunk, 4);                        // y
+    put(out, keep, 4);
+    out += in.substr(chunk + 8, keep);
+  }
+  writeText(path, out);
+}
 
 void expectFailure(const crep::test::ToolResult& r, int status, std::initializer_list<const char*> mentions) {
   INFO(r.output);
@@ -109,6 +144,18 @@ TEST_CASE("crep scatter: unreadable, corrupt and truncated files exit 1 naming t
   crep::writeExr(in.dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
   std::filesystem::remove(in.dir / "frame.json");
   expectFailure(crep::test::runCrep(in.args()), 1, {"frame.json"});
+}
+
+TEST_CASE("crep scatter: a depth EXR whose chunks are shorter than its rows exits 1 naming the file") {
+  // 160-pixel float rows (640 bytes) in 12-byte chunks: OpenEXR would fill the rest of every row from
+  // memory nobody wrote, and the depth values 0 (or ASan's fill bytes) would pass the range check.
+  const Inputs in;
+  crep::writeExr(in.dir / "depth.exr", crep::Image(160, 90, 1, 0.9f),
+                 crep::ExrWriteOptions(crep::ExrPixelType::Float, crep::ExrCompression::None));
+  shortenChunks(in.dir / "depth.exr", 12);
+  expectFailure(crep::test::runCrep(in.args()), 1,
+                {"--depth", "depth.exr", "chunk 0 (scanline 0): data size 12 bytes, expected exactly 640"});
+  CHECK_FALSE(std::filesystem::exists(in.dir / "out.exr"));
 }
 
 TEST_CASE("crep scatter: NaN or out-of-range depth exits 1 naming the file and the pixel") {

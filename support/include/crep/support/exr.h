@@ -23,6 +23,7 @@
 
 #include <crep/core/image.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <span>
 #include <string>
@@ -91,18 +92,34 @@ void writeExrLayers(const std::filesystem::path& path, std::span<const ExrLayer>
 /// The image is the data window (the display window is ignored); data window row maxY (the bottom
 /// row in EXR's y-down convention) becomes row 0.
 /// Before any pixel memory is allocated, the whole file structure is validated: header attribute
-/// sizes, every part's data window (<= kMaxDimension per side and kMaxPixels; the selected part also
-/// <= options.maxPixels), the offset tables, and the position and size of every chunk of every part
-/// (so truncated pixel data is always detected), and the image size must be plausible for the file
-/// size (at most 4096 bytes of float output per byte of file, plus 16 MiB; not applied to DWAA/DWAB,
-/// whose ratio on constant images is unbounded in practice).
+/// sizes and channel lists, every part's data window (<= kMaxDimension per side and kMaxPixels; the
+/// selected part also <= options.maxPixels), the offset tables, and for every chunk of every part
+/// its position, the line or tile its header names, and its data size, which must end inside the
+/// file (so truncated pixel data is always detected) and fit its compression and pixel count:
+/// uncompressed chunks exactly the size of their lines or tile (sum over channels of sampled pixels
+/// times 2 or 4 bytes), compressed ones from 1 byte up to that size (never more: OpenEXR stores a
+/// chunk uncompressed when compression does not make it smaller). The image size must be plausible
+/// for the file size (at most 4096 bytes of float output per byte of file, plus 16 MiB; not applied
+/// to DWAA/DWAB, whose ratio on constant images is unbounded in practice), and the RLE, ZIPS and ZIP
+/// chunks of the part read must decode to exactly their uncompressed size. Every sample of the image
+/// is checked to have been written by the decoder (see detail::kExrUnwrittenSampleBits).
 /// Throws IoError if the file is missing or unreadable; FormatError naming the file if it is not an
-/// EXR file, is corrupt or truncated, is deep, has no matching channels or subsampled ones, or is too
-/// large. InvalidArgument for options.maxPixels <= 0 or options.part < 0.
+/// EXR file, is corrupt or truncated (the message names the chunk: its index, line or tile, size
+/// found and expected), is deep, has no matching channels or subsampled ones, is too large, or its
+/// pixel data is incomplete. InvalidArgument for options.maxPixels <= 0 or options.part < 0.
 Image readExr(const std::filesystem::path& path, const ExrReadOptions& options = {});
 
 /// Describes part `part` from its header, after the same structural validation as readExr (a
 /// truncated file is rejected even though no pixel is decoded). Same exceptions as readExr.
 ExrFileInfo readExrInfo(const std::filesystem::path& path, int part = 0);
+
+namespace detail {
+/// readExr fills the image with this float bit pattern (a signalling NaN that no HALF or UINT sample
+/// converts to) before decoding, and with kExrUnwrittenSampleRetryBits for a second decode where a
+/// FLOAT channel holds the pattern itself: an image readExr returns never holds a sample the
+/// decoder did not write (it throws FormatError "incomplete pixel data" instead). Public for tests.
+inline constexpr std::uint32_t kExrUnwrittenSampleBits = 0x7F800DEAu;
+inline constexpr std::uint32_t kExrUnwrittenSampleRetryBits = 0x7F800BADu;
+} // namespace detail
 
 } // namespace crep
