@@ -8,7 +8,7 @@ CREP_PACKAGES=(
   build-essential cmake pkg-config
   libglm-dev libeigen3-dev libopenexr-dev doctest-dev libstb-dev
   libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
-  glslang-tools nlohmann-json3-dev
+  glslang-tools nlohmann-json3-dev zlib1g-dev
 )
 
 crep_install_packages() {
