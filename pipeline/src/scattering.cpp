@@ -14,6 +14,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -190,10 +191,18 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
 
   FrameResult r;
   const auto stage = [&](const char* name, const auto& work) {
+    if (!info.stageTimings) {
+      work();
+      r.stages.push_back({name, 0.0, 0.0});
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
     m.timer.begin();
     work();
     m.timer.end();
-    r.stages.push_back({name, m.timer.milliseconds()});
+    glFinish();
+    const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
+    r.stages.push_back({name, m.timer.milliseconds(), wall.count()});
   };
   r.rectification = rectify(*f.camera, *f.light, info.rectify);
   std::shared_ptr<const RectifiedLayout> layout;

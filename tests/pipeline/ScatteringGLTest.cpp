@@ -106,6 +106,7 @@ void checkStages(const Scattering::FrameResult& r) {
     names += s.name + "; ";
     CHECK(std::isfinite(s.gpuMilliseconds));
     CHECK(s.gpuMilliseconds >= 0.0);
+    CHECK(s.wallMilliseconds > 0.0);
   }
   MESSAGE("stages: " << names);
   CHECK(names.find("prefilter") != std::string::npos);

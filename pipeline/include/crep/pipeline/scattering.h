@@ -61,6 +61,9 @@ public:
     WorldMarchOptions epipoleBlock;
     /// Radius of the epipole block as a fraction of the screen diagonal (0 = none).
     double epipoleBlockRadius = 0.02;
+    /// Measure every stage (FrameResult::stages): a GL_TIME_ELAPSED query and a glFinish per stage, which
+    /// stalls the pipeline; turn off in production (stages then lists names with zero times).
+    bool stageTimings = true;
     int ownShadowMapSize = 2048; ///< standard shadow map rendered with drawCasters on fallback frames
     /// Depth bias of that map in the epipole block march (depth-buffer units of a map whose depth range
     /// spans the camera frustum along the light), finite and >= 0.
@@ -89,7 +92,8 @@ public:
 
   struct Stage {
     std::string name;
-    double gpuMilliseconds = 0.0; ///< GL_TIME_ELAPSED of the stage
+    double gpuMilliseconds = 0.0;  ///< GL_TIME_ELAPSED of the stage (llvmpipe reports 0 for compute work)
+    double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by glFinish
   };
 
   struct FrameResult {
