@@ -250,3 +250,33 @@ TEST_CASE("Scattering: bad input is named, GL state is restored") {
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
 }
+
+TEST_CASE(
+    "Scattering: the epipole exactly on a screen corner or edge gives a finite image near the reference") {
+  CREP_REQUIRE_GL();
+  Frame f("forest");
+  Scattering scattering(smallInfo());
+  struct Case {
+    const char* name;
+    double ndcX, ndcY;
+  };
+  for (const Case& c : {Case{"corner (1, 1)", 1.0, 1.0}, Case{"corner (-1, -1)", -1.0, -1.0},
+                        Case{"edge (1, 0)", 1.0, 0.0}, Case{"edge (0, -1)", 0.0, -1.0}}) {
+    CAPTURE(c.name);
+    // The light comes from the direction of the view ray through that NDC point: the epipole is there.
+    const glm::dvec3 towardLight = f.scene.camera.rayDirection(c.ndcX, c.ndcY);
+    f.setLight(DirectionalLight(-towardLight, f.scene.sun.irradiance()));
+    const Scattering::FrameResult r = scattering.run(f.attribs(false, true));
+    CHECK(r.layout == Scattering::Layout::Epipolar);
+    const Image ours = f.read();
+    const ImageMetrics m = rgbMetrics(ours, f.reference(r.shadowMap));
+    report(std::string("epipole on the ") + c.name + ": prefiltered (epipolar) vs world-space reference", m);
+    CHECK(m.nanCount == 0);
+    CHECK(m.infCount == 0);
+    CHECK(ours.width() == kWidth);
+    // Accuracy here is an open item (issue 9, "accuracy next to the sun": 2% of the reference): measured
+    // 3.1% (corner (1, 1)), 12% (edge (1, 0)), 66-77% (light from below the ground: edge (0, -1), corner
+    // (-1, -1), where the reference is nearly black). Reported, not asserted, until the fallback improves.
+    WARN(m.relativeRmse < 0.02);
+  }
+}
