@@ -1,5 +1,5 @@
-// The tool's methods, each built from the library's passes: the world-space reference march
-// (WorldMarchPass), Klehm et al. 2014's prefiltered scattering (PrefilterPass + EvaluatePass), and the
+// The tool's methods, each built from the library: the world-space reference march (WorldMarchPass),
+// Klehm et al. 2014's prefiltered scattering on every frame (crep::Scattering), and the
 // min/max tree and brute-force marches over the rectified rows (MinMaxTreePass, RectifiedMarchPass), with
 // the epipolar resampling fallback (EpipolarLayout + ShadowResamplePass + the epipole block) for frames
 // whose rectification is not projective.
@@ -11,8 +11,10 @@
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/gpu_world_march.h>
+#include <crep/scenes/scene_renderer.h>
 
 #include <epoxy/gl.h>
 
@@ -179,72 +181,53 @@ MethodOutput runBrute(Frame& frame, const MethodSettings& settings) {
   return runRectifiedMarch(frame, settings, false, "brute");
 }
 
-/// The prefiltered method on one rectified map on the GPU (Klehm et al. 2014): prefilter (Fourier basis,
-/// transmittance-weighted prefix filter per row) and the constant-time evaluation per pixel, on either
-/// layout (projective, or the epipolar fallback through its layout block).
-void prefilterAndEvaluate(const Frame& frame, const MethodSettings& settings, const RectifiedLayout& layout,
-                          std::uint32_t map, int width, int height, MethodOutput& out) {
-  PrefilterPass::CreateInfo prefilterInfo;
-  prefilterInfo.width = width;
-  prefilterInfo.height = height;
-  prefilterInfo.options = settings.prefilter;
-  auto prefilter =
-      out.timings.time("prefilter setup", [&] { return std::make_unique<PrefilterPass>(prefilterInfo); });
-  EvaluatePass::CreateInfo evaluateInfo;
-  evaluateInfo.bases = settings.prefilter.bases;
-  auto evaluate =
-      out.timings.time("evaluate setup", [&] { return std::make_unique<EvaluatePass>(evaluateInfo); });
-  out.timings.time("prefilter", [&] {
-    PrefilterPass::FrameAttribs f;
-    f.rectifiedDepth = map;
-    f.layout = &layout;
-    f.medium = &frame.medium;
-    prefilter->run(f);
-    glFinish();
-  });
-  out.scattering = newScatteringTexture(frame);
-  out.timings.time("evaluate", [&] {
-    EvaluatePass::FrameAttribs f;
-    f.cameraDepth = frame.cameraDepth.get();
-    f.output = out.scattering.get();
-    f.camera = &frame.camera;
-    f.light = &frame.light;
-    f.medium = &frame.medium;
-    f.layout = &layout;
-    f.basis = prefilter->filteredBasis();
-    evaluate->run(f);
-    glFinish();
-  });
-}
-
-/// Klehm et al. 2014 on every frame: the rectified map when the rectification is projective, else the
-/// standard shadow map resampled into the epipolar layout (Sec. 4.1) and the pixels next to the epipole
-/// marched in world space (Fig. 8).
+/// Klehm et al. 2014 on every frame through the library's front door (crep::Scattering): the rectified map
+/// rasterized with the scene's casters (built-in scenes) or resampled from the standard shadow map (users'
+/// data) when the rectification is projective, else the epipolar fallback with the epipole block. The
+/// stages are Scattering's GPU times.
 MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
   MethodOutput out;
   out.used = "prefilter";
+  Scattering::CreateInfo info;
+  info.width = frame.width;
+  info.height = frame.height;
+  info.mapSize = settings.mapSize;
+  info.rectify = settings.rectify;
+  info.prefilter = settings.prefilter;
+  info.epipoleBlock.steps = settings.steps;
+  auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });
+  const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.shadowWidth, frame.shadowHeight,
+                                     frame.lightClipFromWorld, frame.shadowBias};
+  Scattering::FrameAttribs a;
+  a.camera = &frame.camera;
+  a.light = &frame.light;
+  a.medium = &frame.medium;
+  a.cameraDepth = frame.cameraDepth.get();
+  out.scattering = newScatteringTexture(frame);
+  a.output = out.scattering.get();
+  if (frame.renderer)
+    a.drawCasters = [&](const glm::dmat4& clipFromWorld) { frame.renderer->drawDepth(clipFromWorld); };
+  a.shadowMap = &shadow;
+  const Scattering::FrameResult r = scattering->run(a);
+  for (const Scattering::Stage& stage : r.stages)
+    out.timings.append({{stage.name, stage.wallMilliseconds}}); // comparable with the other methods' stages
   const PrefilterOptions& options = settings.prefilter;
   const std::string basis =
       "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
-  Rectification rect;
-  if (const RectifiedGpuMap* map = frame.rectified(settings, out.timings, &rect)) {
-    out.detail = "projective layout, " + basis + ", " + std::to_string(map->rect.splitCount()) +
-                 " splits, map " + std::to_string(map->size) + "^2 " + map->source;
-    prefilterAndEvaluate(frame, settings, *map->layout, map->texture.get(), map->size, map->size, out);
-    return out;
+  if (r.layout == Scattering::Layout::Projective) {
+    out.detail = "projective layout, " + basis + ", " + std::to_string(r.rectification.splitCount()) +
+                 " splits, map " + std::to_string(settings.mapSize) + "^2 " +
+                 (frame.renderer ? "rasterized" : "resampled from the standard map");
+  } else {
+    std::fprintf(stderr,
+                 "crep: prefilter: rectification is %s (%s); using the epipolar resampling fallback\n",
+                 statusToken(r.rectification.status), r.rectification.message.c_str());
+    char blockText[32];
+    std::snprintf(blockText, sizeof blockText, "%.1f", r.epipoleBlockRadius);
+    out.detail = std::string("epipolar layout (") + reasonToken(r.rectification.reason) +
+                 "), epipole block radius " + blockText + " px, " + basis + ", " +
+                 std::to_string(settings.mapSize) + " slices x " + std::to_string(settings.mapSize);
   }
-  std::fprintf(stderr, "crep: prefilter: rectification is %s (%s); using the epipolar resampling fallback\n",
-               statusToken(rect.status), rect.message.c_str());
-  const EpipolarMap epipolar = makeEpipolarMap(frame, settings, out.timings);
-  const double block = epipolar.layout->epipolePixel() ? epipolar.layout->epipoleBlockRadiusPixels() : 0.0;
-  char blockText[32];
-  std::snprintf(blockText, sizeof blockText, "%.1f", block);
-  out.detail = std::string("epipolar layout (") + reasonToken(rect.reason) + "), epipole block radius " +
-               blockText + " px, " + basis + ", map " + std::to_string(epipolar.width) + "x" +
-               std::to_string(epipolar.height);
-  prefilterAndEvaluate(frame, settings, *epipolar.layout, epipolar.texture.get(), epipolar.width,
-                       epipolar.height, out);
-  marchEpipoleBlock(frame, settings, *epipolar.layout, out.scattering.get(), out.timings);
   return out;
 }
 

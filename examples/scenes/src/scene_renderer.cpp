@@ -59,6 +59,16 @@ SceneRenderer::SceneRenderer(const Mesh& mesh) : impl_(std::make_unique<Impl>())
 
 SceneRenderer::~SceneRenderer() = default;
 
+void SceneRenderer::drawDepth(const glm::dmat4& clipFromWorld) {
+  Impl& d = *impl_;
+  glUseProgram(d.depthProgram.get());
+  setMatrix(d.depthProgram.get(), 0, clipFromWorld);
+  glBindVertexArray(d.vao.get());
+  glDrawElements(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT, nullptr);
+  glBindVertexArray(0);
+  glUseProgram(0);
+}
+
 void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x,
                                 int y, int width, int height, const DepthRenderOptions& options) {
   Impl& d = *impl_;
@@ -85,12 +95,7 @@ void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t d
   glDepthFunc(GL_LESS);
   if (options.depthClamp) glEnable(GL_DEPTH_CLAMP);
   if (options.cullBackFaces) glEnable(GL_CULL_FACE);
-  glUseProgram(d.depthProgram.get());
-  setMatrix(d.depthProgram.get(), 0, clipFromWorld);
-  glBindVertexArray(d.vao.get());
-  glDrawElements(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT, nullptr);
-  glBindVertexArray(0);
-  glUseProgram(0);
+  drawDepth(clipFromWorld);
   glDisable(GL_DEPTH_CLAMP);
   glDisable(GL_CULL_FACE);
   glDisable(GL_SCISSOR_TEST);

@@ -31,9 +31,13 @@ public:
   /// Rasterizes the mesh's depth with `clipFromWorld` into layer `layer` (0 for a 2D texture) of the
   /// caller's depth texture (GL_DEPTH_COMPONENT32F, 2D or 2D array), in the viewport (x, y, width,
   /// height). Clears that viewport to depth 1 first. Values are depth-buffer values in [0, 1].
-  void renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x, int y, int width,
-                   int height, const DepthRenderOptions& options = {});
+  void renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t depthTexture, int layer, int x, int y,
+                   int width, int height, const DepthRenderOptions& options = {});
 
+  /// Draws the mesh's depth with `clipFromWorld` into the currently bound framebuffer and viewport, with
+  /// the caller's depth state: what an engine's caster callback does (crep::Scattering::FrameAttribs::
+  /// drawCasters). Leaves program 0 and vertex array 0 bound.
+  void drawDepth(const glm::dmat4& clipFromWorld);
   /// Renders a projective rectified shadow map: every split with its rectClipFromWorld into its
   /// viewport (Rectification::splitViewport) of the caller's width x height depth texture, with depth
   /// clamping (what rectify.h asks of an engine). Throws InvalidArgument unless `rectification` is
@@ -52,8 +56,8 @@ public:
   };
   /// Renders lit surfaces into the caller's colour texture (RGBA16F or RGBA32F) and depth texture
   /// (GL_DEPTH_COMPONENT32F), both width x height. Background: colour 0, depth 1.
-  void renderShaded(const ShadeInputs& inputs, std::uint32_t colorTexture, std::uint32_t depthTexture, int width,
-                    int height);
+  void renderShaded(const ShadeInputs& inputs, std::uint32_t colorTexture, std::uint32_t depthTexture,
+                    int width, int height);
 
   /// Convenience: renders into a new width x height depth texture and reads it back as a 1-channel
   /// image of depth-buffer values (row 0 = bottom).

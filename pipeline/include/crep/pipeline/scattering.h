@@ -1,0 +1,132 @@
+// The front door: one object per view, one call per frame, every frame prefiltered (Klehm, Seidel,
+// Eisemann 2014). Scattering decides the layout itself: the projective rectification (Sec. 4.2) when
+// rectify() accepts the frame, else the epipolar resampling fallback (Sec. 4.1) with the pixels next to the
+// epipole marched in world space (Fig. 8). It owns every pass and texture it needs; it never creates or
+// owns the GL context (an OpenGL 4.5 core context must be current for its whole lifetime).
+//
+//   crep::Scattering scattering({.width = 1920, .height = 1080});           // once per view
+//   ...
+//   crep::Scattering::FrameAttribs f;                                      // every frame
+//   f.camera = &camera; f.light = &sun; f.medium = &fog;
+//   f.cameraDepth = depthTexture; f.output = scatteringTexture;           // your GL textures
+//   f.drawCasters = [&](const glm::dmat4& clipFromWorld) { drawShadowCasters(clipFromWorld); };
+//   crep::Scattering::FrameResult r = scattering.run(f);                  // r.layout, r.stages
+//   color = surface * output.a + output.rgb                                // your composite
+//
+// Shadow inputs (at least one):
+//   - drawCasters: a callback that draws the shadow casters with the given clip-from-world matrix (your
+//     depth-only shaders, your geometry). Scattering binds its own framebuffer and depth texture, sets
+//     the viewport of each split, GL_DEPTH_TEST with GL_LESS, depth writes, GL_DEPTH_CLAMP (casters between
+//     the light and the frustum must still shadow it), no face culling, and clears depth to 1; the callback
+//     only binds its program and vertex data and draws. On fallback frames without `shadowMap` it is also
+//     called once to render a standard shadow map fitted to the camera frustum.
+//   - shadowMap: your standard (orthographic, along the light) shadow map and its matrix. With it and no
+//     drawCasters the projective map is point-resampled from it (Sec. 4.1's rule on the projective layout);
+//     fallback frames always resample it into the epipolar layout.
+//
+// GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
+// clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/prefilter/prefilter.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scatter/world_march.h>
+
+namespace crep {
+
+class Scattering {
+public:
+  struct CreateInfo {
+    int width = 1280, height = 720; ///< camera image and output, pixels
+    /// Rectified map: mapSize x mapSize texels on both layouts (the fallback uses mapSize epipolar slices),
+    /// so a fallback frame costs what a projective one does. A multiple of rectify.splits * P.
+    int mapSize = 1024;
+    /// Splits (logarithmic by default) and fallback thresholds; splits are also the epipolar layout's
+    /// regions. layout must be SplitLayout::Regions (side by side in one texture).
+    RectifyOptions rectify;
+    PrefilterOptions prefilter; ///< M (32), storage (RGBA8), weights (exact), regions per split, ...
+    EvaluateOptions evaluate;   ///< sampling (bilinear), near-plane correction, ringing filter
+    /// World-space march of the epipole block: sections and refinements (bias comes with the shadow map).
+    WorldMarchOptions epipoleBlock;
+    /// Radius of the epipole block as a fraction of the screen diagonal (0 = none).
+    double epipoleBlockRadius = 0.02;
+    /// Measure every stage (FrameResult::stages): a GL_TIME_ELAPSED query and a glFinish per stage, which
+    /// stalls the pipeline; turn off in production (stages then lists names with zero times).
+    bool stageTimings = true;
+    int ownShadowMapSize = 2048; ///< standard shadow map rendered with drawCasters on fallback frames
+    /// Depth bias of that map in the epipole block march (depth-buffer units of a map whose depth range
+    /// spans the camera frustum along the light), finite and >= 0.
+    double ownShadowMapBias = 1e-4;
+  };
+
+  /// The engine's standard shadow map (depth-buffer values of lightClipFromWorld, cleared to 1).
+  struct ShadowMap {
+    std::uint32_t texture = 0; ///< GL_TEXTURE_2D depth (or R32F) texture
+    int width = 0, height = 0;
+    glm::dmat4 lightClipFromWorld{1.0}; ///< orthographic, looking along the light (validateLightMatrix)
+    double bias = 0.0;                  ///< added to the stored depth by the epipole block march
+  };
+
+  struct FrameAttribs {
+    const Camera* camera = nullptr; ///< the camera of cameraDepth
+    const DirectionalLight* light = nullptr;
+    const Medium* medium = nullptr;
+    std::uint32_t cameraDepth = 0; ///< GL_TEXTURE_2D, width x height, depth-buffer values of `camera`
+    std::uint32_t output = 0; ///< GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance
+    std::function<void(const glm::dmat4& clipFromWorld)> drawCasters; ///< see the top; may be empty
+    const ShadowMap* shadowMap = nullptr;                             ///< see the top; may be null
+  };
+
+  enum class Layout { Projective, Epipolar };
+
+  struct Stage {
+    std::string name;
+    double gpuMilliseconds = 0.0;  ///< GL_TIME_ELAPSED of the stage (llvmpipe reports 0 for compute work)
+    double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by glFinish
+  };
+
+  struct FrameResult {
+    Layout layout = Layout::Projective;
+    Rectification rectification;     ///< the decision (reason, measure, threshold when not projective)
+    double epipoleBlockRadius = 0.0; ///< pixels; 0 without a block (projective, or epipole off screen)
+    std::vector<Stage> stages;       ///< in order: shadow / resample, prefilter, evaluate, epipole block
+    /// Epipolar frames: the standard shadow map resampled and marched (the engine's, or the one rendered
+    /// with drawCasters, valid until the next run()); texture 0 on projective frames.
+    ShadowMap shadowMap;
+  };
+
+  /// Validates (InvalidArgument naming the field, e.g. "Scattering::CreateInfo.mapSize"; GlError beyond
+  /// the GL limits) and builds the passes.
+  explicit Scattering(const CreateInfo& info);
+  ~Scattering();
+  Scattering(Scattering&&) noexcept;
+  Scattering& operator=(Scattering&&) noexcept;
+  Scattering(const Scattering&) = delete;
+  Scattering& operator=(const Scattering&) = delete;
+
+  /// One frame. Throws InvalidArgument naming the FrameAttribs field (null pointers, textures of the
+  /// wrong size or format, no shadow input).
+  FrameResult run(const FrameAttribs& frame);
+
+  const CreateInfo& createInfo() const noexcept;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// "projective" / "epipolar".
+const char* layoutToken(Scattering::Layout layout);
+
+} // namespace crep

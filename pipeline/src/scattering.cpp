@@ -1,0 +1,304 @@
+// The frame-level front door (crep/pipeline/scattering.h): Klehm, Seidel, Eisemann 2014 on every frame,
+// projective rectification (Sec. 4.2) or epipolar resampling fallback (Sec. 4.1) plus the epipole block
+// (Fig. 8), from the passes of scatter/, epipolar/ and prefilter/.
+#include <crep/core/error.h>
+#include <crep/core/gl.h>
+#include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/resample.h>
+#include <crep/pipeline/scattering.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/scatter/gpu_world_march.h>
+
+#include <epoxy/gl.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+namespace crep {
+
+const char* layoutToken(Scattering::Layout layout) {
+  return layout == Scattering::Layout::Projective ? "projective" : "epipolar";
+}
+
+namespace {
+
+void invalid(const std::string& parameter, const std::string& value, const std::string& requirement) {
+  throw InvalidArgument(parameter, value, requirement);
+}
+
+const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
+  gl::checkTextureSize("Scattering::CreateInfo.width/height", info.width, info.height);
+  gl::checkTextureSize("Scattering::CreateInfo.mapSize", info.mapSize, info.mapSize);
+  gl::checkTextureSize("Scattering::CreateInfo.ownShadowMapSize", info.ownShadowMapSize,
+                       info.ownShadowMapSize);
+  validate(info.rectify);
+  if (info.rectify.layout != SplitLayout::Regions)
+    invalid("Scattering::CreateInfo.rectify.layout", "not SplitLayout::Regions",
+            "must be SplitLayout::Regions (the splits side by side in one map)");
+  validate(info.prefilter, "Scattering::CreateInfo.prefilter");
+  validate(info.evaluate, "Scattering::CreateInfo.evaluate");
+  validate(info.epipoleBlock);
+  const int regions = info.rectify.splits * info.prefilter.regionsPerSplit;
+  if (info.mapSize % regions != 0)
+    invalid("Scattering::CreateInfo.mapSize", std::to_string(info.mapSize),
+            "must be a multiple of rectify.splits * prefilter.regionsPerSplit = " + std::to_string(regions));
+  if (!(info.ownShadowMapBias >= 0.0 && std::isfinite(info.ownShadowMapBias)))
+    invalid("Scattering::CreateInfo.ownShadowMapBias", detail::formatValue(info.ownShadowMapBias),
+            "must be finite and >= 0");
+  if (!(info.epipoleBlockRadius >= 0.0 && info.epipoleBlockRadius <= 0.5))
+    invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
+            "must be in [0, 0.5] (a fraction of the screen diagonal)");
+  return info;
+}
+
+/// An orthographic shadow matrix along the light that covers the camera frustum (casters between the light
+/// and the frustum are kept by GL_DEPTH_CLAMP, which puts them at depth 0).
+glm::dmat4 frustumLightClipFromWorld(const Camera& camera, const DirectionalLight& light) {
+  const FrustumCorners corners = camera.frustumCorners();
+  glm::dvec3 centre(0.0);
+  for (const glm::dvec3& c : corners)
+    centre += c / 8.0;
+  const glm::dvec3 dir = light.direction();
+  const glm::dmat4 view = glm::lookAtRH(centre - dir, centre, anyOrthogonal(dir));
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (const glm::dvec3& c : corners) {
+    const glm::dvec3 p(view * glm::dvec4(c, 1.0));
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  const double margin = 1e-3 * glm::length(hi - lo);
+  return glm::orthoRH_NO(lo.x - margin, hi.x + margin, lo.y - margin, hi.y + margin, -hi.z - margin,
+                         -lo.z + margin) *
+         view;
+}
+
+/// The GL state a shadow pass changes, restored on destruction.
+class SavedRasterState {
+public:
+  SavedRasterState() {
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer_);
+    glGetIntegerv(GL_VIEWPORT, viewport_);
+    glGetIntegerv(GL_DEPTH_FUNC, &depthFunc_);
+    glGetBooleanv(GL_DEPTH_WRITEMASK, &depthMask_);
+    depthTest_ = glIsEnabled(GL_DEPTH_TEST);
+    depthClamp_ = glIsEnabled(GL_DEPTH_CLAMP);
+    cull_ = glIsEnabled(GL_CULL_FACE);
+  }
+  ~SavedRasterState() {
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(framebuffer_));
+    glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
+    glDepthFunc(static_cast<GLenum>(depthFunc_));
+    glDepthMask(depthMask_);
+    (depthTest_ ? glEnable : glDisable)(GL_DEPTH_TEST);
+    (depthClamp_ ? glEnable : glDisable)(GL_DEPTH_CLAMP);
+    (cull_ ? glEnable : glDisable)(GL_CULL_FACE);
+  }
+  SavedRasterState(const SavedRasterState&) = delete;
+  SavedRasterState& operator=(const SavedRasterState&) = delete;
+
+private:
+  GLint framebuffer_ = 0, viewport_[4] = {0, 0, 0, 0}, depthFunc_ = GL_LESS;
+  GLboolean depthMask_ = GL_TRUE, depthTest_ = GL_FALSE, depthClamp_ = GL_FALSE, cull_ = GL_FALSE;
+};
+
+/// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
+struct DepthTarget {
+  gl::Handle texture, framebuffer;
+  int size = 0;
+  explicit DepthTarget(int s) : size(s) {
+    texture = gl::createTexture2D(GL_DEPTH_COMPONENT32F, s, s, "depth target");
+    framebuffer = gl::createFramebuffer();
+    glNamedFramebufferTexture(framebuffer.get(), GL_DEPTH_ATTACHMENT, texture.get(), 0);
+    glNamedFramebufferDrawBuffer(framebuffer.get(), GL_NONE);
+    glNamedFramebufferReadBuffer(framebuffer.get(), GL_NONE);
+  }
+  /// Clears to 1 and calls draw(viewport index) with the raster state of the header set.
+  template <class Draw>
+  void render(int viewports, const Draw& draw) {
+    const SavedRasterState saved;
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer.get());
+    glViewport(0, 0, size, size);
+    glDepthMask(GL_TRUE);
+    const float one = 1.0f;
+    glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_DEPTH_CLAMP);
+    glDisable(GL_CULL_FACE);
+    for (int i = 0; i < viewports; ++i)
+      draw(i);
+  }
+};
+
+} // namespace
+
+struct Scattering::Impl {
+  explicit Impl(const CreateInfo& i)
+      : info(validated(i)), prefilter({i.mapSize, i.mapSize, i.prefilter}),
+        evaluate({i.prefilter.bases, i.evaluate}), resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}),
+        rectified(i.mapSize) {
+    resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
+  }
+
+  CreateInfo info;
+  PrefilterPass prefilter;
+  EvaluatePass evaluate;
+  ShadowResamplePass resample;
+  WorldMarchPass block;
+  DepthTarget rectified;                   ///< the projective map rasterized with drawCasters
+  gl::Handle resampled;                    ///< R32F: a map resampled from a standard shadow map
+  std::optional<DepthTarget> ownShadowMap; ///< fallback frames with drawCasters only
+  gl::GpuTimer timer;
+};
+
+Scattering::Scattering(const CreateInfo& info) : impl_(std::make_unique<Impl>(info)) {}
+Scattering::~Scattering() = default;
+Scattering::Scattering(Scattering&&) noexcept = default;
+Scattering& Scattering::operator=(Scattering&&) noexcept = default;
+
+const Scattering::CreateInfo& Scattering::createInfo() const noexcept {
+  return impl_->info;
+}
+
+Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
+  Impl& m = *impl_;
+  const CreateInfo& info = m.info;
+  if (!f.camera) invalid("Scattering::FrameAttribs.camera", "null", "must be set");
+  if (!f.light) invalid("Scattering::FrameAttribs.light", "null", "must be set");
+  if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
+  gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
+  gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
+  if (!f.drawCasters && !f.shadowMap)
+    invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
+  if (f.shadowMap) {
+    gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture,
+                         f.shadowMap->width, f.shadowMap->height);
+    if (!std::isfinite(f.shadowMap->bias))
+      invalid("Scattering::FrameAttribs.shadowMap.bias", detail::formatValue(f.shadowMap->bias),
+              "must be finite");
+    try {
+      validateLightMatrix(f.shadowMap->lightClipFromWorld, f.light->direction());
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument("Scattering::FrameAttribs.shadowMap.lightClipFromWorld", e.what(),
+                            "an orthographic shadow matrix looking along the light");
+    }
+  }
+
+  FrameResult r;
+  const auto stage = [&](const char* name, const auto& work) {
+    if (!info.stageTimings) {
+      work();
+      r.stages.push_back({name, 0.0, 0.0});
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    m.timer.begin();
+    work();
+    m.timer.end();
+    glFinish();
+    const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
+    r.stages.push_back({name, m.timer.milliseconds(), wall.count()});
+  };
+  r.rectification = rectify(*f.camera, *f.light, info.rectify);
+  std::shared_ptr<const RectifiedLayout> layout;
+  std::uint32_t map = 0;
+  ShadowMap own;
+  const ShadowMap* shadow = f.shadowMap;
+  if (r.rectification.projective()) {
+    // Klehm et al. 2014, Sec. 4.2: the casters rendered once per split with its matrix.
+    r.layout = Layout::Projective;
+    auto projective = std::make_shared<const ProjectiveLayout>(r.rectification);
+    layout = projective;
+    if (f.drawCasters) {
+      stage("shadow pass (rectified)", [&] {
+        m.rectified.render(r.rectification.splitCount(), [&](int k) {
+          const SplitViewport v = r.rectification.splitViewport(k, info.mapSize, info.mapSize);
+          glViewport(v.x, v.y, v.width, v.height);
+          f.drawCasters(r.rectification.splits[static_cast<std::size_t>(k)].rectClipFromWorld);
+        });
+      });
+      map = m.rectified.texture.get();
+    } else {
+      stage("resample (projective)", [&] {
+        m.resample.run({projective.get(), shadow->texture, shadow->width, shadow->height,
+                        shadow->lightClipFromWorld, m.resampled.get()});
+      });
+      map = m.resampled.get();
+    }
+  } else {
+    // Sec. 4.1: the standard shadow map resampled into epipolar slices (mapSize of them, so the cost of the
+    // frame stays that of a projective one).
+    r.layout = Layout::Epipolar;
+    EpipolarOptions options;
+    options.slices = info.mapSize;
+    options.regions = info.rectify.splits;
+    options.epipoleBlockRadius = info.epipoleBlockRadius;
+    auto epipolar =
+        std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
+    layout = epipolar;
+    if (!shadow) {
+      if (!m.ownShadowMap) m.ownShadowMap.emplace(info.ownShadowMapSize);
+      own.texture = m.ownShadowMap->texture.get();
+      own.width = own.height = info.ownShadowMapSize;
+      own.lightClipFromWorld = frustumLightClipFromWorld(*f.camera, *f.light);
+      own.bias = info.ownShadowMapBias;
+      stage("shadow pass (standard)",
+            [&] { m.ownShadowMap->render(1, [&](int) { f.drawCasters(own.lightClipFromWorld); }); });
+      shadow = &own;
+    }
+    r.shadowMap = *shadow;
+    stage("resample (epipolar)", [&] {
+      m.resample.run({epipolar.get(), shadow->texture, shadow->width, shadow->height,
+                      shadow->lightClipFromWorld, m.resampled.get()});
+    });
+    map = m.resampled.get();
+  }
+  stage("prefilter", [&] { m.prefilter.run({map, layout.get(), f.medium}); });
+  stage("evaluate", [&] {
+    EvaluatePass::FrameAttribs e;
+    e.cameraDepth = f.cameraDepth;
+    e.output = f.output;
+    e.camera = f.camera;
+    e.light = f.light;
+    e.medium = f.medium;
+    e.layout = layout.get();
+    e.basis = m.prefilter.filteredBasis();
+    m.evaluate.run(e);
+  });
+  if (r.layout == Layout::Epipolar) {
+    const auto& epipolar = static_cast<const EpipolarLayout&>(*layout);
+    const auto centre = epipolar.epipolePixel();
+    const double radius = epipolar.epipoleBlockRadiusPixels();
+    if (centre && radius > 0.0) {
+      // Fig. 8: the pixels next to the epipole, where the slices converge, marched in world space.
+      r.epipoleBlockRadius = radius;
+      stage("epipole block", [&] {
+        WorldMarchPass::FrameAttribs b;
+        b.camera = f.camera;
+        b.light = f.light;
+        b.medium = f.medium;
+        b.cameraDepth = f.cameraDepth;
+        b.width = info.width;
+        b.height = info.height;
+        b.shadowMap = shadow->texture;
+        b.shadowWidth = shadow->width;
+        b.shadowHeight = shadow->height;
+        b.lightClipFromWorld = shadow->lightClipFromWorld;
+        b.bias = shadow->bias;
+        b.scatteringOut = f.output;
+        b.blockCenter = *centre;
+        b.blockRadius = radius;
+        m.block.run(b);
+      });
+    }
+  }
+  gl::checkError("Scattering::run");
+  return r;
+}
+
+} // namespace crep

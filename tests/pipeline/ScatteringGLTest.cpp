@@ -1,0 +1,282 @@
+// crep::Scattering, the frame-level front door (crep/pipeline/scattering.h): the same image as the passes
+// run by hand on projective frames, the prefiltered method on fallback frames (sun in view, sun behind the
+// camera) close to the world-space reference, with either shadow input; bad input named; GL state kept.
+// 160 x 90 screens, 256^2 maps.
+#include "epipolar/epipolar_test_util.h"
+#include "support/gl_fixture.h"
+#include "support/image_check.h"
+
+#include <crep/core/error.h>
+#include <crep/core/gl.h>
+#include <crep/pipeline/scattering.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/scatter/gpu_world_march.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <doctest/doctest.h>
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <string>
+
+using namespace crep;
+using namespace crep::test;
+
+namespace {
+
+constexpr int kWidth = 160, kHeight = 90, kMap = 256, kShadow = 1024;
+
+struct Frame {
+  explicit Frame(const char* name)
+      : scene(scenes::makeScene(name, double(kWidth) / kHeight)), renderer(scene.mesh) {
+    cameraDepth = scenes::createDepthTexture(kWidth, kHeight);
+    renderer.renderDepth(scene.camera.clipFromWorld(), cameraDepth.get(), 0, 0, 0, kWidth, kHeight);
+    output = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+    shadow.texture = shadowTexture.get();
+    setLight(scene.sun);
+  }
+  void setLight(const DirectionalLight& light) {
+    scene.sun = light;
+    shadow.width = shadow.height = kShadow;
+    shadow.lightClipFromWorld = scenes::standardLightClipFromWorld(light, scene.boundsMin, scene.boundsMax);
+    shadow.bias = 1e-4;
+    renderer.renderDepth(shadow.lightClipFromWorld, shadowTexture.get(), 0, 0, 0, kShadow, kShadow,
+                         {.depthClamp = true});
+  }
+  /// Light toward the camera axes combination (forward, right, up).
+  void lightToward(double f, double r, double u) {
+    const Camera& c = scene.camera;
+    setLight(DirectionalLight(-glm::normalize(f * c.forward() + r * c.right() + u * c.up()),
+                              scene.sun.irradiance()));
+  }
+  Scattering::FrameAttribs attribs(bool casters, bool shadowMap) {
+    Scattering::FrameAttribs a;
+    a.camera = &scene.camera;
+    a.light = &scene.sun;
+    a.medium = &scene.medium;
+    a.cameraDepth = cameraDepth.get();
+    a.output = output.get();
+    if (casters)
+      a.drawCasters = [this](const glm::dmat4& clipFromWorld) { renderer.drawDepth(clipFromWorld); };
+    if (shadowMap) a.shadowMap = &shadow;
+    return a;
+  }
+  Image read() const { return gl::readTexture(output.get(), kWidth, kHeight, gl::TexelData::Rgba); }
+  /// The world-space reference march against the standard shadow map (GPU pass, tested against the CPU).
+  Image reference() { return reference(shadow); }
+  Image reference(const Scattering::ShadowMap& map) {
+    static WorldMarchPass pass({{.steps = 256, .refinements = 12}});
+    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+    WorldMarchPass::FrameAttribs f;
+    f.camera = &scene.camera;
+    f.light = &scene.sun;
+    f.medium = &scene.medium;
+    f.cameraDepth = cameraDepth.get();
+    f.width = kWidth;
+    f.height = kHeight;
+    f.shadowMap = map.texture;
+    f.shadowWidth = map.width;
+    f.shadowHeight = map.height;
+    f.lightClipFromWorld = map.lightClipFromWorld;
+    f.bias = map.bias;
+    f.scatteringOut = out.get();
+    pass.run(f);
+    return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
+  }
+
+  scenes::Scene scene;
+  scenes::SceneRenderer renderer;
+  gl::Handle cameraDepth, output, shadowTexture = scenes::createDepthTexture(kShadow, kShadow);
+  Scattering::ShadowMap shadow;
+};
+
+Scattering::CreateInfo smallInfo() {
+  Scattering::CreateInfo info;
+  info.width = kWidth;
+  info.height = kHeight;
+  info.mapSize = kMap;
+  info.ownShadowMapSize = kShadow;
+  return info;
+}
+
+void checkStages(const Scattering::FrameResult& r) {
+  std::string names;
+  for (const Scattering::Stage& s : r.stages) {
+    names += s.name + "; ";
+    CHECK(std::isfinite(s.gpuMilliseconds));
+    CHECK(s.gpuMilliseconds >= 0.0);
+    CHECK(s.wallMilliseconds > 0.0);
+  }
+  MESSAGE("stages: " << names);
+  CHECK(names.find("prefilter") != std::string::npos);
+  CHECK(names.find("evaluate") != std::string::npos);
+}
+
+} // namespace
+
+TEST_CASE("Scattering: a projective frame gives the image of the passes run by hand") {
+  CREP_REQUIRE_GL();
+  Frame f("colonnade");
+  Scattering scattering(smallInfo());
+  const Scattering::FrameResult r = scattering.run(f.attribs(true, true));
+  CHECK(r.layout == Scattering::Layout::Projective);
+  CHECK(r.epipoleBlockRadius == 0.0);
+  checkStages(r);
+  CHECK(r.stages.front().name == "shadow pass (rectified)");
+  const Image ours = f.read();
+
+  // By hand: the rectified map rasterized with the split matrices, the prefilter and evaluation passes.
+  const Rectification rect = rectify(f.scene.camera, f.scene.sun, smallInfo().rectify);
+  REQUIRE(rect.projective());
+  const gl::Handle map = scenes::createDepthTexture(kMap, kMap);
+  f.renderer.renderRectified(rect, map.get(), kMap, kMap);
+  const ProjectiveLayout layout(rect);
+  PrefilterPass prefilter({kMap, kMap, {}});
+  prefilter.run({map.get(), &layout, &f.scene.medium});
+  EvaluatePass evaluate({});
+  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+  evaluate.run({f.cameraDepth.get(), out.get(), &f.scene.camera, &f.scene.sun, &f.scene.medium, &layout,
+                prefilter.filteredBasis()});
+  const Image byHand = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
+  CHECK(maxRelativeDifference(ours, byHand, 1e-6) == 0.0);
+
+  // Without the caster callback the map is resampled from the standard one: close, not equal.
+  const Scattering::FrameResult resampled = scattering.run(f.attribs(false, true));
+  CHECK(resampled.layout == Scattering::Layout::Projective);
+  CHECK(resampled.stages.front().name == "resample (projective)");
+  const ImageMetrics m = rgbMetrics(f.read(), f.reference());
+  report("projective, resampled standard map vs world-space reference", m);
+  CHECK(m.relativeRmse < 0.05);
+}
+
+TEST_CASE("Scattering: fallback frames are prefiltered on the epipolar layout, close to the reference") {
+  CREP_REQUIRE_GL();
+  Frame f("forest");
+  Scattering scattering(smallInfo());
+  struct Case {
+    const char* name;
+    double forward, right, up;
+  };
+  for (const Case& c :
+       {Case{"sun in view", 1.0, 0.25, 0.2}, Case{"sun behind the camera", -1.0, -0.3, 0.4}}) {
+    CAPTURE(c.name);
+    f.lightToward(c.forward, c.right, c.up);
+    for (const bool casters : {false, true}) {
+      CAPTURE(casters);
+      // With casters only, Scattering renders its own standard shadow map (fitted to the frustum).
+      const Scattering::FrameResult r = scattering.run(f.attribs(casters, !casters));
+      INFO(r.rectification.message);
+      CHECK(r.layout == Scattering::Layout::Epipolar);
+      CHECK_FALSE(r.rectification.projective());
+      checkStages(r);
+      if (std::string(c.name) == "sun in view") {
+        CHECK(r.epipoleBlockRadius > 0.0);
+        CHECK(r.stages.back().name == "epipole block");
+      }
+      // The reference marches the standard map the frame used: the engine's, or Scattering's own (fitted to
+      // the frustum, so its texels differ from the engine's: rays toward the sun fall into one texel each).
+      REQUIRE(r.shadowMap.texture != 0);
+      if (casters)
+        CHECK(r.shadowMap.texture != f.shadowTexture.get());
+      else
+        CHECK(r.shadowMap.texture == f.shadowTexture.get());
+      const ImageMetrics m = rgbMetrics(f.read(), f.reference(r.shadowMap));
+      report(std::string(c.name) + (casters ? ", own shadow map" : ", engine's shadow map") +
+                 ": prefiltered (epipolar) vs world-space reference",
+             m);
+      CHECK(m.nanCount == 0);
+      CHECK(m.relativeRmse < 0.05);
+    }
+  }
+}
+
+TEST_CASE("Scattering: bad input is named, GL state is restored") {
+  CREP_REQUIRE_GL();
+  Frame f("boxes");
+  const auto parameterOf = [](const auto& call) -> std::string {
+    try {
+      call();
+    } catch (const InvalidArgument& e) {
+      return e.parameter();
+    }
+    return "(no error)";
+  };
+  Scattering::CreateInfo bad = smallInfo();
+  bad.mapSize = 250; // not a multiple of 4 splits
+  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.mapSize");
+  bad = smallInfo();
+  bad.rectify.layout = SplitLayout::Layers;
+  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.rectify.layout");
+  bad = smallInfo();
+  bad.prefilter.bases = 3;
+  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.prefilter.bases");
+
+  Scattering scattering(smallInfo());
+  Scattering::FrameAttribs a = f.attribs(true, false);
+  a.camera = nullptr;
+  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.camera");
+  a = f.attribs(false, false);
+  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.drawCasters/shadowMap");
+  const gl::Handle rgba8 = gl::createTexture2D(GL_RGBA8, kWidth, kHeight);
+  a = f.attribs(true, false);
+  a.output = rgba8.get();
+  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.output");
+  const gl::Handle small = scenes::createDepthTexture(kWidth / 2, kHeight);
+  a = f.attribs(true, false);
+  a.cameraDepth = small.get();
+  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.cameraDepth");
+
+  // The raster state the shadow pass changes is the caller's again afterwards.
+  const gl::Handle fb = gl::createFramebuffer();
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fb.get());
+  glViewport(3, 4, 50, 60);
+  glEnable(GL_CULL_FACE);
+  glDisable(GL_DEPTH_TEST);
+  glDepthFunc(GL_GEQUAL);
+  scattering.run(f.attribs(true, false));
+  GLint binding = 0, viewport[4] = {}, func = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &binding);
+  glGetIntegerv(GL_VIEWPORT, viewport);
+  glGetIntegerv(GL_DEPTH_FUNC, &func);
+  CHECK(static_cast<GLuint>(binding) == fb.get());
+  CHECK(viewport[0] == 3);
+  CHECK(viewport[3] == 60);
+  CHECK(glIsEnabled(GL_CULL_FACE) == GL_TRUE);
+  CHECK(glIsEnabled(GL_DEPTH_TEST) == GL_FALSE);
+  CHECK(glIsEnabled(GL_DEPTH_CLAMP) == GL_FALSE);
+  CHECK(func == GL_GEQUAL);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+}
+
+TEST_CASE(
+    "Scattering: the epipole exactly on a screen corner or edge gives a finite image near the reference") {
+  CREP_REQUIRE_GL();
+  Frame f("forest");
+  Scattering scattering(smallInfo());
+  struct Case {
+    const char* name;
+    double ndcX, ndcY;
+  };
+  for (const Case& c : {Case{"corner (1, 1)", 1.0, 1.0}, Case{"corner (-1, -1)", -1.0, -1.0},
+                        Case{"edge (1, 0)", 1.0, 0.0}, Case{"edge (0, -1)", 0.0, -1.0}}) {
+    CAPTURE(c.name);
+    // The light comes from the direction of the view ray through that NDC point: the epipole is there.
+    const glm::dvec3 towardLight = f.scene.camera.rayDirection(c.ndcX, c.ndcY);
+    f.setLight(DirectionalLight(-towardLight, f.scene.sun.irradiance()));
+    const Scattering::FrameResult r = scattering.run(f.attribs(false, true));
+    CHECK(r.layout == Scattering::Layout::Epipolar);
+    const Image ours = f.read();
+    const ImageMetrics m = rgbMetrics(ours, f.reference(r.shadowMap));
+    report(std::string("epipole on the ") + c.name + ": prefiltered (epipolar) vs world-space reference", m);
+    CHECK(m.nanCount == 0);
+    CHECK(m.infCount == 0);
+    CHECK(ours.width() == kWidth);
+    // Accuracy here is an open item (issue 9, "accuracy next to the sun": 2% of the reference): measured
+    // 3.1% (corner (1, 1)), 12% (edge (1, 0)), 66-77% (light from below the ground: edge (0, -1), corner
+    // (-1, -1), where the reference is nearly black). Reported, not asserted, until the fallback improves.
+    WARN(m.relativeRmse < 0.02);
+  }
+}
