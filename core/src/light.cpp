@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -62,6 +63,25 @@ glm::dmat4 SpotLight::lightViewFromWorld() const {
 
 glm::dmat4 SpotLight::lightClipFromLightView() const {
   return glm::perspectiveRH_NO(2.0 * coneAngle_, 1.0, near_, range_);
+}
+
+glm::dmat4 orthographicLightClipFromWorld(const DirectionalLight& light, std::span<const glm::dvec3> points) {
+  glm::dvec3 centre(0.0);
+  for (const glm::dvec3& p : points)
+    centre += p / static_cast<double>(points.size());
+  const glm::dvec3 dir = light.direction();
+  const glm::dmat4 lightViewFromWorld = glm::lookAtRH(centre - dir, centre, anyOrthogonal(dir));
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (const glm::dvec3& p : points) {
+    const glm::dvec3 q(lightViewFromWorld * glm::dvec4(p, 1.0));
+    lo = glm::min(lo, q);
+    hi = glm::max(hi, q);
+  }
+  // View space looks down -Z: near = -hi.z, far = -lo.z; a small margin keeps boundary casters.
+  const double margin = 1e-3 * glm::length(hi - lo);
+  return glm::orthoRH_NO(lo.x - margin, hi.x + margin, lo.y - margin, hi.y + margin, -hi.z - margin,
+                         -lo.z + margin) *
+         lightViewFromWorld;
 }
 
 } // namespace crep

@@ -21,11 +21,7 @@ namespace crep {
 namespace gpu {
 
 LayoutKind layoutKind(const RectifiedLayout& layout) {
-  const std::optional<GpuLayoutData> data = layout.gpuLayoutData();
-  if (!data)
-    throw InvalidArgument("layout", "a RectifiedLayout without GPU mapping",
-                          "must be a ProjectiveLayout or an EpipolarLayout");
-  return data->kind;
+  return requireGpuLayout(layout).kind;
 }
 
 } // namespace gpu
@@ -92,7 +88,8 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (!f.layout) throw InvalidArgument("RectifiedMarchPass.FrameAttribs.layout", "null", "must be set");
   if (!f.camera || !f.light || !f.medium)
     throw InvalidArgument("RectifiedMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
-  const gpu::LayoutKind kind = gpu::layoutKind(*f.layout);
+  const GpuLayoutData layoutData = gpu::requireGpuLayout(*f.layout); // serialized once per run
+  const gpu::LayoutKind kind = layoutData.kind;
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (W % f.layout->regionCount() != 0)
     throw InvalidArgument("RectifiedMarchPass.mapSize", std::to_string(W),
@@ -131,7 +128,7 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   gpu::MarchParams params = gpu::makeMarchParams(*f.camera, *f.light, *f.medium, f.width, f.height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-  layoutBuffers_.upload(*f.layout, H);
+  layoutBuffers_.upload(layoutData, H);
 
   const GLuint steps = f.stepsOut != 0 ? f.stepsOut
                                        : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,

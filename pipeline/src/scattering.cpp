@@ -11,12 +11,9 @@
 
 #include <epoxy/gl.h>
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <optional>
 
 namespace crep {
@@ -54,27 +51,6 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
             "must be in [0, 0.5] (a fraction of the screen diagonal)");
   return info;
-}
-
-/// An orthographic shadow matrix along the light that covers the camera frustum (casters between the light
-/// and the frustum are kept by GL_DEPTH_CLAMP, which puts them at depth 0).
-glm::dmat4 frustumLightClipFromWorld(const Camera& camera, const DirectionalLight& light) {
-  const FrustumCorners corners = camera.frustumCorners();
-  glm::dvec3 centre(0.0);
-  for (const glm::dvec3& c : corners)
-    centre += c / 8.0;
-  const glm::dvec3 dir = light.direction();
-  const glm::dmat4 view = glm::lookAtRH(centre - dir, centre, anyOrthogonal(dir));
-  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-  for (const glm::dvec3& c : corners) {
-    const glm::dvec3 p(view * glm::dvec4(c, 1.0));
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  const double margin = 1e-3 * glm::length(hi - lo);
-  return glm::orthoRH_NO(lo.x - margin, hi.x + margin, lo.y - margin, hi.y + margin, -hi.z - margin,
-                         -lo.z + margin) *
-         view;
 }
 
 /// The GL state a shadow pass changes, restored on destruction.
@@ -245,7 +221,8 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
       if (!m.ownShadowMap) m.ownShadowMap.emplace(info.ownShadowMapSize);
       own.texture = m.ownShadowMap->texture.get();
       own.width = own.height = info.ownShadowMapSize;
-      own.lightClipFromWorld = frustumLightClipFromWorld(*f.camera, *f.light);
+      // A standard map covering the frustum (casters between the light and it are kept by GL_DEPTH_CLAMP).
+      own.lightClipFromWorld = orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners());
       own.bias = info.ownShadowMapBias;
       stage("shadow pass (standard)",
             [&] { m.ownShadowMap->render(1, [&](int) { f.drawCasters(own.lightClipFromWorld); }); });

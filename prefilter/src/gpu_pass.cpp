@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 
 namespace crep {
@@ -188,12 +189,11 @@ std::vector<gpu::RegionWeights> gpuRegionWeights(const std::vector<DistanceProfi
   return out;
 }
 
-gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const RectifiedLayout& layout,
-                                           const DirectionalLight& light, const Medium& medium) {
+namespace {
+/// makeScatteringParams() for a layout known to have a GPU mapping (checked by the caller).
+gpu::ScatteringParams scatteringParamsOf(const FilteredBasisView& basis, const RectifiedLayout& layout,
+                                         const DirectionalLight& light, const Medium& medium) {
   const auto* projective = dynamic_cast<const ProjectiveLayout*>(&layout);
-  if (projective == nullptr && !layout.gpuLayoutData())
-    invalid("layout", "a RectifiedLayout without GPU mapping",
-            "must be a ProjectiveLayout or an EpipolarLayout");
   const int K = layout.regionCount();
   if (K != basis.layoutRegions)
     invalid("layout", "regionCount() " + str(K),
@@ -234,6 +234,13 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
                            static_cast<int>(basis.weights));
   p.depthMargin = glm::vec4(static_cast<float>(basis.depthMargin), 0.0f, 0.0f, 0.0f);
   return p;
+}
+} // namespace
+
+gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const RectifiedLayout& layout,
+                                           const DirectionalLight& light, const Medium& medium) {
+  if (dynamic_cast<const ProjectiveLayout*>(&layout) == nullptr) gpu::requireGpuLayout(layout);
+  return scatteringParamsOf(basis, layout, light, medium);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -440,7 +447,6 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   gl::checkError("EvaluatePass: samplers and buffers");
 }
 
-
 EvaluatePass::~EvaluatePass() = default;
 EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
@@ -477,15 +483,18 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     invalid("EvaluatePass::FrameAttribs.output", sizeString(out.width, out.height),
             "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
 
-  const gpu::ScatteringParams scattering =
-      makeScatteringParams(basis, *frame.layout, *frame.light, *frame.medium);
   // A projective layout is evaluated from the scattering block's frame (the default program); any other
-  // layout with a GPU mapping through its own block (Klehm et al. 2014, Sec. 4.1 for the epipolar one).
-  GLuint program = program_.get();
+  // layout with a GPU mapping through its own block (Klehm et al. 2014, Sec. 4.1 for the epipolar one),
+  // serialized once here.
   const bool projective = dynamic_cast<const ProjectiveLayout*>(frame.layout) != nullptr;
+  std::optional<GpuLayoutData> layoutData;
+  if (!projective) layoutData = gpu::requireGpuLayout(*frame.layout);
+  const gpu::ScatteringParams scattering =
+      scatteringParamsOf(basis, *frame.layout, *frame.light, *frame.medium);
+  GLuint program = program_.get();
   if (!projective) {
     const gpu::LayoutKind kind =
-        layoutBuffers_.upload(*frame.layout, basis.height, "EvaluatePass::FrameAttribs.layout");
+        layoutBuffers_.upload(*layoutData, basis.height, "EvaluatePass::FrameAttribs.layout");
     gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
     if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
     program = variant.get();

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 namespace crep::gpu {
 
@@ -14,11 +15,20 @@ namespace {
 constexpr std::size_t kMaxBlockBytes = 16 * (16 + kMaxLayoutRegions);
 } // namespace
 
-LayoutKind LayoutBuffers::upload(const RectifiedLayout& layout, int mapHeight, const char* parameter) {
-  const std::optional<GpuLayoutData> data = layout.gpuLayoutData();
+GpuLayoutData requireGpuLayout(const RectifiedLayout& layout, const char* parameter) {
+  std::optional<GpuLayoutData> data = layout.gpuLayoutData();
   if (!data)
     throw InvalidArgument(parameter, "a RectifiedLayout without GPU mapping",
                           "must be a ProjectiveLayout or an EpipolarLayout");
+  return std::move(*data);
+}
+
+LayoutKind LayoutBuffers::upload(const RectifiedLayout& layout, int mapHeight, const char* parameter) {
+  return upload(requireGpuLayout(layout, parameter), mapHeight, parameter);
+}
+
+LayoutKind LayoutBuffers::upload(const GpuLayoutData& d, int mapHeight, const char* parameter) {
+  const GpuLayoutData* data = &d;
   if (data->regionCount > kMaxLayoutRegions)
     throw InvalidArgument(parameter, "regionCount() " + std::to_string(data->regionCount),
                           "must be <= " + std::to_string(kMaxLayoutRegions) + " on the GPU");

@@ -8,6 +8,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace {
 const double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -128,4 +129,22 @@ TEST_CASE("Medium: invalid coefficients are named") {
   expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, kNan); });
   expectInvalid("Medium.extinction.g", [] { crep::Medium({0.1, 0.0, 0.1}); });
   expectInvalid("Medium.extinction.r", [] { crep::Medium({0, 0, 0}); });
+}
+
+TEST_CASE("orthographicLightClipFromWorld: covers the points, looks along the light") {
+  const crep::DirectionalLight light({0.3, -1.0, 0.2}, {1, 1, 1});
+  const std::vector<glm::dvec3> points = {{-5, 0, -3}, {4, 2, 1}, {0, 7, -9}, {2, -1, 6}};
+  const glm::dmat4 m = crep::orthographicLightClipFromWorld(light, points);
+  for (const glm::dvec3& p : points) {
+    const glm::dvec4 q = m * glm::dvec4(p, 1.0);
+    for (int c = 0; c < 3; ++c) {
+      CHECK(q[c] / q.w > -1.0);
+      CHECK(q[c] / q.w < 1.0);
+    }
+  }
+  // The light direction maps to a pure depth increase (every light ray is one texel).
+  const glm::dvec4 d = m * glm::dvec4(light.direction(), 0.0);
+  CHECK(std::abs(d.x) < 1e-12);
+  CHECK(std::abs(d.y) < 1e-12);
+  CHECK(d.z > 0.0);
 }

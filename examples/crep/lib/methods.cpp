@@ -12,7 +12,6 @@
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/resample.h>
 #include <crep/pipeline/scattering.h>
-#include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scenes/scene_renderer.h>
 
@@ -112,7 +111,7 @@ void marchEpipoleBlock(const Frame& frame, const MethodSettings& settings, const
 
 /// The min/max tree (tree = true) or brute-force march of every pixel's view ray along its row of the
 /// rectified map (projective), or of the epipolar fallback map (plus the epipole block).
-MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, bool tree, const char* caller) {
+MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, bool tree) {
   MethodOutput out;
   out.used = tree ? "minmax" : "brute";
   Rectification rect;
@@ -128,9 +127,9 @@ MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, boo
     out.detail = std::to_string(map->rect.splitCount()) + " splits, map " + std::to_string(map->size) +
                  "^2 " + map->source;
   } else {
-    std::fprintf(stderr,
-                 "crep: %s: rectification is %s (%s); using the epipolar resampling fallback (%s march)\n",
-                 caller, statusToken(rect.status), rect.message.c_str(), tree ? "min/max" : "brute-force");
+    std::fprintf(
+        stderr, "crep: %s: rectification is %s (%s); using the epipolar resampling fallback (%s march)\n",
+        out.used.c_str(), statusToken(rect.status), rect.message.c_str(), tree ? "min/max" : "brute-force");
     epipolar = makeEpipolarMap(frame, settings, out.timings);
     layout = epipolar->layout.get();
     texture = epipolar->texture.get();
@@ -175,16 +174,16 @@ MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, boo
 }
 
 MethodOutput runMinMax(Frame& frame, const MethodSettings& settings) {
-  return runRectifiedMarch(frame, settings, true, "minmax");
+  return runRectifiedMarch(frame, settings, true);
 }
 MethodOutput runBrute(Frame& frame, const MethodSettings& settings) {
-  return runRectifiedMarch(frame, settings, false, "brute");
+  return runRectifiedMarch(frame, settings, false);
 }
 
 /// Klehm et al. 2014 on every frame through the library's front door (crep::Scattering): the rectified map
 /// rasterized with the scene's casters (built-in scenes) or resampled from the standard shadow map (users'
 /// data) when the rectification is projective, else the epipolar fallback with the epipole block. The
-/// stages are Scattering's GPU times.
+/// stages are Scattering's wall-clock stage times (like every other method's).
 MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
   MethodOutput out;
   out.used = "prefilter";

@@ -151,28 +151,16 @@ std::optional<double> RayCaster::firstHit(const glm::dvec3& o, const glm::dvec3&
 
 } // namespace crep::scenes
 
-#include <glm/gtc/matrix_transform.hpp>
-
 namespace crep::scenes {
 
 glm::dmat4 standardLightClipFromWorld(const DirectionalLight& light, const glm::dvec3& boundsMin,
                                       const glm::dvec3& boundsMax) {
-  const glm::dvec3 centre = 0.5 * (boundsMin + boundsMax);
-  const glm::dvec3 dir = light.direction();
-  const glm::dvec3 up = anyOrthogonal(dir);
-  const glm::dmat4 lightViewFromWorld = glm::lookAtRH(centre - dir, centre, up);
-  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-  for (int i = 0; i < 8; ++i) {
-    const glm::dvec3 corner((i & 1) ? boundsMax.x : boundsMin.x, (i & 2) ? boundsMax.y : boundsMin.y,
-                            (i & 4) ? boundsMax.z : boundsMin.z);
-    const glm::dvec3 p(lightViewFromWorld * glm::dvec4(corner, 1.0));
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  // View space looks down -Z: near = -hi.z, far = -lo.z; a small margin keeps boundary casters.
-  const double margin = 1e-3 * glm::length(hi - lo);
-  return glm::orthoRH_NO(lo.x - margin, hi.x + margin, lo.y - margin, hi.y + margin, -hi.z - margin, -lo.z + margin) *
-         lightViewFromWorld;
+  std::array<glm::dvec3, 8> corners;
+  for (int i = 0; i < 8; ++i)
+    corners[static_cast<std::size_t>(i)] =
+        glm::dvec3((i & 1) ? boundsMax.x : boundsMin.x, (i & 2) ? boundsMax.y : boundsMin.y,
+                   (i & 4) ? boundsMax.z : boundsMin.z);
+  return orthographicLightClipFromWorld(light, corners);
 }
 
 } // namespace crep::scenes

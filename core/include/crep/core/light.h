@@ -1,6 +1,8 @@
 // Light sources. Colours are linear RGB. Directions are unit vectors in world space.
 #pragma once
 
+#include <span>
+
 #include <glm/glm.hpp>
 
 namespace crep {
@@ -51,5 +53,10 @@ private:
 
 /// Any unit vector orthogonal to `n` (n must be unit length); stable for every direction.
 glm::dvec3 anyOrthogonal(const glm::dvec3& n);
+
+/// A standard shadow map's matrix for `light`: an orthographic projection looking along the light whose
+/// box tightly covers `points` (plus a margin of 1e-3 of its diagonal), GL conventions (NDC z in [-1, 1]).
+/// Casters between the light and the box need GL_DEPTH_CLAMP to be kept. `points` must not be empty.
+glm::dmat4 orthographicLightClipFromWorld(const DirectionalLight& light, std::span<const glm::dvec3> points);
 
 } // namespace crep

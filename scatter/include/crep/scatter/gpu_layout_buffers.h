@@ -10,6 +10,9 @@
 
 namespace crep::gpu {
 
+/// `layout`'s GPU description; throws InvalidArgument naming `parameter` when it has no GPU mapping.
+GpuLayoutData requireGpuLayout(const RectifiedLayout& layout, const char* parameter = "layout");
+
 class LayoutBuffers {
 public:
   /// Uploads `layout`'s block and row table for a map of `mapHeight` rows. Throws InvalidArgument naming
@@ -17,6 +20,8 @@ public:
   /// different map height (an EpipolarLayout: one row per slice). Returns the layout's kind (the value of
   /// CREP_LAYOUT for the shader).
   LayoutKind upload(const RectifiedLayout& layout, int mapHeight, const char* parameter = "layout");
+  /// The same for a description already made with requireGpuLayout() (a layout is serialized once per run).
+  LayoutKind upload(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
   /// Binds the block at uniform buffer `blockBinding` and, for layouts with a row table, the table at
   /// storage buffer `rowsBinding` (the defaults of glsl/crep/epipolar.glsl are 1 and 1).
   void bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const;
