@@ -31,7 +31,7 @@ commands:
 
 const char* const kRender =
     R"(  render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
-            --scene NAME        colonnade (default) | forest | terrain | boxes
+            --scene NAME        colonnade (default) | forest | terrain | boxes | sunset (sun in view)
             --size WxH          image size (default 1280x720)
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
                                 against a standard shadow map) | the other methods listed below

@@ -140,7 +140,7 @@ Medium defaultMedium() { return Medium(glm::dvec3(0.02, 0.022, 0.025), glm::dvec
 
 } // namespace
 
-std::vector<std::string> sceneNames() { return {"colonnade", "forest", "terrain", "boxes"}; }
+std::vector<std::string> sceneNames() { return {"colonnade", "forest", "terrain", "boxes", "sunset"}; }
 
 Scene makeScene(std::string_view name, double aspect) {
   const double fov = 60.0 * std::numbers::pi / 180.0;
@@ -174,7 +174,17 @@ Scene makeScene(std::string_view name, double aspect) {
     computeBounds(s);
     return s;
   }
-  throw InvalidArgument("scene", std::string(name), "must be one of colonnade, forest, terrain, boxes");
+  if (name == "sunset") {
+    // The forest toward a low sun behind the canopy: the sun is in view (about 12 degrees up, 10 degrees right
+    // of the view axis), so every frame takes the epipolar layout; the classic god-ray picture.
+    Scene s{"sunset", forestMesh(),
+            Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
+            DirectionalLight(-glm::normalize(glm::dvec3(0.18, 0.22, -1.0)), glm::dvec3(6.0, 4.4, 2.8)),
+            Medium(glm::dvec3(0.025, 0.027, 0.03), glm::dvec3(0.005), 0.7), {}, {}};
+    computeBounds(s);
+    return s;
+  }
+  throw InvalidArgument("scene", std::string(name), "must be one of colonnade, forest, terrain, boxes, sunset");
 }
 
 } // namespace crep::scenes

@@ -40,7 +40,8 @@ struct Scene {
 };
 
 /// Names accepted by makeScene: "colonnade" (default), "forest", "terrain", "boxes" (an analytic
-/// arrangement: a ground plane and a few boxes, for exact tests).
+/// arrangement: a ground plane and a few boxes, for exact tests), "sunset" (the forest looking toward a
+/// low sun behind the canopy: the sun in view, an epipolar-layout frame).
 std::vector<std::string> sceneNames();
 /// Builds a scene. `aspect` sets the default camera's aspect ratio. Throws InvalidArgument naming
 /// "scene" for an unknown name.
