@@ -53,6 +53,9 @@ void validate(const EpipolarOptions& o) {
   if (!(o.epipoleBlockRadius >= 0.0) || !std::isfinite(o.epipoleBlockRadius))
     throw InvalidArgument("EpipolarOptions.epipoleBlockRadius", detail::formatValue(o.epipoleBlockRadius),
                           "must be finite and >= 0");
+  if (!(o.depthWarp >= 0.0) || !std::isfinite(o.depthWarp))
+    throw InvalidArgument("EpipolarOptions.depthWarp", detail::formatValue(o.depthWarp),
+                          "must be finite and >= 0");
 }
 
 // Sec. 4.1 (Baran-style epipolar coordinates) with Yusov Sec. 6.1: epipole, exit sides, border arc, slice
@@ -233,9 +236,28 @@ double EpipolarLayout::fractionColumn(double fraction) const {
   return (k + (fraction - f0) / (f1 - f0)) / K;
 }
 
+double EpipolarLayout::warp(double psi) const {
+  const double e = options_.depthWarp;
+  return e > 0.0 ? std::log((psi + e) / (kPi - psi + e)) : psi;
+}
+
+double EpipolarLayout::unwarp(double g) const {
+  const double e = options_.depthWarp;
+  if (!(e > 0.0)) return g;
+  const double r = std::exp(g);
+  return std::clamp((r * (kPi + e) - e) / (1.0 + r), 0.0, kPi);
+}
+
 double EpipolarLayout::psi(int slice, double depth) const {
   const Slice& s = slices_[static_cast<std::size_t>(std::clamp(slice, 0, sliceCount() - 1))];
-  return s.psiMin + depth * (s.psiMax - s.psiMin);
+  const double g0 = warp(s.psiMin), g1 = warp(s.psiMax);
+  return unwarp(g0 + depth * (g1 - g0));
+}
+
+double EpipolarLayout::depthOfPsi(int slice, double psiValue) const {
+  const Slice& s = slices_[static_cast<std::size_t>(std::clamp(slice, 0, sliceCount() - 1))];
+  const double g0 = warp(s.psiMin), g1 = warp(s.psiMax);
+  return (warp(psiValue) - g0) / (g1 - g0);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -345,7 +367,7 @@ RectPoint EpipolarLayout::toRectified(const glm::dvec3& world) const {
   p.row = rowOfSigma(view->exitSigma);
   const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(p.row))];
   const double fraction = b / s.bMax;
-  p.depth = (std::atan2(b, a) - s.psiMin) / (s.psiMax - s.psiMin);
+  p.depth = depthOfPsi(sliceIndex(p.row), std::atan2(b, a));
   const int K = regionCount();
   int k = 0;
   while (k < K - 1 && fraction >= fractions_[static_cast<std::size_t>(k) + 1])
@@ -396,7 +418,7 @@ double EpipolarLayout::referenceDepth(double row) const {
       psiRef = psiB < halfPi ? std::asin(std::min(1.0, k)) : kPi - std::asin(std::min(1.0, k));
     }
   }
-  return (psiRef - s.psiMin) / (s.psiMax - s.psiMin);
+  return depthOfPsi(sliceIndex(row), psiRef);
 }
 
 double EpipolarLayout::referenceDistance(double row, double column) const {

@@ -23,7 +23,8 @@ EpipolarLayoutParams makeEpipolarLayoutParams(const EpipolarLayout& layout) {
   p.border = glm::vec4(static_cast<float>(layout.screenWidth()), static_cast<float>(layout.screenHeight()),
                        static_cast<float>(layout.perimeter()), 0.0f);
   p.arc = glm::vec4(static_cast<float>(layout.arcBegin()), static_cast<float>(layout.arcLength()),
-                    layout.epipoleKind() == EpipoleKind::AntiEpipole ? 0.0f : 1.0f, 0.0f);
+                    layout.epipoleKind() == EpipoleKind::AntiEpipole ? 0.0f : 1.0f,
+                    static_cast<float>(layout.options().depthWarp));
   p.counts = glm::ivec4(layout.sliceCount(), layout.regionCount(), 0, 0);
   const std::vector<double>& f = layout.regionFractions();
   for (std::size_t k = 0; k < f.size(); ++k)
@@ -35,8 +36,8 @@ std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout) {
   std::vector<EpipolarSlice> out;
   out.reserve(layout.slices().size());
   for (const auto& s : layout.slices())
-    out.push_back({glm::vec4(static_cast<float>(s.bMax), static_cast<float>(s.psiMin),
-                             static_cast<float>(s.psiMax), 0.0f)});
+    out.push_back({glm::vec4(static_cast<float>(s.bMax), static_cast<float>(layout.warp(s.psiMin)),
+                             static_cast<float>(layout.warp(s.psiMax)), 0.0f)});
   return out;
 }
 

@@ -169,7 +169,7 @@ struct CrepEpipolarLayoutParams {
 
 // gpu::EpipolarSlice (std430).
 struct CrepEpipolarSlice {
-  vec4 bounds; // x bMax, y psiMin, z psiMax
+  vec4 bounds; // x bMax, y g(psiMin), z g(psiMax) (g: the depth warp)
 };
 
 layout(std140, binding = CREP_LAYOUT_BINDING) uniform CrepEpipolarLayoutBlock {
@@ -261,6 +261,19 @@ void crep_epipolarFractionRegion(float fraction, out int k, out float u) {
   u = (fraction - f0) / (f1 - f0);
 }
 
+// The depth warp g(psi) = log((psi + e) / (pi - psi + e)), e = arc.w (psi itself when e = 0), and its
+// inverse: depth is linear in g between the slice's bounds.
+float crep_epipolarWarp(float psi) {
+  float e = crep_epipolar.arc.w;
+  return e > 0.0 ? log((psi + e) / (3.14159265 - psi + e)) : psi;
+}
+float crep_epipolarUnwarp(float g) {
+  float e = crep_epipolar.arc.w;
+  if (!(e > 0.0)) return g;
+  float r = exp(g);
+  return clamp((r * (3.14159265 + e) - e) / (1.0 + r), 0.0, 3.14159265);
+}
+
 int crep_epipolarSliceIndex(float row) {
   int H = crep_epipolar.counts.x;
   return clamp(int(floor(row * float(H))), 0, H - 1);
@@ -293,7 +306,7 @@ bool crep_layoutToRectified(vec3 world, out vec4 p) {
   int k;
   float u;
   crep_epipolarFractionRegion(b / s.x, k, u);
-  p = vec4(row, (float(k) + u) / float(crep_epipolar.counts.y), (atan(b, a) - s.y) / (s.z - s.y), float(k));
+  p = vec4(row, (float(k) + u) / float(crep_epipolar.counts.y), (crep_epipolarWarp(atan(b, a)) - s.y) / (s.z - s.y), float(k));
   return true;
 }
 
@@ -317,9 +330,9 @@ bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
   r.row = crep_epipolarRowOfSigma(sigma);
   r.texelRow = clamp(int(floor(r.row * float(mapSize.y))), 0, mapSize.y - 1);
   vec4 s = crep_slices[r.texelRow].bounds;
-  r.depth = clamp((atan(sinPsi, a) - s.y) / (s.z - s.y), 0.0, 1.0);
+  r.depth = clamp((crep_epipolarWarp(atan(sinPsi, a)) - s.y) / (s.z - s.y), 0.0, 1.0);
   // Distances along the ray: T = (b / bMax) bMax / sin(psi), psi at z_r, b / bMax piecewise linear in i.
-  float sinRay = max(sin(s.y + r.depth * (s.z - s.y)), 1e-30);
+  float sinRay = max(sin(crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y))), 1e-30);
   int K = crep_epipolar.counts.y, n = mapSize.x / K;
   int k;
   float u;

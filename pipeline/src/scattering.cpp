@@ -44,6 +44,17 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (info.mapSize % regions != 0)
     invalid("Scattering::CreateInfo.mapSize", std::to_string(info.mapSize),
             "must be a multiple of rectify.splits * prefilter.regionsPerSplit = " + std::to_string(regions));
+  if (info.epipolarRegions < 1 || info.epipolarRegions > RectifyOptions::kMaxSplits)
+    invalid("Scattering::CreateInfo.epipolarRegions", std::to_string(info.epipolarRegions),
+            "must be in [1, " + std::to_string(RectifyOptions::kMaxSplits) + "]");
+  const int epipolarRegions = info.epipolarRegions * info.prefilter.regionsPerSplit;
+  if (info.mapSize % epipolarRegions != 0)
+    invalid("Scattering::CreateInfo.mapSize", std::to_string(info.mapSize),
+            "must be a multiple of epipolarRegions * prefilter.regionsPerSplit = " +
+                std::to_string(epipolarRegions));
+  if (!(info.epipolarDepthWarp >= 0.0 && std::isfinite(info.epipolarDepthWarp)))
+    invalid("Scattering::CreateInfo.epipolarDepthWarp", detail::formatValue(info.epipolarDepthWarp),
+            "must be finite and >= 0 (radians; 0 = linear depth)");
   if (!(info.ownShadowMapBias >= 0.0 && std::isfinite(info.ownShadowMapBias)))
     invalid("Scattering::CreateInfo.ownShadowMapBias", detail::formatValue(info.ownShadowMapBias),
             "must be finite and >= 0");
@@ -212,7 +223,9 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     r.layout = Layout::Epipolar;
     EpipolarOptions options;
     options.slices = info.mapSize;
-    options.regions = info.rectify.splits;
+    options.referenceRay = info.rectify.referenceRay;
+    options.regions = info.epipolarRegions;
+    options.depthWarp = info.epipolarDepthWarp;
     options.epipoleBlockRadius = info.epipoleBlockRadius;
     auto epipolar =
         std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
@@ -235,6 +248,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     });
     map = m.resampled.get();
   }
+  r.rectifiedMap = {layout, map, info.mapSize, info.mapSize};
   stage("prefilter", [&] { m.prefilter.run({map, layout.get(), f.medium}); });
   stage("evaluate", [&] {
     EvaluatePass::FrameAttribs e;

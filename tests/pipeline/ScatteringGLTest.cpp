@@ -2,7 +2,7 @@
 // run by hand on projective frames, the prefiltered method on fallback frames (sun in view, sun behind the
 // camera) close to the world-space reference, with either shadow input; bad input named; GL state kept.
 // 160 x 90 screens, 256^2 maps.
-#include "epipolar/epipolar_test_util.h"
+#include "pipeline/scattering_frame.h"
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 
@@ -22,98 +22,6 @@
 
 using namespace crep;
 using namespace crep::test;
-
-namespace {
-
-constexpr int kWidth = 160, kHeight = 90, kMap = 256, kShadow = 1024;
-
-struct Frame {
-  explicit Frame(const char* name)
-      : scene(scenes::makeScene(name, double(kWidth) / kHeight)), renderer(scene.mesh) {
-    cameraDepth = scenes::createDepthTexture(kWidth, kHeight);
-    renderer.renderDepth(scene.camera.clipFromWorld(), cameraDepth.get(), 0, 0, 0, kWidth, kHeight);
-    output = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
-    shadow.texture = shadowTexture.get();
-    setLight(scene.sun);
-  }
-  void setLight(const DirectionalLight& light) {
-    scene.sun = light;
-    shadow.width = shadow.height = kShadow;
-    shadow.lightClipFromWorld = scenes::standardLightClipFromWorld(light, scene.boundsMin, scene.boundsMax);
-    shadow.bias = 1e-4;
-    renderer.renderDepth(shadow.lightClipFromWorld, shadowTexture.get(), 0, 0, 0, kShadow, kShadow,
-                         {.depthClamp = true});
-  }
-  /// Light toward the camera axes combination (forward, right, up).
-  void lightToward(double f, double r, double u) {
-    const Camera& c = scene.camera;
-    setLight(DirectionalLight(-glm::normalize(f * c.forward() + r * c.right() + u * c.up()),
-                              scene.sun.irradiance()));
-  }
-  Scattering::FrameAttribs attribs(bool casters, bool shadowMap) {
-    Scattering::FrameAttribs a;
-    a.camera = &scene.camera;
-    a.light = &scene.sun;
-    a.medium = &scene.medium;
-    a.cameraDepth = cameraDepth.get();
-    a.output = output.get();
-    if (casters)
-      a.drawCasters = [this](const glm::dmat4& clipFromWorld) { renderer.drawDepth(clipFromWorld); };
-    if (shadowMap) a.shadowMap = &shadow;
-    return a;
-  }
-  Image read() const { return gl::readTexture(output.get(), kWidth, kHeight, gl::TexelData::Rgba); }
-  /// The world-space reference march against the standard shadow map (GPU pass, tested against the CPU).
-  Image reference() { return reference(shadow); }
-  Image reference(const Scattering::ShadowMap& map) {
-    static WorldMarchPass pass({{.steps = 256, .refinements = 12}});
-    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
-    WorldMarchPass::FrameAttribs f;
-    f.camera = &scene.camera;
-    f.light = &scene.sun;
-    f.medium = &scene.medium;
-    f.cameraDepth = cameraDepth.get();
-    f.width = kWidth;
-    f.height = kHeight;
-    f.shadowMap = map.texture;
-    f.shadowWidth = map.width;
-    f.shadowHeight = map.height;
-    f.lightClipFromWorld = map.lightClipFromWorld;
-    f.bias = map.bias;
-    f.scatteringOut = out.get();
-    pass.run(f);
-    return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
-  }
-
-  scenes::Scene scene;
-  scenes::SceneRenderer renderer;
-  gl::Handle cameraDepth, output, shadowTexture = scenes::createDepthTexture(kShadow, kShadow);
-  Scattering::ShadowMap shadow;
-};
-
-Scattering::CreateInfo smallInfo() {
-  Scattering::CreateInfo info;
-  info.width = kWidth;
-  info.height = kHeight;
-  info.mapSize = kMap;
-  info.ownShadowMapSize = kShadow;
-  return info;
-}
-
-void checkStages(const Scattering::FrameResult& r) {
-  std::string names;
-  for (const Scattering::Stage& s : r.stages) {
-    names += s.name + "; ";
-    CHECK(std::isfinite(s.gpuMilliseconds));
-    CHECK(s.gpuMilliseconds >= 0.0);
-    CHECK(s.wallMilliseconds > 0.0);
-  }
-  MESSAGE("stages: " << names);
-  CHECK(names.find("prefilter") != std::string::npos);
-  CHECK(names.find("evaluate") != std::string::npos);
-}
-
-} // namespace
 
 TEST_CASE("Scattering: a projective frame gives the image of the passes run by hand") {
   CREP_REQUIRE_GL();
@@ -274,9 +182,10 @@ TEST_CASE(
     CHECK(m.nanCount == 0);
     CHECK(m.infCount == 0);
     CHECK(ours.width() == kWidth);
-    // Accuracy here is an open item (issue 9, "accuracy next to the sun": 2% of the reference): measured
-    // 3.1% (corner (1, 1)), 12% (edge (1, 0)), 66-77% (light from below the ground: edge (0, -1), corner
-    // (-1, -1), where the reference is nearly black). Reported, not asserted, until the fallback improves.
+    // Measured with this 256^2 map: 1.3% (corner (1, 1)), 4.3% (edge (1, 0); 3.0% with a 1024^2 map), 44-55%
+    // with the light from below the ground (edge (0, -1), corner (-1, -1): every caster shadows the view, the
+    // reference is nearly black, peak 0.11, and the resampled map lets light through at the far end; an open
+    // item). Reported, not asserted: the 2% goal is asserted on the sun-in-view cases of SunInViewGLTest.
     WARN(m.relativeRmse < 0.02);
   }
 }

@@ -33,8 +33,14 @@
 //                          b of the far-plane points of the slice row's screen sector (exact: b is convex
 //                          on the far plane, so its maximum is at a vertex of the sector: the entry and
 //                          exit points of the row's two limiting slices and the screen corners inside it)
-//   depth  = (psi - psiMin_j) / (psiMax_j - psiMin_j)   psi bounds of the sector's view rays (its limiting
-//                          slices' entry and exit rays, its centre slice and the corners inside it)
+//   depth  = (g(psi) - g(psiMin_j)) / (g(psiMax_j) - g(psiMin_j))   psi bounds of the sector's view rays
+//                          (its limiting slices' entry and exit rays, its centre slice and the corners
+//                          inside it); g the depth warp (Sec. 5, "depth warp"): g(psi) = log((psi + e) /
+//                          (pi - psi + e)), e = EpipolarOptions::depthWarp (g = psi when e = 0). The shadow
+//                          test compares depths of one slice, so any increasing g gives the same visibility;
+//                          g only moves the Fourier basis's resolution toward the rays next to the light
+//                          axis (both ends: the epipole and the anti-epipole), where view and light rays are
+//                          nearly parallel and linear psi leaves them a few hundredths of the depth range.
 //   region fractions f_0 = 0 < f_1 < ... < f_K = 1: Uniform f_k = k / K; Logarithmic (default, like the
 //   logarithmic splits of the projective rectification, Sec. 4.2 "Non-linearity"): f_k = (near / far)^(1 - k
 //   / K) for 0 < k < K, so region 0 holds the camera's neighbourhood, where the transmittance weights are
@@ -74,8 +80,12 @@ struct EpipolarOptions {
   SplitScheme regionScheme = SplitScheme::Logarithmic;
   /// Reference ray of a row (Sec. 3.2), for the prefilter's weights.
   ReferenceRay referenceRay = ReferenceRay::Bisectrix;
-  /// Radius of the epipole block as a fraction of the screen diagonal (>= 0; 0 = no block).
-  double epipoleBlockRadius = 0.02;
+  /// Radius of the epipole block as a fraction of the screen diagonal (>= 0; 0 = no block); the value
+  /// crep::Scattering uses (its CreateInfo says why).
+  double epipoleBlockRadius = 0.06;
+  /// Depth warp e (radians, >= 0; 0 = linear depth in psi): depth is linear in
+  /// g(psi) = log((psi + e) / (pi - psi + e)), which stretches the rays near the light axis (see top).
+  double depthWarp = 0.1;
 };
 
 /// Throws InvalidArgument naming the field ("EpipolarOptions.slices", ...).
@@ -144,8 +154,12 @@ public:
   glm::dvec3 sliceDirection(double row) const;
   /// Texel row j of a normalized row: clamp(floor(row H), 0, H - 1).
   int sliceIndex(double row) const;
-  /// The psi of a normalized depth in slice row j.
+  /// The psi of a normalized depth in slice row j, and the normalized depth of psi in it.
   double psi(int slice, double depth) const;
+  double depthOfPsi(int slice, double psi) const;
+  /// The depth warp g(psi) (see top; psi itself when options().depthWarp == 0) and its inverse.
+  double warp(double psi) const;
+  double unwarp(double g) const;
   /// The region boundaries f_0 = 0, ..., f_K = 1 in b / bMax (see top).
   const std::vector<double>& regionFractions() const noexcept { return fractions_; }
   /// b / bMax of a normalized column, and its inverse.
