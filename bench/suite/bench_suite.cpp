@@ -8,6 +8,7 @@
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
@@ -143,28 +144,26 @@ bool perFrameStage(const std::string& stage) {
   return true;
 }
 
-/// Every method of the registry on the same frame: median per-frame milliseconds and the ratio to the
-/// prefiltered method.
-void methodsSideBySide(const BenchOptions& o) {
+struct MethodRow {
+  std::string name, used;
+  double ms = 0.0;
+  std::string stages;
+  std::map<std::string, double> stageMs; ///< median per stage
+};
+
+/// The methods named in `only` (every method of the registry when empty) on one built-in scene's frame:
+/// median per-frame milliseconds (sum of the median per-frame stages of `repeat` runs after a warm-up).
+/// `mapMs` receives the rectified shadow pass of the warm-up (shared by the methods).
+std::vector<MethodRow> runMethods(const BenchOptions& o, const std::string& scene,
+                                  const std::vector<std::string>& only, int repeat, double& mapMs) {
   tool::StageTimings setupTimings;
-  tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, setupTimings);
+  tool::SceneFrame s = tool::makeSceneFrame(scene, o.screenWidth, o.screenHeight, o.mapWidth, setupTimings);
   tool::MethodSettings settings;
   settings.mapSize = o.mapWidth;
   settings.prefilter.bases = o.bases;
-  if (o.mapWidth != o.mapHeight || o.mapWidth % settings.rectify.splits != 0) {
-    std::printf("\nmethods side by side: skipped (needs a square map whose size is a multiple of %d)\n",
-                settings.rectify.splits);
-    return;
-  }
-  const int repeat = std::max(1, std::min(o.repeat, 3));
-  struct Row {
-    std::string name, used;
-    double ms;
-    std::string stages;
-  };
-  std::vector<Row> rows;
-  double mapMs = 0.0;
+  std::vector<MethodRow> rows;
   for (const tool::Method& m : tool::methodRegistry()) {
+    if (!only.empty() && std::find(only.begin(), only.end(), m.name) == only.end()) continue;
     std::map<std::string, std::vector<double>> stageMs;
     std::vector<std::string> order;
     std::string used;
@@ -177,14 +176,15 @@ void methodsSideBySide(const BenchOptions& o) {
         continue;
       }
       for (const auto& r : out.timings.rows()) {
-        if (!perFrameStage(r.stage)) continue;
         if (!stageMs.count(r.stage)) order.push_back(r.stage);
         stageMs[r.stage].push_back(r.ms);
       }
     }
-    Row row{m.name, used, 0.0, ""};
+    MethodRow row{m.name, used, 0.0, "", {}};
     for (const auto& stage : order) {
       const double ms = median(stageMs[stage]);
+      row.stageMs[stage] = ms;
+      if (!perFrameStage(stage)) continue;
       row.ms += ms;
       char buf[96];
       std::snprintf(buf, sizeof buf, "%s%s %.2f", row.stages.empty() ? "" : ", ", stage.c_str(), ms);
@@ -192,19 +192,79 @@ void methodsSideBySide(const BenchOptions& o) {
     }
     rows.push_back(row);
   }
-  double prefilterMs = 0.0;
-  for (const Row& r : rows)
-    if (r.name == "prefilter") prefilterMs = r.ms;
+  return rows;
+}
+
+double msOf(const std::vector<MethodRow>& rows, const std::string& name) {
+  for (const MethodRow& r : rows)
+    if (r.name == name) return r.ms;
+  return 0.0;
+}
+
+void printRows(const std::vector<MethodRow>& rows) {
+  const double prefilterMs = msOf(rows, "prefilter");
+  std::printf("%-12s %12s %14s   %s\n", "method", "frame ms", "vs prefilter", "stages (ms)");
+  for (const MethodRow& r : rows)
+    std::printf("%-12s %12.2f %14.2f   %s%s\n", r.name.c_str(), r.ms,
+                prefilterMs > 0 ? r.ms / prefilterMs : 0.0, r.stages.c_str(),
+                r.used != r.name ? ("  [ran " + r.used + "]").c_str() : "");
+}
+
+bool squareMapOk(const BenchOptions& o, const char* what, int multiple) {
+  if (o.mapWidth == o.mapHeight && o.mapWidth % multiple == 0) return true;
+  std::printf("\n%s: skipped (needs a square map whose size is a multiple of %d)\n", what, multiple);
+  return false;
+}
+
+/// Every method of the registry on the same frame: median per-frame milliseconds and the ratio to the
+/// prefiltered method.
+void methodsSideBySide(const BenchOptions& o) {
+  const tool::MethodSettings settings;
+  if (!squareMapOk(o, "methods side by side", settings.rectify.splits)) return;
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  double mapMs = 0.0;
+  const std::vector<MethodRow> rows = runMethods(o, o.scene, {}, repeat, mapMs);
   std::printf(
       "\nmethods side by side (scene %s, %dx%d, map %d^2, M = %d, reference %d steps; per-frame ms = sum of\n"
       "the median per-frame stages of %d runs after a warm-up; the rectified shadow pass, %.2f ms, is "
       "shared):\n",
       o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.bases, settings.steps, repeat, mapMs);
-  std::printf("%-12s %12s %14s   %s\n", "method", "frame ms", "vs prefilter", "stages (ms)");
-  for (const Row& r : rows)
-    std::printf("%-12s %12.2f %14.2f   %s%s\n", r.name.c_str(), r.ms,
-                prefilterMs > 0 ? r.ms / prefilterMs : 0.0, r.stages.c_str(),
-                r.used != r.name ? ("  [ran " + r.used + "]").c_str() : "");
+  printRows(rows);
+}
+
+/// The sun in view (issue "every frame prefiltered"): the "sunset" scene is the forest's mesh and camera
+/// with the sun in view, so every frame takes the epipolar layout. The prefiltered method (crep::Scattering:
+/// resampling, prefilter, evaluation, epipole block) against the min/max march on that frame, and against
+/// the prefiltered method on the forest's own (projective) frame: the constant-cost claim.
+void sunInView(const BenchOptions& o) {
+  const Scattering::CreateInfo defaults;
+  if (!squareMapOk(o, "sun in view", defaults.rectify.splits * defaults.epipolarRegions)) return;
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  double mapMs = 0.0;
+  const std::vector<MethodRow> sun = runMethods(o, "sunset", {"prefilter", "minmax"}, repeat, mapMs);
+  const std::vector<MethodRow> forest = runMethods(o, "forest", {"prefilter"}, repeat, mapMs);
+  std::printf(
+      "\nsun in view (scene sunset: the forest toward the sun, epipolar layout; %dx%d, map %d^2, M = %d;\n"
+      "per-frame ms as above: the shadow inputs, standard shadow pass and resampling, excluded):\n",
+      o.screenWidth, o.screenHeight, o.mapWidth, o.bases);
+  printRows(sun);
+  const double fallbackMs = msOf(sun, "prefilter"), projectiveMs = msOf(forest, "prefilter");
+  std::printf("%-12s %12.2f %14s   %s  [forest: projective]\n", "prefilter", projectiveMs, "",
+              forest.empty() ? "" : forest.front().stages.c_str());
+  const auto stage = [](const std::vector<MethodRow>& rows, const char* method, const char* name) {
+    for (const MethodRow& r : rows)
+      if (r.name == method && r.stageMs.count(name)) return r.stageMs.at(name);
+    return 0.0;
+  };
+  const double resampleMs = stage(sun, "prefilter", "resample (epipolar)"),
+               shadowMs = stage(forest, "prefilter", "shadow pass (rectified)");
+  if (fallbackMs > 0.0 && projectiveMs > 0.0)
+    std::printf(
+        "minmax / prefilter on the sun-in-view frame: %.2f\n"
+        "prefilter on the fallback frame / on the projective frame of the same scene (constant cost): %.2f;\n"
+        "with their shadow inputs (resampling %.2f ms / rectified shadow pass %.2f ms): %.2f\n",
+        msOf(sun, "minmax") / fallbackMs, fallbackMs / projectiveMs, resampleMs, shadowMs,
+        (fallbackMs + resampleMs) / (projectiveMs + shadowMs));
 }
 
 } // namespace
@@ -296,6 +356,7 @@ void runBenchSuite(const BenchOptions& o) {
               mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
 
   methodsSideBySide(o);
+  sunInView(o);
 
   if (!o.quick) {
     // Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8).
