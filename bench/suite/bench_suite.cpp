@@ -25,6 +25,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -220,7 +221,11 @@ bool squareMapOk(const BenchOptions& o, const char* what, int multiple) {
 /// prefiltered method.
 void methodsSideBySide(const BenchOptions& o) {
   const tool::MethodSettings settings;
-  if (!squareMapOk(o, "methods side by side", settings.rectify.splits)) return;
+  const Scattering::CreateInfo defaults;
+  const int P = settings.prefilter.regionsPerSplit;
+  if (!squareMapOk(o, "methods side by side",
+                   std::lcm(settings.rectify.splits * P, defaults.epipolarRegions * P)))
+    return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   double mapMs = 0.0;
   const std::vector<MethodRow> rows = runMethods(o, o.scene, {}, repeat, mapMs);
@@ -238,7 +243,9 @@ void methodsSideBySide(const BenchOptions& o) {
 /// the prefiltered method on the forest's own (projective) frame: the constant-cost claim.
 void sunInView(const BenchOptions& o) {
   const Scattering::CreateInfo defaults;
-  if (!squareMapOk(o, "sun in view", defaults.rectify.splits * defaults.epipolarRegions)) return;
+  const int P = defaults.prefilter.regionsPerSplit;
+  if (!squareMapOk(o, "sun in view", std::lcm(defaults.rectify.splits * P, defaults.epipolarRegions * P)))
+    return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   double mapMs = 0.0;
   const std::vector<MethodRow> sun = runMethods(o, "sunset", {"prefilter", "minmax"}, repeat, mapMs);

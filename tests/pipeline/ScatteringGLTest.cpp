@@ -40,7 +40,7 @@ TEST_CASE("Scattering: a projective frame gives the image of the passes run by h
   const gl::Handle map = scenes::createDepthTexture(kMap, kMap);
   f.renderer.renderRectified(rect, map.get(), kMap, kMap);
   const ProjectiveLayout layout(rect);
-  PrefilterPass prefilter({kMap, kMap, {}});
+  PrefilterPass prefilter({kMap, kMap, smallInfo().prefilter}); // Scattering's: 2 regions per split
   prefilter.run({map.get(), &layout, &f.scene.medium});
   EvaluatePass evaluate({});
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);

@@ -10,6 +10,7 @@
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/pipeline/scattering.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
@@ -27,10 +28,11 @@ namespace crep::tool {
 
 /// The options of the methods (command-line options shared by render, compare, scatter and bench).
 struct MethodSettings {
-  int mapSize = 1024;         ///< rectified map, mapSize x mapSize texels
-  PrefilterOptions prefilter; ///< M, storage format, ... of the prefiltered method (library defaults)
-  RectifyOptions rectify;     ///< splits (logarithmic)
-  int steps = 256;            ///< world-space reference march: sections per pixel
+  int mapSize = 1024; ///< rectified map, mapSize x mapSize texels
+  /// M, storage format, regions per split, ... of the prefiltered method (crep::Scattering's defaults)
+  PrefilterOptions prefilter = Scattering::CreateInfo{}.prefilter;
+  RectifyOptions rectify = Scattering::CreateInfo{}.rectify; ///< splits (logarithmic; Scattering's defaults)
+  int steps = 256; ///< world-space reference march: sections per pixel
 };
 
 /// A rectified depth map on the GPU with its rectification (projective).

@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include <numeric>
+
 namespace crep::tool {
 
 static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
@@ -10,7 +12,8 @@ const char* const kMethodOptionsHelp =
     R"(            --map-size N        shadow map and rectified map size (default 1024, at most 16384)
             --bases M           Fourier bases, even, in [4, 128] (default 32)
             --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
-            --splits K          rectification splits (default 4; --map-size must be a multiple)
+            --splits K          rectification splits (default 8, 2 prefilter regions each; --map-size must
+                                be a multiple of 2 K and of 16, the epipolar fallback's 8 x 2 regions)
             --steps N           reference march: sections per view ray, changes bisected (default 256)
 )";
 
@@ -33,9 +36,15 @@ MethodSettings methodSettings(const Args& args) {
   if (s.prefilter.bases % 2 != 0) throw UsageError("option --bases: must be even");
   s.prefilter.format = parseFormat(args.string("format", "rgba8"));
   s.rectify.splits = args.integer("splits", s.rectify.splits, 1, RectifyOptions::kMaxSplits);
-  if (s.mapSize % s.rectify.splits != 0)
-    throw UsageError("option --map-size: " + std::to_string(s.mapSize) + " must be a multiple of --splits " +
-                     std::to_string(s.rectify.splits));
+  // Scattering's rule (crep/pipeline/scattering.h): a multiple of the prefilter regions of both layouts.
+  const int perSplit = s.prefilter.regionsPerSplit,
+            epipolar = Scattering::CreateInfo{}.epipolarRegions * perSplit;
+  const int multiple = std::lcm(s.rectify.splits * perSplit, epipolar);
+  if (s.mapSize % multiple != 0)
+    throw UsageError("option --map-size: " + std::to_string(s.mapSize) + " must be a multiple of " +
+                     std::to_string(multiple) + " (--splits " + std::to_string(s.rectify.splits) + " x " +
+                     std::to_string(perSplit) + " prefilter regions, and the epipolar fallback's " +
+                     std::to_string(epipolar) + ")");
   return s;
 }
 

@@ -52,13 +52,22 @@ public:
     int width = 1280, height = 720; ///< camera image and output, pixels
     /// Rectified map: mapSize x mapSize texels on both layouts (the fallback uses mapSize epipolar slices),
     /// so a fallback frame costs what a projective one does. A multiple of rectify.splits * P and of
-    /// epipolarRegions * P.
+    /// epipolarRegions * P (P = prefilter.regionsPerSplit).
     int mapSize = 1024;
-    /// Splits (logarithmic by default) and fallback thresholds; splits are also the epipolar layout's
-    /// regions. layout must be SplitLayout::Regions (side by side in one texture).
-    RectifyOptions rectify;
-    PrefilterOptions prefilter; ///< M (32), storage (RGBA8), weights (exact), regions per split, ...
-    EvaluateOptions evaluate;   ///< sampling (bilinear), near-plane correction, ringing filter
+    /// Splits (logarithmic) and fallback thresholds. layout must be SplitLayout::Regions (side by side in
+    /// one texture). Default 8 splits with 2 prefilter regions each (below): 16 prefilter regions on both
+    /// layouts, so both cost the same per pixel. A projective row's rays have world steps up to 11.5x
+    /// apart (rectify.minEpipoleAngleDegrees), and the prefilter's weights, exact for one reference ray
+    /// per region, fit the others only over short regions. Measured over 18 random projective frames near
+    /// the thresholds (tests/pipeline/ThresholdStudyGLTest.cpp, README "Sun in view"), relative RMSE
+    /// against the world-space reference: 4 splits 1.0-12.1%; 4 x 2 regions 1.0-6.5%; 8 splits 0.9-4.0%;
+    /// 8 x 2 regions (default) 0.9-3.0%; 16 splits 0.9-3.0%; the map itself (brute-force march) 0.6-2.2%.
+    /// Cost: the casters are drawn once per split; the evaluation fetches the basis once per layer and
+    /// region a ray crosses (16 regions: 2.4x the evaluation time of 4 on llvmpipe).
+    RectifyOptions rectify{.splits = 8};
+    /// M (32), storage (RGBA8), weights (exact), regions per split (default 2, see rectify), ...
+    PrefilterOptions prefilter{.regionsPerSplit = 2};
+    EvaluateOptions evaluate; ///< sampling (bilinear), near-plane correction, ringing filter
     /// World-space march of the epipole block: sections and refinements (bias comes with the shadow map).
     WorldMarchOptions epipoleBlock;
     /// Radius of the epipole block as a fraction of the screen diagonal (0 = none), in [0, 0.5]. Default 6%:
@@ -68,14 +77,12 @@ public:
     /// world-space march of about 1.1% of the pixels (16:9) when the epipole is on screen.
     double epipoleBlockRadius = 0.06;
     /// Regions of the epipolar layout (its columns, logarithmic in the distance from the light axis; the
-    /// fallback's splits). More than the projective splits: a slice's view rays range from nearly parallel
-    /// to the light (next to the epipole) to the screen border, so their world steps per column differ
-    /// far more than a projective row's (bounded by rectify.minEpipoleAngleDegrees), and the prefilter's
-    /// weights, exact for one reference ray per region, fit the others only over shorter regions. Measured
-    /// with the sun in view (README "Sun in view"; 1024^2 map): 4 regions 4-6% relative RMSE on the forest
-    /// and colonnade, 8 regions 1.8-2.3%, 16 regions 1.5-1.75%. The evaluation fetches the basis once per
-    /// layer and region a ray crosses: 16 regions cost 2.4x the evaluation time of 4 on llvmpipe, 8 1.6x.
-    int epipolarRegions = 16;
+    /// fallback's splits), each cut into P prefilter regions like a split. A slice's view rays range from
+    /// nearly parallel to the light (next to the epipole) to the screen border, so their world steps per
+    /// column differ by up to 20x. Measured with the sun in view (README "Sun in view"; 1024^2 map),
+    /// prefilter regions in all: 4 -> 4-7% relative RMSE on the forest and colonnade, 8 -> 1.8-2.3%,
+    /// 16 (8 x 2, the default, or 16 x 1) -> 1.5-1.75%.
+    int epipolarRegions = 8;
     /// Depth warp of the epipolar layout (EpipolarOptions::depthWarp, radians, >= 0; 0 = linear in psi):
     /// more depth resolution for the view rays next to the light axis (Klehm et al. 2014, Sec. 5), which
     /// lowers the light bleeding around the epipole block. Measured (README "Sun in view"): 0 -> 3.0%
