@@ -182,10 +182,14 @@ TEST_CASE(
     CHECK(m.nanCount == 0);
     CHECK(m.infCount == 0);
     CHECK(ours.width() == kWidth);
-    // Measured with this 256^2 map: 1.3% (corner (1, 1)), 4.3% (edge (1, 0); 3.0% with a 1024^2 map), 44-55%
-    // with the light from below the ground (edge (0, -1), corner (-1, -1): every caster shadows the view, the
-    // reference is nearly black, peak 0.11, and the resampled map lets light through at the far end; an open
-    // item). Reported, not asserted: the 2% goal is asserted on the sun-in-view cases of SunInViewGLTest.
+    // Measured with this 256^2 map: 1.3% (corner (1, 1)), 4.3% (edge (1, 0); 3.1% with a 1024^2 map, where
+    // the brute-force march over the same map, the map's own error, is 2.2%: a sun 4 degrees above the
+    // horizon casts grazing shadows that the resampled slices blur), 44-55% with the light from below the
+    // ground (edge (0, -1), corner (-1, -1): the ground shadows the whole view, the reference is nearly
+    // black, peak 0.11; the brute-force march over the same map is within 4-5%, so the prefilter's smooth
+    // step leaks where the ground is both the receiver and, at grazing depth differences, the only occluder
+    // of the ray; an open item). Reported, not asserted: the 2% goal is asserted on the sun-in-view cases of
+    // SunInViewGLTest.
     WARN(m.relativeRmse < 0.02);
   }
 }
