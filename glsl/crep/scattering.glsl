@@ -32,7 +32,9 @@
 //                              regionWeightsBuffer()) at CREP_REGION_WEIGHTS_BINDING (default 1).
 //   CREP_RINGING_LANCZOS       1: damp the ray coefficients with Lanczos sigma factors (crep::RingingFilter::
 //                              Lanczos, fourier.h; not in the paper); default 0 = Eq. 8 as published
-//   CREP_NO_FP64               1: reduce Fourier angles in float (default: in double, see crep_halfTurns)
+//   CREP_FP64                  1: reduce Fourier angles in double (opt-in; default 0: float only, exact
+//                              reduction from float pairs, see "Accuracy" below). The former CREP_NO_FP64
+//                              is still read: CREP_NO_FP64 0 means CREP_FP64 1.
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
 //   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
 //                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
@@ -51,9 +53,6 @@
 #ifndef CREP_NEAR_PLANE_CORRECTION
 #define CREP_NEAR_PLANE_CORRECTION 0
 #endif
-#ifndef CREP_NO_FP64
-#define CREP_NO_FP64 0
-#endif
 #ifndef CREP_RINGING_LANCZOS
 #define CREP_RINGING_LANCZOS 0
 #endif
@@ -65,22 +64,84 @@
 // so layer l holds harmonics 2l and 2l + 1.
 //
 // Accuracy: the highest harmonic reaches (2h + 1) pi ~ 400 rad for M = 128, where a float angle is only
-// good to ~2e-5 rad. Angles are therefore reduced in half turns, exactly in double (x mod 2), and only
-// the reduced value goes to float; sin and cos of pi r come from crep_sincospi, whose reduction is exact
-// too. Harmonics inside a group advance by the angle-addition recurrence (one sin/cos pair per group).
-// Measured against the double CPU prefilter (RGBA32F, llvmpipe): max error of the stored basis 8e-7 for
-// M = 32 and M = 128 with the double reduction, 1.8e-6 / 1.1e-5 with CREP_NO_FP64.
+// good to ~2e-5 rad. Angles are therefore reduced in half turns exactly (x mod 2) and only the reduced value
+// is rounded; sin and cos of pi r come from crep_sincospi, whose reduction is exact too. Harmonics inside a
+// group advance by the angle-addition recurrence (one sin/cos pair per group).
+// Default (chosen for GPUs: consumer parts run fp64 at 1/16 to 1/64 of the float rate, some have none):
+// float only. A depth is an unevaluated pair hi + lo (CrepDepth = vec2) that holds m + (1 - 2m) d exactly
+// (Dekker's product and Knuth's sum, `precise` so no compiler reassociates or contracts them), and
+// (2h + 1) z is formed from a Veltkamp split of hi into two 12-bit halves, whose products by 2h + 1 < 2^12
+// are exact, so the reduction mod 2 is exact and one rounding remains. CREP_FP64 1 (opt-in) does the same
+// reduction in double instead. Measured against the double CPU prefilter (RGBA32F, llvmpipe; tests/
+// prefilter/PrefilterGpuGLTest.cpp): max error of the stored basis 8e-7 for M = 32 and M = 128 with either.
+// (The former float path, one rounded product, gave 1.8e-6 / 1.1e-5.)
 
-#if CREP_NO_FP64
-#define CREP_REAL float
-#else
-#define CREP_REAL double
+#if !defined(CREP_FP64) && defined(CREP_NO_FP64)
+#define CREP_FP64 (1 - CREP_NO_FP64) // the former switch: CREP_NO_FP64 0 asked for double
+#endif
+#ifndef CREP_FP64
+#define CREP_FP64 0
 #endif
 
+#if CREP_FP64
+#define CrepDepth double
+
 // x mod 2 in [-1, 1): the angle pi x reduced to one turn (exact in double).
-float crep_halfTurns(CREP_REAL x) {
-  return float(x - CREP_REAL(2.0) * floor(x * CREP_REAL(0.5) + CREP_REAL(0.5)));
+float crep_halfTurns(double x) { return float(x - 2.0LF * floor(x * 0.5LF + 0.5LF)); }
+float crep_harmonicTurns(int h, CrepDepth z) { return crep_halfTurns(double(2 * h + 1) * z); }
+float crep_stepTurns(CrepDepth z) { return crep_halfTurns(2.0LF * z); }
+CrepDepth crep_basisDepth(float depth, float margin) {
+  return double(margin) + (1.0LF - 2.0LF * double(margin)) * double(depth);
 }
+CrepDepth crep_depthConstant(float v) { return double(v); }
+#else
+#define CrepDepth vec2
+
+// Knuth's TwoSum: a + b = s + e exactly.
+vec2 crep_twoSum(float a, float b) {
+  precise float s = a + b;
+  precise float bb = s - a;
+  precise float e = (a - (s - bb)) + (b - bb);
+  return vec2(s, e);
+}
+// Veltkamp's split: a = hi + lo, each with at most 12 significant bits.
+vec2 crep_split(float a) {
+  precise float c = 4097.0 * a;
+  precise float hi = c - (c - a);
+  precise float lo = a - hi;
+  return vec2(hi, lo);
+}
+// Dekker's TwoProduct: a b = p + e exactly.
+vec2 crep_twoProduct(float a, float b) {
+  precise float p = a * b;
+  vec2 x = crep_split(a), y = crep_split(b);
+  precise float e = ((x.x * y.x - p) + x.x * y.y + x.y * y.x) + x.y * y.y;
+  return vec2(p, e);
+}
+// x mod 2 in [-1, 1) of a float that is a multiple of its own ulp (exact: the result keeps x's grid).
+float crep_reduce2(float x) {
+  precise float r = x - 2.0 * floor(x * 0.5 + 0.5);
+  return r;
+}
+// (k z) mod 2 for an integer 0 < k < 2^12: exact up to the final rounding.
+float crep_scaledTurns(float k, CrepDepth z) {
+  vec2 h = crep_split(z.x);
+  precise float a = crep_reduce2(k * h.x); // 12 x 12 bits: exact
+  precise float b = crep_reduce2(k * h.y); // exact
+  precise float r = (a + b) + k * z.y;
+  return r;
+}
+float crep_harmonicTurns(int h, CrepDepth z) { return crep_scaledTurns(float(2 * h + 1), z); }
+float crep_stepTurns(CrepDepth z) { return crep_scaledTurns(2.0, z); }
+// m + (1 - 2m) d as hi + lo (exact for the float m and d; 1 - 2m is exact for m a multiple of 2^-24).
+CrepDepth crep_basisDepth(float depth, float margin) {
+  vec2 p = crep_twoProduct(1.0 - 2.0 * margin, depth);
+  vec2 s = crep_twoSum(margin, p.x);
+  precise float lo = s.y + p.y;
+  return crep_twoSum(s.x, lo);
+}
+CrepDepth crep_depthConstant(float v) { return vec2(v, 0.0); }
+#endif
 
 // (sin(pi x), cos(pi x)) for |x| < 2^22, within a few ulp: exact reduction to r in [-1/4, 1/4] and the
 // quadrant, then Taylor polynomials of degree 9 / 10 in r (truncation below 1e-8).
@@ -100,26 +161,24 @@ vec2 crep_sincospi(float x) {
 }
 
 // (sin, cos) of c_k z for harmonic h (k = h + 1): the start of a recurrence.
-vec2 crep_harmonic(int h, CREP_REAL z) { return crep_sincospi(crep_halfTurns(CREP_REAL(2 * h + 1) * z)); }
+vec2 crep_harmonic(int h, CrepDepth z) { return crep_sincospi(crep_harmonicTurns(h, z)); }
 
 // (sin, cos) of the recurrence step 2 pi z between consecutive harmonics.
-vec2 crep_harmonicStep(CREP_REAL z) { return crep_sincospi(crep_halfTurns(CREP_REAL(2.0) * z)); }
+vec2 crep_harmonicStep(CrepDepth z) { return crep_sincospi(crep_stepTurns(z)); }
 
 // Angle addition: (sin, cos) of a + b from those of a and b.
 vec2 crep_rotate(vec2 a, vec2 b) { return vec2(a.x * b.y + a.y * b.x, a.y * b.y - a.x * b.x); }
 
 // The depth fed to B for a stored map depth (crep::texelBasisDepth, fourier.h): the exact end values 0
 // (caster clamped in front) and 1 (nothing) stay, the rest moves into [m, 1 - m].
-CREP_REAL crep_texelBasisDepth(float depth, float margin) {
-  if (depth >= 1.0) return CREP_REAL(1.0);
-  if (depth <= 0.0) return CREP_REAL(0.0);
-  return CREP_REAL(margin) + (CREP_REAL(1.0) - CREP_REAL(2.0) * CREP_REAL(margin)) * CREP_REAL(depth);
+CrepDepth crep_texelBasisDepth(float depth, float margin) {
+  if (depth >= 1.0) return crep_depthConstant(1.0);
+  if (depth <= 0.0) return crep_depthConstant(0.0);
+  return crep_basisDepth(depth, margin);
 }
 
 // The depth fed to a for a view ray (crep::rayBasisDepth): m + (1 - 2m) clamp(depth, 0, 1).
-CREP_REAL crep_rayBasisDepth(float depth, float margin) {
-  return CREP_REAL(margin) + (CREP_REAL(1.0) - CREP_REAL(2.0) * CREP_REAL(margin)) * CREP_REAL(clamp(depth, 0.0, 1.0));
-}
+CrepDepth crep_rayBasisDepth(float depth, float margin) { return crep_basisDepth(clamp(depth, 0.0, 1.0), margin); }
 
 // Eq. 8 coefficients of harmonics h and h + 1 in basis order: (a_{2k-1}, a_{2k}, a_{2k+1}, a_{2k+2}) =
 // (2 cos / c_k, -2 sin / c_k, 2 cos / c_{k+1}, -2 sin / c_{k+1}) from their (sin, cos).
@@ -392,7 +451,7 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
 
   // Eq. 8 coefficients of the ray, by recurrence from one reduced sin/cos pair.
   float margin = crep_scattering.depthMargin.x;
-  CREP_REAL zr = crep_rayBasisDepth(hit.depth, margin);
+  CrepDepth zr = crep_rayBasisDepth(hit.depth, margin);
   vec2 stepSC = crep_harmonicStep(zr);
   vec2 sc = crep_harmonic(0, zr);
   vec4 a[CREP_EVAL_MAX_LAYERS];

@@ -77,7 +77,7 @@ void main() {
   for (int i = 0; i < n; ++i) {
     int x = region * n + i;
     // Listing 3: the basis of the texel's depth (Eq. 8), computed here instead of read from a texture.
-    CREP_REAL z = crep_texelBasisDepth(texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r, margin);
+    CrepDepth z = crep_texelBasisDepth(texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r, margin);
     vec2 stepSC = crep_harmonicStep(z);
     vec2 sc = crep_harmonic(firstHarmonic, z);
     // Listing 2: the normalized weighted prefix.

@@ -77,7 +77,8 @@ RunResult run(const std::string& command) {
 
 /// Writes `text` to the test output folder with the stage's extension and runs glslangValidator on
 /// it (plain validation: OpenGL GLSL semantics, no SPIR-V written).
-RunResult glslang(const std::string& name, const std::string& extension, const std::string& text) {
+RunResult glslang(const std::string& name, const std::string& extension, const std::string& text,
+                  const std::string& flags = "") {
   const std::optional<std::filesystem::path> validator = findInPath("glslangValidator");
   REQUIRE_MESSAGE(
       validator.has_value(),
@@ -90,7 +91,7 @@ RunResult glslang(const std::string& name, const std::string& extension, const s
   if (!flat.ends_with("." + extension)) flat += "." + extension;
   const std::filesystem::path file = dir / flat;
   std::ofstream(file, std::ios::binary) << text;
-  return run("'" + validator->string() + "' '" + file.string() + "'");
+  return run("'" + validator->string() + "' " + flags + " '" + file.string() + "'");
 }
 
 } // namespace
@@ -315,4 +316,61 @@ TEST_CASE("glslangValidator understands the #line markers of an expansion") {
   const std::string log = e.translateLog(r.output);
   CAPTURE(log);
   CHECK(contains(log, "ERROR: test/compile_error_inc.glsl:4: 'crep_test_undefined_symbol'"));
+}
+
+TEST_CASE("no shader uses a double type by default: neither its preprocessed source nor its SPIR-V") {
+  // Consumer GPUs run fp64 at 1/16 to 1/64 of the float rate and several have none (Metal has no double):
+  // every shader of the library and the tool, with its default defines and with each switch a pass turns
+  // on (CREP_FP64 is the one opt-in that may use double), compiled to OpenGL SPIR-V by glslangValidator
+  // (-G -H prints the disassembly): no OpTypeFloat 64, and no double / dvec / dmat token in the source
+  // after preprocessing (-E).
+  const std::vector<std::vector<ShaderDefine>> variants = {
+      {},
+      {{"CREP_EVAL_LAYOUT", "1"}},
+      {{"CREP_EVAL_LAYOUT", "0"}},
+      {{"CREP_NEAR_PLANE_CORRECTION", "1"}},
+      {{"CREP_RINGING_LANCZOS", "1"}},
+      {{"CREP_BASES", "32"}},
+      {{"CREP_MARCH_TREE", "1"}},
+      {{"CREP_LAYOUT", "1"}},
+  };
+  int compiled = 0;
+  for (const auto& file : ShaderLibrary::files()) {
+    if (!isLibraryFile(file.path)) continue;
+    const std::string path(file.path);
+    std::string extension = path.substr(path.rfind('.') + 1);
+    const std::string source(ShaderLibrary::source(path));
+    for (const auto& defines : variants) {
+      // A switch variant only for the files whose text (or includes) reads that switch.
+      ExpandedShader e = ShaderLibrary::expand(path);
+      if (!defines.empty() && !contains(e.text, defines.front().name)) continue;
+      e = ShaderLibrary::expand(path, defines);
+      std::string ext = extension;
+      if (ext == "glsl") {
+        e.text += "layout(local_size_x = 1) in;\nvoid main() {}\n";
+        ext = "comp";
+      }
+      const std::string variant = defines.empty() ? "" : defines.front().name + "=" + defines.front().value;
+      CAPTURE(path);
+      CAPTURE(variant);
+      const std::string name = path + (variant.empty() ? "" : "." + variant);
+      const RunResult spirv = glslang(name, ext, e.text, "-G -H");
+      REQUIRE_MESSAGE(spirv.exitCode == 0, e.translateLog(spirv.output));
+      CHECK_MESSAGE(!contains(spirv.output, "TypeFloat 64"),
+                    "SPIR-V of " << name << " declares a 64-bit float");
+      const RunResult pre = glslang(name, ext, e.text, "-E");
+      REQUIRE(pre.exitCode == 0);
+      for (const char* token : {"double", "dvec", "dmat"})
+        CHECK_MESSAGE(!contains(pre.output, token), "preprocessed " << name << " uses " << token);
+      ++compiled;
+    }
+  }
+  MESSAGE(compiled << " shader variants compiled to SPIR-V without a double type");
+  CHECK(compiled >= 15);
+  // The check itself: the opt-in CREP_FP64 path does declare doubles, and the test sees them.
+  const std::vector<ShaderDefine> opt = {{"CREP_FP64", "1"}};
+  ExpandedShader fp64 = ShaderLibrary::expand("passes/prefilter.comp", opt);
+  const RunResult r = glslang("passes/prefilter.comp.CREP_FP64", "comp", fp64.text, "-G -H");
+  REQUIRE(r.exitCode == 0);
+  CHECK(contains(r.output, "TypeFloat 64"));
 }

@@ -295,7 +295,7 @@ void main() {
     double relativeRmse;
   };
   const Variant variants[] = {
-      {"", 1e-3, 2e-5}, {"#define CREP_BASES 32\n", 1e-6, 1e-6}, {"#define CREP_NO_FP64 1\n", 1e-4, 1e-5}};
+      {"", 1e-3, 2e-5}, {"#define CREP_BASES 32\n", 1e-6, 1e-6}, {"#define CREP_FP64 1\n", 1e-4, 1e-5}};
   Image first;
   for (const Variant& v : variants) {
     CAPTURE(v.defines);
