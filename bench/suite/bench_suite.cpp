@@ -13,6 +13,7 @@
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/ray.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/scenes/shaders.h>
@@ -77,7 +78,7 @@ Setup makeSetup(const std::string& sceneName, int screenW, int screenH, int mapW
           mapH,
           screenW,
           screenH};
-  s.rect = rectify(s.scene.camera, s.scene.sun);
+  s.rect = rectify(s.scene.camera, s.scene.sun, Scattering::CreateInfo{}.rectify); // the library's defaults
   if (!s.rect.projective()) throw Error("scene " + sceneName + " is not projective: " + s.rect.message);
   s.layout = std::make_shared<ProjectiveLayout>(s.rect);
   scenes::SceneRenderer renderer(s.scene.mesh);
@@ -92,12 +93,43 @@ Setup makeSetup(const std::string& sceneName, int screenW, int screenH, int mapW
   return s;
 }
 
-struct GpuTimes {
-  double prefilter, evaluate;
+/// The evaluation's profile on the CPU (the GPU pass's rule): prefilter regions crossed per pixel (the last
+/// one partly) and the filtered-basis fetches that makes (one per RGBA layer and region).
+struct EvaluationProfile {
+  double meanRegions = 0.0;
+  int maxRegions = 0;
+  std::vector<double> histogram; ///< fraction of pixels crossing 1, 2, ... regions
 };
 
-GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat, int regionsPerSplit = 1,
-                 int basesPerInvocation = 8) {
+EvaluationProfile profileEvaluation(const Setup& s, int regionsPerSplit) {
+  EvaluationProfile p;
+  const int R = s.layout->regionCount() * regionsPerSplit;
+  p.histogram.assign(static_cast<std::size_t>(R), 0.0);
+  const int n = s.cameraDepthImage.width() * s.cameraDepthImage.height();
+  for (int y = 0; y < s.cameraDepthImage.height(); ++y)
+    for (int x = 0; x < s.cameraDepthImage.width(); ++x) {
+      const PixelRay ray = pixelRay(s.scene.camera, s.cameraDepthImage, x, y);
+      const RectPoint hit = s.layout->toRectified(s.scene.camera.position() + ray.surface * ray.direction);
+      const int q =
+          std::min(static_cast<int>(std::floor(std::clamp(hit.splitColumn, 0.0, 1.0) * regionsPerSplit)),
+                   regionsPerSplit - 1);
+      const int regions = std::clamp(hit.split * regionsPerSplit + q + 1, 1, R);
+      p.meanRegions += regions;
+      p.maxRegions = std::max(p.maxRegions, regions);
+      p.histogram[static_cast<std::size_t>(regions - 1)] += 1.0 / n;
+    }
+  p.meanRegions /= n;
+  return p;
+}
+
+struct GpuTimes {
+  double prefilter, evaluate;
+  double prefilterLimit = 0.0, evaluateLimit = 0.0; ///< the passes stripped to their memory traffic
+};
+
+GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
+                 int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit,
+                 int basesPerInvocation = 8, bool limits = false) {
   PrefilterPass::CreateInfo info;
   info.width = s.mapW;
   info.height = s.mapH;
@@ -134,6 +166,25 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat, in
     evaluate.run(ev);
     glFinish();
   });
+  if (limits) {
+    // The same passes with memoryLimit: the same reads and writes (prefilter) and the same fetches and
+    // store (evaluation) without the math; the evaluation limit reads the real filtered basis.
+    info.memoryLimit = true;
+    evalInfo.memoryLimit = true;
+    PrefilterPass prefilterLimit(info);
+    EvaluatePass evaluateLimit(evalInfo);
+    prefilterLimit.run(frame);
+    evaluateLimit.run(ev);
+    glFinish();
+    t.prefilterLimit = medianMs(repeat, [&] {
+      prefilterLimit.run(frame);
+      glFinish();
+    });
+    t.evaluateLimit = medianMs(repeat, [&] {
+      evaluateLimit.run(ev);
+      glFinish();
+    });
+  }
   return t;
 }
 
@@ -291,13 +342,14 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   // The rectification's splits lie side by side in the map (SplitLayout::Regions); without --quick the
   // parallelization rows split each into up to kMaxRegionsPerSplit regions and the scaling rows halve
   // the width (a multiple of splits * kMaxRegionsPerSplit halves to a multiple of splits).
-  const int splits = RectifyOptions{}.splits;
-  const int multiple = o.quick ? splits : splits * kMaxRegionsPerSplit;
+  const int splits = Scattering::CreateInfo{}.rectify.splits,
+            perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
+  const int multiple = splits * (o.quick ? perSplit : std::max(perSplit, kMaxRegionsPerSplit));
   if (map.x % multiple != 0)
     throw tool::UsageError("option --map: width " + std::to_string(map.x) + " must be a multiple of " +
                            std::to_string(multiple) + " (the rectification's " + std::to_string(splits) +
                            " splits side by side" +
-                           (o.quick ? std::string(")")
+                           (o.quick ? ", " + std::to_string(perSplit) + " prefilter regions each)"
                                     : std::string(", each in up to ") + std::to_string(kMaxRegionsPerSplit) +
                                           " regions in the parallelization rows; --quick omits them)"));
   if (map.y < scale)
@@ -336,7 +388,7 @@ void runBenchSuite(const BenchOptions& o) {
   });
 
   // CPU reference (all cores) vs GPU pass, same inputs.
-  PrefilterOptions options;
+  PrefilterOptions options = Scattering::CreateInfo{}.prefilter;
   options.bases = bases;
   const RectifiedMap map = makeRectifiedMap(s.layout, s.rectifiedImage);
   FilteredBasis basis;
@@ -346,13 +398,32 @@ void runBenchSuite(const BenchOptions& o) {
     const Image img = evaluate(basis, s.cameraDepthImage, s.scene.camera, s.scene.sun, s.scene.medium);
     (void)img;
   });
-  const GpuTimes gpu = timeGpu(s, bases, StorageFormat::RGBA8, repeat);
+  const GpuTimes gpu = timeGpu(s, bases, StorageFormat::RGBA8, repeat,
+                               Scattering::CreateInfo{}.prefilter.regionsPerSplit, 8, true);
 
   std::printf("\n%-34s %12s %12s %10s\n", "stage", "CPU ms", "GPU ms", "CPU/GPU");
   std::printf("%-34s %12.2f %12.2f %10.2f\n", "prefilter", cpuPrefilterMs, gpu.prefilter,
               cpuPrefilterMs / gpu.prefilter);
   std::printf("%-34s %12.2f %12.2f %10.2f\n", "evaluate", cpuEvaluateMs, gpu.evaluate,
               cpuEvaluateMs / gpu.evaluate);
+  std::printf("\nlimits (the same pass stripped to its memory traffic, same run; goals: prefilter <= 2x,\n"
+              "evaluation <= 1.3x):\n");
+  std::printf(
+      "  prefilter   %8.2f ms   write-only (same map reads, same basis writes) %8.2f ms   ratio %.2f\n",
+      gpu.prefilter, gpu.prefilterLimit, gpu.prefilter / gpu.prefilterLimit);
+  std::printf(
+      "  evaluate    %8.2f ms   fetch-only (same fetches and store, no math)    %8.2f ms   ratio %.2f\n",
+      gpu.evaluate, gpu.evaluateLimit, gpu.evaluate / gpu.evaluateLimit);
+  const int perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
+  const EvaluationProfile profile = profileEvaluation(s, perSplit);
+  std::printf(
+      "\nevaluation profile (%s, %d prefilter regions): %.2f regions crossed per pixel on average, at most\n"
+      "%d; %.1f filtered-basis fetches per pixel (M / 4 = %d per region); pixels by regions crossed:",
+      o.scene.c_str(), s.layout->regionCount() * perSplit, profile.meanRegions, profile.maxRegions,
+      profile.meanRegions * layerCount(bases), layerCount(bases));
+  for (std::size_t i = 0; i < profile.histogram.size(); ++i)
+    if (profile.histogram[i] >= 0.0005) std::printf(" %zu: %.1f%%", i + 1, 100.0 * profile.histogram[i]);
+  std::printf("\n");
   const double mib = double(outBytes) / (1024.0 * 1024.0);
   std::printf("\nbandwidth over the %.1f MiB the prefilter writes (RGBA8):\n", mib);
   std::printf("  memcpy (CPU)          %8.2f ms  %8.0f MiB/s\n", memcpyMs, mib / (memcpyMs / 1000.0));

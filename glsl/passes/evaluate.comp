@@ -19,6 +19,9 @@
 #ifndef CREP_CAMERA_DEPTH_UNIT
 #define CREP_CAMERA_DEPTH_UNIT 1
 #endif
+#ifndef CREP_MEMORY_LIMIT
+#define CREP_MEMORY_LIMIT 0 // 1: benchmark variant, the same fetches and store without the math
+#endif
 #include "crep/scattering.glsl"
 
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y) in;
@@ -31,6 +34,32 @@ layout(std140, binding = CREP_EVALUATE_BINDING) uniform CrepEvaluateBlock { Crep
 // near far / (near + (1 - d)(far - near)): 1 - d is exact for d >= 1/2, so there is no cancellation
 // where crep_linearDepth's (2d - 1) form loses digits (d near 1).
 float crep_viewDepth(float d, float zNear, float zFar) { return zNear * zFar / (zNear + (1.0 - d) * (zFar - zNear)); }
+
+#if CREP_MEMORY_LIMIT
+// The fetches of crep_inScatteringSegment (one per layer and region crossed, at the same coordinates) and
+// nothing else: their sum is stored so that no fetch is optimized away.
+vec4 crep_fetchOnly(vec3 origin, vec3 dir, float start, float surface) {
+  CrepEvalRay hit;
+  if (!crep_evalMap(origin, dir, surface, hit)) return vec4(0.0);
+  int firstRegion = 0;
+  float firstU = 0.0;
+#if CREP_NEAR_PLANE_CORRECTION
+  CrepEvalRay nearPoint;
+  if (start > 0.0 && crep_evalMap(origin, dir, start, nearPoint)) {
+    firstRegion = min(nearPoint.region, hit.region);
+    firstU = nearPoint.u;
+  }
+#endif
+  vec4 sum = vec4(0.0);
+  for (int r = firstRegion; r <= hit.region; ++r) {
+    float ub = r == hit.region ? hit.u : 1.0;
+    for (int l = 0; l < CREP_EVAL_LAYERS; ++l) sum += crep_filteredBasisAt(r, ub, hit.row, l);
+    if (r == firstRegion && firstU > 0.0) // the near-plane correction's second prefix
+      for (int l = 0; l < CREP_EVAL_LAYERS; ++l) sum += crep_filteredBasisAt(r, firstU, hit.row, l);
+  }
+  return sum;
+}
+#endif
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -49,5 +78,9 @@ void main() {
 #if CREP_NEAR_PLANE_CORRECTION
   start = min(zNear / cosForward, surface);
 #endif
+#if CREP_MEMORY_LIMIT
+  imageStore(crep_scatteringOut, pixel, crep_fetchOnly(crep_evaluate.cameraPosition.xyz, dir, start, surface));
+#else
   imageStore(crep_scatteringOut, pixel, crep_inScatteringSegment(crep_evaluate.cameraPosition.xyz, dir, start, surface));
+#endif
 }

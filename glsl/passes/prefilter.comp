@@ -28,6 +28,9 @@
 #ifndef CREP_LOCAL_SIZE_Y
 #define CREP_LOCAL_SIZE_Y 1 // base groups per workgroup
 #endif
+#ifndef CREP_MEMORY_LIMIT
+#define CREP_MEMORY_LIMIT 0 // 1: benchmark variant, the same map reads and basis writes without the math
+#endif
 #ifndef CREP_LOCAL_SIZE_Z
 #define CREP_LOCAL_SIZE_Z 1 // regions per workgroup
 #endif
@@ -77,6 +80,16 @@ void main() {
   for (int i = 0; i < n; ++i) {
     int x = region * n + i;
     // Listing 3: the basis of the texel's depth (Eq. 8), computed here instead of read from a texture.
+#if CREP_MEMORY_LIMIT
+    // Benchmark variant: the same read and the same writes, no basis and no weights.
+    float depth = texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r;
+    for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
+      int layer = firstLayer + v;
+      if (layer >= layers) break;
+      imageStore(crep_filteredBasisOut, ivec3(x, row, layer), vec4(depth));
+    }
+    continue;
+#endif
     CrepDepth z = crep_texelBasisDepth(texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r, margin);
     vec2 stepSC = crep_harmonicStep(z);
     vec2 sc = crep_harmonic(firstHarmonic, z);

@@ -290,7 +290,8 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
         {"CREP_BASIS_HALF", o.format == StorageFormat::RGBA16F ? "1" : "0"},
         {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
         {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
-        {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)}}}};
+        {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)},
+        {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   program_ = buildProgram(stages);
 
   texture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
@@ -412,7 +413,8 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
         {"CREP_NEAR_PLANE_CORRECTION", info.options.nearPlaneCorrection ? "1" : "0"},
         {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
         {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
-        {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)}}}};
+        {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)},
+        {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   if (layoutKind >= 0) {
     std::vector<ShaderDefine>& d = stages[0].defines;
     d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});

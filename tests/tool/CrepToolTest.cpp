@@ -178,12 +178,14 @@ TEST_CASE("crep: out-of-range numbers are usage errors naming the option, before
   expectFailure("compare --size 16x9 --map-size 16385" + out, 2, {"--map-size"});
   if (CREP_TOOL_HAS_BENCH) {
     // Used to fail inside the rectification, naming Rectification.splitViewport.width.
-    for (const char* map : {"1x1", "4x4", "24x24"}) {
-      const auto r = expectFailure(std::string("bench --map ") + map, 2, {"--map", "multiple of 16"});
+    // Scattering's defaults: 8 splits x 2 prefilter regions (--quick: a multiple of 16), and up to 4 regions
+    // per split in the parallelization rows (a multiple of 32).
+    for (const char* map : {"1x1", "4x4", "24x24", "48x48"}) {
+      const auto r = expectFailure(std::string("bench --map ") + map, 2, {"--map", "multiple of 32"});
       CHECK(r.output.find("Rectification") == std::string::npos);
     }
-    expectFailure("bench --quick --map 2x2", 2, {"--map", "multiple of 4"});
-    expectFailure("bench --map 16x1", 2, {"--map", "height"});
+    expectFailure("bench --quick --map 8x8", 2, {"--map", "multiple of 16"});
+    expectFailure("bench --map 32x1", 2, {"--map", "height"});
     expectFailure("bench --map 32768x16", 2, {"--map"});
   }
   CHECK(fileCount(dir) == 0);

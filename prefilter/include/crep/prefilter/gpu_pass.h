@@ -81,6 +81,10 @@ public:
     int workgroupRows = 64;      ///< local_size_x: rows per workgroup, >= 1
     int workgroupBaseGroups = 1; ///< local_size_y: groups of bases per workgroup, >= 1
     int workgroupRegions = 1;    ///< local_size_z: regions per workgroup, >= 1
+    /// Benchmarks only (the output is meaningless): the pass stripped to its memory traffic, the same map
+    /// reads and the same filtered-basis writes in the same order without the Fourier basis and the
+    /// weights (CREP_MEMORY_LIMIT), to measure how close the pass is to its bandwidth limit.
+    bool memoryLimit = false;
   };
 
   struct FrameAttribs {
@@ -139,6 +143,11 @@ public:
     StorageFormat outputFormat = StorageFormat::RGBA32F;
     int workgroupWidth = 8;  ///< local_size_x, pixels, >= 1
     int workgroupHeight = 8; ///< local_size_y, pixels, >= 1
+    /// Benchmarks only (the output is meaningless): the pass stripped to its memory traffic, the same
+    /// camera-depth fetch, the same filtered-basis fetches per pixel (count, format, filtering; the
+    /// mapping that addresses them is kept) and the same store, without the coefficients, the
+    /// transmittance integrals and the phase function (CREP_MEMORY_LIMIT).
+    bool memoryLimit = false;
   };
 
   struct FrameAttribs {
