@@ -35,6 +35,11 @@
 //   CREP_FP64                  1: reduce Fourier angles in double (opt-in; default 0: float only, exact
 //                              reduction from float pairs, see "Accuracy" below). The former CREP_NO_FP64
 //                              is still read: CREP_NO_FP64 0 means CREP_FP64 1.
+//   CREP_VISIBILITY_TABLE_SAMPLES  Z: read the visibility of every region a ray crosses whole from the
+//                              region visibility table (crep::EvaluateOptions::visibilityTableSamples; built
+//                              by EvaluatePass, or glsl/passes/visibility_table.comp) bound as a sampler2D
+//                              with GL_LINEAR at CREP_VISIBILITY_TABLE_UNIT (default 6); one fetch instead of
+//                              M / 4 per such region. Ignored with CREP_NEAR_PLANE_CORRECTION 1.
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
 //   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
 //                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
@@ -279,6 +284,12 @@ float crep_regionWeightTotal(CrepRegionWeights w, int mode, float s, int n, floa
 
 layout(std140, binding = CREP_SCATTERING_BINDING) uniform CrepScatteringBlock { CrepScatteringParams crep_scattering; };
 layout(binding = CREP_FILTERED_BASIS_UNIT) uniform sampler2DArray crep_filteredBasis;
+#ifdef CREP_VISIBILITY_TABLE_SAMPLES
+#ifndef CREP_VISIBILITY_TABLE_UNIT
+#define CREP_VISIBILITY_TABLE_UNIT 6
+#endif
+layout(binding = CREP_VISIBILITY_TABLE_UNIT) uniform sampler2D crep_visibilityTable;
+#endif
 #if CREP_NEAR_PLANE_CORRECTION
 layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegionWeightsBlock {
   CrepRegionWeights crep_regionWeights[];
@@ -472,6 +483,26 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
   int nearestRow = clamp(int(floor(hit.row * float(crep_scattering.mapSize.y))), 0, crep_scattering.mapSize.y - 1);
   int mode = crep_scattering.basisInfo.w;
   float s = crep_scattering.extinction.w;
+#endif
+#if defined(CREP_VISIBILITY_TABLE_SAMPLES) && !CREP_NEAR_PLANE_CORRECTION
+  // The regions crossed whole from the table (crep::evaluate's rule: bilinear in the texel row and the
+  // depth sample d (Z - 1)), then the last region from the basis. Two loops, no branch inside: neighbouring
+  // pixels that end in different regions run the same instructions (SIMD lanes, GPU warps).
+  {
+    int H = crep_scattering.mapSize.y, R = crep_scattering.mapSize.z, Z = CREP_VISIBILITY_TABLE_SAMPLES;
+    float ty = (clamp(hit.row * float(H) - 0.5, 0.0, float(H - 1)) + 0.5) / float(H);
+    float tx = clamp(hit.depth, 0.0, 1.0) * float(Z - 1) + 0.5;
+    for (int r = 0; r < lastRegion; ++r) {
+      float tb = clamp(crep_evalBoundary(hit, r + 1), ta, surface);
+      float V = textureLod(crep_visibilityTable, vec2((float(r * Z) + tx) / float(R * Z), ty), 0.0).r;
+      L += C * V * crep_transmittanceIntegral(sigma, ta, tb);
+      ta = tb;
+    }
+    float dotF = 0.0;
+    for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(lastRegion, lastU, hit.row, l));
+    L += C * clamp(0.5 + dotF, 0.0, 1.0) * crep_transmittanceIntegral(sigma, ta, surface);
+    return vec4(L, transmittance);
+  }
 #endif
   for (int r = firstRegion; r <= lastRegion; ++r) {
     float ua = r == firstRegion ? firstU : 0.0;

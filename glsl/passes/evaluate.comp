@@ -51,6 +51,16 @@ vec4 crep_fetchOnly(vec3 origin, vec3 dir, float start, float surface) {
   }
 #endif
   vec4 sum = vec4(0.0);
+#if defined(CREP_VISIBILITY_TABLE_SAMPLES) && !CREP_NEAR_PLANE_CORRECTION
+  // The table path: one table fetch per region crossed whole, the basis of the last region.
+  int H = crep_scattering.mapSize.y, R = crep_scattering.mapSize.z, Z = CREP_VISIBILITY_TABLE_SAMPLES;
+  float ty = (clamp(hit.row * float(H) - 0.5, 0.0, float(H - 1)) + 0.5) / float(H);
+  float tx = clamp(hit.depth, 0.0, 1.0) * float(Z - 1) + 0.5;
+  for (int r = 0; r < hit.region; ++r)
+    sum += textureLod(crep_visibilityTable, vec2((float(r * Z) + tx) / float(R * Z), ty), 0.0);
+  for (int l = 0; l < CREP_EVAL_LAYERS; ++l) sum += crep_filteredBasisAt(hit.region, hit.u, hit.row, l);
+  return sum;
+#endif
   for (int r = firstRegion; r <= hit.region; ++r) {
     float ub = r == hit.region ? hit.u : 1.0;
     for (int l = 0; l < CREP_EVAL_LAYERS; ++l) sum += crep_filteredBasisAt(r, ub, hit.row, l);

@@ -31,6 +31,9 @@ namespace {
 // Binding points (see gpu_pass.h and the shaders' defaults).
 constexpr GLuint kScatteringBinding = 0, kEvaluateBinding = 1, kRegionWeightsEvalBinding = 1;
 constexpr GLuint kBasisUnit = 0, kCameraDepthUnit = 1;
+/// The region visibility table: its texture unit in the evaluation (CREP_VISIBILITY_TABLE_UNIT's default)
+/// and the basis's unit in the table pass.
+constexpr GLuint kTableUnit = 6, kTableBasisUnit = 0;
 // Layouts other than projective: their block (gpu::LayoutBuffers) next to the scattering and evaluate blocks.
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 
@@ -415,6 +418,8 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
         {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
         {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
+  if (usesVisibilityTable(info.options))
+    stages[0].defines.push_back({"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)});
   if (layoutKind >= 0) {
     std::vector<ShaderDefine>& d = stages[0].defines;
     d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
@@ -444,6 +449,16 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   basisSampler_ =
       gl::createClampSampler(info.options.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
   depthSampler_ = gl::createClampSampler(GL_NEAREST);
+  if (usesVisibilityTable(info.options)) {
+    tableProgram_ =
+        buildProgram({{ShaderStage::Compute,
+                       "passes/visibility_table.comp",
+                       {{"CREP_BASES", str(info.bases)},
+                        {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
+                        {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
+                        {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}});
+    tableSampler_ = gl::createClampSampler(GL_LINEAR);
+  }
   scatteringBuffer_ = gl::createDynamicBuffer(sizeof(gpu::ScatteringParams));
   evaluateBuffer_ = gl::createDynamicBuffer(sizeof(gpu::EvaluateParams));
   gl::checkError("EvaluatePass: samplers and buffers");
@@ -512,6 +527,30 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
 
+  const bool table = usesVisibilityTable(info_.options);
+  if (table) {
+    // The region visibility table of this basis (EvaluateOptions::visibilityTableSamples), rebuilt every run.
+    const int Z = info_.options.visibilityTableSamples, R = basis.regions();
+    if (tableWidth_ != R * Z || tableHeight_ != basis.height) {
+      tableTexture_ = gl::createTexture2D(GL_R32F, R * Z, basis.height,
+                                          "EvaluatePass: visibility table (regions x samples, rows)");
+      tableWidth_ = R * Z;
+      tableHeight_ = basis.height;
+    }
+    glUseProgram(tableProgram_.get());
+    glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
+    glProgramUniform1f(tableProgram_.get(), 1, static_cast<float>(basis.depthMargin));
+    glBindTextureUnit(kTableBasisUnit, basis.texture);
+    glBindSampler(kTableBasisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
+    glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height),
+                      static_cast<GLuint>(R));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindSampler(kTableBasisUnit, 0);
+    glBindTextureUnit(kTableBasisUnit, 0);
+    glBindTextureUnit(kTableUnit, tableTexture_.get());
+    glBindSampler(kTableUnit, tableSampler_.get());
+  }
   glUseProgram(program);
   if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
   glBindTextureUnit(kBasisUnit, basis.texture);
@@ -540,6 +579,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glBindTextureUnit(kCameraDepthUnit, 0);
   glBindSampler(kBasisUnit, 0);
   glBindTextureUnit(kBasisUnit, 0);
+  if (table) {
+    glBindSampler(kTableUnit, 0);
+    glBindTextureUnit(kTableUnit, 0);
+  }
   glUseProgram(0);
   gl::checkError("EvaluatePass::run");
 }

@@ -171,6 +171,11 @@ void validate(const EvaluateOptions& o, std::string_view owner) {
   if (o.ringing != RingingFilter::None && o.ringing != RingingFilter::Lanczos)
     throw InvalidArgument(field("ringing"), detail::formatValue(static_cast<int>(o.ringing)),
                           "must be None or Lanczos");
+  if (o.visibilityTableSamples != 0 &&
+      (o.visibilityTableSamples < 2 || o.visibilityTableSamples > kMaxVisibilityTableSamples))
+    throw InvalidArgument(field("visibilityTableSamples"), detail::formatValue(o.visibilityTableSamples),
+                          "must be 0 (no table) or in [2, " + std::to_string(kMaxVisibilityTableSamples) +
+                              "]");
   if (o.threads < 0) throw InvalidArgument(field("threads"), detail::formatValue(o.threads), "must be >= 0");
 }
 
@@ -284,6 +289,37 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
   return b;
 }
 
+std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing) {
+  validateBasis(basis);
+  if (samples < 2 || samples > kMaxVisibilityTableSamples)
+    throw InvalidArgument("visibilityTable.samples", detail::formatValue(samples),
+                          "must be in [2, " + std::to_string(kMaxVisibilityTableSamples) + "]");
+  const int H = basis.height, R = basis.regions, M = basis.bases, n = basis.regionWidth();
+  std::vector<double> table(static_cast<std::size_t>(H) * static_cast<std::size_t>(R) *
+                            static_cast<std::size_t>(samples));
+  std::vector<double> a(static_cast<std::size_t>(samples) * static_cast<std::size_t>(M));
+  for (int s = 0; s < samples; ++s) {
+    const std::span<double> as(a.data() + static_cast<std::size_t>(s) * static_cast<std::size_t>(M),
+                               static_cast<std::size_t>(M));
+    fourierCoefficients(rayBasisDepth(static_cast<double>(s) / (samples - 1), basis.depthMargin), as);
+    applyRingingFilter(ringing, as);
+  }
+  for (int j = 0; j < H; ++j)
+    for (int r = 0; r < R; ++r) {
+      const int x = r * n + n - 1; // the region's last texel: its whole weighted average
+      for (int s = 0; s < samples; ++s) {
+        double dot = 0.0;
+        for (int k = 0; k < M; ++k)
+          dot += a[static_cast<std::size_t>(s) * static_cast<std::size_t>(M) + static_cast<std::size_t>(k)] *
+                 basis.filtered(x, j, k);
+        table[(static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
+                  static_cast<std::size_t>(samples) +
+              static_cast<std::size_t>(s)] = std::clamp(0.5 + dot, 0.0, 1.0);
+      }
+    }
+  return table;
+}
+
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
                const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
   validateBasis(basis);
@@ -295,6 +331,27 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
   const glm::dvec3 sigma = medium.extinction();
   const double greySigma = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
+  const bool table = usesVisibilityTable(options);
+  const int Z = options.visibilityTableSamples;
+  const std::vector<double> tableValues =
+      table ? visibilityTable(basis, Z, options.ringing) : std::vector<double>();
+  // GL_LINEAR of the table texture (width R Z, height H) at depth d and normalized row: x = d (Z - 1)
+  // inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for the basis.
+  const auto tableAt = [&](int r, double depth, double row) {
+    const double xs = std::clamp(depth, 0.0, 1.0) * (Z - 1);
+    const double ys = std::clamp(row * basis.height - 0.5, 0.0, static_cast<double>(basis.height - 1));
+    const int x0 = static_cast<int>(std::floor(xs)), y0 = static_cast<int>(std::floor(ys));
+    const int x1 = std::min(x0 + 1, Z - 1), y1 = std::min(y0 + 1, basis.height - 1);
+    const double fx = xs - x0, fy = ys - y0;
+    const auto at = [&](int xi, int yi) {
+      return tableValues[(static_cast<std::size_t>(yi) * static_cast<std::size_t>(R) +
+                          static_cast<std::size_t>(r)) *
+                             static_cast<std::size_t>(Z) +
+                         static_cast<std::size_t>(xi)];
+    };
+    return (1.0 - fy) * ((1.0 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+           fy * ((1.0 - fx) * at(x0, y1) + fx * at(x1, y1));
+  };
   Image out(w, h, 4);
   parallelRows(h, options.threads, [&](int y) {
     std::array<double, kMaxBases> a{}, Fa{}, Fb{};
@@ -312,6 +369,10 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
         const int nearestRow =
             std::clamp(static_cast<int>(std::floor(m.row * basis.height)), 0, basis.height - 1);
         forEachSegment(layout, ray, m, R, [&](int r, double ua, double ub, double ta, double tb) {
+          if (table && r < m.last.region) { // a region crossed whole: the table (see EvaluateOptions)
+            L += C * tableAt(r, m.depth, m.row) * transmittanceIntegral(sigma, ta, tb);
+            return;
+          }
           sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data());
           double dot = 0.0;
           bool plain = ua <= 0.0;

@@ -3,8 +3,9 @@
 // nothing. The write-only prefilter writes every layer of every texel (the map depth, raw); the fetch-only
 // evaluation fetches M / 4 layers per prefilter region a ray crosses, which a basis of constant texels
 // turns into a count: with every stored value e = 1 (decoded F = 2 e - 1 = 1) a pixel's sum is
-// layers x regions crossed, compared with the regions counted on the CPU by the layout (the rule of
-// crep::evaluate: the surface point's region, all before it crossed).
+// layers x regions crossed without the region visibility table, and (regions crossed - 1) table fetches
+// (the table's write-only pass writes 1) + layers with it; compared with the regions counted on the CPU by
+// the layout (the rule of crep::evaluate: the surface point's region, all before it crossed).
 #include "prefilter_gpu_util.h"
 #include "support/gl_fixture.h"
 
@@ -55,31 +56,35 @@ TEST_CASE("memory-limit variants: the write-only prefilter writes every layer, t
     CHECK(hi == 1.0f);
   }
 
-  EvaluatePass::CreateInfo ei;
-  ei.bases = kBases;
-  ei.memoryLimit = true;
-  EvaluatePass fetchOnly(ei);
-  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kScreenW, kScreenH);
-  fetchOnly.run({s.depthTexture.get(), out.get(), &s.scene.camera, &s.scene.sun, &s.scene.medium,
-                 s.layout.get(), writeOnly.filteredBasis()});
-  const Image sums = gl::readTexture(out.get(), kScreenW, kScreenH, gl::TexelData::Rgba);
-  int mismatched = 0, total = 0;
-  double meanRegions = 0.0;
-  for (int y = 0; y < kScreenH; ++y)
-    for (int x = 0; x < kScreenW; ++x) {
-      const PixelRay ray = pixelRay(s.scene.camera, s.cameraDepth, x, y);
-      const RectPoint hit = s.layout->toRectified(s.scene.camera.position() + ray.surface * ray.direction);
-      const int q =
-          std::min(static_cast<int>(std::floor(std::clamp(hit.splitColumn, 0.0, 1.0) * kP)), kP - 1);
-      const int regions = hit.split * kP + q + 1;
-      meanRegions += regions;
-      ++total;
-      const double fetched = sums.at(x, y, 0) / layers;
-      if (std::abs(fetched - regions) > 1e-3) ++mismatched;
-      // A float mapping on a region boundary may land one region off; never more.
-      CHECK(std::abs(fetched - regions) <= 1.0 + 1e-3);
-    }
-  MESSAGE("regions crossed per pixel " << meanRegions / total << "; GPU count differs from the CPU's at "
-                                       << mismatched << " of " << total << " pixels");
-  CHECK(mismatched <= total / 200);
+  for (const int tableSamples : {0, 128}) {
+    CAPTURE(tableSamples);
+    EvaluatePass::CreateInfo ei;
+    ei.bases = kBases;
+    ei.options.visibilityTableSamples = tableSamples;
+    ei.memoryLimit = true;
+    EvaluatePass fetchOnly(ei);
+    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kScreenW, kScreenH);
+    fetchOnly.run({s.depthTexture.get(), out.get(), &s.scene.camera, &s.scene.sun, &s.scene.medium,
+                   s.layout.get(), writeOnly.filteredBasis()});
+    const Image sums = gl::readTexture(out.get(), kScreenW, kScreenH, gl::TexelData::Rgba);
+    int mismatched = 0, total = 0;
+    double meanRegions = 0.0;
+    for (int y = 0; y < kScreenH; ++y)
+      for (int x = 0; x < kScreenW; ++x) {
+        const PixelRay ray = pixelRay(s.scene.camera, s.cameraDepth, x, y);
+        const RectPoint hit = s.layout->toRectified(s.scene.camera.position() + ray.surface * ray.direction);
+        const int q =
+            std::min(static_cast<int>(std::floor(std::clamp(hit.splitColumn, 0.0, 1.0) * kP)), kP - 1);
+        const int regions = hit.split * kP + q + 1;
+        meanRegions += regions;
+        ++total;
+        const double fetched = tableSamples > 0 ? sums.at(x, y, 0) - layers + 1 : sums.at(x, y, 0) / layers;
+        if (std::abs(fetched - regions) > 1e-3) ++mismatched;
+        // A float mapping on a region boundary may land one region off; never more.
+        CHECK(std::abs(fetched - regions) <= 1.0 + 1e-3);
+      }
+    MESSAGE("regions crossed per pixel " << meanRegions / total << "; GPU count differs from the CPU's at "
+                                         << mismatched << " of " << total << " pixels");
+    CHECK(mismatched <= total / 200);
+  }
 }

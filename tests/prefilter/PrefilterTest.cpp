@@ -513,3 +513,60 @@ TEST_CASE("prefilter: bad input gets a named InvalidArgument") {
   layers.layout = SplitLayout::Layers;
   CHECK(parameterOf([&] { ProjectiveLayout(rectify(camera, light, layers)); }) == "Rectification.layout");
 }
+
+TEST_CASE("prefilter: the region visibility table keeps the analytic ground truth within 0.1%") {
+  // EvaluateOptions::visibilityTableSamples: the regions a ray crosses whole read their visibility from a
+  // table over (row, depth) instead of the basis. Against the closed forms of (a) and (b), with the
+  // library's splits (8 x 2 prefilter regions) and the former 4 x 1: the table may not cost more than 0.1%
+  // relative RMSE (issue "performance", item 3). The table itself is tested against its definition.
+  const Camera camera = test::groundCamera();
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const Image depth = groundDepth(camera, 160, 90);
+  const HalfSpace plane;
+  for (const int splits : {4, 8}) {
+    CAPTURE(splits);
+    const auto layout = test::projectiveLayout(camera, light, splits);
+    PrefilterOptions po;
+    po.regionsPerSplit = splits == 8 ? 2 : 1;
+    for (const bool shadow : {false, true}) {
+      CAPTURE(shadow);
+      const RectifiedMap map =
+          shadow ? halfSpaceMap(layout, plane, 512, 256)
+                 : castRectifiedMap(layout, 512, 256, [](const LightRay&) { return std::nullopt; });
+      const Image truth = shadow ? halfSpaceTruth(depth, camera, light, medium, plane)
+                                 : unshadowedScattering(depth, camera, light, medium);
+      const FilteredBasis basis = prefilter(map, medium, po);
+      EvaluateOptions direct, tabled;
+      direct.visibilityTableSamples = 0;
+      REQUIRE(usesVisibilityTable(tabled));
+      const ImageMetrics md = rgbMetrics(evaluate(basis, depth, camera, light, medium, direct), truth);
+      const ImageMetrics mt = rgbMetrics(evaluate(basis, depth, camera, light, medium, tabled), truth);
+      MESSAGE((shadow ? "(b)" : "(a)")
+              << " " << splits << " splits x " << po.regionsPerSplit << ": relative RMSE direct "
+              << md.relativeRmse << ", with the table " << mt.relativeRmse);
+      CHECK(std::abs(mt.relativeRmse - md.relativeRmse) < 0.001);
+    }
+    // The table's definition at a few entries: clamp(0.5 + a(z_s) . F_r(last texel of r), 0, 1).
+    const RectifiedMap map = halfSpaceMap(layout, plane, 512, 256);
+    const FilteredBasis basis = prefilter(map, medium, po);
+    const int Z = 16;
+    const std::vector<double> table = visibilityTable(basis, Z, RingingFilter::None);
+    REQUIRE(table.size() == std::size_t(basis.height) * basis.regions * Z);
+    std::vector<double> a(static_cast<std::size_t>(basis.bases));
+    for (const int j : {0, 100, 255})
+      for (const int r : {0, basis.regions - 1})
+        for (const int s : {0, 7, Z - 1}) {
+          fourierCoefficients(rayBasisDepth(double(s) / (Z - 1), basis.depthMargin), a);
+          double dot = 0.0;
+          for (int k = 0; k < basis.bases; ++k)
+            dot += a[std::size_t(k)] * basis.filtered((r + 1) * basis.regionWidth() - 1, j, k);
+          CHECK(table[(std::size_t(j) * basis.regions + r) * Z + s] ==
+                doctest::Approx(std::clamp(0.5 + dot, 0.0, 1.0)).epsilon(1e-12));
+        }
+  }
+  // Bad sample counts are named.
+  EvaluateOptions bad;
+  bad.visibilityTableSamples = 1;
+  CHECK_THROWS_AS(validate(bad), InvalidArgument);
+}

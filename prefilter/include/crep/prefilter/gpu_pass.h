@@ -16,7 +16,9 @@
 //   PrefilterPass::run: texture unit 0 (+ sampler), image unit 0, uniform buffer 0, storage buffer 0.
 //   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0, uniform buffers 0 and 1,
 //                       storage buffer 1 (near-plane correction); for a non-projective layout also
-//                       uniform buffer 2 and storage buffer 2 (its layout block and row table).
+//                       uniform buffer 2 and storage buffer 2 (its layout block and row table); with the
+//                       region visibility table (EvaluateOptions::visibilityTableSamples) texture unit 6
+//                       (+ sampler) and a second program (the table pass) run first.
 // Engines that evaluate in their own shader use crep/scattering.glsl with filteredBasis() and
 // makeScatteringParams() (see that file's header).
 #pragma once
@@ -181,6 +183,10 @@ private:
   CreateInfo info_;
   gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
   gl::Handle layoutPrograms_[2]; ///< per gpu::LayoutKind, built on first use (non-projective layouts)
+  /// The region visibility table (EvaluateOptions::visibilityTableSamples): its pass, R32F texture
+  /// (R Z x H, reallocated when the basis's size changes) and linear sampler.
+  gl::Handle tableProgram_, tableTexture_, tableSampler_;
+  int tableWidth_ = 0, tableHeight_ = 0;
   gpu::LayoutBuffers layoutBuffers_;
 };
 

@@ -181,11 +181,32 @@ struct EvaluateOptions {
   /// scenes Lanczos damping is worse (its wider step darkens the texels just before each receiver, which
   /// lies in the map itself); it is much better for open, unoccluded views (prefilter/README.md).
   RingingFilter ringing = RingingFilter::None;
+  /// Z samples of the region visibility table (0 = none): a region the ray crosses whole contributes
+  /// V = clamp(0.5 + a(z) . F_r(end), 0, 1), which depends only on the texel row and the ray's depth z, so
+  /// it is tabulated once per frame (H rows x R regions x Z depths, built from the stored basis) and read
+  /// with one bilinear fetch (row, depth) instead of M / 4; only the region where the ray ends fetches the
+  /// basis. Used with Sampling::Bilinear and without the near-plane correction (else the direct path).
+  /// Not in the paper: the evaluation is bound by its basis fetches (bench/README.md, "Profile").
+  /// Default 128: ~8 samples across the step of M = 32 (README "Measured figures").
+  int visibilityTableSamples = 128;
   /// CPU worker threads: 0 = hardware concurrency. Never changes the result.
   int threads = 0;
 };
 
-/// Throws InvalidArgument naming the field as `<owner>.sampling`, `<owner>.ringing`, `<owner>.threads`.
+/// Whether evaluation with `options` uses the region visibility table (see visibilityTableSamples).
+inline bool usesVisibilityTable(const EvaluateOptions& options) {
+  return options.visibilityTableSamples > 0 && options.sampling == Sampling::Bilinear &&
+         !options.nearPlaneCorrection;
+}
+inline constexpr int kMaxVisibilityTableSamples = 4096;
+
+/// The region visibility table of `basis` (see visibilityTableSamples), in double from the stored values:
+/// index (row * R + region) * Z + s, sample s at normalized ray depth s / (Z - 1), ray coefficients with
+/// `ringing`. What EvaluatePass builds on the GPU in float (glsl/passes/visibility_table.comp).
+std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing);
+
+/// Throws InvalidArgument naming the field as `<owner>.sampling`, `<owner>.ringing`,
+/// `<owner>.visibilityTableSamples` (0 or in [2, kMaxVisibilityTableSamples]), `<owner>.threads`.
 void validate(const EvaluateOptions& options, std::string_view owner = "EvaluateOptions");
 
 /// Evaluation (see top): a 4-channel image of cameraDepth's size, RGB = in-scattered radiance, A =
