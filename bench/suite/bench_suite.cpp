@@ -8,6 +8,7 @@
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/epipolar/march.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
@@ -325,6 +326,54 @@ void sunInView(const BenchOptions& o) {
         (fallbackMs + resampleMs) / (projectiveMs + shadowMs));
 }
 
+/// GPU memory per configuration (issue "performance", item 6): what crep::Scattering and the peers own,
+/// from the same size functions the passes use, and Scattering::memoryBytes() after one frame of this run.
+void memoryTable(const BenchOptions& o) {
+  const Scattering::CreateInfo d;
+  const int R = d.rectify.splits * d.prefilter.regionsPerSplit, Z = d.evaluate.visibilityTableSamples;
+  const auto mib = [](std::size_t b) { return double(b) / (1024.0 * 1024.0); };
+  std::printf(
+      "\nGPU memory, MiB (M = %d; %d prefilter regions, table of %d samples; rectified maps D32F + R32F;\n"
+      "trees: min/max march only; own shadow map %d^2 D32F, fallback frames without an engine map):\n",
+      o.bases, R, Z, d.ownShadowMapSize);
+  std::printf("%-8s %10s %10s %10s %10s %10s %10s %10s\n", "map", "basis 8", "basis 16F", "basis 32F",
+              "table", "maps", "trees", "own map");
+  for (const int size : {512, 1024, 2048, 4096}) {
+    const std::size_t map = std::size_t(size) * std::size_t(size) * 4;
+    const std::size_t trees = std::size_t(MinMaxTrees::rowStrideFor(size)) * std::size_t(size) * 8;
+    std::printf("%-8d %10.1f %10.1f %10.1f %10.1f %10.1f %10.1f %10.1f\n", size,
+                mib(filteredBasisBytes(size, size, o.bases, StorageFormat::RGBA8)),
+                mib(filteredBasisBytes(size, size, o.bases, StorageFormat::RGBA16F)),
+                mib(filteredBasisBytes(size, size, o.bases, StorageFormat::RGBA32F)),
+                mib(visibilityTableBytes(size, R, Z)), mib(2 * map), mib(trees),
+                mib(std::size_t(d.ownShadowMapSize) * std::size_t(d.ownShadowMapSize) * 4));
+  }
+  if (o.mapWidth == o.mapHeight &&
+      o.mapWidth % std::lcm(R, d.epipolarRegions * d.prefilter.regionsPerSplit) == 0) {
+    tool::StageTimings timings;
+    tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings);
+    Scattering::CreateInfo info;
+    info.width = o.screenWidth;
+    info.height = o.screenHeight;
+    info.mapSize = o.mapWidth;
+    info.prefilter.bases = o.bases;
+    Scattering scattering(info);
+    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight);
+    Scattering::FrameAttribs a;
+    a.camera = &s.frame->camera;
+    a.light = &s.frame->light;
+    a.medium = &s.frame->medium;
+    a.cameraDepth = s.frame->cameraDepth.get();
+    a.output = out.get();
+    const Scattering::ShadowMap shadow{s.frame->shadowMap.get(), s.frame->shadowWidth, s.frame->shadowHeight,
+                                       s.frame->lightClipFromWorld, s.frame->shadowBias};
+    a.shadowMap = &shadow;
+    scattering.run(a);
+    std::printf("crep::Scattering::memoryBytes() after a frame of %s at %dx%d, map %d^2, RGBA8: %.1f MiB\n",
+                o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, mib(scattering.memoryBytes()));
+  }
+}
+
 } // namespace
 
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
@@ -433,6 +482,7 @@ void runBenchSuite(const BenchOptions& o) {
   std::printf("  CPU prefilter         %8.2f ms  %8.0f MiB/s  (%.1f%% of memcpy)\n", cpuPrefilterMs,
               mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
 
+  memoryTable(o);
   methodsSideBySide(o);
   sunInView(o);
 

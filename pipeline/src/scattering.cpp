@@ -152,6 +152,17 @@ const Scattering::CreateInfo& Scattering::createInfo() const noexcept {
   return impl_->info;
 }
 
+std::size_t Scattering::memoryBytes() const noexcept {
+  const Impl& m = *impl_;
+  const std::size_t map =
+      static_cast<std::size_t>(m.info.mapSize) * static_cast<std::size_t>(m.info.mapSize) * 4;
+  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() + 2 * map; // D32F + R32F maps
+  if (m.ownShadowMap)
+    bytes +=
+        static_cast<std::size_t>(m.ownShadowMap->size) * static_cast<std::size_t>(m.ownShadowMap->size) * 4;
+  return bytes;
+}
+
 Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   Impl& m = *impl_;
   const CreateInfo& info = m.info;

@@ -464,9 +464,19 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   gl::checkError("EvaluatePass: samplers and buffers");
 }
 
+std::size_t EvaluatePass::memoryBytes() const noexcept {
+  return static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_) * 4 +
+         sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
+}
+
 EvaluatePass::~EvaluatePass() = default;
 EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
+
+std::size_t PrefilterPass::memoryBytes() const noexcept {
+  return filteredBasisBytes(info_.width, info_.height, info_.options.bases, info_.options.format) +
+         weightsCapacity_ + sizeof(gpu::PrefilterParams);
+}
 
 void EvaluatePass::run(const FrameAttribs& frame) {
   if (frame.camera == nullptr) invalid("EvaluatePass::FrameAttribs.camera", "null", "must be set");

@@ -193,3 +193,28 @@ TEST_CASE(
     WARN(m.relativeRmse < 0.02);
   }
 }
+
+TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
+  CREP_REQUIRE_GL();
+  Frame f("forest");
+  const Scattering::CreateInfo info = smallInfo();
+  Scattering scattering(info);
+  const std::size_t map = std::size_t(kMap) * kMap * 4; // D32F rasterized + R32F resampled
+  const std::size_t basis = filteredBasisBytes(kMap, kMap, info.prefilter.bases, info.prefilter.format);
+  const std::size_t table = visibilityTableBytes(kMap, info.rectify.splits * info.prefilter.regionsPerSplit,
+                                                 info.evaluate.visibilityTableSamples);
+  // Buffers: the region weights (16 bytes per row and region) and a few uniform blocks.
+  const auto within = [](std::size_t bytes, std::size_t textures) {
+    return bytes >= textures && bytes <= textures + std::size_t(kMap) * 16 * 16 + 4096;
+  };
+  scattering.run(f.attribs(true, false)); // projective frame
+  CHECK(within(scattering.memoryBytes(), basis + table + 2 * map));
+  f.lightToward(1.0, 0.25, 0.2); // a fallback frame with the casters only: its own standard shadow map
+  const Scattering::FrameResult r = scattering.run(f.attribs(true, false));
+  REQUIRE(r.layout == Scattering::Layout::Epipolar);
+  const std::size_t own = std::size_t(info.ownShadowMapSize) * info.ownShadowMapSize * 4;
+  const std::size_t epipolarTable = visibilityTableBytes(
+      kMap, info.epipolarRegions * info.prefilter.regionsPerSplit, info.evaluate.visibilityTableSamples);
+  CHECK(within(scattering.memoryBytes(), basis + epipolarTable + 2 * map + own));
+  MESSAGE("Scattering at " << kMap << "^2 after a fallback frame: " << scattering.memoryBytes() << " bytes");
+}

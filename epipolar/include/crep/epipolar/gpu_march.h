@@ -17,6 +17,7 @@
 // a NaN standard shadow-map texel as empty (lit). The CPU functions reject NaN with InvalidArgument.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -53,6 +54,11 @@ public:
   int rowStride() const noexcept { return rowStride_; }
   /// Reads the buffer back: 2 floats per node, MinMaxTrees::data()'s layout.
   std::vector<float> readNodes() const;
+  /// GPU memory it owns, bytes: the trees (rowStride() x mapHeight nodes of 2 floats).
+  std::size_t memoryBytes() const noexcept {
+    return static_cast<std::size_t>(rowStride_ > 0 ? rowStride_ : 1) *
+           static_cast<std::size_t>(info_.mapHeight) * 8;
+  }
 
 private:
   CreateInfo info_;

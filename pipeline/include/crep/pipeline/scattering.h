@@ -157,6 +157,10 @@ public:
   FrameResult run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept;
+  /// GPU memory it owns now, bytes: the filtered basis and the region visibility table, the rasterized
+  /// (D32F) and resampled (R32F) rectified maps, its own standard shadow map once a fallback frame needed
+  /// it, and the passes' buffers (bench: "memory").
+  std::size_t memoryBytes() const noexcept;
 
 private:
   struct Impl;

@@ -117,6 +117,8 @@ public:
 
   const CreateInfo& createInfo() const noexcept { return info_; }
   int layers() const noexcept { return layerCount(info_.options.bases); }
+  /// GPU memory it owns, bytes: the filtered basis (filteredBasisBytes) and its buffers.
+  std::size_t memoryBytes() const noexcept;
   /// GL_TEXTURE_2D_ARRAY of the filtered basis (GL_LINEAR, clamp to edge), valid after run().
   std::uint32_t filteredBasisTexture() const noexcept { return texture_.get(); }
   /// GL buffer of gpu::RegionWeights of the last run (for the near-plane correction).
@@ -178,6 +180,8 @@ public:
   void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
+  /// GPU memory it owns, bytes: the region visibility table (visibilityTableBytes, once run) and buffers.
+  std::size_t memoryBytes() const noexcept;
 
 private:
   CreateInfo info_;

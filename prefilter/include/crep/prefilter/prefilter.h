@@ -120,6 +120,21 @@ inline int layerCount(int bases) {
   return (bases + 3) / 4;
 }
 
+/// Bytes of one RGBA texel in `format` (4, 8 or 16).
+inline std::size_t texelBytes(StorageFormat format) {
+  return format == StorageFormat::RGBA8 ? 4 : format == StorageFormat::RGBA16F ? 8 : 16;
+}
+/// GPU bytes of a W x H filtered basis of M bases (ceil(M / 4) RGBA layers in `format`).
+inline std::size_t filteredBasisBytes(int width, int height, int bases, StorageFormat format) {
+  return static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
+         static_cast<std::size_t>(layerCount(bases)) * texelBytes(format);
+}
+/// GPU bytes of the region visibility table (EvaluateOptions::visibilityTableSamples Z): R Z x H, R32F.
+inline std::size_t visibilityTableBytes(int height, int regions, int samples) {
+  return static_cast<std::size_t>(height) * static_cast<std::size_t>(regions) *
+         static_cast<std::size_t>(samples) * 4;
+}
+
 /// The storage rule of the filtered basis: encode F in [-1, 1] as e = 0.5 + 0.5 F and round it to
 /// `format` (RGBA8: round(clamp(e, 0, 1) * 255) / 255; RGBA16F: nearest binary16, ties to even; RGBA32F:
 /// nearest float). Returns the stored value e as the GPU reads it back.
