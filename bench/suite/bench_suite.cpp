@@ -18,6 +18,7 @@
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/scenes/shaders.h>
+#include <crep/support/image_compare.h>
 
 #include <epoxy/gl.h>
 
@@ -374,6 +375,68 @@ void memoryTable(const BenchOptions& o) {
   }
 }
 
+/// Reduced-resolution evaluation (issue "performance", item 4): crep::Scattering at evaluation scales 1,
+/// 0.5 and 0.25 on this run's scene, one object each, per-stage wall-clock medians after a warm-up, and the
+/// difference of the image from the full-resolution one.
+void reducedResolution(const BenchOptions& o) {
+  if (o.screenWidth % 4 != 0 || o.screenHeight % 4 != 0 || o.mapWidth != o.mapHeight) {
+    std::printf(
+        "\nreduced resolution: skipped (needs a screen size that is a multiple of 4 and a square map)\n");
+    return;
+  }
+  tool::StageTimings timings;
+  tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings);
+  const Scattering::ShadowMap shadow{s.frame->shadowMap.get(), s.frame->shadowWidth, s.frame->shadowHeight,
+                                     s.frame->lightClipFromWorld, s.frame->shadowBias};
+  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight);
+  Scattering::FrameAttribs a;
+  a.camera = &s.frame->camera;
+  a.light = &s.frame->light;
+  a.medium = &s.frame->medium;
+  a.cameraDepth = s.frame->cameraDepth.get();
+  a.output = out.get();
+  a.shadowMap = &shadow;
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  std::printf(
+      "\nreduced resolution (%s, %dx%d, map %d^2; crep::Scattering, wall-clock medians of %d frames after\n"
+      "a warm-up; difference to the full-resolution image as relative RMSE of the in-scattering):\n",
+      o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, repeat);
+  std::printf("%-7s %12s %12s %12s %12s %12s\n", "scale", "evaluate ms", "resample ms", "frame ms",
+              "vs scale 1", "difference");
+  Image full;
+  double fullMs = 0.0;
+  for (const double scale : {1.0, 0.5, 0.25}) {
+    Scattering::CreateInfo info;
+    info.width = o.screenWidth;
+    info.height = o.screenHeight;
+    info.mapSize = o.mapWidth;
+    info.prefilter.bases = o.bases;
+    info.evaluationScale = scale;
+    Scattering scattering(info);
+    scattering.run(a); // warm-up: shader specialization on the first dispatch
+    std::map<std::string, std::vector<double>> ms;
+    for (int i = 0; i < repeat; ++i)
+      for (const Scattering::Stage& st : scattering.run(a).stages)
+        ms[st.name].push_back(st.wallMilliseconds);
+    double frame = 0.0;
+    for (auto& [name, v] : ms)
+      if (name.find("resample") == std::string::npos && name.find("shadow") == std::string::npos)
+        frame += median(v);
+    const double evaluate = median(ms["evaluate"]);
+    const double resample =
+        ms.count("upsample") ? median(ms["upsample"]) + median(ms["downsample depth"]) : 0.0;
+    const Image image = gl::readTexture(out.get(), o.screenWidth, o.screenHeight, gl::TexelData::Rgba);
+    if (scale == 1.0) {
+      full = image;
+      fullMs = frame;
+    }
+    CompareOptions c;
+    c.channels = 3;
+    std::printf("%-7.2f %12.2f %12.2f %12.2f %12.2f %11.2f%%\n", scale, evaluate, resample, frame,
+                frame / fullMs, 100.0 * compareImages(image, full, c).relativeRmse);
+  }
+}
+
 } // namespace
 
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
@@ -483,6 +546,7 @@ void runBenchSuite(const BenchOptions& o) {
               mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
 
   memoryTable(o);
+  reducedResolution(o);
   methodsSideBySide(o);
   sunInView(o);
 

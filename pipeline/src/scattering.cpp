@@ -5,6 +5,7 @@
 #include <crep/core/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
+#include <crep/pipeline/reduced_resolution.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -58,6 +59,14 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (!(info.ownShadowMapBias >= 0.0 && std::isfinite(info.ownShadowMapBias)))
     invalid("Scattering::CreateInfo.ownShadowMapBias", detail::formatValue(info.ownShadowMapBias),
             "must be finite and >= 0");
+  if (info.evaluationScale != 1.0 && info.evaluationScale != 0.5 && info.evaluationScale != 0.25)
+    invalid("Scattering::CreateInfo.evaluationScale", detail::formatValue(info.evaluationScale),
+            "must be 1, 0.5 or 0.25");
+  const int factor = static_cast<int>(std::lround(1.0 / info.evaluationScale));
+  if (info.width % factor != 0 || info.height % factor != 0)
+    invalid("Scattering::CreateInfo.width/height",
+            std::to_string(info.width) + " x " + std::to_string(info.height),
+            "must be multiples of 1 / evaluationScale = " + std::to_string(factor));
   if (!(info.epipoleBlockRadius >= 0.0 && info.epipoleBlockRadius <= 0.5))
     invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
             "must be in [0, 0.5] (a fraction of the screen diagonal)");
@@ -130,6 +139,13 @@ struct Scattering::Impl {
         evaluate({i.prefilter.bases, i.evaluate}), resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}),
         rectified(i.mapSize) {
     resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
+    const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
+    if (factor > 1) {
+      reduced.emplace(DepthAwareResamplePass::CreateInfo{i.width, i.height, factor});
+      lowDepth = gl::createTexture2D(GL_R32F, reduced->lowWidth(), reduced->lowHeight(), "reduced depth");
+      lowOutput =
+          gl::createTexture2D(GL_RGBA32F, reduced->lowWidth(), reduced->lowHeight(), "reduced output");
+    }
   }
 
   CreateInfo info;
@@ -137,9 +153,11 @@ struct Scattering::Impl {
   EvaluatePass evaluate;
   ShadowResamplePass resample;
   WorldMarchPass block;
-  DepthTarget rectified;                   ///< the projective map rasterized with drawCasters
-  gl::Handle resampled;                    ///< R32F: a map resampled from a standard shadow map
-  std::optional<DepthTarget> ownShadowMap; ///< fallback frames with drawCasters only
+  DepthTarget rectified;                         ///< the projective map rasterized with drawCasters
+  gl::Handle resampled;                          ///< R32F: a map resampled from a standard shadow map
+  std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
+  std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
+  gl::Handle lowDepth, lowOutput;                ///< its camera depth (R32F) and scattering (RGBA32F)
   gl::GpuTimer timer;
 };
 
@@ -157,6 +175,9 @@ std::size_t Scattering::memoryBytes() const noexcept {
   const std::size_t map =
       static_cast<std::size_t>(m.info.mapSize) * static_cast<std::size_t>(m.info.mapSize) * 4;
   std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() + 2 * map; // D32F + R32F maps
+  if (m.reduced)
+    bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
+             static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
   if (m.ownShadowMap)
     bytes +=
         static_cast<std::size_t>(m.ownShadowMap->size) * static_cast<std::size_t>(m.ownShadowMap->size) * 4;
@@ -261,10 +282,11 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   }
   r.rectifiedMap = {layout, map, info.mapSize, info.mapSize};
   stage("prefilter", [&] { m.prefilter.run({map, layout.get(), f.medium}); });
+  if (m.reduced) stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
   stage("evaluate", [&] {
     EvaluatePass::FrameAttribs e;
-    e.cameraDepth = f.cameraDepth;
-    e.output = f.output;
+    e.cameraDepth = m.reduced ? m.lowDepth.get() : f.cameraDepth;
+    e.output = m.reduced ? m.lowOutput.get() : f.output;
     e.camera = f.camera;
     e.light = f.light;
     e.medium = f.medium;
@@ -272,6 +294,11 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     e.basis = m.prefilter.filteredBasis();
     m.evaluate.run(e);
   });
+  if (m.reduced)
+    stage("upsample", [&] {
+      m.reduced->upsample(m.lowOutput.get(), m.lowDepth.get(), f.cameraDepth, f.output, f.camera->near(),
+                          f.camera->far());
+    });
   if (r.layout == Layout::Epipolar) {
     const auto& epipolar = static_cast<const EpipolarLayout&>(*layout);
     const auto centre = epipolar.epipolePixel();

@@ -33,7 +33,7 @@ constexpr GLuint kScatteringBinding = 0, kEvaluateBinding = 1, kRegionWeightsEva
 constexpr GLuint kBasisUnit = 0, kCameraDepthUnit = 1;
 /// The region visibility table: its texture unit in the evaluation (CREP_VISIBILITY_TABLE_UNIT's default)
 /// and the basis's unit in the table pass.
-constexpr GLuint kTableUnit = 6, kTableBasisUnit = 0;
+constexpr GLuint kTableUnit = 6, kTableBasisUnit = 0, kTableCoefficientsBinding = 0;
 // Layouts other than projective: their block (gpu::LayoutBuffers) next to the scattering and evaluate blocks.
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 
@@ -465,7 +465,11 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
 }
 
 std::size_t EvaluatePass::memoryBytes() const noexcept {
-  return static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_) * 4 +
+  const std::size_t coefficients = tableCoefficients_
+                                       ? static_cast<std::size_t>(info_.options.visibilityTableSamples) *
+                                             static_cast<std::size_t>(layerCount(info_.bases)) * 16
+                                       : 0;
+  return static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_) * 4 + coefficients +
          sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
 }
 
@@ -547,15 +551,32 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       tableWidth_ = R * Z;
       tableHeight_ = basis.height;
     }
+    if (!tableCoefficients_ || tableMargin_ != basis.depthMargin) {
+      // a(z_s) of every sample, in double (the CPU reference's values), as M / 4 vec4 per sample.
+      const int layers = layerCount(info_.bases);
+      std::vector<float> a(static_cast<std::size_t>(Z) * static_cast<std::size_t>(layers) * 4, 0.0f);
+      std::vector<double> as(static_cast<std::size_t>(info_.bases));
+      for (int k = 0; k < Z; ++k) {
+        fourierCoefficients(rayBasisDepth(static_cast<double>(k) / (Z - 1), basis.depthMargin), as);
+        applyRingingFilter(info_.options.ringing, as);
+        for (int m = 0; m < info_.bases; ++m)
+          a[static_cast<std::size_t>(k) * static_cast<std::size_t>(layers) * 4 +
+            static_cast<std::size_t>(m)] = static_cast<float>(as[static_cast<std::size_t>(m)]);
+      }
+      tableCoefficients_ = gl::createBuffer();
+      glNamedBufferStorage(tableCoefficients_.get(), static_cast<GLsizeiptr>(a.size() * sizeof(float)),
+                           a.data(), 0);
+      tableMargin_ = basis.depthMargin;
+    }
     glUseProgram(tableProgram_.get());
     glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
-    glProgramUniform1f(tableProgram_.get(), 1, static_cast<float>(basis.depthMargin));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, tableCoefficients_.get());
     glBindTextureUnit(kTableBasisUnit, basis.texture);
     glBindSampler(kTableBasisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
     glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height),
-                      static_cast<GLuint>(R));
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, 0);
     glBindSampler(kTableBasisUnit, 0);
     glBindTextureUnit(kTableBasisUnit, 0);
     glBindTextureUnit(kTableUnit, tableTexture_.get());

@@ -203,9 +203,12 @@ TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
   const std::size_t basis = filteredBasisBytes(kMap, kMap, info.prefilter.bases, info.prefilter.format);
   const std::size_t table = visibilityTableBytes(kMap, info.rectify.splits * info.prefilter.regionsPerSplit,
                                                  info.evaluate.visibilityTableSamples);
-  // Buffers: the region weights (16 bytes per row and region) and a few uniform blocks.
-  const auto within = [](std::size_t bytes, std::size_t textures) {
-    return bytes >= textures && bytes <= textures + std::size_t(kMap) * 16 * 16 + 4096;
+  // Buffers: the region weights (16 bytes per row and region), the table's ray coefficients (a vec4 per
+  // sample and layer) and a few uniform blocks.
+  const std::size_t coefficients =
+      std::size_t(info.evaluate.visibilityTableSamples) * layerCount(info.prefilter.bases) * 16;
+  const auto within = [&](std::size_t bytes, std::size_t textures) {
+    return bytes >= textures && bytes <= textures + std::size_t(kMap) * 16 * 16 + coefficients + 4096;
   };
   scattering.run(f.attribs(true, false)); // projective frame
   CHECK(within(scattering.memoryBytes(), basis + table + 2 * map));

@@ -33,6 +33,7 @@ struct MethodSettings {
   PrefilterOptions prefilter = Scattering::CreateInfo{}.prefilter;
   RectifyOptions rectify = Scattering::CreateInfo{}.rectify; ///< splits (logarithmic; Scattering's defaults)
   int steps = 256; ///< world-space reference march: sections per pixel
+  double scale = 1.0; ///< prefiltered method: Scattering::CreateInfo::evaluationScale (1, 0.5 or 0.25)
 };
 
 /// A rectified depth map on the GPU with its rectification (projective).

@@ -194,6 +194,7 @@ MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
   info.rectify = settings.rectify;
   info.prefilter = settings.prefilter;
   info.epipoleBlock.steps = settings.steps;
+  info.evaluationScale = settings.scale;
   auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });
   const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.shadowWidth, frame.shadowHeight,
                                      frame.lightClipFromWorld, frame.shadowBias};

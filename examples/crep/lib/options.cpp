@@ -6,7 +6,8 @@ namespace crep::tool {
 
 static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
 
-const std::set<std::string> kMethodOptions = {"method", "map-size", "bases", "format", "splits", "steps"};
+const std::set<std::string> kMethodOptions = {"method", "map-size", "bases", "format",
+                                              "splits", "steps",    "scale"};
 
 const char* const kMethodOptionsHelp =
     R"(            --map-size N        shadow map and rectified map size (default 1024, at most 16384)
@@ -15,6 +16,8 @@ const char* const kMethodOptionsHelp =
             --splits K          rectification splits (default 8, 2 prefilter regions each; --map-size must
                                 be a multiple of 2 K and of 16, the epipolar fallback's 8 x 2 regions)
             --steps N           reference march: sections per view ray, changes bisected (default 256)
+            --scale S           prefiltered method: evaluate at 1 (default), 0.5 or 0.25 of the image
+                                size per axis, depth-aware upsampling (the size a multiple of 1 / S)
 )";
 
 StorageFormat parseFormat(const std::string& text) {
@@ -36,6 +39,9 @@ MethodSettings methodSettings(const Args& args) {
   if (s.prefilter.bases % 2 != 0) throw UsageError("option --bases: must be even");
   s.prefilter.format = parseFormat(args.string("format", "rgba8"));
   s.rectify.splits = args.integer("splits", s.rectify.splits, 1, RectifyOptions::kMaxSplits);
+  s.scale = args.number("scale", 1.0, 0.25, 1.0);
+  if (s.scale != 1.0 && s.scale != 0.5 && s.scale != 0.25)
+    throw UsageError("option --scale: must be 1, 0.5 or 0.25");
   // Scattering's rule (crep/pipeline/scattering.h): a multiple of the prefilter regions of both layouts.
   const int perSplit = s.prefilter.regionsPerSplit,
             epipolar = Scattering::CreateInfo{}.epipolarRegions * perSplit;

@@ -90,6 +90,12 @@ public:
     /// lowers the light bleeding around the epipole block. Measured (README "Sun in view"): 0 -> 3.0%
     /// relative RMSE with the sun just outside the screen, 0.1 -> 2.1%, 0.3 -> 2.4%, 1 -> 2.8%.
     double epipolarDepthWarp = 0.1;
+    /// Reduced-resolution evaluation (crep/pipeline/reduced_resolution.h; not in the paper): 1 (full), 0.5
+    /// or 0.25. Below 1 the evaluation runs on a camera image 2x or 4x smaller per axis (checkerboard
+    /// min/max depth) and a depth-aware upsample brings it back; the epipole block is still marched at full
+    /// resolution. width and height must then be multiples of 1 / evaluationScale. Cost and added error:
+    /// README "Reduced resolution".
+    double evaluationScale = 1.0;
     /// Measure every stage (FrameResult::stages): a GL_TIME_ELAPSED query and a glFinish per stage, which
     /// stalls the pipeline; turn off in production (stages then lists names with zero times).
     bool stageTimings = true;
@@ -159,7 +165,7 @@ public:
   const CreateInfo& createInfo() const noexcept;
   /// GPU memory it owns now, bytes: the filtered basis and the region visibility table, the rasterized
   /// (D32F) and resampled (R32F) rectified maps, its own standard shadow map once a fallback frame needed
-  /// it, and the passes' buffers (bench: "memory").
+  /// it, the reduced-resolution depth and scattering (evaluationScale < 1) and the passes' buffers.
   std::size_t memoryBytes() const noexcept;
 
 private:

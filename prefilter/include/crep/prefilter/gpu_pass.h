@@ -18,7 +18,7 @@
 //                       storage buffer 1 (near-plane correction); for a non-projective layout also
 //                       uniform buffer 2 and storage buffer 2 (its layout block and row table); with the
 //                       region visibility table (EvaluateOptions::visibilityTableSamples) texture unit 6
-//                       (+ sampler) and a second program (the table pass) run first.
+//                       (+ sampler), and storage buffer 0 for the table pass that runs first.
 // Engines that evaluate in their own shader use crep/scattering.glsl with filteredBasis() and
 // makeScatteringParams() (see that file's header).
 #pragma once
@@ -190,6 +190,8 @@ private:
   /// The region visibility table (EvaluateOptions::visibilityTableSamples): its pass, R32F texture
   /// (R Z x H, reallocated when the basis's size changes) and linear sampler.
   gl::Handle tableProgram_, tableTexture_, tableSampler_;
+  gl::Handle tableCoefficients_; ///< a(z_s) of the table's samples (storage buffer), for tableMargin_
+  double tableMargin_ = -1.0;
   int tableWidth_ = 0, tableHeight_ = 0;
   gpu::LayoutBuffers layoutBuffers_;
 };
