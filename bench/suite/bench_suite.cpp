@@ -1,4 +1,5 @@
 #include "bench_suite.h"
+#include "plot.h"
 
 #include "args.h"
 #include "gl_session.h"
@@ -440,7 +441,7 @@ void reducedResolution(const BenchOptions& o) {
 } // namespace
 
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
-  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat"}, {"quick"});
+  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot"}, {"quick"});
   BenchOptions o;
   o.scene = args.string("scene", o.scene);
   o.quick = args.has("quick");
@@ -474,6 +475,10 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
   if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
   o.repeat = args.integer("repeat", o.repeat, 1, 1000);
+  o.plot = args.string("plot", "");
+  if (!o.plot.empty() && o.quick)
+    throw tool::UsageError("option --plot: needs the Table 1/2 rows, which --quick omits");
+  if (!o.plot.empty() && !o.plot.ends_with(".svg")) throw tool::UsageError("option --plot: must end in .svg");
   return o;
 }
 
@@ -556,6 +561,8 @@ void runBenchSuite(const BenchOptions& o) {
                 bases);
     std::printf("%-18s %6s %12s %12s %8s\n", "map", "M", "prefilter ms", "evaluate ms", "ratio");
     const double base = gpu.prefilter + gpu.evaluate;
+    std::vector<std::string> scaleNames;
+    std::vector<double> scalePrefilter, scaleEvaluate;
     struct Row {
       int w, h, m;
     };
@@ -569,12 +576,25 @@ void runBenchSuite(const BenchOptions& o) {
       const GpuTimes t = timeGpu(use, r.m, StorageFormat::RGBA8, repeat);
       std::printf("%6dx%-11d %6d %12.2f %12.2f %8.2f\n", r.w, r.h, r.m, t.prefilter, t.evaluate,
                   (t.prefilter + t.evaluate) / base);
+      scaleNames.push_back(r.m != bases ? "M " + std::to_string(r.m)
+                                        : std::to_string(r.w) + "x" + std::to_string(r.h));
+      scalePrefilter.push_back(t.prefilter / gpu.prefilter);
+      scaleEvaluate.push_back(t.evaluate / gpu.evaluate);
     }
     // Table 1's study: regions per split x bases per invocation.
     std::printf("\nparallelization (Table 1; GPU prefilter ms):\n%-10s", "regions");
     for (int bpi : {4, 8, 16, 32})
       std::printf(" %8d", bpi);
     std::printf("   <- bases per invocation\n");
+    std::vector<std::string> parNames;
+    std::vector<double> parOurs, parPaper;
+    double parBase = 0.0;
+    // The paper's Table 1 (NVIDIA Titan, San Miguel): prefix-sum ms for (regions, bases per thread).
+    const auto paperTable1 = [](int p, int bpi) {
+      const double t[4][3] = {{1.85, 2.49, 4.05}, {1.19, 1.37, 2.03}, {1.50, 0.93, 1.32}, {1.28, 1.16, 1.10}};
+      const int row = p - 1, col = bpi == 4 ? 0 : bpi == 8 ? 1 : bpi == 16 ? 2 : -1;
+      return row >= 0 && row < 4 && col >= 0 ? t[row][col] / 1.85 : -1.0;
+    };
     for (int p : {1, 2, kMaxRegionsPerSplit}) {
       std::printf("%-10d", p);
       for (int bpi : {4, 8, 16, 32}) {
@@ -582,9 +602,48 @@ void runBenchSuite(const BenchOptions& o) {
           std::printf(" %8s", "-");
           continue;
         }
-        std::printf(" %8.2f", timeGpu(s, bases, StorageFormat::RGBA8, repeat, p, bpi).prefilter);
+        const double ms = timeGpu(s, bases, StorageFormat::RGBA8, repeat, p, bpi).prefilter;
+        std::printf(" %8.2f", ms);
+        if (parBase == 0.0) parBase = ms;
+        parNames.push_back(std::to_string(p) + "/" + std::to_string(bpi));
+        parOurs.push_back(ms / parBase);
+        parPaper.push_back(paperTable1(p, bpi));
       }
       std::printf("\n");
+    }
+    if (!o.plot.empty()) {
+      // The paper's Table 2 (prefix sum and scattering relative to its 1024x1024, M = 32 row), where it has
+      // the row; our rows are relative to this run's map and M (the paper's are for 1024^2 too).
+      const auto paperTable2 = [&](const std::string& name, bool prefix) -> double {
+        if (mapW != 1024 || mapH != 1024 || bases != 32) return -1.0;
+        if (name == "512x1024") return prefix ? 0.54 / 0.94 : 1.47 / 1.30;
+        if (name == "2048x1024") return prefix ? 2.17 / 0.94 : 1.31 / 1.30;
+        if (name == "1024x512") return prefix ? 0.97 / 0.94 : 1.47 / 1.30;
+        if (name == "M 16") return prefix ? 0.96 / 0.94 : 0.92 / 1.30;
+        if (name == "M 64") return prefix ? 3.07 / 0.94 : 2.63 / 1.30;
+        return -1.0;
+      };
+      std::vector<double> paperPrefilter, paperEvaluate;
+      for (const std::string& n : scaleNames) {
+        paperPrefilter.push_back(paperTable2(n, true));
+        paperEvaluate.push_back(paperTable2(n, false));
+      }
+      const std::string ours = "crepuscular, llvmpipe";
+      const std::string paper = "Klehm et al. 2014, NVIDIA Titan";
+      writeBarChartSvg(o.plot,
+                       "Table 2 and Table 1 shapes: time relative to the " + std::to_string(mapW) + "x" +
+                           std::to_string(mapH) + ", M = " + std::to_string(bases) + " row (" + o.scene +
+                           ", " + std::to_string(o.screenWidth) + "x" + std::to_string(o.screenHeight) + ")",
+                       {{"prefilter vs map size and M (Table 2)",
+                         scaleNames,
+                         {{ours, "#d95f02", scalePrefilter}, {paper, "#7570b3", paperPrefilter}}},
+                        {"evaluation vs map size and M (Table 2)",
+                         scaleNames,
+                         {{ours, "#d95f02", scaleEvaluate}, {paper, "#7570b3", paperEvaluate}}},
+                        {"prefilter: regions / bases per invocation (Table 1)",
+                         parNames,
+                         {{ours, "#d95f02", parOurs}, {paper, "#7570b3", parPaper}}}});
+      std::printf("\nwrote %s (the Table 1/2 rows above beside the paper's)\n", o.plot.c_str());
     }
   }
   std::printf(

@@ -18,10 +18,11 @@ struct BenchOptions {
   int bases = 32;
   int repeat = 5;     ///< runs per measurement (median)
   bool quick = false; ///< one size only: no Table 1/2 rows, one CPU run
+  std::string plot;   ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
 };
 
-/// Parses [--scene NAME] [--size WxH] [--map WxH] [--bases M] [--repeat N] [--quick]; throws
-/// crep::tool::UsageError naming the option.
+/// Parses [--scene NAME] [--size WxH] [--map WxH] [--bases M] [--repeat N] [--quick] [--plot FILE.svg];
+/// throws crep::tool::UsageError naming the option.
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv);
 
 /// Runs the suite, printing to stdout. Creates the process's GL context if there is none. Throws

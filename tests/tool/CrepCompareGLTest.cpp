@@ -7,9 +7,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -151,5 +153,36 @@ TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
                            "reference", "vs prefilter", "how measured"})
     CHECK(r.output.find(text) != std::string::npos);
   CHECK(r.output.find("Table 1") == std::string::npos); // --quick: no tables
+  for (const char* text : {"limits", "fetch-only", "write-only", "evaluation profile", "GPU memory",
+                           "reduced resolution", "sun in view", "constant cost"})
+    CHECK(r.output.find(text) != std::string::npos);
+}
+
+TEST_CASE("crep bench --plot: the Table 1/2 rows as an SVG chart beside the paper's") {
+  CREP_REQUIRE_GL();
+  const std::string svg = std::string(CREP_TEST_OUTPUT_DIR) + "/bench-tables.svg";
+  std::remove(svg.c_str());
+  const auto r = crep::test::runCrep("bench --size 160x90 --map 128x128 --repeat 1 --plot " + svg);
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output.find("Table 1") != std::string::npos);
+  std::ifstream in(svg);
+  REQUIRE(in.good());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(text.starts_with("<svg"));
+  CHECK(text.find("</svg>") != std::string::npos);
+  for (const char* title : {"Table 2", "Table 1", "crepuscular, llvmpipe", "Klehm et al. 2014"})
+    CHECK(text.find(title) != std::string::npos);
+  // One bar per measured row and series: 6 scaling rows x 2 panels + 9 parallelization cells (M = 32: 4, 8,
+  // 16, 32 bases per invocation x 3 region counts, minus none), ours only at a 128^2 map (the paper's rows
+  // are for 1024^2) except Table 1's relative shape.
+  std::size_t bars = 0;
+  for (std::size_t at = text.find("<rect x="); at != std::string::npos; at = text.find("<rect x=", at + 1))
+    ++bars;
+  CHECK(bars >= 12 + 12);
+  CHECK(r.output.find("wrote " + svg) != std::string::npos);
+  const auto bad = crep::test::runCrep("bench --quick --plot " + svg);
+  CHECK(bad.status == 2);
+  CHECK(bad.output.find("--plot") != std::string::npos);
 }
 #endif
