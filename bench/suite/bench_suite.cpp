@@ -328,6 +328,29 @@ void sunInView(const BenchOptions& o) {
         (fallbackMs + resampleMs) / (projectiveMs + shadowMs));
 }
 
+/// A built-in scene's frame as crep::Scattering input: the tool's frame (camera depth, standard shadow map)
+/// and an output texture.
+struct ScatteringFrame {
+  tool::SceneFrame scene;
+  Scattering::ShadowMap shadow;
+  gl::Handle output;
+  ScatteringFrame(const BenchOptions& o, tool::StageTimings& timings)
+      : scene(tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings)),
+        shadow{scene.frame->shadowMap.get(), scene.frame->shadowWidth, scene.frame->shadowHeight,
+               scene.frame->lightClipFromWorld, scene.frame->shadowBias},
+        output(gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight)) {}
+  Scattering::FrameAttribs attribs() const {
+    Scattering::FrameAttribs a;
+    a.camera = &scene.frame->camera;
+    a.light = &scene.frame->light;
+    a.medium = &scene.frame->medium;
+    a.cameraDepth = scene.frame->cameraDepth.get();
+    a.output = output.get();
+    a.shadowMap = &shadow;
+    return a;
+  }
+};
+
 /// GPU memory per configuration (issue "performance", item 6): what crep::Scattering and the peers own,
 /// from the same size functions the passes use, and Scattering::memoryBytes() after one frame of this run.
 void memoryTable(const BenchOptions& o) {
@@ -353,24 +376,14 @@ void memoryTable(const BenchOptions& o) {
   if (o.mapWidth == o.mapHeight &&
       o.mapWidth % std::lcm(R, d.epipolarRegions * d.prefilter.regionsPerSplit) == 0) {
     tool::StageTimings timings;
-    tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings);
+    const ScatteringFrame frame(o, timings);
     Scattering::CreateInfo info;
     info.width = o.screenWidth;
     info.height = o.screenHeight;
     info.mapSize = o.mapWidth;
     info.prefilter.bases = o.bases;
     Scattering scattering(info);
-    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight);
-    Scattering::FrameAttribs a;
-    a.camera = &s.frame->camera;
-    a.light = &s.frame->light;
-    a.medium = &s.frame->medium;
-    a.cameraDepth = s.frame->cameraDepth.get();
-    a.output = out.get();
-    const Scattering::ShadowMap shadow{s.frame->shadowMap.get(), s.frame->shadowWidth, s.frame->shadowHeight,
-                                       s.frame->lightClipFromWorld, s.frame->shadowBias};
-    a.shadowMap = &shadow;
-    scattering.run(a);
+    scattering.run(frame.attribs());
     std::printf("crep::Scattering::memoryBytes() after a frame of %s at %dx%d, map %d^2, RGBA8: %.1f MiB\n",
                 o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, mib(scattering.memoryBytes()));
   }
@@ -386,17 +399,8 @@ void reducedResolution(const BenchOptions& o) {
     return;
   }
   tool::StageTimings timings;
-  tool::SceneFrame s = tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings);
-  const Scattering::ShadowMap shadow{s.frame->shadowMap.get(), s.frame->shadowWidth, s.frame->shadowHeight,
-                                     s.frame->lightClipFromWorld, s.frame->shadowBias};
-  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight);
-  Scattering::FrameAttribs a;
-  a.camera = &s.frame->camera;
-  a.light = &s.frame->light;
-  a.medium = &s.frame->medium;
-  a.cameraDepth = s.frame->cameraDepth.get();
-  a.output = out.get();
-  a.shadowMap = &shadow;
+  const ScatteringFrame input(o, timings);
+  const Scattering::FrameAttribs a = input.attribs();
   const int repeat = std::max(1, std::min(o.repeat, 3));
   std::printf(
       "\nreduced resolution (%s, %dx%d, map %d^2; crep::Scattering, wall-clock medians of %d frames after\n"
@@ -426,7 +430,8 @@ void reducedResolution(const BenchOptions& o) {
     const double evaluate = median(ms["evaluate"]);
     const double resample =
         ms.count("upsample") ? median(ms["upsample"]) + median(ms["downsample depth"]) : 0.0;
-    const Image image = gl::readTexture(out.get(), o.screenWidth, o.screenHeight, gl::TexelData::Rgba);
+    const Image image =
+        gl::readTexture(input.output.get(), o.screenWidth, o.screenHeight, gl::TexelData::Rgba);
     if (scale == 1.0) {
       full = image;
       fullMs = frame;
