@@ -75,9 +75,10 @@ TEST_CASE("threshold study: the projective path next to the span and epipole-ang
       const Scattering::FrameResult p = projectiveOnly.run(f.attribs(false, true));
       REQUIRE(p.layout == Scattering::Layout::Projective);
       const ImageMetrics mp = rgbMetrics(f.read(), f.reference()); // projective: the engine's map throughout
-      MESSAGE(b.name << ": span " << r.span << ", epipole angle " << r.epipoleAngle << "; defaults ("
-                     << layoutToken(a.layout) << ") " << m.relativeRmse << " (the map's own error " << floor
-                     << "), projective with the thresholds relaxed " << mp.relativeRmse);
+      MESSAGE(std::string(b.name) << ": span " << r.span << ", epipole angle " << r.epipoleAngle
+                                  << "; defaults (" << std::string(layoutToken(a.layout)) << ") "
+                                  << m.relativeRmse << " (the map's own error " << floor
+                                  << "), projective with the thresholds relaxed " << mp.relativeRmse);
       CHECK(m.nanCount == 0);
       if (b.fallback) {
         // Beyond the thresholds the fallback is the more accurate layout, and within the 2% goal.
