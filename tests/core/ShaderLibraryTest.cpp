@@ -91,7 +91,12 @@ RunResult glslang(const std::string& name, const std::string& extension, const s
   if (!flat.ends_with("." + extension)) flat += "." + extension;
   const std::filesystem::path file = dir / flat;
   std::ofstream(file, std::ios::binary) << text;
-  return run("'" + validator->string() + "' " + flags + " '" + file.string() + "'");
+  // SPIR-V output (-G, -V, -H) goes next to the source, never into the working directory.
+  const std::string output = flags.find("-G") != std::string::npos || flags.find("-V") != std::string::npos ||
+                                     flags.find("-H") != std::string::npos
+                                 ? " -o '" + file.string() + ".spv'"
+                                 : "";
+  return run("'" + validator->string() + "' " + flags + output + " '" + file.string() + "'");
 }
 
 } // namespace
