@@ -21,6 +21,18 @@ float crep_linearDepth(float depth, float zNear, float zFar) {
   return 2.0 * zNear * zFar / (zFar + zNear - ndcZ * (zFar - zNear));
 }
 
+// The same distance written near far / (near + (1 - depth)(far - near)): 1 - depth is exact for depth >= 1/2,
+// so there is no cancellation where crep_linearDepth's (2 depth - 1) form loses digits (depth near 1).
+float crep_viewDepth(float depth, float zNear, float zFar) {
+  return zNear * zFar / (zNear + (1.0 - depth) * (zFar - zNear));
+}
+
+// The view-space distance of a surface in a camera depth buffer: the sky (depth >= 1, also NaN) is the far
+// plane, depth < 0 the near plane (what the evaluation integrates to; crep::pixelRay's rule).
+float crep_surfaceViewDepth(float depth, float zNear, float zFar) {
+  return depth < 1.0 ? crep_viewDepth(max(depth, 0.0), zNear, zFar) : zFar;
+}
+
 // sRGB transfer function (IEC 61966-2-1): linear [0, 1] to encoded [0, 1], per channel.
 vec3 crep_srgbEncode(vec3 linearColor) {
   vec3 c = clamp(linearColor, 0.0, 1.0);

@@ -422,6 +422,21 @@ vec4 crep_filteredBasisAt(int region, float u, float row, int layer) {
   return 2.0 * textureLod(crep_filteredBasis, coord, 0.0) - 1.0;
 }
 
+#ifdef CREP_VISIBILITY_TABLE_SAMPLES
+// The region visibility table (crep::evaluate's rule): GL_LINEAR in the texel row, y = clamp(row H - 0.5,
+// 0, H - 1) as for the basis, and in the depth sample d (Z - 1) inside the region's Z samples. The
+// coordinate is per ray (x: the sample inside a region, y: the row), the region adds r Z texels.
+vec2 crep_visibilityTableCoord(float row, float depth) {
+  int H = crep_scattering.mapSize.y;
+  return vec2(clamp(depth, 0.0, 1.0) * float(CREP_VISIBILITY_TABLE_SAMPLES - 1) + 0.5,
+              (clamp(row * float(H) - 0.5, 0.0, float(H - 1)) + 0.5) / float(H));
+}
+float crep_visibilityTableAt(int r, vec2 coord) {
+  int Z = CREP_VISIBILITY_TABLE_SAMPLES, RZ = crep_scattering.mapSize.z * Z;
+  return textureLod(crep_visibilityTable, vec2((float(r * Z) + coord.x) / float(RZ), coord.y), 0.0).r;
+}
+#endif
+
 // C of Eq. 1 for a view direction (unit, from the camera): irradiance * sigma_s * phase, per channel.
 vec3 crep_scatteringConstant(vec3 viewDirection) {
   float cosTheta = dot(crep_scattering.lightDirection.xyz, -viewDirection);
@@ -489,12 +504,10 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
   // depth sample d (Z - 1)), then the last region from the basis. Two loops, no branch inside: neighbouring
   // pixels that end in different regions run the same instructions (SIMD lanes, GPU warps).
   {
-    int H = crep_scattering.mapSize.y, R = crep_scattering.mapSize.z, Z = CREP_VISIBILITY_TABLE_SAMPLES;
-    float ty = (clamp(hit.row * float(H) - 0.5, 0.0, float(H - 1)) + 0.5) / float(H);
-    float tx = clamp(hit.depth, 0.0, 1.0) * float(Z - 1) + 0.5;
+    vec2 coord = crep_visibilityTableCoord(hit.row, hit.depth);
     for (int r = 0; r < lastRegion; ++r) {
       float tb = clamp(crep_evalBoundary(hit, r + 1), ta, surface);
-      float V = textureLod(crep_visibilityTable, vec2((float(r * Z) + tx) / float(R * Z), ty), 0.0).r;
+      float V = crep_visibilityTableAt(r, coord);
       L += C * V * crep_transmittanceIntegral(sigma, ta, tb);
       ta = tb;
     }

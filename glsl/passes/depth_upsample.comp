@@ -5,6 +5,7 @@
 #ifndef CREP_FACTOR
 #define CREP_FACTOR 2
 #endif
+#include "crep/common.glsl"
 #ifndef CREP_DEPTH_EPSILON
 #define CREP_DEPTH_EPSILON 0.01
 #endif
@@ -16,17 +17,12 @@ layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_output;
 layout(location = 0) uniform ivec4 crep_sizes;        // full width, height, low width, height
 layout(location = 1) uniform vec2 crep_nearFar;
 
-// View-space distance of a depth-buffer value (the sky, d >= 1, is the far plane); as evaluate.comp.
-float crep_upsampleViewDepth(float d) {
-  float n = crep_nearFar.x, f = crep_nearFar.y;
-  return d < 1.0 ? n * f / (n + (1.0 - max(d, 0.0)) * (f - n)) : f;
-}
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(p, crep_sizes.xy))) return;
   ivec2 lowSize = crep_sizes.zw;
-  float Z = crep_upsampleViewDepth(texelFetch(crep_fullDepth, p, 0).r);
+  float Z = crep_surfaceViewDepth(texelFetch(crep_fullDepth, p, 0).r, crep_nearFar.x, crep_nearFar.y);
   vec2 u = (vec2(p) + 0.5) / float(CREP_FACTOR) - 0.5;
   ivec2 i0 = ivec2(floor(u));
   vec2 f = u - vec2(i0);
@@ -36,7 +32,7 @@ void main() {
     ivec2 o = ivec2(k & 1, k >> 1);
     ivec2 q = clamp(i0 + o, ivec2(0), lowSize - 1);
     float b = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
-    float Zk = crep_upsampleViewDepth(texelFetch(crep_lowDepth, q, 0).r);
+    float Zk = crep_surfaceViewDepth(texelFetch(crep_lowDepth, q, 0).r, crep_nearFar.x, crep_nearFar.y);
     float w = b / (CREP_DEPTH_EPSILON + abs(Z - Zk) / Z);
     sum += w * texelFetch(crep_low, q, 0);
     total += w;

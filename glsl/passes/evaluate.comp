@@ -30,10 +30,6 @@ layout(binding = CREP_CAMERA_DEPTH_UNIT) uniform sampler2D crep_cameraDepth; // 
 layout(binding = 0, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
 layout(std140, binding = CREP_EVALUATE_BINDING) uniform CrepEvaluateBlock { CrepEvaluateParams crep_evaluate; };
 
-// View-space distance of a depth-buffer value (GL perspective, glDepthRange(0, 1)), written as
-// near far / (near + (1 - d)(far - near)): 1 - d is exact for d >= 1/2, so there is no cancellation
-// where crep_linearDepth's (2d - 1) form loses digits (d near 1).
-float crep_viewDepth(float d, float zNear, float zFar) { return zNear * zFar / (zNear + (1.0 - d) * (zFar - zNear)); }
 
 #if CREP_MEMORY_LIMIT
 // The fetches of crep_inScatteringSegment (one per layer and region crossed, at the same coordinates) and
@@ -53,11 +49,8 @@ vec4 crep_fetchOnly(vec3 origin, vec3 dir, float start, float surface) {
   vec4 sum = vec4(0.0);
 #if defined(CREP_VISIBILITY_TABLE_SAMPLES) && !CREP_NEAR_PLANE_CORRECTION
   // The table path: one table fetch per region crossed whole, the basis of the last region.
-  int H = crep_scattering.mapSize.y, R = crep_scattering.mapSize.z, Z = CREP_VISIBILITY_TABLE_SAMPLES;
-  float ty = (clamp(hit.row * float(H) - 0.5, 0.0, float(H - 1)) + 0.5) / float(H);
-  float tx = clamp(hit.depth, 0.0, 1.0) * float(Z - 1) + 0.5;
-  for (int r = 0; r < hit.region; ++r)
-    sum += textureLod(crep_visibilityTable, vec2((float(r * Z) + tx) / float(R * Z), ty), 0.0);
+  vec2 coord = crep_visibilityTableCoord(hit.row, hit.depth);
+  for (int r = 0; r < hit.region; ++r) sum += vec4(crep_visibilityTableAt(r, coord));
   for (int l = 0; l < CREP_EVAL_LAYERS; ++l) sum += crep_filteredBasisAt(hit.region, hit.u, hit.row, l);
   return sum;
 #endif
@@ -82,7 +75,7 @@ void main() {
   float cosForward = dot(dir, forward);
   float d = texelFetch(crep_cameraDepth, pixel, 0).r;
   // Sky (d >= 1, also NaN): integrate to the far plane; d < 0 is treated as 0 (the near plane).
-  float viewDepth = d < 1.0 ? crep_viewDepth(max(d, 0.0), zNear, zFar) : zFar;
+  float viewDepth = crep_surfaceViewDepth(d, zNear, zFar);
   float surface = viewDepth / cosForward;
   float start = 0.0;
 #if CREP_NEAR_PLANE_CORRECTION
