@@ -552,17 +552,17 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       tableHeight_ = basis.height;
     }
     if (!tableCoefficients_ || tableMargin_ != basis.depthMargin) {
-      // a(z_s) of every sample, in double (the CPU reference's values), as M / 4 vec4 per sample.
-      const int layers = layerCount(info_.bases);
+      // a(z_s) of every sample (the CPU reference's values), as M / 4 vec4 per sample (zero beyond M).
+      const int M = info_.bases, layers = layerCount(M);
+      const std::vector<double> as =
+          visibilityTableCoefficients(Z, M, basis.depthMargin, info_.options.ringing);
       std::vector<float> a(static_cast<std::size_t>(Z) * static_cast<std::size_t>(layers) * 4, 0.0f);
-      std::vector<double> as(static_cast<std::size_t>(info_.bases));
-      for (int k = 0; k < Z; ++k) {
-        fourierCoefficients(rayBasisDepth(static_cast<double>(k) / (Z - 1), basis.depthMargin), as);
-        applyRingingFilter(info_.options.ringing, as);
-        for (int m = 0; m < info_.bases; ++m)
+      for (int k = 0; k < Z; ++k)
+        for (int m = 0; m < M; ++m)
           a[static_cast<std::size_t>(k) * static_cast<std::size_t>(layers) * 4 +
-            static_cast<std::size_t>(m)] = static_cast<float>(as[static_cast<std::size_t>(m)]);
-      }
+            static_cast<std::size_t>(m)] =
+              static_cast<float>(as[static_cast<std::size_t>(k) * static_cast<std::size_t>(M) +
+                                    static_cast<std::size_t>(m)]);
       tableCoefficients_ = gl::createBuffer();
       glNamedBufferStorage(tableCoefficients_.get(), static_cast<GLsizeiptr>(a.size() * sizeof(float)),
                            a.data(), 0);

@@ -289,6 +289,18 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
   return b;
 }
 
+std::vector<double> visibilityTableCoefficients(int samples, int bases, double depthMargin,
+                                                RingingFilter ringing) {
+  std::vector<double> a(static_cast<std::size_t>(samples) * static_cast<std::size_t>(bases));
+  for (int s = 0; s < samples; ++s) {
+    const std::span<double> as(a.data() + static_cast<std::size_t>(s) * static_cast<std::size_t>(bases),
+                               static_cast<std::size_t>(bases));
+    fourierCoefficients(rayBasisDepth(static_cast<double>(s) / (samples - 1), depthMargin), as);
+    applyRingingFilter(ringing, as);
+  }
+  return a;
+}
+
 std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing) {
   validateBasis(basis);
   if (samples < 2 || samples > kMaxVisibilityTableSamples)
@@ -297,13 +309,7 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
   const int H = basis.height, R = basis.regions, M = basis.bases, n = basis.regionWidth();
   std::vector<double> table(static_cast<std::size_t>(H) * static_cast<std::size_t>(R) *
                             static_cast<std::size_t>(samples));
-  std::vector<double> a(static_cast<std::size_t>(samples) * static_cast<std::size_t>(M));
-  for (int s = 0; s < samples; ++s) {
-    const std::span<double> as(a.data() + static_cast<std::size_t>(s) * static_cast<std::size_t>(M),
-                               static_cast<std::size_t>(M));
-    fourierCoefficients(rayBasisDepth(static_cast<double>(s) / (samples - 1), basis.depthMargin), as);
-    applyRingingFilter(ringing, as);
-  }
+  const std::vector<double> a = visibilityTableCoefficients(samples, M, basis.depthMargin, ringing);
   for (int j = 0; j < H; ++j)
     for (int r = 0; r < R; ++r) {
       const int x = r * n + n - 1; // the region's last texel: its whole weighted average

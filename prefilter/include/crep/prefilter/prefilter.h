@@ -215,6 +215,12 @@ inline bool usesVisibilityTable(const EvaluateOptions& options) {
 }
 inline constexpr int kMaxVisibilityTableSamples = 4096;
 
+/// The ray coefficients of the region visibility table's samples: a(z_s) of Eq. 8 (with `ringing`) at the
+/// ray basis depth of the normalized depth s / (samples - 1), M values per sample, index s * M + k. The one
+/// definition of the samples, for visibilityTable() and EvaluatePass's table pass.
+std::vector<double> visibilityTableCoefficients(int samples, int bases, double depthMargin,
+                                                RingingFilter ringing);
+
 /// The region visibility table of `basis` (see visibilityTableSamples), in double from the stored values:
 /// index (row * R + region) * Z + s, sample s at normalized ray depth s / (Z - 1), ray coefficients with
 /// `ringing`. What EvaluatePass builds on the GPU in float (glsl/passes/visibility_table.comp).
