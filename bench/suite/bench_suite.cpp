@@ -29,7 +29,6 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <numeric>
 #include <optional>
 #include <vector>
 
@@ -274,12 +273,8 @@ bool squareMapOk(const BenchOptions& o, const char* what, int multiple) {
 /// Every method of the registry on the same frame: median per-frame milliseconds and the ratio to the
 /// prefiltered method.
 void methodsSideBySide(const BenchOptions& o) {
-  const tool::MethodSettings settings;
-  const Scattering::CreateInfo defaults;
-  const int P = settings.prefilter.regionsPerSplit;
-  if (!squareMapOk(o, "methods side by side",
-                   std::lcm(settings.rectify.splits * P, defaults.epipolarRegions * P)))
-    return;
+  const tool::MethodSettings settings; // Scattering's defaults
+  if (!squareMapOk(o, "methods side by side", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   double mapMs = 0.0;
   const std::vector<MethodRow> rows = runMethods(o, o.scene, {}, repeat, mapMs);
@@ -296,10 +291,7 @@ void methodsSideBySide(const BenchOptions& o) {
 /// resampling, prefilter, evaluation, epipole block) against the min/max march on that frame, and against
 /// the prefiltered method on the forest's own (projective) frame: the constant-cost claim.
 void sunInView(const BenchOptions& o) {
-  const Scattering::CreateInfo defaults;
-  const int P = defaults.prefilter.regionsPerSplit;
-  if (!squareMapOk(o, "sun in view", std::lcm(defaults.rectify.splits * P, defaults.epipolarRegions * P)))
-    return;
+  if (!squareMapOk(o, "sun in view", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   double mapMs = 0.0;
   const std::vector<MethodRow> sun = runMethods(o, "sunset", {"prefilter", "minmax"}, repeat, mapMs);
@@ -373,8 +365,7 @@ void memoryTable(const BenchOptions& o) {
                 mib(visibilityTableBytes(size, R, Z)), mib(2 * map), mib(trees),
                 mib(std::size_t(d.ownShadowMapSize) * std::size_t(d.ownShadowMapSize) * 4));
   }
-  if (o.mapWidth == o.mapHeight &&
-      o.mapWidth % std::lcm(R, d.epipolarRegions * d.prefilter.regionsPerSplit) == 0) {
+  if (o.mapWidth == o.mapHeight && o.mapWidth % d.mapSizeMultiple() == 0) {
     tool::StageTimings timings;
     const ScatteringFrame frame(o, timings);
     Scattering::CreateInfo info;

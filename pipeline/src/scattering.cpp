@@ -15,9 +15,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <optional>
 
 namespace crep {
+
+int Scattering::CreateInfo::mapSizeMultiple() const {
+  const int P = prefilter.regionsPerSplit;
+  return std::lcm(rectify.splits * P, epipolarRegions * P);
+}
 
 const char* layoutToken(Scattering::Layout layout) {
   return layout == Scattering::Layout::Projective ? "projective" : "epipolar";

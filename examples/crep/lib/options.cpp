@@ -1,7 +1,5 @@
 #include "options.h"
 
-#include <numeric>
-
 namespace crep::tool {
 
 static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
@@ -43,14 +41,15 @@ MethodSettings methodSettings(const Args& args) {
   if (s.scale != 1.0 && s.scale != 0.5 && s.scale != 0.25)
     throw UsageError("option --scale: must be 1, 0.5 or 0.25");
   // Scattering's rule (crep/pipeline/scattering.h): a multiple of the prefilter regions of both layouts.
-  const int perSplit = s.prefilter.regionsPerSplit,
-            epipolar = Scattering::CreateInfo{}.epipolarRegions * perSplit;
-  const int multiple = std::lcm(s.rectify.splits * perSplit, epipolar);
+  Scattering::CreateInfo info;
+  info.rectify = s.rectify;
+  info.prefilter = s.prefilter;
+  const int perSplit = s.prefilter.regionsPerSplit, multiple = info.mapSizeMultiple();
   if (s.mapSize % multiple != 0)
     throw UsageError("option --map-size: " + std::to_string(s.mapSize) + " must be a multiple of " +
                      std::to_string(multiple) + " (--splits " + std::to_string(s.rectify.splits) + " x " +
                      std::to_string(perSplit) + " prefilter regions, and the epipolar fallback's " +
-                     std::to_string(epipolar) + ")");
+                     std::to_string(info.epipolarRegions * perSplit) + ")");
   return s;
 }
 

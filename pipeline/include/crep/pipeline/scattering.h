@@ -100,6 +100,9 @@ public:
     /// stalls the pipeline; turn off in production (stages then lists names with zero times).
     bool stageTimings = true;
     int ownShadowMapSize = 2048; ///< standard shadow map rendered with drawCasters on fallback frames
+    /// The multiple mapSize must be: lcm(rectify.splits * P, epipolarRegions * P), P =
+    /// prefilter.regionsPerSplit (16 with the defaults).
+    int mapSizeMultiple() const;
     /// Depth bias of that map in the epipole block march (depth-buffer units of a map whose depth range
     /// spans the camera frustum along the light), finite and >= 0.
     double ownShadowMapBias = 1e-4;
