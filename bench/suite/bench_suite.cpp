@@ -127,6 +127,11 @@ EvaluationProfile profileEvaluation(const Setup& s, int regionsPerSplit) {
 struct GpuTimes {
   double prefilter, evaluate;
   double prefilterLimit = 0.0, evaluateLimit = 0.0; ///< the passes stripped to their memory traffic
+  /// Evaluation variants (with `limits`): the per-region loop over the visibility table (scatteringPrefix
+  /// false), no table at all (visibilityTableSamples 0), and the default's per-frame tables alone (the
+  /// evaluation of an 8 x 8 image: what does not scale with the screen).
+  double evaluatePerRegion = 0.0, evaluateDirect = 0.0, evaluateTablesOnly = 0.0;
+  double evaluateVisibilityTableOnly = 0.0; ///< the same for the visibility table alone
 };
 
 GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
@@ -186,6 +191,32 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
       evaluateLimit.run(ev);
       glFinish();
     });
+    const auto timeVariant = [&](const EvaluateOptions& options, const EvaluatePass::FrameAttribs& attribs) {
+      EvaluatePass::CreateInfo vi;
+      vi.bases = bases;
+      vi.options = options;
+      EvaluatePass variant(vi);
+      variant.run(attribs);
+      glFinish();
+      return medianMs(repeat, [&] {
+        variant.run(attribs);
+        glFinish();
+      });
+    };
+    EvaluateOptions perRegion, direct;
+    perRegion.scatteringPrefix = false;
+    direct.visibilityTableSamples = 0;
+    t.evaluatePerRegion = timeVariant(perRegion, ev);
+    t.evaluateDirect = timeVariant(direct, ev);
+    const gl::Handle tinyDepth = gl::createTexture2D(GL_R32F, 8, 8),
+                     tinyOut = gl::createTexture2D(GL_RGBA32F, 8, 8);
+    const std::vector<float> half(64, 0.5f);
+    glTextureSubImage2D(tinyDepth.get(), 0, 0, 0, 8, 8, GL_RED, GL_FLOAT, half.data());
+    EvaluatePass::FrameAttribs tiny = ev;
+    tiny.cameraDepth = tinyDepth.get();
+    tiny.output = tinyOut.get();
+    t.evaluateTablesOnly = timeVariant(EvaluateOptions{}, tiny);
+    t.evaluateVisibilityTableOnly = timeVariant(perRegion, tiny);
   }
   return t;
 }
@@ -350,7 +381,8 @@ void memoryTable(const BenchOptions& o) {
   const int R = d.rectify.splits * d.prefilter.regionsPerSplit, Z = d.evaluate.visibilityTableSamples;
   const auto mib = [](std::size_t b) { return double(b) / (1024.0 * 1024.0); };
   std::printf(
-      "\nGPU memory, MiB (M = %d; %d prefilter regions, table of %d samples; rectified maps D32F + R32F;\n"
+      "\nGPU memory, MiB (M = %d; %d prefilter regions, scattering prefix table of %d samples,\n"
+      "RGBA32F; rectified maps D32F + R32F;\n"
       "trees: min/max march only; own shadow map %d^2 D32F, fallback frames without an engine map):\n",
       o.bases, R, Z, d.ownShadowMapSize);
   std::printf("%-8s %10s %10s %10s %10s %10s %10s %10s\n", "map", "basis 8", "basis 16F", "basis 32F",
@@ -362,7 +394,7 @@ void memoryTable(const BenchOptions& o) {
                 mib(filteredBasisBytes(size, size, o.bases, StorageFormat::RGBA8)),
                 mib(filteredBasisBytes(size, size, o.bases, StorageFormat::RGBA16F)),
                 mib(filteredBasisBytes(size, size, o.bases, StorageFormat::RGBA32F)),
-                mib(visibilityTableBytes(size, R, Z)), mib(2 * map), mib(trees),
+                mib(scatteringPrefixBytes(size, R, Z)), mib(2 * map), mib(trees),
                 mib(std::size_t(d.ownShadowMapSize) * std::size_t(d.ownShadowMapSize) * 4));
   }
   if (o.mapWidth == o.mapHeight && o.mapWidth % d.mapSizeMultiple() == 0) {
@@ -527,15 +559,23 @@ void runBenchSuite(const BenchOptions& o) {
   std::printf(
       "  evaluate    %8.2f ms   fetch-only (same fetches and store, no math)    %8.2f ms   ratio %.2f\n",
       gpu.evaluate, gpu.evaluateLimit, gpu.evaluate / gpu.evaluateLimit);
+  std::printf(
+      "evaluation variants (same run): scattering prefix (default) %.2f ms, of which its per-frame\n"
+      "tables %.2f ms (the evaluation of an 8x8 image; the visibility table alone %.2f ms); per-region\n"
+      "loop over the visibility table %.2f ms (%.2fx); no table %.2f ms (%.2fx)\n",
+      gpu.evaluate, gpu.evaluateTablesOnly, gpu.evaluateVisibilityTableOnly, gpu.evaluatePerRegion,
+      gpu.evaluatePerRegion / gpu.evaluate, gpu.evaluateDirect, gpu.evaluateDirect / gpu.evaluate);
   const int perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
   const EvaluationProfile profile = profileEvaluation(s, perSplit);
   std::printf(
       "\nevaluation profile (%s, %d prefilter regions): %.2f regions crossed per pixel on average, at most\n"
-      "%d; filtered-basis fetches per pixel: %.1f without the region visibility table (M / 4 = %d per\n"
-      "region), %.1f with it (a table fetch per region crossed whole + M / 4); pixels by regions crossed:",
+      "%d; fetches per pixel: %.1f without the tables (M / 4 = %d per region), %.1f with the per-region\n"
+      "loop over the visibility table (a table fetch per region crossed whole + M / 4), %d with the "
+      "scattering\n"
+      "prefix (the default: one prefix fetch + M / 4); pixels by regions crossed:",
       o.scene.c_str(), s.layout->regionCount() * perSplit, profile.meanRegions, profile.maxRegions,
       profile.meanRegions * layerCount(bases), layerCount(bases),
-      profile.meanRegions - 1.0 + layerCount(bases));
+      profile.meanRegions - 1.0 + layerCount(bases), 1 + layerCount(bases));
   for (std::size_t i = 0; i < profile.histogram.size(); ++i)
     if (profile.histogram[i] >= 0.0005) std::printf(" %zu: %.1f%%", i + 1, 100.0 * profile.histogram[i]);
   std::printf("\n");

@@ -40,6 +40,11 @@
 //                              by EvaluatePass, or glsl/passes/visibility_table.comp) bound as a sampler2D
 //                              with GL_LINEAR at CREP_VISIBILITY_TABLE_UNIT (default 6); one fetch instead of
 //                              M / 4 per such region. Ignored with CREP_NEAR_PLANE_CORRECTION 1.
+//   CREP_SCATTERING_PREFIX     1 (with CREP_VISIBILITY_TABLE_SAMPLES): read the regions a ray crosses whole
+//                              from the scattering prefix table instead (crep::EvaluateOptions::
+//                              scatteringPrefix; built by EvaluatePass, or glsl/passes/scattering_prefix.comp)
+//                              bound as an RGBA32F sampler2D with GL_LINEAR at CREP_SCATTERING_PREFIX_UNIT
+//                              (default 7): one fetch per pixel, whatever the number of regions crossed.
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
 //   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
 //                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
@@ -289,6 +294,15 @@ layout(binding = CREP_FILTERED_BASIS_UNIT) uniform sampler2DArray crep_filteredB
 #define CREP_VISIBILITY_TABLE_UNIT 6
 #endif
 layout(binding = CREP_VISIBILITY_TABLE_UNIT) uniform sampler2D crep_visibilityTable;
+#ifndef CREP_SCATTERING_PREFIX
+#define CREP_SCATTERING_PREFIX 0
+#endif
+#if CREP_SCATTERING_PREFIX
+#ifndef CREP_SCATTERING_PREFIX_UNIT
+#define CREP_SCATTERING_PREFIX_UNIT 7
+#endif
+layout(binding = CREP_SCATTERING_PREFIX_UNIT) uniform sampler2D crep_scatteringPrefix;
+#endif
 #endif
 #if CREP_NEAR_PLANE_CORRECTION
 layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegionWeightsBlock {
@@ -401,6 +415,36 @@ bool crep_evalMap(vec3 origin, vec3 dir, float t, out CrepEvalRay e) {
 #endif
 }
 
+// The ray of normalized row and depth (every point of a ray from the camera has the same row and depth):
+// what crep_evalBoundary needs, as crep_evalMap gives it for a ray there. Region and column are not set.
+CrepEvalRay crep_evalRayAt(float row, float depth) {
+#ifdef CREP_EVAL_LAYOUT
+  CrepEvalRay e = CrepEvalRay(row, depth, 0, 0.0, vec4(0.0), CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0)));
+#if CREP_EVAL_LAYOUT == CREP_LAYOUT_EPIPOLAR
+  // crep_mapRowRay's distance data: bMax of the texel row over sin(psi) at the depth.
+  ivec2 mapSize = crep_scattering.mapSize.xy;
+  e.rr.row = row;
+  e.rr.depth = clamp(depth, 0.0, 1.0);
+  e.rr.texelRow = clamp(int(floor(row * float(mapSize.y))), 0, mapSize.y - 1);
+  vec4 s = crep_slices[e.rr.texelRow].bounds;
+  e.rr.dist = vec4(s.x / max(sin(crep_epipolarUnwarp(s.y + e.rr.depth * (s.z - s.y))), 1e-30), 0.0, 0.0, 0.0);
+#else
+  // crep_mapRowRay's distance data of the projective layout block at the (clamped) depth.
+  vec4 s = crep_projective.slopes;
+  e.rr.row = row;
+  e.rr.depth = clamp(depth, 0.0, 1.0);
+  float y = s.x + row * (s.y - s.x), z = s.z + e.rr.depth * (s.w - s.z);
+  e.rr.dist = vec4(sqrt(1.0 + y * y + z * z), crep_projective.origin.w * z, 0.0, 0.0);
+#endif
+  return e;
+#else
+  // The slopes of the scattering block's frame (inverse of crep_toRectified's row and depth).
+  float y = crep_scattering.slopes.x + row / crep_scattering.slopes.y;
+  float z = crep_scattering.slopes.z + depth / crep_scattering.slopes.w;
+  return CrepEvalRay(row, depth, 0, 0.0, vec4(y, z, 0.0, 0.0));
+#endif
+}
+
 // World distance along the mapped ray to the boundary column b / R of the prefilter regions.
 float crep_evalBoundary(CrepEvalRay e, int b) {
 #ifdef CREP_EVAL_LAYOUT
@@ -435,6 +479,13 @@ float crep_visibilityTableAt(int r, vec2 coord) {
   int Z = CREP_VISIBILITY_TABLE_SAMPLES, RZ = crep_scattering.mapSize.z * Z;
   return textureLod(crep_visibilityTable, vec2((float(r * Z) + coord.x) / float(RZ), coord.y), 0.0).r;
 }
+#if CREP_SCATTERING_PREFIX
+// The scattering prefix table at region r (same texel layout and filtering as the visibility table).
+vec3 crep_scatteringPrefixAt(int r, vec2 coord) {
+  int Z = CREP_VISIBILITY_TABLE_SAMPLES, RZ = crep_scattering.mapSize.z * Z;
+  return textureLod(crep_scatteringPrefix, vec2((float(r * Z) + coord.x) / float(RZ), coord.y), 0.0).rgb;
+}
+#endif
 #endif
 
 // C of Eq. 1 for a view direction (unit, from the camera): irradiance * sigma_s * phase, per channel.
@@ -505,16 +556,23 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
   // pixels that end in different regions run the same instructions (SIMD lanes, GPU warps).
   {
     vec2 coord = crep_visibilityTableCoord(hit.row, hit.depth);
+#if CREP_SCATTERING_PREFIX
+    // Every region before the last in one fetch (crep::EvaluateOptions::scatteringPrefix); the last region
+    // starts at the ray's own boundary distance. Constant cost per pixel: M / 4 + 1 fetches.
+    L = crep_scatteringPrefixAt(lastRegion, coord);
+    if (lastRegion > 0) ta = clamp(crep_evalBoundary(hit, lastRegion), ta, surface);
+#else
     for (int r = 0; r < lastRegion; ++r) {
       float tb = clamp(crep_evalBoundary(hit, r + 1), ta, surface);
       float V = crep_visibilityTableAt(r, coord);
-      L += C * V * crep_transmittanceIntegral(sigma, ta, tb);
+      L += V * crep_transmittanceIntegral(sigma, ta, tb);
       ta = tb;
     }
+#endif
     float dotF = 0.0;
     for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(lastRegion, lastU, hit.row, l));
-    L += C * clamp(0.5 + dotF, 0.0, 1.0) * crep_transmittanceIntegral(sigma, ta, surface);
-    return vec4(L, transmittance);
+    L += clamp(0.5 + dotF, 0.0, 1.0) * crep_transmittanceIntegral(sigma, ta, surface);
+    return vec4(C * L, transmittance);
   }
 #endif
   for (int r = firstRegion; r <= lastRegion; ++r) {

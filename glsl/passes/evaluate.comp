@@ -50,7 +50,11 @@ vec4 crep_fetchOnly(vec3 origin, vec3 dir, float start, float surface) {
 #if defined(CREP_VISIBILITY_TABLE_SAMPLES) && !CREP_NEAR_PLANE_CORRECTION
   // The table path: one table fetch per region crossed whole, the basis of the last region.
   vec2 coord = crep_visibilityTableCoord(hit.row, hit.depth);
+#if CREP_SCATTERING_PREFIX
+  sum += vec4(crep_scatteringPrefixAt(hit.region, coord), 0.0); // one fetch for the regions crossed whole
+#else
   for (int r = 0; r < hit.region; ++r) sum += vec4(crep_visibilityTableAt(r, coord));
+#endif
   for (int l = 0; l < CREP_EVAL_LAYERS; ++l) sum += crep_filteredBasisAt(hit.region, hit.u, hit.row, l);
   return sum;
 #endif

@@ -7,8 +7,9 @@
 // depth) in crep_inScatteringSegment instead of M / 4.
 // One invocation per (row, region): it fetches the region's M / 4 texels once and writes its Z samples
 // (consecutive texels of the table); the ray coefficients a(z_s) of every sample come precomputed (in
-// double on the CPU, with the ringing filter) from a storage buffer shared by all invocations. For a GPU
-// this keeps the work at H R (M / 4 fetches + Z M multiply-adds) and the writes coalesced.
+// double on the CPU, with the ringing filter) from a storage buffer shared by all invocations: H R (M / 4
+// fetches + Z M multiply-adds) in all. Used only with EvaluateOptions::scatteringPrefix = false (the
+// default builds the scattering prefix table, passes/scattering_prefix.comp, which includes this step).
 // Driven by crep::EvaluatePass.
 #ifndef CREP_BASES
 #define CREP_BASES 32

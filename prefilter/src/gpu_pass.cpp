@@ -34,6 +34,8 @@ constexpr GLuint kBasisUnit = 0, kCameraDepthUnit = 1;
 /// The region visibility table: its texture unit in the evaluation (CREP_VISIBILITY_TABLE_UNIT's default)
 /// and the basis's unit in the table pass.
 constexpr GLuint kTableUnit = 6, kTableBasisUnit = 0, kTableCoefficientsBinding = 0;
+/// The scattering prefix table's unit in the evaluation (CREP_SCATTERING_PREFIX_UNIT's default).
+constexpr GLuint kPrefixUnit = 7;
 // Layouts other than projective: their block (gpu::LayoutBuffers) next to the scattering and evaluate blocks.
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 
@@ -420,6 +422,26 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   if (usesVisibilityTable(info.options))
     stages[0].defines.push_back({"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)});
+  if (usesScatteringPrefix(info.options)) stages[0].defines.push_back({"CREP_SCATTERING_PREFIX", "1"});
+  if (layoutKind >= 0) {
+    std::vector<ShaderDefine>& d = stages[0].defines;
+    d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
+    d.push_back({"CREP_LAYOUT_BINDING", str(kLayoutBinding)});
+    d.push_back({"CREP_SLICES_BINDING", str(kLayoutRowsBinding)});
+  }
+  return stages;
+}
+
+/// The scattering prefix table's program (EvaluateOptions::scatteringPrefix), on the same layout block as
+/// evaluateStages(info, layoutKind).
+std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info, int layoutKind) {
+  std::vector<ShaderStageSource> stages = {
+      {ShaderStage::Compute,
+       "passes/scattering_prefix.comp",
+       {{"CREP_BASES", str(info.bases)},
+        {"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
+        {"CREP_TABLE_COEFFICIENTS_BINDING", str(kTableCoefficientsBinding)},
+        {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   if (layoutKind >= 0) {
     std::vector<ShaderDefine>& d = stages[0].defines;
     d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
@@ -449,16 +471,15 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   basisSampler_ =
       gl::createClampSampler(info.options.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
   depthSampler_ = gl::createClampSampler(GL_NEAREST);
-  if (usesVisibilityTable(info.options)) {
-    tableProgram_ =
-        buildProgram({{ShaderStage::Compute,
-                       "passes/visibility_table.comp",
-                       {{"CREP_BASES", str(info.bases)},
-                        {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
-                        {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
-                        {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}});
-    tableSampler_ = gl::createClampSampler(GL_LINEAR);
-  }
+  if (usesVisibilityTable(info.options)) tableSampler_ = gl::createClampSampler(GL_LINEAR);
+  if (usesScatteringPrefix(info.options))
+    prefixPrograms_[0] = buildProgram(prefixStages(info, -1));
+  else if (usesVisibilityTable(info.options))
+    tableProgram_ = buildProgram({{ShaderStage::Compute,
+                                   "passes/visibility_table.comp",
+                                   {{"CREP_BASES", str(info.bases)},
+                                    {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
+                                    {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}});
   scatteringBuffer_ = gl::createDynamicBuffer(sizeof(gpu::ScatteringParams));
   evaluateBuffer_ = gl::createDynamicBuffer(sizeof(gpu::EvaluateParams));
   gl::checkError("EvaluatePass: samplers and buffers");
@@ -469,7 +490,8 @@ std::size_t EvaluatePass::memoryBytes() const noexcept {
                                        ? static_cast<std::size_t>(info_.options.visibilityTableSamples) *
                                              static_cast<std::size_t>(layerCount(info_.bases)) * 16
                                        : 0;
-  return static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_) * 4 + coefficients +
+  const std::size_t texels = static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_);
+  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + coefficients +
          sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
 }
 
@@ -523,9 +545,11 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   const gpu::ScatteringParams scattering =
       scatteringParamsOf(basis, *frame.layout, *frame.light, *frame.medium);
   GLuint program = program_.get();
+  gpu::LayoutKind layoutKind{};
   if (!projective) {
     const gpu::LayoutKind kind =
         layoutBuffers_.upload(*layoutData, basis.height, "EvaluatePass::FrameAttribs.layout");
+    layoutKind = kind;
     gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
     if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
     program = variant.get();
@@ -542,12 +566,17 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
 
   const bool table = usesVisibilityTable(info_.options);
+  const bool prefix = usesScatteringPrefix(info_.options);
   if (table) {
-    // The region visibility table of this basis (EvaluateOptions::visibilityTableSamples), rebuilt every run.
+    // The per-frame table of this basis (EvaluateOptions::visibilityTableSamples / scatteringPrefix): the
+    // scattering prefix table (RGBA32F, the default) or the region visibility table (R32F), rebuilt every
+    // run; both R Z x H texels.
     const int Z = info_.options.visibilityTableSamples, R = basis.regions();
     if (tableWidth_ != R * Z || tableHeight_ != basis.height) {
-      tableTexture_ = gl::createTexture2D(GL_R32F, R * Z, basis.height,
-                                          "EvaluatePass: visibility table (regions x samples, rows)");
+      tableTexture_ =
+          gl::createTexture2D(prefix ? GL_RGBA32F : GL_R32F, R * Z, basis.height,
+                              prefix ? "EvaluatePass: scattering prefix table (regions x samples, rows)"
+                                     : "EvaluatePass: visibility table (regions x samples, rows)");
       tableWidth_ = R * Z;
       tableHeight_ = basis.height;
     }
@@ -568,19 +597,32 @@ void EvaluatePass::run(const FrameAttribs& frame) {
                            a.data(), 0);
       tableMargin_ = basis.depthMargin;
     }
-    glUseProgram(tableProgram_.get());
-    glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, tableCoefficients_.get());
     glBindTextureUnit(kTableBasisUnit, basis.texture);
     glBindSampler(kTableBasisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
-    glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
+    if (prefix) {
+      // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
+      gl::Handle& prefixProgram = prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
+      if (!prefixProgram)
+        prefixProgram = buildProgram(prefixStages(info_, projective ? -1 : static_cast<int>(layoutKind)));
+      glUseProgram(prefixProgram.get());
+      if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
+      glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
+      glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height), 1);
+    } else {
+      glUseProgram(tableProgram_.get());
+      glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
+      glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+      glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
+    }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, 0);
     glBindSampler(kTableBasisUnit, 0);
     glBindTextureUnit(kTableBasisUnit, 0);
-    glBindTextureUnit(kTableUnit, tableTexture_.get());
-    glBindSampler(kTableUnit, tableSampler_.get());
+    const GLuint unit = prefix ? kPrefixUnit : kTableUnit;
+    glBindTextureUnit(unit, tableTexture_.get());
+    glBindSampler(unit, tableSampler_.get());
   }
   glUseProgram(program);
   if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
@@ -613,6 +655,8 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   if (table) {
     glBindSampler(kTableUnit, 0);
     glBindTextureUnit(kTableUnit, 0);
+    glBindSampler(kPrefixUnit, 0);
+    glBindTextureUnit(kPrefixUnit, 0);
   }
   glUseProgram(0);
   gl::checkError("EvaluatePass::run");

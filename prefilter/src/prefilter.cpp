@@ -326,6 +326,41 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
   return table;
 }
 
+std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                          int samples, const glm::dvec3& extinction) {
+  validateBasis(basis);
+  const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
+  const std::size_t cells =
+      static_cast<std::size_t>(H) * static_cast<std::size_t>(R) * static_cast<std::size_t>(Z);
+  if (samples < 2 || samples > kMaxVisibilityTableSamples || visibility.size() != cells)
+    throw InvalidArgument("scatteringPrefixTable.visibility", "size " + std::to_string(visibility.size()),
+                          "must be visibilityTable(basis, samples) with samples in [2, " +
+                              std::to_string(kMaxVisibilityTableSamples) + "]");
+  const RectifiedLayout& layout = *basis.layout;
+  std::vector<double> table(cells * static_cast<std::size_t>(C));
+  const auto index = [&](int j, int r, int s) {
+    return (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
+               static_cast<std::size_t>(Z) +
+           static_cast<std::size_t>(s);
+  };
+  for (int j = 0; j < H; ++j) {
+    const double row = (j + 0.5) / H;
+    for (int s = 0; s < Z; ++s) {
+      const double depth = static_cast<double>(s) / (Z - 1);
+      glm::dvec3 sum(0.0);
+      double ta = 0.0;
+      for (int r = 0; r < R; ++r) {
+        for (int c = 0; c < C; ++c)
+          table[index(j, r, s) * C + static_cast<std::size_t>(c)] = sum[c];
+        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
+        sum += visibility[index(j, r, s)] * transmittanceIntegral(extinction, ta, tb);
+        ta = tb;
+      }
+    }
+  }
+  return table;
+}
+
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
                const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
   validateBasis(basis);
@@ -339,24 +374,34 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
   const glm::dvec3 origin = camera.position();
   const bool table = usesVisibilityTable(options);
   const int Z = options.visibilityTableSamples;
+  const bool prefix = usesScatteringPrefix(options);
   const std::vector<double> tableValues =
       table ? visibilityTable(basis, Z, options.ringing) : std::vector<double>();
-  // GL_LINEAR of the table texture (width R Z, height H) at depth d and normalized row: x = d (Z - 1)
-  // inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for the basis.
-  const auto tableAt = [&](int r, double depth, double row) {
+  const std::vector<double> prefixValues =
+      prefix ? scatteringPrefixTable(basis, tableValues, Z, sigma) : std::vector<double>();
+  // GL_LINEAR of a table texture (width R Z, height H, `channels` values per texel) at depth d and
+  // normalized row: x = d (Z - 1) inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for
+  // the basis.
+  const auto lerpTable = [&](const std::vector<double>& values, int channels, int channel, int r,
+                             double depth, double row) {
     const double xs = std::clamp(depth, 0.0, 1.0) * (Z - 1);
     const double ys = std::clamp(row * basis.height - 0.5, 0.0, static_cast<double>(basis.height - 1));
     const int x0 = static_cast<int>(std::floor(xs)), y0 = static_cast<int>(std::floor(ys));
     const int x1 = std::min(x0 + 1, Z - 1), y1 = std::min(y0 + 1, basis.height - 1);
     const double fx = xs - x0, fy = ys - y0;
     const auto at = [&](int xi, int yi) {
-      return tableValues[(static_cast<std::size_t>(yi) * static_cast<std::size_t>(R) +
-                          static_cast<std::size_t>(r)) *
-                             static_cast<std::size_t>(Z) +
-                         static_cast<std::size_t>(xi)];
+      return values[((static_cast<std::size_t>(yi) * static_cast<std::size_t>(R) +
+                      static_cast<std::size_t>(r)) *
+                         static_cast<std::size_t>(Z) +
+                     static_cast<std::size_t>(xi)) *
+                        static_cast<std::size_t>(channels) +
+                    static_cast<std::size_t>(channel)];
     };
     return (1.0 - fy) * ((1.0 - fx) * at(x0, y0) + fx * at(x1, y0)) +
            fy * ((1.0 - fx) * at(x0, y1) + fx * at(x1, y1));
+  };
+  const auto tableAt = [&](int r, double depth, double row) {
+    return lerpTable(tableValues, 1, 0, r, depth, row);
   };
   Image out(w, h, 4);
   parallelRows(h, options.threads, [&](int y) {
@@ -374,6 +419,27 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
         applyRingingFilter(options.ringing, aSpan);
         const int nearestRow =
             std::clamp(static_cast<int>(std::floor(m.row * basis.height)), 0, basis.height - 1);
+        if (prefix && m.last.region > 0) {
+          // The regions crossed whole from the scattering prefix table (EvaluateOptions::scatteringPrefix),
+          // then the last region as below from t_last = rayDistance(row, z_r, last / R) of the ray itself.
+          glm::dvec3 S;
+          for (int c = 0; c < kScatteringPrefixChannels; ++c)
+            S[c] = lerpTable(prefixValues, kScatteringPrefixChannels, c, m.last.region, m.depth, m.row);
+          L += C * S;
+          PixelRay rest = ray;
+          rest.start = std::clamp(layout.rayDistance(m.row, m.depth, static_cast<double>(m.last.region) / R),
+                                  ray.start, ray.surface);
+          m.first = {m.last.region, 0.0};
+          forEachSegment(layout, rest, m, R, [&](int r, double, double ub, double ta, double tb) {
+            sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data());
+            double dot = 0.0;
+            for (int k = 0; k < M; ++k)
+              dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
+            L += C * std::clamp(0.5 + dot, 0.0, 1.0) * transmittanceIntegral(sigma, ta, tb);
+          });
+          storeScattering(out, x, y, L, std::exp(-greySigma * ray.surface));
+          continue;
+        }
         forEachSegment(layout, ray, m, R, [&](int r, double ua, double ub, double ta, double tb) {
           if (table && r < m.last.region) { // a region crossed whole: the table (see EvaluateOptions)
             L += C * tableAt(r, m.depth, m.row) * transmittanceIntegral(sigma, ta, tb);

@@ -338,6 +338,8 @@ TEST_CASE("no shader uses a double type by default: neither its preprocessed sou
       {{"CREP_BASES", "32"}},
       {{"CREP_MARCH_TREE", "1"}},
       {{"CREP_LAYOUT", "1"}},
+      {{"CREP_VISIBILITY_TABLE_SAMPLES", "128"}},
+      {{"CREP_VISIBILITY_TABLE_SAMPLES", "128"}, {"CREP_SCATTERING_PREFIX", "1"}},
   };
   int compiled = 0;
   for (const auto& file : ShaderLibrary::files()) {

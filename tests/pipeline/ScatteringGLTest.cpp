@@ -201,8 +201,12 @@ TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
   Scattering scattering(info);
   const std::size_t map = std::size_t(kMap) * kMap * 4; // D32F rasterized + R32F resampled
   const std::size_t basis = filteredBasisBytes(kMap, kMap, info.prefilter.bases, info.prefilter.format);
-  const std::size_t table = visibilityTableBytes(kMap, info.rectify.splits * info.prefilter.regionsPerSplit,
-                                                 info.evaluate.visibilityTableSamples);
+  const auto tables = [&](int regions) {
+    const int Z = info.evaluate.visibilityTableSamples;
+    return info.evaluate.scatteringPrefix ? scatteringPrefixBytes(kMap, regions, Z)
+                                          : visibilityTableBytes(kMap, regions, Z);
+  };
+  const std::size_t table = tables(info.rectify.splits * info.prefilter.regionsPerSplit);
   // Buffers: the region weights (16 bytes per row and region), the table's ray coefficients (a vec4 per
   // sample and layer) and a few uniform blocks.
   const std::size_t coefficients =
@@ -216,8 +220,7 @@ TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
   const Scattering::FrameResult r = scattering.run(f.attribs(true, false));
   REQUIRE(r.layout == Scattering::Layout::Epipolar);
   const std::size_t own = std::size_t(info.ownShadowMapSize) * info.ownShadowMapSize * 4;
-  const std::size_t epipolarTable = visibilityTableBytes(
-      kMap, info.epipolarRegions * info.prefilter.regionsPerSplit, info.evaluate.visibilityTableSamples);
+  const std::size_t epipolarTable = tables(info.epipolarRegions * info.prefilter.regionsPerSplit);
   CHECK(within(scattering.memoryBytes(), basis + epipolarTable + 2 * map + own));
   MESSAGE("Scattering at " << kMap << "^2 after a fallback frame: " << scattering.memoryBytes() << " bytes");
 }

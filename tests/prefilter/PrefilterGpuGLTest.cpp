@@ -142,10 +142,7 @@ ImageMetrics checkEvaluation(const Image& gpu, const Image& cpu, const EvalToler
 }
 
 Image cpuEvaluate(const GpuScene& s, const FilteredBasis& basis, const EvaluatePass::CreateInfo& info) {
-  EvaluateOptions o;
-  o.sampling = info.options.sampling;
-  o.nearPlaneCorrection = info.options.nearPlaneCorrection;
-  o.ringing = info.options.ringing;
+  const EvaluateOptions o = info.options; // the same rule on both sides
   return evaluate(basis, s.cameraDepth, s.scene.camera, s.scene.sun, s.scene.medium, o);
 }
 
@@ -283,16 +280,22 @@ TEST_CASE("prefilter GPU: evaluation equals the CPU evaluation for every format,
     // The CPU basis uploaded as it is: only the evaluation differs.
     const UploadedBasis uploaded = uploadBasis(cpu, format);
     for (const Sampling sampling : {Sampling::Bilinear, Sampling::Nearest})
-      for (const int option : {0, 1, 2}) {
+      for (const int option : {0, 1, 2, 3, 4}) {
+        // 0: defaults (scattering prefix), 1: near-plane correction, 2: Lanczos and RGBA16F output, 3: the
+        // per-region loop over the visibility table, 4: no table (every region from the basis).
         EvaluatePass::CreateInfo e;
         e.options.sampling = sampling;
         e.options.nearPlaneCorrection = option == 1;
         e.options.ringing = option == 2 ? RingingFilter::Lanczos : RingingFilter::None;
+        e.options.scatteringPrefix = option != 3;
+        if (option == 4) e.options.visibilityTableSamples = 0;
         e.outputFormat = option == 2 ? StorageFormat::RGBA16F : StorageFormat::RGBA32F;
         const std::string name = std::string("prefilter_gpu_eval_") + storageFormatToken(format) +
                                  (sampling == Sampling::Nearest ? "_nearest" : "_bilinear") +
                                  (option == 1   ? "_nearplane"
                                   : option == 2 ? "_lanczos_rgba16f"
+                                  : option == 3 ? "_per_region_table"
+                                  : option == 4 ? "_no_table"
                                                 : "");
         CAPTURE(name);
         EvalTolerance t = evalTolerance(format, sampling);

@@ -537,15 +537,21 @@ TEST_CASE("prefilter: the region visibility table keeps the analytic ground trut
       const Image truth = shadow ? halfSpaceTruth(depth, camera, light, medium, plane)
                                  : unshadowedScattering(depth, camera, light, medium);
       const FilteredBasis basis = prefilter(map, medium, po);
-      EvaluateOptions direct, tabled;
+      EvaluateOptions direct, tabled, prefixed;
       direct.visibilityTableSamples = 0;
+      tabled.scatteringPrefix = false;
       REQUIRE(usesVisibilityTable(tabled));
+      REQUIRE(!usesScatteringPrefix(tabled));
+      REQUIRE(usesScatteringPrefix(prefixed));
       const ImageMetrics md = rgbMetrics(evaluate(basis, depth, camera, light, medium, direct), truth);
       const ImageMetrics mt = rgbMetrics(evaluate(basis, depth, camera, light, medium, tabled), truth);
+      const ImageMetrics mp = rgbMetrics(evaluate(basis, depth, camera, light, medium, prefixed), truth);
       MESSAGE((shadow ? "(b)" : "(a)")
               << " " << splits << " splits x " << po.regionsPerSplit << ": relative RMSE direct "
-              << md.relativeRmse << ", with the table " << mt.relativeRmse);
+              << md.relativeRmse << ", with the table " << mt.relativeRmse << ", with the scattering prefix "
+              << mp.relativeRmse);
       CHECK(std::abs(mt.relativeRmse - md.relativeRmse) < 0.001);
+      CHECK(std::abs(mp.relativeRmse - md.relativeRmse) < 0.001);
     }
     // The table's definition at a few entries: clamp(0.5 + a(z_s) . F_r(last texel of r), 0, 1).
     const RectifiedMap map = halfSpaceMap(layout, plane, 512, 256);
@@ -569,4 +575,54 @@ TEST_CASE("prefilter: the region visibility table keeps the analytic ground trut
   EvaluateOptions bad;
   bad.visibilityTableSamples = 1;
   CHECK_THROWS_AS(validate(bad), InvalidArgument);
+}
+
+TEST_CASE("prefilter: the scattering prefix table telescopes to the closed form where nothing is shadowed") {
+  // EvaluateOptions::scatteringPrefix. With V = 1 in every region the prefix of regions 0 .. r - 1 is the
+  // transmittance integral from the camera to the boundary t_r: (1 - exp(-sigma t_r)) / sigma per channel
+  // (Eq. 3), whatever the cuts in between; t_r from the layout's rayDistance, never below t_{r-1}.
+  const Camera camera = test::groundCamera();
+  const DirectionalLight light = test::sideLight();
+  const Medium medium = test::colouredMedium();
+  const glm::dvec3 sigma = medium.extinction();
+  const auto layout = test::projectiveLayout(camera, light, 8);
+  const RectifiedMap map = castRectifiedMap(layout, 512, 64, [](const LightRay&) { return std::nullopt; });
+  PrefilterOptions po;
+  po.regionsPerSplit = 2;
+  const FilteredBasis basis = prefilter(map, medium, po);
+  const int Z = 9, R = basis.regions;
+  const std::vector<double> ones(std::size_t(basis.height) * R * Z, 1.0);
+  const std::vector<double> S = scatteringPrefixTable(basis, ones, Z, sigma);
+  REQUIRE(S.size() == ones.size() * kScatteringPrefixChannels);
+  double worst = 0.0;
+  for (const int j : {0, 31, 63})
+    for (int s = 0; s < Z; ++s) {
+      const double row = (j + 0.5) / basis.height, d = double(s) / (Z - 1);
+      double t = 0.0;
+      for (int r = 0; r < R; ++r) {
+        if (r > 0) t = std::max(t, layout->rayDistance(row, d, double(r) / R));
+        for (int c = 0; c < 3; ++c) {
+          const double expected = t == 0.0 ? 0.0 : -std::expm1(-sigma[c] * t) / sigma[c];
+          const double got = S[((std::size_t(j) * R + r) * Z + s) * 3 + c];
+          worst = std::max(worst, std::abs(got - expected) / std::max(expected, 1e-300));
+          if (r == 0) CHECK(got == 0.0);
+        }
+      }
+    }
+  MESSAGE("scattering prefix vs closed form: max relative error " << worst);
+  CHECK(worst < 1e-12);
+  // With a shadowed region the prefixes after it stop growing by exactly that region's integral.
+  std::vector<double> gap = ones;
+  const int j = 10, s = 4, dark = 5;
+  gap[(std::size_t(j) * R + dark) * Z + s] = 0.0;
+  const std::vector<double> G = scatteringPrefixTable(basis, gap, Z, sigma);
+  for (int r = 0; r < R; ++r)
+    for (int c = 0; c < 3; ++c) {
+      const std::size_t i = ((std::size_t(j) * R + r) * Z + s) * 3 + c;
+      const std::size_t cut = ((std::size_t(j) * R + dark + 1) * Z + s) * 3 + c;
+      const std::size_t before = ((std::size_t(j) * R + dark) * Z + s) * 3 + c;
+      const double lost = r > dark ? S[cut] - S[before] : 0.0;
+      CHECK(G[i] == doctest::Approx(S[i] - lost).epsilon(1e-12));
+    }
+  CHECK_THROWS_AS(scatteringPrefixTable(basis, std::vector<double>(3), Z, sigma), InvalidArgument);
 }

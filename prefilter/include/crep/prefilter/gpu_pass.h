@@ -17,8 +17,9 @@
 //   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0, uniform buffers 0 and 1,
 //                       storage buffer 1 (near-plane correction); for a non-projective layout also
 //                       uniform buffer 2 and storage buffer 2 (its layout block and row table); with the
-//                       region visibility table (EvaluateOptions::visibilityTableSamples) texture unit 6
-//                       (+ sampler), and storage buffer 0 for the table pass that runs first.
+//                       scattering prefix table (EvaluateOptions::scatteringPrefix, the default) texture
+//                       unit 7, or with the region visibility table alone texture unit 6 (+ sampler), and
+//                       storage buffer 0 for the table pass that runs first.
 // Engines that evaluate in their own shader use crep/scattering.glsl with filteredBasis() and
 // makeScatteringParams() (see that file's header).
 #pragma once
@@ -180,7 +181,8 @@ public:
   void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
-  /// GPU memory it owns, bytes: the region visibility table (visibilityTableBytes, once run) and buffers.
+  /// GPU memory it owns, bytes: the scattering prefix table (scatteringPrefixBytes, once run) or the region
+  /// visibility table (visibilityTableBytes) and buffers.
   std::size_t memoryBytes() const noexcept;
 
 private:
@@ -189,7 +191,10 @@ private:
   gl::Handle layoutPrograms_[2]; ///< per gpu::LayoutKind, built on first use (non-projective layouts)
   /// The region visibility table (EvaluateOptions::visibilityTableSamples): its pass, R32F texture
   /// (R Z x H, reallocated when the basis's size changes) and linear sampler.
+  /// With scatteringPrefix the texture holds the scattering prefix table instead (RGBA32F, same size),
+  /// built by prefixPrograms_ (projective frame, then per gpu::LayoutKind, built on first use).
   gl::Handle tableProgram_, tableTexture_, tableSampler_;
+  gl::Handle prefixPrograms_[3];
   gl::Handle tableCoefficients_; ///< a(z_s) of the table's samples (storage buffer), for tableMargin_
   double tableMargin_ = -1.0;
   int tableWidth_ = 0, tableHeight_ = 0;

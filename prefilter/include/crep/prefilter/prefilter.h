@@ -134,6 +134,10 @@ inline std::size_t visibilityTableBytes(int height, int regions, int samples) {
   return static_cast<std::size_t>(height) * static_cast<std::size_t>(regions) *
          static_cast<std::size_t>(samples) * 4;
 }
+/// GPU bytes of the scattering prefix table (EvaluateOptions::scatteringPrefix): R Z x H, RGBA32F.
+inline std::size_t scatteringPrefixBytes(int height, int regions, int samples) {
+  return 4 * visibilityTableBytes(height, regions, samples);
+}
 
 /// The storage rule of the filtered basis: encode F in [-1, 1] as e = 0.5 + 0.5 F and round it to
 /// `format` (RGBA8: round(clamp(e, 0, 1) * 255) / 255; RGBA16F: nearest binary16, ties to even; RGBA32F:
@@ -204,6 +208,15 @@ struct EvaluateOptions {
   /// Not in the paper: the evaluation is bound by its basis fetches (bench/README.md, "Profile").
   /// Default 128: ~8 samples across the step of M = 32 (README "Measured figures").
   int visibilityTableSamples = 128;
+  /// With the visibility table: also tabulate the prefix sums of the regions' in-scattering along the
+  /// table's sample rays, S_r(row, z) = sum_{r' < r} V_r'(row, z) TI_r'(row, z) per colour channel, with TI
+  /// the transmittance integral of Eq. 3 over region r' of the ray of that row and depth (the ray is fixed
+  /// by its row and depth z_r: all its points share them). A pixel then reads every region it crosses
+  /// whole in one bilinear RGB fetch and evaluates only its last region: constant cost, whatever the
+  /// number of regions it crosses (Klehm et al. 2014 Sec. 5's "constant performance"; the prefix of
+  /// Sec. 3.1 run across regions, not in the paper). Default true; false = the per-region loop over the
+  /// visibility table (the figures of bench/README.md, "Profile", compare them).
+  bool scatteringPrefix = true;
   /// CPU worker threads: 0 = hardware concurrency. Never changes the result.
   int threads = 0;
 };
@@ -212,6 +225,10 @@ struct EvaluateOptions {
 inline bool usesVisibilityTable(const EvaluateOptions& options) {
   return options.visibilityTableSamples > 0 && options.sampling == Sampling::Bilinear &&
          !options.nearPlaneCorrection;
+}
+/// Whether evaluation with `options` uses the scattering prefix table (see scatteringPrefix).
+inline bool usesScatteringPrefix(const EvaluateOptions& options) {
+  return usesVisibilityTable(options) && options.scatteringPrefix;
 }
 inline constexpr int kMaxVisibilityTableSamples = 4096;
 
@@ -225,6 +242,16 @@ std::vector<double> visibilityTableCoefficients(int samples, int bases, double d
 /// index (row * R + region) * Z + s, sample s at normalized ray depth s / (Z - 1), ray coefficients with
 /// `ringing`. What EvaluatePass builds on the GPU in float (glsl/passes/visibility_table.comp).
 std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing);
+
+/// The scattering prefix table (see EvaluateOptions::scatteringPrefix) of `basis` and its region
+/// visibility table `visibility` (visibilityTable(), Z = samples): index ((row * R + region) * Z + s) * 3 +
+/// c, the in-scattering (without the constant C of Eq. 1) of regions 0 .. region - 1 along the ray of texel
+/// row (row + 0.5) / H and normalized depth s / (Z - 1), region r' cut at t_r' = layout.rayDistance(row,
+/// depth, r' / R) (t_0 = 0, each t at least the one before), per channel of `extinction`. What
+/// EvaluatePass builds on the GPU in float (glsl/passes/scattering_prefix.comp).
+std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                          int samples, const glm::dvec3& extinction);
+inline constexpr int kScatteringPrefixChannels = 3;
 
 /// Throws InvalidArgument naming the field as `<owner>.sampling`, `<owner>.ringing`,
 /// `<owner>.visibilityTableSamples` (0 or in [2, kMaxVisibilityTableSamples]), `<owner>.threads`.

@@ -1,0 +1,76 @@
+#version 450 core
+// The scattering prefix table of the evaluation (crep::EvaluateOptions::scatteringPrefix; the CPU
+// reference is crep::scatteringPrefixTable over crep::visibilityTable): for texel row j, depth sample s and
+// prefilter region r, S_r = sum_{r' < r} V_r' TI_r' per colour channel, with
+//   V_r' = clamp(0.5 + a(z_s) . F_r'(j), 0, 1)  the visibility of region r' crossed whole (F at its last
+//          texel: the region's whole weighted average, Klehm et al. 2014 Eq. 9 and Appendix A),
+//   TI_r'  the transmittance integral (Eq. 3) over region r' of the view ray of row (j + 0.5) / H and
+//          normalized depth s / (Z - 1): a ray from the camera is fixed by its row and depth, so its
+//          region boundary distances are too (crep_evalRayAt, crep_evalBoundary).
+// A pixel then reads every region it crosses whole with one bilinear fetch (crep_inScatteringSegment with
+// CREP_SCATTERING_PREFIX).
+// One invocation per (sample, row), looping over the R regions: the invocations of a workgroup share the
+// row, so every basis fetch has the same address in all of them (served once by a GPU's texture cache),
+// and consecutive invocations write consecutive table texels (coalesced). Staging the row's basis in shared
+// memory behind barriers was measured slower on llvmpipe (37 vs 14 ms at 512 rows, 128 samples, 16
+// regions; `crep bench`, "evaluation variants"). The transmittance integral of each region comes from the
+// carried exp(-sigma t) at its ends (one exp per channel and region instead of crep_transmittanceIntegral's
+// two). The ray coefficients a(z_s) come precomputed (in double
+// on the CPU, with the ringing filter) from a storage buffer.
+// Layouts as the evaluation: the scattering block's projective frame, or CREP_EVAL_LAYOUT.
+// Driven by crep::EvaluatePass.
+#ifndef CREP_BASES
+#define CREP_BASES 32
+#endif
+#ifndef CREP_VISIBILITY_TABLE_SAMPLES
+#define CREP_VISIBILITY_TABLE_SAMPLES 128
+#endif
+#ifndef CREP_MEMORY_LIMIT
+#define CREP_MEMORY_LIMIT 0 // 1: benchmark variant, the same fetches and stores without the math
+#endif
+#ifndef CREP_TABLE_COEFFICIENTS_BINDING
+#define CREP_TABLE_COEFFICIENTS_BINDING 0
+#endif
+#include "crep/scattering.glsl"
+
+#define CREP_PREFIX_LAYERS ((CREP_BASES + 3) / 4)
+
+layout(local_size_x = 64) in;
+layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_prefixOut; // width R Z, height H
+// a(z_s) of sample s, layer l at index s * layers + l (Eq. 8 order, zero beyond M).
+layout(std430, binding = CREP_TABLE_COEFFICIENTS_BINDING) readonly restrict buffer CrepTableCoefficients {
+  vec4 crep_tableA[];
+};
+
+void main() {
+  const int Z = CREP_VISIBILITY_TABLE_SAMPLES, L = CREP_PREFIX_LAYERS;
+  int s = int(gl_GlobalInvocationID.x), j = int(gl_GlobalInvocationID.y);
+  int H = crep_scattering.mapSize.y, R = crep_scattering.mapSize.z, n = crep_scattering.mapSize.x / R;
+  if (s >= Z) return;
+  vec4 a[L];
+  for (int l = 0; l < L; ++l) a[l] = crep_tableA[s * L + l];
+  CrepEvalRay ray = crep_evalRayAt((float(j) + 0.5) / float(H), float(s) / float(Z - 1));
+  vec3 sigma = crep_scattering.extinction.rgb;
+  vec3 sum = vec3(0.0), Ea = vec3(1.0);
+  float ta = 0.0;
+  for (int r = 0; r < R; ++r) {
+    imageStore(crep_prefixOut, ivec2(r * Z + s, j), vec4(sum, 0.0));
+    float dotF = 0.0;
+    for (int l = 0; l < L; ++l) dotF += dot(a[l], 2.0 * texelFetch(crep_filteredBasis, ivec3(r * n + n - 1, j, l), 0) - 1.0);
+#if CREP_MEMORY_LIMIT
+    sum += vec3(dotF > 1e30 ? 0.0 : 1.0); // counts the regions (memory-limit test), keeps the reads
+#else
+    float tb = max(ta, crep_evalBoundary(ray, r + 1));
+    vec3 Eb = exp(-sigma * tb);
+    // (Ea - Eb) / sigma, and below sigma (tb - ta) = 1/4 (where that difference cancels) Ea (tb - ta)
+    // phi(x) by the series of crep_oneMinusExpOverX: both relative errors stay near float rounding.
+    float len = tb - ta;
+    vec3 x = sigma * len;
+    vec3 phi = 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0 - x * (1.0 / 720.0 - x / 5040.0)))));
+    vec3 integral = mix((Ea - Eb) / sigma, Ea * len * phi, lessThan(x, vec3(0.25)));
+    sum += clamp(0.5 + dotF, 0.0, 1.0) * integral;
+    Ea = Eb;
+    ta = tb;
+#endif
+  }
+}
