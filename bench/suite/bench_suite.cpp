@@ -127,6 +127,9 @@ EvaluationProfile profileEvaluation(const Setup& s, int regionsPerSplit) {
 struct GpuTimes {
   double prefilter, evaluate;
   double prefilterLimit = 0.0, evaluateLimit = 0.0; ///< the passes stripped to their memory traffic
+  /// The fastest write-only prefilter over 4, 8, 16 and 32 bases per invocation, and that count.
+  double prefilterLimitFastest = 0.0;
+  int prefilterLimitFastestBases = 0;
   /// Evaluation variants (with `limits`): the per-region loop over the visibility table (scatteringPrefix
   /// false), no table at all (visibilityTableSamples 0), and the default's per-frame tables alone (the
   /// evaluation of an 8 x 8 image: what does not scale with the screen).
@@ -136,7 +139,7 @@ struct GpuTimes {
 
 GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
                  int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit,
-                 int basesPerInvocation = 8, bool limits = false) {
+                 int basesPerInvocation = PrefilterOptions{}.basesPerInvocation, bool limits = false) {
   PrefilterPass::CreateInfo info;
   info.width = s.mapW;
   info.height = s.mapH;
@@ -191,6 +194,21 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
       evaluateLimit.run(ev);
       glFinish();
     });
+    for (const int perInvocation : {4, 8, 16, 32}) {
+      PrefilterPass::CreateInfo writer = info;
+      writer.options.basesPerInvocation = std::min(perInvocation, bases);
+      PrefilterPass writeOnly(writer);
+      writeOnly.run(frame);
+      glFinish();
+      const double ms = medianMs(repeat, [&] {
+        writeOnly.run(frame);
+        glFinish();
+      });
+      if (t.prefilterLimitFastestBases == 0 || ms < t.prefilterLimitFastest) {
+        t.prefilterLimitFastest = ms;
+        t.prefilterLimitFastestBases = writer.options.basesPerInvocation;
+      }
+    }
     const auto timeVariant = [&](const EvaluateOptions& options, const EvaluatePass::FrameAttribs& attribs) {
       EvaluatePass::CreateInfo vi;
       vi.bases = bases;
@@ -543,8 +561,9 @@ void runBenchSuite(const BenchOptions& o) {
     const Image img = evaluate(basis, s.cameraDepthImage, s.scene.camera, s.scene.sun, s.scene.medium);
     (void)img;
   });
+  const int perInvocation = PrefilterOptions{}.basesPerInvocation;
   const GpuTimes gpu = timeGpu(s, bases, StorageFormat::RGBA8, repeat,
-                               Scattering::CreateInfo{}.prefilter.regionsPerSplit, 8, true);
+                               Scattering::CreateInfo{}.prefilter.regionsPerSplit, perInvocation, true);
 
   std::printf("\n%-34s %12s %12s %10s\n", "stage", "CPU ms", "GPU ms", "CPU/GPU");
   std::printf("%-34s %12.2f %12.2f %10.2f\n", "prefilter", cpuPrefilterMs, gpu.prefilter,
@@ -556,6 +575,11 @@ void runBenchSuite(const BenchOptions& o) {
   std::printf(
       "  prefilter   %8.2f ms   write-only (same map reads, same basis writes) %8.2f ms   ratio %.2f\n",
       gpu.prefilter, gpu.prefilterLimit, gpu.prefilter / gpu.prefilterLimit);
+  std::printf(
+      "              (%d bases per invocation, the default; the fastest write-only, %d per invocation: "
+      "%.2f ms, ratio %.2f)\n",
+      perInvocation, gpu.prefilterLimitFastestBases, gpu.prefilterLimitFastest,
+      gpu.prefilter / gpu.prefilterLimitFastest);
   std::printf(
       "  evaluate    %8.2f ms   fetch-only (same fetches and store, no math)    %8.2f ms   ratio %.2f\n",
       gpu.evaluate, gpu.evaluateLimit, gpu.evaluate / gpu.evaluateLimit);

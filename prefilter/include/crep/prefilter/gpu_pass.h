@@ -78,8 +78,9 @@ public:
     /// The prefilter it runs: M (ceil(M / 4) RGBA layers), storage format (Sec. 3.3), weights
     /// (weights.h), regions per split P (Table 1 "regions", <= width), depth margin, bases per invocation
     /// (Table 1). The same options give the CPU reference crep::prefilter(); `threads` is not used.
-    /// basesPerInvocation: on llvmpipe 32 is fastest (more invocations only repeat the depth reads and
-    /// weights on a CPU); GPUs prefer 8 (the paper's choice on an NVIDIA Titan), the default.
+    /// basesPerInvocation: default 16 (see PrefilterOptions); on llvmpipe 32 is fastest (more invocations
+    /// only repeat the depth reads and weights on a CPU); the paper chose 8 on an NVIDIA Titan with 1-3
+    /// regions per row.
     PrefilterOptions options;
     int workgroupRows = 64;      ///< local_size_x: rows per workgroup, >= 1
     int workgroupBaseGroups = 1; ///< local_size_y: groups of bases per workgroup, >= 1
