@@ -16,6 +16,8 @@
 //   float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize)
 //         the ray's own world distance at texel boundary i (unclamped; 3e38 = never)
 //   bool  crep_layoutToRectified(vec3 world, out vec4 p)   p = (row, column, depth, region)
+//   bool  crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p)
+//         both of the above for a view ray and its end point camera + surface dir
 //   CrepLightRay crep_layoutLightRay(float column, float row)
 #ifndef CREP_EPIPOLAR_GLSL
 #define CREP_EPIPOLAR_GLSL
@@ -142,6 +144,12 @@ float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
   vec2 range = crep_projective.splitZeta[k].xy;
   float den = range.x + (float(q) / float(n)) * (range.y - range.x) - r.dist.y;
   return den > 0.0 ? r.dist.x / den : CREP_NEVER;
+}
+// crep_mapRowRay and crep_layoutToRectified of its end point (origin + surface dir) at once.
+bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
+  p = vec4(0.0);
+  if (!crep_mapRowRay(dir, surface, mapSize, r)) return false;
+  return crep_layoutToRectified(crep_projective.origin.xyz + surface * dir, p);
 }
 #endif // CREP_LAYOUT_PROJECTIVE
 
@@ -339,6 +347,35 @@ bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
   crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
   r.last = crep_lastTexel(k, u, K, n);
   r.dist = vec4(s.x / sinRay, 0.0, 0.0, 0.0);
+  return true;
+}
+
+// crep_mapRowRay and crep_layoutToRectified of its end point (camera + surface dir) at once: the end point
+// has the ray's slice, psi and b = surface sin(psi), so the exit border position (four atan) is found once.
+bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
+  r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
+  p = vec4(0.0);
+  vec3 m = crep_epipolar.towardLight.xyz;
+  float a = dot(dir, m);
+  vec3 perp = dir - a * m;
+  float sinPsi = length(perp);
+  if (!(sinPsi > 0.0) || !(surface > 0.0)) return false;
+  float sigma;
+  vec2 range;
+  if (!crep_epipolarExitSigma(perp / sinPsi, sigma, range)) return false;
+  r.row = crep_epipolarRowOfSigma(sigma);
+  r.texelRow = clamp(int(floor(r.row * float(mapSize.y))), 0, mapSize.y - 1);
+  vec4 s = crep_slices[crep_epipolarSliceIndex(r.row)].bounds;
+  float depth = (crep_epipolarWarp(atan(sinPsi, a)) - s.y) / (s.z - s.y);
+  r.depth = clamp(depth, 0.0, 1.0);
+  float sinRay = max(sin(crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y))), 1e-30);
+  int K = crep_epipolar.counts.y, n = mapSize.x / K;
+  int k;
+  float u;
+  crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
+  r.last = crep_lastTexel(k, u, K, n);
+  r.dist = vec4(s.x / sinRay, 0.0, 0.0, 0.0);
+  p = vec4(r.row, (float(k) + u) / float(K), depth, float(k));
   return true;
 }
 

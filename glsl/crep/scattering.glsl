@@ -395,9 +395,8 @@ struct CrepEvalRay {
 bool crep_evalMap(vec3 origin, vec3 dir, float t, out CrepEvalRay e) {
 #ifdef CREP_EVAL_LAYOUT
   e = CrepEvalRay(0.0, 0.0, 0, 0.0, vec4(0.0), CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0)));
-  vec4 p; // (row, column, depth, layout region)
-  if (!crep_layoutToRectified(origin + t * dir, p)) return false;
-  if (!crep_mapRowRay(dir, t, crep_scattering.mapSize.xy, e.rr)) return false;
+  vec4 p; // (row, column, depth, layout region) of the end point, from the ray's own mapping
+  if (!crep_mapRowRayPoint(dir, t, crep_scattering.mapSize.xy, e.rr, p)) return false;
   CrepRectPoint hit = CrepRectPoint(0.0, 0.0, p.x, p.z, int(p.w), p.y * float(crep_scattering.mapSize.w) - p.w);
   crep_regionPoint(hit, e.region, e.u);
   e.row = p.x;
