@@ -528,6 +528,73 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   return o;
 }
 
+/// Constant cost (Klehm et al. 2014, Sec. 5): the GPU prefilter and evaluation of the four projective
+/// built-in scenes at the same sizes, timed interleaved (scene after scene, `repeat` rounds) so that a
+/// change of the machine's load hits every scene alike; medians per scene and the largest / smallest.
+void constantCost(const BenchOptions& o) {
+  const std::vector<std::string> names = {"colonnade", "forest", "terrain", "boxes"};
+  struct Scene {
+    Setup setup;
+    std::unique_ptr<PrefilterPass> prefilter;
+    std::unique_ptr<EvaluatePass> evaluate;
+    std::vector<double> prefilterMs, evaluateMs;
+  };
+  std::vector<Scene> scenes;
+  for (const std::string& name : names) {
+    Scene sc{makeSetup(name, o.screenWidth, o.screenHeight, o.mapWidth, o.mapHeight), {}, {}, {}, {}};
+    PrefilterPass::CreateInfo info;
+    info.width = o.mapWidth;
+    info.height = o.mapHeight;
+    info.options = Scattering::CreateInfo{}.prefilter;
+    info.options.bases = o.bases;
+    info.options.basesPerInvocation = std::min(info.options.basesPerInvocation, o.bases);
+    sc.prefilter = std::make_unique<PrefilterPass>(info);
+    EvaluatePass::CreateInfo evalInfo;
+    evalInfo.bases = o.bases;
+    sc.evaluate = std::make_unique<EvaluatePass>(evalInfo);
+    scenes.push_back(std::move(sc));
+  }
+  const auto run = [&](Scene& sc, bool record) {
+    const Setup& st = sc.setup;
+    double ms = medianMs(1, [&] {
+      sc.prefilter->run({st.rectified.get(), st.layout.get(), &st.scene.medium});
+      glFinish();
+    });
+    if (record) sc.prefilterMs.push_back(ms);
+    EvaluatePass::FrameAttribs ev;
+    ev.cameraDepth = st.cameraDepth.get();
+    ev.output = st.scattering.get();
+    ev.camera = &st.scene.camera;
+    ev.light = &st.scene.sun;
+    ev.medium = &st.scene.medium;
+    ev.layout = st.layout.get();
+    ev.basis = sc.prefilter->filteredBasis();
+    ms = medianMs(1, [&] {
+      sc.evaluate->run(ev);
+      glFinish();
+    });
+    if (record) sc.evaluateMs.push_back(ms);
+  };
+  for (Scene& sc : scenes)
+    run(sc, false); // warm-up
+  for (int i = 0; i < std::max(3, o.repeat); ++i)
+    for (Scene& sc : scenes)
+      run(sc, true);
+  std::printf(
+      "\nconstant cost (GPU prefilter and evaluation of the four projective scenes, %dx%d, map %dx%d, "
+      "M = %d;\ninterleaved, medians of %d rounds):\n",
+      o.screenWidth, o.screenHeight, o.mapWidth, o.mapHeight, o.bases, std::max(3, o.repeat));
+  std::printf("%-12s %12s %12s\n", "scene", "prefilter ms", "evaluate ms");
+  double lo = 1e30, hi = 0.0;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const double e = median(scenes[i].evaluateMs);
+    lo = std::min(lo, e);
+    hi = std::max(hi, e);
+    std::printf("%-12s %12.2f %12.2f\n", names[i].c_str(), median(scenes[i].prefilterMs), e);
+  }
+  std::printf("evaluation, largest / smallest: %.3f (goal: within 10%%)\n", hi / lo);
+}
+
 void runBenchSuite(const BenchOptions& o) {
   scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
   tool::StageTimings contextTimings;
@@ -613,6 +680,7 @@ void runBenchSuite(const BenchOptions& o) {
               mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
 
   memoryTable(o);
+  constantCost(o);
   reducedResolution(o);
   methodsSideBySide(o);
   sunInView(o);
