@@ -198,6 +198,35 @@ void checkError(const char* what) {
   if (!errors.empty()) throw GlError(std::string("crep: GL error in ") + what + ": " + errors);
 }
 
+RasterStateGuard::RasterStateGuard() {
+  GLint framebuffer = 0, depthFunc = GL_LESS;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
+  glGetIntegerv(GL_VIEWPORT, viewport_);
+  glGetIntegerv(GL_SCISSOR_BOX, scissor_);
+  glGetIntegerv(GL_DEPTH_FUNC, &depthFunc);
+  GLboolean mask = GL_TRUE;
+  glGetBooleanv(GL_DEPTH_WRITEMASK, &mask);
+  framebuffer_ = framebuffer;
+  depthFunc_ = depthFunc;
+  depthMask_ = mask == GL_TRUE;
+  depthTest_ = glIsEnabled(GL_DEPTH_TEST) == GL_TRUE;
+  depthClamp_ = glIsEnabled(GL_DEPTH_CLAMP) == GL_TRUE;
+  cull_ = glIsEnabled(GL_CULL_FACE) == GL_TRUE;
+  scissorTest_ = glIsEnabled(GL_SCISSOR_TEST) == GL_TRUE;
+}
+
+RasterStateGuard::~RasterStateGuard() {
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(framebuffer_));
+  glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
+  glScissor(scissor_[0], scissor_[1], scissor_[2], scissor_[3]);
+  glDepthFunc(static_cast<GLenum>(depthFunc_));
+  glDepthMask(depthMask_ ? GL_TRUE : GL_FALSE);
+  (depthTest_ ? glEnable : glDisable)(GL_DEPTH_TEST);
+  (depthClamp_ ? glEnable : glDisable)(GL_DEPTH_CLAMP);
+  (cull_ ? glEnable : glDisable)(GL_CULL_FACE);
+  (scissorTest_ ? glEnable : glDisable)(GL_SCISSOR_TEST);
+}
+
 GpuTimer::GpuTimer() : query_(createQuery(GL_TIME_ELAPSED)) {}
 
 void GpuTimer::begin() {

@@ -5,6 +5,7 @@
 #include <crep/core/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
+#include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
@@ -79,35 +80,6 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   return info;
 }
 
-/// The GL state a shadow pass changes, restored on destruction.
-class SavedRasterState {
-public:
-  SavedRasterState() {
-    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer_);
-    glGetIntegerv(GL_VIEWPORT, viewport_);
-    glGetIntegerv(GL_DEPTH_FUNC, &depthFunc_);
-    glGetBooleanv(GL_DEPTH_WRITEMASK, &depthMask_);
-    depthTest_ = glIsEnabled(GL_DEPTH_TEST);
-    depthClamp_ = glIsEnabled(GL_DEPTH_CLAMP);
-    cull_ = glIsEnabled(GL_CULL_FACE);
-  }
-  ~SavedRasterState() {
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(framebuffer_));
-    glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
-    glDepthFunc(static_cast<GLenum>(depthFunc_));
-    glDepthMask(depthMask_);
-    (depthTest_ ? glEnable : glDisable)(GL_DEPTH_TEST);
-    (depthClamp_ ? glEnable : glDisable)(GL_DEPTH_CLAMP);
-    (cull_ ? glEnable : glDisable)(GL_CULL_FACE);
-  }
-  SavedRasterState(const SavedRasterState&) = delete;
-  SavedRasterState& operator=(const SavedRasterState&) = delete;
-
-private:
-  GLint framebuffer_ = 0, viewport_[4] = {0, 0, 0, 0}, depthFunc_ = GL_LESS;
-  GLboolean depthMask_ = GL_TRUE, depthTest_ = GL_FALSE, depthClamp_ = GL_FALSE, cull_ = GL_FALSE;
-};
-
 /// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
 struct DepthTarget {
   gl::Handle texture, framebuffer;
@@ -122,7 +94,7 @@ struct DepthTarget {
   /// Clears to 1 and calls draw(viewport index) with the raster state of the header set.
   template <class Draw>
   void render(int viewports, const Draw& draw) {
-    const SavedRasterState saved;
+    const gl::RasterStateGuard saved;
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer.get());
     glViewport(0, 0, size, size);
     glDepthMask(GL_TRUE);
@@ -143,7 +115,7 @@ struct Scattering::Impl {
   explicit Impl(const CreateInfo& i)
       : info(validated(i)), prefilter({i.mapSize, i.mapSize, i.prefilter}),
         evaluate({i.prefilter.bases, i.evaluate}), resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}),
-        rectified(i.mapSize) {
+        rectified({i.mapSize, i.mapSize}) {
     resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
     const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
     if (factor > 1) {
@@ -159,7 +131,7 @@ struct Scattering::Impl {
   EvaluatePass evaluate;
   ShadowResamplePass resample;
   WorldMarchPass block;
-  DepthTarget rectified;                         ///< the projective map rasterized with drawCasters
+  RectifiedShadowPass rectified;                 ///< the projective map rasterized with drawCasters
   gl::Handle resampled;                          ///< R32F: a map resampled from a standard shadow map
   std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
@@ -180,7 +152,8 @@ std::size_t Scattering::memoryBytes() const noexcept {
   const Impl& m = *impl_;
   const std::size_t map =
       static_cast<std::size_t>(m.info.mapSize) * static_cast<std::size_t>(m.info.mapSize) * 4;
-  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() + 2 * map; // D32F + R32F maps
+  // The R32F resampled map, and the D32F rasterized one once a frame has drawn casters into it.
+  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() + m.rectified.memoryBytes() + map;
   if (m.reduced)
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
@@ -241,13 +214,10 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     layout = projective;
     if (f.drawCasters) {
       stage("shadow pass (rectified)", [&] {
-        m.rectified.render(r.rectification.splitCount(), [&](int k) {
-          const SplitViewport v = r.rectification.splitViewport(k, info.mapSize, info.mapSize);
-          glViewport(v.x, v.y, v.width, v.height);
-          f.drawCasters(r.rectification.splits[static_cast<std::size_t>(k)].rectClipFromWorld);
-        });
+        m.rectified.run(
+            {&r.rectification, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
       });
-      map = m.rectified.texture.get();
+      map = m.rectified.depthTexture();
     } else {
       stage("resample (projective)", [&] {
         m.resample.run({projective.get(), shadow->texture, shadow->width, shadow->height,

@@ -1,5 +1,6 @@
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
+#include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/scenes/shaders.h>
 
@@ -110,11 +111,10 @@ void SceneRenderer::renderRectified(const Rectification& r, std::uint32_t depthT
   if (!r.projective())
     throw InvalidArgument("Rectification.status", statusToken(r.status),
                           "must be projective to render a rectified map");
-  for (int k = 0; k < r.splitCount(); ++k) {
-    const SplitViewport v = r.splitViewport(k, width, height);
-    renderDepth(r.splits[static_cast<std::size_t>(k)].rectClipFromWorld, depthTexture, v.layer, v.x, v.y,
-                v.width, v.height, {.depthClamp = true});
-  }
+  // The library's split pass (what the README shows an engine): clear once, viewport + scissor per split,
+  // depth clamp, GL_LESS, no culling.
+  RectifiedShadowPass pass({width, height});
+  pass.run({&r, [&](int, const glm::dmat4& clipFromWorld) { drawDepth(clipFromWorld); }, depthTexture});
 }
 
 void SceneRenderer::renderShaded(const ShadeInputs& in, std::uint32_t colorTexture,

@@ -1,0 +1,83 @@
+#include <crep/core/error.h>
+#include <crep/pipeline/rectified_shadow_pass.h>
+
+#include <epoxy/gl.h>
+
+#include <string>
+
+namespace crep {
+
+namespace {
+[[noreturn]] void invalid(const std::string& parameter, const std::string& value,
+                          const std::string& requirement) {
+  throw InvalidArgument(parameter, value, requirement);
+}
+} // namespace
+
+RectifiedShadowPass::RectifiedShadowPass(const CreateInfo& info) : info_(info) {
+  gl::checkTextureSize("RectifiedShadowPass::CreateInfo.width/height", info.width, info.height);
+  framebuffer_ = gl::createFramebuffer();
+  glNamedFramebufferDrawBuffer(framebuffer_.get(), GL_NONE);
+  glNamedFramebufferReadBuffer(framebuffer_.get(), GL_NONE);
+  gl::checkError("RectifiedShadowPass: texture and framebuffer");
+}
+
+RectifiedShadowPass::~RectifiedShadowPass() = default;
+RectifiedShadowPass::RectifiedShadowPass(RectifiedShadowPass&&) noexcept = default;
+RectifiedShadowPass& RectifiedShadowPass::operator=(RectifiedShadowPass&&) noexcept = default;
+
+std::size_t RectifiedShadowPass::memoryBytes() const noexcept {
+  return texture_ ? static_cast<std::size_t>(info_.width) * static_cast<std::size_t>(info_.height) * 4 : 0;
+}
+
+void RectifiedShadowPass::run(const FrameAttribs& frame) {
+  const Rectification* r = frame.rectification;
+  if (r == nullptr) invalid("RectifiedShadowPass::FrameAttribs.rectification", "null", "must be set");
+  if (!r->projective())
+    invalid("RectifiedShadowPass::FrameAttribs.rectification", r->message,
+            "must be projective (else use the epipolar fallback)");
+  if (r->layout != SplitLayout::Regions)
+    invalid("RectifiedShadowPass::FrameAttribs.rectification", "SplitLayout::Layers",
+            "must use SplitLayout::Regions (the splits side by side in one map)");
+  if (!frame.drawCasters) invalid("RectifiedShadowPass::FrameAttribs.drawCasters", "empty", "must be set");
+  const int W = info_.width, H = info_.height;
+  if (W % r->splitCount() != 0)
+    invalid("RectifiedShadowPass::CreateInfo.width", std::to_string(W),
+            "must be a multiple of the split count " + std::to_string(r->splitCount()));
+  if (frame.depthTexture != 0)
+    gl::requireTexture2D("RectifiedShadowPass::FrameAttribs.depthTexture", frame.depthTexture, W, H);
+  else if (!texture_)
+    texture_ =
+        gl::createTexture2D(GL_DEPTH_COMPONENT32F, W, H, "RectifiedShadowPass::CreateInfo.width/height");
+  const std::uint32_t target = frame.depthTexture != 0 ? frame.depthTexture : texture_.get();
+  const GLuint fb = framebuffer_.get();
+  glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, target, 0);
+  if (glCheckNamedFramebufferStatus(fb, GL_DRAW_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0);
+    invalid("RectifiedShadowPass::FrameAttribs.depthTexture", std::to_string(target),
+            "must have a depth format (GL_DEPTH_COMPONENT32F, 24 or 16)");
+  }
+  {
+    const gl::RasterStateGuard guard;
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fb);
+    glDisable(GL_SCISSOR_TEST);
+    glDepthMask(GL_TRUE);
+    const float one = 1.0f;
+    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &one); // once, the whole map
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_DEPTH_CLAMP);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_SCISSOR_TEST);
+    for (int k = 0; k < r->splitCount(); ++k) {
+      const SplitViewport v = r->splitViewport(k, W, H);
+      glViewport(v.x, v.y, v.width, v.height);
+      glScissor(v.x, v.y, v.width, v.height); // a clear in the callback stays inside split k
+      frame.drawCasters(k, r->splits[static_cast<std::size_t>(k)].rectClipFromWorld);
+    }
+  }
+  glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0);
+  gl::checkError("RectifiedShadowPass::run");
+}
+
+} // namespace crep
