@@ -22,7 +22,7 @@
 // with the grey weights (error grows with |s_c - s| t). Storing three weight sets would triple the
 // filtered basis, as the paper notes for coloured light textures (Sec. 3.2).
 //
-// sigma -> 0: mixFactor and weightTotal are written with phi(x) = -expm1(-x) / x (phi(0) = 1), so they
+// sigma -> 0: regionMixFactors and regionWeightTotal are written with phi(x) = -expm1(-x) / x (phi(0) = 1), so they
 // reach the length-weighted limit without any division by zero, and s = 0 is allowed.
 #pragma once
 

@@ -115,7 +115,7 @@ private:
 struct RectifiedMap {
   std::shared_ptr<const RectifiedLayout> layout;
   /// 1 channel, W x H, W a multiple of layout->regionCount(), depth-buffer values in [0, 1], row 0 at
-  /// the bottom (Image convention, as glReadPixels / readDepthTexture return it).
+  /// the bottom (Image convention, as glReadPixels and gl::readTexture(..., gl::TexelData::Depth) return it).
   Image depth;
 
   int width() const noexcept { return depth.width(); }
@@ -127,7 +127,7 @@ struct RectifiedMap {
 /// with its texel coordinates).
 void validate(const RectifiedMap& map);
 
-/// Builds a map from a CPU depth image (e.g. readDepthTexture of a map rendered with the split
+/// Builds a map from a CPU depth image (e.g. gl::readTexture(texture, W, H, gl::TexelData::Depth) of a map rendered with the split
 /// matrices) and validates it.
 RectifiedMap makeRectifiedMap(std::shared_ptr<const RectifiedLayout> layout, Image depth);
 

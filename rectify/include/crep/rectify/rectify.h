@@ -55,7 +55,9 @@
 //   - glEnable(GL_DEPTH_CLAMP): casters between the light and the frustum lie in front of depth 0 and
 //     must be kept (clamped to 0), not clipped (Sec. 4.2). Casters behind the frustum clamp to 1.
 //   - Default depth conventions: glDepthRange(0, 1), glClipControl(GL_LOWER_LEFT,
-//     GL_NEGATIVE_ONE_TO_ONE); depth test GL_LESS, cleared to 1. The stored value is `depth` above.
+//     GL_NEGATIVE_ONE_TO_ONE); depth test GL_LESS; the whole map cleared to 1 once before the first split
+//     (glClear ignores the viewport: a clear per split wipes the splits before it). The stored value is
+//     `depth` above. crep::RectifiedShadowPass (crep/pipeline/rectified_shadow_pass.h) sets all of this.
 //   - Face culling off (the rectification may mirror the winding).
 //   - Viewport per split (splitViewport()): SplitLayout::Regions renders split k into columns
 //     [k W/K, (k+1) W/K) of one W x H map (W a multiple of K); SplitLayout::Layers renders split k into
