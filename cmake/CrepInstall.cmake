@@ -11,6 +11,8 @@ foreach(module IN LISTS CREP_MODULES)
   endif()
 endforeach()
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/support/include/crep DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/generated/include/crep/core/version.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/crep/core)
 # Public GLSL includes an engine can #include in its own shaders.
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/glsl/crep DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/glsl)
 

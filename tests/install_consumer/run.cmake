@@ -39,6 +39,31 @@ if(NOT link_support MATCHES "libcrepuscular_support\\.(a|so)")
   message(FATAL_ERROR "the support consumer does not link libcrepuscular_support:\n${link_support}")
 endif()
 
+# BUILD_SHARED_LIBS: the runtime library built from source as a shared library (without tools, tests and
+# benchmarks), installed, and linked by the same engine consumer. Its compile line must carry no include
+# directory of the library's private dependencies (Eigen, OpenEXR, Imath): a shared runtime library
+# requires none of them of an engine.
+set(shared ${WORK_DIR}/shared-build)
+run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${shared} -DCMAKE_BUILD_TYPE=Release -DBUILD_SHARED_LIBS=ON
+    -DCREP_BUILD_TESTS=OFF -DCREP_BUILD_TOOLS=OFF -DCREP_BUILD_BENCH=OFF)
+run(${CMAKE_COMMAND} --build ${shared} --parallel 2)
+run(${CMAKE_COMMAND} --install ${shared} --prefix ${WORK_DIR}/shared-prefix)
+set(build ${WORK_DIR}/runtime-shared)
+run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE}/runtime -B ${build} -DCMAKE_PREFIX_PATH=${WORK_DIR}/shared-prefix
+    -DCMAKE_BUILD_TYPE=Release)
+run(${CMAKE_COMMAND} --build ${build})
+file(READ ${build}/CMakeFiles/consumer.dir/link.txt link_shared)
+file(READ ${build}/CMakeFiles/consumer.dir/flags.make flags_shared)
+message(STATUS "shared runtime consumer link line: ${link_shared}")
+if(NOT link_shared MATCHES "libcrepuscular\\.so")
+  message(FATAL_ERROR "the shared-library consumer does not link libcrepuscular.so:\n${link_shared}")
+endif()
+if(flags_shared MATCHES "[Ee]igen|OpenEXR|Imath")
+  message(FATAL_ERROR "the shared runtime consumer's compile flags name a private dependency (${CMAKE_MATCH_0}):\n"
+                      "${flags_shared}")
+endif()
+run(${build}/consumer ${build})
+
 # pkg-config: both files resolve; the runtime one names no OpenEXR, even with --static.
 find_program(PKG_CONFIG pkg-config REQUIRED)
 file(GLOB_RECURSE pc ${WORK_DIR}/prefix/*/crepuscular.pc)

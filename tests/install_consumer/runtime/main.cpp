@@ -11,6 +11,7 @@
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/core/shader_library.h>
+#include <crep/core/version.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
@@ -40,6 +41,13 @@ GLuint depthTexture(int width, int height, const std::vector<float>& values) {
 }
 
 int checks() {
+  // The installed version header agrees with the package version find_package reported.
+  if (std::string_view(CREP_VERSION_STRING) != CREP_PACKAGE_VERSION ||
+      crep::kVersion != CREP_VERSION_MAJOR * 10000 + CREP_VERSION_MINOR * 100 + CREP_VERSION_PATCH) {
+    std::fprintf(stderr, "consumer: crep/core/version.h says %s, the package %s\n", CREP_VERSION_STRING,
+                 CREP_PACKAGE_VERSION);
+    return 1;
+  }
   // Only the library's shaders are shipped: no tool, scene or test shader.
   for (const crep::ShaderLibrary::File& f : crep::ShaderLibrary::files()) {
     const std::string_view p = f.path;
