@@ -133,7 +133,14 @@ bool EpipolarLayout::epipoleOnScreen() const noexcept {
 
 std::optional<glm::dvec2> EpipolarLayout::epipolePixel() const {
   if (kind_ == EpipoleKind::AtInfinity || !(vanishing_.z > 0.0)) return std::nullopt;
-  return glm::dvec2((epipoleNdc_.x + 1.0) * 0.5 * width_, (epipoleNdc_.y + 1.0) * 0.5 * height_);
+  glm::dvec2 ndc = epipoleNdc_; // of the symmetric frustum covering the camera's (its slices' screen)
+  if (!camera_.symmetric()) {
+    // The camera's own (off-centre) image: tangent X = ndc.x tanX, ndc' = (X - centre) / half-width.
+    const glm::dvec4& t = camera_.tangents();
+    ndc = glm::dvec2((ndc.x * tanX_ - 0.5 * (t.x + t.y)) / (0.5 * (t.y - t.x)),
+                     (ndc.y * tanY_ - 0.5 * (t.z + t.w)) / (0.5 * (t.w - t.z)));
+  }
+  return glm::dvec2((ndc.x + 1.0) * 0.5 * width_, (ndc.y + 1.0) * 0.5 * height_);
 }
 
 double EpipolarLayout::epipoleBlockRadiusPixels() const {

@@ -33,6 +33,18 @@ float crep_surfaceViewDepth(float depth, float zNear, float zFar) {
   return depth < 1.0 ? crep_viewDepth(max(depth, 0.0), zNear, zFar) : zFar;
 }
 
+// The same for a camera of any depth convention (crep::Camera::surfaceViewDepth): map = (near, projection
+// far or 0 for an infinite far plane, integration far, 1 for reversed-Z else 0). t = 1 - depth (standard) or
+// depth (reversed) is (1/Z - 1/f) / (1/n - 1/f); the cleared value (t <= 0, also NaN) is the integration
+// far, t >= 1 the near plane. For GL's default convention this is crep_surfaceViewDepth exactly.
+float crep_cameraViewDepth(float depth, vec4 map) {
+  float t = map.w > 0.5 ? depth : 1.0 - depth;
+  if (!(t > 0.0)) return map.z;
+  if (t >= 1.0) return map.x;
+  float Z = map.y > 0.0 ? map.x * map.y / (map.x + t * (map.y - map.x)) : map.x / t;
+  return min(Z, map.z);
+}
+
 // sRGB transfer function (IEC 61966-2-1): linear [0, 1] to encoded [0, 1], per channel.
 vec3 crep_srgbEncode(vec3 linearColor) {
   vec3 c = clamp(linearColor, 0.0, 1.0);

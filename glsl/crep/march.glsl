@@ -25,15 +25,16 @@ struct CrepMarchParams {
   vec4 block;              // world march: xy centre (pixels), z radius (pixels, < 0: every pixel), w 0
   ivec4 region;            // world march: xy first pixel of the dispatch, zw its size
   mat4 lightClipFromWorld; // world march / resampling: the standard shadow map's matrix
+  vec4 cameraCenter;       // xyz the image centre's offset from forward (off-centre projections); w 0
+  vec4 cameraDepth;        // x near, y projection far (0 = infinite), z integration far, w 1 = reversed-Z
 };
 
 // The view ray of pixel p of a w x h camera image and its surface distance (crep/scatter/ray.h: sky
 // pixels end at the far plane). xyz = unit direction, w = distance.
 vec4 crep_pixelRay(CrepMarchParams m, ivec2 p, float depth) {
   vec2 ndc = 2.0 * (vec2(p) + 0.5) / vec2(m.sizes.xy) - 1.0;
-  vec3 dir = normalize(m.cameraForward.xyz + ndc.x * m.cameraRight.xyz + ndc.y * m.cameraUp.xyz);
-  float viewDepth = depth >= 1.0 || !(depth >= 0.0) ? m.cameraForward.w
-                                                    : crep_linearDepth(depth, m.cameraPosition.w, m.cameraForward.w);
+  vec3 dir = normalize(m.cameraForward.xyz + m.cameraCenter.xyz + ndc.x * m.cameraRight.xyz + ndc.y * m.cameraUp.xyz);
+  float viewDepth = crep_cameraViewDepth(depth, m.cameraDepth);
   return vec4(dir, viewDepth / dot(dir, m.cameraForward.xyz));
 }
 

@@ -55,6 +55,8 @@ struct CrepEvaluateParams {
   vec4 cameraRight;    // xyz right * tan(fovY / 2) * aspect
   vec4 cameraUp;       // xyz up * tan(fovY / 2)
   ivec4 imageSize;     // xy
+  vec4 cameraCenter;   // xyz the image centre's offset from forward (off-centre projections); w 0
+  vec4 cameraDepth;    // depth convention: x near, y projection far (0 = infinite), z integration far, w reversed
 };
 
 #endif // CREP_SCATTERING_STRUCTS_GLSL

@@ -15,14 +15,14 @@ layout(binding = 1) uniform sampler2D crep_lowDepth;  // R32F, low size
 layout(binding = 2) uniform sampler2D crep_fullDepth; // full size
 layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_output;
 layout(location = 0) uniform ivec4 crep_sizes;        // full width, height, low width, height
-layout(location = 1) uniform vec2 crep_nearFar;
+layout(location = 1) uniform vec4 crep_cameraDepthMap; // crep_cameraViewDepth's map of the camera
 
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(p, crep_sizes.xy))) return;
   ivec2 lowSize = crep_sizes.zw;
-  float Z = crep_surfaceViewDepth(texelFetch(crep_fullDepth, p, 0).r, crep_nearFar.x, crep_nearFar.y);
+  float Z = crep_cameraViewDepth(texelFetch(crep_fullDepth, p, 0).r, crep_cameraDepthMap);
   vec2 u = (vec2(p) + 0.5) / float(CREP_FACTOR) - 0.5;
   ivec2 i0 = ivec2(floor(u));
   vec2 f = u - vec2(i0);
@@ -32,7 +32,7 @@ void main() {
     ivec2 o = ivec2(k & 1, k >> 1);
     ivec2 q = clamp(i0 + o, ivec2(0), lowSize - 1);
     float b = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
-    float Zk = crep_surfaceViewDepth(texelFetch(crep_lowDepth, q, 0).r, crep_nearFar.x, crep_nearFar.y);
+    float Zk = crep_cameraViewDepth(texelFetch(crep_lowDepth, q, 0).r, crep_cameraDepthMap);
     float w = b / (CREP_DEPTH_EPSILON + abs(Z - Zk) / Z);
     sum += w * texelFetch(crep_low, q, 0);
     total += w;

@@ -72,14 +72,15 @@ void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = crep_evaluate.imageSize.xy;
   if (any(greaterThanEqual(pixel, size))) return;
-  float zNear = crep_evaluate.cameraPosition.w, zFar = crep_evaluate.cameraForward.w;
+  float zNear = crep_evaluate.cameraPosition.w;
   vec3 forward = crep_evaluate.cameraForward.xyz;
   vec2 ndc = 2.0 * (vec2(pixel) + 0.5) / vec2(size) - 1.0;
-  vec3 dir = normalize(forward + ndc.x * crep_evaluate.cameraRight.xyz + ndc.y * crep_evaluate.cameraUp.xyz);
+  vec3 dir = normalize(forward + crep_evaluate.cameraCenter.xyz + ndc.x * crep_evaluate.cameraRight.xyz +
+                       ndc.y * crep_evaluate.cameraUp.xyz);
   float cosForward = dot(dir, forward);
   float d = texelFetch(crep_cameraDepth, pixel, 0).r;
-  // Sky (d >= 1, also NaN): integrate to the far plane; d < 0 is treated as 0 (the near plane).
-  float viewDepth = crep_surfaceViewDepth(d, zNear, zFar);
+  // Sky (the cleared value, also NaN): integrate to the far distance; beyond the near plane's value: near.
+  float viewDepth = crep_cameraViewDepth(d, crep_evaluate.cameraDepth);
   float surface = viewDepth / cosForward;
   float start = 0.0;
 #if CREP_NEAR_PLANE_CORRECTION

@@ -28,7 +28,7 @@ void checkMultiple(const std::string& parameter, int width, int height, int fact
 /// View-space distance of a depth-buffer value; the sky (d >= 1) is the far plane. (The GLSL twin uses
 /// near far / (near + (1 - d)(far - near)); Camera::linearDepth is the same value.)
 double viewDepth(const Camera& camera, double d) {
-  return d < 1.0 ? camera.linearDepth(std::max(d, 0.0)) : camera.far();
+  return camera.surfaceViewDepth(d);
 }
 
 } // namespace
@@ -126,19 +126,33 @@ void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t l
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, double zNear, double zFar) {
+  if (!(zNear > 0.0 && zFar > zNear && std::isfinite(zFar)))
+    throw InvalidArgument("DepthAwareResamplePass.upsample.zNear/zFar",
+                          std::to_string(zNear) + ", " + std::to_string(zFar), "must satisfy 0 < near < far");
+  upsample(low, lowDepth, fullDepth, output,
+           glm::vec4(static_cast<float>(zNear), static_cast<float>(zFar), static_cast<float>(zFar), 0.0f));
+}
+
+void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
+                                      std::uint32_t output, const Camera& camera) {
+  const double projectionFar = std::isinf(camera.projectionFar()) ? 0.0 : camera.projectionFar();
+  upsample(low, lowDepth, fullDepth, output,
+           glm::vec4(static_cast<float>(camera.near()), static_cast<float>(projectionFar),
+                     static_cast<float>(camera.far()), camera.reversedZ() ? 1.0f : 0.0f));
+}
+
+void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
+                                      std::uint32_t output, const glm::vec4& depthMap) {
   gl::requireTexture2D("DepthAwareResamplePass.upsample.low", low, lowWidth(), lowHeight(), GL_RGBA32F);
   gl::requireTexture2D("DepthAwareResamplePass.upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
                        GL_R32F);
   gl::requireTexture2D("DepthAwareResamplePass.upsample.fullDepth", fullDepth, info_.width, info_.height);
   gl::requireTexture2D("DepthAwareResamplePass.upsample.output", output, info_.width, info_.height,
                        GL_RGBA32F);
-  if (!(zNear > 0.0 && zFar > zNear && std::isfinite(zFar)))
-    throw InvalidArgument("DepthAwareResamplePass.upsample.zNear/zFar",
-                          std::to_string(zNear) + ", " + std::to_string(zFar), "must satisfy 0 < near < far");
   const GLuint p = upsampleProgram_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.width, info_.height, lowWidth(), lowHeight());
-  glProgramUniform2f(p, 1, static_cast<float>(zNear), static_cast<float>(zFar));
+  glProgramUniform4f(p, 1, depthMap.x, depthMap.y, depthMap.z, depthMap.w);
   const GLuint textures[3] = {low, lowDepth, fullDepth};
   for (GLuint unit = 0; unit < 3; ++unit) {
     glBindTextureUnit(unit, textures[unit]);

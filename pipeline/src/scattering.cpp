@@ -272,8 +272,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   });
   if (m.reduced)
     stage("upsample", [&] {
-      m.reduced->upsample(m.lowOutput.get(), m.lowDepth.get(), f.cameraDepth, f.output, f.camera->near(),
-                          f.camera->far());
+      m.reduced->upsample(m.lowOutput.get(), m.lowDepth.get(), f.cameraDepth, f.output, *f.camera);
     });
   if (r.layout == Layout::Epipolar) {
     const auto& epipolar = static_cast<const EpipolarLayout&>(*layout);

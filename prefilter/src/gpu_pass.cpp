@@ -7,6 +7,7 @@
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
+#include <crep/scatter/gpu_world_march.h>
 
 #include <epoxy/gl.h>
 
@@ -555,12 +556,14 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     program = variant.get();
   }
   const Camera& cam = *frame.camera;
-  const double ty = std::tan(0.5 * cam.fovY()), tx = ty * cam.aspect();
+  const gpu::GpuCamera c = gpu::gpuCamera(cam);
   gpu::EvaluateParams params;
-  params.cameraPosition = vec4Of(cam.position(), cam.near());
-  params.cameraForward = vec4Of(cam.forward(), cam.far());
-  params.cameraRight = vec4Of(cam.right() * tx);
-  params.cameraUp = vec4Of(cam.up() * ty);
+  params.cameraPosition = c.position;
+  params.cameraForward = c.forward;
+  params.cameraRight = c.right;
+  params.cameraUp = c.up;
+  params.cameraCenter = c.center;
+  params.cameraDepth = c.depth;
   params.imageSize = glm::ivec4(depth.width, depth.height, 0, 0);
   glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);

@@ -125,12 +125,12 @@ Pyramid cameraPyramid(const Camera& camera) {
   Pyramid p;
   p.apex = camera.position();
   p.axis = camera.forward();
-  const double ty = std::tan(0.5 * camera.fovY()), tx = ty * camera.aspect();
+  const glm::dvec4& t = camera.tangents(); // left, right, bottom, top at unit distance (off-centre too)
   const glm::dvec3 r = camera.right(), u = camera.up();
   // Same corner order as Camera::frustumCorners: (-x,-y), (+x,-y), (+x,+y), (-x,+y).
-  const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+  const double sx[4] = {t.x, t.y, t.y, t.x}, sy[4] = {t.z, t.z, t.w, t.w};
   for (unsigned i = 0; i < 4; ++i)
-    p.edges[i] = p.axis + sx[i] * tx * r + sy[i] * ty * u;
+    p.edges[i] = p.axis + sx[i] * r + sy[i] * u;
   p.near = camera.near();
   p.far = camera.far();
   return p;

@@ -14,14 +14,31 @@ namespace crep {
 
 namespace gpu {
 
+GpuCamera gpuCamera(const Camera& camera) {
+  const glm::dvec4& t = camera.tangents();
+  const double hx = 0.5 * (t.y - t.x), hy = 0.5 * (t.w - t.z), cx = 0.5 * (t.x + t.y), cy = 0.5 * (t.z + t.w);
+  GpuCamera c;
+  c.position = glm::vec4(glm::vec3(camera.position()), static_cast<float>(camera.near()));
+  c.forward = glm::vec4(glm::vec3(camera.forward()), static_cast<float>(camera.far()));
+  c.right = glm::vec4(glm::vec3(camera.right() * hx), 0.0f);
+  c.up = glm::vec4(glm::vec3(camera.up() * hy), 0.0f);
+  c.center = glm::vec4(glm::vec3(camera.right() * cx + camera.up() * cy), 0.0f);
+  const double projectionFar = std::isinf(camera.projectionFar()) ? 0.0 : camera.projectionFar();
+  c.depth = glm::vec4(static_cast<float>(camera.near()), static_cast<float>(projectionFar),
+                      static_cast<float>(camera.far()), camera.reversedZ() ? 1.0f : 0.0f);
+  return c;
+}
+
 MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
                             int width, int height, int mapWidth, int mapHeight) {
   MarchParams p;
-  const double ty = std::tan(0.5 * camera.fovY()), tx = ty * camera.aspect();
-  p.cameraPosition = glm::vec4(glm::vec3(camera.position()), static_cast<float>(camera.near()));
-  p.cameraForward = glm::vec4(glm::vec3(camera.forward()), static_cast<float>(camera.far()));
-  p.cameraRight = glm::vec4(glm::vec3(camera.right() * tx), 0.0f);
-  p.cameraUp = glm::vec4(glm::vec3(camera.up() * ty), 0.0f);
+  const GpuCamera c = gpuCamera(camera);
+  p.cameraPosition = c.position;
+  p.cameraForward = c.forward;
+  p.cameraRight = c.right;
+  p.cameraUp = c.up;
+  p.cameraCenter = c.center;
+  p.cameraDepth = c.depth;
   p.lightDirection = glm::vec4(glm::vec3(light.direction()), 0.0f);
   p.lightIrradiance = glm::vec4(glm::vec3(light.irradiance()), 0.0f);
   p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));

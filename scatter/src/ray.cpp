@@ -38,7 +38,7 @@ PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y, bool n
   r.direction = camera.rayDirection(ndcX, ndcY);
   const double cosForward = glm::dot(r.direction, camera.forward());
   const double d = depth.at(x, y, 0);
-  const double viewDepth = d >= 1.0 ? camera.far() : camera.linearDepth(d);
+  const double viewDepth = camera.surfaceViewDepth(d); // the sky (cleared value) integrates to far()
   r.surface = viewDepth / cosForward;
   r.start = nearPlaneCorrection ? std::min(camera.near() / cosForward, r.surface) : 0.0;
   return r;

@@ -478,6 +478,8 @@ TEST_CASE("epipolar GL: uniform and storage blocks match their C++ structs") {
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, block);
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, region);
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightClipFromWorld);
+  CREP_CHECK_MEMBER(p, "crep_march", MarchParams, cameraCenter);
+  CREP_CHECK_MEMBER(p, "crep_march", MarchParams, cameraDepth);
   CHECK(blockSize(p, "CrepProjectiveLayoutBlock") == static_cast<GLint>(sizeof(ProjectiveLayoutParams)));
   CREP_CHECK_MEMBER(p, "crep_projective", ProjectiveLayoutParams, origin);
   CREP_CHECK_MEMBER(p, "crep_projective", ProjectiveLayoutParams, slopes);

@@ -106,8 +106,9 @@ const std::vector<Member> kPrefilterMembers = {CREP_MEMBER(gpu::PrefilterParams,
                                                CREP_MEMBER(gpu::PrefilterParams, weights)};
 const std::vector<Member> kEvaluateMembers = {
     CREP_MEMBER(gpu::EvaluateParams, cameraPosition), CREP_MEMBER(gpu::EvaluateParams, cameraForward),
-    CREP_MEMBER(gpu::EvaluateParams, cameraRight), CREP_MEMBER(gpu::EvaluateParams, cameraUp),
-    CREP_MEMBER(gpu::EvaluateParams, imageSize)};
+    CREP_MEMBER(gpu::EvaluateParams, cameraRight),    CREP_MEMBER(gpu::EvaluateParams, cameraUp),
+    CREP_MEMBER(gpu::EvaluateParams, imageSize),      CREP_MEMBER(gpu::EvaluateParams, cameraCenter),
+    CREP_MEMBER(gpu::EvaluateParams, cameraDepth)};
 const std::vector<Member> kRegionWeightsMembers = {
     CREP_MEMBER(gpu::RegionWeights, scale), CREP_MEMBER(gpu::RegionWeights, c),
     CREP_MEMBER(gpu::RegionWeights, d), CREP_MEMBER(gpu::RegionWeights, valid)};
@@ -178,7 +179,7 @@ void main() {
   for (int k = 0; k < CREP_MAX_SPLITS; ++k) v += s.splitZeta[k];
   v += vec4(crep_prefilter.mapSize + crep_prefilter.basisInfo) + crep_prefilter.weights;
   v += crep_evaluate.cameraPosition + crep_evaluate.cameraForward + crep_evaluate.cameraRight + crep_evaluate.cameraUp +
-       vec4(crep_evaluate.imageSize);
+       vec4(crep_evaluate.imageSize) + crep_evaluate.cameraCenter + crep_evaluate.cameraDepth;
   CrepRegionWeights w = crep_regionWeights[gl_WorkGroupID.x];
   v += vec4(w.scale, w.c, w.d, float(w.valid));
   result = v;
@@ -207,7 +208,7 @@ void main() {
   CHECK(checkUniformBlock(evaluate.get(), "CrepScatteringBlock", "crep_scattering", kScatteringMembers,
                           sizeof(gpu::ScatteringParams), false) >= 12);
   CHECK(checkUniformBlock(evaluate.get(), "CrepEvaluateBlock", "crep_evaluate", kEvaluateMembers,
-                          sizeof(gpu::EvaluateParams), false) == 5);
+                          sizeof(gpu::EvaluateParams), false) == 7);
   checkRegionWeightsBlock(evaluate.get());
 }
 

@@ -1,6 +1,18 @@
-// Perspective camera in double precision, OpenGL conventions: the view looks down -Z of view space,
-// clip space z in [-w, w], depth-buffer values in [0, 1] with the default glDepthRange.
-// Matrices are named target-from-source: clip = clipFromView() * viewFromWorld() * world.
+// Perspective camera in double precision: the view looks down -Z of view space, depth-buffer values in
+// [0, 1] (glDepthRange(0, 1)). Matrices are named target-from-source: clip = clipFromView() *
+// viewFromWorld() * world.
+//
+// Engine conventions (Camera::fromMatrices): the engine's own viewFromWorld and clipFromView, with
+//   - clip depth [-w, w] (GL's default) or [0, w] (glClipControl(..., GL_ZERO_TO_ONE), Vulkan, Metal),
+//   - standard or reversed depth (near -> 1, far -> 0; GL_GREATER, cleared to 0), detected,
+//   - a finite or an infinite far plane (detected; the scattering is then integrated up to maxDistance,
+//     which every pass uses as the far distance and the sky's distance),
+//   - off-centre projections: sub-pixel jitter (TAA) and asymmetric frusta (VR), detected.
+// The depth-buffer value d of a surface at view distance Z depends only on near, far and reversal, not on
+// the clip convention: standard d = (1/n - 1/Z) / (1/n - 1/f), reversed d = (1/Z - 1/f) / (1/n - 1/f)
+// (1/f = 0 for an infinite far plane). Accepted depth textures: any format the GL samples as a float in
+// [0, 1] (GL_DEPTH_COMPONENT32F, GL_DEPTH24_STENCIL8 / GL_DEPTH_COMPONENT24 read as depth, GL_R32F).
+// The constructor and lookAt() make the symmetric GL camera of the tools and tests.
 #pragma once
 
 #include <array>
@@ -14,6 +26,12 @@ namespace crep {
 /// order (-x,-y), (+x,-y), (+x,+y), (-x,+y) of the image plane (bottom-left first, counter-clockwise).
 using FrustumCorners = std::array<glm::dvec3, 8>;
 
+/// Clip-space depth range of the engine's projection matrix (glClipControl's depth mode).
+enum class ClipDepth {
+  NegativeOneToOne, ///< OpenGL's default: clip z in [-w, w]
+  ZeroToOne,        ///< GL_ZERO_TO_ONE, Vulkan, Metal and the other APIs: clip z in [0, w]
+};
+
 class Camera {
 public:
   /// Validating constructor. `orientation` rotates view space into world space (normalized here).
@@ -24,15 +42,36 @@ public:
 
   /// Camera at `position` looking at `target` with `up` as the approximate up vector. Throws
   /// InvalidArgument when target == position or up is zero or parallel to the view direction.
-  static Camera lookAt(const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& up, double fovY,
-                       double aspect, double near, double far);
+  static Camera lookAt(const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& up,
+                       double fovY, double aspect, double near, double far);
+
+  /// The camera of an engine's matrices (see top). `viewFromWorld`: rigid (rotation + translation).
+  /// `clipFromView`: a perspective projection in the `clipDepth` convention, standard or reversed, finite
+  /// or infinite far, possibly off-centre. `maxDistance` > near: how far the scattering is integrated (the
+  /// sky's distance); required with an infinite far plane; with a finite one 0 means the far plane and a
+  /// larger value is clamped to it. Throws InvalidArgument naming "Camera.viewFromWorld",
+  /// "Camera.clipFromView" or "Camera.maxDistance" (non-finite values, not rigid, not a perspective
+  /// projection, near >= far, no maxDistance with an infinite far plane).
+  static Camera fromMatrices(const glm::dmat4& viewFromWorld, const glm::dmat4& clipFromView,
+                             ClipDepth clipDepth = ClipDepth::NegativeOneToOne, double maxDistance = 0.0);
 
   const glm::dvec3& position() const noexcept { return position_; }
   const glm::dquat& orientation() const noexcept { return orientation_; }
-  double fovY() const noexcept { return fovY_; }     ///< vertical field of view, radians
-  double aspect() const noexcept { return aspect_; } ///< width / height
-  double near() const noexcept { return near_; }     ///< distance to the near plane, world units
-  double far() const noexcept { return far_; }       ///< distance to the far plane, world units
+  /// Vertical field of view, radians, and width / height: of the symmetric frustum that covers this one
+  /// (the frustum itself when it is symmetric).
+  double fovY() const noexcept { return fovY_; }
+  double aspect() const noexcept { return aspect_; }
+  double near() const noexcept { return near_; } ///< distance to the near plane, world units
+  /// How far the scattering is integrated, world units: the far plane, or maxDistance (fromMatrices).
+  double far() const noexcept { return far_; }
+  /// The projection's far plane: far(), or +infinity for an infinite far plane.
+  double projectionFar() const noexcept { return projectionFar_; }
+  bool reversedZ() const noexcept { return reversedZ_; } ///< near -> depth 1, far -> depth 0
+  ClipDepth clipDepth() const noexcept { return clipDepth_; }
+  /// The image plane at unit distance: x from tangents.x (left) to .y (right), y from .z (bottom) to .w
+  /// (top), in units of the view distance. Symmetric: (-tan(fovY/2) aspect, +.., -tan(fovY/2), +..).
+  const glm::dvec4& tangents() const noexcept { return tangents_; }
+  bool symmetric() const noexcept { return tangents_.x == -tangents_.y && tangents_.z == -tangents_.w; }
 
   glm::dvec3 forward() const; ///< unit view direction in world space (-Z of view space)
   glm::dvec3 right() const;   ///< unit +X of view space in world space
@@ -40,7 +79,9 @@ public:
 
   glm::dmat4 viewFromWorld() const;
   glm::dmat4 worldFromView() const;
-  glm::dmat4 clipFromView() const; ///< OpenGL perspective, NDC z in [-1, 1]
+  /// The projection in the camera's conventions (clip depth, reversal, far plane, off-centre): a depth
+  /// buffer rendered with it holds the values linearDepth() reads.
+  glm::dmat4 clipFromView() const;
   glm::dmat4 clipFromWorld() const { return clipFromView() * viewFromWorld(); }
 
   FrustumCorners frustumCorners() const; ///< world space, see FrustumCorners for the order
@@ -48,13 +89,23 @@ public:
   /// World-space unit direction of the view ray through normalized device coordinates (x, y) in [-1, 1].
   glm::dvec3 rayDirection(double ndcX, double ndcY) const;
 
-  /// Converts a depth-buffer value d in [0, 1] (glDepthRange(0, 1)) to the view-space distance along -Z.
+  /// Converts a depth-buffer value d in [0, 1] (glDepthRange(0, 1)) to the view-space distance along -Z
+  /// (the camera's conventions; +infinity at the far plane of an infinite projection).
   double linearDepth(double depthBufferValue) const;
+  /// The depth-buffer value of view distance Z > 0 (inverse of linearDepth).
+  double depthBufferValue(double viewDistance) const;
+  /// The distance a pixel's scattering is integrated to (crep::pixelRay's rule): linearDepth(d) within
+  /// [near(), far()]; the sky (the cleared value: d >= 1 standard, d <= 0 reversed, also NaN) is far().
+  double surfaceViewDepth(double depthBufferValue) const;
 
 private:
   glm::dvec3 position_;
   glm::dquat orientation_;
   double fovY_, aspect_, near_, far_;
+  double projectionFar_;
+  glm::dvec4 tangents_;
+  bool reversedZ_ = false;
+  ClipDepth clipDepth_ = ClipDepth::NegativeOneToOne;
 };
 
 } // namespace crep

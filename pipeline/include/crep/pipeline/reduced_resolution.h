@@ -58,11 +58,17 @@ public:
 
   /// fullDepth (width x height depth texture) -> lowDepth (R32F, lowWidth x lowHeight).
   void downsample(std::uint32_t fullDepth, std::uint32_t lowDepth);
-  /// low (RGBA32F, low size), lowDepth, fullDepth -> output (RGBA32F, full size); near/far of the camera.
+  /// low (RGBA32F, low size), lowDepth, fullDepth -> output (RGBA32F, full size); the depths are read in
+  /// `camera`'s depth convention (Camera::surfaceViewDepth).
+  void upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth, std::uint32_t output,
+                const Camera& camera);
+  /// The same for GL's default depth convention with near and far planes zNear and zFar.
   void upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth, std::uint32_t output,
                 double zNear, double zFar);
 
 private:
+  void upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth, std::uint32_t output,
+                const glm::vec4& depthMap);
   CreateInfo info_;
   gl::Handle downsampleProgram_, upsampleProgram_, sampler_;
 };

@@ -77,7 +77,12 @@ struct EvaluateParams {
   glm::vec4 cameraRight{1.0f, 0.0f, 0.0f, 0.0f};    ///< xyz: right * tan(fovY / 2) * aspect; w: 0
   glm::vec4 cameraUp{0.0f, 1.0f, 0.0f, 0.0f};       ///< xyz: up * tan(fovY / 2); w: 0
   glm::ivec4 imageSize{0};                          ///< xy: output size (pixels); zw: 0
+  /// xyz: (cx right + cy up) for an off-centre image (Camera::tangents' centre); w: 0
+  glm::vec4 cameraCenter{0.0f};
+  /// The camera's depth convention (crep_cameraViewDepth): x near, y projection far (0 = infinite), z
+  /// integration far, w 1 = reversed-Z
+  glm::vec4 cameraDepth{0.0f};
 };
-static_assert(sizeof(EvaluateParams) == 80, "std140 layout of CrepEvaluateParams");
+static_assert(sizeof(EvaluateParams) == 112, "std140 layout of CrepEvaluateParams");
 
 } // namespace crep::gpu

@@ -49,8 +49,24 @@ struct MarchParams {
   glm::vec4 block{0.0f, 0.0f, -1.0f, 0.0f}; ///< world march: xy centre, z radius (pixels; < 0: all pixels)
   glm::ivec4 region{0};               ///< world march: xy first pixel of the dispatch, zw its size (pixels)
   glm::mat4 lightClipFromWorld{1.0f}; ///< world march / resampling: the standard shadow map's matrix
+  glm::vec4 cameraCenter{0.0f};       ///< xyz: the image centre's offset from forward (off-centre); w: 0
+  /// The camera's depth convention: x near, y projection far (0 = infinite), z integration far, w 1 =
+  /// reversed
+  glm::vec4 cameraDepth{0.0f};
 };
-static_assert(sizeof(MarchParams) == 16 * 18, "std140 CrepMarchParams");
+static_assert(sizeof(MarchParams) == 16 * 20, "std140 CrepMarchParams");
+
+/// The camera vectors of the GPU blocks (MarchParams, gpu::EvaluateParams): a pixel at NDC (x, y) looks
+/// along forward + center + x right + y up (right and up scaled by the image's half extents at unit
+/// distance), and its depth-buffer value maps to a distance with `depth` (crep_cameraViewDepth).
+struct GpuCamera {
+  glm::vec4 position;  ///< xyz; w near
+  glm::vec4 forward;   ///< xyz unit; w integration far
+  glm::vec4 right, up; ///< xyz; w 0
+  glm::vec4 center;    ///< xyz; w 0
+  glm::vec4 depth;     ///< near, projection far (0 = infinite), integration far, reversed (1 / 0)
+};
+GpuCamera gpuCamera(const Camera& camera);
 
 /// The camera, light and medium part of MarchParams for a w x h camera image and a W x H map.
 MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
