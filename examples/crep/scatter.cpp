@@ -129,8 +129,10 @@ int scatterCommand(const std::vector<std::string>& argv) {
                       " does not match the shadow map '" + shadowPath + "' (" +
                       sizeText(shadow.width(), shadow.height()) + ")");
   const double imageAspect = double(depth.width()) / double(depth.height());
-  if (std::abs(camera.aspect() / imageAspect - 1.0) > 0.01)
-    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " + shortest(camera.aspect()) +
+  const glm::dvec4& tangents = camera.tangents(); // the frustum's own extent (off-centre ones too)
+  const double frustumAspect = (tangents.y - tangents.x) / (tangents.w - tangents.z);
+  if (std::abs(frustumAspect / imageAspect - 1.0) > 0.01)
+    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " + shortest(frustumAspect) +
                       ", which does not match the depth image '" + depthPath + "' (" +
                       sizeText(depth.width(), depth.height()) + ", aspect " + shortest(imageAspect) + ")");
 

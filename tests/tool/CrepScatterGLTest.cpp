@@ -214,3 +214,62 @@ TEST_CASE("crep scatter: a light in view is not projective and falls back, still
   // march over the epipolar resampling of the same map (measured 0.53%).
   CHECK(metrics.relativeRmse < 0.02);
 }
+
+TEST_CASE("crep scatter: the example frame as an engine with reversed-Z, [0, 1] clip depth and an infinite "
+          "far plane gives the same image") {
+  // The optional camera.clipDepth and camera.maxDistance fields: the frame's camera rewritten as a
+  // reversed-Z, infinite-far, [0, 1] projection (depth = near / Z, cleared to 0) integrated to the original
+  // far plane. Same rays, same distances: the outputs must agree to float precision.
+  CREP_REQUIRE_GL();
+  std::ifstream file(std::string(CREP_SOURCE_DIR) + "/examples/data/frame.json");
+  std::stringstream text;
+  text << file.rdbuf();
+  Json j = Json::parse(text.str());
+  const glm::dmat4 view = matrix(j["camera"]["viewFromWorld"]), proj = matrix(j["camera"]["clipFromView"]);
+  const crep::Camera gl = crep::Camera::fromMatrices(view, proj);
+  const int w = j["camera"]["size"][0].get<int>(), h = j["camera"]["size"][1].get<int>();
+  // The ground plane y = 0 in both conventions.
+  crep::Image depth(w, h, 1, 1.0f), reversedDepth(w, h, 1, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::dvec3 dir = gl.rayDirection(2.0 * (x + 0.5) / w - 1.0, 2.0 * (y + 0.5) / h - 1.0);
+      if (dir.y >= 0.0) continue;
+      const double t = -gl.position().y / dir.y, Z = t * glm::dot(dir, gl.forward());
+      if (Z >= gl.far()) continue;
+      depth.at(x, y) = static_cast<float>(gl.depthBufferValue(Z));
+      reversedDepth.at(x, y) = static_cast<float>(gl.near() / Z);
+    }
+  glm::dmat4 reversed(0.0);
+  reversed[0][0] = proj[0][0];
+  reversed[1][1] = proj[1][1];
+  reversed[2][3] = -1.0;
+  reversed[3][2] = gl.near();
+  for (int k = 0; k < 16; ++k)
+    j["camera"]["clipFromView"][static_cast<std::size_t>(k)] = reversed[k / 4][k % 4];
+  j["camera"]["clipDepth"] = "zeroToOne";
+  j["camera"]["maxDistance"] = gl.far();
+  crep::test::TempDir dir("crep-scatter-reversed");
+  std::ofstream(dir / "reversed.json") << j.dump(2);
+  crep::writeExr(dir / "depth.exr", depth, crep::ExrPixelType::Float);
+  crep::writeExr(dir / "reversed.exr", reversedDepth, crep::ExrPixelType::Float);
+  const int sw = j["shadowMap"]["size"][0].get<int>(), sh = j["shadowMap"]["size"][1].get<int>();
+  crep::writeExr(dir / "shadow.exr", crep::Image(sw, sh, 1, 1.0f), crep::ExrPixelType::Float);
+  for (const char* method : {"reference", "prefilter"}) {
+    const auto run = [&](const std::string& depthFile, const std::string& frame, const std::string& out) {
+      const auto r = crep::test::runCrep("scatter --depth '" + (dir / depthFile).string() + "' --shadow '" +
+                                         (dir / "shadow.exr").string() + "' --frame '" + frame +
+                                         "' --map-size 256 --method " + method + " --out '" +
+                                         (dir / out).string() + "'");
+      INFO(method << "\n" << r.output);
+      REQUIRE(r.status == 0);
+      return crep::readExr((dir / out).string());
+    };
+    const crep::Image standard = run("depth.exr", std::string(CREP_SOURCE_DIR) + "/examples/data/frame.json",
+                                     std::string(method) + "_gl.exr");
+    const crep::Image engine =
+        run("reversed.exr", (dir / "reversed.json").string(), std::string(method) + "_rev.exr");
+    const crep::ImageMetrics rgb = compareRgb(engine, standard);
+    MESSAGE(std::string(method) << ": reversed-Z infinite frame vs the GL frame: " << crep::describe(rgb));
+    CHECK(rgb.relativeRmse < 1e-4);
+  }
+}

@@ -227,7 +227,20 @@ TEST_CASE("crep scatter: malformed frame descriptions exit 1 naming the field") 
        },
        "light.direction[0]"},
       {"scaled view", [](Json& j) { j["camera"]["viewFromWorld"][0] = 2.0; }, "camera.viewFromWorld"},
-      {"off-centre projection", [](Json& j) { j["camera"]["clipFromView"][8] = 0.2; }, "camera.clipFromView"},
+      {"infinite far plane without maxDistance",
+       [](Json& j) {
+         Json& p = j["camera"]["clipFromView"];
+         p[14] = p[14].get<double>() / (1.0 - p[10].get<double>()) * 2.0; // -2 near
+         p[10] = -1.0;
+       },
+       "camera.maxDistance"},
+      {"unknown clip depth", [](Json& j) { j["camera"]["clipDepth"] = "minusOneToOne"; }, "camera.clipDepth"},
+      {"orthographic projection",
+       [](Json& j) {
+         j["camera"]["clipFromView"][11] = 0.0;
+         j["camera"]["clipFromView"][15] = 1.0;
+       },
+       "camera.clipFromView"},
       {"reversed depth",
        [](Json& j) {
          j["camera"]["clipFromView"][10] = 0.001;

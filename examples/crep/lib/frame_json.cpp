@@ -244,10 +244,17 @@ FrameDescription parseFrameDescription(const std::string& text, const std::strin
 
   FrameDescription f;
   const Json& camera = r.get(root, "", "camera");
-  r.requireObject(camera, "camera", {"viewFromWorld", "clipFromView", "size"});
+  r.requireObject(camera, "camera", {"viewFromWorld", "clipFromView", "size", "clipDepth", "maxDistance"});
   f.viewFromWorld = r.mat4(r.get(camera, "camera", "viewFromWorld"), "camera.viewFromWorld");
   f.clipFromView = r.mat4(r.get(camera, "camera", "clipFromView"), "camera.clipFromView");
   if (const Json* s = r.find(camera, "size")) f.cameraSize = r.size(*s, "camera.size");
+  if (const Json* c = r.find(camera, "clipDepth")) {
+    if (!c->is_string() || (*c != "negativeOneToOne" && *c != "zeroToOne"))
+      r.fail("camera.clipDepth", "must be \"negativeOneToOne\" (OpenGL's default) or \"zeroToOne\" "
+                                 "(glClipControl GL_ZERO_TO_ONE, Vulkan, Metal)");
+    f.clipDepth = *c == "zeroToOne" ? ClipDepth::ZeroToOne : ClipDepth::NegativeOneToOne;
+  }
+  if (const Json* m = r.find(camera, "maxDistance")) f.maxDistance = r.number(*m, "camera.maxDistance");
 
   const Json& light = r.get(root, "", "light");
   r.requireObject(light, "light", {"direction", "color", "intensity"});
@@ -312,6 +319,8 @@ std::string toJson(const FrameDescription& f) {
   if (f.cameraSize)
     s +=
         ",\n    \"size\": [" + std::to_string(f.cameraSize->x) + ", " + std::to_string(f.cameraSize->y) + "]";
+  if (f.clipDepth == ClipDepth::ZeroToOne) s += ",\n    \"clipDepth\": \"zeroToOne\"";
+  if (f.maxDistance != 0.0) s += ",\n    \"maxDistance\": " + Reader::format(f.maxDistance);
   s += "\n  },\n  \"light\": {\n";
   s += "    \"direction\": " + formatVec(f.lightDirection) + ",\n";
   s += "    \"color\": " + formatVec(f.lightColor) + ",\n";
@@ -330,72 +339,43 @@ std::string toJson(const FrameDescription& f) {
 
 Camera cameraOf(const FrameDescription& f, const std::string& source) {
   const Reader r(source);
-  // viewFromWorld: rotation + translation only.
-  const glm::dmat4& v = f.viewFromWorld;
-  if (v[0][3] != 0.0 || v[1][3] != 0.0 || v[2][3] != 0.0 || v[3][3] != 1.0)
-    r.fail("camera.viewFromWorld", "last row must be 0 0 0 1 (a rigid transform)");
-  const glm::dmat3 rot(v);
-  const glm::dmat3 rtr = glm::transpose(rot) * rot;
-  double err = 0.0;
-  for (int c = 0; c < 3; ++c)
-    for (int k = 0; k < 3; ++k)
-      err = std::max(err, std::abs(rtr[c][k] - (c == k ? 1.0 : 0.0)));
-  if (err > 1e-4 || glm::determinant(rot) <= 0.0)
-    r.fail("camera.viewFromWorld",
-           "not a rigid transform (its 3x3 part must be a rotation: orthonormal, determinant "
-           "1; no scale or mirror)");
-  const glm::dmat4 worldFromView = glm::inverse(v);
-  const glm::dvec3 position(worldFromView[3]);
-
-  // clipFromView: symmetric OpenGL perspective.
-  const glm::dmat4& p = f.clipFromView;
-  const double a = p[2][2], b = p[3][2];
-  const double scale = std::max(std::abs(p[0][0]), std::abs(p[1][1]));
-  struct Zero {
-    int c, k;
-  };
-  for (const Zero z : {Zero{1, 0}, Zero{2, 0}, Zero{3, 0}, Zero{0, 1}, Zero{2, 1}, Zero{3, 1}, Zero{0, 2},
-                       Zero{1, 2}, Zero{0, 3}, Zero{1, 3}, Zero{3, 3}})
-    if (std::abs(p[z.c][z.k]) > 1e-9 * std::max(1.0, scale))
-      r.fail("camera.clipFromView", "not a symmetric OpenGL perspective projection: element " +
-                                        std::to_string(4 * z.c + z.k) + " (column " + std::to_string(z.c) +
-                                        ", row " + std::to_string(z.k) + ") is " +
-                                        Reader::format(p[z.c][z.k]) +
-                                        ", expected 0 (off-centre and orthographic "
-                                        "projections are not supported)");
-  if (std::abs(p[2][3] + 1.0) > 1e-9)
-    r.fail("camera.clipFromView",
-           "element 11 (column 2, row 3) must be -1 (OpenGL perspective), got " + Reader::format(p[2][3]));
-  if (!(p[0][0] > 0.0) || !(p[1][1] > 0.0))
-    r.fail("camera.clipFromView", "elements 0 and 5 (focal lengths) must be > 0");
-  const double near = b / (a - 1.0), far = b / (a + 1.0);
-  // near / far = (a + 1) / (a - 1): element 10 rounds to -1 for an infinite far plane and for a near plane
-  // too small against the far one; the matrix cannot tell them apart, the message names both.
-  if (std::abs(a + 1.0) < 1e-12)
-    r.fail(
-        "camera.clipFromView",
-        "near / far below 1e-12 (element 10 = " + Reader::format(a) + ", near = " + Reader::format(near) +
-            "): an infinite far plane or a near plane too small for the depth buffer; neither is supported "
-            "(the map covers the frustum up to a finite far plane)");
-  if (!(near > 0.0) || !(far > near) || !std::isfinite(far))
-    r.fail("camera.clipFromView",
-           "near " + Reader::format(near) + " and far " + Reader::format(far) +
-               " (from elements 10 and 14) must satisfy 0 < near < far: OpenGL depth conventions "
-               "(NDC z in [-1, 1]; reversed Z is not supported)");
+  // crep::Camera::fromMatrices reads the engine's conventions: clip depth (camera.clipDepth), reversed-Z and
+  // an infinite far plane (detected; then camera.maxDistance is required), off-centre projections.
+  {
+    // A near plane the depth buffer cannot resolve: its projection rounds to an infinite far plane (element
+    // 10 = -1 in GL's convention), so name it before fromMatrices asks for a maxDistance.
+    const glm::dmat4& p = f.clipFromView;
+    const bool no = f.clipDepth == ClipDepth::NegativeOneToOne;
+    const double a = no ? 0.5 * (1.0 - p[2][2]) : -p[2][2], b = no ? 0.5 * p[3][2] : p[3][2];
+    const double near = b < 0.0 ? (a != 0.0 ? -b / a : 0.0) : (a != 1.0 ? b / (1.0 - a) : 0.0);
+    if (near > 0.0 && near < 1e-12 * std::max(1.0, f.maxDistance))
+      r.fail("camera.clipFromView", "near / far below 1e-12 (near = " + Reader::format(near) +
+                                        "): a near plane too small for the depth buffer");
+  }
+  Camera camera = [&] {
+    try {
+      return Camera::fromMatrices(f.viewFromWorld, f.clipFromView, f.clipDepth, f.maxDistance);
+    } catch (const InvalidArgument& e) {
+      const std::string field = e.parameter() == "Camera.viewFromWorld" ? "camera.viewFromWorld"
+                                : e.parameter() == "Camera.maxDistance" ? "camera.maxDistance"
+                                                                        : "camera.clipFromView";
+      std::string what = e.what();
+      if (const std::size_t at = what.find(" = "); at != std::string::npos) what = what.substr(at + 3);
+      r.fail(field, what);
+    }
+  }();
   // World coordinates must resolve the near plane: beyond |position| = 1e12 near, double precision no
   // longer separates the frustum corners from the camera (and float GPU math failed long before).
-  if (!(glm::length(position) < 1e12 * near))
+  if (!(glm::length(camera.position()) < 1e12 * camera.near()))
     r.fail("camera.viewFromWorld",
-           "camera position at distance " + Reader::format(glm::length(position)) +
-               " from the origin is not representable against the near plane " + Reader::format(near) +
+           "camera position at distance " + Reader::format(glm::length(camera.position())) +
+               " from the origin is not representable against the near plane " +
+               Reader::format(camera.near()) +
                " (|position| must be < 1e12 near): use camera-relative world coordinates");
-  const double fovY = 2.0 * std::atan(1.0 / p[1][1]);
-  const double aspect = p[1][1] / p[0][0];
-  try {
-    return Camera(position, glm::quat_cast(glm::transpose(rot)), fovY, aspect, near, far);
-  } catch (const InvalidArgument& e) {
-    r.fail("camera", e.what());
-  }
+  if (camera.near() / camera.far() < 1e-12)
+    r.fail("camera.clipFromView", "near / far = " + Reader::format(camera.near() / camera.far()) +
+                                      " below 1e-12: a near plane too small for the depth buffer");
+  return camera;
 }
 
 DirectionalLight lightOf(const FrameDescription& f, const std::string& source) {

@@ -5,8 +5,14 @@
 //     "version": 1,                                  optional; 1 if given
 //     "camera": {
 //       "viewFromWorld": [16 numbers],               rigid transform (rotation + translation)
-//       "clipFromView":  [16 numbers],               symmetric OpenGL perspective (NDC z in [-1, 1]), finite
-//       far "size": [width, height]                      optional: must equal the depth EXR's size
+//       "clipFromView":  [16 numbers],               perspective projection: standard or reversed depth,
+//                                                    finite or infinite far plane, centred or off-centre
+//       "clipDepth": "negativeOneToOne",             optional (default, OpenGL) or "zeroToOne"
+//                                                    (glClipControl GL_ZERO_TO_ONE): the matrix's clip depth
+//       "maxDistance": d,                            optional: how far the scattering is integrated (the
+//                                                    sky's distance); required with an infinite far plane,
+//                                                    else at most the far plane (default: the far plane)
+//       "size": [width, height]                      optional: must equal the depth EXR's size
 //     },
 //     "light": {                                     directional light
 //       "direction": [x, y, z],                      the direction light travels (sun -> scene), non-zero
@@ -58,6 +64,8 @@ struct FrameDescription {
   glm::dmat4 viewFromWorld{1.0};
   glm::dmat4 clipFromView{1.0};
   std::optional<glm::ivec2> cameraSize;
+  ClipDepth clipDepth = ClipDepth::NegativeOneToOne; ///< camera.clipDepth (optional)
+  double maxDistance = 0.0;                          ///< camera.maxDistance (optional; 0 = the far plane)
   glm::dvec3 lightDirection{0.0, -1.0, 0.0};
   glm::dvec3 lightColor{1.0};
   double lightIntensity = 1.0;
@@ -78,8 +86,10 @@ FrameDescription readFrameDescription(const std::filesystem::path& path);
 /// The description as JSON (the schema above; full double precision, so it reads back exactly).
 std::string toJson(const FrameDescription& frame);
 
-/// The camera of camera.viewFromWorld and camera.clipFromView; FormatError naming the field when the
-/// matrix is not a rigid transform / a symmetric finite OpenGL perspective. `source` prefixes messages.
+/// The camera of camera.viewFromWorld, camera.clipFromView, camera.clipDepth and camera.maxDistance
+/// (Camera::fromMatrices); FormatError naming the field when the view is not a rigid transform or the
+/// projection not a perspective one. `source` prefixes messages. The depth EXR holds the depth-buffer
+/// values of that projection (cleared to 1, or to 0 with reversed-Z).
 Camera cameraOf(const FrameDescription& frame, const std::string& source);
 /// light.direction, color * intensity; FormatError naming the field.
 DirectionalLight lightOf(const FrameDescription& frame, const std::string& source);
