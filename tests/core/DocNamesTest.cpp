@@ -76,6 +76,7 @@ const std::set<std::string> kProse = {
     "NaN",
     "R32F",
     "D32F",
+    "D24S8",
     "RGBA8",
     "RGBA32F", // formats and APIs
     "tX",

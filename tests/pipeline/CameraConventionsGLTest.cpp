@@ -127,6 +127,21 @@ TEST_CASE("camera conventions GL: reversed-Z infinite, jittered and asymmetric c
   MESSAGE("asymmetric left half vs the symmetric frustum covering it: max |difference| " << leftError);
   CHECK(leftError < 2e-5);
 
+  // The depth texture formats the README lists: the scene's depth rendered into D24S8 and D24 textures (read
+  // as depth through a sampler2D) gives the D32F result up to the 24-bit depth quantization.
+  for (const GLenum format : {GLenum(GL_DEPTH24_STENCIL8), GLenum(GL_DEPTH_COMPONENT24)}) {
+    const gl::Handle depth24 = gl::createTexture2D(format, kW, kH);
+    scenes::SceneRenderer renderer(s.scene.mesh);
+    renderer.renderDepth(gl.clipFromWorld(), depth24.get(), 0, 0, 0, kW, kH);
+    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kW, kH);
+    evaluate.run({depth24.get(), out.get(), &gl, &s.scene.sun, &s.scene.medium, s.layout.get(),
+                  prefilter.filteredBasis()});
+    const double error = worstRelative(readRgbaTexture(out.get(), kW, kH), reference, 0, kW);
+    MESSAGE((format == GL_DEPTH24_STENCIL8 ? std::string("D24S8") : std::string("D24"))
+            << " camera depth vs D32F: max |difference| " << error << " of the peak");
+    CHECK(error < 2e-3);
+  }
+
   // The world-space march reads the reversed depth buffer the same way (march.glsl).
   WorldMarchPass march({});
   const auto marchWith = [&](const Camera& camera, const Image& depth) {

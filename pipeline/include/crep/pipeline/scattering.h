@@ -117,10 +117,15 @@ public:
   };
 
   struct FrameAttribs {
-    const Camera* camera = nullptr; ///< the camera of cameraDepth
+    /// The camera of cameraDepth, in your conventions: Camera::fromMatrices(viewFromWorld, clipFromView,
+    /// clipDepth, maxDistance) (reversed-Z, [0, 1] clip depth, infinite far plane, jitter, asymmetric
+    /// frusta; crep/core/camera.h). The scattering is integrated up to camera->far().
+    const Camera* camera = nullptr;
     const DirectionalLight* light = nullptr;
     const Medium* medium = nullptr;
-    std::uint32_t cameraDepth = 0; ///< GL_TEXTURE_2D, width x height, depth-buffer values of `camera`
+    /// GL_TEXTURE_2D, width x height, depth-buffer values of `camera` in its convention: D32F, D24S8 / D24
+    /// (read as depth) or R32F.
+    std::uint32_t cameraDepth = 0;
     std::uint32_t output = 0; ///< GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance
     std::function<void(const glm::dmat4& clipFromWorld)> drawCasters; ///< see the top; may be empty
     const ShadowMap* shadowMap = nullptr;                             ///< see the top; may be null
