@@ -113,7 +113,7 @@ int renderCommand(const std::vector<std::string>& argv) {
   const std::string exrPath = out + ".exr", pngPath = out + ".png";
   timings.time("write exr", [&] {
     const ExrLayer layers[] = {{"composite", &compositeImg}, {"scattering", &scatteringImage}};
-    writeExrLayers(exrPath, layers);
+    writeExrLayers(exrPath, layers, ExrPixelType::Half); // the tool's picture file, as it always was
   });
   timings.time("write png", [&] { writePng(pngPath, compositeImg, ToneMap{static_cast<float>(exposure)}); });
   if (args.has("export-frame")) exportFrame(exportDir, s, timings);

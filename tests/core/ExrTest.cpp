@@ -571,7 +571,7 @@ TEST_CASE("EXR: half rounds non-representable values to nearest, overflows to In
   image.at(2, 0) = 70000.0f;  // > 65504: Inf
   image.at(3, 0) = -70000.0f; // -Inf
   image.at(4, 0) = kNan;
-  crep::writeExr(dir / "round.exr", image);
+  crep::writeExr(dir / "round.exr", image, crep::ExrPixelType::Half);
   const Image back = crep::readExr(dir / "round.exr");
   const double halfUlpRelative = std::ldexp(1.0, -11);
   for (int x = 0; x < 2; ++x) {
@@ -1396,4 +1396,17 @@ TEST_CASE(
                    << acceptedCut << " with cut data)");
   CHECK(rejected > 0);
   CHECK(accepted > 0);
+}
+
+TEST_CASE("EXR: writeExr writes float by default (data images keep every bit)") {
+  crep::test::TempDir dir;
+  Image image(3, 1, 1);
+  image.at(0, 0) = 1.0f / 3.0f;
+  image.at(1, 0) = 0.9995f; // a depth half rounds to 1 (the sky)
+  image.at(2, 0) = 70000.0f;
+  crep::writeExr(dir / "default.exr", image);
+  const Image back = crep::readExr(dir / "default.exr");
+  for (int x = 0; x < 3; ++x)
+    CHECK(back.at(x, 0) == image.at(x, 0));
+  CHECK(crep::readExrInfo(dir / "default.exr").channels.at(0).pixelType == crep::ExrPixelType::Float);
 }

@@ -148,3 +148,20 @@ TEST_CASE("orthographicLightClipFromWorld: covers the points, looks along the li
   CHECK(std::abs(d.y) < 1e-12);
   CHECK(d.z > 0.0);
 }
+
+TEST_CASE("Medium: the named form equals the positional one and reads back by name") {
+  const crep::Medium named({.mieScattering = glm::dvec3(0.02, 0.03, 0.04),
+                            .hgG = 0.76,
+                            .rayleighScattering = glm::dvec3(0.001, 0.002, 0.005),
+                            .absorption = glm::dvec3(0.003)});
+  const crep::Medium positional({0.02, 0.03, 0.04}, glm::dvec3(0.003), 0.76, {0.001, 0.002, 0.005});
+  CHECK(named.mieScattering() == positional.mieScattering());
+  CHECK(named.absorption() == positional.absorption());
+  CHECK(named.hgG() == positional.hgG());
+  CHECK(named.rayleighScattering() == positional.rayleighScattering());
+  const crep::MediumCoefficients c = named.coefficients();
+  CHECK(c.hgG == 0.76);
+  CHECK(c.absorption == glm::dvec3(0.003));
+  CHECK_THROWS_AS(crep::Medium({.mieScattering = glm::dvec3(0.1), .hgG = 1.0}), crep::InvalidArgument);
+  CHECK_THROWS_AS(crep::Medium(crep::MediumCoefficients{}), crep::InvalidArgument); // zero extinction
+}

@@ -40,8 +40,9 @@ enum class ExrPixelType { Half, Float };
 enum class ExrCompression { None, Zip, Piz };
 
 struct ExrWriteOptions {
-  // Implicit on purpose: writeExr(path, image, ExrPixelType::Float) reads naturally.
-  ExrWriteOptions(ExrPixelType type = ExrPixelType::Half, ExrCompression comp = ExrCompression::Zip)
+  // Implicit on purpose: writeExr(path, image, ExrPixelType::Half) reads naturally. Default Float: depth
+  // buffers and scattering images are data, and half's 11 bits lose them (a depth of 0.9995 is 1 in half).
+  ExrWriteOptions(ExrPixelType type = ExrPixelType::Float, ExrCompression comp = ExrCompression::Zip)
       : pixelType(type), compression(comp) {}
   ExrPixelType pixelType;
   ExrCompression compression;
