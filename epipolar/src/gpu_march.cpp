@@ -100,10 +100,10 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
   gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
   gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.scatteringOut", f.scatteringOut, f.width, f.height,
-                       GL_RGBA32F);
-  if (f.stepsOut != 0)
-    gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.stepsOut", f.stepsOut, f.width, f.height, GL_R32F);
+  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.output", f.output, f.width, f.height, GL_RGBA32F);
+  if (f.stepsOutput != 0)
+    gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.stepsOutput", f.stepsOutput, f.width, f.height,
+                         GL_R32F);
   const bool tree = info_.mode == Mode::MinMaxTree;
   if (tree && (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer)))
     throw InvalidArgument("RectifiedMarchPass.FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
@@ -130,11 +130,11 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
   layoutBuffers_.upload(layoutData, H);
 
-  const GLuint steps = f.stepsOut != 0 ? f.stepsOut
-                                       : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
-                                                              f.width, f.height);
+  const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
+                                          : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
+                                                                 GL_R32F, f.width, f.height);
   gpu::bindMarchResources(program.get(), params_.get(), f.cameraDepth, f.rectifiedDepth, sampler_.get(),
-                          f.scatteringOut, steps);
+                          f.output, steps);
   layoutBuffers_.bind(1, 1);
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
   gpu::dispatchMarch(f.width, f.height, "RectifiedMarchPass::run");

@@ -116,7 +116,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
   gl::requireTexture2D("ShadowResamplePass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth,
                        f.shadowHeight);
-  gl::requireTexture2D("ShadowResamplePass.FrameAttribs.rectifiedOut", f.rectifiedOut, W, H, GL_R32F);
+  gl::requireTexture2D("ShadowResamplePass.FrameAttribs.output", f.output, W, H, GL_R32F);
   validateLightMatrix(f.lightClipFromWorld, f.layout->lightRay(0.5, 0.5).direction);
 
   const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
@@ -138,7 +138,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   layoutBuffers_.bind(1, 1);
   glBindTextureUnit(0, f.shadowMap);
   glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, f.rectifiedOut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(2);

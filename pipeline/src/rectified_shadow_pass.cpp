@@ -15,7 +15,7 @@ namespace {
 } // namespace
 
 RectifiedShadowPass::RectifiedShadowPass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("RectifiedShadowPass::CreateInfo.width/height", info.width, info.height);
+  gl::checkTextureSize("RectifiedShadowPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   framebuffer_ = gl::createFramebuffer();
   glNamedFramebufferDrawBuffer(framebuffer_.get(), GL_NONE);
   glNamedFramebufferReadBuffer(framebuffer_.get(), GL_NONE);
@@ -27,7 +27,8 @@ RectifiedShadowPass::RectifiedShadowPass(RectifiedShadowPass&&) noexcept = defau
 RectifiedShadowPass& RectifiedShadowPass::operator=(RectifiedShadowPass&&) noexcept = default;
 
 std::size_t RectifiedShadowPass::memoryBytes() const noexcept {
-  return texture_ ? static_cast<std::size_t>(info_.width) * static_cast<std::size_t>(info_.height) * 4 : 0;
+  return texture_ ? static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight) * 4
+                  : 0;
 }
 
 void RectifiedShadowPass::run(const FrameAttribs& frame) {
@@ -40,15 +41,15 @@ void RectifiedShadowPass::run(const FrameAttribs& frame) {
     invalid("RectifiedShadowPass::FrameAttribs.rectification", "SplitLayout::Layers",
             "must use SplitLayout::Regions (the splits side by side in one map)");
   if (!frame.drawCasters) invalid("RectifiedShadowPass::FrameAttribs.drawCasters", "empty", "must be set");
-  const int W = info_.width, H = info_.height;
+  const int W = info_.mapWidth, H = info_.mapHeight;
   if (W % r->splitCount() != 0)
-    invalid("RectifiedShadowPass::CreateInfo.width", std::to_string(W),
+    invalid("RectifiedShadowPass::CreateInfo.mapWidth", std::to_string(W),
             "must be a multiple of the split count " + std::to_string(r->splitCount()));
   if (frame.depthTexture != 0)
     gl::requireTexture2D("RectifiedShadowPass::FrameAttribs.depthTexture", frame.depthTexture, W, H);
   else if (!texture_)
-    texture_ =
-        gl::createTexture2D(GL_DEPTH_COMPONENT32F, W, H, "RectifiedShadowPass::CreateInfo.width/height");
+    texture_ = gl::createTexture2D(GL_DEPTH_COMPONENT32F, W, H,
+                                   "RectifiedShadowPass::CreateInfo.mapWidth/mapHeight");
   const std::uint32_t target = frame.depthTexture != 0 ? frame.depthTexture : texture_.get();
   const GLuint fb = framebuffer_.get();
   glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, target, 0);

@@ -294,7 +294,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
         b.shadowHeight = shadow->height;
         b.lightClipFromWorld = shadow->lightClipFromWorld;
         b.bias = shadow->bias;
-        b.scatteringOut = f.output;
+        b.output = f.output;
         b.blockCenter = *centre;
         b.blockRadius = radius;
         m.block.run(b);

@@ -86,10 +86,10 @@ void WorldMarchPass::run(const FrameAttribs& f) {
     throw InvalidArgument("WorldMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
   gl::requireTexture2D("WorldMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
   gl::requireTexture2D("WorldMarchPass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth, f.shadowHeight);
-  gl::requireTexture2D("WorldMarchPass.FrameAttribs.scatteringOut", f.scatteringOut, f.width, f.height,
-                       GL_RGBA32F);
-  if (f.stepsOut != 0)
-    gl::requireTexture2D("WorldMarchPass.FrameAttribs.stepsOut", f.stepsOut, f.width, f.height, GL_R32F);
+  gl::requireTexture2D("WorldMarchPass.FrameAttribs.output", f.output, f.width, f.height, GL_RGBA32F);
+  if (f.stepsOutput != 0)
+    gl::requireTexture2D("WorldMarchPass.FrameAttribs.stepsOutput", f.stepsOutput, f.width, f.height,
+                         GL_R32F);
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(f.lightClipFromWorld[c][r]))
@@ -121,11 +121,11 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   if (region.z == 0 || region.w == 0) return; // the block misses the image
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
 
-  const GLuint steps = f.stepsOut != 0 ? f.stepsOut
-                                       : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_, GL_R32F,
-                                                              f.width, f.height);
-  gpu::bindMarchResources(program_.get(), params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(),
-                          f.scatteringOut, steps);
+  const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
+                                          : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
+                                                                 GL_R32F, f.width, f.height);
+  gpu::bindMarchResources(program_.get(), params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,
+                          steps);
   gpu::dispatchMarch(region.z, region.w, "WorldMarchPass::run");
 }
 

@@ -94,7 +94,7 @@ Image gpuMarch(const GpuScene& g, const RectifiedLayout& layout, GLuint map, int
   f.height = kHeight;
   f.rectifiedDepth = map;
   f.minMaxBuffer = p.trees.treeBuffer();
-  f.scatteringOut = out.get();
+  f.output = out.get();
   (mode == RectifiedMarchPass::Mode::MinMaxTree ? p.tree : p.brute).run(f);
   return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
 }
@@ -125,7 +125,7 @@ Image fallbackPath(const GpuScene& g, const EpipolarLayout& layout, int W = 512)
   r.shadowWidth = kShadowSize;
   r.shadowHeight = kShadowSize;
   r.lightClipFromWorld = g.lightMatrix;
-  r.rectifiedOut = map.get();
+  r.output = map.get();
   resample.run(r);
   Image image = gpuMarch(g, layout, map.get(), W, H);
   if (const auto e = layout.epipolePixel(); e && layout.epipoleBlockRadiusPixels() > 0.0) {
@@ -144,7 +144,7 @@ Image fallbackPath(const GpuScene& g, const EpipolarLayout& layout, int W = 512)
     f.shadowHeight = kShadowSize;
     f.lightClipFromWorld = g.lightMatrix;
     f.bias = 1e-4;
-    f.scatteringOut = out.get();
+    f.output = out.get();
     f.blockCenter = *e;
     f.blockRadius = layout.epipoleBlockRadiusPixels();
     block.run(f);
@@ -178,7 +178,7 @@ Image gpuReference(const GpuScene& g) {
   f.shadowHeight = kShadowSize;
   f.lightClipFromWorld = g.lightMatrix;
   f.bias = 1e-4;
-  f.scatteringOut = out.get();
+  f.output = out.get();
   pass.run(f);
   return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
 }
@@ -214,7 +214,7 @@ TEST_CASE("epipolar GL: the resampling pass matches the CPU resampling (epipolar
     f.shadowWidth = kShadowSize;
     f.shadowHeight = kShadowSize;
     f.lightClipFromWorld = g.lightMatrix;
-    f.rectifiedOut = map.get();
+    f.output = map.get();
     pass.run(f);
     const Image gpu = gl::readTexture(map.get(), W, H, gl::TexelData::Red);
     // Float light rays pick a neighbouring standard texel now and then (at silhouettes that changes the
@@ -400,10 +400,10 @@ TEST_CASE("epipolar GL: bad input to the passes") {
   f.shadowHeight = kShadowSize;
   f.lightClipFromWorld = g.lightMatrix;
   const gl::Handle wrongFormat = gl::createTexture2D(GL_RGBA32F, 64, H);
-  f.rectifiedOut = wrongFormat.get();
-  CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass.FrameAttribs.rectifiedOut");
+  f.output = wrongFormat.get();
+  CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass.FrameAttribs.output");
   const gl::Handle out = gl::createTexture2D(GL_R32F, 64, H);
-  f.rectifiedOut = out.get();
+  f.output = out.get();
   f.shadowWidth = 10;
   CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass.FrameAttribs.shadowMap");
   f.shadowWidth = kShadowSize;

@@ -79,8 +79,8 @@ GpuMarch gpuMarch(const SceneMaps& s, RectifiedMarchPass::Mode mode) {
   f.height = kHeight;
   f.rectifiedDepth = s.mapTexture.get();
   f.minMaxBuffer = trees.treeBuffer();
-  f.scatteringOut = out.get();
-  f.stepsOut = steps.get();
+  f.output = out.get();
+  f.stepsOutput = steps.get();
   pass.run(f);
   return {gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba),
           gl::readTexture(steps.get(), kWidth, kHeight, gl::TexelData::Red)};
@@ -238,8 +238,8 @@ TEST_CASE("epipolar world march GL: the GPU pass agrees with the CPU world-space
   f.shadowHeight = S;
   f.lightClipFromWorld = lightMatrix;
   f.bias = bias;
-  f.scatteringOut = out.get();
-  f.stepsOut = steps.get();
+  f.output = out.get();
+  f.stepsOutput = steps.get();
   pass.run(f);
   const Image gpu = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
   const ImageMetrics m = rgbMetrics(gpu, cpu.scattering);
@@ -257,8 +257,8 @@ TEST_CASE("epipolar world march GL: the GPU pass agrees with the CPU world-space
   const gl::Handle blockOut = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
   const float minusOne[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
   glClearTexImage(blockOut.get(), 0, GL_RGBA, GL_FLOAT, minusOne);
-  f.scatteringOut = blockOut.get();
-  f.stepsOut = 0;
+  f.output = blockOut.get();
+  f.stepsOutput = 0;
   f.blockCenter = {40.0, 30.0};
   f.blockRadius = 10.0;
   pass.run(f);

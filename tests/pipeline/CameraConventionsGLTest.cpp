@@ -162,7 +162,7 @@ TEST_CASE("camera conventions GL: reversed-Z infinite, jittered and asymmetric c
     b.shadowWidth = 512;
     b.shadowHeight = 512;
     b.lightClipFromWorld = light;
-    b.scatteringOut = out.get();
+    b.output = out.get();
     march.run(b);
     return readRgbaTexture(out.get(), kW, kH);
   };

@@ -173,6 +173,6 @@ TEST_CASE("RectifiedShadowPass: restores the caller's raster state and names bad
           pass.run({&r, draw, colour.get()});
         }) == "RectifiedShadowPass::FrameAttribs.depthTexture");
   RectifiedShadowPass odd({kW + 1, kH});
-  CHECK(parameterOf([&] { odd.run({&r, draw}); }) == "RectifiedShadowPass::CreateInfo.width");
+  CHECK(parameterOf([&] { odd.run({&r, draw}); }) == "RectifiedShadowPass::CreateInfo.mapWidth");
   CHECK(parameterOf([&] { RectifiedShadowPass({0, kH}); }).find("RectifiedShadowPass::CreateInfo") == 0);
 }

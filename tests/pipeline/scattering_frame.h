@@ -81,7 +81,7 @@ struct Frame {
     f.shadowHeight = map.height;
     f.lightClipFromWorld = map.lightClipFromWorld;
     f.bias = map.bias;
-    f.scatteringOut = out.get();
+    f.output = out.get();
     pass.run(f);
     return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
   }
@@ -129,7 +129,7 @@ inline Image marchSameMap(Frame& f, const Scattering::FrameResult& r) {
   a.width = kWidth;
   a.height = kHeight;
   a.rectifiedDepth = m.texture;
-  a.scatteringOut = out.get();
+  a.output = out.get();
   pass.run(a);
   return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
 }

@@ -47,7 +47,7 @@ void runWorldMarch(const Frame& frame, const MethodSettings& settings, std::uint
   a.shadowHeight = frame.shadowHeight;
   a.lightClipFromWorld = frame.lightClipFromWorld;
   a.bias = frame.shadowBias;
-  a.scatteringOut = scattering;
+  a.output = scattering;
   a.blockCenter = blockCenter;
   a.blockRadius = blockRadius;
   pass.run(a);
@@ -92,7 +92,7 @@ EpipolarMap makeEpipolarMap(const Frame& frame, const MethodSettings& settings, 
     a.shadowWidth = frame.shadowWidth;
     a.shadowHeight = frame.shadowHeight;
     a.lightClipFromWorld = frame.lightClipFromWorld;
-    a.rectifiedOut = m.texture.get();
+    a.output = m.texture.get();
     pass.run(a);
     glFinish();
   });
@@ -165,7 +165,7 @@ MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, boo
     a.height = frame.height;
     a.rectifiedDepth = texture;
     a.minMaxBuffer = trees ? trees->treeBuffer() : 0;
-    a.scatteringOut = out.scattering.get();
+    a.output = out.scattering.get();
     pass->run(a);
     glFinish();
   });

@@ -86,10 +86,10 @@ public:
     std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
     int width = 0, height = 0;     ///< camera image size (pixels)
     std::uint32_t rectifiedDepth =
-        0;                           ///< mapWidth x mapHeight depth texture rendered / resampled for `layout`
-    std::uint32_t minMaxBuffer = 0;  ///< MinMaxTreePass::treeBuffer() of that map (MinMaxTree mode)
-    std::uint32_t scatteringOut = 0; ///< GL_RGBA32F width x height texture
-    std::uint32_t stepsOut = 0;      ///< GL_R32F width x height texture, or 0 (steps not written)
+        0;                          ///< mapWidth x mapHeight depth texture rendered / resampled for `layout`
+    std::uint32_t minMaxBuffer = 0; ///< MinMaxTreePass::treeBuffer() of that map (MinMaxTree mode)
+    std::uint32_t output = 0;       ///< GL_RGBA32F width x height texture
+    std::uint32_t stepsOutput = 0;  ///< GL_R32F width x height texture, or 0 (steps not written)
   };
   /// Throws InvalidArgument ("RectifiedMarchPass.mapSize") / GlError like MinMaxTreePass.
   explicit RectifiedMarchPass(const CreateInfo& info);

@@ -57,7 +57,7 @@ public:
     std::uint32_t shadowMap = 0;             ///< standard shadow map: depth texture (or GL_R32F)
     int shadowWidth = 0, shadowHeight = 0;
     glm::dmat4 lightClipFromWorld{1.0}; ///< the matrix it was rendered with (validateLightMatrix)
-    std::uint32_t rectifiedOut = 0;     ///< GL_R32F mapWidth x mapHeight texture (written)
+    std::uint32_t output = 0;           ///< GL_R32F mapWidth x mapHeight texture (written)
   };
   /// Throws InvalidArgument ("ShadowResamplePass.mapSize") for sizes <= 0, GlError beyond
   /// GL_MAX_TEXTURE_SIZE.

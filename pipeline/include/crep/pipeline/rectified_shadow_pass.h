@@ -27,15 +27,15 @@ namespace crep {
 class RectifiedShadowPass {
 public:
   struct CreateInfo {
-    int width = 1024;  ///< map width W (a multiple of the split count)
-    int height = 1024; ///< map height H (rows)
+    int mapWidth = 1024;  ///< map width W (a multiple of the split count)
+    int mapHeight = 1024; ///< map height H (rows)
   };
   /// Draws the casters of split `split` with its rectClipFromWorld matrix.
   using DrawCasters = std::function<void(int split, const glm::dmat4& clipFromWorld)>;
   struct FrameAttribs {
     const Rectification* rectification = nullptr; ///< projective, SplitLayout::Regions
     DrawCasters drawCasters;                      ///< required
-    /// Depth texture to render into (GL_TEXTURE_2D of width x height, a depth format: D32F recommended,
+    /// Depth texture to render into (GL_TEXTURE_2D of mapWidth x mapHeight, a depth format: D32F recommended,
     /// D24 works since the depth is linear in the depth slope); 0 = the pass's own D32F texture.
     std::uint32_t depthTexture = 0;
   };

@@ -104,9 +104,9 @@ public:
     std::uint32_t shadowMap = 0; ///< standard shadow map (depth texture) rendered with lightClipFromWorld
     int shadowWidth = 0, shadowHeight = 0;
     glm::dmat4 lightClipFromWorld{1.0};
-    double bias = 0.0;               ///< added to the stored depth (depth-buffer units)
-    std::uint32_t scatteringOut = 0; ///< GL_RGBA32F width x height
-    std::uint32_t stepsOut = 0;      ///< GL_R32F width x height, or 0
+    double bias = 0.0;             ///< added to the stored depth (depth-buffer units)
+    std::uint32_t output = 0;      ///< GL_RGBA32F width x height
+    std::uint32_t stepsOutput = 0; ///< GL_R32F width x height, or 0
     /// Epipole block: when blockRadius >= 0, only pixels whose centre is within blockRadius pixels of
     /// blockCenter (pixel coordinates, origin at the bottom-left corner of the image) are marched.
     glm::dvec2 blockCenter{0.0};
