@@ -141,8 +141,8 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
                  int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit,
                  int basesPerInvocation = PrefilterOptions{}.basesPerInvocation, bool limits = false) {
   PrefilterPass::CreateInfo info;
-  info.width = s.mapW;
-  info.height = s.mapH;
+  info.mapWidth = s.mapW;
+  info.mapHeight = s.mapH;
   info.options.bases = bases;
   info.options.format = format;
   info.options.regionsPerSplit = regionsPerSplit;
@@ -543,8 +543,8 @@ void constantCost(const BenchOptions& o) {
   for (const std::string& name : names) {
     Scene sc{makeSetup(name, o.screenWidth, o.screenHeight, o.mapWidth, o.mapHeight), {}, {}, {}, {}};
     PrefilterPass::CreateInfo info;
-    info.width = o.mapWidth;
-    info.height = o.mapHeight;
+    info.mapWidth = o.mapWidth;
+    info.mapHeight = o.mapHeight;
     info.options = Scattering::CreateInfo{}.prefilter;
     info.options.bases = o.bases;
     info.options.basesPerInvocation = std::min(info.options.basesPerInvocation, o.bases);

@@ -253,23 +253,23 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 // PrefilterPass
 
 PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
-  requireAtLeast("PrefilterPass::CreateInfo.width", info.width, 1);
-  requireAtLeast("PrefilterPass::CreateInfo.height", info.height, 1);
+  requireAtLeast("PrefilterPass::CreateInfo.mapWidth", info.mapWidth, 1);
+  requireAtLeast("PrefilterPass::CreateInfo.mapHeight", info.mapHeight, 1);
   const PrefilterOptions& o = info.options;
   validate(o, "PrefilterPass::CreateInfo.options");
-  if (o.regionsPerSplit > info.width)
+  if (o.regionsPerSplit > info.mapWidth)
     invalid("PrefilterPass::CreateInfo.options.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
-            "must be in [1, width = " + str(info.width) + "]");
+            "must be in [1, width = " + str(info.mapWidth) + "]");
   requireAtLeast("PrefilterPass::CreateInfo.workgroupRows", info.workgroupRows, 1);
   requireAtLeast("PrefilterPass::CreateInfo.workgroupBaseGroups", info.workgroupBaseGroups, 1);
   requireAtLeast("PrefilterPass::CreateInfo.workgroupRegions", info.workgroupRegions, 1);
 
   const int maxSize = gl::maxTextureSize();
-  if (info.width > maxSize)
-    throw GlError("PrefilterPass::CreateInfo.width = " + str(info.width) +
+  if (info.mapWidth > maxSize)
+    throw GlError("PrefilterPass::CreateInfo.mapWidth = " + str(info.mapWidth) +
                   " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
-  if (info.height > maxSize)
-    throw GlError("PrefilterPass::CreateInfo.height = " + str(info.height) +
+  if (info.mapHeight > maxSize)
+    throw GlError("PrefilterPass::CreateInfo.mapHeight = " + str(info.mapHeight) +
                   " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
   const int maxLayers = gl::maxArrayTextureLayers();
   if (layers() > maxLayers)
@@ -281,9 +281,9 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
                             "PrefilterPass::CreateInfo.workgroupRegions"};
     const int local[3] = {info.workgroupRows, info.workgroupBaseGroups, info.workgroupRegions};
     // The most regions a run can have is one per column.
-    const int groups[3] = {ceilDiv(info.height, info.workgroupRows),
+    const int groups[3] = {ceilDiv(info.mapHeight, info.workgroupRows),
                            ceilDiv(baseGroups(info), info.workgroupBaseGroups),
-                           ceilDiv(info.width, info.workgroupRegions)};
+                           ceilDiv(info.mapWidth, info.workgroupRegions)};
     checkWorkgroup(names, local, groups);
   }
 
@@ -301,7 +301,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   program_ = buildProgram(stages);
 
   texture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(texture_.get(), 1, internalFormat(o.format), info.width, info.height, layers());
+  glTextureStorage3D(texture_.get(), 1, internalFormat(o.format), info.mapWidth, info.mapHeight, layers());
   glTextureParameteri(texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTextureParameteri(texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -325,9 +325,9 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   if (depth.target != GL_TEXTURE_2D)
     invalid("PrefilterPass::FrameAttribs.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
             "must be a GL_TEXTURE_2D");
-  if (depth.width != info_.width || depth.height != info_.height)
+  if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
     invalid("PrefilterPass::FrameAttribs.rectifiedDepth", sizeString(depth.width, depth.height),
-            "must be the created size " + sizeString(info_.width, info_.height));
+            "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
   double s = frame.extinctionOverride;
   if (s < 0.0) {
     if (frame.medium == nullptr)
@@ -338,7 +338,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
     invalid("PrefilterPass::FrameAttribs.extinctionOverride", detail::formatValue(s), "must be finite");
 
   const int K = frame.layout->regionCount(), P = info_.options.regionsPerSplit, R = K * P;
-  const int W = info_.width, H = info_.height;
+  const int W = info_.mapWidth, H = info_.mapHeight;
   if (K < 1 || W % R != 0)
     invalid("PrefilterPass::FrameAttribs.layout", "regionCount() " + str(K),
             "regionCount() x regionsPerSplit (" + str(K) + " x " + str(P) + ") must divide the map width " +
@@ -393,8 +393,8 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
   FilteredBasisView v;
   v.texture = texture_.get();
   v.regionWeights = weightsBuffer_.get();
-  v.width = info_.width;
-  v.height = info_.height;
+  v.width = info_.mapWidth;
+  v.height = info_.mapHeight;
   v.bases = info_.options.bases;
   v.layoutRegions = lastLayoutRegions_;
   v.regionsPerSplit = info_.options.regionsPerSplit;
@@ -501,7 +501,7 @@ EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
 
 std::size_t PrefilterPass::memoryBytes() const noexcept {
-  return filteredBasisBytes(info_.width, info_.height, info_.options.bases, info_.options.format) +
+  return filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
          weightsCapacity_ + sizeof(gpu::PrefilterParams);
 }
 

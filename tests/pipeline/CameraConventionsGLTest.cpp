@@ -71,8 +71,8 @@ TEST_CASE("camera conventions GL: reversed-Z infinite, jittered and asymmetric c
   const GpuScene s = renderGpuScene("colonnade", kMap, kMap, 4, kW, kH);
   const Camera& gl = s.scene.camera;
   PrefilterPass::CreateInfo pi;
-  pi.width = kMap;
-  pi.height = kMap;
+  pi.mapWidth = kMap;
+  pi.mapHeight = kMap;
   PrefilterPass prefilter(pi);
   prefilter.run({s.mapTexture.get(), s.layout.get(), &s.scene.medium});
   EvaluatePass evaluate({});

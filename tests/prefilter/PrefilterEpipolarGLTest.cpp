@@ -58,8 +58,8 @@ void checkEpipolarEvaluation(const EpipolarCase& c, StorageFormat format) {
   glTextureSubImage2D(mapTexture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
 
   PrefilterPass::CreateInfo info;
-  info.width = W;
-  info.height = H;
+  info.mapWidth = W;
+  info.mapHeight = H;
   info.options.format = format;
   PrefilterPass prefilterPass(info);
   PrefilterPass::FrameAttribs pf;

@@ -78,7 +78,7 @@ FilteredBasis cpuPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& i
 BasisDifference checkBasis(const PrefilterPass& pass, const FilteredBasis& cpu, const std::string& what) {
   const PrefilterPass::CreateInfo& info = pass.createInfo();
   const std::vector<float> gpu =
-      readTextureArray(pass.filteredBasisTexture(), info.width, info.height, pass.layers());
+      readTextureArray(pass.filteredBasisTexture(), info.mapWidth, info.mapHeight, pass.layers());
   REQUIRE(gpu.size() == cpu.texels.size());
   const FormatTolerance tolerance{info.options.format};
   const BasisDifference d = compareBasis(gpu, cpu, tolerance);
@@ -148,8 +148,8 @@ Image cpuEvaluate(const GpuScene& s, const FilteredBasis& basis, const EvaluateP
 
 PrefilterPass::CreateInfo baseInfo() {
   PrefilterPass::CreateInfo info;
-  info.width = kMapW;
-  info.height = kMapH;
+  info.mapWidth = kMapW;
+  info.mapHeight = kMapH;
   return info;
 }
 
@@ -345,8 +345,8 @@ TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random conte
   for (const char* name : {"colonnade", "forest", "terrain"}) {
     const GpuScene other = renderGpuScene(name, 136, 45, 4, 97, 61);
     PrefilterPass::CreateInfo o;
-    o.width = 136;
-    o.height = 45;
+    o.mapWidth = 136;
+    o.mapHeight = 45;
     o.options.regionsPerSplit = 2;
     const PrefilterPass pass = runPrefilter(other, o);
     const FilteredBasis cpu = cpuPrefilter(other, o);
@@ -407,9 +407,10 @@ TEST_CASE("prefilter GPU: invalid create infos throw errors naming the parameter
     };
   };
   using Info = PrefilterPass::CreateInfo;
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.width = 0; })) == "PrefilterPass::CreateInfo.width");
-  CHECK(invalidParameter(prefilterWith([](Info& i) { i.height = -3; })) ==
-        "PrefilterPass::CreateInfo.height");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.mapWidth = 0; })) ==
+        "PrefilterPass::CreateInfo.mapWidth");
+  CHECK(invalidParameter(prefilterWith([](Info& i) { i.mapHeight = -3; })) ==
+        "PrefilterPass::CreateInfo.mapHeight");
   CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.bases = 0; })) ==
         "PrefilterPass::CreateInfo.options.bases");
   CHECK(invalidParameter(prefilterWith([](Info& i) { i.options.bases = 31; })) ==
@@ -437,11 +438,11 @@ TEST_CASE("prefilter GPU: invalid create infos throw errors naming the parameter
 
   // Implementation limits: the message names the parameter and the limit.
   const int maxSize = gl::maxTextureSize();
-  std::string message = glErrorMessage(prefilterWith([&](Info& i) { i.width = maxSize + 1; }));
-  CHECK_MESSAGE(message.find("PrefilterPass::CreateInfo.width") != std::string::npos, message);
+  std::string message = glErrorMessage(prefilterWith([&](Info& i) { i.mapWidth = maxSize + 1; }));
+  CHECK_MESSAGE(message.find("PrefilterPass::CreateInfo.mapWidth") != std::string::npos, message);
   CHECK_MESSAGE(message.find("GL_MAX_TEXTURE_SIZE") != std::string::npos, message);
-  message = glErrorMessage(prefilterWith([&](Info& i) { i.height = maxSize + 1; }));
-  CHECK_MESSAGE(message.find("PrefilterPass::CreateInfo.height") != std::string::npos, message);
+  message = glErrorMessage(prefilterWith([&](Info& i) { i.mapHeight = maxSize + 1; }));
+  CHECK_MESSAGE(message.find("PrefilterPass::CreateInfo.mapHeight") != std::string::npos, message);
   message = glErrorMessage(prefilterWith([](Info& i) { i.workgroupRows = 4096; }));
   CHECK_MESSAGE(message.find("PrefilterPass::CreateInfo.workgroupRows") != std::string::npos, message);
   message = glErrorMessage(prefilterWith([](Info& i) {

@@ -254,8 +254,8 @@ void main() {
 
   // The library's pass on the same basis, the reference for the engine shader.
   PrefilterPass::CreateInfo info;
-  info.width = W;
-  info.height = H;
+  info.mapWidth = W;
+  info.mapHeight = H;
   PrefilterPass prefilterPass(info);
   PrefilterPass::FrameAttribs pf;
   pf.rectifiedDepth = s.mapTexture.get();

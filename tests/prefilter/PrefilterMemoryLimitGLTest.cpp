@@ -34,8 +34,8 @@ TEST_CASE("memory-limit variants: the write-only prefilter writes every layer, t
   glTextureSubImage2D(empty.get(), 0, 0, 0, kMapW, kMapH, GL_RED, GL_FLOAT, ones.data());
 
   PrefilterPass::CreateInfo pi;
-  pi.width = kMapW;
-  pi.height = kMapH;
+  pi.mapWidth = kMapW;
+  pi.mapHeight = kMapH;
   pi.options.bases = kBases;
   pi.options.format = StorageFormat::RGBA32F;
   pi.options.regionsPerSplit = kP;

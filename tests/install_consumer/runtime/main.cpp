@@ -120,7 +120,7 @@ int main() {
     glTextureStorage2D(output, 1, GL_RGBA32F, kCameraWidth, kCameraHeight);
 
     // The library's passes on the engine's context.
-    crep::PrefilterPass prefilter({.width = kMapSize, .height = kMapSize});
+    crep::PrefilterPass prefilter({.mapWidth = kMapSize, .mapHeight = kMapSize});
     crep::EvaluatePass evaluate({});
     prefilter.run({.rectifiedDepth = rectifiedDepth, .layout = &layout, .medium = &medium});
     evaluate.run({.cameraDepth = cameraDepth,

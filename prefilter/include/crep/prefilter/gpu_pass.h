@@ -73,8 +73,8 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 class PrefilterPass {
 public:
   struct CreateInfo {
-    int width = 1024;  ///< map width W, texels; a multiple of the regions R = K P at run()
-    int height = 1024; ///< map height H, texels (rows = epipolar slices)
+    int mapWidth = 1024;  ///< map width W, texels; a multiple of the regions R = K P at run()
+    int mapHeight = 1024; ///< map height H, texels (rows = epipolar slices)
     /// The prefilter it runs: M (ceil(M / 4) RGBA layers), storage format (Sec. 3.3), weights
     /// (weights.h), regions per split P (Table 1 "regions", <= width), depth margin, bases per invocation
     /// (Table 1). The same options give the CPU reference crep::prefilter(); `threads` is not used.
