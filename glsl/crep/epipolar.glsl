@@ -17,7 +17,9 @@
 //         the ray's own world distance at texel boundary i (unclamped; 3e38 = never)
 //   bool  crep_layoutToRectified(vec3 world, out vec4 p)   p = (row, column, depth, region)
 //   bool  crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p)
-//         both of the above for a view ray and its end point camera + surface dir
+//         crep_mapRowRay and crep_layoutToRectified of the end point camera + surface dir at once
+//   CrepRowRay crep_rowRayAt(float row, float depth, ivec2 mapSize)
+//         the row ray of a normalized row and depth (its `last` left 0)
 //   CrepLightRay crep_layoutLightRay(float column, float row)
 #ifndef CREP_EPIPOLAR_GLSL
 #define CREP_EPIPOLAR_GLSL
@@ -116,21 +118,25 @@ CrepLightRay crep_layoutLightRay(float column, float row) {
                       crep_projective.axisZ.xyz);
 }
 
-bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
+// The row ray of a normalized row and depth (every point of a ray from the camera shares them): its texel
+// row, depth clamped to [0, 1] and the distance data of crep_rowRayDistance, the slopes at that depth:
+// s(zeta) = sqrt(1 + y^2 + z^2) / (zeta - rho z). `last` is left 0.
+CrepRowRay crep_rowRayAt(float row, float depth, ivec2 mapSize) {
+  CrepRowRay r = CrepRowRay(row, clamp(depth, 0.0, 1.0), clamp(int(floor(row * float(mapSize.y))), 0, mapSize.y - 1),
+                            0, vec4(0.0));
+  vec4 s = crep_projective.slopes;
+  float y = s.x + row * (s.y - s.x), z = s.z + r.depth * (s.w - s.z);
+  r.dist = vec4(sqrt(1.0 + y * y + z * z), crep_projective.origin.w * z, 0.0, 0.0);
+  return r;
+}
+
+bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
   r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
-  vec4 p;
   if (!crep_layoutToRectified(crep_projective.origin.xyz + surface * dir, p)) return false;
   int K = crep_projective.counts.x, n = mapSize.x / K;
   int k = int(p.w);
-  float u = p.y * float(K) - float(k);
-  r.row = p.x;
-  r.depth = clamp(p.z, 0.0, 1.0);
-  r.texelRow = clamp(int(floor(p.x * float(mapSize.y))), 0, mapSize.y - 1);
-  r.last = crep_lastTexel(k, u, K, n);
-  // The ray's slopes at its (clamped) depth: s(zeta) = sqrt(1 + y^2 + z^2) / (zeta - rho z).
-  vec4 s = crep_projective.slopes;
-  float y = s.x + p.x * (s.y - s.x), z = s.z + r.depth * (s.w - s.z);
-  r.dist = vec4(sqrt(1.0 + y * y + z * z), crep_projective.origin.w * z, 0.0, 0.0);
+  r = crep_rowRayAt(p.x, p.z, mapSize);
+  r.last = crep_lastTexel(k, p.y * float(K) - float(k), K, n);
   return true;
 }
 
@@ -144,12 +150,6 @@ float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
   vec2 range = crep_projective.splitZeta[k].xy;
   float den = range.x + (float(q) / float(n)) * (range.y - range.x) - r.dist.y;
   return den > 0.0 ? r.dist.x / den : CREP_NEVER;
-}
-// crep_mapRowRay and crep_layoutToRectified of its end point (origin + surface dir) at once.
-bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
-  p = vec4(0.0);
-  if (!crep_mapRowRay(dir, surface, mapSize, r)) return false;
-  return crep_layoutToRectified(crep_projective.origin.xyz + surface * dir, p);
 }
 #endif // CREP_LAYOUT_PROJECTIVE
 
@@ -325,8 +325,25 @@ CrepLightRay crep_layoutLightRay(float column, float row) {
                       -crep_epipolar.towardLight.xyz);
 }
 
-bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
+// The row ray of a normalized row and depth (every point of a ray from the camera shares them) in texel row
+// `texelRow` with slice bounds `s`: depth clamped to [0, 1] and the distance data of crep_rowRayDistance,
+// T = (b / bMax) bMax / sin(psi) with psi at that depth. `last` is left 0.
+CrepRowRay crep_epipolarRowRay(float row, float depth, int texelRow, vec4 s) {
+  CrepRowRay r = CrepRowRay(row, clamp(depth, 0.0, 1.0), texelRow, 0, vec4(0.0));
+  r.dist = vec4(s.x / max(sin(crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y))), 1e-30), 0.0, 0.0, 0.0);
+  return r;
+}
+
+CrepRowRay crep_rowRayAt(float row, float depth, ivec2 mapSize) {
+  int j = clamp(int(floor(row * float(mapSize.y))), 0, mapSize.y - 1);
+  return crep_epipolarRowRay(row, depth, j, crep_slices[j].bounds);
+}
+
+// The end point (camera + surface dir) has the ray's slice, psi and b = surface sin(psi): the exit border
+// position (four atan) is found once for the ray and its end point.
+bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
   r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
+  p = vec4(0.0);
   vec3 m = crep_epipolar.towardLight.xyz;
   float a = dot(dir, m);
   vec3 perp = dir - a * m;
@@ -335,47 +352,17 @@ bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
   float sigma;
   vec2 range;
   if (!crep_epipolarExitSigma(perp / sinPsi, sigma, range)) return false;
-  r.row = crep_epipolarRowOfSigma(sigma);
-  r.texelRow = clamp(int(floor(r.row * float(mapSize.y))), 0, mapSize.y - 1);
-  vec4 s = crep_slices[r.texelRow].bounds;
-  r.depth = clamp((crep_epipolarWarp(atan(sinPsi, a)) - s.y) / (s.z - s.y), 0.0, 1.0);
-  // Distances along the ray: T = (b / bMax) bMax / sin(psi), psi at z_r, b / bMax piecewise linear in i.
-  float sinRay = max(sin(crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y))), 1e-30);
-  int K = crep_epipolar.counts.y, n = mapSize.x / K;
-  int k;
-  float u;
-  crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
-  r.last = crep_lastTexel(k, u, K, n);
-  r.dist = vec4(s.x / sinRay, 0.0, 0.0, 0.0);
-  return true;
-}
-
-// crep_mapRowRay and crep_layoutToRectified of its end point (camera + surface dir) at once: the end point
-// has the ray's slice, psi and b = surface sin(psi), so the exit border position (four atan) is found once.
-bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
-  r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
-  p = vec4(0.0);
-  vec3 m = crep_epipolar.towardLight.xyz;
-  float a = dot(dir, m);
-  vec3 perp = dir - a * m;
-  float sinPsi = length(perp);
-  if (!(sinPsi > 0.0) || !(surface > 0.0)) return false;
-  float sigma;
-  vec2 range;
-  if (!crep_epipolarExitSigma(perp / sinPsi, sigma, range)) return false;
-  r.row = crep_epipolarRowOfSigma(sigma);
-  r.texelRow = clamp(int(floor(r.row * float(mapSize.y))), 0, mapSize.y - 1);
-  vec4 s = crep_slices[crep_epipolarSliceIndex(r.row)].bounds;
+  float row = crep_epipolarRowOfSigma(sigma);
+  int j = clamp(int(floor(row * float(mapSize.y))), 0, mapSize.y - 1);
+  vec4 s = crep_slices[j].bounds;
   float depth = (crep_epipolarWarp(atan(sinPsi, a)) - s.y) / (s.z - s.y);
-  r.depth = clamp(depth, 0.0, 1.0);
-  float sinRay = max(sin(crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y))), 1e-30);
+  r = crep_epipolarRowRay(row, depth, j, s);
   int K = crep_epipolar.counts.y, n = mapSize.x / K;
   int k;
   float u;
   crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
   r.last = crep_lastTexel(k, u, K, n);
-  r.dist = vec4(s.x / sinRay, 0.0, 0.0, 0.0);
-  p = vec4(r.row, (float(k) + u) / float(K), depth, float(k));
+  p = vec4(row, (float(k) + u) / float(K), depth, float(k));
   return true;
 }
 
@@ -387,5 +374,12 @@ float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
   return (f0 + (f1 - f0) * float(q) / float(n)) * r.dist.x;
 }
 #endif // CREP_LAYOUT_EPIPOLAR
+
+// A view ray (unit dir from the camera, surface distance) -> its row ray; false where the layout cannot
+// map its end point.
+bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
+  vec4 p;
+  return crep_mapRowRayPoint(dir, surface, mapSize, r, p);
+}
 
 #endif // CREP_EPIPOLAR_GLSL

@@ -396,7 +396,7 @@ bool crep_evalMap(vec3 origin, vec3 dir, float t, out CrepEvalRay e) {
 #ifdef CREP_EVAL_LAYOUT
   e = CrepEvalRay(0.0, 0.0, 0, 0.0, vec4(0.0), CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0)));
   vec4 p; // (row, column, depth, layout region) of the end point, from the ray's own mapping
-  if (!crep_mapRowRayPoint(dir, t, crep_scattering.mapSize.xy, e.rr, p)) return false;
+  if (!(t > 0.0) || !crep_mapRowRayPoint(dir, t, crep_scattering.mapSize.xy, e.rr, p)) return false;
   CrepRectPoint hit = CrepRectPoint(0.0, 0.0, p.x, p.z, int(p.w), p.y * float(crep_scattering.mapSize.w) - p.w);
   crep_regionPoint(hit, e.region, e.u);
   e.row = p.x;
@@ -418,24 +418,7 @@ bool crep_evalMap(vec3 origin, vec3 dir, float t, out CrepEvalRay e) {
 // what crep_evalBoundary needs, as crep_evalMap gives it for a ray there. Region and column are not set.
 CrepEvalRay crep_evalRayAt(float row, float depth) {
 #ifdef CREP_EVAL_LAYOUT
-  CrepEvalRay e = CrepEvalRay(row, depth, 0, 0.0, vec4(0.0), CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0)));
-#if CREP_EVAL_LAYOUT == CREP_LAYOUT_EPIPOLAR
-  // crep_mapRowRay's distance data: bMax of the texel row over sin(psi) at the depth.
-  ivec2 mapSize = crep_scattering.mapSize.xy;
-  e.rr.row = row;
-  e.rr.depth = clamp(depth, 0.0, 1.0);
-  e.rr.texelRow = clamp(int(floor(row * float(mapSize.y))), 0, mapSize.y - 1);
-  vec4 s = crep_slices[e.rr.texelRow].bounds;
-  e.rr.dist = vec4(s.x / max(sin(crep_epipolarUnwarp(s.y + e.rr.depth * (s.z - s.y))), 1e-30), 0.0, 0.0, 0.0);
-#else
-  // crep_mapRowRay's distance data of the projective layout block at the (clamped) depth.
-  vec4 s = crep_projective.slopes;
-  e.rr.row = row;
-  e.rr.depth = clamp(depth, 0.0, 1.0);
-  float y = s.x + row * (s.y - s.x), z = s.z + e.rr.depth * (s.w - s.z);
-  e.rr.dist = vec4(sqrt(1.0 + y * y + z * z), crep_projective.origin.w * z, 0.0, 0.0);
-#endif
-  return e;
+  return CrepEvalRay(row, depth, 0, 0.0, vec4(0.0), crep_rowRayAt(row, depth, crep_scattering.mapSize.xy));
 #else
   // The slopes of the scattering block's frame (inverse of crep_toRectified's row and depth).
   float y = crep_scattering.slopes.x + row / crep_scattering.slopes.y;
