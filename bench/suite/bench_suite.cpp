@@ -137,6 +137,19 @@ struct GpuTimes {
   double evaluateVisibilityTableOnly = 0.0; ///< the same for the visibility table alone
 };
 
+/// The evaluation pass's inputs for a set-up's frame and a filtered basis.
+EvaluatePass::FrameAttribs evaluateAttribs(const Setup& s, const FilteredBasisView& basis) {
+  EvaluatePass::FrameAttribs ev;
+  ev.cameraDepth = s.cameraDepth.get();
+  ev.output = s.scattering.get();
+  ev.camera = &s.scene.camera;
+  ev.light = &s.scene.sun;
+  ev.medium = &s.scene.medium;
+  ev.layout = s.layout.get();
+  ev.basis = basis;
+  return ev;
+}
+
 GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
                  int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit,
                  int basesPerInvocation = PrefilterOptions{}.basesPerInvocation, bool limits = false) {
@@ -162,14 +175,7 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
     prefilter.run(frame);
     glFinish();
   });
-  EvaluatePass::FrameAttribs ev;
-  ev.cameraDepth = s.cameraDepth.get();
-  ev.output = s.scattering.get();
-  ev.camera = &s.scene.camera;
-  ev.light = &s.scene.sun;
-  ev.medium = &s.scene.medium;
-  ev.layout = s.layout.get();
-  ev.basis = prefilter.filteredBasis();
+  const EvaluatePass::FrameAttribs ev = evaluateAttribs(s, prefilter.filteredBasis());
   evaluate.run(ev);
   glFinish();
   t.evaluate = medianMs(repeat, [&] {
@@ -561,14 +567,7 @@ void constantCost(const BenchOptions& o) {
       glFinish();
     });
     if (record) sc.prefilterMs.push_back(ms);
-    EvaluatePass::FrameAttribs ev;
-    ev.cameraDepth = st.cameraDepth.get();
-    ev.output = st.scattering.get();
-    ev.camera = &st.scene.camera;
-    ev.light = &st.scene.sun;
-    ev.medium = &st.scene.medium;
-    ev.layout = st.layout.get();
-    ev.basis = sc.prefilter->filteredBasis();
+    const EvaluatePass::FrameAttribs ev = evaluateAttribs(st, sc.prefilter->filteredBasis());
     ms = medianMs(1, [&] {
       sc.evaluate->run(ev);
       glFinish();

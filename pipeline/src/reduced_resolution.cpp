@@ -3,6 +3,7 @@
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/pipeline/reduced_resolution.h>
+#include <crep/scatter/gpu_world_march.h>
 
 #include <epoxy/gl.h>
 
@@ -135,10 +136,7 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, const Camera& camera) {
-  const double projectionFar = std::isinf(camera.projectionFar()) ? 0.0 : camera.projectionFar();
-  upsample(low, lowDepth, fullDepth, output,
-           glm::vec4(static_cast<float>(camera.near()), static_cast<float>(projectionFar),
-                     static_cast<float>(camera.far()), camera.reversedZ() ? 1.0f : 0.0f));
+  upsample(low, lowDepth, fullDepth, output, gpu::gpuCamera(camera).depth); // crep_cameraViewDepth's map
 }
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,

@@ -408,6 +408,15 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
 // EvaluatePass
 
 namespace {
+/// CREP_EVAL_LAYOUT and its bindings for a layout of kind `layoutKind` (nothing for < 0: the projective frame
+/// of the scattering block), shared by the evaluation and the scattering prefix programs.
+void addLayoutDefines(std::vector<ShaderDefine>& defines, int layoutKind) {
+  if (layoutKind < 0) return;
+  defines.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
+  defines.push_back({"CREP_LAYOUT_BINDING", str(kLayoutBinding)});
+  defines.push_back({"CREP_SLICES_BINDING", str(kLayoutRowsBinding)});
+}
+
 /// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
 /// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
 std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind) {
@@ -424,12 +433,7 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
   if (usesVisibilityTable(info.options))
     stages[0].defines.push_back({"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)});
   if (usesScatteringPrefix(info.options)) stages[0].defines.push_back({"CREP_SCATTERING_PREFIX", "1"});
-  if (layoutKind >= 0) {
-    std::vector<ShaderDefine>& d = stages[0].defines;
-    d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
-    d.push_back({"CREP_LAYOUT_BINDING", str(kLayoutBinding)});
-    d.push_back({"CREP_SLICES_BINDING", str(kLayoutRowsBinding)});
-  }
+  addLayoutDefines(stages[0].defines, layoutKind);
   return stages;
 }
 
@@ -443,12 +447,7 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
         {"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
         {"CREP_TABLE_COEFFICIENTS_BINDING", str(kTableCoefficientsBinding)},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
-  if (layoutKind >= 0) {
-    std::vector<ShaderDefine>& d = stages[0].defines;
-    d.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
-    d.push_back({"CREP_LAYOUT_BINDING", str(kLayoutBinding)});
-    d.push_back({"CREP_SLICES_BINDING", str(kLayoutRowsBinding)});
-  }
+  addLayoutDefines(stages[0].defines, layoutKind);
   return stages;
 }
 } // namespace
@@ -555,15 +554,8 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
     program = variant.get();
   }
-  const Camera& cam = *frame.camera;
-  const gpu::GpuCamera c = gpu::gpuCamera(cam);
   gpu::EvaluateParams params;
-  params.cameraPosition = c.position;
-  params.cameraForward = c.forward;
-  params.cameraRight = c.right;
-  params.cameraUp = c.up;
-  params.cameraCenter = c.center;
-  params.cameraDepth = c.depth;
+  gpu::assignCamera(params, *frame.camera);
   params.imageSize = glm::ivec4(depth.width, depth.height, 0, 0);
   glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);

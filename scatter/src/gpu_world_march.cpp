@@ -32,13 +32,7 @@ GpuCamera gpuCamera(const Camera& camera) {
 MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
                             int width, int height, int mapWidth, int mapHeight) {
   MarchParams p;
-  const GpuCamera c = gpuCamera(camera);
-  p.cameraPosition = c.position;
-  p.cameraForward = c.forward;
-  p.cameraRight = c.right;
-  p.cameraUp = c.up;
-  p.cameraCenter = c.center;
-  p.cameraDepth = c.depth;
+  assignCamera(p, camera);
   p.lightDirection = glm::vec4(glm::vec3(light.direction()), 0.0f);
   p.lightIrradiance = glm::vec4(glm::vec3(light.irradiance()), 0.0f);
   p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));

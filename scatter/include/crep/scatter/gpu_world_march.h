@@ -67,6 +67,18 @@ struct GpuCamera {
   glm::vec4 depth;     ///< near, projection far (0 = infinite), integration far, reversed (1 / 0)
 };
 GpuCamera gpuCamera(const Camera& camera);
+/// Sets the camera members of a GPU block (MarchParams, gpu::EvaluateParams: cameraPosition, cameraForward,
+/// cameraRight, cameraUp, cameraCenter, cameraDepth) from gpuCamera(camera).
+template <class Block>
+void assignCamera(Block& block, const Camera& camera) {
+  const GpuCamera c = gpuCamera(camera);
+  block.cameraPosition = c.position;
+  block.cameraForward = c.forward;
+  block.cameraRight = c.right;
+  block.cameraUp = c.up;
+  block.cameraCenter = c.center;
+  block.cameraDepth = c.depth;
+}
 
 /// The camera, light and medium part of MarchParams for a w x h camera image and a W x H map.
 MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
