@@ -419,28 +419,21 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
         applyRingingFilter(options.ringing, aSpan);
         const int nearestRow =
             std::clamp(static_cast<int>(std::floor(m.row * basis.height)), 0, basis.height - 1);
+        PixelRay segments = ray; // what the region loop below integrates
         if (prefix && m.last.region > 0) {
-          // The regions crossed whole from the scattering prefix table (EvaluateOptions::scatteringPrefix),
-          // then the last region as below from t_last = rayDistance(row, z_r, last / R) of the ray itself.
+          // The regions crossed whole from the scattering prefix table (EvaluateOptions::scatteringPrefix);
+          // the loop then integrates the last region alone, from t_last = rayDistance(row, z_r, last / R)
+          // of the ray itself.
           glm::dvec3 S;
           for (int c = 0; c < kScatteringPrefixChannels; ++c)
             S[c] = lerpTable(prefixValues, kScatteringPrefixChannels, c, m.last.region, m.depth, m.row);
           L += C * S;
-          PixelRay rest = ray;
-          rest.start = std::clamp(layout.rayDistance(m.row, m.depth, static_cast<double>(m.last.region) / R),
-                                  ray.start, ray.surface);
+          segments.start =
+              std::clamp(layout.rayDistance(m.row, m.depth, static_cast<double>(m.last.region) / R),
+                         ray.start, ray.surface);
           m.first = {m.last.region, 0.0};
-          forEachSegment(layout, rest, m, R, [&](int r, double, double ub, double ta, double tb) {
-            sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data());
-            double dot = 0.0;
-            for (int k = 0; k < M; ++k)
-              dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
-            L += C * std::clamp(0.5 + dot, 0.0, 1.0) * transmittanceIntegral(sigma, ta, tb);
-          });
-          storeScattering(out, x, y, L, std::exp(-greySigma * ray.surface));
-          continue;
         }
-        forEachSegment(layout, ray, m, R, [&](int r, double ua, double ub, double ta, double tb) {
+        forEachSegment(layout, segments, m, R, [&](int r, double ua, double ub, double ta, double tb) {
           if (table && r < m.last.region) { // a region crossed whole: the table (see EvaluateOptions)
             L += C * tableAt(r, m.depth, m.row) * transmittanceIntegral(sigma, ta, tb);
             return;
