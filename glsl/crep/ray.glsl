@@ -10,9 +10,12 @@
 
 // phi(x) = (1 - exp(-x)) / x for x >= 0, phi(0) = 1 (crep::oneMinusExpOverX): the series below 1/4
 // (truncation < 2e-9) keeps the sigma -> 0 limit exact and free of the cancellation of 1 - exp(-x) in float.
+// The series alone (for x < 1/4), per component.
+vec3 crep_oneMinusExpOverXSeries(vec3 x) {
+  return 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0 - x * (1.0 / 720.0 - x / 5040.0)))));
+}
 float crep_oneMinusExpOverX(float x) {
-  if (x < 0.25)
-    return 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0 - x * (1.0 / 720.0 - x / 5040.0)))));
+  if (x < 0.25) return crep_oneMinusExpOverXSeries(vec3(x)).x;
   return (1.0 - exp(-x)) / x;
 }
 

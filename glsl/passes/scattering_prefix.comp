@@ -66,8 +66,7 @@ void main() {
     // phi(x) by the series of crep_oneMinusExpOverX: both relative errors stay near float rounding.
     float len = tb - ta;
     vec3 x = sigma * len;
-    vec3 phi = 1.0 - x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x * (1.0 / 120.0 - x * (1.0 / 720.0 - x / 5040.0)))));
-    vec3 integral = mix((Ea - Eb) / sigma, Ea * len * phi, lessThan(x, vec3(0.25)));
+    vec3 integral = mix((Ea - Eb) / sigma, Ea * len * crep_oneMinusExpOverXSeries(x), lessThan(x, vec3(0.25)));
     sum += clamp(0.5 + dotF, 0.0, 1.0) * integral;
     Ea = Eb;
     ta = tb;
