@@ -13,7 +13,9 @@ double henyeyGreenstein(double g, double cosTheta) {
   return (1.0 - g * g) / (4.0 * std::numbers::pi * denom * std::sqrt(denom));
 }
 
-double rayleighPhase(double cosTheta) { return 3.0 / (16.0 * std::numbers::pi) * (1.0 + cosTheta * cosTheta); }
+double rayleighPhase(double cosTheta) {
+  return 3.0 / (16.0 * std::numbers::pi) * (1.0 + cosTheta * cosTheta);
+}
 
 namespace {
 void requireCoefficients(const char* parameter, const glm::dvec3& c) {
@@ -21,14 +23,13 @@ void requireCoefficients(const char* parameter, const glm::dvec3& c) {
 }
 } // namespace
 
-Medium::Medium(const glm::dvec3& mieScattering, const glm::dvec3& absorption, double hgG,
-               const glm::dvec3& rayleighScattering)
-    : mie_(mieScattering), absorption_(absorption), g_(hgG), rayleigh_(rayleighScattering) {
-  requireCoefficients("Medium.mieScattering", mieScattering);
-  requireCoefficients("Medium.absorption", absorption);
-  requireCoefficients("Medium.rayleighScattering", rayleighScattering);
-  if (!std::isfinite(hgG) || !(std::abs(hgG) < 1.0))
-    throw InvalidArgument("Medium.hgG", detail::formatValue(hgG), "must be in (-1, 1)");
+Medium::Medium(const MediumCoefficients& c)
+    : mie_(c.mieScattering), absorption_(c.absorption), g_(c.hgG), rayleigh_(c.rayleighScattering) {
+  requireCoefficients("Medium.mieScattering", mie_);
+  requireCoefficients("Medium.absorption", absorption_);
+  requireCoefficients("Medium.rayleighScattering", rayleigh_);
+  if (!std::isfinite(g_) || !(std::abs(g_) < 1.0))
+    throw InvalidArgument("Medium.hgG", detail::formatValue(g_), "must be in (-1, 1)");
   const glm::dvec3 t = extinction();
   const char* channel[3] = {"Medium.extinction.r", "Medium.extinction.g", "Medium.extinction.b"};
   for (int i = 0; i < 3; ++i)

@@ -110,7 +110,10 @@ TEST_CASE("Phase functions are normalized over the sphere") {
 }
 
 TEST_CASE("Medium: extinction derived, scatteringTimesPhase combines HG and Rayleigh") {
-  const crep::Medium m({0.1, 0.2, 0.3}, {0.01, 0.02, 0.03}, 0.7, {0.001, 0.002, 0.004});
+  const crep::Medium m({.mieScattering = {0.1, 0.2, 0.3},
+                        .hgG = 0.7,
+                        .rayleighScattering = {0.001, 0.002, 0.004},
+                        .absorption = {0.01, 0.02, 0.03}});
   CHECK(m.extinction().x == doctest::Approx(0.111));
   CHECK(m.extinction().z == doctest::Approx(0.334));
   CHECK(m.scattering().y == doctest::Approx(0.202));
@@ -119,16 +122,25 @@ TEST_CASE("Medium: extinction derived, scatteringTimesPhase combines HG and Rayl
 }
 
 TEST_CASE("Medium: invalid coefficients are named") {
-  expectInvalid("Medium.mieScattering", [] { crep::Medium({-0.1, 0.1, 0.1}); });
-  expectInvalid("Medium.mieScattering", [] { crep::Medium({kNan, 0.1, 0.1}); });
-  expectInvalid("Medium.absorption", [] { crep::Medium({0.1, 0.1, 0.1}, {0, -1e-3, 0}); });
-  expectInvalid("Medium.rayleighScattering", [] {
-    crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 0.0, {0, 0, -1});
+  expectInvalid("Medium.mieScattering", [] { crep::Medium({.mieScattering = {-0.1, 0.1, 0.1}}); });
+  expectInvalid("Medium.mieScattering", [] { crep::Medium({.mieScattering = {kNan, 0.1, 0.1}}); });
+  expectInvalid("Medium.absorption", [] {
+    crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .absorption = {0, -1e-3, 0}});
   });
-  expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, 1.0); });
-  expectInvalid("Medium.hgG", [] { crep::Medium({0.1, 0.1, 0.1}, {0, 0, 0}, kNan); });
-  expectInvalid("Medium.extinction.g", [] { crep::Medium({0.1, 0.0, 0.1}); });
-  expectInvalid("Medium.extinction.r", [] { crep::Medium({0, 0, 0}); });
+  expectInvalid("Medium.rayleighScattering", [] {
+    crep::Medium({.mieScattering = {0.1, 0.1, 0.1},
+                  .hgG = 0.0,
+                  .rayleighScattering = {0, 0, -1},
+                  .absorption = {0, 0, 0}});
+  });
+  expectInvalid("Medium.hgG", [] {
+    crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .hgG = 1.0, .absorption = {0, 0, 0}});
+  });
+  expectInvalid("Medium.hgG", [] {
+    crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .hgG = kNan, .absorption = {0, 0, 0}});
+  });
+  expectInvalid("Medium.extinction.g", [] { crep::Medium({.mieScattering = {0.1, 0.0, 0.1}}); });
+  expectInvalid("Medium.extinction.r", [] { crep::Medium({.mieScattering = {0, 0, 0}}); });
 }
 
 TEST_CASE("orthographicLightClipFromWorld: covers the points, looks along the light") {
@@ -149,12 +161,16 @@ TEST_CASE("orthographicLightClipFromWorld: covers the points, looks along the li
   CHECK(d.z > 0.0);
 }
 
-TEST_CASE("Medium: the named form equals the positional one and reads back by name") {
+TEST_CASE("Medium: the named form equals the deprecated positional one and reads back by name") {
   const crep::Medium named({.mieScattering = glm::dvec3(0.02, 0.03, 0.04),
                             .hgG = 0.76,
                             .rayleighScattering = glm::dvec3(0.001, 0.002, 0.005),
                             .absorption = glm::dvec3(0.003)});
+  // The deprecated positional form (mie, absorption, g, rayleigh) still builds the same medium.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
   const crep::Medium positional({0.02, 0.03, 0.04}, glm::dvec3(0.003), 0.76, {0.001, 0.002, 0.005});
+#pragma GCC diagnostic pop
   CHECK(named.mieScattering() == positional.mieScattering());
   CHECK(named.absorption() == positional.absorption());
   CHECK(named.hgG() == positional.hgG());

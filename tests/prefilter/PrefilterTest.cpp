@@ -292,7 +292,7 @@ TEST_CASE("prefilter: ground truth (b) half-space shadow equals the closed form 
   const Image march = bruteForceMarch(map, depth, camera, light, medium).scattering;
   report("(b) march vs closed form", rgbMetrics(march, truth));
   report("(b) prefiltered vs march (the method's own error)", rgbMetrics(ours, march));
-  const Medium grey(glm::dvec3(0.06), glm::dvec3(0.0), 0.6);
+  const Medium grey({.mieScattering = glm::dvec3(0.06), .hgG = 0.6, .absorption = glm::dvec3(0.0)});
   const Image greyTruth = halfSpaceTruth(depth, camera, light, grey, plane);
   const ImageMetrics greyMetrics =
       rgbMetrics(evaluate(prefilter(map, grey), depth, camera, light, grey), greyTruth);
@@ -425,7 +425,7 @@ TEST_CASE("prefilter: clamped visibility keeps 0 <= L <= unshadowed for arbitrar
 TEST_CASE("prefilter: sigma -> 0 gives the linear limit without NaN") {
   const Camera camera = test::groundCamera(64, 36);
   const DirectionalLight light = test::sideLight();
-  const Medium thin(glm::dvec3(1e-14), glm::dvec3(0.0), 0.3);
+  const Medium thin({.mieScattering = glm::dvec3(1e-14), .hgG = 0.3, .absorption = glm::dvec3(0.0)});
   const auto layout = test::projectiveLayout(camera, light);
   const RectifiedMap empty = castRectifiedMap(layout, 256, 128, [](const LightRay&) { return std::nullopt; });
   const Image depth = groundDepth(camera, 64, 36);

@@ -226,7 +226,7 @@ TEST_CASE("weights: invalid arguments are named") {
   CHECK_THROWS_AS(regionWeights(WeightMode::Exact, std::nan(""), p, 4, w), InvalidArgument);
   CHECK_THROWS_AS(regionWeights(WeightMode::Exact, 1.0, p, 5, w), InvalidArgument);
   CHECK_THROWS_AS(regionWeights(WeightMode::Exact, 1.0, p, 0, std::span<double>()), InvalidArgument);
-  const Medium medium(glm::dvec3(0.1, 0.2, 0.3), glm::dvec3(0.3, 0.0, 0.0));
+  const Medium medium({.mieScattering = glm::dvec3(0.1, 0.2, 0.3), .absorption = glm::dvec3(0.3, 0.0, 0.0)});
   CHECK(weightExtinction(medium) == doctest::Approx(0.3));
   CHECK(std::string(weightModeToken(WeightMode::Exact)) == "exact");
 }

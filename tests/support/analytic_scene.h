@@ -26,7 +26,10 @@ inline DirectionalLight sideLight() {
   return DirectionalLight(glm::dvec3(1.0, -1.0, -0.3), glm::dvec3(2.0, 1.8, 1.5));
 }
 inline Medium colouredMedium() {
-  return Medium(glm::dvec3(0.03, 0.04, 0.05), glm::dvec3(0.01), 0.6, glm::dvec3(0.005, 0.01, 0.02));
+  return Medium({.mieScattering = glm::dvec3(0.03, 0.04, 0.05),
+                 .hgG = 0.6,
+                 .rayleighScattering = glm::dvec3(0.005, 0.01, 0.02),
+                 .absorption = glm::dvec3(0.01)});
 }
 
 inline std::shared_ptr<const ProjectiveLayout>

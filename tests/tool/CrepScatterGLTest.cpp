@@ -70,8 +70,10 @@ TEST_CASE("crep scatter: the example frame over a ground plane without casters m
   const crep::DirectionalLight light(vec3(j["light"]["direction"]),
                                      vec3(j["light"]["color"]) * j["light"]["intensity"].get<double>());
   const Json& m = j["medium"];
-  const crep::Medium medium(vec3(m["mieScattering"]), vec3(m["absorption"]), m["hgG"].get<double>(),
-                            vec3(m["rayleighScattering"]));
+  const crep::Medium medium({.mieScattering = vec3(m["mieScattering"]),
+                             .hgG = m["hgG"].get<double>(),
+                             .rayleighScattering = vec3(m["rayleighScattering"]),
+                             .absorption = vec3(m["absorption"])});
 
   // Depth of the ground plane y = 0 (sky above the horizon), and an empty shadow map.
   const int w = j["camera"]["size"][0].get<int>(), h = j["camera"]["size"][1].get<int>();

@@ -416,7 +416,10 @@ double radianceBound(const FrameDescription& f, const Medium& m) {
 
 Medium mediumOf(const FrameDescription& f, const std::string& source) {
   try {
-    Medium m(f.mieScattering, f.absorption, f.hgG, f.rayleighScattering);
+    Medium m({.mieScattering = f.mieScattering,
+              .hgG = f.hgG,
+              .rayleighScattering = f.rayleighScattering,
+              .absorption = f.absorption});
     const double bound = radianceBound(f, m);
     if (!(bound <= kMaxRadiance))
       Reader(source).fail("light.intensity",

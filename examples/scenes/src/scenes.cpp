@@ -56,7 +56,8 @@ Mesh colonnadeMesh() {
   const double y0 = height, y1 = height + 0.6;
   const double x0 = -8.0, x1 = 8.0, z0 = -33.0, z1 = 27.0;
   // Beams along z (three: both edges and the centre line).
-  for (double x : {x0, -1.0, 6.0}) appendBox(m, {{x, y0, z0}, {x + 2.0, y1, z1}});
+  for (double x : {x0, -1.0, 6.0})
+    appendBox(m, {{x, y0, z0}, {x + 2.0, y1, z1}});
   // Cross beams along x between openings.
   for (int i = 0; i <= 10; ++i) {
     const double z = z0 + 6.0 * i;
@@ -90,8 +91,9 @@ Mesh forestMesh() {
 }
 
 double terrainHeight(double x, double z) {
-  return 3.0 * std::sin(0.045 * x) * std::cos(0.038 * z) + 1.6 * std::sin(0.11 * x + 0.7) * std::sin(0.09 * z + 1.3) +
-         0.5 * std::cos(0.23 * x - 0.31 * z) + 0.002 * (x * x + z * z) * 0.2;
+  return 3.0 * std::sin(0.045 * x) * std::cos(0.038 * z) +
+         1.6 * std::sin(0.11 * x + 0.7) * std::sin(0.09 * z + 1.3) + 0.5 * std::cos(0.23 * x - 0.31 * z) +
+         0.002 * (x * x + z * z) * 0.2;
 }
 
 // A smooth height field with a few blockers: smooth shadow-map depth.
@@ -103,21 +105,27 @@ Mesh terrainMesh() {
     for (int i = 0; i <= n; ++i) {
       const double x = -half + i * step, z = -half + j * step;
       const double h = terrainHeight(x, z), e = 0.5 * step;
-      const glm::dvec3 nrm = glm::normalize(glm::dvec3(terrainHeight(x - e, z) - terrainHeight(x + e, z), 2.0 * e,
-                                                       terrainHeight(x, z - e) - terrainHeight(x, z + e)));
+      const glm::dvec3 nrm =
+          glm::normalize(glm::dvec3(terrainHeight(x - e, z) - terrainHeight(x + e, z), 2.0 * e,
+                                    terrainHeight(x, z - e) - terrainHeight(x, z + e)));
       m.positions.emplace_back(x, h, z);
       m.normals.emplace_back(nrm);
     }
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
-      const auto a = static_cast<std::uint32_t>(j * (n + 1) + i), b = a + 1, c = a + static_cast<std::uint32_t>(n + 1),
-                 d = c + 1;
-      for (std::uint32_t k : {a, c, b, b, c, d}) m.indices.push_back(k);
+      const auto a = static_cast<std::uint32_t>(j * (n + 1) + i), b = a + 1,
+                 c = a + static_cast<std::uint32_t>(n + 1), d = c + 1;
+      for (std::uint32_t k : {a, c, b, b, c, d})
+        m.indices.push_back(k);
     }
   // Blockers: a few tall slabs and towers standing on the terrain.
   const struct {
     double x, z, w, d, h;
-  } blockers[] = {{-12, -25, 3, 3, 16}, {8, -40, 10, 2, 12}, {22, -15, 2, 2, 20}, {-30, -55, 14, 3, 10}, {0, -70, 4, 4, 25}};
+  } blockers[] = {{-12, -25, 3, 3, 16},
+                  {8, -40, 10, 2, 12},
+                  {22, -15, 2, 2, 20},
+                  {-30, -55, 14, 3, 10},
+                  {0, -70, 4, 4, 25}};
   for (const auto& bl : blockers) {
     const double y = terrainHeight(bl.x, bl.z) - 1.0;
     appendBox(m, {{bl.x - bl.w / 2, y, bl.z - bl.d / 2}, {bl.x + bl.w / 2, y + bl.h, bl.z + bl.d / 2}});
@@ -136,55 +144,87 @@ Mesh boxesMesh() {
   return m;
 }
 
-Medium defaultMedium() { return Medium(glm::dvec3(0.02, 0.022, 0.025), glm::dvec3(0.004), 0.6); }
+Medium defaultMedium() {
+  return Medium(
+      {.mieScattering = glm::dvec3(0.02, 0.022, 0.025), .hgG = 0.6, .absorption = glm::dvec3(0.004)});
+}
 
 } // namespace
 
-std::vector<std::string> sceneNames() { return {"colonnade", "forest", "terrain", "boxes", "sunset"}; }
+std::vector<std::string> sceneNames() {
+  return {"colonnade", "forest", "terrain", "boxes", "sunset"};
+}
 
 Scene makeScene(std::string_view name, double aspect) {
   const double fov = 60.0 * std::numbers::pi / 180.0;
   if (name == "colonnade") {
-    Scene s{"colonnade", colonnadeMesh(),
-            Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
-            DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(5.0, 4.6, 4.0)),
-            Medium(glm::dvec3(0.04, 0.042, 0.045), glm::dvec3(0.004), 0.5), {}, {}};
+    Scene s{
+        "colonnade",
+        colonnadeMesh(),
+        Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
+        DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(5.0, 4.6, 4.0)),
+        Medium(
+            {.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}),
+        {},
+        {}};
     computeBounds(s);
     return s;
   }
   if (name == "forest") {
-    Scene s{"forest", forestMesh(),
-            Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
-            DirectionalLight(glm::dvec3(-0.45, -0.6, -0.65), glm::dvec3(4.0, 3.8, 3.4)),
-            Medium(glm::dvec3(0.025, 0.027, 0.03), glm::dvec3(0.005), 0.7), {}, {}};
+    Scene s{
+        "forest",
+        forestMesh(),
+        Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
+        DirectionalLight(glm::dvec3(-0.45, -0.6, -0.65), glm::dvec3(4.0, 3.8, 3.4)),
+        Medium(
+            {.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}),
+        {},
+        {}};
     computeBounds(s);
     return s;
   }
   if (name == "terrain") {
-    Scene s{"terrain", terrainMesh(),
+    Scene s{"terrain",
+            terrainMesh(),
             Camera::lookAt({0.0, 12.0, 40.0}, {0.0, 6.0, -40.0}, {0, 1, 0}, fov, aspect, 0.1, 200.0),
             DirectionalLight(glm::dvec3(0.8, -0.45, 0.2), glm::dvec3(4.0, 3.5, 2.8)),
-            Medium(glm::dvec3(0.012, 0.014, 0.018), glm::dvec3(0.002), 0.5, glm::dvec3(0.002, 0.004, 0.008)), {}, {}};
+            Medium({.mieScattering = glm::dvec3(0.012, 0.014, 0.018),
+                    .hgG = 0.5,
+                    .rayleighScattering = glm::dvec3(0.002, 0.004, 0.008),
+                    .absorption = glm::dvec3(0.002)}),
+            {},
+            {}};
     computeBounds(s);
     return s;
   }
   if (name == "boxes") {
-    Scene s{"boxes", boxesMesh(), Camera::lookAt({0.0, 3.0, 10.0}, {0.0, 1.5, -5.0}, {0, 1, 0}, fov, aspect, 0.1, 60.0),
-            DirectionalLight(glm::dvec3(0.5, -0.8, -0.3), glm::dvec3(3.0)), defaultMedium(), {}, {}};
+    Scene s{"boxes",
+            boxesMesh(),
+            Camera::lookAt({0.0, 3.0, 10.0}, {0.0, 1.5, -5.0}, {0, 1, 0}, fov, aspect, 0.1, 60.0),
+            DirectionalLight(glm::dvec3(0.5, -0.8, -0.3), glm::dvec3(3.0)),
+            defaultMedium(),
+            {},
+            {}};
     computeBounds(s);
     return s;
   }
   if (name == "sunset") {
-    // The forest toward a low sun behind the canopy: the sun is in view (about 12 degrees up, 10 degrees right
-    // of the view axis), so every frame takes the epipolar layout; the classic god-ray picture.
-    Scene s{"sunset", forestMesh(),
-            Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
-            DirectionalLight(-glm::normalize(glm::dvec3(0.18, 0.22, -1.0)), glm::dvec3(6.0, 4.4, 2.8)),
-            Medium(glm::dvec3(0.025, 0.027, 0.03), glm::dvec3(0.005), 0.7), {}, {}};
+    // The forest toward a low sun behind the canopy: the sun is in view (about 12 degrees up, 10 degrees
+    // right of the view axis), so every frame takes the epipolar layout; the classic god-ray picture.
+    Scene s{
+        "sunset",
+        forestMesh(),
+        Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
+        DirectionalLight(-glm::normalize(glm::dvec3(0.18, 0.22, -1.0)), glm::dvec3(6.0, 4.4, 2.8)),
+        Medium(
+            {.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}),
+        {},
+        {}};
     computeBounds(s);
     return s;
   }
-  throw InvalidArgument("scene", std::string(name), "must be one of colonnade, forest, terrain, boxes, sunset");
+  throw InvalidArgument("scene", std::string(name),
+                        "must be one of colonnade, forest, terrain, boxes, sunset");
 }
 
 } // namespace crep::scenes

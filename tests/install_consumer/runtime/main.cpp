@@ -92,7 +92,8 @@ int main() {
     const crep::Camera camera = crep::Camera::lookAt({0, 2, 8}, {0, 1, 0}, {0, 1, 0}, glm::radians(60.0),
                                                      double(kCameraWidth) / kCameraHeight, 0.1, 50.0);
     const crep::DirectionalLight sun({1.0, -0.6, -0.3}, glm::dvec3(3.0));
-    const crep::Medium medium({0.05, 0.05, 0.05}, {0.01, 0.01, 0.01}, 0.5);
+    const crep::Medium medium(
+        {.mieScattering = {0.05, 0.05, 0.05}, .hgG = 0.5, .absorption = {0.01, 0.01, 0.01}});
     const crep::Rectification rect = crep::rectify(camera, sun);
     if (!rect.projective()) {
       std::fprintf(stderr, "consumer: the rectification is not projective: %s\n", rect.message.c_str());

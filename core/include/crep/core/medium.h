@@ -22,14 +22,17 @@ struct MediumCoefficients {
 
 class Medium {
 public:
-  /// The named form (prefer it: absorption and g are easy to swap in the positional one).
-  explicit Medium(const MediumCoefficients& c)
-      : Medium(c.mieScattering, c.absorption, c.hgG, c.rayleighScattering) {}
-  /// `mieScattering` scatters with Henyey-Greenstein(g), `rayleighScattering` with the Rayleigh
-  /// phase, `absorption` only extinguishes. Throws InvalidArgument for negative or non-finite
-  /// coefficients, |g| >= 1, or a channel whose extinction is not > 0.
-  Medium(const glm::dvec3& mieScattering, const glm::dvec3& absorption = glm::dvec3(0.0), double hgG = 0.0,
-         const glm::dvec3& rayleighScattering = glm::dvec3(0.0));
+  /// `mieScattering` scatters with Henyey-Greenstein(hgG), `rayleighScattering` with the Rayleigh
+  /// phase, `absorption` only extinguishes. Throws InvalidArgument naming the coefficient ("Medium.hgG",
+  /// "Medium.extinction.g", ...) for negative or non-finite coefficients, |g| >= 1, or a channel whose
+  /// extinction is not > 0.
+  explicit Medium(const MediumCoefficients& c);
+  /// The positional form of 0.1: deprecated, absorption and g were easy to swap.
+  [[deprecated("name the coefficients: crep::Medium({.mieScattering = ..., .hgG = ..., .absorption = "
+               "...})")]] Medium(const glm::dvec3& mieScattering,
+                                 const glm::dvec3& absorption = glm::dvec3(0.0), double hgG = 0.0,
+                                 const glm::dvec3& rayleighScattering = glm::dvec3(0.0))
+      : Medium(MediumCoefficients{mieScattering, hgG, rayleighScattering, absorption}) {}
   /// The coefficients back by name.
   MediumCoefficients coefficients() const { return {mie_, g_, rayleigh_, absorption_}; }
 
