@@ -383,8 +383,7 @@ struct ScatteringFrame {
   gl::Handle output;
   ScatteringFrame(const BenchOptions& o, tool::StageTimings& timings)
       : scene(tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings)),
-        shadow{scene.frame->shadowMap.get(), scene.frame->shadowWidth, scene.frame->shadowHeight,
-               scene.frame->lightClipFromWorld, scene.frame->shadowBias},
+        shadow{scene.frame->shadowMap.get(), scene.frame->lightClipFromWorld, scene.frame->shadowBias},
         output(gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight)) {}
   Scattering::FrameAttribs attribs() const {
     Scattering::FrameAttribs a;

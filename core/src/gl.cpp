@@ -276,6 +276,30 @@ std::uint32_t scratchTexture2D(Handle& texture, int& w, int& h, std::uint32_t in
   return texture.get();
 }
 
+TextureLevel textureLevel(const char* parameter, std::uint32_t texture) {
+  if (texture == 0 || glIsTexture(texture) != GL_TRUE)
+    throw InvalidArgument(parameter, std::to_string(texture), "must be the name of an existing texture");
+  GLint target = 0, w = 0, h = 0, d = 0, f = 0;
+  glGetTextureParameteriv(texture, GL_TEXTURE_TARGET, &target);
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_WIDTH, &w);
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_HEIGHT, &h);
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_DEPTH, &d);
+  glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &f);
+  return {static_cast<std::uint32_t>(target), w, h, d, static_cast<std::uint32_t>(f)};
+}
+
+TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture) {
+  const TextureLevel level = textureLevel(parameter, texture);
+  if (level.target != GL_TEXTURE_2D)
+    throw InvalidArgument(parameter, "texture " + std::to_string(texture) + " of target " + hex(level.target),
+                          "must be a GL_TEXTURE_2D");
+  if (level.width <= 0 || level.height <= 0)
+    throw InvalidArgument(parameter, "texture " + std::to_string(texture),
+                          "has no storage (level 0 is " + std::to_string(level.width) + " x " +
+                              std::to_string(level.height) + ")");
+  return level;
+}
+
 void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
                       std::uint32_t format) {
   if (width <= 0 || height <= 0)

@@ -30,10 +30,10 @@ LayoutKind layoutKind(const RectifiedLayout& layout) {
 // MinMaxTreePass
 
 MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("MinMaxTreePass.mapSize", info.mapWidth, info.mapHeight);
+  gl::checkTextureSize("MinMaxTreePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   levels_ = MinMaxTrees::levelCount(info.mapWidth);
   if (levels_ > 16)
-    throw GlError("crep: MinMaxTreePass.mapSize width " + std::to_string(info.mapWidth) +
+    throw GlError("crep: MinMaxTreePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
                   " needs more than 16 tree levels");
   rowStride_ = MinMaxTrees::rowStrideFor(info.mapWidth);
   program_ = buildProgram({{ShaderStage::Compute, "passes/minmax_build.comp", {}}});
@@ -45,7 +45,7 @@ MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
 }
 
 void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
-  gl::requireTexture2D("MinMaxTreePass.rectifiedDepth", rectifiedDepth, info_.mapWidth, info_.mapHeight);
+  gl::requireTexture2D("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth, info_.mapHeight);
   const GLuint p = program_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
@@ -75,9 +75,9 @@ std::vector<float> MinMaxTreePass::readNodes() const {
 // RectifiedMarchPass
 
 RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("RectifiedMarchPass.mapSize", info.mapWidth, info.mapHeight);
+  gl::checkTextureSize("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   if (MinMaxTrees::levelCount(info.mapWidth) > 16)
-    throw GlError("crep: RectifiedMarchPass.mapSize width " + std::to_string(info.mapWidth) +
+    throw GlError("crep: RectifiedMarchPass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
                   " needs more than 16 tree levels");
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
@@ -85,35 +85,38 @@ RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
 }
 
 void RectifiedMarchPass::run(const FrameAttribs& f) {
-  if (!f.layout) throw InvalidArgument("RectifiedMarchPass.FrameAttribs.layout", "null", "must be set");
+  if (!f.layout) throw InvalidArgument("RectifiedMarchPass::FrameAttribs.layout", "null", "must be set");
   if (!f.camera || !f.light || !f.medium)
-    throw InvalidArgument("RectifiedMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
+    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.camera/light/medium", "null", "must be set");
   const GpuLayoutData layoutData = gpu::requireGpuLayout(*f.layout); // serialized once per run
   const gpu::LayoutKind kind = layoutData.kind;
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (W % f.layout->regionCount() != 0)
-    throw InvalidArgument("RectifiedMarchPass.mapSize", std::to_string(W),
+    throw InvalidArgument("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", std::to_string(W),
                           "must be a multiple of the layout's region count " +
                               std::to_string(f.layout->regionCount()));
   if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
-    throw InvalidArgument("RectifiedMarchPass.mapSize", "height " + std::to_string(H),
+    throw InvalidArgument("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", "height " + std::to_string(H),
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
-  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
-  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-  gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.output", f.output, f.width, f.height, GL_RGBA32F);
+  // The image size is the camera depth texture's own (gl::textureLevel).
+  const gl::TextureLevel depth =
+      gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
+  const int width = depth.width, height = depth.height;
+  gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
+  gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   if (f.stepsOutput != 0)
-    gl::requireTexture2D("RectifiedMarchPass.FrameAttribs.stepsOutput", f.stepsOutput, f.width, f.height,
+    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, width, height,
                          GL_R32F);
   const bool tree = info_.mode == Mode::MinMaxTree;
   if (tree && (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer)))
-    throw InvalidArgument("RectifiedMarchPass.FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
+    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
                           "must be the MinMaxTreePass::treeBuffer() of the map (MinMaxTree mode)");
   if (tree) {
     GLint64 size = 0;
     glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
     const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
     if (size < needed)
-      throw InvalidArgument("RectifiedMarchPass.FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
+      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
                             "must hold the trees of a " + std::to_string(W) + " x " + std::to_string(H) +
                                 " map (" + std::to_string(needed) + " bytes)");
   }
@@ -125,19 +128,19 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
           "passes/march_rectified.comp",
           {{"CREP_MARCH_TREE", tree ? "1" : "0"}, {"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
 
-  gpu::MarchParams params = gpu::makeMarchParams(*f.camera, *f.light, *f.medium, f.width, f.height, W, H);
+  gpu::MarchParams params = gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
   layoutBuffers_.upload(layoutData, H);
 
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, f.width, f.height);
+                                                                 GL_R32F, width, height);
   gpu::bindMarchResources(program.get(), params_.get(), f.cameraDepth, f.rectifiedDepth, sampler_.get(),
                           f.output, steps);
   layoutBuffers_.bind(1, 1);
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
-  gpu::dispatchMarch(f.width, f.height, "RectifiedMarchPass::run");
+  gpu::dispatchMarch(width, height, "RectifiedMarchPass::run");
 }
 
 } // namespace crep

@@ -98,25 +98,25 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
 // ShadowResamplePass
 
 ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("ShadowResamplePass.mapSize", info.mapWidth, info.mapHeight);
+  gl::checkTextureSize("ShadowResamplePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("ShadowResamplePass");
 }
 
 void ShadowResamplePass::run(const FrameAttribs& f) {
-  if (!f.layout) throw InvalidArgument("ShadowResamplePass.FrameAttribs.layout", "null", "must be set");
+  if (!f.layout) throw InvalidArgument("ShadowResamplePass::FrameAttribs.layout", "null", "must be set");
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (W % f.layout->regionCount() != 0)
-    throw InvalidArgument("ShadowResamplePass.mapSize", std::to_string(W),
+    throw InvalidArgument("ShadowResamplePass::CreateInfo.mapWidth/mapHeight", std::to_string(W),
                           "must be a multiple of the layout's region count " +
                               std::to_string(f.layout->regionCount()));
   if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
-    throw InvalidArgument("ShadowResamplePass.mapSize", "height " + std::to_string(H),
+    throw InvalidArgument("ShadowResamplePass::CreateInfo.mapWidth/mapHeight", "height " + std::to_string(H),
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
-  gl::requireTexture2D("ShadowResamplePass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth,
-                       f.shadowHeight);
-  gl::requireTexture2D("ShadowResamplePass.FrameAttribs.output", f.output, W, H, GL_R32F);
+  const gl::TextureLevel shadow =
+      gl::requireTexture2D("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
+  gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);
   validateLightMatrix(f.lightClipFromWorld, f.layout->lightRay(0.5, 0.5).direction);
 
   const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
@@ -126,7 +126,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
                              "passes/epipolar_resample.comp",
                              {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
   gpu::MarchParams params;
-  params.sizes = glm::ivec4(f.shadowWidth, f.shadowHeight, W, H);
+  params.sizes = glm::ivec4(shadow.width, shadow.height, W, H);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
   const glm::mat4 worldFromClip(glm::inverse(f.lightClipFromWorld));

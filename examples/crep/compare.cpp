@@ -114,7 +114,7 @@ int compareCommand(const std::vector<std::string>& argv) {
   if (isatty(2)) timings.setProgress("crep compare");
   ensureGlContext("compare", args.has("debug-gl"), timings);
   SceneFrame s = makeSceneFrame(sceneName, size.x, size.y, settings.mapSize, timings);
-  Frame& frame = *s.frame;
+  FrameInputs& frame = *s.frame;
 
   std::vector<Result> results;
   for (const std::string& name : names) {

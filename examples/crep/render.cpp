@@ -31,7 +31,7 @@ namespace crep::tool {
 namespace {
 
 void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTimings& timings) {
-  const Frame& f = *s.frame;
+  const FrameInputs& f = *s.frame;
   timings.time("export frame", [&] {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
@@ -94,7 +94,7 @@ int renderCommand(const std::vector<std::string>& argv) {
   if (isatty(2)) timings.setProgress("crep render");
   ensureGlContext("render", args.has("debug-gl"), timings);
   SceneFrame s = makeSceneFrame(sceneName, size.x, size.y, settings.mapSize, timings);
-  Frame& frame = *s.frame;
+  FrameInputs& frame = *s.frame;
 
   MethodOutput result = runMethod(method, frame, settings);
   timings.append(result.timings.rows());

@@ -137,7 +137,7 @@ int scatterCommand(const std::vector<std::string>& argv) {
                       sizeText(depth.width(), depth.height()) + ", aspect " + shortest(imageAspect) + ")");
 
   ensureGlContext("scatter", args.has("debug-gl"), timings);
-  Frame frame(camera, light, medium);
+  FrameInputs frame(camera, light, medium);
   frame.width = depth.width();
   frame.height = depth.height();
   timings.time("upload", [&] {

@@ -111,8 +111,8 @@ DepthAwareResamplePass::DepthAwareResamplePass(DepthAwareResamplePass&&) noexcep
 DepthAwareResamplePass& DepthAwareResamplePass::operator=(DepthAwareResamplePass&&) noexcept = default;
 
 void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t lowDepth) {
-  gl::requireTexture2D("DepthAwareResamplePass.downsample.fullDepth", fullDepth, info_.width, info_.height);
-  gl::requireTexture2D("DepthAwareResamplePass.downsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
+  gl::requireTexture2D("DepthAwareResamplePass::downsample.fullDepth", fullDepth, info_.width, info_.height);
+  gl::requireTexture2D("DepthAwareResamplePass::downsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
                        GL_R32F);
   glUseProgram(downsampleProgram_.get());
   glProgramUniform2i(downsampleProgram_.get(), 0, lowWidth(), lowHeight());
@@ -128,7 +128,7 @@ void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t l
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, double zNear, double zFar) {
   if (!(zNear > 0.0 && zFar > zNear && std::isfinite(zFar)))
-    throw InvalidArgument("DepthAwareResamplePass.upsample.zNear/zFar",
+    throw InvalidArgument("DepthAwareResamplePass::upsample.zNear/zFar",
                           std::to_string(zNear) + ", " + std::to_string(zFar), "must satisfy 0 < near < far");
   upsample(low, lowDepth, fullDepth, output,
            glm::vec4(static_cast<float>(zNear), static_cast<float>(zFar), static_cast<float>(zFar), 0.0f));
@@ -141,11 +141,11 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, const glm::vec4& depthMap) {
-  gl::requireTexture2D("DepthAwareResamplePass.upsample.low", low, lowWidth(), lowHeight(), GL_RGBA32F);
-  gl::requireTexture2D("DepthAwareResamplePass.upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
+  gl::requireTexture2D("DepthAwareResamplePass::upsample.low", low, lowWidth(), lowHeight(), GL_RGBA32F);
+  gl::requireTexture2D("DepthAwareResamplePass::upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
                        GL_R32F);
-  gl::requireTexture2D("DepthAwareResamplePass.upsample.fullDepth", fullDepth, info_.width, info_.height);
-  gl::requireTexture2D("DepthAwareResamplePass.upsample.output", output, info_.width, info_.height,
+  gl::requireTexture2D("DepthAwareResamplePass::upsample.fullDepth", fullDepth, info_.width, info_.height);
+  gl::requireTexture2D("DepthAwareResamplePass::upsample.output", output, info_.width, info_.height,
                        GL_RGBA32F);
   const GLuint p = upsampleProgram_.get();
   glUseProgram(p);

@@ -174,8 +174,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   if (!f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
   if (f.shadowMap) {
-    gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture,
-                         f.shadowMap->width, f.shadowMap->height);
+    gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
     if (!std::isfinite(f.shadowMap->bias))
       invalid("Scattering::FrameAttribs.shadowMap.bias", detail::formatValue(f.shadowMap->bias),
               "must be finite");
@@ -220,8 +219,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
       map = m.rectified.depthTexture();
     } else {
       stage("resample (projective)", [&] {
-        m.resample.run({projective.get(), shadow->texture, shadow->width, shadow->height,
-                        shadow->lightClipFromWorld, m.resampled.get()});
+        m.resample.run({projective.get(), shadow->texture, shadow->lightClipFromWorld, m.resampled.get()});
       });
       map = m.resampled.get();
     }
@@ -241,7 +239,6 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     if (!shadow) {
       if (!m.ownShadowMap) m.ownShadowMap.emplace(info.ownShadowMapSize);
       own.texture = m.ownShadowMap->texture.get();
-      own.width = own.height = info.ownShadowMapSize;
       // A standard map covering the frustum (casters between the light and it are kept by GL_DEPTH_CLAMP).
       own.lightClipFromWorld = orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners());
       own.bias = info.ownShadowMapBias;
@@ -251,8 +248,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     }
     r.shadowMap = *shadow;
     stage("resample (epipolar)", [&] {
-      m.resample.run({epipolar.get(), shadow->texture, shadow->width, shadow->height,
-                      shadow->lightClipFromWorld, m.resampled.get()});
+      m.resample.run({epipolar.get(), shadow->texture, shadow->lightClipFromWorld, m.resampled.get()});
     });
     map = m.resampled.get();
   }
@@ -287,11 +283,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
         b.light = f.light;
         b.medium = f.medium;
         b.cameraDepth = f.cameraDepth;
-        b.width = info.width;
-        b.height = info.height;
         b.shadowMap = shadow->texture;
-        b.shadowWidth = shadow->width;
-        b.shadowHeight = shadow->height;
         b.lightClipFromWorld = shadow->lightClipFromWorld;
         b.bias = shadow->bias;
         b.output = f.output;

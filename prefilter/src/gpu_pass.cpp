@@ -111,24 +111,6 @@ const char* imageFormatQualifier(StorageFormat format) {
   return storageFormatToken(format);
 }
 
-struct TextureInfo {
-  GLint target = 0, width = 0, height = 0, depth = 0, format = 0;
-};
-
-/// Target, level-0 size and internal format of a caller's texture; InvalidArgument naming `parameter`
-/// if `name` is 0 or not a texture.
-TextureInfo textureInfo(const char* parameter, std::uint32_t name) {
-  if (name == 0 || glIsTexture(name) != GL_TRUE)
-    invalid(parameter, str(name), "must name an existing GL texture");
-  TextureInfo t;
-  glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &t.target);
-  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_WIDTH, &t.width);
-  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_HEIGHT, &t.height);
-  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_DEPTH, &t.depth);
-  glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_INTERNAL_FORMAT, &t.format);
-  return t;
-}
-
 std::string sizeString(int w, int h) {
   return str(w) + " x " + str(h);
 }
@@ -321,7 +303,8 @@ PrefilterPass& PrefilterPass::operator=(PrefilterPass&&) noexcept = default;
 void PrefilterPass::run(const FrameAttribs& frame) {
   if (frame.layout == nullptr)
     invalid("PrefilterPass::FrameAttribs.layout", "null", "must point to the map's layout");
-  const TextureInfo depth = textureInfo("PrefilterPass::FrameAttribs.rectifiedDepth", frame.rectifiedDepth);
+  const gl::TextureLevel depth =
+      gl::textureLevel("PrefilterPass::FrameAttribs.rectifiedDepth", frame.rectifiedDepth);
   if (depth.target != GL_TEXTURE_2D)
     invalid("PrefilterPass::FrameAttribs.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
             "must be a GL_TEXTURE_2D");
@@ -513,7 +496,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   if (basis.bases != info_.bases)
     invalid("EvaluatePass::FrameAttribs.basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info_.bases));
-  const TextureInfo b = textureInfo("EvaluatePass::FrameAttribs.basis.texture", basis.texture);
+  const gl::TextureLevel b = gl::textureLevel("EvaluatePass::FrameAttribs.basis.texture", basis.texture);
   if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
       b.depth < layerCount(basis.bases))
     invalid("EvaluatePass::FrameAttribs.basis.texture", "texture " + str(basis.texture),
@@ -523,13 +506,14 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
     invalid("EvaluatePass::FrameAttribs.basis.regionWeights", str(basis.regionWeights),
             "must name the region-weights buffer (near-plane correction)");
-  const TextureInfo depth = textureInfo("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
+  const gl::TextureLevel depth =
+      gl::textureLevel("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
   if (depth.target != GL_TEXTURE_2D)
     invalid("EvaluatePass::FrameAttribs.cameraDepth", "texture " + str(frame.cameraDepth),
             "must be a GL_TEXTURE_2D");
-  const TextureInfo out = textureInfo("EvaluatePass::FrameAttribs.output", frame.output);
+  const gl::TextureLevel out = gl::textureLevel("EvaluatePass::FrameAttribs.output", frame.output);
   const GLenum outFormat = internalFormat(info_.outputFormat);
-  if (out.target != GL_TEXTURE_2D || static_cast<GLenum>(out.format) != outFormat)
+  if (out.target != GL_TEXTURE_2D || out.internalFormat != outFormat)
     invalid("EvaluatePass::FrameAttribs.output", "texture " + str(frame.output),
             std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info_.outputFormat));
   if (out.width != depth.width || out.height != depth.height)

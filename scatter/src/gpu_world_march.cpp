@@ -77,34 +77,36 @@ WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
 
 void WorldMarchPass::run(const FrameAttribs& f) {
   if (!f.camera || !f.light || !f.medium)
-    throw InvalidArgument("WorldMarchPass.FrameAttribs.camera/light/medium", "null", "must be set");
-  gl::requireTexture2D("WorldMarchPass.FrameAttribs.cameraDepth", f.cameraDepth, f.width, f.height);
-  gl::requireTexture2D("WorldMarchPass.FrameAttribs.shadowMap", f.shadowMap, f.shadowWidth, f.shadowHeight);
-  gl::requireTexture2D("WorldMarchPass.FrameAttribs.output", f.output, f.width, f.height, GL_RGBA32F);
+    throw InvalidArgument("WorldMarchPass::FrameAttribs.camera/light/medium", "null", "must be set");
+  // The image and map sizes are the textures' own (gl::textureLevel).
+  const gl::TextureLevel depth =
+      gl::requireTexture2D("WorldMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
+  const gl::TextureLevel shadow = gl::requireTexture2D("WorldMarchPass::FrameAttribs.shadowMap", f.shadowMap);
+  const int width = depth.width, height = depth.height;
+  gl::requireTexture2D("WorldMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   if (f.stepsOutput != 0)
-    gl::requireTexture2D("WorldMarchPass.FrameAttribs.stepsOutput", f.stepsOutput, f.width, f.height,
-                         GL_R32F);
+    gl::requireTexture2D("WorldMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, width, height, GL_R32F);
   for (int c = 0; c < 4; ++c)
     for (int r = 0; r < 4; ++r)
       if (!std::isfinite(f.lightClipFromWorld[c][r]))
-        throw InvalidArgument("WorldMarchPass.FrameAttribs.lightClipFromWorld",
+        throw InvalidArgument("WorldMarchPass::FrameAttribs.lightClipFromWorld",
                               detail::formatValue(f.lightClipFromWorld[c][r]), "must be finite");
   if (!std::isfinite(f.bias))
-    throw InvalidArgument("WorldMarchPass.FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
+    throw InvalidArgument("WorldMarchPass::FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
   if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
-    throw InvalidArgument("WorldMarchPass.FrameAttribs.blockCenter/blockRadius",
+    throw InvalidArgument("WorldMarchPass::FrameAttribs.blockCenter/blockRadius",
                           detail::formatValue(f.blockRadius), "must be finite");
 
   gpu::MarchParams params =
-      gpu::makeMarchParams(*f.camera, *f.light, *f.medium, f.width, f.height, f.shadowWidth, f.shadowHeight);
+      gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, shadow.width, shadow.height);
   params.info = glm::ivec4(info_.options.steps, info_.options.refinements, 0, 0);
   params.bias = glm::vec4(static_cast<float>(f.bias), 0.0f, 0.0f, 0.0f);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
   // The dispatch: the whole image, or the block's bounding box clipped to it.
-  glm::ivec4 region(0, 0, f.width, f.height);
+  glm::ivec4 region(0, 0, width, height);
   if (f.blockRadius >= 0.0) {
     const auto lo = glm::max(glm::floor(f.blockCenter - f.blockRadius - 1.0), glm::dvec2(0.0));
-    const auto hi = glm::min(glm::ceil(f.blockCenter + f.blockRadius + 1.0), glm::dvec2(f.width, f.height));
+    const auto hi = glm::min(glm::ceil(f.blockCenter + f.blockRadius + 1.0), glm::dvec2(width, height));
     region =
         glm::ivec4(static_cast<int>(lo.x), static_cast<int>(lo.y), std::max(0, static_cast<int>(hi.x - lo.x)),
                    std::max(0, static_cast<int>(hi.y - lo.y)));
@@ -117,7 +119,7 @@ void WorldMarchPass::run(const FrameAttribs& f) {
 
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, f.width, f.height);
+                                                                 GL_R32F, width, height);
   gpu::bindMarchResources(program_.get(), params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,
                           steps);
   gpu::dispatchMarch(region.z, region.w, "WorldMarchPass::run");

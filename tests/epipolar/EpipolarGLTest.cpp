@@ -90,8 +90,6 @@ Image gpuMarch(const GpuScene& g, const RectifiedLayout& layout, GLuint map, int
   f.light = &g.scene.sun;
   f.medium = &g.scene.medium;
   f.cameraDepth = g.cameraDepth.get();
-  f.width = kWidth;
-  f.height = kHeight;
   f.rectifiedDepth = map;
   f.minMaxBuffer = p.trees.treeBuffer();
   f.output = out.get();
@@ -122,8 +120,6 @@ Image fallbackPath(const GpuScene& g, const EpipolarLayout& layout, int W = 512)
   ShadowResamplePass::FrameAttribs r;
   r.layout = &layout;
   r.shadowMap = g.shadow.get();
-  r.shadowWidth = kShadowSize;
-  r.shadowHeight = kShadowSize;
   r.lightClipFromWorld = g.lightMatrix;
   r.output = map.get();
   resample.run(r);
@@ -137,11 +133,7 @@ Image fallbackPath(const GpuScene& g, const EpipolarLayout& layout, int W = 512)
     f.light = &g.scene.sun;
     f.medium = &g.scene.medium;
     f.cameraDepth = g.cameraDepth.get();
-    f.width = kWidth;
-    f.height = kHeight;
     f.shadowMap = g.shadow.get();
-    f.shadowWidth = kShadowSize;
-    f.shadowHeight = kShadowSize;
     f.lightClipFromWorld = g.lightMatrix;
     f.bias = 1e-4;
     f.output = out.get();
@@ -171,11 +163,7 @@ Image gpuReference(const GpuScene& g) {
   f.light = &g.scene.sun;
   f.medium = &g.scene.medium;
   f.cameraDepth = g.cameraDepth.get();
-  f.width = kWidth;
-  f.height = kHeight;
   f.shadowMap = g.shadow.get();
-  f.shadowWidth = kShadowSize;
-  f.shadowHeight = kShadowSize;
   f.lightClipFromWorld = g.lightMatrix;
   f.bias = 1e-4;
   f.output = out.get();
@@ -211,8 +199,6 @@ TEST_CASE("epipolar GL: the resampling pass matches the CPU resampling (epipolar
     ShadowResamplePass::FrameAttribs f;
     f.layout = layout.get();
     f.shadowMap = g.shadow.get();
-    f.shadowWidth = kShadowSize;
-    f.shadowHeight = kShadowSize;
     f.lightClipFromWorld = g.lightMatrix;
     f.output = map.get();
     pass.run(f);
@@ -381,11 +367,17 @@ TEST_CASE("epipolar GL: bad input to the passes") {
     return std::string("no exception");
   };
   const int limit = gl::maxTextureSize();
-  CHECK(glError([] { MinMaxTreePass({0, 16}); }) == "InvalidArgument MinMaxTreePass.mapSize");
+  CHECK(glError([] {
+          MinMaxTreePass({0, 16});
+        }) == "InvalidArgument MinMaxTreePass::CreateInfo.mapWidth/mapHeight");
   CHECK(glError([&] { MinMaxTreePass({limit + 1, 16}); }) == "GlError");
-  CHECK(glError([] { RectifiedMarchPass({16, -1}); }) == "InvalidArgument RectifiedMarchPass.mapSize");
+  CHECK(glError([] {
+          RectifiedMarchPass({16, -1});
+        }) == "InvalidArgument RectifiedMarchPass::CreateInfo.mapWidth/mapHeight");
   CHECK(glError([&] { RectifiedMarchPass({16, limit + 1}); }) == "GlError");
-  CHECK(glError([] { ShadowResamplePass({0, 0}); }) == "InvalidArgument ShadowResamplePass.mapSize");
+  CHECK(glError([] {
+          ShadowResamplePass({0, 0});
+        }) == "InvalidArgument ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
   CHECK(glError([&] { ShadowResamplePass({limit * 2, 8}); }) == "GlError");
   CHECK(glError([] { WorldMarchPass({0, 4}); }) == "InvalidArgument WorldMarchOptions.steps");
 
@@ -396,22 +388,26 @@ TEST_CASE("epipolar GL: bad input to the passes") {
   ShadowResamplePass::FrameAttribs f;
   f.layout = &layout;
   f.shadowMap = g.shadow.get();
-  f.shadowWidth = kShadowSize;
-  f.shadowHeight = kShadowSize;
   f.lightClipFromWorld = g.lightMatrix;
   const gl::Handle wrongFormat = gl::createTexture2D(GL_RGBA32F, 64, H);
   f.output = wrongFormat.get();
-  CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass.FrameAttribs.output");
+  CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass::FrameAttribs.output");
   const gl::Handle out = gl::createTexture2D(GL_R32F, 64, H);
   f.output = out.get();
-  f.shadowWidth = 10;
-  CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass.FrameAttribs.shadowMap");
-  f.shadowWidth = kShadowSize;
+  // The shadow map's size is read from the texture: a texture that is not 2D, or no texture, is named.
+  const gl::Handle layered = gl::createTexture(GL_TEXTURE_2D_ARRAY);
+  glTextureStorage3D(layered.get(), 1, GL_R32F, kShadowSize, kShadowSize, 2);
+  for (const GLuint bad : {layered.get(), 0u}) {
+    f.shadowMap = bad;
+    CHECK(glError([&] { resample.run(f); }) == "InvalidArgument ShadowResamplePass::FrameAttribs.shadowMap");
+  }
+  f.shadowMap = g.shadow.get();
   f.lightClipFromWorld = g.scene.camera.clipFromWorld();
   CHECK(glError([&] { resample.run(f); }) == "InvalidArgument lightClipFromWorld");
   ShadowResamplePass wrongHeight({64, H + 1});
   f.lightClipFromWorld = g.lightMatrix;
-  CHECK(glError([&] { wrongHeight.run(f); }) == "InvalidArgument ShadowResamplePass.mapSize");
+  CHECK(glError([&] { wrongHeight.run(f); }) ==
+        "InvalidArgument ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
 
   // NaN in GPU depth inputs (documented handling, gpu_march.h). Depth textures clamp uploads to [0, 1],
   // so the NaN inputs are GL_R32F textures, which the passes accept as well.
@@ -419,8 +415,6 @@ TEST_CASE("epipolar GL: bad input to the passes") {
   const std::vector<float> nans(static_cast<std::size_t>(kWidth) * kHeight, std::nanf(""));
   glTextureSubImage2D(nanShadow.get(), 0, 0, 0, 64, 64, GL_RED, GL_FLOAT, nans.data());
   f.shadowMap = nanShadow.get();
-  f.shadowWidth = 64;
-  f.shadowHeight = 64;
   resample.run(f);
   const Image resampled = gl::readTexture(out.get(), 64, H, gl::TexelData::Red);
   CHECK(nonFinite(resampled) == 0);

@@ -75,8 +75,6 @@ GpuMarch gpuMarch(const SceneMaps& s, RectifiedMarchPass::Mode mode) {
   f.light = &s.scene.sun;
   f.medium = &s.scene.medium;
   f.cameraDepth = s.cameraTexture.get();
-  f.width = kWidth;
-  f.height = kHeight;
   f.rectifiedDepth = s.mapTexture.get();
   f.minMaxBuffer = trees.treeBuffer();
   f.output = out.get();
@@ -231,11 +229,7 @@ TEST_CASE("epipolar world march GL: the GPU pass agrees with the CPU world-space
   f.light = &scene.sun;
   f.medium = &scene.medium;
   f.cameraDepth = camera.get();
-  f.width = kWidth;
-  f.height = kHeight;
   f.shadowMap = shadow.get();
-  f.shadowWidth = S;
-  f.shadowHeight = S;
   f.lightClipFromWorld = lightMatrix;
   f.bias = bias;
   f.output = out.get();

@@ -20,7 +20,7 @@ using namespace crep::test;
 
 TEST_CASE("reduced resolution GL: the downsample and upsample passes follow the CPU rules") {
   CREP_REQUIRE_GL();
-  Frame f("colonnade"); // 160 x 90 camera depth with many edges
+  ScatteringFixture f("colonnade"); // 160 x 90 camera depth with many edges
   const Image depth = gl::readTexture(f.cameraDepth.get(), kWidth, kHeight, gl::TexelData::Depth);
   for (const int factor : {2}) {
     CAPTURE(factor);
@@ -57,7 +57,7 @@ TEST_CASE("reduced resolution GL: Scattering at half resolution against full res
   CREP_REQUIRE_GL();
   for (const std::string& name : scenes::sceneNames()) {
     CAPTURE(name);
-    Frame f(name);
+    ScatteringFixture f(name);
     Scattering full(smallInfo());
     Scattering::CreateInfo halfInfo = smallInfo();
     halfInfo.evaluationScale = 0.5;

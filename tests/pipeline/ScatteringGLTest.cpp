@@ -25,7 +25,7 @@ using namespace crep::test;
 
 TEST_CASE("Scattering: a projective frame gives the image of the passes run by hand") {
   CREP_REQUIRE_GL();
-  Frame f("colonnade");
+  ScatteringFixture f("colonnade");
   Scattering scattering(smallInfo());
   const Scattering::FrameResult r = scattering.run(f.attribs(true, true));
   CHECK(r.layout == Scattering::Layout::Projective);
@@ -60,7 +60,7 @@ TEST_CASE("Scattering: a projective frame gives the image of the passes run by h
 
 TEST_CASE("Scattering: fallback frames are prefiltered on the epipolar layout, close to the reference") {
   CREP_REQUIRE_GL();
-  Frame f("forest");
+  ScatteringFixture f("forest");
   Scattering scattering(smallInfo());
   struct Case {
     const char* name;
@@ -101,7 +101,7 @@ TEST_CASE("Scattering: fallback frames are prefiltered on the epipolar layout, c
 
 TEST_CASE("Scattering: bad input is named, GL state is restored") {
   CREP_REQUIRE_GL();
-  Frame f("boxes");
+  ScatteringFixture f("boxes");
   const auto parameterOf = [](const auto& call) -> std::string {
     try {
       call();
@@ -162,7 +162,7 @@ TEST_CASE("Scattering: bad input is named, GL state is restored") {
 TEST_CASE(
     "Scattering: the epipole exactly on a screen corner or edge gives a finite image near the reference") {
   CREP_REQUIRE_GL();
-  Frame f("forest");
+  ScatteringFixture f("forest");
   Scattering scattering(smallInfo());
   struct Case {
     const char* name;
@@ -196,7 +196,7 @@ TEST_CASE(
 
 TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
   CREP_REQUIRE_GL();
-  Frame f("forest");
+  ScatteringFixture f("forest");
   const Scattering::CreateInfo info = smallInfo();
   Scattering scattering(info);
   const std::size_t map = std::size_t(kMap) * kMap * 4; // D32F rasterized + R32F resampled

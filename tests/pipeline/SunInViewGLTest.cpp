@@ -53,7 +53,7 @@ TEST_CASE(
   Scattering scattering(accurateInfo());
   for (const std::string& name : scenes::sceneNames()) {
     CAPTURE(name);
-    Frame f(name);
+    ScatteringFixture f(name);
     // The sun 12 degrees right of and 11 degrees above the view axis ("sunset" has it there already).
     if (name != "sunset") f.lightToward(1.0, 0.25, 0.2);
     const Scattering::FrameResult r = scattering.run(f.attribs(false, true));
@@ -91,7 +91,6 @@ TEST_CASE("sun in view: the analytic ground and half-space occluder against the 
   const DirectionalLight light(-glm::normalize(camera.forward() + 0.3 * camera.up()),
                                glm::dvec3(2.0, 1.8, 1.5));
   Scattering::ShadowMap shadow;
-  shadow.width = shadow.height = kShadow;
   shadow.lightClipFromWorld = analyticLightMatrix(light);
   gl::Handle shadowTexture, depthTexture;
   uploadAndKeep(shadowTexture, halfSpaceShadowMap(plane, shadow.lightClipFromWorld, kShadow));
@@ -125,7 +124,7 @@ TEST_CASE("sun in view: the analytic ground and half-space occluder against the 
 TEST_CASE("sun in view: the light just outside the screen and behind the camera") {
   CREP_REQUIRE_GL();
   Scattering scattering(accurateInfo());
-  Frame f("forest");
+  ScatteringFixture f("forest");
   struct Case {
     const char* name;
     glm::dvec3 direction; // the direction the light travels
@@ -150,7 +149,7 @@ TEST_CASE("sun in view: the light just outside the screen and behind the camera"
 TEST_CASE("sun in view: a light sweep through the view, every step prefiltered and without flashes") {
   CREP_REQUIRE_GL();
   Scattering scattering(accurateInfo());
-  Frame f("colonnade");
+  ScatteringFixture f("colonnade");
   const Camera& c = f.scene.camera;
   // The direction toward the light turns in the plane of forward and right, 20 degrees above it: the epipole
   // enters the screen from the left, crosses it, leaves it on the right, goes to infinity and comes back as
@@ -196,7 +195,7 @@ TEST_CASE("sun in view: a light sweep through the view, every step prefiltered a
 TEST_CASE("sun in view: a slow camera strafe on a fallback frame does not shimmer") {
   CREP_REQUIRE_GL();
   Scattering scattering(accurateInfo());
-  Frame f("sunset");
+  ScatteringFixture f("sunset");
   const Camera start = f.scene.camera;
   // 8 frames, 2 cm to the right each (a tenth of a pixel at 20 m): the slices, their bounds and the
   // resampled texels move with the camera.

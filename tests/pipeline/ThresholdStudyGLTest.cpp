@@ -23,7 +23,7 @@ using namespace crep::test;
 
 TEST_CASE("threshold study: the projective path next to the span and epipole-angle thresholds") {
   CREP_REQUIRE_GL();
-  Frame f("forest");
+  ScatteringFixture f("forest");
   Scattering::CreateInfo defaults = smallInfo();
   defaults.mapSize = 1024;
   Scattering::CreateInfo relaxed = defaults;

@@ -24,8 +24,8 @@ namespace crep::test {
 
 constexpr int kWidth = 160, kHeight = 90, kMap = 256, kShadow = 1024;
 
-struct Frame {
-  explicit Frame(const std::string& name)
+struct ScatteringFixture {
+  explicit ScatteringFixture(const std::string& name)
       : scene(scenes::makeScene(name, double(kWidth) / kHeight)), renderer(scene.mesh) {
     cameraDepth = scenes::createDepthTexture(kWidth, kHeight);
     renderer.renderDepth(scene.camera.clipFromWorld(), cameraDepth.get(), 0, 0, 0, kWidth, kHeight);
@@ -39,7 +39,6 @@ struct Frame {
   }
   void setLight(const DirectionalLight& light) {
     scene.sun = light;
-    shadow.width = shadow.height = kShadow;
     shadow.lightClipFromWorld = scenes::standardLightClipFromWorld(light, scene.boundsMin, scene.boundsMax);
     shadow.bias = 1e-4;
     renderer.renderDepth(shadow.lightClipFromWorld, shadowTexture.get(), 0, 0, 0, kShadow, kShadow,
@@ -74,11 +73,7 @@ struct Frame {
     f.light = &scene.sun;
     f.medium = &scene.medium;
     f.cameraDepth = cameraDepth.get();
-    f.width = kWidth;
-    f.height = kHeight;
     f.shadowMap = map.texture;
-    f.shadowWidth = map.width;
-    f.shadowHeight = map.height;
     f.lightClipFromWorld = map.lightClipFromWorld;
     f.bias = map.bias;
     f.output = out.get();
@@ -116,7 +111,7 @@ inline void checkStages(const Scattering::FrameResult& r) {
 
 /// The brute-force march (exact visibility per texel) over the rectified map a frame was prefiltered from:
 /// the accuracy floor the map itself sets, without the prefilter's approximations.
-inline Image marchSameMap(Frame& f, const Scattering::FrameResult& r) {
+inline Image marchSameMap(ScatteringFixture& f, const Scattering::FrameResult& r) {
   const Scattering::FrameResult::RectifiedMapView& m = r.rectifiedMap;
   RectifiedMarchPass pass({m.width, m.height, RectifiedMarchPass::Mode::BruteForce});
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
@@ -126,8 +121,6 @@ inline Image marchSameMap(Frame& f, const Scattering::FrameResult& r) {
   a.light = &f.scene.sun;
   a.medium = &f.scene.medium;
   a.cameraDepth = f.cameraDepth.get();
-  a.width = kWidth;
-  a.height = kHeight;
   a.rectifiedDepth = m.texture;
   a.output = out.get();
   pass.run(a);

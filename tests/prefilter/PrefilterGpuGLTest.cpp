@@ -487,17 +487,17 @@ TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
       pass.run(f);
     };
   };
-  using Frame = PrefilterPass::FrameAttribs;
-  CHECK(invalidParameter(runWith([](Frame& f) { f.layout = nullptr; })) ==
+  using Attribs = PrefilterPass::FrameAttribs;
+  CHECK(invalidParameter(runWith([](Attribs& f) { f.layout = nullptr; })) ==
         "PrefilterPass::FrameAttribs.layout");
-  CHECK(invalidParameter(runWith([](Frame& f) { f.medium = nullptr; })) ==
+  CHECK(invalidParameter(runWith([](Attribs& f) { f.medium = nullptr; })) ==
         "PrefilterPass::FrameAttribs.medium");
-  CHECK(invalidParameter(runWith([](Frame& f) { f.rectifiedDepth = 0; })) ==
+  CHECK(invalidParameter(runWith([](Attribs& f) { f.rectifiedDepth = 0; })) ==
         "PrefilterPass::FrameAttribs.rectifiedDepth");
-  CHECK(invalidParameter(runWith([](Frame& f) { f.rectifiedDepth = 123456; })) ==
+  CHECK(invalidParameter(runWith([](Attribs& f) { f.rectifiedDepth = 123456; })) ==
         "PrefilterPass::FrameAttribs.rectifiedDepth");
   const gl::Handle wrongSize = createTexture2D(GL_R32F, kMapW + 1, kMapH);
-  CHECK(invalidParameter(runWith([&](Frame& f) { f.rectifiedDepth = wrongSize.get(); })) ==
+  CHECK(invalidParameter(runWith([&](Attribs& f) { f.rectifiedDepth = wrongSize.get(); })) ==
         "PrefilterPass::FrameAttribs.rectifiedDepth");
   {
     // K = 2 splits x P = 3 regions do not divide 250 columns.
@@ -510,7 +510,7 @@ TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
     f.medium = &s.scene.medium;
     CHECK(invalidParameter([&] { three.run(f); }) == "PrefilterPass::FrameAttribs.layout");
   }
-  CHECK_NOTHROW(runWith([](Frame&) {})());
+  CHECK_NOTHROW(runWith([](Attribs&) {})());
 
   EvaluatePass eval({});
   const gl::Handle out = createTexture2D(GL_RGBA32F, kScreenW, kScreenH);

@@ -10,8 +10,8 @@
 
 namespace crep::tool {
 
-const RectifiedGpuMap* Frame::rectified(const MethodSettings& settings, StageTimings& timings,
-                                        Rectification* rectOut) {
+const RectifiedGpuMap* FrameInputs::rectified(const MethodSettings& settings, StageTimings& timings,
+                                              Rectification* rectOut) {
   if (rect_ && rectifiedSize_ == settings.mapSize && rectifiedOptions_ == settings.rectify) {
     if (rectOut) *rectOut = *rect_;
     if (!rectified_) return nullptr;

@@ -32,7 +32,7 @@ struct MethodSettings {
   /// M, storage format, regions per split, ... of the prefiltered method (crep::Scattering's defaults)
   PrefilterOptions prefilter = Scattering::CreateInfo{}.prefilter;
   RectifyOptions rectify = Scattering::CreateInfo{}.rectify; ///< splits (logarithmic; Scattering's defaults)
-  int steps = 256; ///< world-space reference march: sections per pixel
+  int steps = 256;    ///< world-space reference march: sections per pixel
   double scale = 1.0; ///< prefiltered method: Scattering::CreateInfo::evaluationScale (1, 0.5 or 0.25)
 };
 
@@ -49,8 +49,8 @@ struct RectifiedGpuMap {
 };
 
 /// One frame's inputs: what every method reads. GL names are owned here.
-struct Frame {
-  Frame(const Camera& c, const DirectionalLight& l, const Medium& m) : camera(c), light(l), medium(m) {}
+struct FrameInputs {
+  FrameInputs(const Camera& c, const DirectionalLight& l, const Medium& m) : camera(c), light(l), medium(m) {}
 
   Camera camera;
   DirectionalLight light;

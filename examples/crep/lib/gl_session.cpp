@@ -3,8 +3,8 @@
 #include "frame.h"
 
 #include <crep/core/error.h>
-#include <crep/support/gl_context.h>
 #include <crep/core/shader_library.h>
+#include <crep/support/gl_context.h>
 
 #include <epoxy/gl.h>
 
@@ -77,7 +77,7 @@ Image readRgba(std::uint32_t texture, int width, int height) {
   return gl::readTexture(texture, width, height, gl::TexelData::Rgba);
 }
 
-gl::Handle compositeImage(const Frame& frame, std::uint32_t surfaceColor, std::uint32_t scattering) {
+gl::Handle compositeImage(const FrameInputs& frame, std::uint32_t surfaceColor, std::uint32_t scattering) {
   static gl::Handle* program = nullptr; // built once per process, lives with the context
   if (!program) program = new gl::Handle(buildProgram({{ShaderStage::Compute, "passes/composite.comp", {}}}));
   gl::Handle out = gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "--size");

@@ -12,7 +12,7 @@
 
 namespace crep::tool {
 
-struct Frame;
+struct FrameInputs;
 
 /// The process-wide GL context of the tool (created on first call; never destroyed: destroying the last
 /// context unloads Mesa's driver, after which LeakSanitizer cannot attribute the driver's own
@@ -30,7 +30,7 @@ gl::Handle uploadR32F(const Image& image, const char* parameter);
 /// Reads an RGBA texture back (row 0 = bottom).
 Image readRgba(std::uint32_t texture, int width, int height);
 /// surface * exp(-sigma_t s) + in-scattering (glsl/passes/composite.comp), a new RGBA32F texture.
-gl::Handle compositeImage(const Frame& frame, std::uint32_t surfaceColor, std::uint32_t scattering);
+gl::Handle compositeImage(const FrameInputs& frame, std::uint32_t surfaceColor, std::uint32_t scattering);
 
 /// Throws crep::Error when `image` holds NaN or infinity (refuse to write a silently wrong image).
 void requireFinite(const Image& image, const std::string& what);

@@ -25,12 +25,12 @@ namespace crep::tool {
 
 namespace {
 
-gl::Handle newScatteringTexture(const Frame& frame) {
+gl::Handle newScatteringTexture(const FrameInputs& frame) {
   return gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "--size");
 }
 
 /// WorldMarchPass on `pixels` of the frame (all, or the block around `blockCenter`).
-void runWorldMarch(const Frame& frame, const MethodSettings& settings, std::uint32_t scattering,
+void runWorldMarch(const FrameInputs& frame, const MethodSettings& settings, std::uint32_t scattering,
                    const glm::dvec2& blockCenter = glm::dvec2(0.0), double blockRadius = -1.0) {
   WorldMarchPass::CreateInfo info;
   info.options.steps = settings.steps;
@@ -40,11 +40,7 @@ void runWorldMarch(const Frame& frame, const MethodSettings& settings, std::uint
   a.light = &frame.light;
   a.medium = &frame.medium;
   a.cameraDepth = frame.cameraDepth.get();
-  a.width = frame.width;
-  a.height = frame.height;
   a.shadowMap = frame.shadowMap.get();
-  a.shadowWidth = frame.shadowWidth;
-  a.shadowHeight = frame.shadowHeight;
   a.lightClipFromWorld = frame.lightClipFromWorld;
   a.bias = frame.shadowBias;
   a.output = scattering;
@@ -56,7 +52,7 @@ void runWorldMarch(const Frame& frame, const MethodSettings& settings, std::uint
 
 /// The world-space reference: every pixel's view ray marched against the standard shadow map
 /// (crep/scatter/world_march.h), independent of any rectification.
-MethodOutput runReference(Frame& frame, const MethodSettings& settings) {
+MethodOutput runReference(FrameInputs& frame, const MethodSettings& settings) {
   MethodOutput out;
   out.used = "reference";
   out.detail = std::to_string(settings.steps) + " march steps, standard map " +
@@ -74,7 +70,7 @@ struct EpipolarMap {
   int width = 0, height = 0;
 };
 
-EpipolarMap makeEpipolarMap(const Frame& frame, const MethodSettings& settings, StageTimings& timings) {
+EpipolarMap makeEpipolarMap(const FrameInputs& frame, const MethodSettings& settings, StageTimings& timings) {
   EpipolarMap m;
   EpipolarOptions options;
   options.regions = settings.rectify.splits;
@@ -89,8 +85,6 @@ EpipolarMap makeEpipolarMap(const Frame& frame, const MethodSettings& settings, 
     ShadowResamplePass::FrameAttribs a;
     a.layout = m.layout.get();
     a.shadowMap = frame.shadowMap.get();
-    a.shadowWidth = frame.shadowWidth;
-    a.shadowHeight = frame.shadowHeight;
     a.lightClipFromWorld = frame.lightClipFromWorld;
     a.output = m.texture.get();
     pass.run(a);
@@ -100,7 +94,7 @@ EpipolarMap makeEpipolarMap(const Frame& frame, const MethodSettings& settings, 
 }
 
 /// The world-space march of the pixels around the epipole (Klehm et al. 2014, Fig. 8), over `scattering`.
-void marchEpipoleBlock(const Frame& frame, const MethodSettings& settings, const EpipolarLayout& layout,
+void marchEpipoleBlock(const FrameInputs& frame, const MethodSettings& settings, const EpipolarLayout& layout,
                        std::uint32_t scattering, StageTimings& timings) {
   const auto centre = layout.epipolePixel();
   if (!centre || layout.epipoleBlockRadiusPixels() <= 0.0) return;
@@ -111,7 +105,7 @@ void marchEpipoleBlock(const Frame& frame, const MethodSettings& settings, const
 
 /// The min/max tree (tree = true) or brute-force march of every pixel's view ray along its row of the
 /// rectified map (projective), or of the epipolar fallback map (plus the epipole block).
-MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, bool tree) {
+MethodOutput runRectifiedMarch(FrameInputs& frame, const MethodSettings& settings, bool tree) {
   MethodOutput out;
   out.used = tree ? "minmax" : "brute";
   Rectification rect;
@@ -161,8 +155,6 @@ MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, boo
     a.light = &frame.light;
     a.medium = &frame.medium;
     a.cameraDepth = frame.cameraDepth.get();
-    a.width = frame.width;
-    a.height = frame.height;
     a.rectifiedDepth = texture;
     a.minMaxBuffer = trees ? trees->treeBuffer() : 0;
     a.output = out.scattering.get();
@@ -173,10 +165,10 @@ MethodOutput runRectifiedMarch(Frame& frame, const MethodSettings& settings, boo
   return out;
 }
 
-MethodOutput runMinMax(Frame& frame, const MethodSettings& settings) {
+MethodOutput runMinMax(FrameInputs& frame, const MethodSettings& settings) {
   return runRectifiedMarch(frame, settings, true);
 }
-MethodOutput runBrute(Frame& frame, const MethodSettings& settings) {
+MethodOutput runBrute(FrameInputs& frame, const MethodSettings& settings) {
   return runRectifiedMarch(frame, settings, false);
 }
 
@@ -184,7 +176,7 @@ MethodOutput runBrute(Frame& frame, const MethodSettings& settings) {
 /// rasterized with the scene's casters (built-in scenes) or resampled from the standard shadow map (users'
 /// data) when the rectification is projective, else the epipolar fallback with the epipole block. The
 /// stages are Scattering's wall-clock stage times (like every other method's).
-MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
+MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
   MethodOutput out;
   out.used = "prefilter";
   Scattering::CreateInfo info;
@@ -196,8 +188,7 @@ MethodOutput runPrefilter(Frame& frame, const MethodSettings& settings) {
   info.epipoleBlock.steps = settings.steps;
   info.evaluationScale = settings.scale;
   auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });
-  const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.shadowWidth, frame.shadowHeight,
-                                     frame.lightClipFromWorld, frame.shadowBias};
+  const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.lightClipFromWorld, frame.shadowBias};
   Scattering::FrameAttribs a;
   a.camera = &frame.camera;
   a.light = &frame.light;
@@ -259,7 +250,7 @@ const Method& findMethod(const std::string& name, const std::string& option) {
   throw UsageError("option " + option + ": '" + name + "' is not a method (" + methodNames() + ")");
 }
 
-MethodOutput runMethod(const std::string& name, Frame& frame, const MethodSettings& settings) {
+MethodOutput runMethod(const std::string& name, FrameInputs& frame, const MethodSettings& settings) {
   return findMethod(name).run(frame, settings);
 }
 

@@ -1,6 +1,6 @@
-// The tool's registry of scattering methods: each a function that runs on one Frame and reports its
+// The tool's registry of scattering methods: each a function that runs on one FrameInputs and reports its
 // stages. Adding a method is one entry in methodRegistry() (methods.cpp): a name, a one-line summary and
-// a function Frame -> MethodOutput built from the library's passes.
+// a function FrameInputs -> MethodOutput built from the library's passes.
 #pragma once
 
 #include "frame.h"
@@ -27,7 +27,7 @@ struct Method {
   std::string name;
   std::string summary;
   bool reference = false; ///< the reference of `crep compare`
-  std::function<MethodOutput(Frame&, const MethodSettings&)> run;
+  std::function<MethodOutput(FrameInputs&, const MethodSettings&)> run;
 };
 
 /// Every method available in this build, the reference first.
@@ -39,6 +39,6 @@ std::string methodNames();
 
 /// Runs `name` and, when the rectification is not projective and the method needs it, the fallback
 /// (announced on stderr by the method).
-MethodOutput runMethod(const std::string& name, Frame& frame, const MethodSettings& settings);
+MethodOutput runMethod(const std::string& name, FrameInputs& frame, const MethodSettings& settings);
 
 } // namespace crep::tool

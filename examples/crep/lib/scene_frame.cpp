@@ -27,8 +27,8 @@ SceneFrame makeSceneFrame(const std::string& name, int width, int height, int sh
     glFinish();
     return r;
   });
-  s.frame = std::make_unique<Frame>(scene.camera, scene.sun, scene.medium);
-  Frame& f = *s.frame;
+  s.frame = std::make_unique<FrameInputs>(scene.camera, scene.sun, scene.medium);
+  FrameInputs& f = *s.frame;
   f.width = width;
   f.height = height;
   f.renderer = s.renderer.get();

@@ -1,4 +1,5 @@
-// A built-in scene (crep/scenes) rendered into a Frame: the standard shadow pass and the lit camera pass.
+// A built-in scene (crep/scenes) rendered into a FrameInputs: the standard shadow pass and the lit camera
+// pass.
 #pragma once
 
 #include "frame.h"
@@ -19,7 +20,7 @@ namespace crep::tool {
 struct SceneFrame {
   std::unique_ptr<scenes::Scene> scene;
   std::unique_ptr<scenes::SceneRenderer> renderer;
-  std::unique_ptr<Frame> frame;
+  std::unique_ptr<FrameInputs> frame;
   gl::Handle color; ///< lit surfaces, RGBA32F width x height
   SceneFrame();
   ~SceneFrame();

@@ -68,6 +68,20 @@ Handle createDynamicBuffer(std::size_t bytes);
 std::uint32_t scratchTexture2D(Handle& texture, int& capacityWidth, int& capacityHeight,
                                std::uint32_t internalFormat, int width, int height);
 
+/// Level 0 of a caller's texture as GL reports it.
+struct TextureLevel {
+  std::uint32_t target = 0; ///< GL_TEXTURE_2D, GL_TEXTURE_2D_ARRAY, ...
+  int width = 0, height = 0, depth = 0;
+  std::uint32_t internalFormat = 0;
+};
+/// The target, size and format of `texture`'s level 0; InvalidArgument naming `parameter` if `texture` is
+/// 0 or not an existing texture. The passes read the sizes of the textures they are given from the
+/// textures themselves (no per-frame size fields), and check them against each other and their
+/// create-infos.
+TextureLevel textureLevel(const char* parameter, std::uint32_t texture);
+/// textureLevel(), and InvalidArgument naming `parameter` unless the target is GL_TEXTURE_2D.
+TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture);
+
 /// Throws InvalidArgument naming `parameter` unless `texture` names an existing texture whose level 0 is
 /// width x height (sizes > 0) and, when `internalFormat` is not 0, of that internal format.
 void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,

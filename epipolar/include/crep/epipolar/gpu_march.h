@@ -42,8 +42,8 @@ public:
     int mapWidth = 0;  ///< W texels (> 0, <= GL_MAX_TEXTURE_SIZE)
     int mapHeight = 0; ///< H texels (> 0, <= GL_MAX_TEXTURE_SIZE)
   };
-  /// Throws InvalidArgument ("MinMaxTreePass.mapSize") for sizes <= 0, GlError beyond GL_MAX_TEXTURE_SIZE
-  /// or above 2^16 columns (16 tree levels), ShaderError if the shader does not build.
+  /// Throws InvalidArgument ("MinMaxTreePass::CreateInfo.mapWidth/mapHeight") for sizes <= 0, GlError beyond
+  /// GL_MAX_TEXTURE_SIZE or above 2^16 columns (16 tree levels), ShaderError if the shader does not build.
   explicit MinMaxTreePass(const CreateInfo& info);
 
   /// Builds the trees of `rectifiedDepth` (the caller's W x H depth texture).
@@ -83,15 +83,16 @@ public:
     const Camera* camera = nullptr;
     const DirectionalLight* light = nullptr;
     const Medium* medium = nullptr;
-    std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
-    int width = 0, height = 0;     ///< camera image size (pixels)
+    /// GL_TEXTURE_2D of depth-buffer values of `camera` (its convention); the image size is its size
+    std::uint32_t cameraDepth = 0;
     std::uint32_t rectifiedDepth =
         0;                          ///< mapWidth x mapHeight depth texture rendered / resampled for `layout`
     std::uint32_t minMaxBuffer = 0; ///< MinMaxTreePass::treeBuffer() of that map (MinMaxTree mode)
-    std::uint32_t output = 0;       ///< GL_RGBA32F width x height texture
-    std::uint32_t stepsOutput = 0;  ///< GL_R32F width x height texture, or 0 (steps not written)
+    std::uint32_t output = 0;       ///< GL_RGBA32F texture, the size of cameraDepth
+    std::uint32_t stepsOutput = 0;  ///< GL_R32F texture, the size of cameraDepth, or 0 (steps not written)
   };
-  /// Throws InvalidArgument ("RectifiedMarchPass.mapSize") / GlError like MinMaxTreePass.
+  /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
+  /// MinMaxTreePass.
   explicit RectifiedMarchPass(const CreateInfo& info);
   /// Throws InvalidArgument naming the field of FrameAttribs (null pointers, zero names, sizes that do not
   /// match the textures, wrong output formats, a layout with no GPU mapping or too many regions).

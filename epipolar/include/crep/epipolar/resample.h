@@ -54,13 +54,13 @@ public:
   };
   struct FrameAttribs {
     const RectifiedLayout* layout = nullptr; ///< ProjectiveLayout or EpipolarLayout (not stored)
-    std::uint32_t shadowMap = 0;             ///< standard shadow map: depth texture (or GL_R32F)
-    int shadowWidth = 0, shadowHeight = 0;
+    /// standard shadow map: GL_TEXTURE_2D depth (or GL_R32F) texture, any size (read from the texture)
+    std::uint32_t shadowMap = 0;
     glm::dmat4 lightClipFromWorld{1.0}; ///< the matrix it was rendered with (validateLightMatrix)
     std::uint32_t output = 0;           ///< GL_R32F mapWidth x mapHeight texture (written)
   };
-  /// Throws InvalidArgument ("ShadowResamplePass.mapSize") for sizes <= 0, GlError beyond
-  /// GL_MAX_TEXTURE_SIZE.
+  /// Throws InvalidArgument ("ShadowResamplePass::CreateInfo.mapWidth/mapHeight") for sizes <= 0, GlError
+  /// beyond GL_MAX_TEXTURE_SIZE.
   explicit ShadowResamplePass(const CreateInfo& info);
   /// Throws InvalidArgument naming the FrameAttribs field.
   void run(const FrameAttribs& frame);

@@ -110,8 +110,7 @@ public:
 
   /// The engine's standard shadow map (depth-buffer values of lightClipFromWorld, cleared to 1).
   struct ShadowMap {
-    std::uint32_t texture = 0; ///< GL_TEXTURE_2D depth (or R32F) texture
-    int width = 0, height = 0;
+    std::uint32_t texture = 0; ///< GL_TEXTURE_2D depth (or R32F) texture, any size (read from the texture)
     glm::dmat4 lightClipFromWorld{1.0}; ///< orthographic, looking along the light (validateLightMatrix)
     double bias = 0.0;                  ///< added to the stored depth by the epipole block march
   };

@@ -111,14 +111,14 @@ public:
     const Camera* camera = nullptr;
     const DirectionalLight* light = nullptr;
     const Medium* medium = nullptr;
-    std::uint32_t cameraDepth = 0; ///< width x height depth texture of `camera`
-    int width = 0, height = 0;
-    std::uint32_t shadowMap = 0; ///< standard shadow map (depth texture) rendered with lightClipFromWorld
-    int shadowWidth = 0, shadowHeight = 0;
+    /// GL_TEXTURE_2D of depth-buffer values of `camera` (its convention); the image size is its size
+    std::uint32_t cameraDepth = 0;
+    std::uint32_t shadowMap =
+        0; ///< standard shadow map (GL_TEXTURE_2D depth) rendered with lightClipFromWorld
     glm::dmat4 lightClipFromWorld{1.0};
     double bias = 0.0;             ///< added to the stored depth (depth-buffer units)
-    std::uint32_t output = 0;      ///< GL_RGBA32F width x height
-    std::uint32_t stepsOutput = 0; ///< GL_R32F width x height, or 0
+    std::uint32_t output = 0;      ///< GL_RGBA32F, the size of cameraDepth
+    std::uint32_t stepsOutput = 0; ///< GL_R32F, the size of cameraDepth, or 0
     /// Epipole block: when blockRadius >= 0, only pixels whose centre is within blockRadius pixels of
     /// blockCenter (pixel coordinates, origin at the bottom-left corner of the image) are marched.
     glm::dvec2 blockCenter{0.0};
