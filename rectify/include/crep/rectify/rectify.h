@@ -96,7 +96,11 @@ enum class SplitScheme {
 /// How the splits are laid out in the rectified map.
 enum class SplitLayout {
   Regions, ///< split k renders into the k-th of K equal column ranges of one 2D map (a row is contiguous)
-  Layers,  ///< split k renders into layer k of a 2D texture array, full width
+  /// Split k renders into layer k of a 2D texture array, full width: only for engines that sample the
+  /// splits themselves (splitViewport() gives the layer). Nothing downstream in this library reads such a
+  /// map: ProjectiveLayout, RectifiedShadowPass, the prefilter and the marches need Regions and say so
+  /// (InvalidArgument naming the layout).
+  Layers,
 };
 
 /// The reference ray of an epipolar slice (Sec. 3.2): the one ray whose world step per texel stands for
