@@ -2,7 +2,8 @@ cmake_minimum_required(VERSION 3.25)
 # Script mode: installs the build tree into WORK_DIR/prefix, then configures, builds and runs two
 # consumer projects against it and checks the pkg-config files:
 #   runtime/  an engine: find_package(crepuscular) (runtime only), its own EGL context, the prefilter
-#             and evaluation passes on it; its link line must not mention OpenEXR or stb
+#             and evaluation passes on it, then a crep::Scattering frame from its own reversed-Z camera
+#             matrices and shadow map; its link line must not mention OpenEXR or stb
 #   support/  a tool: find_package(crepuscular COMPONENTS support), an EXR round trip
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)

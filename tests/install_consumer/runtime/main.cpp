@@ -2,7 +2,9 @@
 // owns the GL context (a headless EGL context on Mesa's surfaceless platform, created with libEGL in
 // engine_context.cpp) and its GL loader (libepoxy); the library's passes run on that context. It rectifies a
 // camera and a sun, fills a rectified depth map and a camera depth buffer with ramps, runs
-// crep::PrefilterPass and crep::EvaluatePass and checks the scattering image.
+// crep::PrefilterPass and crep::EvaluatePass and checks the scattering image; then one frame through the
+// frame-level API (crep::Scattering) with the engine's own reversed-Z, [0, 1], infinite-far camera matrices
+// and its own standard shadow map, checked against the same frame through a GL-convention camera.
 //
 // Exit status: 0 success, 1 failure, 77 no GL context (the install test treats that as a failure too:
 // llvmpipe is expected wherever the tests run).
@@ -12,6 +14,7 @@
 #include <crep/core/medium.h>
 #include <crep/core/shader_library.h>
 #include <crep/core/version.h>
+#include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
@@ -73,6 +76,93 @@ int checks() {
     return 1;
   } catch (const crep::InvalidArgument& e) {
     std::printf("expected error: %s\n", e.what());
+  }
+  return 0;
+}
+
+/// An RGBA32F texture the size of the camera image.
+GLuint outputTexture(int width, int height) {
+  GLuint texture = 0;
+  glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+  glTextureStorage2D(texture, 1, GL_RGBA32F, width, height);
+  return texture;
+}
+
+/// One frame through crep::Scattering, as an engine with reversed-Z and its own shadow map runs it: the
+/// camera from the engine's matrices, its depth buffer in its convention (near / Z, sky 0), its standard
+/// shadow map. The same frame through `camera` (OpenGL conventions, standard depth) must agree.
+int engineFrame(const crep::Camera& camera, const crep::DirectionalLight& sun, const crep::Medium& medium,
+                int width, int height) {
+  // The engine's projection: reversed-Z, [0, 1] clip depth (glClipControl), infinite far plane.
+  glm::dmat4 clipFromView(0.0);
+  const double ty = std::tan(0.5 * camera.fovY());
+  clipFromView[0][0] = 1.0 / (ty * camera.aspect());
+  clipFromView[1][1] = 1.0 / ty;
+  clipFromView[2][3] = -1.0;
+  clipFromView[3][2] = camera.near();
+  const crep::Camera engineCamera = crep::Camera::fromMatrices(camera.viewFromWorld(), clipFromView,
+                                                               crep::ClipDepth::ZeroToOne, camera.far());
+  // Depth buffers of a wall at view depth 4 + 2 v (v = row / height), sky in the top rows.
+  std::vector<float> standardDepth(std::size_t(width) * height), reversedDepth(standardDepth.size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const bool sky = y >= height - 4;
+      const double z = 4.0 + 2.0 * y / height;
+      standardDepth[std::size_t(y) * width + x] = sky ? 1.0f : float(camera.depthBufferValue(z));
+      reversedDepth[std::size_t(y) * width + x] = sky ? 0.0f : float(engineCamera.depthBufferValue(z));
+    }
+  // The engine's standard shadow map: orthographic along the sun over the frustum, an occluder over half
+  // of it.
+  const crep::FrustumCorners corners = camera.frustumCorners();
+  const crep::Scattering::ShadowMap shadowMap{
+      .texture = 0, .lightClipFromWorld = crep::orthographicLightClipFromWorld(sun, corners), .bias = 1e-4};
+  constexpr int kShadowSize = 128;
+  std::vector<float> shadow(std::size_t(kShadowSize) * kShadowSize);
+  for (int y = 0; y < kShadowSize; ++y)
+    for (int x = 0; x < kShadowSize; ++x)
+      shadow[std::size_t(y) * kShadowSize + x] = x < kShadowSize / 2 ? 0.3f : 1.0f;
+
+  crep::Scattering scattering({.width = width, .height = height, .mapSize = 64});
+  std::vector<float> images[2];
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool engine = pass == 1;
+    const GLuint depth = depthTexture(width, height, engine ? reversedDepth : standardDepth);
+    const GLuint shadowTexture = depthTexture(kShadowSize, kShadowSize, shadow);
+    const GLuint output = outputTexture(width, height);
+    crep::Scattering::ShadowMap map = shadowMap;
+    map.texture = shadowTexture;
+    crep::Scattering::FrameAttribs f;
+    f.camera = engine ? &engineCamera : &camera;
+    f.light = &sun;
+    f.medium = &medium;
+    f.cameraDepth = depth;
+    f.output = output;
+    f.shadowMap = &map;
+    const crep::Scattering::FrameResult r = scattering.run(f);
+    std::printf("crep::Scattering, %s camera: %s layout, %zu stages\n", engine ? "reversed-Z" : "GL",
+                r.layout == crep::Scattering::Layout::Projective ? "projective" : "epipolar",
+                r.stages.size());
+    images[pass].resize(std::size_t(width) * height * 4);
+    glGetTextureImage(output, 0, GL_RGBA, GL_FLOAT, GLsizei(images[pass].size() * sizeof(float)),
+                      images[pass].data());
+    glDeleteTextures(1, &output);
+    glDeleteTextures(1, &shadowTexture);
+    glDeleteTextures(1, &depth);
+  }
+  double peak = 0.0, worst = 0.0;
+  for (std::size_t i = 0; i < images[0].size(); ++i) {
+    if (!std::isfinite(images[1][i])) {
+      std::fprintf(stderr, "consumer: crep::Scattering value %g at %zu\n", double(images[1][i]), i);
+      return 1;
+    }
+    if (i % 4 != 3) peak = std::fmax(peak, images[0][i]);
+    worst = std::fmax(worst, std::fabs(double(images[1][i]) - images[0][i]));
+  }
+  std::printf("crep::Scattering: reversed-Z engine camera vs GL camera: max |difference| %.3g, peak %.4g\n",
+              worst, peak);
+  if (!(peak > 0.0) || !(worst <= 1e-4 * peak)) {
+    std::fprintf(stderr, "consumer: the engine camera's frame differs from the GL camera's\n");
+    return 1;
   }
   return 0;
 }
@@ -158,6 +248,8 @@ int main() {
     glDeleteTextures(1, &output);
     glDeleteTextures(1, &cameraDepth);
     glDeleteTextures(1, &rectifiedDepth);
+    if (const int status = engineFrame(camera, sun, medium, kCameraWidth, kCameraHeight); status != 0)
+      return status;
     std::printf("consumer ok: %zu embedded shader files; %dx%d scattering image, max in-scattered %.4g, "
                 "min transmittance %.4g\n",
                 crep::ShaderLibrary::files().size(), kCameraWidth, kCameraHeight, maxRadiance,
