@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -41,19 +42,39 @@ DirectionalLight::DirectionalLight(const glm::dvec3& direction, const glm::dvec3
   requireColor("DirectionalLight.irradiance", irradiance);
 }
 
-SpotLight::SpotLight(const glm::dvec3& position, const glm::dvec3& direction, double coneAngle, double range,
-                     const glm::dvec3& intensity, double nearPlane)
-    : position_(position), direction_(unitDirection("SpotLight.direction", direction)), coneAngle_(coneAngle),
-      range_(range), near_(nearPlane), intensity_(intensity) {
-  detail::requireFiniteVec3("SpotLight.position", position);
-  if (!std::isfinite(coneAngle) || !(coneAngle > 0.0) || !(coneAngle < 0.5 * std::numbers::pi))
-    throw InvalidArgument("SpotLight.coneAngle", detail::formatValue(coneAngle),
+SpotLight::SpotLight(const SpotLightParams& p)
+    : position_(p.position), direction_(unitDirection("SpotLight.direction", p.direction)),
+      inner_(p.innerConeAngle), outer_(p.outerConeAngle), range_(p.range), near_(p.nearPlane),
+      intensity_(p.color * p.intensity) {
+  detail::requireFiniteVec3("SpotLight.position", p.position);
+  const double quarter = 0.5 * std::numbers::pi;
+  if (!std::isfinite(outer_) || !(outer_ > 0.0) || !(outer_ < quarter))
+    throw InvalidArgument("SpotLight.outerConeAngle", detail::formatValue(outer_),
                           "half angle in radians, must be in (0, pi/2)");
-  requirePositive("SpotLight.range", range);
-  if (nearPlane == -1.0) near_ = range * 1e-3;
-  if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range))
-    throw InvalidArgument("SpotLight.nearPlane", detail::formatValue(nearPlane), "must be in (0, range)");
-  requireColor("SpotLight.intensity", intensity);
+  if (!std::isfinite(inner_) || !(inner_ > 0.0) || !(inner_ < outer_))
+    throw InvalidArgument(
+        "SpotLight.innerConeAngle", detail::formatValue(inner_),
+        "half angle in radians, must be in (0, outerConeAngle = " + detail::formatValue(outer_) + ")");
+  requirePositive("SpotLight.range", range_);
+  if (near_ == -1.0) near_ = range_ * 1e-3;
+  if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range_))
+    throw InvalidArgument("SpotLight.nearPlane", detail::formatValue(p.nearPlane), "must be in (0, range)");
+  requireColor("SpotLight.color", p.color);
+  if (!std::isfinite(p.intensity) || !(p.intensity > 0.0))
+    throw InvalidArgument("SpotLight.intensity", detail::formatValue(p.intensity), "must be finite and > 0");
+  if (!(std::max({p.color.x, p.color.y, p.color.z}) > 0.0))
+    throw InvalidArgument("SpotLight.color", "(0, 0, 0)", "at least one channel must be > 0");
+  cosInner_ = std::cos(inner_);
+  cosOuter_ = std::cos(outer_);
+}
+
+double spotFalloff(double cosAngle, double cosInner, double cosOuter) {
+  const double t = std::clamp((cosAngle - cosOuter) / (cosInner - cosOuter), 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
+
+double SpotLight::falloff(double cosAngle) const {
+  return spotFalloff(cosAngle, cosInner_, cosOuter_);
 }
 
 glm::dmat4 SpotLight::lightViewFromWorld() const {
@@ -62,7 +83,46 @@ glm::dmat4 SpotLight::lightViewFromWorld() const {
 }
 
 glm::dmat4 SpotLight::lightClipFromLightView() const {
-  return glm::perspectiveRH_NO(2.0 * coneAngle_, 1.0, near_, range_);
+  return glm::perspectiveRH_NO(2.0 * outer_, 1.0, near_, range_);
+}
+
+PointLight::PointLight(const PointLightParams& p)
+    : position_(p.position), range_(p.range), near_(p.nearPlane), intensity_(p.color * p.intensity) {
+  detail::requireFiniteVec3("PointLight.position", p.position);
+  requirePositive("PointLight.range", range_);
+  if (near_ == -1.0) near_ = range_ * 1e-3;
+  if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range_))
+    throw InvalidArgument("PointLight.nearPlane", detail::formatValue(p.nearPlane), "must be in (0, range)");
+  requireColor("PointLight.color", p.color);
+  if (!(std::max({p.color.x, p.color.y, p.color.z}) > 0.0))
+    throw InvalidArgument("PointLight.color", "(0, 0, 0)", "at least one channel must be > 0");
+  if (!std::isfinite(p.intensity) || !(p.intensity > 0.0))
+    throw InvalidArgument("PointLight.intensity", detail::formatValue(p.intensity), "must be finite and > 0");
+}
+
+glm::dvec3 PointLight::faceAxis(int face) {
+  if (face < 0 || face > 5)
+    throw InvalidArgument("PointLight face", std::to_string(face), "must be in [0, 5]");
+  glm::dvec3 axis(0.0);
+  axis[face / 2] = face % 2 == 0 ? 1.0 : -1.0;
+  return axis;
+}
+
+int PointLight::faceOf(const glm::dvec3& w) {
+  const glm::dvec3 a = glm::abs(w);
+  const int major = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+  return 2 * major + (w[major] >= 0.0 ? 0 : 1);
+}
+
+glm::dmat4 PointLight::faceViewFromWorld(int face) const {
+  const glm::dvec3 axis = faceAxis(face);
+  glm::dvec3 up(0.0);
+  up[(face / 2 + 2) % 3] = 1.0; // orthogonal to the axis
+  return glm::lookAtRH(position_, position_ + axis, up);
+}
+
+glm::dmat4 PointLight::faceClipFromWorld(int face) const {
+  return glm::perspectiveRH_NO(0.5 * std::numbers::pi, 1.0, near_, range_) * faceViewFromWorld(face);
 }
 
 glm::dmat4 orthographicLightClipFromWorld(const DirectionalLight& light, std::span<const glm::dvec3> points) {

@@ -537,4 +537,9 @@ std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::
   return faces;
 }
 
+std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const PointLight& light,
+                                               const RectifyOptions& options) {
+  return rectifyPointLight(camera, light.position(), light.range(), options, light.nearPlane());
+}
+
 } // namespace crep

@@ -67,7 +67,11 @@ TEST_CASE("anyOrthogonal: unit and orthogonal for every axis and sign") {
 
 TEST_CASE("SpotLight: cone maps to the NDC square, invalid input named") {
   const double cone = 0.4;
-  const crep::SpotLight spot({1, 5, 2}, {0.2, -1, 0.1}, cone, 50.0);
+  const crep::SpotLight spot({.position = {1, 5, 2},
+                              .direction = {0.2, -1, 0.1},
+                              .innerConeAngle = 0.3,
+                              .outerConeAngle = cone,
+                              .range = 50.0});
   const glm::dmat4 m = spot.lightClipFromWorld();
   // A point on the axis maps to the NDC centre; a point at the cone edge (rotated about an axis
   // orthogonal to the light's up/right frame) maps to |x| or |y| = 1.
@@ -83,14 +87,32 @@ TEST_CASE("SpotLight: cone maps to the NDC square, invalid input named") {
   // Near and far planes map to -1 and 1.
   c = m * glm::dvec4(spot.position() + spot.range() * spot.direction(), 1.0);
   CHECK(c.z / c.w == doctest::Approx(1.0).epsilon(1e-12));
-  expectInvalid("SpotLight.coneAngle", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.0, 10.0); });
-  expectInvalid("SpotLight.coneAngle", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 1.6, 10.0); });
-  expectInvalid("SpotLight.range", [] { crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 0.0); });
-  expectInvalid("SpotLight.direction", [] { crep::SpotLight({0, 0, 0}, {0, 0, 0}, 0.5, 10.0); });
-  expectInvalid("SpotLight.position", [] { crep::SpotLight({kNan, 0, 0}, {0, -1, 0}, 0.5, 10.0); });
-  expectInvalid("SpotLight.nearPlane", [] {
-    crep::SpotLight({0, 0, 0}, {0, -1, 0}, 0.5, 10.0, {1, 1, 1}, 20.0);
-  });
+  using P = crep::SpotLightParams;
+  const auto spotWith = [](auto edit) {
+    return [edit] {
+      P p{.position = {0, 0, 0},
+          .direction = {0, -1, 0},
+          .innerConeAngle = 0.3,
+          .outerConeAngle = 0.5,
+          .range = 10.0};
+      edit(p);
+      crep::SpotLight{p};
+    };
+  };
+  expectInvalid("SpotLight.outerConeAngle", spotWith([](P& p) { p.outerConeAngle = 0.0; }));
+  expectInvalid("SpotLight.outerConeAngle", spotWith([](P& p) { p.outerConeAngle = 1.6; }));
+  expectInvalid("SpotLight.outerConeAngle", spotWith([](P& p) { p.outerConeAngle = kNan; }));
+  expectInvalid("SpotLight.innerConeAngle", spotWith([](P& p) { p.innerConeAngle = 0.6; })); // out of order
+  expectInvalid("SpotLight.innerConeAngle", spotWith([](P& p) { p.innerConeAngle = 0.5; }));
+  expectInvalid("SpotLight.innerConeAngle", spotWith([](P& p) { p.innerConeAngle = 0.0; }));
+  expectInvalid("SpotLight.intensity", spotWith([](P& p) { p.intensity = 0.0; }));
+  expectInvalid("SpotLight.intensity", spotWith([](P& p) { p.intensity = kNan; }));
+  expectInvalid("SpotLight.color", spotWith([](P& p) { p.color = {0, 0, 0}; }));
+  expectInvalid("SpotLight.color", spotWith([](P& p) { p.color = {1, -1, 0}; }));
+  expectInvalid("SpotLight.range", spotWith([](P& p) { p.range = 0.0; }));
+  expectInvalid("SpotLight.direction", spotWith([](P& p) { p.direction = {0, 0, 0}; }));
+  expectInvalid("SpotLight.position", spotWith([](P& p) { p.position = {kNan, 0, 0}; }));
+  expectInvalid("SpotLight.nearPlane", spotWith([](P& p) { p.nearPlane = 20.0; }));
 }
 
 TEST_CASE("Phase functions are normalized over the sphere") {
@@ -180,4 +202,54 @@ TEST_CASE("Medium: the named form equals the deprecated positional one and reads
   CHECK(c.absorption == glm::dvec3(0.003));
   CHECK_THROWS_AS(crep::Medium({.mieScattering = glm::dvec3(0.1), .hgG = 1.0}), crep::InvalidArgument);
   CHECK_THROWS_AS(crep::Medium(crep::MediumCoefficients{}), crep::InvalidArgument); // zero extinction
+}
+
+TEST_CASE("SpotLight: the smooth angular falloff t^2 (3 - 2 t) between the cone angles") {
+  const double inner = 0.3, outer = 0.5;
+  const crep::SpotLight spot({.direction = {0, 0, -1},
+                              .innerConeAngle = inner,
+                              .outerConeAngle = outer,
+                              .color = {1.0, 0.5, 0.25},
+                              .intensity = 8.0});
+  CHECK(spot.intensity() == glm::dvec3(8.0, 4.0, 2.0));
+  CHECK(spot.falloff(1.0) == 1.0);
+  CHECK(spot.falloff(std::cos(inner)) == doctest::Approx(1.0).epsilon(1e-12));
+  CHECK(spot.falloff(std::cos(outer)) == doctest::Approx(0.0).epsilon(1e-12));
+  CHECK(spot.falloff(std::cos(0.7)) == 0.0);
+  CHECK(spot.falloff(-1.0) == 0.0);
+  // Half way in cosine: t = 1/2 gives s = 1/2; a quarter: 1/16 (3 - 1/2) = 5/32.
+  const double ci = std::cos(inner), co = std::cos(outer);
+  CHECK(spot.falloff(0.5 * (ci + co)) == doctest::Approx(0.5).epsilon(1e-12));
+  CHECK(spot.falloff(co + 0.25 * (ci - co)) == doctest::Approx(5.0 / 32.0).epsilon(1e-12));
+  // Monotonic in the angle.
+  double previous = 1.0;
+  for (int i = 0; i <= 100; ++i) {
+    const double s = spot.falloff(std::cos(0.6 * i / 100.0));
+    CHECK(s <= previous);
+    previous = s;
+  }
+}
+
+TEST_CASE("PointLight: faces partition the directions, face frusta look along their axes") {
+  const crep::PointLight light({.position = {1, 2, 3}, .color = {1, 1, 1}, .intensity = 5.0, .range = 20.0});
+  for (int face = 0; face < 6; ++face) {
+    const glm::dvec3 axis = crep::PointLight::faceAxis(face);
+    CHECK(crep::PointLight::faceOf(axis) == face);
+    const glm::dvec4 c = light.faceClipFromWorld(face) * glm::dvec4(light.position() + 10.0 * axis, 1.0);
+    CHECK(std::abs(c.x / c.w) < 1e-12);
+    CHECK(std::abs(c.y / c.w) < 1e-12);
+    // A direction in the face's sector projects inside the face's NDC square.
+    glm::dvec3 w = axis;
+    w[(face / 2 + 1) % 3] = 0.9;
+    w[(face / 2 + 2) % 3] = -0.7;
+    CHECK(crep::PointLight::faceOf(w) == face);
+    const glm::dvec4 q = light.faceClipFromWorld(face) * glm::dvec4(light.position() + 3.0 * w, 1.0);
+    CHECK(std::abs(q.x / q.w) <= 1.0);
+    CHECK(std::abs(q.y / q.w) <= 1.0);
+  }
+  CHECK(crep::PointLight::faceOf({1, 1, 1}) == 0); // ties: the first face in cube-map order
+  expectInvalid("PointLight.intensity", [] { crep::PointLight({.intensity = -1.0}); });
+  expectInvalid("PointLight.range", [] { crep::PointLight({.range = 0.0}); });
+  expectInvalid("PointLight.nearPlane", [] { crep::PointLight({.range = 1.0, .nearPlane = 2.0}); });
+  expectInvalid("PointLight.color", [] { crep::PointLight({.color = {0, 0, 0}}); });
 }

@@ -396,7 +396,11 @@ TEST_CASE("rectify: layouts, viewports and light rays") {
     }
   }
   // Spot light rays start at the light.
-  const SpotLight spot({3, 5, 0}, glm::dvec3(-0.5, -1, 0), glm::radians(40.0), 30.0);
+  const SpotLight spot({.position = {3, 5, 0},
+                        .direction = {-0.5, -1, 0},
+                        .innerConeAngle = glm::radians(30.0),
+                        .outerConeAngle = glm::radians(40.0),
+                        .range = 30.0});
   const Rectification rs = rectify(kCamera, spot);
   REQUIRE(rs.projective());
   const LightRay sr = rs.lightRay(0.5, 0.5);

@@ -137,7 +137,11 @@ TEST_CASE("rectify GL: each split's map stores the first occluder along the texe
   CREP_REQUIRE_GL();
   const Scene scene = makeScene("boxes", 16.0 / 9.0);
   // High above and behind-left of the camera, aimed at the boxes: off screen by ~20 degrees.
-  const SpotLight spot({-8.0, 14.0, 2.0}, glm::dvec3(8.0, -14.0, -7.0), glm::radians(35.0), 40.0);
+  const SpotLight spot({.position = {-8.0, 14.0, 2.0},
+                        .direction = {8.0, -14.0, -7.0},
+                        .innerConeAngle = glm::radians(25.0),
+                        .outerConeAngle = glm::radians(35.0),
+                        .range = 40.0});
   RectifyOptions options;
   options.splits = 3;
   const Rectification r = rectify(scene.camera, spot, options);

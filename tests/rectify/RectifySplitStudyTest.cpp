@@ -73,7 +73,8 @@ const Scheme kSchemes[] = {{"uniform", SplitScheme::Uniform, 0.0},
 } // namespace
 
 TEST_CASE("rectify: split scheme study (spread of world length per texel along the rows)") {
-  // The calibration setup of rectify/README.md: 60 degree camera, near 0.1, far 80, 1024 columns, light from the side.
+  // The calibration setup of rectify/README.md: 60 degree camera, near 0.1, far 80, 1024 columns, light from
+  // the side.
   const Camera cam = Camera::lookAt({0, 2, 0}, {0, 2, -1}, {0, 1, 0}, glm::radians(60.0), 1.0, 0.1, 80.0);
   const DirectionalLight light(glm::dvec3(1, -0.3, 0.2));
   const int W = 1024;

@@ -70,7 +70,11 @@ inline SpotLight randomSpot(std::mt19937_64& rng, const Camera& cam) {
   if (uniform(rng, 0, 1) < 0.2) dir = randomUnit(rng); // sometimes anywhere (often an empty region)
   const double cone = glm::radians(uniform(rng, 10.0, 80.0));
   const double range = dist * logUniform(rng, 1.2, 20.0);
-  return SpotLight(pos, dir, cone, range);
+  return SpotLight({.position = pos,
+                    .direction = dir,
+                    .innerConeAngle = 0.8 * cone,
+                    .outerConeAngle = cone,
+                    .range = range});
 }
 
 /// Independent: is the direction inside the camera's closed view cone (pyramid test in view space)?

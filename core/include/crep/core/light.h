@@ -23,21 +23,47 @@ private:
   glm::dvec3 irradiance_;
 };
 
-/// A cone light: light leaves `position` in the directions within `coneAngle` of `direction`.
+/// The parameters of a SpotLight by name (designated initializers):
+///   crep::SpotLight lamp({.position = p, .direction = axis, .innerConeAngle = 0.35, .outerConeAngle = 0.5,
+///                         .color = glm::dvec3(1.0, 0.8, 0.6), .intensity = 40.0, .range = 30.0});
+struct SpotLightParams {
+  glm::dvec3 position{0.0};
+  glm::dvec3 direction{0.0, 0.0, -1.0}; ///< the cone's axis, the direction light travels along it
+  double innerConeAngle = 0.35;         ///< half angle (radians) of full intensity, in (0, outerConeAngle)
+  double outerConeAngle = 0.5;          ///< half angle (radians) beyond which nothing is emitted, < pi / 2
+  glm::dvec3 color{1.0};                ///< linear RGB, >= 0
+  double intensity = 1.0;  ///< radiant intensity on the axis per unit colour (per steradian), > 0
+  double range = 100.0;    ///< far plane of its shadow frustum (world units), > 0
+  double nearPlane = -1.0; ///< near plane of its shadow frustum, in (0, range); -1: range * 1e-3
+};
+
+/// A cone light at `position` (a local light: Klehm et al. 2014, Sec. 3.2 "Local Lights", "Angular-dependency
+/// for Sources"). Radiant intensity toward direction w (unit): intensity() * falloff(dot(w, direction())),
+/// with the smooth angular falloff s(t) = t^2 (3 - 2 t), t = clamp((cos a - cos outer) / (cos inner - cos
+/// outer), 0, 1) for the angle a to the axis; irradiance at distance d on a facing surface in vacuum is
+/// that / d^2 (in a medium, times exp(-sigma_t d)). Its shadow map is the perspective frustum of
+/// lightClipFromWorld(): square, half angle outerConeAngle in both axial planes, from nearPlane to range.
 class SpotLight {
 public:
-  /// `coneAngle` is the half angle in radians, in (0, pi/2); `range` > 0 is the far plane of its
-  /// shadow frustum; `nearPlane` in (0, range) its near plane. Intensity is radiant intensity (W/sr
-  /// per channel): irradiance at distance r on a facing surface is intensity / r^2.
-  SpotLight(const glm::dvec3& position, const glm::dvec3& direction, double coneAngle, double range,
-            const glm::dvec3& intensity = glm::dvec3(1.0), double nearPlane = -1.0 /* range * 1e-3 */);
+  /// Throws InvalidArgument naming the field ("SpotLight.innerConeAngle", "SpotLight.outerConeAngle" (also
+  /// when the angles are out of order), "SpotLight.intensity", "SpotLight.color", "SpotLight.range",
+  /// "SpotLight.nearPlane", "SpotLight.direction", "SpotLight.position").
+  explicit SpotLight(const SpotLightParams& params);
 
   const glm::dvec3& position() const noexcept { return position_; }
   const glm::dvec3& direction() const noexcept { return direction_; }
-  double coneAngle() const noexcept { return coneAngle_; }
+  double innerConeAngle() const noexcept { return inner_; }
+  double outerConeAngle() const noexcept { return outer_; }
+  /// The shadow frustum's half angle (= outerConeAngle()).
+  double coneAngle() const noexcept { return outer_; }
   double range() const noexcept { return range_; }
   double nearPlane() const noexcept { return near_; }
+  /// Radiant intensity on the axis per channel: color * intensity (W / sr, arbitrary units).
   const glm::dvec3& intensity() const noexcept { return intensity_; }
+  double cosInner() const noexcept { return cosInner_; }
+  double cosOuter() const noexcept { return cosOuter_; }
+  /// The angular falloff s in [0, 1] for the cosine of the angle to the axis (see the class comment).
+  double falloff(double cosAngle) const;
 
   /// The light's own view (looking down -Z along `direction`) and perspective projection covering the cone.
   glm::dmat4 lightViewFromWorld() const;
@@ -47,9 +73,54 @@ public:
 private:
   glm::dvec3 position_;
   glm::dvec3 direction_;
-  double coneAngle_, range_, near_;
+  double inner_, outer_, range_, near_;
+  glm::dvec3 intensity_;
+  double cosInner_, cosOuter_;
+};
+
+/// The parameters of a PointLight by name.
+struct PointLightParams {
+  glm::dvec3 position{0.0};
+  glm::dvec3 color{1.0};   ///< linear RGB, >= 0
+  double intensity = 1.0;  ///< radiant intensity per unit colour (per steradian, every direction), > 0
+  double range = 100.0;    ///< far plane of its six shadow frusta (world units), > 0
+  double nearPlane = -1.0; ///< near plane of the frusta, in (0, range); -1: range * 1e-3
+};
+
+/// An omnidirectional light as six spot faces (Klehm et al. 2014, Sec. 3.2 "Local Lights": six spotlights,
+/// one per cube-map sector, contributions added). Face i in GL cube-map order +X, -X, +Y, -Y, +Z, -Z covers
+/// the directions w with |w_j| <= |w_axis| for its axis (ties belong to the first face in that order, so
+/// every direction belongs to exactly one face); its shadow map is faceClipFromWorld(i), a 90 degree square
+/// perspective frustum from nearPlane to range.
+class PointLight {
+public:
+  /// Throws InvalidArgument naming the field ("PointLight.position", ".color", ".intensity", ".range",
+  /// ".nearPlane").
+  explicit PointLight(const PointLightParams& params);
+
+  const glm::dvec3& position() const noexcept { return position_; }
+  double range() const noexcept { return range_; }
+  double nearPlane() const noexcept { return near_; }
+  /// Radiant intensity per channel: color * intensity.
+  const glm::dvec3& intensity() const noexcept { return intensity_; }
+
+  /// Unit axis of face i (+X, -X, +Y, -Y, +Z, -Z for i = 0..5).
+  static glm::dvec3 faceAxis(int face);
+  /// The face whose sector holds direction w (any non-zero vector; see the class comment).
+  static int faceOf(const glm::dvec3& w);
+  /// Face i's view (looking down -Z along faceAxis(i)) and its 90 degree perspective projection.
+  glm::dmat4 faceViewFromWorld(int face) const;
+  glm::dmat4 faceClipFromWorld(int face) const;
+
+private:
+  glm::dvec3 position_;
+  double range_, near_;
   glm::dvec3 intensity_;
 };
+
+/// s(t) = t^2 (3 - 2 t) with t = clamp((cosAngle - cosOuter) / (cosInner - cosOuter), 0, 1) (cosInner >
+/// cosOuter): the spot falloff, shared by SpotLight::falloff and the marches.
+double spotFalloff(double cosAngle, double cosInner, double cosOuter);
 
 /// Any unit vector orthogonal to `n` (n must be unit length); stable for every direction.
 glm::dvec3 anyOrthogonal(const glm::dvec3& n);

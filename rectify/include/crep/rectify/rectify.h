@@ -311,6 +311,9 @@ Rectification rectify(const Camera& camera, const SpotLight& light, const Rectif
 /// falls back too (EpipoleTooClose). Add the faces' contributions.
 std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::dvec3& position, double range,
                                                const RectifyOptions& options = {}, double nearPlane = -1.0);
+/// The same for a PointLight: its faces are PointLight::faceClipFromWorld(i)'s frusta.
+std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const PointLight& light,
+                                               const RectifyOptions& options = {});
 
 /// Split boundaries x_0..x_K of a scheme on [xmin, xmax] (0 < xmin < xmax), exact at both ends.
 std::vector<double> splitPositions(double xmin, double xmax, int splits, SplitScheme scheme, double blend);
