@@ -25,6 +25,8 @@ void validate(const WorldMarchOptions& o) {
 bool standardShadowLit(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld, const glm::dvec3& p,
                        double bias) {
   const glm::dvec4 q = lightClipFromWorld * glm::dvec4(p, 1.0);
+  // Behind a perspective light's eye plane: not in its map (local lights emit nothing there).
+  if (!(q.w > 0.0)) return true;
   const glm::dvec3 uvd = glm::dvec3(q) / q.w * 0.5 + 0.5;
   if (!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0)) return true;
   const int W = shadowDepth.width(), H = shadowDepth.height();
@@ -53,9 +55,11 @@ void validateShadowMap(const Image& shadowDepth, const glm::dmat4& m) {
         throw InvalidArgument("lightClipFromWorld", detail::formatValue(m[c][r]), "must be finite");
 }
 
-/// One pixel of the world-space march; returns the lookups.
+/// One pixel of the world-space march; `segment(ta, tb)` integrates a lit section (per channel); returns
+/// the lookups.
+template <class Segment>
 int worldMarchPixel(const Image& shadowDepth, const glm::dmat4& M, const glm::dvec3& origin,
-                    const PixelRay& ray, const glm::dvec3& sigma, const WorldMarchOptions& o, glm::dvec3& L) {
+                    const PixelRay& ray, const Segment& segment, const WorldMarchOptions& o, glm::dvec3& L) {
   const double s = ray.surface;
   int lookups = 0;
   const auto lit = [&](double t) {
@@ -69,7 +73,7 @@ int worldMarchPixel(const Image& shadowDepth, const glm::dmat4& M, const glm::dv
     const double tb = k == o.steps ? s : s * k / o.steps;
     const bool vb = lit(tb);
     if (va == vb) {
-      if (va) L += transmittanceIntegral(sigma, ta, tb);
+      if (va) L += segment(ta, tb);
     } else {
       // Bisect for the change: [lo, hi] keeps va at lo and vb at hi.
       double lo = ta, hi = tb;
@@ -78,8 +82,8 @@ int worldMarchPixel(const Image& shadowDepth, const glm::dmat4& M, const glm::dv
         (lit(mid) == va ? lo : hi) = mid;
       }
       const double change = 0.5 * (lo + hi);
-      if (va) L += transmittanceIntegral(sigma, ta, change);
-      if (vb) L += transmittanceIntegral(sigma, change, tb);
+      if (va) L += segment(ta, change);
+      if (vb) L += segment(change, tb);
     }
     ta = tb;
     va = vb;
@@ -105,8 +109,9 @@ MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightCli
     for (int x = 0; x < w; ++x) {
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
       glm::dvec3 L;
-      const int lookups =
-          worldMarchPixel(shadowDepth, lightClipFromWorld, camera.position(), ray, sigma, options, L);
+      const int lookups = worldMarchPixel(
+          shadowDepth, lightClipFromWorld, camera.position(), ray,
+          [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); }, options, L);
       storeScattering(out.scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
                       std::exp(-grey * ray.surface));
       out.steps.at(x, y) = static_cast<float>(lookups);
@@ -141,12 +146,38 @@ void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClip
     const int p = pixels[static_cast<std::size_t>(k)], x = p % w, y = p / w;
     const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
     glm::dvec3 L;
-    const int lookups =
-        worldMarchPixel(shadowDepth, lightClipFromWorld, camera.position(), ray, sigma, options, L);
+    const int lookups = worldMarchPixel(
+        shadowDepth, lightClipFromWorld, camera.position(), ray,
+        [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); }, options, L);
     storeScattering(scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
                     std::exp(-grey * ray.surface));
     if (steps) steps->at(x, y) = static_cast<float>(lookups);
   });
+}
+
+// The same for a local light (crep/scatter/ray_scattering.h): each lit section integrated by RayScattering.
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const LocalLight& light,
+                            const Medium& medium, const WorldMarchOptions& options) {
+  validateShadowMap(shadowDepth, lightClipFromWorld);
+  validateCameraDepth(cameraDepth);
+  validate(options);
+  const int w = cameraDepth.width(), h = cameraDepth.height();
+  MarchResult out{Image(w, h, 4), Image(w, h, 1)};
+  const double grey = weightExtinction(medium);
+  parallelRows(h, options.threads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
+      const RayScattering rs(light, medium, camera.position(), ray.direction);
+      glm::dvec3 L;
+      const int lookups = worldMarchPixel(
+          shadowDepth, lightClipFromWorld, camera.position(), ray,
+          [&](double ta, double tb) { return rs.segment(ta, tb); }, options, L);
+      storeScattering(out.scattering, x, y, L, std::exp(-grey * ray.surface));
+      out.steps.at(x, y) = static_cast<float>(lookups);
+    }
+  });
+  return out;
 }
 
 } // namespace crep

@@ -24,9 +24,9 @@
 
 namespace crep::test {
 
-/// The standard shadow map of the half-space occluder for an orthographic light matrix: each texel
+/// The shadow map of the half-space occluder for an orthographic or perspective light matrix: each texel
 /// stores the depth-buffer value of the plane along the light ray through its centre (clamped like
-/// GL_DEPTH_CLAMP).
+/// GL_DEPTH_CLAMP; 1 where the ray misses the plane).
 inline Image halfSpaceShadowMap(const HalfSpace& plane, const glm::dmat4& lightClipFromWorld, int size) {
   const glm::dmat4 worldFromClip = glm::inverse(lightClipFromWorld);
   Image d(size, size, 1, 1.0f);
@@ -39,8 +39,10 @@ inline Image halfSpaceShadowMap(const HalfSpace& plane, const glm::dmat4& lightC
       const double f0 = glm::dot(plane.normal, p0 - plane.point),
                    f1 = glm::dot(plane.normal, p1 - plane.point);
       if (f0 == f1) continue;
-      const double t = f0 / (f0 - f1); // clip z = -1 + 2 t
-      d.at(i, j) = static_cast<float>(std::clamp(t, 0.0, 1.0));
+      const double t = f0 / (f0 - f1); // the hit p0 + t (p1 - p0), projected
+      const glm::dvec4 q = lightClipFromWorld * glm::dvec4(p0 + t * (p1 - p0), 1.0);
+      if (!(q.w > 0.0)) continue; // behind a perspective light
+      d.at(i, j) = static_cast<float>(std::clamp(0.5 * q.z / q.w + 0.5, 0.0, 1.0));
     }
   return d;
 }
@@ -59,8 +61,8 @@ inline glm::dvec3 segmentIntegral(const glm::dvec3& sigma, double a, double b) {
   return r;
 }
 
-/// Closed-form single scattering (Klehm et al. 2014, Eq. 1, 3) with an optional half-space shadow, per pixel of a
-/// camera depth image (sky to the far plane), RGBA like the marches (A = grey transmittance).
+/// Closed-form single scattering (Klehm et al. 2014, Eq. 1, 3) with an optional half-space shadow, per pixel
+/// of a camera depth image (sky to the far plane), RGBA like the marches (A = grey transmittance).
 inline Image closedForm(const Image& depth, const Camera& camera, const DirectionalLight& light,
                         const Medium& medium, const std::optional<HalfSpace>& plane) {
   Image out(depth.width(), depth.height(), 4);

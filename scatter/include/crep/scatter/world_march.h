@@ -7,7 +7,8 @@
 // GL_LESS, cleared to 1), texel (i, j) covering uv in [i / W, (i + 1) / W) x [j / H, (j + 1) / H).
 // Visibility of a world point p: q = lightClipFromWorld p, (u, v, d) = q.xyz / q.w * 0.5 + 0.5; outside
 // the map (u or v outside [0, 1]) -> lit; else lit iff clamp(d, 0, 1) <= depth(floor(u W), floor(v H)) +
-// bias (nearest texel, clamped to the map). The ray [0, s] is cut into N = steps equal sections; the
+// bias (nearest texel, clamped to the map); a point with clip w <= 0 (behind a perspective light's eye
+// plane) -> lit. The ray [0, s] is cut into N = steps equal sections; the
 // visibility is sampled at their N + 1 ends; a section whose ends agree takes that visibility, a section
 // whose ends differ is bisected `refinements` times to locate the change, and the parts on either side
 // take the visibility of their end. Each lit part is integrated exactly (transmittanceIntegral), so the
@@ -24,6 +25,7 @@
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/scatter/ray.h>
+#include <crep/scatter/ray_scattering.h>
 
 namespace crep {
 
@@ -48,6 +50,13 @@ MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightCli
                             const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
                             const Medium& medium, const WorldMarchOptions& options = {});
 
+/// The same for a local light (a spot, or one face of a point light: add the six faces' results) against
+/// its perspective shadow map (SpotLight::lightClipFromWorld, PointLight::faceClipFromWorld): each lit part
+/// integrated by RayScattering (the falloffs, 1 / d^2 and the light path's extinction included). Points
+/// behind the light's eye plane count as lit (nothing is emitted there). RGB is the radiance itself.
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const LocalLight& light,
+                            const Medium& medium, const WorldMarchOptions& options = {});
 /// The same for the pixels of `pixels` only (indices y * w + x), written into `scattering` (RGBA,
 /// cameraDepth's size, e.g. the output of another method) and, if given, `steps` (1 channel, same size);
 /// other pixels are left untouched. What the epipole block uses (Klehm et al. 2014, Fig. 8: brute-force

@@ -1,0 +1,122 @@
+// The world-space reference march for local lights (crep::worldSpaceMarch with a LocalLight) against the
+// closed form of the analytic scene: a camera over the ground, a plane occluder (half-space shadow) and a
+// spot or point light on its lit side. The lit part of every view ray is known exactly (the plane), and
+// its in-scattering is RayScattering::segment (tested against an independent quadrature in
+// RayScatteringTest), so the march's own error is its shadow-map visibility.
+#include "epipolar/epipolar_test_util.h"
+#include "support/analytic_scene.h"
+
+#include <crep/scatter/ray_scattering.h>
+#include <crep/scatter/world_march.h>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+using namespace crep;
+using namespace crep::test;
+
+namespace {
+
+constexpr int kW = 96, kH = 54, kShadow = 1024;
+
+/// The occluder: x > 2 is shadowed (the lights are at x < 2).
+HalfSpace wall() {
+  return HalfSpace{.normal = {1.0, 0.0, 0.0}, .point = {2.0, 0.0, -10.0}};
+}
+
+/// Closed form per pixel: the in-scattering of the part of the ray on the lit side of the wall.
+Image closedFormLocal(const Image& depth, const Camera& camera, const std::vector<LocalLight>& lights,
+                      const Medium& medium) {
+  const HalfSpace plane = wall();
+  Image out(depth.width(), depth.height(), 4);
+  const double grey = weightExtinction(medium);
+  for (int y = 0; y < depth.height(); ++y)
+    for (int x = 0; x < depth.width(); ++x) {
+      const glm::dvec3 v =
+          camera.rayDirection(2.0 * (x + 0.5) / depth.width() - 1.0, 2.0 * (y + 0.5) / depth.height() - 1.0);
+      const double d = depth.at(x, y);
+      const double s = (d >= 1.0 ? camera.far() : camera.linearDepth(d)) / glm::dot(v, camera.forward());
+      const double f0 = glm::dot(plane.normal, camera.position() - plane.point),
+                   fv = glm::dot(plane.normal, v);
+      double lo = 0.0, hi = s;
+      if (fv > 0.0)
+        hi = std::min(s, -f0 / fv);
+      else if (fv < 0.0)
+        lo = std::max(0.0, -f0 / fv);
+      glm::dvec3 L(0.0);
+      for (const LocalLight& light : lights)
+        L += RayScattering(light, medium, camera.position(), v).segment(lo, hi);
+      storeScattering(out, x, y, L, std::exp(-grey * s));
+    }
+  return out;
+}
+
+} // namespace
+
+TEST_CASE("world march, spot light: the half-space shadow's closed form within 0.5%, unoccluded exactly") {
+  const Camera camera = groundCamera(kW, kH);
+  const Image depth = groundDepth(camera, kW, kH);
+  const Medium medium = colouredMedium();
+  const SpotLight spot({.position = {-1.0, 6.0, -10.0},
+                        .direction = {3.0, -6.0, -2.0},
+                        .innerConeAngle = 0.45,
+                        .outerConeAngle = 0.7,
+                        .color = {1.0, 0.85, 0.7},
+                        .intensity = 30.0,
+                        .range = 60.0});
+  const LocalLight light = LocalLight::spot(spot);
+  const glm::dmat4 M = spot.lightClipFromWorld();
+
+  // No occluder: every section lit, the march sums RayScattering over them.
+  const MarchResult open =
+      worldSpaceMarch(Image(64, 64, 1, 1.0f), M, depth, camera, light, medium, {.steps = 16});
+  const Image unoccluded = closedFormLocal(depth, camera, {light}, medium);
+  double worst = 0.0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      const glm::dvec3 v = camera.rayDirection(2.0 * (x + 0.5) / kW - 1.0, 2.0 * (y + 0.5) / kH - 1.0);
+      const double s = camera.surfaceViewDepth(depth.at(x, y)) / glm::dot(v, camera.forward());
+      const glm::dvec3 all = RayScattering(light, medium, camera.position(), v).segment(0.0, s);
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(open.scattering.at(x, y, c) - all[c]) / std::max(all[c], 1e-30));
+    }
+  MESSAGE("unoccluded: max relative difference to one section " << worst);
+  CHECK(worst < 1e-5); // float storage of the output
+
+  const Image shadow = halfSpaceShadowMap(wall(), M, kShadow);
+  const MarchResult march =
+      worldSpaceMarch(shadow, M, depth, camera, light, medium, {.steps = 256, .bias = 1e-5});
+  const ImageMetrics m = rgbMetrics(march.scattering, closedFormLocal(depth, camera, {light}, medium));
+  report("spot light, half-space shadow: world march vs closed form", m);
+  CHECK(m.nanCount == 0);
+  CHECK(m.relativeRmse < 0.005);
+}
+
+TEST_CASE("world march, point light: six faces add up to the closed form, no seam at the face borders") {
+  const Camera camera = groundCamera(kW, kH);
+  const Image depth = groundDepth(camera, kW, kH);
+  const Medium medium = colouredMedium();
+  const PointLight point(
+      {.position = {-1.0, 3.0, -9.0}, .color = {1.0, 0.9, 0.8}, .intensity = 20.0, .range = 60.0});
+  std::vector<LocalLight> faces;
+  Image sum(kW, kH, 4);
+  for (int face = 0; face < 6; ++face) {
+    faces.push_back(LocalLight::pointFace(point, face));
+    const glm::dmat4 M = point.faceClipFromWorld(face);
+    const MarchResult r = worldSpaceMarch(halfSpaceShadowMap(wall(), M, kShadow / 2), M, depth, camera,
+                                          faces.back(), medium, {.steps = 256, .bias = 1e-5});
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        for (int c = 0; c < 3; ++c)
+          sum.at(x, y, c) += r.scattering.at(x, y, c);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        sum.at(x, y, 3) = r.scattering.at(x, y, 3);
+  }
+  const Image expected = closedFormLocal(depth, camera, faces, medium);
+  const ImageMetrics m = rgbMetrics(sum, expected);
+  report("point light (six faces), half-space shadow: world march vs closed form", m);
+  CHECK(m.nanCount == 0);
+  CHECK(m.relativeRmse < 0.005);
+}
