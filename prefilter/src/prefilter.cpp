@@ -231,7 +231,26 @@ FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const Pre
   return prefilter(map, weightExtinction(medium), options);
 }
 
+namespace {
+
+FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const PrefilterOptions& options,
+                            const LocalLight* light, const Medium* medium);
+
+} // namespace
+
 FilteredBasis prefilter(const RectifiedMap& map, double extinction, const PrefilterOptions& options) {
+  return prefilterImpl(map, extinction, options, nullptr, nullptr);
+}
+
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const LocalLight& light,
+                        const PrefilterOptions& options) {
+  return prefilterImpl(map, weightExtinction(medium), options, &light, &medium);
+}
+
+namespace {
+
+FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const PrefilterOptions& options,
+                            const LocalLight* light, const Medium* medium) {
   validate(map);
   validate(options);
   if (!(extinction >= 0.0) || !std::isfinite(extinction))
@@ -254,6 +273,7 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
   b.extinction = extinction;
   b.depthMargin = options.depthMargin;
   b.layout = map.layout;
+  b.localLight = light != nullptr;
   b.profiles = referenceProfiles(*map.layout, H, options.regionsPerSplit);
   b.texels.assign(static_cast<std::size_t>(b.layers) * static_cast<std::size_t>(H) *
                       static_cast<std::size_t>(W) * 4,
@@ -263,12 +283,24 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
   const std::size_t layerStride = static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 4;
   parallelRows(H, options.threads, [&](int j) {
     std::vector<double> mix(static_cast<std::size_t>(n));
+    std::vector<double> lightSamples(light ? 2 * static_cast<std::size_t>(n) + 1 : 0);
     std::array<double, kMaxBases> F{}, B{};
     const std::span<double> basisSpan(B.data(), static_cast<std::size_t>(M));
+    const double row = (j + 0.5) / H;
+    const glm::dvec3 origin = map.layout->origin();
+    const glm::dvec3 reference =
+        light ? map.layout->viewRayDirection(row, map.layout->referenceDepth(row)) : glm::dvec3(0.0);
     for (int r = 0; r < R; ++r) {
       const DistanceProfile& profile =
           b.profiles[static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)];
-      regionMixFactors(options.weights, extinction, profile, n, mix);
+      // Sec. 3.2: the light-side factor along the region's reference ray (texel boundaries and centres).
+      for (std::size_t k = 0; k < lightSamples.size(); ++k) {
+        const double t = profile(static_cast<double>(k) / (2.0 * n));
+        lightSamples[k] = std::isfinite(t)
+                              ? light->weightFactor(*medium, extinction, origin + t * reference, reference)
+                              : 0.0;
+      }
+      regionMixFactors(options.weights, extinction, profile, n, lightSamples, mix);
       std::fill(F.begin(), F.end(), 0.0);
       for (int i = 0; i < n; ++i) {
         const int x = r * n + i;
@@ -288,6 +320,8 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
   });
   return b;
 }
+
+} // namespace
 
 std::vector<double> visibilityTableCoefficients(int samples, int bases, double depthMargin,
                                                 RingingFilter ringing) {
@@ -361,15 +395,72 @@ std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std:
   return table;
 }
 
-Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
-               const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
+std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                          int samples, const LocalLight& light, const Medium& medium) {
+  validateBasis(basis);
+  const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
+  const std::size_t cells =
+      static_cast<std::size_t>(H) * static_cast<std::size_t>(R) * static_cast<std::size_t>(Z);
+  if (samples < 2 || samples > kMaxVisibilityTableSamples || visibility.size() != cells)
+    throw InvalidArgument("scatteringPrefixTable.visibility", "size " + std::to_string(visibility.size()),
+                          "must be visibilityTable(basis, samples) with samples in [2, " +
+                              std::to_string(kMaxVisibilityTableSamples) + "]");
+  const RectifiedLayout& layout = *basis.layout;
+  const glm::dvec3 origin = layout.origin();
+  std::vector<double> table(cells * static_cast<std::size_t>(C));
+  parallelRows(H, 0, [&](int j) {
+    const double row = (j + 0.5) / H;
+    for (int s = 0; s < Z; ++s) {
+      const double depth = static_cast<double>(s) / (Z - 1);
+      const RayScattering ray(light, medium, origin, layout.viewRayDirection(row, depth));
+      glm::dvec3 sum(0.0);
+      double ta = 0.0;
+      for (int r = 0; r < R; ++r) {
+        const std::size_t cell =
+            (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
+                static_cast<std::size_t>(Z) +
+            static_cast<std::size_t>(s);
+        for (int c = 0; c < C; ++c)
+          table[cell * C + static_cast<std::size_t>(c)] = sum[c];
+        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
+        if (std::isfinite(tb)) sum += visibility[cell] * ray.segment(ta, tb);
+        ta = tb;
+      }
+    }
+  });
+  return table;
+}
+
+namespace {
+
+/// The in-scattering of a region segment of one view ray for a directional light: C V TI (Eq. 1, 3, 11).
+struct DirectionalSegments {
+  glm::dvec3 C, sigma;
+  glm::dvec3 weighted(double V, double ta, double tb) const {
+    return C * V * transmittanceIntegral(sigma, ta, tb);
+  }
+  glm::dvec3 prefix(const glm::dvec3& S) const { return C * S; }
+};
+
+/// The same for a local light: V times the ray's own unoccluded in-scattering of the segment.
+struct LocalSegments {
+  RayScattering ray;
+  glm::dvec3 weighted(double V, double ta, double tb) const { return V * ray.segment(ta, tb); }
+  glm::dvec3 prefix(const glm::dvec3& S) const { return S; }
+};
+
+/// The evaluation (see prefilter.h) with `segmentsFor(direction)` giving the light's segment rule and
+/// `prefixTable(visibility)` the scattering prefix table.
+template <class SegmentsFor, class PrefixTable>
+Image evaluateImpl(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+                   const Medium& medium, const EvaluateOptions& options, const SegmentsFor& segmentsFor,
+                   const PrefixTable& prefixTable) {
   validateBasis(basis);
   validateCameraDepth(cameraDepth);
   validate(options);
   const RectifiedLayout& layout = *basis.layout;
   const int w = cameraDepth.width(), h = cameraDepth.height(), M = basis.bases, R = basis.regions;
   const int n = basis.regionWidth();
-  const glm::dvec3 sigma = medium.extinction();
   const double greySigma = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
   const bool table = usesVisibilityTable(options);
@@ -377,8 +468,7 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
   const bool prefix = usesScatteringPrefix(options);
   const std::vector<double> tableValues =
       table ? visibilityTable(basis, Z, options.ringing) : std::vector<double>();
-  const std::vector<double> prefixValues =
-      prefix ? scatteringPrefixTable(basis, tableValues, Z, sigma) : std::vector<double>();
+  const std::vector<double> prefixValues = prefix ? prefixTable(tableValues) : std::vector<double>();
   // GL_LINEAR of a table texture (width R Z, height H, `channels` values per texel) at depth d and
   // normalized row: x = d (Z - 1) inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for
   // the basis.
@@ -409,11 +499,11 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
     const std::span<double> aSpan(a.data(), static_cast<std::size_t>(M));
     for (int x = 0; x < w; ++x) {
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
-      const glm::dvec3 C = scatteringConstant(light, medium, ray.direction);
+      const auto segment = segmentsFor(ray.direction);
       glm::dvec3 L(0.0);
       MappedRay m;
       if (!mapRay(layout, origin, ray, basis.regionsPerSplit, options.nearPlaneCorrection, m)) {
-        L = C * transmittanceIntegral(sigma, ray.start, ray.surface);
+        L = segment.weighted(1.0, ray.start, ray.surface);
       } else {
         fourierCoefficients(rayBasisDepth(m.depth, basis.depthMargin), aSpan);
         applyRingingFilter(options.ringing, aSpan);
@@ -427,7 +517,7 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
           glm::dvec3 S;
           for (int c = 0; c < kScatteringPrefixChannels; ++c)
             S[c] = lerpTable(prefixValues, kScatteringPrefixChannels, c, m.last.region, m.depth, m.row);
-          L += C * S;
+          L += segment.prefix(S);
           segments.start =
               std::clamp(layout.rayDistance(m.row, m.depth, static_cast<double>(m.last.region) / R),
                          ray.start, ray.surface);
@@ -435,7 +525,7 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
         }
         forEachSegment(layout, segments, m, R, [&](int r, double ua, double ub, double ta, double tb) {
           if (table && r < m.last.region) { // a region crossed whole: the table (see EvaluateOptions)
-            L += C * tableAt(r, m.depth, m.row) * transmittanceIntegral(sigma, ta, tb);
+            L += segment.weighted(tableAt(r, m.depth, m.row), ta, tb);
             return;
           }
           sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data());
@@ -464,13 +554,48 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
             for (int k = 0; k < M; ++k)
               dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
           const double V = std::clamp(0.5 + dot, 0.0, 1.0);
-          L += C * V * transmittanceIntegral(sigma, ta, tb);
+          L += segment.weighted(V, ta, tb);
         });
       }
       storeScattering(out, x, y, L, std::exp(-greySigma * ray.surface));
     }
   });
   return out;
+}
+
+} // namespace
+
+Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+               const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options) {
+  if (basis.localLight)
+    throw InvalidArgument("FilteredBasis.localLight", "true",
+                          "the basis was prefiltered for a local light: evaluate it with that LocalLight");
+  const glm::dvec3 sigma = medium.extinction();
+  const int Z = options.visibilityTableSamples;
+  return evaluateImpl(
+      basis, cameraDepth, camera, medium, options,
+      [&](const glm::dvec3& v) {
+        return DirectionalSegments{scatteringConstant(light, medium, v), sigma};
+      },
+      [&](const std::vector<double>& visibility) {
+        return scatteringPrefixTable(basis, visibility, Z, sigma);
+      });
+}
+
+Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+               const LocalLight& light, const Medium& medium, const EvaluateOptions& options) {
+  if (!basis.localLight)
+    throw InvalidArgument("FilteredBasis.localLight", "false",
+                          "the basis was prefiltered for a directional light: prefilter(map, medium, light)");
+  if (options.nearPlaneCorrection)
+    throw InvalidArgument("EvaluateOptions.nearPlaneCorrection", "true", "not supported for local lights");
+  const int Z = options.visibilityTableSamples;
+  return evaluateImpl(
+      basis, cameraDepth, camera, medium, options,
+      [&](const glm::dvec3& v) { return LocalSegments{RayScattering(light, medium, camera.position(), v)}; },
+      [&](const std::vector<double>& visibility) {
+        return scatteringPrefixTable(basis, visibility, Z, light, medium);
+      });
 }
 
 } // namespace crep

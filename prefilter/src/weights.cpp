@@ -154,6 +154,34 @@ void regionMixFactors(WeightMode mode, double extinction, const DistanceProfile&
   }
 }
 
+void regionMixFactors(WeightMode mode, double extinction, const DistanceProfile& profile, int texels,
+                      std::span<const double> light, std::span<double> mix) {
+  if (light.empty()) {
+    regionMixFactors(mode, extinction, profile, texels, mix);
+    return;
+  }
+  requireExtinction(extinction);
+  requireTexels(texels, mix.size(), static_cast<std::size_t>(texels));
+  requireTexels(texels, light.size(), 2 * static_cast<std::size_t>(texels) + 1);
+  std::vector<double> tau(static_cast<std::size_t>(texels) + 1);
+  regionDistances(mode, profile, texels, tau);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < mix.size(); ++i) {
+    const double t0 = tau[i], t1 = tau[i + 1];
+    double w = 0.0;
+    if (std::isfinite(t0) && std::isfinite(t1)) {
+      const double dt = t1 - t0;
+      const double transmittance = mode == WeightMode::AverageVisibility
+                                       ? 1.0
+                                       : std::exp(-extinction * t0) * oneMinusExpOverX(extinction * dt) * dt;
+      const double g = (light[2 * i] + 4.0 * light[2 * i + 1] + light[2 * i + 2]) / 6.0;
+      w = std::isfinite(g) && g > 0.0 ? g * transmittance : 0.0;
+    }
+    sum += w;
+    mix[i] = sum > 0.0 ? std::clamp(w / sum, 0.0, 1.0) : 1.0 / static_cast<double>(i + 1);
+  }
+}
+
 double regionWeightTotal(WeightMode mode, double extinction, const DistanceProfile& profile, int texels,
                          double u) {
   requireExtinction(extinction);

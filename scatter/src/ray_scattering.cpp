@@ -69,6 +69,18 @@ glm::dvec3 LocalLight::intensityToward(const glm::dvec3& w) const {
   return intensity;
 }
 
+double LocalLight::weightFactor(const Medium& medium, double greyExtinction, const glm::dvec3& point,
+                                const glm::dvec3& v) const {
+  const glm::dvec3 p = point - position;
+  const double d = glm::length(p);
+  const glm::dvec3 w = d > 0.0 ? p / d : v;
+  const double dc = std::max(d, nearPlane);
+  const glm::dvec3 I = intensityToward(w);
+  const glm::dvec3 phase = medium.scatteringTimesPhase(glm::dot(w, -v));
+  return (phase.x + phase.y + phase.z) / 3.0 * (I.x + I.y + I.z) / 3.0 * std::exp(-greyExtinction * dc) /
+         (dc * dc);
+}
+
 RayScattering::RayScattering(const DirectionalLight& light, const Medium& medium, const glm::dvec3& origin,
                              const glm::dvec3& direction)
     : medium_(&medium), origin_(origin), direction_(direction), sigma_(medium.extinction()), local_(false),

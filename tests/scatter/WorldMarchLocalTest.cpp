@@ -4,6 +4,7 @@
 // its in-scattering is RayScattering::segment (tested against an independent quadrature in
 // RayScatteringTest), so the march's own error is its shadow-map visibility.
 #include "epipolar/epipolar_test_util.h"
+#include "scatter/local_light_util.h"
 #include "support/analytic_scene.h"
 
 #include <crep/scatter/ray_scattering.h>
@@ -17,54 +18,14 @@ using namespace crep;
 using namespace crep::test;
 
 namespace {
-
 constexpr int kW = 96, kH = 54, kShadow = 1024;
-
-/// The occluder: x > 2 is shadowed (the lights are at x < 2).
-HalfSpace wall() {
-  return HalfSpace{.normal = {1.0, 0.0, 0.0}, .point = {2.0, 0.0, -10.0}};
-}
-
-/// Closed form per pixel: the in-scattering of the part of the ray on the lit side of the wall.
-Image closedFormLocal(const Image& depth, const Camera& camera, const std::vector<LocalLight>& lights,
-                      const Medium& medium) {
-  const HalfSpace plane = wall();
-  Image out(depth.width(), depth.height(), 4);
-  const double grey = weightExtinction(medium);
-  for (int y = 0; y < depth.height(); ++y)
-    for (int x = 0; x < depth.width(); ++x) {
-      const glm::dvec3 v =
-          camera.rayDirection(2.0 * (x + 0.5) / depth.width() - 1.0, 2.0 * (y + 0.5) / depth.height() - 1.0);
-      const double d = depth.at(x, y);
-      const double s = (d >= 1.0 ? camera.far() : camera.linearDepth(d)) / glm::dot(v, camera.forward());
-      const double f0 = glm::dot(plane.normal, camera.position() - plane.point),
-                   fv = glm::dot(plane.normal, v);
-      double lo = 0.0, hi = s;
-      if (fv > 0.0)
-        hi = std::min(s, -f0 / fv);
-      else if (fv < 0.0)
-        lo = std::max(0.0, -f0 / fv);
-      glm::dvec3 L(0.0);
-      for (const LocalLight& light : lights)
-        L += RayScattering(light, medium, camera.position(), v).segment(lo, hi);
-      storeScattering(out, x, y, L, std::exp(-grey * s));
-    }
-  return out;
-}
-
 } // namespace
 
 TEST_CASE("world march, spot light: the half-space shadow's closed form within 0.5%, unoccluded exactly") {
   const Camera camera = groundCamera(kW, kH);
   const Image depth = groundDepth(camera, kW, kH);
   const Medium medium = colouredMedium();
-  const SpotLight spot({.position = {-1.0, 6.0, -10.0},
-                        .direction = {3.0, -6.0, -2.0},
-                        .innerConeAngle = 0.45,
-                        .outerConeAngle = 0.7,
-                        .color = {1.0, 0.85, 0.7},
-                        .intensity = 30.0,
-                        .range = 60.0});
+  const SpotLight spot = analyticSpot();
   const LocalLight light = LocalLight::spot(spot);
   const glm::dmat4 M = spot.lightClipFromWorld();
 
@@ -97,8 +58,7 @@ TEST_CASE("world march, point light: six faces add up to the closed form, no sea
   const Camera camera = groundCamera(kW, kH);
   const Image depth = groundDepth(camera, kW, kH);
   const Medium medium = colouredMedium();
-  const PointLight point(
-      {.position = {-1.0, 3.0, -9.0}, .color = {1.0, 0.9, 0.8}, .intensity = 20.0, .range = 60.0});
+  const PointLight point = analyticPoint();
   std::vector<LocalLight> faces;
   Image sum(kW, kH, 4);
   for (int face = 0; face < 6; ++face) {

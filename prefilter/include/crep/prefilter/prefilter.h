@@ -74,6 +74,7 @@
 #include <crep/prefilter/weights.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/ray.h>
+#include <crep/scatter/ray_scattering.h>
 
 namespace crep {
 
@@ -174,6 +175,8 @@ struct FilteredBasis {
   std::vector<DistanceProfile> profiles;
   /// The map's layout (shared with the RectifiedMap).
   std::shared_ptr<const RectifiedLayout> layout;
+  /// Prefiltered for a local light (its light-side factor in the weights): evaluate with that light.
+  bool localLight = false;
 
   int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
   float stored(int x, int y, int basis) const {
@@ -195,6 +198,13 @@ struct FilteredBasis {
 FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const PrefilterOptions& options = {});
 /// The same with an explicit scalar weight extinction s >= 0 (1/world unit).
 FilteredBasis prefilter(const RectifiedMap& map, double extinction, const PrefilterOptions& options = {});
+/// For a local light (a spot, or one point-light face; the map rendered with its rectification): the
+/// weights also carry the light-side factor along each region's reference ray (regionMixFactors with
+/// light samples; LocalLight::weightFactor), Klehm et al. 2014, Sec. 3.2 "Local Lights" / "Angular-
+/// dependency for Sources". The evaluation then restores each view ray's exact unoccluded in-scattering
+/// per region (RayScattering), so the weights only shape the visibility average within a region.
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const LocalLight& light,
+                        const PrefilterOptions& options = {});
 
 struct EvaluateOptions {
   Sampling sampling = Sampling::Bilinear;
@@ -269,5 +279,17 @@ void validate(const EvaluateOptions& options, std::string_view owner = "Evaluate
 /// rectification's camera) get the unshadowed value (V = 1 on the whole ray), never NaN.
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
                const DirectionalLight& light, const Medium& medium, const EvaluateOptions& options = {});
+/// The same for a local light, on a basis prefiltered for it (prefilter(map, medium, light)): every region
+/// segment [ta, tb] of a view ray contributes V RayScattering::segment(ta, tb) (the falloffs, 1 / d^2 and
+/// the light path's extinction of the ray itself), the scattering prefix table holds the same along its
+/// sample rays, and RGB is the radiance itself. Throws InvalidArgument ("FilteredBasis.localLight") when
+/// the basis was prefiltered for the other kind of light; the near-plane correction is not supported for
+/// local lights ("EvaluateOptions.nearPlaneCorrection").
+Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+               const LocalLight& light, const Medium& medium, const EvaluateOptions& options = {});
+/// scatteringPrefixTable for a local light: the in-scattering itself (RayScattering along each sample ray
+/// from layout.origin() in the direction layout.viewRayDirection(row, depth)).
+std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                          int samples, const LocalLight& light, const Medium& medium);
 
 } // namespace crep

@@ -22,8 +22,8 @@
 // with the grey weights (error grows with |s_c - s| t). Storing three weight sets would triple the
 // filtered basis, as the paper notes for coloured light textures (Sec. 3.2).
 //
-// sigma -> 0: regionMixFactors and regionWeightTotal are written with phi(x) = -expm1(-x) / x (phi(0) = 1), so they
-// reach the length-weighted limit without any division by zero, and s = 0 is allowed.
+// sigma -> 0: regionMixFactors and regionWeightTotal are written with phi(x) = -expm1(-x) / x (phi(0) = 1),
+// so they reach the length-weighted limit without any division by zero, and s = 0 is allowed.
 #pragma once
 
 #include <span>
@@ -63,6 +63,15 @@ void regionWeights(WeightMode mode, double extinction, const DistanceProfile& pr
 /// The filter is F_i = F_{i-1} + m_i (B(z_i) - F_{i-1}), F_{-1} = 0.
 void regionMixFactors(WeightMode mode, double extinction, const DistanceProfile& profile, int texels,
                       std::span<double> mix);
+
+/// The same with a light-side factor per texel (Klehm et al. 2014, Sec. 3.2 "Angular-dependency for
+/// Sources": each visibility weighted by the light's contribution, as for the transmittance): `light`
+/// holds 2 n + 1 samples g(k / (2 n)) of the factor along the region's reference ray (texel boundaries
+/// and centres), and w_i = gbar_i (exp(-s tau_i) - exp(-s tau_{i+1})) with gbar_i = (g_2i + 4 g_2i+1 +
+/// g_2i+2) / 6 (Simpson). m_i = w_i / sum_{j<=i} w_j; 1 / (i + 1) while the sum is 0 (no light yet: equal
+/// weights); non-finite distances give w = 0. An empty `light` is the overload above.
+void regionMixFactors(WeightMode mode, double extinction, const DistanceProfile& profile, int texels,
+                      std::span<const double> light, std::span<double> mix);
 
 /// The weight total of the first u n texels divided by s, for a continuous u in [0, 1] (tau(u) is the
 /// mode's distance at fractional texel u n; exponential modes: (1 - exp(-s tau(u))) / s = tau phi(s tau),

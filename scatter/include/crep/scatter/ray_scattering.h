@@ -46,6 +46,11 @@ struct LocalLight {
   static LocalLight pointFace(const PointLight& light, int face);
   /// Radiant intensity toward unit direction w (falloff and sector applied).
   glm::dvec3 intensityToward(const glm::dvec3& w) const;
+  /// The grey light-side factor of the integrand at `point` on a view ray of unit direction `v` (the
+  /// prefilter's weights, Klehm et al. 2014, Sec. 3.2): mean_c(sigma_s p(theta))_c * mean_c(I_c falloff) *
+  /// exp(-s d) / d^2 with s the grey extinction and d clamped below at the near plane.
+  double weightFactor(const Medium& medium, double greyExtinction, const glm::dvec3& point,
+                      const glm::dvec3& v) const;
 };
 
 /// S(ta, tb) of one view ray (see top).
