@@ -97,9 +97,11 @@ void requireSameSize(const RectifiedMap& map, const MinMaxTrees& trees) {
 
 // Yusov 2012, Algorithm 2 on a rectified row (Klehm et al. 2014, Sec. 2.2: the ray's depth is constant),
 // Eq. 16 sums.
-MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
-                        const Camera& camera, const DirectionalLight& light, const Medium& medium,
-                        const MarchOptions& options) {
+namespace {
+template <class Light>
+MarchResult minMaxMarchImpl(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                            const Camera& camera, const Light& light, const Medium& medium,
+                            const MarchOptions& options) {
   requireSameSize(map, trees);
   const int W = map.width(), L = trees.levels(), stride = trees.rowStride();
   std::vector<int> offsets(static_cast<std::size_t>(L) + 1, 0);
@@ -142,8 +144,30 @@ MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const
                             });
 }
 
+} // namespace
+
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                        const MarchOptions& options) {
+  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options);
+}
+
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const LocalLight& light, const Medium& medium,
+                        const MarchOptions& options) {
+  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options);
+}
+
 MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                         const DirectionalLight& light, const Medium& medium, const MarchOptions& options) {
+  validate(map);
+  validate(options);
+  const MinMaxTrees trees(map.depth, options.threads);
+  return minMaxMarch(map, trees, cameraDepth, camera, light, medium, options);
+}
+
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const LocalLight& light, const Medium& medium, const MarchOptions& options) {
   validate(map);
   validate(options);
   const MinMaxTrees trees(map.depth, options.threads);

@@ -51,9 +51,10 @@ double RowDistances::at(int i) const {
 
 // Yusov 2012, Eq. 16 texel by texel on a rectified row; Klehm et al. 2014, Eq. 5 with the exact
 // transmittance of Eq. 1.
-MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                            const DirectionalLight& light, const Medium& medium,
-                            const MarchOptions& options) {
+namespace {
+template <class Light>
+MarchResult bruteForce(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                       const Light& light, const Medium& medium, const MarchOptions& options) {
   return marchRectifiedRows(map, cameraDepth, camera, light, medium, options,
                             [&](const RowRay& r, const RowDistances& T, const auto& litSection, int& steps) {
                               for (int i = 0; i <= r.last; ++i) {
@@ -61,6 +62,18 @@ MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, c
                                 if (map.depth.at(i, r.texelRow) >= r.depth) litSection(T.at(i), T.at(i + 1));
                               }
                             });
+}
+} // namespace
+
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const DirectionalLight& light, const Medium& medium,
+                            const MarchOptions& options) {
+  return bruteForce(map, cameraDepth, camera, light, medium, options);
+}
+
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const LocalLight& light, const Medium& medium, const MarchOptions& options) {
+  return bruteForce(map, cameraDepth, camera, light, medium, options);
 }
 
 } // namespace crep

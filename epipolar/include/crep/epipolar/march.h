@@ -77,5 +77,12 @@ MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const
 MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                         const DirectionalLight& light, const Medium& medium,
                         const MarchOptions& options = {});
+/// The tree march for a local light (a spot, or one point-light face, on a map of its rectification):
+/// each lit section integrated by RayScattering, as bruteForceMarch does.
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const LocalLight& light, const Medium& medium,
+                        const MarchOptions& options = {});
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const LocalLight& light, const Medium& medium, const MarchOptions& options = {});
 
 } // namespace crep

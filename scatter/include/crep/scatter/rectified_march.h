@@ -22,6 +22,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -33,6 +35,7 @@
 #include <crep/core/parallel.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/ray.h>
+#include <crep/scatter/ray_scattering.h>
 
 namespace crep {
 
@@ -64,11 +67,14 @@ private:
 /// The per-pixel scaffolding of the rectified marches: validates the inputs (map, "cameraDepth",
 /// options), maps every pixel's ray and calls walk(const RowRay&, const RowDistances&, litSection, int&
 /// steps), where litSection(ta, tb) adds the lit section [ta, tb] (clipped to the integration range).
-/// Unmapped pixels are unshadowed. Rows of the camera image run in parallel.
-template <class Walk>
+/// Unmapped pixels are unshadowed. Rows of the camera image run in parallel. `Light` is DirectionalLight
+/// (sections integrated as transmittance integrals, times C) or LocalLight (sections integrated by
+/// RayScattering: the same integrand as every other method, exactly per section).
+template <class Light, class Walk>
 MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                               const DirectionalLight& light, const Medium& medium,
-                               const MarchOptions& options, const Walk& walk) {
+                               const Light& light, const Medium& medium, const MarchOptions& options,
+                               const Walk& walk) {
+  constexpr bool kLocal = std::is_same_v<Light, LocalLight>;
   validate(map);
   validateCameraDepth(cameraDepth);
   validate(options);
@@ -81,20 +87,26 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
   parallelRows(h, options.threads, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      std::optional<RayScattering> local;
+      if constexpr (kLocal) local.emplace(light, medium, origin, ray.direction);
+      const auto section = [&](double ta, double tb) {
+        if constexpr (kLocal)
+          return local->segment(ta, tb);
+        else
+          return transmittanceIntegral(sigma, ta, tb);
+      };
       glm::dvec3 L(0.0);
       int steps = 0;
       RowRay r;
       if (!mapRowRay(layout, origin, ray, W, H, r)) {
-        L = transmittanceIntegral(sigma, ray.start, ray.surface);
+        L = section(ray.start, ray.surface);
       } else {
         const RowDistances T(layout, r, W, ray.surface);
         walk(
-            r, T,
-            [&](double ta, double tb) { L += transmittanceIntegral(sigma, std::max(ta, ray.start), tb); },
-            steps);
+            r, T, [&](double ta, double tb) { L += section(std::max(ta, ray.start), tb); }, steps);
       }
-      storeScattering(out.scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
-                      std::exp(-grey * ray.surface));
+      if constexpr (!kLocal) L = scatteringConstant(light, medium, ray.direction) * L;
+      storeScattering(out.scattering, x, y, L, std::exp(-grey * ray.surface));
       out.steps.at(x, y) = static_cast<float>(steps);
     }
   });
@@ -107,5 +119,8 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const DirectionalLight& light, const Medium& medium,
                             const MarchOptions& options = {});
+/// The same for a local light (a spot, or one point-light face, on a map of its rectification).
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const LocalLight& light, const Medium& medium, const MarchOptions& options = {});
 
 } // namespace crep
