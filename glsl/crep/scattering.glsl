@@ -265,6 +265,36 @@ float crep_mixFactor(CrepRegionWeights w, int mode, float s, int i, int n) {
   return m >= 0.0 ? min(m, 1.0) : 0.0; // also sends NaN (float overflow far out) to 0
 }
 
+// crep::PointLight::faceOf: the cube-map face (+X, -X, +Y, -Y, +Z, -Z = 0..5) whose sector holds w.
+int crep_faceOf(vec3 w) {
+  vec3 a = abs(w);
+  int major = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+  return 2 * major + (w[major] >= 0.0 ? 0 : 1);
+}
+
+// Radiant intensity of a local light toward unit direction w (crep::LocalLight::intensityToward): the spot
+// falloff s(t) = t^2 (3 - 2 t) and the point face's sector.
+vec3 crep_localIntensityToward(CrepLocalLightParams L, vec3 w) {
+  if (L.axis.w >= 0.0 && crep_faceOf(w) != int(L.axis.w)) return vec3(0.0);
+  if (L.cone.z == 0.0) return L.intensity.rgb;
+  float t = clamp((dot(w, L.axis.xyz) - L.cone.y) / (L.cone.x - L.cone.y), 0.0, 1.0);
+  return L.intensity.rgb * (t * t * (3.0 - 2.0 * t));
+}
+
+// The grey light-side factor of the prefilter's weights at `point` of a view ray of direction v
+// (crep::LocalLight::weightFactor; Klehm et al. 2014, Sec. 3.2 "Angular-dependency for Sources").
+float crep_localWeightFactor(CrepLocalLightParams L, vec3 point, vec3 v) {
+  vec3 p = point - L.position.xyz;
+  float d = length(p);
+  vec3 w = d > 0.0 ? p / d : v;
+  float dc = max(d, L.position.w);
+  float mu = dot(w, -v);
+  vec3 phase = L.mieScattering.rgb * crep_henyeyGreenstein(L.mieScattering.w, mu) +
+               L.rayleighScattering.rgb * crep_rayleighPhase(mu);
+  vec3 I = crep_localIntensityToward(L, w);
+  return (phase.r + phase.g + phase.b) * (I.r + I.g + I.b) / 9.0 * exp(-L.origin.w * dc) / (dc * dc);
+}
+
 // The weight total of the first u n texels divided by s (crep::regionWeightTotal): tau phi(s tau).
 float crep_regionWeightTotal(CrepRegionWeights w, int mode, float s, int n, float u) {
   if (mode == CREP_WEIGHTS_AVERAGE_VISIBILITY) return u * float(n);

@@ -48,6 +48,17 @@ struct CrepPrefilterParams {
   vec4 weights;    // weight extinction s, depth margin m, 0, 0
 };
 
+// gpu::LocalLightParams (std140).
+struct CrepLocalLightParams {
+  vec4 origin;             // xyz camera position; w grey extinction s
+  vec4 position;           // xyz light position; w near plane
+  vec4 axis;               // xyz spot or face axis; w point face 0-5, -1 none
+  vec4 cone;               // x cos inner, y cos outer, z 1 = spot falloff
+  vec4 intensity;          // rgb radiant intensity
+  vec4 mieScattering;      // rgb; w Henyey-Greenstein g
+  vec4 rayleighScattering; // rgb
+};
+
 // gpu::EvaluateParams (std140).
 struct CrepEvaluateParams {
   vec4 cameraPosition; // xyz; w near

@@ -34,6 +34,9 @@
 #ifndef CREP_LOCAL_SIZE_Z
 #define CREP_LOCAL_SIZE_Z 1 // regions per workgroup
 #endif
+#ifndef CREP_LOCAL_LIGHT
+#define CREP_LOCAL_LIGHT 0 // 1: a local light's factor in the weights (crep::prefilter(map, medium, LocalLight))
+#endif
 
 #define CREP_GROUP_VEC4S (CREP_BASES_PER_INVOCATION / 4)
 
@@ -43,6 +46,17 @@ layout(binding = 0) uniform sampler2D crep_rectifiedDepth; // W x H depth-buffer
 layout(binding = 0, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray crep_filteredBasisOut;
 layout(std140, binding = 0) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
 layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
+#if CREP_LOCAL_LIGHT
+layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localLight; };
+layout(std430, binding = 1) readonly restrict buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; };
+
+// The light-side factor at fractional texel x of the region's reference ray (0 beyond the horizon).
+float crep_lightFactorAt(CrepRegionWeights w, vec4 ray, int n, float x) {
+  float tau = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, x);
+  if (tau < 0.0 || ray.w < 0.0) return 0.0;
+  return crep_localWeightFactor(crep_localLight, crep_localLight.origin.xyz + (ray.w + tau) * ray.xyz, ray.xyz);
+}
+#endif
 
 // The stored value e = 0.5 + 0.5 F, rounded by crep::storeFiltered's rule of the format, so that the
 // store itself is exact (the GL leaves the rounding of float -> unorm / half conversions open; Mesa
@@ -76,6 +90,13 @@ void main() {
 
   vec4 F[CREP_GROUP_VEC4S];
   for (int v = 0; v < CREP_GROUP_VEC4S; ++v) F[v] = vec4(0.0);
+#if CREP_LOCAL_LIGHT
+  // Sec. 3.2 "Angular-dependency for Sources": w_i = gbar_i (exp(-s tau_i) - exp(-s tau_{i+1})), gbar_i the
+  // light-side factor by Simpson's rule over the texel, m_i = w_i / sum_{j<=i} w_j (crep::regionMixFactors
+  // with light samples; Exact weights). The running sum lives in the loop: one texel's set-up per step.
+  vec4 ray = crep_regionRays[row * R + region];
+  float gLeft = crep_lightFactorAt(w, ray, n, 0.0), weightSum = 0.0;
+#endif
 
   for (int i = 0; i < n; ++i) {
     int x = region * n + i;
@@ -94,7 +115,23 @@ void main() {
     vec2 stepSC = crep_harmonicStep(z);
     vec2 sc = crep_harmonic(firstHarmonic, z);
     // Listing 2: the normalized weighted prefix.
+#if CREP_LOCAL_LIGHT
+    float gMid = crep_lightFactorAt(w, ray, n, float(i) + 0.5), gRight = crep_lightFactorAt(w, ray, n, float(i + 1));
+    float tau0 = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i));
+    float tau1 = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i + 1));
+    float wi = 0.0;
+    if (tau0 >= 0.0 && tau1 >= 0.0) {
+      float dt = tau1 - tau0;
+      float g = (gLeft + 4.0 * gMid + gRight) / 6.0;
+      wi = g * exp(-s * tau0) * crep_oneMinusExpOverX(s * dt) * dt;
+      if (!(wi > 0.0) || isinf(wi)) wi = 0.0;
+    }
+    gLeft = gRight;
+    weightSum += wi;
+    float m = weightSum > 0.0 ? clamp(wi / weightSum, 0.0, 1.0) : 1.0 / float(i + 1);
+#else
     float m = crep_mixFactor(w, mode, s, i, n);
+#endif
     for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
       int layer = firstLayer + v;
       if (layer >= layers) break;

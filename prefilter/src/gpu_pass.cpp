@@ -234,6 +234,37 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 // ---------------------------------------------------------------------------------------------------
 // PrefilterPass
 
+/// The prefilter program's sources: the options compiled in; `local` the local-light variant.
+std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& info, bool local) {
+  const PrefilterOptions& o = info.options;
+  return {{ShaderStage::Compute,
+           "passes/prefilter.comp",
+           {{"CREP_BASES_PER_INVOCATION", str(o.basesPerInvocation)},
+            {"CREP_BASIS_FORMAT", imageFormatQualifier(o.format)},
+            {"CREP_BASIS_UNORM8", o.format == StorageFormat::RGBA8 ? "1" : "0"},
+            {"CREP_BASIS_HALF", o.format == StorageFormat::RGBA16F ? "1" : "0"},
+            {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
+            {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
+            {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)},
+            {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"},
+            {"CREP_LOCAL_LIGHT", local ? "1" : "0"}}}};
+}
+
+/// The local-light block of a light and medium (gpu::LocalLightParams) seen from `origin`.
+gpu::LocalLightParams localLightParams(const LocalLight& light, const Medium& medium,
+                                       const glm::dvec3& origin, double greyExtinction) {
+  gpu::LocalLightParams p;
+  p.origin = glm::vec4(glm::vec3(origin), static_cast<float>(greyExtinction));
+  p.position = glm::vec4(glm::vec3(light.position), static_cast<float>(light.nearPlane));
+  p.axis = glm::vec4(glm::vec3(light.axis), static_cast<float>(light.face));
+  p.cone = glm::vec4(static_cast<float>(light.cosInner), static_cast<float>(light.cosOuter),
+                     light.cone ? 1.0f : 0.0f, 0.0f);
+  p.intensity = glm::vec4(glm::vec3(light.intensity), 0.0f);
+  p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));
+  p.rayleighScattering = glm::vec4(glm::vec3(medium.rayleighScattering()), 0.0f);
+  return p;
+}
+
 PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.mapWidth", info.mapWidth, 1);
   requireAtLeast("PrefilterPass::CreateInfo.mapHeight", info.mapHeight, 1);
@@ -269,18 +300,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
     checkWorkgroup(names, local, groups);
   }
 
-  const std::vector<ShaderStageSource> stages = {
-      {ShaderStage::Compute,
-       "passes/prefilter.comp",
-       {{"CREP_BASES_PER_INVOCATION", str(o.basesPerInvocation)},
-        {"CREP_BASIS_FORMAT", imageFormatQualifier(o.format)},
-        {"CREP_BASIS_UNORM8", o.format == StorageFormat::RGBA8 ? "1" : "0"},
-        {"CREP_BASIS_HALF", o.format == StorageFormat::RGBA16F ? "1" : "0"},
-        {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
-        {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
-        {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)},
-        {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
-  program_ = buildProgram(stages);
+  program_ = buildProgram(prefilterStages(info, false));
 
   texture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
   glTextureStorage3D(texture_.get(), 1, internalFormat(o.format), info.mapWidth, info.mapHeight, layers());
@@ -327,9 +347,42 @@ void PrefilterPass::run(const FrameAttribs& frame) {
             "regionCount() x regionsPerSplit (" + str(K) + " x " + str(P) + ") must divide the map width " +
                 str(W));
   const int n = W / R;
+  const bool local = frame.localLight != nullptr;
+  if (local && frame.medium == nullptr)
+    invalid("PrefilterPass::FrameAttribs.medium", "null", "must be set with a localLight");
+  if (local && info_.options.weights != WeightMode::Exact)
+    invalid("PrefilterPass::CreateInfo.options.weights", weightModeToken(info_.options.weights),
+            "must be exact with a localLight");
 
-  const std::vector<gpu::RegionWeights> weights =
-      gpuRegionWeights(referenceProfiles(*frame.layout, H, P), info_.options.weights, n);
+  const std::vector<DistanceProfile> profiles = referenceProfiles(*frame.layout, H, P);
+  const std::vector<gpu::RegionWeights> weights = gpuRegionWeights(profiles, info_.options.weights, n);
+  if (local) {
+    // Sec. 3.2: the reference rays the light-side factor is sampled along (direction, start distance).
+    std::vector<gpu::RegionRay> rays(profiles.size());
+    for (int j = 0; j < H; ++j) {
+      const double row = (j + 0.5) / H;
+      const glm::vec3 direction(frame.layout->viewRayDirection(row, frame.layout->referenceDepth(row)));
+      for (int r = 0; r < R; ++r) {
+        const std::size_t k =
+            static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r);
+        const double t0 = profiles[k](0.0);
+        rays[k] = gpu::RegionRay(direction, std::isfinite(t0) ? static_cast<float>(t0) : -1.0f);
+      }
+    }
+    const std::size_t rayBytes = rays.size() * sizeof(gpu::RegionRay);
+    if (rayBytes > raysCapacity_) {
+      raysBuffer_ = gl::createBuffer();
+      glNamedBufferStorage(raysBuffer_.get(), static_cast<GLsizeiptr>(rayBytes), nullptr,
+                           GL_DYNAMIC_STORAGE_BIT);
+      raysCapacity_ = rayBytes;
+    }
+    glNamedBufferSubData(raysBuffer_.get(), 0, static_cast<GLsizeiptr>(rayBytes), rays.data());
+    if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
+    const gpu::LocalLightParams lp =
+        localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), s);
+    glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
+    if (!programLocal_) programLocal_ = buildProgram(prefilterStages(info_, true));
+  }
   const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
   if (bytes > weightsCapacity_) {
     weightsBuffer_ = gl::createBuffer();
@@ -347,7 +400,11 @@ void PrefilterPass::run(const FrameAttribs& frame) {
       glm::vec4(static_cast<float>(s), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
   glNamedBufferSubData(paramsBuffer_.get(), 0, sizeof params, &params);
 
-  glUseProgram(program_.get());
+  glUseProgram(local ? programLocal_.get() : program_.get());
+  if (local) {
+    glBindBufferBase(GL_UNIFORM_BUFFER, 1, localBuffer_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, raysBuffer_.get());
+  }
   glBindTextureUnit(0, frame.rectifiedDepth);
   glBindSampler(0, sampler_.get());
   glBindImageTexture(0, texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, internalFormat(info_.options.format));
@@ -360,6 +417,8 @@ void PrefilterPass::run(const FrameAttribs& frame) {
                   GL_TEXTURE_UPDATE_BARRIER_BIT);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 1, 0);
   glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
   glBindSampler(0, 0);
   glBindTextureUnit(0, 0);
@@ -369,6 +428,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   ran_ = true;
   lastLayoutRegions_ = K;
   lastExtinction_ = s;
+  lastLocal_ = local;
 }
 
 FilteredBasisView PrefilterPass::filteredBasis() const {
@@ -381,6 +441,7 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
   v.bases = info_.options.bases;
   v.layoutRegions = lastLayoutRegions_;
   v.regionsPerSplit = info_.options.regionsPerSplit;
+  v.localLight = lastLocal_;
   v.weights = info_.options.weights;
   v.extinction = lastExtinction_;
   v.depthMargin = info_.options.depthMargin;
@@ -484,7 +545,8 @@ EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
 
 std::size_t PrefilterPass::memoryBytes() const noexcept {
   return filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
-         weightsCapacity_ + sizeof(gpu::PrefilterParams);
+         weightsCapacity_ + sizeof(gpu::PrefilterParams) + raysCapacity_ +
+         (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }
 
 void EvaluatePass::run(const FrameAttribs& frame) {

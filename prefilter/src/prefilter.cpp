@@ -272,6 +272,9 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
   b.weights = options.weights;
   b.extinction = extinction;
   b.depthMargin = options.depthMargin;
+  if (light && options.weights != WeightMode::Exact)
+    throw InvalidArgument("PrefilterOptions.weights", weightModeToken(options.weights),
+                          "must be exact with a local light (its factor is sampled at exact distances)");
   b.layout = map.layout;
   b.localLight = light != nullptr;
   b.profiles = referenceProfiles(*map.layout, H, options.regionsPerSplit);

@@ -109,6 +109,13 @@ const std::vector<Member> kEvaluateMembers = {
     CREP_MEMBER(gpu::EvaluateParams, cameraRight),    CREP_MEMBER(gpu::EvaluateParams, cameraUp),
     CREP_MEMBER(gpu::EvaluateParams, imageSize),      CREP_MEMBER(gpu::EvaluateParams, cameraCenter),
     CREP_MEMBER(gpu::EvaluateParams, cameraDepth)};
+const std::vector<Member> kLocalLightMembers = {CREP_MEMBER(gpu::LocalLightParams, origin),
+                                                CREP_MEMBER(gpu::LocalLightParams, position),
+                                                CREP_MEMBER(gpu::LocalLightParams, axis),
+                                                CREP_MEMBER(gpu::LocalLightParams, cone),
+                                                CREP_MEMBER(gpu::LocalLightParams, intensity),
+                                                CREP_MEMBER(gpu::LocalLightParams, mieScattering),
+                                                CREP_MEMBER(gpu::LocalLightParams, rayleighScattering)};
 const std::vector<Member> kRegionWeightsMembers = {
     CREP_MEMBER(gpu::RegionWeights, scale), CREP_MEMBER(gpu::RegionWeights, c),
     CREP_MEMBER(gpu::RegionWeights, d), CREP_MEMBER(gpu::RegionWeights, valid)};
@@ -170,6 +177,7 @@ layout(local_size_x = 1) in;
 layout(std140, binding = 0) uniform CrepScatteringBlock { CrepScatteringParams crep_scattering; };
 layout(std140, binding = 1) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
 layout(std140, binding = 2) uniform CrepEvaluateBlock { CrepEvaluateParams crep_evaluate; };
+layout(std140, binding = 3) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localLight; };
 layout(std430, binding = 0) readonly buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
 layout(std430, binding = 1) writeonly buffer Out { vec4 result; };
 void main() {
@@ -180,6 +188,8 @@ void main() {
   v += vec4(crep_prefilter.mapSize + crep_prefilter.basisInfo) + crep_prefilter.weights;
   v += crep_evaluate.cameraPosition + crep_evaluate.cameraForward + crep_evaluate.cameraRight + crep_evaluate.cameraUp +
        vec4(crep_evaluate.imageSize) + crep_evaluate.cameraCenter + crep_evaluate.cameraDepth;
+  v += crep_localLight.origin + crep_localLight.position + crep_localLight.axis + crep_localLight.cone +
+       crep_localLight.intensity + crep_localLight.mieScattering + crep_localLight.rayleighScattering;
   CrepRegionWeights w = crep_regionWeights[gl_WorkGroupID.x];
   v += vec4(w.scale, w.c, w.d, float(w.valid));
   result = v;
@@ -195,6 +205,8 @@ void main() {
                     sizeof(gpu::PrefilterParams), true);
   checkUniformBlock(p, "CrepEvaluateBlock", "crep_evaluate", kEvaluateMembers, sizeof(gpu::EvaluateParams),
                     true);
+  checkUniformBlock(p, "CrepLocalLightBlock", "crep_localLight", kLocalLightMembers,
+                    sizeof(gpu::LocalLightParams), true);
   checkRegionWeightsBlock(p);
 
   // The passes' own programs declare the same blocks (with their own binding defines): same layout
@@ -203,6 +215,10 @@ void main() {
   CHECK(checkUniformBlock(prefilter.get(), "CrepPrefilterBlock", "crep_prefilter", kPrefilterMembers,
                           sizeof(gpu::PrefilterParams), false) >= 3);
   checkRegionWeightsBlock(prefilter.get());
+  const gl::Handle prefilterLocal =
+      buildProgram({{ShaderStage::Compute, "passes/prefilter.comp", {{"CREP_LOCAL_LIGHT", "1"}}}});
+  CHECK(checkUniformBlock(prefilterLocal.get(), "CrepLocalLightBlock", "crep_localLight", kLocalLightMembers,
+                          sizeof(gpu::LocalLightParams), false) == 7);
   const gl::Handle evaluate =
       buildProgram({{ShaderStage::Compute, "passes/evaluate.comp", {{"CREP_NEAR_PLANE_CORRECTION", "1"}}}});
   CHECK(checkUniformBlock(evaluate.get(), "CrepScatteringBlock", "crep_scattering", kScatteringMembers,

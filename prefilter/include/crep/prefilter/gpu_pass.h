@@ -51,6 +51,7 @@ struct FilteredBasisView {
   WeightMode weights = WeightMode::Exact; ///< weight mode used
   double extinction = 0.0;                ///< scalar weight extinction s used (1/world unit)
   double depthMargin = 0.0625;            ///< m of fourier.h used
+  bool localLight = false;                ///< prefiltered with a local light's factor in the weights
 
   int regions() const noexcept { return layoutRegions * regionsPerSplit; } ///< R
 };
@@ -99,6 +100,10 @@ public:
     const RectifiedLayout* layout = nullptr; ///< the map's layout (reference-ray profiles); not owned
     const Medium* medium = nullptr;   ///< weight extinction = weightExtinction(*medium), unless overridden
     double extinctionOverride = -1.0; ///< >= 0: use this weight extinction s instead (1/world unit)
+    /// A local light (a spot, or one point-light face; the map of its rectification): its light-side factor
+    /// goes into the weights as crep::prefilter(map, medium, light) does (CREP_LOCAL_LIGHT variant, built on
+    /// first use; needs `medium` and options.weights = Exact). Null: a directional light.
+    const LocalLight* localLight = nullptr;
   };
 
   /// Validates `info` (InvalidArgument naming the field, e.g. "PrefilterPass::CreateInfo.options.bases";
@@ -130,9 +135,10 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle program_, texture_, sampler_, paramsBuffer_, weightsBuffer_;
-  std::size_t weightsCapacity_ = 0;
-  bool ran_ = false;
+  gl::Handle program_, programLocal_, texture_, sampler_, paramsBuffer_, weightsBuffer_, localBuffer_,
+      raysBuffer_;
+  std::size_t weightsCapacity_ = 0, raysCapacity_ = 0;
+  bool ran_ = false, lastLocal_ = false;
   int lastLayoutRegions_ = 1;
   double lastExtinction_ = 0.0;
 };

@@ -70,6 +70,26 @@ struct PrefilterParams {
 };
 static_assert(sizeof(PrefilterParams) == 48, "std140 layout of CrepPrefilterParams");
 
+/// std140 uniform block CrepLocalLightBlock { CrepLocalLightParams crep_localLight; } of the local-light
+/// variants of the prefilter and evaluation passes (CREP_LOCAL_LIGHT 1): a spot light or one point-light
+/// face (crep::LocalLight) and the medium's phase coefficients, for the light-side factor of the weights
+/// (crep::LocalLight::weightFactor) and the view rays' in-scattering (crep::RayScattering).
+struct LocalLightParams {
+  glm::vec4 origin{0.0f};             ///< xyz: camera position = rectification origin; w: grey extinction s
+  glm::vec4 position{0.0f};           ///< xyz: light position; w: near plane (d is clamped below at it)
+  glm::vec4 axis{0.0f};               ///< xyz: spot axis or face axis (unit); w: point face 0-5, -1 none
+  glm::vec4 cone{0.0f};               ///< x: cos inner, y: cos outer, z: 1 = spot falloff, w: 0
+  glm::vec4 intensity{0.0f};          ///< rgb: radiant intensity (on the axis for a spot); w: 0
+  glm::vec4 mieScattering{0.0f};      ///< rgb: sigma_s of the Henyey-Greenstein part; w: g
+  glm::vec4 rayleighScattering{0.0f}; ///< rgb: sigma_s of the Rayleigh part; w: 0
+};
+static_assert(sizeof(LocalLightParams) == 16 * 7, "std140 layout of CrepLocalLightParams");
+
+/// std430 element of the storage buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; } of the local-light
+/// prefilter (index row * R + region): xyz the row's reference ray direction (unit), w its distance from the
+/// camera at the region's start, t(0) of the region's DistanceProfile (+inf -> -1: beyond the horizon).
+using RegionRay = glm::vec4;
+
 /// std140 uniform block CrepEvaluateBlock of passes/evaluate.comp: the camera whose depth buffer is read.
 struct EvaluateParams {
   glm::vec4 cameraPosition{0.0f};                   ///< xyz: world; w: near plane distance (world units)
