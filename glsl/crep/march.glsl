@@ -27,6 +27,11 @@ struct CrepMarchParams {
   mat4 lightClipFromWorld; // world march / resampling: the standard shadow map's matrix
   vec4 cameraCenter;       // xyz the image centre's offset from forward (off-centre projections); w 0
   vec4 cameraDepth;        // x near, y projection far (0 = infinite), z integration far, w 1 = reversed-Z
+  // The world march's local light (zeros: directional; crep/local_light.glsl, crep_localLight reads them).
+  vec4 lightPosition;      // xyz world; w 1 = local light (spot or point face), 0 = directional
+  vec4 lightAxis;          // xyz unit spot axis or point-face axis; w point face index, or -1
+  vec4 lightCone;          // x cosInner, y cosOuter, z near plane, w 1 = the spot falloff applies
+  vec4 lightIntensity;     // rgb radiant intensity (on the axis for a spot); w 0
 };
 
 // The view ray of pixel p of a w x h camera image and its surface distance (crep/scatter/ray.h: sky

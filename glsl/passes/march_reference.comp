@@ -4,10 +4,15 @@
 // surface, visibility at their ends, bisection of every section whose ends differ, exact transmittance
 // integral of every lit part. Same rules as crep::worldSpaceMarch; float precision.
 //
+// Light: directional (crep_march.lightPosition.w = 0: each lit part C * transmittance integral) or local,
+// a spot or one point-light face (lightPosition.w = 1: each lit part crep_localSegment of
+// crep/local_light.glsl, the output RGB the radiance itself), as the two crep::worldSpaceMarch overloads.
+//
 // The dispatch covers the pixel rectangle crep_march.region (origin xy, size zw); with block.z >= 0 only
 // the pixels within block.z pixels of block.xy (pixel centres) are written: the epipole block of Klehm
 // et al. 2014, Fig. 8. Resources: params block (binding 0), camera depth (unit 0), shadow map (unit 1, texelFetch),
 // outputs: RGBA32F scattering (image 0), R32F steps (image 1).
+#include "crep/local_light.glsl"
 #include "crep/march.glsl"
 #include "crep/phase.glsl"
 
@@ -21,16 +26,25 @@ layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
 
 int crep_lookups = 0;
 
-// crep::standardShadowLit: nearest texel, outside the map lit, NaN texels lit (documented GPU rule).
+// crep::standardShadowLit: nearest texel, outside the map lit, behind a perspective light's eye plane
+// (clip w <= 0) lit, NaN texels lit (documented GPU rule).
 bool crep_lit(vec3 p) {
   ++crep_lookups;
   vec4 q = crep_march.lightClipFromWorld * vec4(p, 1.0);
+  if (!(q.w > 0.0)) return true;
   vec3 uvd = q.xyz / q.w * 0.5 + 0.5;
   if (!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0)) return true;
   ivec2 size = crep_march.sizes.zw;
   ivec2 texel = min(ivec2(uvd.xy * vec2(size)), size - 1);
   float stored = texelFetch(shadowMap, texel, 0).r;
   return !(clamp(uvd.z, 0.0, 1.0) > stored + crep_march.bias.x);
+}
+
+// The lit part [ta, tb] of the ray: the transmittance integral (directional, times C in main) or the
+// local light's in-scattering.
+vec3 crep_section(bool local, CrepLocalLight light, CrepLocalMedium medium, vec3 origin, vec3 dir, float ta, float tb) {
+  if (local) return crep_localSegment(light, medium, origin, dir, ta, tb);
+  return crep_transmittanceIntegral(medium.extinction, ta, tb);
 }
 
 void main() {
@@ -43,10 +57,16 @@ void main() {
   vec3 dir = ray.xyz, origin = crep_march.cameraPosition.xyz;
   float s = ray.w;
   vec3 sigma = crep_march.extinction.rgb;
+  bool local = crep_march.lightPosition.w > 0.5;
+  CrepLocalLight light = crep_localLight(crep_march.lightPosition, crep_march.lightAxis, crep_march.lightCone,
+                                         crep_march.lightIntensity);
+  CrepLocalMedium medium = CrepLocalMedium(crep_march.mieScattering, crep_march.rayleighScattering.rgb, sigma);
   float cosTheta = dot(crep_march.lightDirection.xyz, -dir);
-  vec3 C = crep_march.lightIrradiance.rgb *
-           (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
-            crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
+  // Directional: S = C * transmittance integral; local: S = crep_localSegment and C = 1.
+  vec3 C = local ? vec3(1.0)
+                 : crep_march.lightIrradiance.rgb *
+                       (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
+                        crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
   int N = crep_march.info.x, refinements = crep_march.info.y;
   vec3 L = vec3(0.0);
   float ta = 0.0;
@@ -55,7 +75,7 @@ void main() {
     float tb = k == N ? s : s * float(k) / float(N);
     bool vb = crep_lit(origin + tb * dir);
     if (va == vb) {
-      if (va) L += crep_transmittanceIntegral(sigma, ta, tb);
+      if (va) L += crep_section(local, light, medium, origin, dir, ta, tb);
     } else {
       float lo = ta, hi = tb;
       for (int r = 0; r < refinements; ++r) {
@@ -66,8 +86,8 @@ void main() {
           hi = mid;
       }
       float change = 0.5 * (lo + hi);
-      if (va) L += crep_transmittanceIntegral(sigma, ta, change);
-      if (vb) L += crep_transmittanceIntegral(sigma, change, tb);
+      if (va) L += crep_section(local, light, medium, origin, dir, ta, change);
+      if (vb) L += crep_section(local, light, medium, origin, dir, change, tb);
     }
     ta = tb;
     va = vb;

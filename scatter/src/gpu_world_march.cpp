@@ -1,5 +1,6 @@
 // The GL pass of the world-space reference march (crep/scatter/gpu_world_march.h; Klehm et al. 2014,
-// Eq. 1 and 3) and the shared march block. Shader: passes/march_reference.comp, crep/march.glsl.
+// Eq. 1 and 3) and the shared march block. Shader: passes/march_reference.comp, crep/march.glsl,
+// crep/local_light.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -29,17 +30,40 @@ GpuCamera gpuCamera(const Camera& camera) {
   return c;
 }
 
-MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
-                            int width, int height, int mapWidth, int mapHeight) {
+namespace {
+
+/// The camera and medium part of MarchParams (no light: the light members stay zero).
+MarchParams cameraMediumParams(const Camera& camera, const Medium& medium, int width, int height,
+                               int mapWidth, int mapHeight) {
   MarchParams p;
   assignCamera(p, camera);
-  p.lightDirection = glm::vec4(glm::vec3(light.direction()), 0.0f);
-  p.lightIrradiance = glm::vec4(glm::vec3(light.irradiance()), 0.0f);
+  p.lightDirection = glm::vec4(0.0f);
   p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));
   p.rayleighScattering = glm::vec4(glm::vec3(medium.rayleighScattering()), 0.0f);
   const glm::dvec3 sigma = medium.extinction();
   p.extinction = glm::vec4(glm::vec3(sigma), static_cast<float>(weightExtinction(medium)));
   p.sizes = glm::ivec4(width, height, mapWidth, mapHeight);
+  return p;
+}
+
+} // namespace
+
+MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                            int width, int height, int mapWidth, int mapHeight) {
+  MarchParams p = cameraMediumParams(camera, medium, width, height, mapWidth, mapHeight);
+  p.lightDirection = glm::vec4(glm::vec3(light.direction()), 0.0f);
+  p.lightIrradiance = glm::vec4(glm::vec3(light.irradiance()), 0.0f);
+  return p;
+}
+
+MarchParams makeMarchParams(const Camera& camera, const LocalLight& light, const Medium& medium, int width,
+                            int height, int mapWidth, int mapHeight) {
+  MarchParams p = cameraMediumParams(camera, medium, width, height, mapWidth, mapHeight);
+  p.lightPosition = glm::vec4(glm::vec3(light.position), 1.0f);
+  p.lightAxis = glm::vec4(glm::vec3(light.axis), static_cast<float>(light.face));
+  p.lightCone = glm::vec4(static_cast<float>(light.cosInner), static_cast<float>(light.cosOuter),
+                          static_cast<float>(light.nearPlane), light.cone ? 1.0f : 0.0f);
+  p.lightIntensity = glm::vec4(glm::vec3(light.intensity), 0.0f);
   return p;
 }
 
@@ -76,8 +100,11 @@ WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
 }
 
 void WorldMarchPass::run(const FrameAttribs& f) {
-  if (!f.camera || !f.light || !f.medium)
-    throw InvalidArgument("WorldMarchPass::FrameAttribs.camera/light/medium", "null", "must be set");
+  if (!f.camera || !f.medium)
+    throw InvalidArgument("WorldMarchPass::FrameAttribs.camera/medium", "null", "must be set");
+  if ((f.light != nullptr) == (f.localLight != nullptr))
+    throw InvalidArgument("WorldMarchPass::FrameAttribs.light/localLight", f.light ? "both set" : "both null",
+                          "exactly one must be set");
   // The image and map sizes are the textures' own (gl::textureLevel).
   const gl::TextureLevel depth =
       gl::requireTexture2D("WorldMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
@@ -91,14 +118,30 @@ void WorldMarchPass::run(const FrameAttribs& f) {
       if (!std::isfinite(f.lightClipFromWorld[c][r]))
         throw InvalidArgument("WorldMarchPass::FrameAttribs.lightClipFromWorld",
                               detail::formatValue(f.lightClipFromWorld[c][r]), "must be finite");
+  if (const LocalLight* l = f.localLight) {
+    const auto finite3 = [](const glm::dvec3& v) {
+      return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+    };
+    const bool finite = finite3(l->position) && finite3(l->intensity) && finite3(l->axis) &&
+                        std::isfinite(l->nearPlane) && std::isfinite(l->cosInner) &&
+                        std::isfinite(l->cosOuter);
+    if (!finite)
+      throw InvalidArgument("WorldMarchPass::FrameAttribs.localLight", "a non-finite member",
+                            "must be finite");
+    if (l->face < -1 || l->face > 5)
+      throw InvalidArgument("WorldMarchPass::FrameAttribs.localLight->face", detail::formatValue(l->face),
+                            "must be -1 or a point light face in [0, 5]");
+  }
   if (!std::isfinite(f.bias))
     throw InvalidArgument("WorldMarchPass::FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
   if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
     throw InvalidArgument("WorldMarchPass::FrameAttribs.blockCenter/blockRadius",
                           detail::formatValue(f.blockRadius), "must be finite");
 
-  gpu::MarchParams params =
-      gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, shadow.width, shadow.height);
+  gpu::MarchParams params = f.light ? gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height,
+                                                           shadow.width, shadow.height)
+                                    : gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height,
+                                                           shadow.width, shadow.height);
   params.info = glm::ivec4(info_.options.steps, info_.options.refinements, 0, 0);
   params.bias = glm::vec4(static_cast<float>(f.bias), 0.0f, 0.0f, 0.0f);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);

@@ -474,6 +474,20 @@ TEST_CASE("epipolar GL: uniform and storage blocks match their C++ structs") {
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightClipFromWorld);
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, cameraCenter);
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, cameraDepth);
+  CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightPosition);
+  CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightAxis);
+  CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightCone);
+  CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightIntensity);
+  // The world march (the one pass that reads the local-light members) sees the same block.
+  const gl::Handle reference = buildProgram({{ShaderStage::Compute, "passes/march_reference.comp", {}}});
+  const GLuint w = reference.get();
+  CHECK(blockSize(w, "CrepMarchBlock") == static_cast<GLint>(sizeof(MarchParams)));
+  CREP_CHECK_MEMBER(w, "crep_march", MarchParams, lightClipFromWorld);
+  CREP_CHECK_MEMBER(w, "crep_march", MarchParams, cameraDepth);
+  CREP_CHECK_MEMBER(w, "crep_march", MarchParams, lightPosition);
+  CREP_CHECK_MEMBER(w, "crep_march", MarchParams, lightAxis);
+  CREP_CHECK_MEMBER(w, "crep_march", MarchParams, lightCone);
+  CREP_CHECK_MEMBER(w, "crep_march", MarchParams, lightIntensity);
   CHECK(blockSize(p, "CrepProjectiveLayoutBlock") == static_cast<GLint>(sizeof(ProjectiveLayoutParams)));
   CREP_CHECK_MEMBER(p, "crep_projective", ProjectiveLayoutParams, origin);
   CREP_CHECK_MEMBER(p, "crep_projective", ProjectiveLayoutParams, slopes);

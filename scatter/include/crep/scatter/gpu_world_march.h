@@ -25,6 +25,7 @@
 #include <crep/core/gl.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/scatter/ray_scattering.h>
 #include <crep/scatter/world_march.h>
 
 namespace crep {
@@ -53,8 +54,14 @@ struct MarchParams {
   /// The camera's depth convention: x near, y projection far (0 = infinite), z integration far, w 1 =
   /// reversed
   glm::vec4 cameraDepth{0.0f};
+  // The local light of the world march (appended: the members above keep their offsets; zeros = a
+  // directional light, what every other pass of the block leaves them at).
+  glm::vec4 lightPosition{0.0f};  ///< xyz: world; w: 1 = local light (spot or point face), 0 = directional
+  glm::vec4 lightAxis{0.0f};      ///< xyz: unit spot axis or point-face axis; w: point face index, or -1
+  glm::vec4 lightCone{0.0f};      ///< x cosInner, y cosOuter, z near plane, w 1 = the spot falloff applies
+  glm::vec4 lightIntensity{0.0f}; ///< rgb: radiant intensity (on the axis for a spot); w: 0
 };
-static_assert(sizeof(MarchParams) == 16 * 20, "std140 CrepMarchParams");
+static_assert(sizeof(MarchParams) == 16 * 24, "std140 CrepMarchParams");
 
 /// The camera vectors of the GPU blocks (MarchParams, gpu::EvaluateParams): a pixel at NDC (x, y) looks
 /// along forward + center + x right + y up (right and up scaled by the image's half extents at unit
@@ -83,6 +90,10 @@ void assignCamera(Block& block, const Camera& camera) {
 /// The camera, light and medium part of MarchParams for a w x h camera image and a W x H map.
 MarchParams makeMarchParams(const Camera& camera, const DirectionalLight& light, const Medium& medium,
                             int width, int height, int mapWidth, int mapHeight);
+/// The same for a local light (lightPosition, lightAxis, lightCone, lightIntensity; the directional
+/// members stay zero).
+MarchParams makeMarchParams(const Camera& camera, const LocalLight& light, const Medium& medium, int width,
+                            int height, int mapWidth, int mapHeight);
 
 /// The resources of every march pass's shader (this module's and epipolar/'s): `program` current,
 /// MarchParams buffer `params` at uniform binding 0, the camera depth at texture unit 0 and the map it
@@ -109,7 +120,15 @@ public:
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
+    /// The light: exactly one of `light` (directional) and `localLight` (a spot light,
+    /// LocalLight::spot, or one face of a point light, LocalLight::pointFace: march each face with its
+    /// own map and add the outputs) is set. For a local light, lightClipFromWorld is its perspective
+    /// shadow map's matrix (SpotLight::lightClipFromWorld, PointLight::faceClipFromWorld), points with
+    /// clip w <= 0 count as lit, each lit part is integrated with crep_localSegment
+    /// (glsl/crep/local_light.glsl, the float twin of RayScattering::segment) and the output RGB is
+    /// the radiance itself, as worldSpaceMarch with a LocalLight.
     const DirectionalLight* light = nullptr;
+    const LocalLight* localLight = nullptr;
     const Medium* medium = nullptr;
     /// GL_TEXTURE_2D of depth-buffer values of `camera` (its convention); the image size is its size
     std::uint32_t cameraDepth = 0;
@@ -126,7 +145,8 @@ public:
   };
   /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
   explicit WorldMarchPass(const CreateInfo& info);
-  /// Throws InvalidArgument naming the FrameAttribs field.
+  /// Throws InvalidArgument naming the FrameAttribs field ("WorldMarchPass::FrameAttribs.light/localLight"
+  /// when both or neither are set).
   void run(const FrameAttribs& frame);
 
 private:

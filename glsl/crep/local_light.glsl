@@ -1,0 +1,266 @@
+// crepuscular: the in-scattering of a view-ray section for a local light, a spot light or one face of a
+// point light (Klehm et al. 2014, Eq. 1; Sec. 3.2 "Local Lights": a point light is six perspective
+// faces, each lighting the sector of directions whose major axis is its own, and "Angular-dependency for
+// Sources": the spot's angular weighting). GLSL twin in float of crep::RayScattering::segment for a
+// crep::LocalLight (crep/scatter/ray_scattering.h, whose header comment is the rule): for the view ray
+// x(t) = origin + t dir (dir unit) and a lit section [ta, tb],
+//
+//   S(ta, tb) = integral_ta^tb exp(-sigma t) sigma_s p(theta(t)) I(w) exp(-sigma dc) / dc^2 dt
+//
+// per RGB channel, with w the unit direction from the light to x(t), d = |x(t) - position|, dc = max(d,
+// nearPlane), I(w) the intensity times the spot falloff t^2 (3 - 2 t) (crep::spotFalloff) and, for a
+// point face, 0 outside the face's sector (crep::PointLight::faceOf), theta the scattering angle
+// (cos theta = dot(w, -dir)). The same breakpoints (the near ball, the cone angles, the sector planes),
+// the same substitution t = t0 + hq tan gamma (hq = max(h, nearPlane), t0 and h the nearest point of the
+// ray's line to the light and its distance), the same parts (at most gammaStep radians each, gammaStep =
+// clamp(min(pi / 32, (1 - |g|) / 2), 1e-3, ...)), 8-point Gauss-Legendre on each, and 8 parts in t inside
+// the near ball. Add the six faces' results for a whole point light. The result is the radiance itself
+// (no C factor as for a directional light).
+//
+// Public include (conventions in crep/common.glsl). Choices for GPUs (float only, no fp64; few
+// registers; fixed loop bounds) are marked "GPU:" below. Differences to the CPU reference are float
+// rounding only: the GL test (tests/scatter/WorldMarchLocalGLTest.cpp) measures a relative RMSE of
+// 2e-6 to 1e-5 against it.
+#ifndef CREP_LOCAL_LIGHT_GLSL
+#define CREP_LOCAL_LIGHT_GLSL
+
+#include "common.glsl"
+#include "phase.glsl"
+
+// GPU: the loop bound of the Gauss-Legendre parts of one smooth piece. ceil(pi / 1e-3) = 3142 is the most
+// the CPU rule can ask for (a piece spans less than pi radians, gammaStep >= 1e-3), so the bound never
+// coarsens the rule; the loop ends at the piece's own part count (32 at most for |g| <= 0.8).
+#ifndef CREP_LOCAL_MAX_PARTS
+#define CREP_LOCAL_MAX_PARTS 3142
+#endif
+
+// GPU: the breakpoints of a section: its two ends, 2 near-ball crossings, 2 x 2 cone crossings (inner,
+// outer) and 4 sector planes: at most 12, kept sorted by insertion in one fixed array of floats (few
+// registers: no list, no separate sort; the CPU collects them in a vector and sorts).
+#define CREP_LOCAL_MAX_CUTS 12
+
+// A local light (crep::LocalLight): a spot light, or face `face` of a point light.
+struct CrepLocalLight {
+  vec3 position;   // world
+  vec3 intensity;  // radiant intensity per channel (on the axis for a spot)
+  vec3 axis;       // spot: unit axis (the direction the light points); point face: the face's axis
+  float nearPlane; // d is clamped below at it (the light is a ball of that radius)
+  float cosInner;  // spot falloff: full intensity for cos(angle to axis) >= cosInner
+  float cosOuter;  // spot falloff: none for cos(angle to axis) <= cosOuter
+  bool cone;       // the spot falloff applies
+  int face;        // point light face 0..5 (+x, -x, +y, -y, +z, -z), -1: every direction
+};
+
+// The medium of crep::Medium as the integrand sees it: mie = (rgb sigma_s of the Henyey-Greenstein part,
+// w g), rayleigh = rgb sigma_s of the Rayleigh part, extinction = rgb sigma_t.
+struct CrepLocalMedium {
+  vec4 mie;
+  vec3 rayleigh;
+  vec3 extinction;
+};
+
+// The light of the packed vectors of gpu::MarchParams (crep/march.glsl: lightPosition, lightAxis,
+// lightCone, lightIntensity).
+CrepLocalLight crep_localLight(vec4 position, vec4 axis, vec4 cone, vec4 intensity) {
+  CrepLocalLight l;
+  l.position = position.xyz;
+  l.intensity = intensity.rgb;
+  l.axis = axis.xyz;
+  l.nearPlane = cone.z;
+  l.cosInner = cone.x;
+  l.cosOuter = cone.y;
+  l.cone = cone.w > 0.5;
+  l.face = int(round(axis.w));
+  return l;
+}
+
+// crep::PointLight::faceOf: the face whose sector holds w (ties go to the lower axis, then to +).
+int crep_pointFaceOf(vec3 w) {
+  vec3 a = abs(w);
+  int major = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+  return 2 * major + (w[major] >= 0.0 ? 0 : 1);
+}
+
+// crep::spotFalloff: s = t^2 (3 - 2 t), t = clamp((cosAngle - cosOuter) / (cosInner - cosOuter), 0, 1).
+float crep_spotFalloff(float cosAngle, float cosInner, float cosOuter) {
+  float t = clamp((cosAngle - cosOuter) / (cosInner - cosOuter), 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
+
+// crep::LocalLight::intensityToward: the radiant intensity toward unit direction w.
+vec3 crep_localIntensityToward(CrepLocalLight l, vec3 w) {
+  if (l.face >= 0 && crep_pointFaceOf(w) != l.face) return vec3(0.0);
+  if (l.cone) return l.intensity * crep_spotFalloff(dot(w, l.axis), l.cosInner, l.cosOuter);
+  return l.intensity;
+}
+
+// The ray as the integrand sees it. GPU: positions are relative to the nearest point of the ray's line
+// to the light, x(t) - position = perp + u dir with u = t - t0 (perp orthogonal to dir, |perp| = h), so
+// d, w and cos theta carry no cancellation of two large float vectors (the CPU forms x(t) - position in
+// double).
+struct CrepLocalRay {
+  vec3 perp; // nearest point of the line minus the light position
+  vec3 dir;  // unit
+  float t0;  // parameter of the nearest point
+  float h;   // |perp|
+  float hq;  // max(h, nearPlane): the substitution's scale
+  float gammaStep;
+};
+
+CrepLocalRay crep_localRay(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 dir) {
+  CrepLocalRay r;
+  vec3 p = origin - l.position;
+  r.dir = dir;
+  r.t0 = -dot(p, dir);
+  r.perp = p + r.t0 * dir;
+  r.h = length(r.perp);
+  r.hq = max(r.h, l.nearPlane);
+  r.gammaStep = max(min(float(CREP_PI / 32.0), 0.5 * (1.0 - abs(m.mie.w))), 1e-3);
+  return r;
+}
+
+// exp(-sigma t) sigma_s p(theta) I(w) exp(-sigma dc) at u = t - t0, without the 1 / dc^2 (the caller's
+// Jacobian holds it).
+vec3 crep_localDensityNumerator(CrepLocalLight l, CrepLocalMedium m, CrepLocalRay r, float u) {
+  float d = sqrt(r.h * r.h + u * u);
+  vec3 w = d > 0.0 ? (r.perp + u * r.dir) / d : r.dir;
+  float cosTheta = d > 0.0 ? -u / d : -1.0; // dot(w, -dir): perp is orthogonal to dir
+  float dc = max(d, l.nearPlane);
+  vec3 phase =
+      m.mie.rgb * crep_henyeyGreenstein(m.mie.w, cosTheta) + m.rayleigh * crep_rayleighPhase(cosTheta);
+  return exp(-m.extinction * (r.t0 + u + dc)) * phase * crep_localIntensityToward(l, w);
+}
+
+// crep::RayScattering::density at u = t - t0.
+vec3 crep_localDensity(CrepLocalLight l, CrepLocalMedium m, CrepLocalRay r, float u) {
+  float dc = max(sqrt(r.h * r.h + u * u), l.nearPlane);
+  return crep_localDensityNumerator(l, m, r, u) / (dc * dc);
+}
+
+// The integrand in gamma: density(t(gamma)) dt / dgamma, t = t0 + hq tan gamma. GPU: the Jacobian
+// hq / (cos^2 gamma dc^2) is evaluated as hq / max(h^2 cos^2 + hq^2 sin^2, near^2 cos^2) (the same value:
+// cos^2 d^2 = h^2 cos^2 + (hq sin)^2), which stays finite and accurate in float as gamma nears +-pi/2.
+vec3 crep_localIntegrandInGamma(CrepLocalLight l, CrepLocalMedium m, CrepLocalRay r, float gamma) {
+  float s = sin(gamma), c = cos(gamma);
+  float u = r.hq * s / c;
+  float cc = c * c;
+  float jacobian = r.hq / max(r.h * r.h * cc + r.hq * r.hq * s * s, l.nearPlane * l.nearPlane * cc);
+  return crep_localDensityNumerator(l, m, r, u) * jacobian;
+}
+
+// 8-point Gauss-Legendre on [a, b], in gamma (inGamma) or in u = t - t0.
+vec3 crep_localGaussLegendre(CrepLocalLight l, CrepLocalMedium m, CrepLocalRay r, float a, float b,
+                             bool inGamma) {
+  const float nodes[4] =
+      float[4](0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363);
+  const float weights[4] =
+      float[4](0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763);
+  float mid = 0.5 * (a + b), halfWidth = 0.5 * (b - a);
+  vec3 sum = vec3(0.0);
+  for (int i = 0; i < 4; ++i) {
+    float dx = halfWidth * nodes[i];
+    if (inGamma)
+      sum += weights[i] *
+             (crep_localIntegrandInGamma(l, m, r, mid - dx) + crep_localIntegrandInGamma(l, m, r, mid + dx));
+    else
+      sum += weights[i] * (crep_localDensity(l, m, r, mid - dx) + crep_localDensity(l, m, r, mid + dx));
+  }
+  return sum * halfWidth;
+}
+
+// Inserts u into the sorted cuts[0, n) when it lies strictly inside (lo, hi).
+void crep_localAddCut(inout float cuts[CREP_LOCAL_MAX_CUTS], inout int n, float u, float lo, float hi) {
+  if (!(u > lo && u < hi) || n >= CREP_LOCAL_MAX_CUTS) return;
+  int i = n;
+  while (i > 0 && cuts[i - 1] > u) {
+    cuts[i] = cuts[i - 1];
+    --i;
+  }
+  cuts[i] = u;
+  ++n;
+}
+
+// The cone crossings of cos(angle to the axis) = cosAngle on the forward nappe, in u: (bp + a u)^2 =
+// c2 (h^2 + u^2) with bp + a u >= 0 (the CPU's quadratic in t, shifted by t0; the stable root pair).
+void crep_localConeCuts(inout float cuts[CREP_LOCAL_MAX_CUTS], inout int n, float a, float bp, float h2,
+                        float cosAngle, float lo, float hi) {
+  float c2 = cosAngle * cosAngle;
+  float qa = a * a - c2, qb = 2.0 * a * bp, qc = bp * bp - c2 * h2;
+  float scale = max(abs(qa), max(abs(qb), abs(qc)));
+  if (!(scale > 0.0)) return;
+  float roots[2] = float[2](lo, lo); // lo: not a cut
+  if (abs(qa) <= 1e-7 * scale) {     // GPU: the float counterpart of the CPU's 1e-14
+    if (qb != 0.0) roots[0] = -qc / qb;
+  } else {
+    float disc = qb * qb - 4.0 * qa * qc;
+    if (disc < 0.0) return;
+    float q = -0.5 * (qb + (qb >= 0.0 ? 1.0 : -1.0) * sqrt(disc));
+    roots[0] = q / qa;
+    if (q != 0.0) roots[1] = qc / q;
+  }
+  for (int i = 0; i < 2; ++i)
+    if (bp + a * roots[i] >= 0.0) crep_localAddCut(cuts, n, roots[i], lo, hi);
+}
+
+// S(ta, tb) per channel for the view ray origin + t dir (dir unit); 0 when tb <= ta. The float twin of
+// crep::RayScattering::segment (see the top). GPU: the ray's constants (CrepLocalRay) are recomputed per
+// call (a dot product and a length) rather than held by the caller across its march (few registers).
+vec3 crep_localSegment(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 dir, float ta, float tb) {
+  if (!(tb > ta)) return vec3(0.0);
+  CrepLocalRay r = crep_localRay(l, m, origin, dir);
+  float lo = ta - r.t0, hi = tb - r.t0; // the section in u = t - t0
+  float cuts[CREP_LOCAL_MAX_CUTS];
+  for (int i = 0; i < CREP_LOCAL_MAX_CUTS; ++i)
+    cuts[i] = hi;
+  cuts[0] = lo;
+  cuts[1] = hi;
+  int n = 2;
+  float near2 = l.nearPlane * l.nearPlane, h2 = r.h * r.h;
+  // The near ball: |perp + u dir| = near at u = +-sqrt(near^2 - h^2).
+  if (h2 < near2) {
+    float e = sqrt(near2 - h2);
+    crep_localAddCut(cuts, n, -e, lo, hi);
+    crep_localAddCut(cuts, n, e, lo, hi);
+  }
+  if (l.cone) {
+    float a = dot(dir, l.axis), bp = dot(r.perp, l.axis);
+    crep_localConeCuts(cuts, n, a, bp, h2, l.cosInner, lo, hi);
+    crep_localConeCuts(cuts, n, a, bp, h2, l.cosOuter, lo, hi);
+  }
+  if (l.face >= 0) {
+    int major = l.face / 2;
+    for (int j = 0; j < 3; ++j) {
+      if (j == major) continue;
+      for (int k = 0; k < 2; ++k) {
+        float sgn = k == 0 ? 1.0 : -1.0;
+        float slope = dir[major] - sgn * dir[j], offset = r.perp[major] - sgn * r.perp[j];
+        if (slope != 0.0) crep_localAddCut(cuts, n, -offset / slope, lo, hi);
+      }
+    }
+  }
+
+  vec3 total = vec3(0.0);
+  for (int i = 0; i + 1 < CREP_LOCAL_MAX_CUTS; ++i) {
+    if (i + 1 >= n) break;
+    float u1 = cuts[i], u2 = cuts[i + 1];
+    if (!(u2 > u1)) continue;
+    float um = 0.5 * (u1 + u2);
+    if (h2 + um * um < near2) {
+      // Inside the near ball: 8 equal parts in t.
+      for (int k = 0; k < 8; ++k)
+        total += crep_localGaussLegendre(l, m, r, u1 + (u2 - u1) * float(k) / 8.0,
+                                         u1 + (u2 - u1) * float(k + 1) / 8.0, false);
+      continue;
+    }
+    float ga = atan(u1 / r.hq), gb = atan(u2 / r.hq);
+    int parts = clamp(int(ceil((gb - ga) / r.gammaStep)), 1, CREP_LOCAL_MAX_PARTS);
+    for (int k = 0; k < CREP_LOCAL_MAX_PARTS; ++k) {
+      if (k >= parts) break;
+      total += crep_localGaussLegendre(l, m, r, ga + (gb - ga) * float(k) / float(parts),
+                                       ga + (gb - ga) * float(k + 1) / float(parts), true);
+    }
+  }
+  return total;
+}
+
+#endif // CREP_LOCAL_LIGHT_GLSL
