@@ -45,6 +45,12 @@
 //                              scatteringPrefix; built by EvaluatePass, or glsl/passes/scattering_prefix.comp)
 //                              bound as an RGBA32F sampler2D with GL_LINEAR at CREP_SCATTERING_PREFIX_UNIT
 //                              (default 7): one fetch per pixel, whatever the number of regions crossed.
+//   CREP_LOCAL_LIGHT           1: a local light (spot, or one point-light face) instead of the directional
+//                              light of the block: declares CrepLocalLightBlock (gpu::LocalLightParams,
+//                              binding CREP_LOCAL_LIGHT_BINDING, default 3) and integrates every region
+//                              segment with crep_localSegment (crep/local_light.glsl) times its
+//                              visibility; the basis must be prefiltered with the same light. Projective
+//                              frame only, no near-plane correction.
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
 //   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
 //                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
@@ -56,12 +62,19 @@
 #define CREP_SCATTERING_GLSL
 
 #include "common.glsl"
+#include "local_light.glsl"
 #include "phase.glsl"
 #include "ray.glsl"
 #include "scattering_structs.glsl"
 
 #ifndef CREP_NEAR_PLANE_CORRECTION
 #define CREP_NEAR_PLANE_CORRECTION 0
+#endif
+#ifndef CREP_LOCAL_LIGHT
+#define CREP_LOCAL_LIGHT 0
+#endif
+#ifndef CREP_LOCAL_LIGHT_BINDING
+#define CREP_LOCAL_LIGHT_BINDING 3
 #endif
 #ifndef CREP_RINGING_LANCZOS
 #define CREP_RINGING_LANCZOS 0
@@ -265,20 +278,18 @@ float crep_mixFactor(CrepRegionWeights w, int mode, float s, int i, int n) {
   return m >= 0.0 ? min(m, 1.0) : 0.0; // also sends NaN (float overflow far out) to 0
 }
 
-// crep::PointLight::faceOf: the cube-map face (+X, -X, +Y, -Y, +Z, -Z = 0..5) whose sector holds w.
-int crep_faceOf(vec3 w) {
-  vec3 a = abs(w);
-  int major = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
-  return 2 * major + (w[major] >= 0.0 ? 0 : 1);
-}
-
-// Radiant intensity of a local light toward unit direction w (crep::LocalLight::intensityToward): the spot
-// falloff s(t) = t^2 (3 - 2 t) and the point face's sector.
-vec3 crep_localIntensityToward(CrepLocalLightParams L, vec3 w) {
-  if (L.axis.w >= 0.0 && crep_faceOf(w) != int(L.axis.w)) return vec3(0.0);
-  if (L.cone.z == 0.0) return L.intensity.rgb;
-  float t = clamp((dot(w, L.axis.xyz) - L.cone.y) / (L.cone.x - L.cone.y), 0.0, 1.0);
-  return L.intensity.rgb * (t * t * (3.0 - 2.0 * t));
+// The local light of a gpu::LocalLightParams block as crep_localSegment takes it (crep/local_light.glsl).
+CrepLocalLight crep_localLightOf(CrepLocalLightParams L) {
+  CrepLocalLight l;
+  l.position = L.position.xyz;
+  l.intensity = L.intensity.rgb;
+  l.axis = L.axis.xyz;
+  l.nearPlane = L.position.w;
+  l.cosInner = L.cone.x;
+  l.cosOuter = L.cone.y;
+  l.cone = L.cone.z != 0.0;
+  l.face = int(L.axis.w);
+  return l;
 }
 
 // The grey light-side factor of the prefilter's weights at `point` of a view ray of direction v
@@ -291,7 +302,7 @@ float crep_localWeightFactor(CrepLocalLightParams L, vec3 point, vec3 v) {
   float mu = dot(w, -v);
   vec3 phase = L.mieScattering.rgb * crep_henyeyGreenstein(L.mieScattering.w, mu) +
                L.rayleighScattering.rgb * crep_rayleighPhase(mu);
-  vec3 I = crep_localIntensityToward(L, w);
+  vec3 I = crep_localIntensityToward(crep_localLightOf(L), w);
   return (phase.r + phase.g + phase.b) * (I.r + I.g + I.b) / 9.0 * exp(-L.origin.w * dc) / (dc * dc);
 }
 
@@ -354,6 +365,32 @@ layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegion
 #define CREP_LAYOUT CREP_EVAL_LAYOUT
 #include "epipolar.glsl"
 #endif
+
+#if CREP_LOCAL_LIGHT
+#ifdef CREP_EVAL_LAYOUT
+#error "CREP_LOCAL_LIGHT: local lights are evaluated on the projective frame only"
+#endif
+layout(std140, binding = CREP_LOCAL_LIGHT_BINDING) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
+
+// The block's light and medium as crep_localSegment takes them.
+CrepLocalLight crep_blockLocalLight() { return crep_localLightOf(crep_localParams); }
+CrepLocalMedium crep_blockLocalMedium() {
+  return CrepLocalMedium(crep_localParams.mieScattering, crep_localParams.rayleighScattering.rgb,
+                         crep_scattering.extinction.rgb);
+}
+#endif
+
+// The light-dependent factor of a lit section [ta, tb] of the ray origin + t dir: the transmittance
+// integral of Eq. 3 for the directional light (the caller multiplies by C), or with CREP_LOCAL_LIGHT the
+// local light's own in-scattering of the section (crep_localSegment; crep::evaluate(..., LocalLight)).
+vec3 crep_sectionIntegral(vec3 origin, vec3 dir, vec3 sigma, float ta, float tb) {
+#if CREP_LOCAL_LIGHT
+  if (!(tb < 1e30)) return vec3(0.0); // beyond a region boundary the ray never reaches
+  return crep_localSegment(crep_blockLocalLight(), crep_blockLocalMedium(), origin, dir, ta, tb);
+#else
+  return crep_transmittanceIntegral(sigma, ta, tb);
+#endif
+}
 
 // A world point in the rectified map (crep::Rectification::toRectified): slopes y = Y / X, z = Z / X,
 // normalized row and depth, split k and the column within it.
@@ -515,18 +552,22 @@ vec3 crep_scatteringConstant(vec3 viewDirection) {
 // transmittance integral over that region (Eq. 3, 11). start > 0 needs CREP_NEAR_PLANE_CORRECTION.
 vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface) {
   vec3 sigma = crep_scattering.extinction.rgb;
+#if CREP_LOCAL_LIGHT
+  vec3 C = vec3(1.0); // the local light's factors are in each section's integral
+#else
   vec3 C = crep_scatteringConstant(dir);
+#endif
   float transmittance = exp(-dot(sigma, vec3(1.0 / 3.0)) * surface);
   CrepEvalRay hit;
   if (!crep_evalMap(origin, dir, surface, hit))
-    return vec4(C * crep_transmittanceIntegral(sigma, start, surface), transmittance);
+    return vec4(C * crep_sectionIntegral(origin, dir, sigma, start, surface), transmittance);
   int lastRegion = hit.region, firstRegion = 0;
   float lastU = hit.u, firstU = 0.0;
 #if CREP_NEAR_PLANE_CORRECTION
   if (start > 0.0) {
     CrepEvalRay nearPoint;
     if (!crep_evalMap(origin, dir, start, nearPoint))
-      return vec4(C * crep_transmittanceIntegral(sigma, start, surface), transmittance);
+      return vec4(C * crep_sectionIntegral(origin, dir, sigma, start, surface), transmittance);
     firstRegion = nearPoint.region;
     firstU = nearPoint.u;
     if (firstRegion > lastRegion || (firstRegion == lastRegion && firstU > lastU)) {
@@ -577,13 +618,13 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
     for (int r = 0; r < lastRegion; ++r) {
       float tb = clamp(crep_evalBoundary(hit, r + 1), ta, surface);
       float V = crep_visibilityTableAt(r, coord);
-      L += V * crep_transmittanceIntegral(sigma, ta, tb);
+      L += V * crep_sectionIntegral(origin, dir, sigma, ta, tb);
       ta = tb;
     }
 #endif
     float dotF = 0.0;
     for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(lastRegion, lastU, hit.row, l));
-    L += clamp(0.5 + dotF, 0.0, 1.0) * crep_transmittanceIntegral(sigma, ta, surface);
+    L += clamp(0.5 + dotF, 0.0, 1.0) * crep_sectionIntegral(origin, dir, sigma, ta, surface);
     return vec4(C * L, transmittance);
   }
 #endif
@@ -610,7 +651,7 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
     if (plain)
       for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(r, ub, hit.row, l));
     float V = clamp(0.5 + dotF, 0.0, 1.0);
-    L += C * V * crep_transmittanceIntegral(sigma, ta, tb);
+    L += C * V * crep_sectionIntegral(origin, dir, sigma, ta, tb);
     ta = tb;
   }
   return vec4(L, transmittance);

@@ -47,14 +47,14 @@ layout(binding = 0, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray c
 layout(std140, binding = 0) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
 layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
 #if CREP_LOCAL_LIGHT
-layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localLight; };
+layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
 layout(std430, binding = 1) readonly restrict buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; };
 
 // The light-side factor at fractional texel x of the region's reference ray (0 beyond the horizon).
 float crep_lightFactorAt(CrepRegionWeights w, vec4 ray, int n, float x) {
   float tau = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, x);
   if (tau < 0.0 || ray.w < 0.0) return 0.0;
-  return crep_localWeightFactor(crep_localLight, crep_localLight.origin.xyz + (ray.w + tau) * ray.xyz, ray.xyz);
+  return crep_localWeightFactor(crep_localParams, crep_localParams.origin.xyz + (ray.w + tau) * ray.xyz, ray.xyz);
 }
 #endif
 

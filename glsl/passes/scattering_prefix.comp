@@ -61,6 +61,15 @@ void main() {
     sum += vec3(dotF > 1e30 ? 0.0 : 1.0); // counts the regions (memory-limit test), keeps the reads
 #else
     float tb = max(ta, crep_evalBoundary(ray, r + 1));
+#if CREP_LOCAL_LIGHT
+    // The local light's in-scattering of the region along the sample ray (crep::scatteringPrefixTable for a
+    // LocalLight): the ray of slopes (y, z) in the scattering block's frame.
+    vec3 dir = normalize(crep_scattering.frameAxisX.xyz + ray.data.x * crep_scattering.frameAxisY.xyz +
+                         ray.data.y * crep_scattering.frameAxisZ.xyz);
+    sum += clamp(0.5 + dotF, 0.0, 1.0) * crep_sectionIntegral(crep_scattering.frameOrigin.xyz, dir, sigma, ta, tb);
+    ta = tb;
+    continue;
+#endif
     vec3 Eb = exp(-sigma * tb);
     // (Ea - Eb) / sigma, and below sigma (tb - ta) = 1/4 (where that difference cancels) Ea (tb - ta)
     // phi(x) by the series of crep_oneMinusExpOverX: both relative errors stay near float rounding.

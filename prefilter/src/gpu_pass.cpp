@@ -39,6 +39,8 @@ constexpr GLuint kTableUnit = 6, kTableBasisUnit = 0, kTableCoefficientsBinding 
 constexpr GLuint kPrefixUnit = 7;
 // Layouts other than projective: their block (gpu::LayoutBuffers) next to the scattering and evaluate blocks.
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
+// The local-light block (CREP_LOCAL_LIGHT) of the evaluation and scattering prefix programs.
+constexpr GLuint kLocalLightBinding = 3;
 
 std::string str(long long v) {
   return std::to_string(v);
@@ -463,7 +465,8 @@ void addLayoutDefines(std::vector<ShaderDefine>& defines, int layoutKind) {
 
 /// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
 /// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
-std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind) {
+std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind,
+                                              bool local = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/evaluate.comp",
@@ -478,12 +481,17 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
     stages[0].defines.push_back({"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)});
   if (usesScatteringPrefix(info.options)) stages[0].defines.push_back({"CREP_SCATTERING_PREFIX", "1"});
   addLayoutDefines(stages[0].defines, layoutKind);
+  if (local) {
+    stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
+    stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
+  }
   return stages;
 }
 
 /// The scattering prefix table's program (EvaluateOptions::scatteringPrefix), on the same layout block as
 /// evaluateStages(info, layoutKind).
-std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info, int layoutKind) {
+std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info, int layoutKind,
+                                            bool local = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/scattering_prefix.comp",
@@ -492,6 +500,10 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
         {"CREP_TABLE_COEFFICIENTS_BINDING", str(kTableCoefficientsBinding)},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   addLayoutDefines(stages[0].defines, layoutKind);
+  if (local) {
+    stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
+    stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
+  }
   return stages;
 }
 } // namespace
@@ -551,7 +563,10 @@ std::size_t PrefilterPass::memoryBytes() const noexcept {
 
 void EvaluatePass::run(const FrameAttribs& frame) {
   if (frame.camera == nullptr) invalid("EvaluatePass::FrameAttribs.camera", "null", "must be set");
-  if (frame.light == nullptr) invalid("EvaluatePass::FrameAttribs.light", "null", "must be set");
+  const bool local = frame.localLight != nullptr;
+  if ((frame.light == nullptr) == !local)
+    invalid("EvaluatePass::FrameAttribs.light/localLight", local ? "both set" : "both null",
+            "exactly one must be set");
   if (frame.medium == nullptr) invalid("EvaluatePass::FrameAttribs.medium", "null", "must be set");
   if (frame.layout == nullptr) invalid("EvaluatePass::FrameAttribs.layout", "null", "must be set");
   const FilteredBasisView& basis = frame.basis;
@@ -586,11 +601,31 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   // layout with a GPU mapping through its own block (Klehm et al. 2014, Sec. 4.1 for the epipolar one),
   // serialized once here.
   const bool projective = dynamic_cast<const ProjectiveLayout*>(frame.layout) != nullptr;
+  if (local != basis.localLight)
+    invalid(
+        "EvaluatePass::FrameAttribs.basis.localLight", basis.localLight ? "true" : "false",
+        local ? "the basis must be prefiltered with the local light (PrefilterPass::FrameAttribs::localLight)"
+              : "a basis prefiltered for a local light needs FrameAttribs::localLight");
+  if (local && !projective)
+    invalid("EvaluatePass::FrameAttribs.layout", "not projective", "local lights need a ProjectiveLayout");
+  if (local && info_.options.nearPlaneCorrection)
+    invalid("EvaluatePass::CreateInfo.options.nearPlaneCorrection", "true", "not supported for local lights");
   std::optional<GpuLayoutData> layoutData;
   if (!projective) layoutData = gpu::requireGpuLayout(*frame.layout);
+  // A local light has no constant C: the block's directional light is unused (zero irradiance).
+  const DirectionalLight unusedLight(glm::dvec3(0.0, 0.0, -1.0), glm::dvec3(0.0));
   const gpu::ScatteringParams scattering =
-      scatteringParamsOf(basis, *frame.layout, *frame.light, *frame.medium);
+      scatteringParamsOf(basis, *frame.layout, local ? unusedLight : *frame.light, *frame.medium);
   GLuint program = program_.get();
+  if (local) {
+    if (!localProgram_) localProgram_ = buildProgram(evaluateStages(info_, -1, true));
+    program = localProgram_.get();
+    if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
+    const gpu::LocalLightParams lp = localLightParams(
+        *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
+    glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
+    glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, localBuffer_.get());
+  }
   gpu::LayoutKind layoutKind{};
   if (!projective) {
     const gpu::LayoutKind kind =
@@ -643,9 +678,11 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindSampler(kTableBasisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
     if (prefix) {
       // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
-      gl::Handle& prefixProgram = prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
+      gl::Handle& prefixProgram =
+          local ? localPrefixProgram_ : prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
       if (!prefixProgram)
-        prefixProgram = buildProgram(prefixStages(info_, projective ? -1 : static_cast<int>(layoutKind)));
+        prefixProgram =
+            buildProgram(prefixStages(info_, projective ? -1 : static_cast<int>(layoutKind), local));
       glUseProgram(prefixProgram.get());
       if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
       glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
@@ -684,6 +721,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
+  if (local) glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, 0);
   if (!projective) {
     glBindBufferBase(GL_UNIFORM_BUFFER, kLayoutBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLayoutRowsBinding, 0);

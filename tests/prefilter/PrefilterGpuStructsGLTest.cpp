@@ -217,7 +217,7 @@ void main() {
   checkRegionWeightsBlock(prefilter.get());
   const gl::Handle prefilterLocal =
       buildProgram({{ShaderStage::Compute, "passes/prefilter.comp", {{"CREP_LOCAL_LIGHT", "1"}}}});
-  CHECK(checkUniformBlock(prefilterLocal.get(), "CrepLocalLightBlock", "crep_localLight", kLocalLightMembers,
+  CHECK(checkUniformBlock(prefilterLocal.get(), "CrepLocalLightBlock", "crep_localParams", kLocalLightMembers,
                           sizeof(gpu::LocalLightParams), false) == 7);
   const gl::Handle evaluate =
       buildProgram({{ShaderStage::Compute, "passes/evaluate.comp", {{"CREP_NEAR_PLANE_CORRECTION", "1"}}}});

@@ -1,6 +1,7 @@
 // The GPU prefilter pass for local lights (PrefilterPass::FrameAttribs::localLight, CREP_LOCAL_LIGHT)
 // against the CPU reference crep::prefilter(map, medium, LocalLight) on the analytic spot light's map
 // (scatter/local_light_util.h): the stored basis, RGBA32F, value by value.
+#include "epipolar/epipolar_test_util.h"
 #include "prefilter/prefilter_gpu_util.h"
 #include "scatter/local_light_util.h"
 #include "support/gl_fixture.h"
@@ -72,4 +73,63 @@ TEST_CASE("prefilter GL, local lights: the GPU basis equals the CPU reference (s
   CHECK_THROWS_WITH_AS(
       pass.run({.rectifiedDepth = texture.get(), .layout = layout.get(), .localLight = &light}),
       doctest::Contains("PrefilterPass::FrameAttribs.medium"), crep::InvalidArgument);
+}
+
+TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation and the closed form") {
+  CREP_REQUIRE_GL();
+  constexpr int W = 512, H = 256, w = 160, h = 90;
+  const Camera camera = groundCamera(w, h);
+  const Image depth = groundDepth(camera, w, h);
+  const Medium medium = colouredMedium();
+  RectifyOptions ro;
+  ro.splits = 8;
+  PrefilterOptions o;
+  o.regionsPerSplit = 2;
+  PrefilterPass prefilterPass({.mapWidth = W, .mapHeight = H, .options = o});
+  const gl::Handle depthTexture = createTexture2D(GL_R32F, w, h);
+  glTextureSubImage2D(depthTexture.get(), 0, 0, 0, w, h, GL_RED, GL_FLOAT, depth.data().data());
+  const SpotLight spot = analyticSpot();
+  const PointLight point = analyticPoint();
+  struct Case {
+    const char* name;
+    Rectification rect;
+    LocalLight light;
+  };
+  for (const bool prefixTable : {true, false}) {
+    EvaluateOptions eo;
+    eo.scatteringPrefix = prefixTable;
+    EvaluatePass evaluatePass({.options = eo});
+    for (const Case& k : {Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
+                          Case{"point light face +X", rectifyPointLight(camera, point, ro)[0],
+                               LocalLight::pointFace(point, 0)}}) {
+      const std::string name = std::string(k.name) + (prefixTable ? ", prefix table" : ", per-region table");
+      CAPTURE(name);
+      REQUIRE(k.rect.projective());
+      const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
+      const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
+      const gl::Handle texture = createTexture2D(GL_R32F, W, H);
+      glTextureSubImage2D(texture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
+      prefilterPass.run({.rectifiedDepth = texture.get(),
+                         .layout = layout.get(),
+                         .medium = &medium,
+                         .localLight = &k.light});
+      const gl::Handle out = createTexture2D(GL_RGBA32F, w, h);
+      evaluatePass.run({.cameraDepth = depthTexture.get(),
+                        .output = out.get(),
+                        .camera = &camera,
+                        .medium = &medium,
+                        .layout = layout.get(),
+                        .basis = prefilterPass.filteredBasis(),
+                        .localLight = &k.light});
+      const Image gpu = readRgbaTexture(out.get(), w, h);
+      const Image cpu = evaluate(prefilter(map, medium, k.light, o), depth, camera, k.light, medium, eo);
+      const ImageMetrics vsCpu = rgbMetrics(gpu, cpu);
+      const ImageMetrics vsTruth = rgbMetrics(gpu, closedFormLocal(depth, camera, {k.light}, medium, true));
+      report(name + ": GPU vs CPU evaluation", vsCpu);
+      report(name + ": GPU vs closed form", vsTruth);
+      CHECK(vsCpu.nanCount == 0);
+      CHECK(vsCpu.relativeRmse < 1e-3); // RGBA8 basis read through GL_LINEAR with 8-bit weights
+      CHECK(vsTruth.relativeRmse < 0.01);
+    }
+  }
 }

@@ -166,12 +166,18 @@ public:
     std::uint32_t cameraDepth = 0;  ///< caller's GL_TEXTURE_2D, depth-buffer values of `camera` in [0, 1]
     std::uint32_t output = 0;       ///< caller's GL_TEXTURE_2D of the same size in outputFormat: RGB L, A T
     const Camera* camera = nullptr; ///< the camera of cameraDepth (normally the rectified one)
-    const DirectionalLight* light = nullptr; ///< the light of the rectification
+    const DirectionalLight* light = nullptr; ///< the light of the rectification (or null with localLight)
     const Medium* medium = nullptr;          ///< the medium (C of Eq. 1, per-channel extinction)
     /// The layout the basis was prefiltered from: a ProjectiveLayout, or any layout with a GPU mapping
     /// (an EpipolarLayout: the fallback of Klehm et al. 2014, Sec. 4.1), evaluated through its layout block.
     const RectifiedLayout* layout = nullptr;
     FilteredBasisView basis; ///< e.g. PrefilterPass::filteredBasis()
+    /// Instead of `light`: a local light (a spot, or one point-light face) whose rectification the basis
+    /// was prefiltered from with PrefilterPass::FrameAttribs::localLight. Every region segment of a pixel
+    /// ray contributes its visibility times the ray's own in-scattering (crep_localSegment of
+    /// crep/local_light.glsl; crep::evaluate(..., LocalLight) on the CPU). Projective layouts only, no
+    /// near-plane correction (InvalidArgument naming the field).
+    const LocalLight* localLight = nullptr;
   };
 
   /// Validates `info` (InvalidArgument naming the field, GlError beyond the workgroup limits) and
@@ -195,6 +201,9 @@ public:
 private:
   CreateInfo info_;
   gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
+  /// The local-light variants (CREP_LOCAL_LIGHT): evaluation and scattering prefix programs on the
+  /// projective frame, built on first use, and their light block.
+  gl::Handle localProgram_, localPrefixProgram_, localBuffer_;
   gl::Handle layoutPrograms_[2]; ///< per gpu::LayoutKind, built on first use (non-projective layouts)
   /// The region visibility table (EvaluateOptions::visibilityTableSamples): its pass, R32F texture
   /// (R Z x H, reallocated when the basis's size changes) and linear sampler.
