@@ -295,6 +295,7 @@ CrepLocalLight crep_localLightOf(CrepLocalLightParams L) {
 // The grey light-side factor of the prefilter's weights at `point` of a view ray of direction v
 // (crep::LocalLight::weightFactor; Klehm et al. 2014, Sec. 3.2 "Angular-dependency for Sources").
 float crep_localWeightFactor(CrepLocalLightParams L, vec3 point, vec3 v) {
+  if (L.cone.w == 2.0) return 1.0; // crep::LocalLightWeights::None
   vec3 p = point - L.position.xyz;
   float d = length(p);
   vec3 w = d > 0.0 ? p / d : v;
@@ -303,6 +304,7 @@ float crep_localWeightFactor(CrepLocalLightParams L, vec3 point, vec3 v) {
   vec3 phase = L.mieScattering.rgb * crep_henyeyGreenstein(L.mieScattering.w, mu) +
                L.rayleighScattering.rgb * crep_rayleighPhase(mu);
   vec3 I = crep_localIntensityToward(crep_localLightOf(L), w);
+  if (L.cone.w == 1.0) return (I.r + I.g + I.b) / 3.0; // crep::LocalLightWeights::Angular
   return (phase.r + phase.g + phase.b) * (I.r + I.g + I.b) / 9.0 * exp(-L.origin.w * dc) / (dc * dc);
 }
 

@@ -53,7 +53,7 @@ struct CrepLocalLightParams {
   vec4 origin;             // xyz camera position; w grey extinction s
   vec4 position;           // xyz light position; w near plane
   vec4 axis;               // xyz spot or face axis; w point face 0-5, -1 none
-  vec4 cone;               // x cos inner, y cos outer, z 1 = spot falloff
+  vec4 cone;               // x cos inner, y cos outer, z 1 = spot falloff, w prefilter weights (0 full, 1 angular, 2 none)
   vec4 intensity;          // rgb radiant intensity
   vec4 mieScattering;      // rgb; w Henyey-Greenstein g
   vec4 rayleighScattering; // rgb

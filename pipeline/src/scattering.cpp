@@ -3,6 +3,7 @@
 // (Fig. 8), from the passes of scatter/, epipolar/ and prefilter/.
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
@@ -137,6 +138,11 @@ struct Scattering::Impl {
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
   gl::Handle lowDepth, lowOutput;                ///< its camera depth (R32F) and scattering (RGBA32F)
   gl::GpuTimer timer;
+  /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
+  /// made on the first frame with local lights; their fallback's perspective shadow map.
+  gl::Handle localScattering, accumulate;
+  std::optional<DepthTarget> localShadowMap;
+  std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
 };
 
 Scattering::Scattering(const CreateInfo& info) : impl_(std::make_unique<Impl>(info)) {}
@@ -157,6 +163,12 @@ std::size_t Scattering::memoryBytes() const noexcept {
   if (m.reduced)
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
+  if (m.localRectified) bytes += m.localRectified->memoryBytes();
+  if (m.localScattering)
+    bytes += static_cast<std::size_t>(m.info.width) * static_cast<std::size_t>(m.info.height) * 16;
+  if (m.localShadowMap)
+    bytes += static_cast<std::size_t>(m.localShadowMap->size) *
+             static_cast<std::size_t>(m.localShadowMap->size) * 4;
   if (m.ownShadowMap)
     bytes +=
         static_cast<std::size_t>(m.ownShadowMap->size) * static_cast<std::size_t>(m.ownShadowMap->size) * 4;
@@ -173,6 +185,8 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
   if (!f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
+  if ((!f.spotLights.empty() || !f.pointLights.empty()) && !f.drawCasters)
+    invalid("Scattering::FrameAttribs.drawCasters", "empty", "local lights render their maps with it");
   if (f.shadowMap) {
     gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
     if (!std::isfinite(f.shadowMap->bias))
@@ -293,8 +307,120 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
       });
     }
   }
+  runLocalLights(f, r);
   gl::checkError("Scattering::run");
   return r;
+}
+
+// Klehm et al. 2014, Sec. 3.2 "Local Lights": every spot light and point-light face rectified for the camera,
+// prefiltered with its light-side factor when projective, marched in world space otherwise, and added.
+void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
+  Impl& m = *impl_;
+  const CreateInfo& info = m.info;
+  if (f.spotLights.empty() && f.pointLights.empty()) return;
+  if (!m.localScattering) {
+    m.localScattering = gl::createTexture2D(GL_RGBA32F, info.width, info.height, "Scattering: local light");
+    m.accumulate = buildProgram({{ShaderStage::Compute, "passes/accumulate.comp", {}}});
+  }
+  if (!m.localRectified)
+    m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
+  const auto timed = [&](LightResult& result, const char* name, const auto& work) {
+    if (!info.stageTimings) {
+      work();
+      r.stages.push_back({name, 0.0, 0.0});
+      return;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    m.timer.begin();
+    work();
+    m.timer.end();
+    glFinish();
+    const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
+    r.stages.push_back({name, m.timer.milliseconds(), wall.count()});
+    result.wallMilliseconds += wall.count();
+    result.gpuMilliseconds += m.timer.milliseconds();
+  };
+  const auto addToOutput = [&] {
+    glUseProgram(m.accumulate.get());
+    glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, m.localScattering.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>((info.width + 7) / 8), static_cast<GLuint>((info.height + 7) / 8),
+                      1);
+    gl::passOutputBarrier();
+    gl::unbindPassState(2);
+  };
+  const auto one = [&](const LocalLight& light, const Rectification& rect,
+                       const glm::dmat4& lightClipFromWorld, LightResult result) {
+    result.status = rect.status;
+    result.message = rect.message;
+    if (rect.status == RectifyStatus::Empty) {
+      r.localLights.push_back(result);
+      return;
+    }
+    if (rect.projective()) {
+      const auto layout = std::make_shared<const ProjectiveLayout>(rect);
+      timed(result, "local light: shadow pass (rectified)", [&] {
+        m.localRectified->run(
+            {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
+      });
+      timed(result, "local light: prefilter", [&] {
+        m.prefilter.run({.rectifiedDepth = m.localRectified->depthTexture(),
+                         .layout = layout.get(),
+                         .medium = f.medium,
+                         .localLight = &light});
+      });
+      timed(result, "local light: evaluate", [&] {
+        EvaluatePass::FrameAttribs e;
+        e.cameraDepth = f.cameraDepth;
+        e.output = m.localScattering.get();
+        e.camera = f.camera;
+        e.medium = f.medium;
+        e.layout = layout.get();
+        e.basis = m.prefilter.filteredBasis();
+        e.localLight = &light;
+        m.evaluate.run(e);
+        addToOutput();
+      });
+    } else {
+      // In or near the view: the world-space march against the light's own perspective shadow map.
+      if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
+      timed(result, "local light: shadow pass (perspective)",
+            [&] { m.localShadowMap->render(1, [&](int) { f.drawCasters(lightClipFromWorld); }); });
+      timed(result, "local light: world-space march", [&] {
+        WorldMarchPass::FrameAttribs b;
+        b.camera = f.camera;
+        b.localLight = &light;
+        b.medium = f.medium;
+        b.cameraDepth = f.cameraDepth;
+        b.shadowMap = m.localShadowMap->texture.get();
+        b.lightClipFromWorld = lightClipFromWorld;
+        b.bias = info.ownShadowMapBias;
+        b.output = m.localScattering.get();
+        m.block.run(b);
+        addToOutput();
+      });
+    }
+    r.localLights.push_back(result);
+  };
+  for (std::size_t i = 0; i < f.spotLights.size(); ++i) {
+    const SpotLight& spot = f.spotLights[i];
+    LightResult result;
+    result.kind = LightResult::Kind::Spot;
+    result.index = static_cast<int>(i);
+    one(LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify), spot.lightClipFromWorld(), result);
+  }
+  for (std::size_t i = 0; i < f.pointLights.size(); ++i) {
+    const PointLight& point = f.pointLights[i];
+    const std::array<Rectification, 6> faces = rectifyPointLight(*f.camera, point, info.rectify);
+    for (int face = 0; face < 6; ++face) {
+      LightResult result;
+      result.kind = LightResult::Kind::PointFace;
+      result.index = static_cast<int>(i);
+      result.face = face;
+      one(LocalLight::pointFace(point, face), faces[static_cast<std::size_t>(face)],
+          point.faceClipFromWorld(face), result);
+    }
+  }
 }
 
 } // namespace crep

@@ -380,8 +380,8 @@ void PrefilterPass::run(const FrameAttribs& frame) {
     }
     glNamedBufferSubData(raysBuffer_.get(), 0, static_cast<GLsizeiptr>(rayBytes), rays.data());
     if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
-    const gpu::LocalLightParams lp =
-        localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), s);
+    gpu::LocalLightParams lp = localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), s);
+    lp.cone.w = static_cast<float>(static_cast<int>(info_.options.localLightWeights));
     glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
     if (!programLocal_) programLocal_ = buildProgram(prefilterStages(info_, true));
   }

@@ -299,9 +299,9 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
       // Sec. 3.2: the light-side factor along the region's reference ray (texel boundaries and centres).
       for (std::size_t k = 0; k < lightSamples.size(); ++k) {
         const double t = profile(static_cast<double>(k) / (2.0 * n));
-        lightSamples[k] = std::isfinite(t)
-                              ? light->weightFactor(*medium, extinction, origin + t * reference, reference)
-                              : 0.0;
+        lightSamples[k] = std::isfinite(t) ? light->weightFactor(*medium, extinction, origin + t * reference,
+                                                                 reference, options.localLightWeights)
+                                           : 0.0;
       }
       regionMixFactors(options.weights, extinction, profile, n, lightSamples, mix);
       std::fill(F.begin(), F.end(), 0.0);

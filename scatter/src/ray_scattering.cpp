@@ -69,13 +69,27 @@ glm::dvec3 LocalLight::intensityToward(const glm::dvec3& w) const {
   return intensity;
 }
 
+const char* localLightWeightsToken(LocalLightWeights weights) {
+  switch (weights) {
+  case LocalLightWeights::Full:
+    return "full";
+  case LocalLightWeights::Angular:
+    return "angular";
+  case LocalLightWeights::None:
+    break;
+  }
+  return "none";
+}
+
 double LocalLight::weightFactor(const Medium& medium, double greyExtinction, const glm::dvec3& point,
-                                const glm::dvec3& v) const {
+                                const glm::dvec3& v, LocalLightWeights weights) const {
+  if (weights == LocalLightWeights::None) return 1.0;
   const glm::dvec3 p = point - position;
   const double d = glm::length(p);
   const glm::dvec3 w = d > 0.0 ? p / d : v;
   const double dc = std::max(d, nearPlane);
   const glm::dvec3 I = intensityToward(w);
+  if (weights == LocalLightWeights::Angular) return (I.x + I.y + I.z) / 3.0;
   const glm::dvec3 phase = medium.scatteringTimesPhase(glm::dot(w, -v));
   return (phase.x + phase.y + phase.z) / 3.0 * (I.x + I.y + I.z) / 3.0 * std::exp(-greyExtinction * dc) /
          (dc * dc);

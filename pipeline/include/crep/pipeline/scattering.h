@@ -24,6 +24,15 @@
 //     drawCasters the projective map is point-resampled from it (Sec. 4.1's rule on the projective layout);
 //     fallback frames always resample it into the epipolar layout.
 //
+// Local lights (Klehm et al. 2014, Sec. 3.2 "Local Lights"): FrameAttribs::spotLights and pointLights
+// (six faces each) are added to the directional light's result (pass a zero-irradiance light for a night
+// without sun or moon). Each is rectified for the camera; a projective light (the light off screen) is
+// rendered with drawCasters into its rectified map (RectifiedShadowPass), prefiltered with its light-side
+// factor in the weights and evaluated with every ray's exact in-scattering; a light whose rectification is
+// not projective (in or near the view) is marched in world space against a perspective shadow map rendered
+// with drawCasters (WorldMarchPass, epipoleBlock's steps: the reference's cost, not the prefiltered one);
+// one that does not reach the camera frustum costs nothing. Local lights are evaluated at full resolution.
+//
 // GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
 // clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
 #pragma once
@@ -31,6 +40,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -128,6 +138,21 @@ public:
     std::uint32_t output = 0; ///< GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance
     std::function<void(const glm::dmat4& clipFromWorld)> drawCasters; ///< see the top; may be empty
     const ShadowMap* shadowMap = nullptr;                             ///< see the top; may be null
+    /// Local lights added to the result (see the top); they need drawCasters.
+    std::span<const SpotLight> spotLights;
+    std::span<const PointLight> pointLights; ///< six cube-map faces each
+  };
+
+  /// What a local light (or one point-light face) cost and how it was computed.
+  struct LightResult {
+    enum class Kind { Spot, PointFace } kind = Kind::Spot;
+    int index = 0; ///< into FrameAttribs::spotLights or pointLights
+    int face = -1; ///< point light face 0-5 (+X, -X, +Y, -Y, +Z, -Z), -1 for a spot
+    /// Projective: prefiltered; Fallback: marched in world space; Empty: outside the view, nothing done.
+    RectifyStatus status = RectifyStatus::Empty;
+    std::string message;           ///< the rectification's explanation
+    double wallMilliseconds = 0.0; ///< CPU wall clock of its stages (0 without stageTimings)
+    double gpuMilliseconds = 0.0;  ///< GL_TIME_ELAPSED of its stages
   };
 
   enum class Layout { Projective, Epipolar };
@@ -149,6 +174,8 @@ public:
     /// The rectified map the frame was prefiltered from (rasterized or resampled; depth-buffer values or
     /// R32F, mapSize x mapSize) and its layout, valid until the next run(): for debug views, and for
     /// running the peers of the prefiltered method (RectifiedMarchPass, MinMaxTreePass) on the same data.
+    /// The local lights, in order (spots, then the faces of each point light).
+    std::vector<LightResult> localLights;
     struct RectifiedMapView {
       std::shared_ptr<const RectifiedLayout> layout;
       std::uint32_t texture = 0;
@@ -176,6 +203,8 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
+  void runLocalLights(const FrameAttribs& frame, FrameResult& result);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

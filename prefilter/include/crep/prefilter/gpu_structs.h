@@ -75,10 +75,10 @@ static_assert(sizeof(PrefilterParams) == 48, "std140 layout of CrepPrefilterPara
 /// face (crep::LocalLight) and the medium's phase coefficients, for the light-side factor of the weights
 /// (crep::LocalLight::weightFactor) and the view rays' in-scattering (crep::RayScattering).
 struct LocalLightParams {
-  glm::vec4 origin{0.0f};             ///< xyz: camera position = rectification origin; w: grey extinction s
-  glm::vec4 position{0.0f};           ///< xyz: light position; w: near plane (d is clamped below at it)
-  glm::vec4 axis{0.0f};               ///< xyz: spot axis or face axis (unit); w: point face 0-5, -1 none
-  glm::vec4 cone{0.0f};               ///< x: cos inner, y: cos outer, z: 1 = spot falloff, w: 0
+  glm::vec4 origin{0.0f};   ///< xyz: camera position = rectification origin; w: grey extinction s
+  glm::vec4 position{0.0f}; ///< xyz: light position; w: near plane (d is clamped below at it)
+  glm::vec4 axis{0.0f};     ///< xyz: spot axis or face axis (unit); w: point face 0-5, -1 none
+  glm::vec4 cone{0.0f}; ///< x: cos inner, y: cos outer, z: 1 = spot falloff, w: LocalLightWeights (0, 1, 2)
   glm::vec4 intensity{0.0f};          ///< rgb: radiant intensity (on the axis for a spot); w: 0
   glm::vec4 mieScattering{0.0f};      ///< rgb: sigma_s of the Henyey-Greenstein part; w: g
   glm::vec4 rayleighScattering{0.0f}; ///< rgb: sigma_s of the Rayleigh part; w: 0

@@ -110,6 +110,9 @@ struct PrefilterOptions {
   /// to fill low-end and integrated GPUs, which are the ALU-bound ones (the paper's 8 was measured with
   /// 1-3 regions per row). On llvmpipe 16 is 1.5x faster than 8 (`crep bench`, "limits").
   int basesPerInvocation = 16;
+  /// Local lights only: the light-side factors in the weights (LocalLightWeights; README "Local lights"
+  /// gives the figures of each).
+  LocalLightWeights localLightWeights = LocalLightWeights::Full;
   /// CPU worker threads: 0 = std::thread::hardware_concurrency(). Never changes the result.
   int threads = 0;
 };

@@ -32,6 +32,18 @@
 
 namespace crep {
 
+/// Which light-side factors a local light's prefilter weights carry along a region's reference ray (Klehm
+/// et al. 2014, Sec. 3.2: "each visibility function is simply weighted by the light's contribution"). The
+/// evaluation restores each ray's exact in-scattering per region in every mode; the mode only decides how
+/// the visibility inside a region is averaged.
+enum class LocalLightWeights {
+  Full,    ///< phase x angular falloff x exp(-s d) / d^2 of the reference ray
+  Angular, ///< the angular falloff (and the point face's sector) only
+  None,    ///< none: the transmittance weights of a directional light
+};
+/// "full", "angular", "none".
+const char* localLightWeightsToken(LocalLightWeights weights);
+
 /// A local light as the integrand sees it: a spot light, or face `face` of a point light.
 struct LocalLight {
   glm::dvec3 position{0.0};
@@ -50,7 +62,7 @@ struct LocalLight {
   /// prefilter's weights, Klehm et al. 2014, Sec. 3.2): mean_c(sigma_s p(theta))_c * mean_c(I_c falloff) *
   /// exp(-s d) / d^2 with s the grey extinction and d clamped below at the near plane.
   double weightFactor(const Medium& medium, double greyExtinction, const glm::dvec3& point,
-                      const glm::dvec3& v) const;
+                      const glm::dvec3& v, LocalLightWeights weights = LocalLightWeights::Full) const;
 };
 
 /// S(ta, tb) of one view ray (see top).
