@@ -86,8 +86,11 @@ RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
 
 void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (!f.layout) throw InvalidArgument("RectifiedMarchPass::FrameAttribs.layout", "null", "must be set");
-  if (!f.camera || !f.light || !f.medium)
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.camera/light/medium", "null", "must be set");
+  if (!f.camera || !f.medium)
+    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.camera/medium", "null", "must be set");
+  if ((f.light == nullptr) == (f.localLight == nullptr))
+    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.light/localLight",
+                          f.light ? "both set" : "both null", "exactly one must be set");
   const GpuLayoutData layoutData = gpu::requireGpuLayout(*f.layout); // serialized once per run
   const gpu::LayoutKind kind = layoutData.kind;
   const int W = info_.mapWidth, H = info_.mapHeight;
@@ -128,7 +131,9 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
           "passes/march_rectified.comp",
           {{"CREP_MARCH_TREE", tree ? "1" : "0"}, {"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
 
-  gpu::MarchParams params = gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
+  gpu::MarchParams params =
+      f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
+                   : gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
   layoutBuffers_.upload(layoutData, H);

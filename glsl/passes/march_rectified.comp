@@ -8,6 +8,7 @@
 // (unit 0), rectified map depth (unit 1, texelFetch), min/max nodes (storage buffer 0, tree variant),
 // outputs: RGBA32F scattering (image 0), R32F steps (image 1).
 #include "crep/epipolar.glsl"
+#include "crep/local_light.glsl"
 #include "crep/phase.glsl"
 
 #ifndef CREP_MARCH_TREE
@@ -26,6 +27,18 @@ layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]
 layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
 layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
 
+bool local = false;
+CrepLocalLight localLight;
+CrepLocalMedium localMedium;
+vec3 rayDirection = vec3(0.0);
+
+// The light-dependent factor of the lit section [ta, tb] (crep/scatter/rectified_march.h's rule).
+vec3 crep_section(vec3 sigma, float ta, float tb) {
+  if (local)
+    return crep_localSegment(localLight, localMedium, crep_march.cameraPosition.xyz, rayDirection, ta, tb);
+  return crep_transmittanceIntegral(sigma, ta, tb);
+}
+
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, crep_march.sizes.xy))) return;
@@ -34,15 +47,23 @@ void main() {
   float s = ray.w;
   vec3 sigma = crep_march.extinction.rgb;
   float cosTheta = dot(crep_march.lightDirection.xyz, -dir);
-  vec3 C = crep_march.lightIrradiance.rgb *
-           (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
-            crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
+  // Directional: S = C * transmittance integral; a local light (lightPosition.w = 1): S = crep_localSegment
+  // of each lit section (the same integrand as the CPU's RayScattering) and C = 1.
+  local = crep_march.lightPosition.w > 0.5;
+  localLight = crep_localLight(crep_march.lightPosition, crep_march.lightAxis, crep_march.lightCone,
+                               crep_march.lightIntensity);
+  localMedium = CrepLocalMedium(crep_march.mieScattering, crep_march.rayleighScattering.rgb, sigma);
+  rayDirection = dir;
+  vec3 C = local ? vec3(1.0)
+                 : crep_march.lightIrradiance.rgb *
+                       (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
+                        crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
   ivec2 mapSize = crep_march.sizes.zw;
   vec3 L = vec3(0.0);
   int steps = 0;
   CrepRowRay r;
   if (!crep_mapRowRay(dir, s, mapSize, r)) {
-    L = crep_transmittanceIntegral(sigma, 0.0, s);
+    L = crep_section(sigma, 0.0, s);
   } else {
     int j = r.texelRow, end = r.last + 1;
     float z = r.depth;
@@ -78,7 +99,7 @@ void main() {
       int next = min(i + (1 << level), end);
       float tb = next > r.last ? s : min(crep_rowRayDistance(r, next, mapSize), s);
       tb = max(tb, ta);
-      if (lit) L += crep_transmittanceIntegral(sigma, ta, tb);
+      if (lit) L += crep_section(sigma, ta, tb);
       ta = tb;
       i = next;
     }
@@ -88,7 +109,7 @@ void main() {
       ++steps;
       float tb = i + 1 > r.last ? s : min(crep_rowRayDistance(r, i + 1, mapSize), s);
       tb = max(tb, ta);
-      if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z) L += crep_transmittanceIntegral(sigma, ta, tb);
+      if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z) L += crep_section(sigma, ta, tb);
       ta = tb;
     }
 #endif

@@ -90,6 +90,10 @@ public:
     std::uint32_t minMaxBuffer = 0; ///< MinMaxTreePass::treeBuffer() of that map (MinMaxTree mode)
     std::uint32_t output = 0;       ///< GL_RGBA32F texture, the size of cameraDepth
     std::uint32_t stepsOutput = 0;  ///< GL_R32F texture, the size of cameraDepth, or 0 (steps not written)
+    /// Instead of `light`: a local light (a spot, or one point-light face) on a map of its rectification;
+    /// each lit section is integrated by crep_localSegment (crep::bruteForceMarch / minMaxMarch with a
+    /// LocalLight on the CPU).
+    const LocalLight* localLight = nullptr;
   };
   /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
   /// MinMaxTreePass.
