@@ -9,7 +9,9 @@
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
@@ -593,6 +595,99 @@ void constantCost(const BenchOptions& o) {
   std::printf("evaluation, largest / smallest: %.3f (goal: within 10%%)\n", hi / lo);
 }
 
+/// Local lights (issue "local lights", benchmark): crep::Scattering on this run's scene with the sun alone
+/// and with one spot light off screen (projective: prefiltered), same object and frame, wall-clock medians
+/// after a warm-up: the spot's cost against the sun's. Then the spot's own rectified map marched with the
+/// min/max trees (RectifiedMarchPass, GPU) against its prefilter + evaluation.
+void localLights(const BenchOptions& o) {
+  const Scattering::CreateInfo d;
+  if (o.mapWidth != o.mapHeight || o.mapWidth % d.mapSizeMultiple() != 0) {
+    std::printf("\nlocal lights: skipped (needs a square map, a multiple of %d)\n", d.mapSizeMultiple());
+    return;
+  }
+  tool::StageTimings timings;
+  const ScatteringFrame input(o, timings);
+  scenes::SceneRenderer* renderer = input.scene.frame->renderer;
+  if (!renderer) return;
+  Scattering::FrameAttribs a = input.attribs();
+  a.drawCasters = [&](const glm::dmat4& m) { renderer->drawDepth(m); };
+  const Camera& c = input.scene.frame->camera;
+  const glm::dvec3 position = c.position() - 4.0 * c.forward() + 7.0 * c.up();
+  const SpotLight spot({.position = position,
+                        .direction = c.position() + 14.0 * c.forward() - position,
+                        .innerConeAngle = 0.35,
+                        .outerConeAngle = 0.55,
+                        .intensity = 150.0,
+                        .range = 200.0});
+  Scattering::CreateInfo info;
+  info.width = o.screenWidth;
+  info.height = o.screenHeight;
+  info.mapSize = o.mapWidth;
+  info.prefilter.bases = o.bases;
+  Scattering scattering(info);
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  const auto frameMs = [&](const Scattering::FrameAttribs& f, double* spotMs, RectifyStatus* status) {
+    scattering.run(f); // warm-up
+    std::vector<double> total, local;
+    for (int i = 0; i < repeat; ++i) {
+      const Scattering::FrameResult r = scattering.run(f);
+      double sum = 0.0;
+      for (const Scattering::Stage& st : r.stages)
+        sum += st.wallMilliseconds;
+      total.push_back(sum);
+      if (!r.localLights.empty()) {
+        local.push_back(r.localLights[0].wallMilliseconds);
+        *status = r.localLights[0].status;
+      }
+    }
+    std::sort(total.begin(), total.end());
+    std::sort(local.begin(), local.end());
+    if (spotMs && !local.empty()) *spotMs = local[local.size() / 2];
+    return total[total.size() / 2];
+  };
+  RectifyStatus status = RectifyStatus::Empty;
+  const double sunMs = frameMs(a, nullptr, &status);
+  Scattering::FrameAttribs withSpot = a;
+  withSpot.spotLights = std::span<const SpotLight>(&spot, 1);
+  double spotMs = 0.0;
+  const double bothMs = frameMs(withSpot, &spotMs, &status);
+  std::printf(
+      "\nlocal lights (%s, %dx%d, map %d^2, M = %d; crep::Scattering wall-clock medians of %d frames\n"
+      "after a warm-up, one spot light off screen):\n",
+      o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.bases, repeat);
+  std::printf("  sun alone %.1f ms | sun + spot %.1f ms | the spot %.1f ms (%s) | spot / sun %.2f\n", sunMs,
+              bothMs, spotMs, status == RectifyStatus::Projective ? "prefiltered" : "world-space march",
+              spotMs / sunMs);
+  if (status != RectifyStatus::Projective) return;
+  // The same spot map marched with the min/max trees (the peer), timed as the prefilter + evaluation were.
+  const Rectification rect = rectify(c, spot, info.rectify);
+  const auto layout = std::make_shared<const ProjectiveLayout>(rect);
+  RectifiedShadowPass shadow({o.mapWidth, o.mapWidth});
+  shadow.run({&rect, [&](int, const glm::dmat4& m) { renderer->drawDepth(m); }});
+  MinMaxTreePass trees({o.mapWidth, o.mapWidth});
+  RectifiedMarchPass march({o.mapWidth, o.mapWidth, RectifiedMarchPass::Mode::MinMaxTree});
+  const LocalLight light = LocalLight::spot(spot);
+  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight);
+  RectifiedMarchPass::FrameAttribs m;
+  m.layout = layout.get();
+  m.camera = &c;
+  m.medium = &input.scene.frame->medium;
+  m.cameraDepth = input.scene.frame->cameraDepth.get();
+  m.rectifiedDepth = shadow.depthTexture();
+  m.minMaxBuffer = trees.treeBuffer();
+  m.output = out.get();
+  m.localLight = &light;
+  const double treeMs = medianMs(repeat, [&] {
+    trees.run(shadow.depthTexture());
+    march.run(m);
+    glFinish();
+  });
+  std::printf(
+      "  the spot's map: min/max trees + march %.1f ms | prefiltered spot (shadow pass included) %.1f ms"
+      " | ratio %.2f\n",
+      treeMs, spotMs, treeMs / spotMs);
+}
+
 void runBenchSuite(const BenchOptions& o) {
   scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
   tool::StageTimings contextTimings;
@@ -678,6 +773,7 @@ void runBenchSuite(const BenchOptions& o) {
               mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
 
   memoryTable(o);
+  localLights(o);
   constantCost(o);
   reducedResolution(o);
   methodsSideBySide(o);
