@@ -363,8 +363,9 @@ void PrefilterPass::run(const FrameAttribs& frame) {
     std::vector<gpu::RegionRay> rays(profiles.size());
     for (int j = 0; j < H; ++j) {
       const double row = (j + 0.5) / H;
-      const glm::vec3 direction(frame.layout->viewRayDirection(row, frame.layout->referenceDepth(row)));
       for (int r = 0; r < R; ++r) {
+        const glm::vec3 direction(
+            frame.layout->viewRayDirection(row, frame.layout->regionReferenceDepth(row, r / P)));
         const std::size_t k =
             static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r);
         const double t0 = profiles[k](0.0);

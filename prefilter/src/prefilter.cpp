@@ -216,9 +216,8 @@ std::vector<DistanceProfile> referenceProfiles(const RectifiedLayout& layout, in
   std::vector<DistanceProfile> out(static_cast<std::size_t>(height) * static_cast<std::size_t>(R));
   for (int j = 0; j < height; ++j) {
     const double row = (j + 0.5) / height;
-    const double depth = layout.referenceDepth(row);
     for (int k = 0; k < K; ++k) {
-      const DistanceProfile p = layout.rayProfile(row, depth, k);
+      const DistanceProfile p = layout.rayProfile(row, layout.regionReferenceDepth(row, k), k);
       for (int q = 0; q < P; ++q)
         out[static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(k * P + q)] =
             P == 1 ? p : p.sub(static_cast<double>(q) / P, static_cast<double>(q + 1) / P);
@@ -291,11 +290,13 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
     const std::span<double> basisSpan(B.data(), static_cast<std::size_t>(M));
     const double row = (j + 0.5) / H;
     const glm::dvec3 origin = map.layout->origin();
-    const glm::dvec3 reference =
-        light ? map.layout->viewRayDirection(row, map.layout->referenceDepth(row)) : glm::dvec3(0.0);
     for (int r = 0; r < R; ++r) {
       const DistanceProfile& profile =
           b.profiles[static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)];
+      const glm::dvec3 reference =
+          light ? map.layout->viewRayDirection(
+                      row, map.layout->regionReferenceDepth(row, r / options.regionsPerSplit))
+                : glm::dvec3(0.0);
       // Sec. 3.2: the light-side factor along the region's reference ray (texel boundaries and centres).
       for (std::size_t k = 0; k < lightSamples.size(); ++k) {
         const double t = profile(static_cast<double>(k) / (2.0 * n));

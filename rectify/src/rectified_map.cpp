@@ -117,6 +117,14 @@ DistanceProfile ProjectiveLayout::referenceProfile(double row, int region) const
   return rayProfile(row, referenceDepth(row), region);
 }
 
+double ProjectiveLayout::regionReferenceDepth(double row, int region) const {
+  const RowReference ref = rect_.rowReference(row);
+  if (rect_.frame.inverseLightDistance == 0.0)
+    return ref.depth; // directional: every ray reaches every column
+  const DistanceProfile lo = rayProfile(row, ref.depthLo, region), hi = rayProfile(row, ref.depthHi, region);
+  return lo.c + lo.d >= hi.c + hi.d ? ref.depthLo : ref.depthHi;
+}
+
 // ---------------------------------------------------------------------------------------------------
 // RectifiedMap
 

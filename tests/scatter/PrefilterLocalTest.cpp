@@ -11,6 +11,7 @@
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scatter/rectified_march.h>
+#include <crep/scenes/scene.h>
 
 #include <doctest/doctest.h>
 
@@ -151,4 +152,44 @@ TEST_CASE("rectified marches, spot light: brute force and min/max on the same ma
   // The tree only skips texels of equal visibility: the same lit sections, summed in larger pieces.
   CHECK(rgbMetrics(tree.scattering, brute.scattering).relativeRmse < 1e-6);
   CHECK(tree.meanSteps() < brute.meanSteps());
+}
+
+TEST_CASE("prefiltered point light: every region's reference ray is finite where the row's rays cross it") {
+  // Regression (colonnade, point light 3 units behind the camera, face -Z): the row's reference ray (depth
+  // ~0.3 of [0.003, 0.95]) reached its horizon (t = +inf) in the middle of the map while the row's
+  // shallower rays crossed the rest of it, so the exact weights of those texels were 0 and the prefiltered
+  // face showed a lit wedge (24% from the brute-force march over the same map; tests/pipeline/
+  // PrefilterPointFaceGLTest.cpp). ProjectiveLayout::regionReferenceDepth takes the row's ray reaching
+  // furthest instead.
+  const scenes::Scene scene = scenes::makeScene("colonnade", 160.0 / 90.0);
+  const Camera& c = scene.camera;
+  const PointLight point({.position = c.position() - 5.0 * c.right() + 3.0 * c.up() - 3.0 * c.forward(),
+                          .color = {1.0, 0.8, 0.6},
+                          .intensity = 60.0,
+                          .range = 80.0});
+  RectifyOptions ro;
+  ro.splits = 8;
+  const auto faces = rectifyPointLight(c, point, ro);
+  REQUIRE(faces[5].projective());
+  const ProjectiveLayout layout(faces[5]);
+  const int H = 512, P = 2, K = layout.regionCount();
+  const std::vector<DistanceProfile> profiles = referenceProfiles(layout, H, P);
+  int crossed = 0, invalid = 0;
+  for (int j = 0; j < H; ++j) {
+    const double row = (j + 0.5) / H;
+    const RowReference ref = faces[5].rowReference(row);
+    for (int k = 0; k < K; ++k) {
+      // Some ray of the row crosses layout region k with finite distances.
+      if (!layout.rayProfile(row, ref.depthLo, k).valid() && !layout.rayProfile(row, ref.depthHi, k).valid())
+        continue;
+      for (int q = 0; q < P; ++q) {
+        ++crossed;
+        invalid += profiles[static_cast<std::size_t>(j * K * P + k * P + q)].valid() ? 0 : 1;
+      }
+    }
+  }
+  MESSAGE("regions crossed by the row's rays: " << crossed
+                                                << ", with an infinite reference profile: " << invalid);
+  CHECK(crossed > 0);
+  CHECK(invalid == 0);
 }

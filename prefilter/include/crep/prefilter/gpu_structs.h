@@ -86,8 +86,8 @@ struct LocalLightParams {
 static_assert(sizeof(LocalLightParams) == 16 * 7, "std140 layout of CrepLocalLightParams");
 
 /// std430 element of the storage buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; } of the local-light
-/// prefilter (index row * R + region): xyz the row's reference ray direction (unit), w its distance from the
-/// camera at the region's start, t(0) of the region's DistanceProfile (+inf -> -1: beyond the horizon).
+/// prefilter (index row * R + region): xyz the region's reference ray direction (unit), w its distance from
+/// the camera at the region's start, t(0) of the region's DistanceProfile (+inf -> -1: beyond the horizon).
 using RegionRay = glm::vec4;
 
 /// std140 uniform block CrepEvaluateBlock of passes/evaluate.comp: the camera whose depth buffer is read.

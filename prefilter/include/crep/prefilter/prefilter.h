@@ -7,8 +7,10 @@
 // Prefilter (prefilter())
 // Prefilter regions: every layout region (split) k is cut into P = regionsPerSplit equal parts, so
 // there are R = K P regions of n = W / R texels; region r = k P + q covers texel columns
-// [r n, (r + 1) n) and its reference-ray profile is layout.referenceProfile(row, k).sub(q / P, (q+1) / P)
-// (referenceProfiles()). Per texel row j (row coordinate (j + 0.5) / H) and region r, left to right:
+// [r n, (r + 1) n) and its reference-ray profile is layout.rayProfile(row, zk, k).sub(q / P, (q+1) / P),
+// zk = layout.regionReferenceDepth(row, k): the row's reference ray, or for spot/point lights the row's
+// ray reaching furthest (crep/rectify/rectified_map.h ProjectiveLayout) (referenceProfiles()). Per texel row
+// j (row coordinate (j + 0.5) / H) and region r, left to right:
 //   z_i = texelBasisDepth(depth(i, j), depthMargin)     (fourier.h)
 //   F_i = F_{i-1} + m_i (B(z_i) - F_{i-1}),  F_{-1} = 0, m_i = regionMixFactors(...)   (weights.h)
 // so F_i = sum_{l<=i} w_l B(z_l) / sum_{l<=i} w_l in [-1, 1] (Appendix A), the region's own normalized
