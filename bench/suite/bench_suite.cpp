@@ -387,6 +387,15 @@ struct ScatteringFrame {
       : scene(tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings)),
         shadow{scene.frame->shadowMap.get(), scene.frame->lightClipFromWorld, scene.frame->shadowBias},
         output(gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight)) {}
+  /// crep::Scattering's defaults at this run's screen, square map and M.
+  static Scattering::CreateInfo createInfo(const BenchOptions& o) {
+    Scattering::CreateInfo info;
+    info.width = o.screenWidth;
+    info.height = o.screenHeight;
+    info.mapSize = o.mapWidth;
+    info.prefilter.bases = o.bases;
+    return info;
+  }
   Scattering::FrameAttribs attribs() const {
     Scattering::FrameAttribs a;
     a.camera = &scene.frame->camera;
@@ -425,11 +434,7 @@ void memoryTable(const BenchOptions& o) {
   if (o.mapWidth == o.mapHeight && o.mapWidth % d.mapSizeMultiple() == 0) {
     tool::StageTimings timings;
     const ScatteringFrame frame(o, timings);
-    Scattering::CreateInfo info;
-    info.width = o.screenWidth;
-    info.height = o.screenHeight;
-    info.mapSize = o.mapWidth;
-    info.prefilter.bases = o.bases;
+    const Scattering::CreateInfo info = ScatteringFrame::createInfo(o);
     Scattering scattering(info);
     scattering.run(frame.attribs());
     std::printf("crep::Scattering::memoryBytes() after a frame of %s at %dx%d, map %d^2, RGBA8: %.1f MiB\n",
@@ -459,11 +464,7 @@ void reducedResolution(const BenchOptions& o) {
   Image full;
   double fullMs = 0.0;
   for (const double scale : {1.0, 0.5, 0.25}) {
-    Scattering::CreateInfo info;
-    info.width = o.screenWidth;
-    info.height = o.screenHeight;
-    info.mapSize = o.mapWidth;
-    info.prefilter.bases = o.bases;
+    Scattering::CreateInfo info = ScatteringFrame::createInfo(o);
     info.evaluationScale = scale;
     Scattering scattering(info);
     scattering.run(a); // warm-up: shader specialization on the first dispatch
@@ -619,11 +620,7 @@ void localLights(const BenchOptions& o) {
                         .outerConeAngle = 0.55,
                         .intensity = 150.0,
                         .range = 200.0});
-  Scattering::CreateInfo info;
-  info.width = o.screenWidth;
-  info.height = o.screenHeight;
-  info.mapSize = o.mapWidth;
-  info.prefilter.bases = o.bases;
+  const Scattering::CreateInfo info = ScatteringFrame::createInfo(o);
   Scattering scattering(info);
   const int repeat = std::max(1, std::min(o.repeat, 3));
   const auto frameMs = [&](const Scattering::FrameAttribs& f, double* spotMs, RectifyStatus* status) {

@@ -158,20 +158,26 @@ MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const
   return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options);
 }
 
-MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                        const DirectionalLight& light, const Medium& medium, const MarchOptions& options) {
+namespace {
+/// minMaxMarch after building the trees of the map.
+template <class Light>
+MarchResult minMaxMarchBuildingTrees(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                                     const Light& light, const Medium& medium, const MarchOptions& options) {
   validate(map);
   validate(options);
   const MinMaxTrees trees(map.depth, options.threads);
-  return minMaxMarch(map, trees, cameraDepth, camera, light, medium, options);
+  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options);
+}
+} // namespace
+
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const DirectionalLight& light, const Medium& medium, const MarchOptions& options) {
+  return minMaxMarchBuildingTrees(map, cameraDepth, camera, light, medium, options);
 }
 
 MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                         const LocalLight& light, const Medium& medium, const MarchOptions& options) {
-  validate(map);
-  validate(options);
-  const MinMaxTrees trees(map.depth, options.threads);
-  return minMaxMarch(map, trees, cameraDepth, camera, light, medium, options);
+  return minMaxMarchBuildingTrees(map, cameraDepth, camera, light, medium, options);
 }
 
 } // namespace crep

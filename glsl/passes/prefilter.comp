@@ -50,9 +50,9 @@ layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { Cr
 layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
 layout(std430, binding = 1) readonly restrict buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; };
 
-// The light-side factor at fractional texel x of the region's reference ray (0 beyond the horizon).
-float crep_lightFactorAt(CrepRegionWeights w, vec4 ray, int n, float x) {
-  float tau = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, x);
+// The light-side factor at distance tau from the region's start along its reference ray (crep_regionDistance;
+// 0 beyond the horizon, tau < 0).
+float crep_lightFactorAt(vec4 ray, float tau) {
   if (tau < 0.0 || ray.w < 0.0) return 0.0;
   return crep_localWeightFactor(crep_localParams, crep_localParams.origin.xyz + (ray.w + tau) * ray.xyz, ray.xyz);
 }
@@ -95,7 +95,10 @@ void main() {
   // light-side factor by Simpson's rule over the texel, m_i = w_i / sum_{j<=i} w_j (crep::regionMixFactors
   // with light samples; Exact weights). The running sum lives in the loop: one texel's set-up per step.
   vec4 ray = crep_regionRays[row * R + region];
-  float gLeft = crep_lightFactorAt(w, ray, n, 0.0), weightSum = 0.0;
+  // The left boundary's distance and factor carry over from the texel before (one distance and two
+  // factors per texel).
+  float tauLeft = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, 0.0);
+  float gLeft = crep_lightFactorAt(ray, tauLeft), weightSum = 0.0;
 #endif
 
   for (int i = 0; i < n; ++i) {
@@ -116,17 +119,18 @@ void main() {
     vec2 sc = crep_harmonic(firstHarmonic, z);
     // Listing 2: the normalized weighted prefix.
 #if CREP_LOCAL_LIGHT
-    float gMid = crep_lightFactorAt(w, ray, n, float(i) + 0.5), gRight = crep_lightFactorAt(w, ray, n, float(i + 1));
-    float tau0 = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i));
-    float tau1 = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i + 1));
+    float tauRight = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i + 1));
+    float gMid = crep_lightFactorAt(ray, crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i) + 0.5));
+    float gRight = crep_lightFactorAt(ray, tauRight);
     float wi = 0.0;
-    if (tau0 >= 0.0 && tau1 >= 0.0) {
-      float dt = tau1 - tau0;
+    if (tauLeft >= 0.0 && tauRight >= 0.0) {
+      float dt = tauRight - tauLeft;
       float g = (gLeft + 4.0 * gMid + gRight) / 6.0;
-      wi = g * exp(-s * tau0) * crep_oneMinusExpOverX(s * dt) * dt;
+      wi = g * exp(-s * tauLeft) * crep_oneMinusExpOverX(s * dt) * dt;
       if (!(wi > 0.0) || isinf(wi)) wi = 0.0;
     }
     gLeft = gRight;
+    tauLeft = tauRight;
     weightSum += wi;
     float m = weightSum > 0.0 ? clamp(wi / weightSum, 0.0, 1.0) : 1.0 / float(i + 1);
 #else

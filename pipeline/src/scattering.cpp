@@ -143,6 +143,22 @@ struct Scattering::Impl {
   gl::Handle localScattering, accumulate;
   std::optional<DepthTarget> localShadowMap;
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
+
+  /// Runs `work` as one stage: with stageTimings, its GL_TIME_ELAPSED and wall clock (ended by glFinish).
+  template <class Work>
+  Stage timedStage(const char* name, const Work& work) {
+    if (!info.stageTimings) {
+      work();
+      return {name, 0.0, 0.0};
+    }
+    const auto start = std::chrono::steady_clock::now();
+    timer.begin();
+    work();
+    timer.end();
+    glFinish();
+    const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
+    return {name, timer.milliseconds(), wall.count()};
+  }
 };
 
 Scattering::Scattering(const CreateInfo& info) : impl_(std::make_unique<Impl>(info)) {}
@@ -202,18 +218,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
 
   FrameResult r;
   const auto stage = [&](const char* name, const auto& work) {
-    if (!info.stageTimings) {
-      work();
-      r.stages.push_back({name, 0.0, 0.0});
-      return;
-    }
-    const auto start = std::chrono::steady_clock::now();
-    m.timer.begin();
-    work();
-    m.timer.end();
-    glFinish();
-    const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
-    r.stages.push_back({name, m.timer.milliseconds(), wall.count()});
+    r.stages.push_back(m.timedStage(name, work));
   };
   r.rectification = rectify(*f.camera, *f.light, info.rectify);
   std::shared_ptr<const RectifiedLayout> layout;
@@ -325,20 +330,10 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
   if (!m.localRectified)
     m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
   const auto timed = [&](LightResult& result, const char* name, const auto& work) {
-    if (!info.stageTimings) {
-      work();
-      r.stages.push_back({name, 0.0, 0.0});
-      return;
-    }
-    const auto start = std::chrono::steady_clock::now();
-    m.timer.begin();
-    work();
-    m.timer.end();
-    glFinish();
-    const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
-    r.stages.push_back({name, m.timer.milliseconds(), wall.count()});
-    result.wallMilliseconds += wall.count();
-    result.gpuMilliseconds += m.timer.milliseconds();
+    const Stage s = m.timedStage(name, work);
+    r.stages.push_back(s);
+    result.wallMilliseconds += s.wallMilliseconds;
+    result.gpuMilliseconds += s.gpuMilliseconds;
   };
   const auto addToOutput = [&] {
     glUseProgram(m.accumulate.get());

@@ -372,14 +372,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
         rays[k] = gpu::RegionRay(direction, std::isfinite(t0) ? static_cast<float>(t0) : -1.0f);
       }
     }
-    const std::size_t rayBytes = rays.size() * sizeof(gpu::RegionRay);
-    if (rayBytes > raysCapacity_) {
-      raysBuffer_ = gl::createBuffer();
-      glNamedBufferStorage(raysBuffer_.get(), static_cast<GLsizeiptr>(rayBytes), nullptr,
-                           GL_DYNAMIC_STORAGE_BIT);
-      raysCapacity_ = rayBytes;
-    }
-    glNamedBufferSubData(raysBuffer_.get(), 0, static_cast<GLsizeiptr>(rayBytes), rays.data());
+    gl::uploadGrowingBuffer(raysBuffer_, raysCapacity_, rays.data(), rays.size() * sizeof(gpu::RegionRay));
     if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
     gpu::LocalLightParams lp = localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), s);
     lp.cone.w = static_cast<float>(static_cast<int>(info_.options.localLightWeights));
@@ -387,13 +380,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
     if (!programLocal_) programLocal_ = buildProgram(prefilterStages(info_, true));
   }
   const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
-  if (bytes > weightsCapacity_) {
-    weightsBuffer_ = gl::createBuffer();
-    glNamedBufferStorage(weightsBuffer_.get(), static_cast<GLsizeiptr>(bytes), nullptr,
-                         GL_DYNAMIC_STORAGE_BIT);
-    weightsCapacity_ = bytes;
-  }
-  glNamedBufferSubData(weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes), weights.data());
+  gl::uploadGrowingBuffer(weightsBuffer_, weightsCapacity_, weights.data(), bytes);
 
   gpu::PrefilterParams params;
   params.mapSize = glm::ivec4(W, H, R, n);

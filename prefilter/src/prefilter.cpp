@@ -364,43 +364,13 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
   return table;
 }
 
-std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
-                                          int samples, const glm::dvec3& extinction) {
-  validateBasis(basis);
-  const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
-  const std::size_t cells =
-      static_cast<std::size_t>(H) * static_cast<std::size_t>(R) * static_cast<std::size_t>(Z);
-  if (samples < 2 || samples > kMaxVisibilityTableSamples || visibility.size() != cells)
-    throw InvalidArgument("scatteringPrefixTable.visibility", "size " + std::to_string(visibility.size()),
-                          "must be visibilityTable(basis, samples) with samples in [2, " +
-                              std::to_string(kMaxVisibilityTableSamples) + "]");
-  const RectifiedLayout& layout = *basis.layout;
-  std::vector<double> table(cells * static_cast<std::size_t>(C));
-  const auto index = [&](int j, int r, int s) {
-    return (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
-               static_cast<std::size_t>(Z) +
-           static_cast<std::size_t>(s);
-  };
-  for (int j = 0; j < H; ++j) {
-    const double row = (j + 0.5) / H;
-    for (int s = 0; s < Z; ++s) {
-      const double depth = static_cast<double>(s) / (Z - 1);
-      glm::dvec3 sum(0.0);
-      double ta = 0.0;
-      for (int r = 0; r < R; ++r) {
-        for (int c = 0; c < C; ++c)
-          table[index(j, r, s) * C + static_cast<std::size_t>(c)] = sum[c];
-        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
-        sum += visibility[index(j, r, s)] * transmittanceIntegral(extinction, ta, tb);
-        ta = tb;
-      }
-    }
-  }
-  return table;
-}
+namespace {
 
-std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
-                                          int samples, const LocalLight& light, const Medium& medium) {
+/// The scattering prefix table (prefilter.h) with `sectionsFor(row, depth)` giving the sample ray's
+/// section rule section(ta, tb) (per channel; region boundaries at +infinity contribute nothing).
+template <class SectionsFor>
+std::vector<double> prefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                int samples, const SectionsFor& sectionsFor) {
   validateBasis(basis);
   const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
   const std::size_t cells =
@@ -410,13 +380,12 @@ std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std:
                           "must be visibilityTable(basis, samples) with samples in [2, " +
                               std::to_string(kMaxVisibilityTableSamples) + "]");
   const RectifiedLayout& layout = *basis.layout;
-  const glm::dvec3 origin = layout.origin();
   std::vector<double> table(cells * static_cast<std::size_t>(C));
   parallelRows(H, 0, [&](int j) {
     const double row = (j + 0.5) / H;
     for (int s = 0; s < Z; ++s) {
       const double depth = static_cast<double>(s) / (Z - 1);
-      const RayScattering ray(light, medium, origin, layout.viewRayDirection(row, depth));
+      const auto section = sectionsFor(row, depth);
       glm::dvec3 sum(0.0);
       double ta = 0.0;
       for (int r = 0; r < R; ++r) {
@@ -427,12 +396,30 @@ std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std:
         for (int c = 0; c < C; ++c)
           table[cell * C + static_cast<std::size_t>(c)] = sum[c];
         const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
-        if (std::isfinite(tb)) sum += visibility[cell] * ray.segment(ta, tb);
+        if (std::isfinite(tb)) sum += visibility[cell] * section(ta, tb);
         ta = tb;
       }
     }
   });
   return table;
+}
+
+} // namespace
+
+std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                          int samples, const glm::dvec3& extinction) {
+  return prefixTable(basis, visibility, samples, [&](double, double) {
+    return [&](double ta, double tb) { return transmittanceIntegral(extinction, ta, tb); };
+  });
+}
+
+std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
+                                          int samples, const LocalLight& light, const Medium& medium) {
+  return prefixTable(basis, visibility, samples, [&](double row, double depth) {
+    const RectifiedLayout& layout = *basis.layout; // validated by prefixTable
+    return [ray = RayScattering(light, medium, layout.origin(), layout.viewRayDirection(row, depth))](
+               double ta, double tb) { return ray.segment(ta, tb); };
+  });
 }
 
 namespace {

@@ -43,11 +43,7 @@ LayoutKind LayoutBuffers::upload(const GpuLayoutData& d, int mapHeight, const ch
   glNamedBufferSubData(block_.get(), 0, static_cast<GLsizeiptr>(data->block.size()), data->block.data());
   hasRows_ = !data->rows.empty();
   if (hasRows_) {
-    if (!rows_ || rowsCapacity_ < data->rows.size()) {
-      rowsCapacity_ = data->rows.size();
-      rows_ = gl::createDynamicBuffer(rowsCapacity_);
-    }
-    glNamedBufferSubData(rows_.get(), 0, static_cast<GLsizeiptr>(data->rows.size()), data->rows.data());
+    gl::uploadGrowingBuffer(rows_, rowsCapacity_, data->rows.data(), data->rows.size());
   }
   kind_ = data->kind;
   return kind_;

@@ -93,31 +93,69 @@ int worldMarchPixel(const Image& shadowDepth, const glm::dmat4& M, const glm::dv
 
 } // namespace
 
-// Klehm et al. 2014, Eq. 1 and 3 (Yusov 2012, Eq. 15-16) against a standard shadow map: the
-// rectification-free reference.
-MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
-                            const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
-                            const Medium& medium, const WorldMarchOptions& options) {
+namespace {
+
+/// One pixel ray's march with the light's rule for a lit section, its radiance and its lookups: C times
+/// the transmittance integrals for the directional light, RayScattering's section integrals for a local one.
+int marchRadiance(const Image& shadowDepth, const glm::dmat4& M, const Camera& camera, const PixelRay& ray,
+                  const DirectionalLight& light, const Medium& medium, const WorldMarchOptions& options,
+                  glm::dvec3& radiance) {
+  const glm::dvec3 sigma = medium.extinction();
+  glm::dvec3 L;
+  const int lookups = worldMarchPixel(
+      shadowDepth, M, camera.position(), ray,
+      [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); }, options, L);
+  radiance = scatteringConstant(light, medium, ray.direction) * L;
+  return lookups;
+}
+
+int marchRadiance(const Image& shadowDepth, const glm::dmat4& M, const Camera& camera, const PixelRay& ray,
+                  const LocalLight& light, const Medium& medium, const WorldMarchOptions& options,
+                  glm::dvec3& radiance) {
+  const RayScattering rs(light, medium, camera.position(), ray.direction);
+  return worldMarchPixel(
+      shadowDepth, M, camera.position(), ray, [&](double ta, double tb) { return rs.segment(ta, tb); },
+      options, radiance);
+}
+
+template <class Light>
+MarchResult marchImage(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                       const Image& cameraDepth, const Camera& camera, const Light& light,
+                       const Medium& medium, const WorldMarchOptions& options) {
   validateShadowMap(shadowDepth, lightClipFromWorld);
   validateCameraDepth(cameraDepth);
   validate(options);
   const int w = cameraDepth.width(), h = cameraDepth.height();
   MarchResult out{Image(w, h, 4), Image(w, h, 1)};
-  const glm::dvec3 sigma = medium.extinction();
   const double grey = weightExtinction(medium);
   parallelRows(h, options.threads, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
       glm::dvec3 L;
-      const int lookups = worldMarchPixel(
-          shadowDepth, lightClipFromWorld, camera.position(), ray,
-          [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); }, options, L);
-      storeScattering(out.scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
-                      std::exp(-grey * ray.surface));
+      const int lookups =
+          marchRadiance(shadowDepth, lightClipFromWorld, camera, ray, light, medium, options, L);
+      storeScattering(out.scattering, x, y, L, std::exp(-grey * ray.surface));
       out.steps.at(x, y) = static_cast<float>(lookups);
     }
   });
   return out;
+}
+
+} // namespace
+
+// Klehm et al. 2014, Eq. 1 and 3 (Yusov 2012, Eq. 15-16) against a standard shadow map: the
+// rectification-free reference.
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                            const Medium& medium, const WorldMarchOptions& options) {
+  return marchImage(shadowDepth, lightClipFromWorld, cameraDepth, camera, light, medium, options);
+}
+
+// The same for a local light (crep/scatter/ray_scattering.h): each lit section integrated by RayScattering.
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const LocalLight& light,
+                            const Medium& medium, const WorldMarchOptions& options) {
+  return marchImage(shadowDepth, lightClipFromWorld, cameraDepth, camera, light, medium, options);
 }
 
 void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
@@ -139,45 +177,17 @@ void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClip
     if (p < 0 || p >= w * h)
       throw InvalidArgument("pixels", detail::formatValue(p),
                             "must be in [0, " + std::to_string(w * h) + ")");
-  const glm::dvec3 sigma = medium.extinction();
   const double grey = weightExtinction(medium);
   const int count = static_cast<int>(pixels.size());
   parallelRows(count, options.threads, [&](int k) {
     const int p = pixels[static_cast<std::size_t>(k)], x = p % w, y = p / w;
     const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
     glm::dvec3 L;
-    const int lookups = worldMarchPixel(
-        shadowDepth, lightClipFromWorld, camera.position(), ray,
-        [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); }, options, L);
-    storeScattering(scattering, x, y, scatteringConstant(light, medium, ray.direction) * L,
-                    std::exp(-grey * ray.surface));
+    const int lookups =
+        marchRadiance(shadowDepth, lightClipFromWorld, camera, ray, light, medium, options, L);
+    storeScattering(scattering, x, y, L, std::exp(-grey * ray.surface));
     if (steps) steps->at(x, y) = static_cast<float>(lookups);
   });
-}
-
-// The same for a local light (crep/scatter/ray_scattering.h): each lit section integrated by RayScattering.
-MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
-                            const Image& cameraDepth, const Camera& camera, const LocalLight& light,
-                            const Medium& medium, const WorldMarchOptions& options) {
-  validateShadowMap(shadowDepth, lightClipFromWorld);
-  validateCameraDepth(cameraDepth);
-  validate(options);
-  const int w = cameraDepth.width(), h = cameraDepth.height();
-  MarchResult out{Image(w, h, 4), Image(w, h, 1)};
-  const double grey = weightExtinction(medium);
-  parallelRows(h, options.threads, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
-      const RayScattering rs(light, medium, camera.position(), ray.direction);
-      glm::dvec3 L;
-      const int lookups = worldMarchPixel(
-          shadowDepth, lightClipFromWorld, camera.position(), ray,
-          [&](double ta, double tb) { return rs.segment(ta, tb); }, options, L);
-      storeScattering(out.scattering, x, y, L, std::exp(-grey * ray.surface));
-      out.steps.at(x, y) = static_cast<float>(lookups);
-    }
-  });
-  return out;
 }
 
 } // namespace crep

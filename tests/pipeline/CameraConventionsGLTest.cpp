@@ -33,20 +33,9 @@ namespace {
 
 constexpr int kW = 96, kH = 54, kMapSize = 256;
 
-gl::Handle uploadDepth(const Image& depth) {
-  gl::Handle t = gl::createTexture2D(GL_R32F, depth.width(), depth.height());
-  std::vector<float> row(static_cast<std::size_t>(depth.width()));
-  for (int y = 0; y < depth.height(); ++y) {
-    for (int x = 0; x < depth.width(); ++x)
-      row[std::size_t(x)] = depth.at(x, y, 0);
-    glTextureSubImage2D(t.get(), 0, 0, y, depth.width(), 1, GL_RED, GL_FLOAT, row.data());
-  }
-  return t;
-}
-
 Image evaluateWith(EvaluatePass& pass, const GpuScene& s, const PrefilterPass& prefilter,
                    const Camera& camera, const Image& depth) {
-  const gl::Handle depthTexture = uploadDepth(depth);
+  const gl::Handle depthTexture = uploadR32F(depth);
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, depth.width(), depth.height());
   pass.run({depthTexture.get(), out.get(), &camera, &s.scene.sun, &s.scene.medium, s.layout.get(),
             prefilter.filteredBasis()});
@@ -148,7 +137,7 @@ TEST_CASE("camera conventions GL: reversed-Z infinite, jittered and asymmetric c
   // The world-space march reads the reversed depth buffer the same way (march.glsl).
   WorldMarchPass march({});
   const auto marchWith = [&](const Camera& camera, const Image& depth) {
-    const gl::Handle depthTexture = uploadDepth(depth);
+    const gl::Handle depthTexture = uploadR32F(depth);
     const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kW, kH);
     const glm::dmat4 light = orthographicLightClipFromWorld(s.scene.sun, gl.frustumCorners());
     const gl::Handle shadow = scenes::createDepthTexture(512, 512);
@@ -194,7 +183,7 @@ struct AsymmetricFrame {
 AsymmetricFrame scatterAndReference(const scenes::Scene& scene, scenes::SceneRenderer& renderer,
                                     const Camera& camera, const Image& cameraDepth) {
   const int width = cameraDepth.width(), height = cameraDepth.height();
-  const gl::Handle depth = uploadDepth(cameraDepth);
+  const gl::Handle depth = uploadR32F(cameraDepth);
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, width, height);
   Scattering::CreateInfo info;
   info.width = width;

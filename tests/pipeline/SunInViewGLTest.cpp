@@ -4,6 +4,7 @@
 // crep::Scattering with its defaults except the map (1024^2, so the map's own error, reported as the
 // brute-force march over the same map, stays below the goal); 160 x 90 screens.
 #include "pipeline/scattering_frame.h"
+#include "prefilter/prefilter_gpu_util.h"
 #include "support/gl_fixture.h"
 
 #include <crep/core/gl.h>
@@ -39,9 +40,7 @@ glm::dvec2 epipolePixel(const Scattering::FrameResult& r) {
 }
 
 Image uploadAndKeep(gl::Handle& texture, const Image& image) {
-  texture = gl::createTexture2D(GL_R32F, image.width(), image.height());
-  glTextureSubImage2D(texture.get(), 0, 0, 0, image.width(), image.height(), GL_RED, GL_FLOAT,
-                      image.data().data());
+  texture = uploadR32F(image);
   return image;
 }
 

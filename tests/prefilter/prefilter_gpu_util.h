@@ -150,6 +150,14 @@ inline gl::Handle createTexture2D(std::uint32_t format, int width, int height) {
   return gl::createTexture2D(format, width, height);
 }
 
+/// A GL_R32F texture holding channel 0 of a 1-channel image (camera depth, rectified or shadow map).
+inline gl::Handle uploadR32F(const Image& image) {
+  REQUIRE(image.channels() == 1);
+  gl::Handle t = gl::createTexture2D(GL_R32F, image.width(), image.height());
+  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RED, GL_FLOAT, image.data().data());
+  return t;
+}
+
 inline UploadedBasis uploadBasis(const FilteredBasis& basis, StorageFormat format) {
   UploadedBasis u;
   const GLenum internal = format == StorageFormat::RGBA8     ? GL_RGBA8

@@ -49,8 +49,7 @@ TEST_CASE("prefilter GL, local lights: the GPU basis equals the CPU reference (s
     const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
     const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
     const FilteredBasis cpu = prefilter(map, medium, k.light, o);
-    const gl::Handle texture = createTexture2D(GL_R32F, W, H);
-    glTextureSubImage2D(texture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
+    const gl::Handle texture = uploadR32F(map.depth);
     pass.run(
         {.rectifiedDepth = texture.get(), .layout = layout.get(), .medium = &medium, .localLight = &k.light});
     CHECK(pass.filteredBasis().localLight);
@@ -88,8 +87,7 @@ TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation an
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   PrefilterPass prefilterPass({.mapWidth = W, .mapHeight = H, .options = o});
-  const gl::Handle depthTexture = createTexture2D(GL_R32F, w, h);
-  glTextureSubImage2D(depthTexture.get(), 0, 0, 0, w, h, GL_RED, GL_FLOAT, depth.data().data());
+  const gl::Handle depthTexture = uploadR32F(depth);
   const SpotLight spot = analyticSpot();
   const PointLight point = analyticPoint();
   struct Case {
@@ -109,8 +107,7 @@ TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation an
       REQUIRE(k.rect.projective());
       const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
       const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-      const gl::Handle texture = createTexture2D(GL_R32F, W, H);
-      glTextureSubImage2D(texture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
+      const gl::Handle texture = uploadR32F(map.depth);
       prefilterPass.run({.rectifiedDepth = texture.get(),
                          .layout = layout.get(),
                          .medium = &medium,
@@ -148,10 +145,8 @@ TEST_CASE("rectified marches GL, local lights: brute force and min/max equal the
   const LocalLight light = LocalLight::spot(spot);
   const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
   const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-  const gl::Handle mapTexture = createTexture2D(GL_R32F, W, H);
-  glTextureSubImage2D(mapTexture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
-  const gl::Handle depthTexture = createTexture2D(GL_R32F, w, h);
-  glTextureSubImage2D(depthTexture.get(), 0, 0, 0, w, h, GL_RED, GL_FLOAT, depth.data().data());
+  const gl::Handle mapTexture = uploadR32F(map.depth);
+  const gl::Handle depthTexture = uploadR32F(depth);
   const Image cpu = bruteForceMarch(map, depth, camera, light, medium).scattering;
   MinMaxTreePass trees({W, H});
   trees.run(mapTexture.get());

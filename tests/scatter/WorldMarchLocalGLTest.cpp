@@ -8,6 +8,7 @@
 // the other side, and the bisection then lands in a neighbouring interval (at most one section of s / N):
 // those pixels are counted and left out of a masked metric; the rest must agree to float precision.
 #include "epipolar/epipolar_test_util.h"
+#include "prefilter/prefilter_gpu_util.h"
 #include "support/analytic_scene.h"
 #include "support/gl_fixture.h"
 
@@ -53,12 +54,6 @@ SpotLight spotLight() {
 PointLight pointLight() {
   return PointLight(
       {.position = {-1.0, 3.0, -9.0}, .color = {1.0, 0.9, 0.8}, .intensity = 20.0, .range = 60.0});
-}
-
-gl::Handle uploadR32F(const Image& image) {
-  gl::Handle t = gl::createTexture2D(GL_R32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RED, GL_FLOAT, image.data().data());
-  return t;
 }
 
 struct Scene {
