@@ -25,6 +25,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <unistd.h>
 
@@ -68,6 +69,27 @@ std::string sizeText(int w, int h) {
   return std::to_string(w) + "x" + std::to_string(h);
 }
 
+/// "A light inside an occluder": every texel of its shadow map at the near plane (depth 0), so it lights
+/// nothing; refused, naming the file, rather than producing a black image.
+void requireNotEnclosed(const Image& shadow, const std::string& what) {
+  for (float d : shadow.data())
+    if (!(d < 1e-6f)) return;
+  throw FormatError(what +
+                    ": every texel is at the light's near plane (depth 0): the light is inside an "
+                    "occluder and lights nothing; move it out of the geometry (or lower its nearPlane)");
+}
+
+/// Face k (+X, -X, +Y, -Y, +Z, -Z) of a point light's shadow EXR: faces stacked top to bottom, each in the
+/// usual orientation (frame_json.h), i.e. image rows (5 - k) S .. (6 - k) S - 1 counted from the bottom.
+Image pointFace(const Image& stacked, int face) {
+  const int S = stacked.width();
+  Image out(S, S, 1);
+  for (int y = 0; y < S; ++y)
+    for (int x = 0; x < S; ++x)
+      out.at(x, y) = stacked.at(x, (5 - face) * S + y, 0);
+  return out;
+}
+
 } // namespace
 
 int scatterCommand(const std::vector<std::string>& argv) {
@@ -106,16 +128,37 @@ int scatterCommand(const std::vector<std::string>& argv) {
   const FrameDescription desc =
       timings.time("read frame json", [&] { return readFrameDescription(framePath); });
   const Camera camera = cameraOf(desc, framePath);
-  const DirectionalLight light = lightOf(desc, framePath);
+  const bool directional = desc.lightType == LightType::Directional;
+  // A night frame (the main light a spot or point light): no directional light; `light` is unused.
+  const DirectionalLight light =
+      directional ? lightOf(desc, framePath) : DirectionalLight(glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(0.0));
   const Medium medium = mediumOf(desc, framePath);
-  try {
-    validateLightMatrix(desc.lightClipFromWorld, light.direction());
-  } catch (const InvalidArgument& e) {
+  const std::vector<FrameLocalLight> localLights = localLightsOf(desc, framePath);
+  const auto strip = [](const InvalidArgument& e) {
     std::string what = e.what(); // "crep: invalid lightClipFromWorld = <value> (<requirement>)"
     const std::string prefix = "crep: invalid lightClipFromWorld = ";
     if (what.starts_with(prefix)) what = what.substr(prefix.size());
-    throw FormatError(framePath + ": shadowMap.lightClipFromWorld: " + what);
+    return what;
+  };
+  if (directional) {
+    try {
+      validateLightMatrix(desc.lightClipFromWorld, light.direction());
+    } catch (const InvalidArgument& e) {
+      throw FormatError(framePath + ": shadowMap.lightClipFromWorld: " + strip(e));
+    }
   }
+  // The additional lights' shadow EXRs, relative to the JSON file; they must not be outputs either.
+  std::vector<PathOption> lightFiles;
+  for (const FrameLocalLight& l : localLights)
+    if (!l.shadowFile.empty()) {
+      const std::filesystem::path file = std::filesystem::path(framePath).parent_path() / l.shadowFile;
+      lightFiles.push_back({l.shadowPath + ".file", file.string()});
+      std::error_code ec;
+      if (!std::filesystem::exists(file, ec))
+        throw IoError(framePath + ": " + l.shadowPath + ".file: '" + file.string() + "' does not exist");
+      requireInputFile(lightFiles.back());
+    }
+  requireDistinctFiles(outputs, lightFiles);
   const Image depth =
       timings.time("read depth exr", [&] { return readDepthExr("--depth", depthPath, "camera depth"); });
   const Image shadow =
@@ -124,10 +167,32 @@ int scatterCommand(const std::vector<std::string>& argv) {
     throw FormatError(framePath + ": camera.size " + sizeText(desc.cameraSize->x, desc.cameraSize->y) +
                       " does not match the depth image '" + depthPath + "' (" +
                       sizeText(depth.width(), depth.height()) + ")");
-  if (desc.shadowSize && (desc.shadowSize->x != shadow.width() || desc.shadowSize->y != shadow.height()))
+  if (directional && desc.shadowSize &&
+      (desc.shadowSize->x != shadow.width() || desc.shadowSize->y != shadow.height()))
     throw FormatError(framePath + ": shadowMap.size " + sizeText(desc.shadowSize->x, desc.shadowSize->y) +
                       " does not match the shadow map '" + shadowPath + "' (" +
                       sizeText(shadow.width(), shadow.height()) + ")");
+  // Each local light's map: the main light's is --shadow, the others' their files.
+  std::vector<Image> localShadows;
+  for (std::size_t i = 0, file = 0; i < localLights.size(); ++i) {
+    const FrameLocalLight& l = localLights[i];
+    const bool main = l.shadowFile.empty();
+    const std::string option = main ? "--shadow" : framePath + ": " + l.shadowPath + ".file";
+    const std::string path = main ? shadowPath : lightFiles[file++].path;
+    Image image = main ? shadow : timings.time("read shadow exr (local lights)", [&] {
+      return readDepthExr(option, path, "local light shadow map");
+    });
+    if (l.shadowSize && (l.shadowSize->x != image.width() || l.shadowSize->y != image.height()))
+      throw FormatError(framePath + ": " + l.shadowPath + ".size " +
+                        sizeText(l.shadowSize->x, l.shadowSize->y) + " does not match the shadow map '" +
+                        path + "' (" + sizeText(image.width(), image.height()) + ")");
+    if (l.point && image.height() != 6 * image.width())
+      throw FormatError(option + ": '" + path + "' is " + sizeText(image.width(), image.height()) +
+                        "; the point light " + l.path +
+                        " needs its six faces stacked top to bottom (+X, -X, +Y, -Y, +Z, -Z): S x 6 S");
+    requireNotEnclosed(image, option + ": '" + path + "' (shadow map of " + l.path + ")");
+    localShadows.push_back(std::move(image));
+  }
   const double imageAspect = double(depth.width()) / double(depth.height());
   const glm::dvec4& tangents = camera.tangents(); // the frustum's own extent (off-centre ones too)
   const double frustumAspect = (tangents.y - tangents.x) / (tangents.w - tangents.z);
@@ -148,7 +213,32 @@ int scatterCommand(const std::vector<std::string>& argv) {
   frame.shadowHeight = shadow.height();
   frame.lightClipFromWorld = desc.lightClipFromWorld;
   frame.shadowBias = desc.shadowBias;
-  frame.shadowImage = shadow;
+  frame.directional = directional;
+  if (directional) frame.shadowImage = shadow;
+  timings.time("upload (local lights)", [&] {
+    for (std::size_t i = 0; i < localLights.size(); ++i) {
+      const FrameLocalLight& l = localLights[i];
+      const auto add = [&](std::vector<LocalShadowMap>& maps, Image image, const glm::dmat4& matrix) {
+        LocalShadowMap m;
+        m.texture = uploadR32F(image, "--shadow");
+        m.width = image.width();
+        m.height = image.height();
+        m.lightClipFromWorld = matrix;
+        m.bias = l.shadowBias;
+        m.image = std::move(image);
+        maps.push_back(std::move(m));
+      };
+      if (l.spot) {
+        frame.spotLights.push_back(*l.spot);
+        add(frame.spotShadows, localShadows[i], l.lightClipFromWorld[0]);
+      } else {
+        frame.pointLights.push_back(*l.point);
+        for (int k = 0; k < 6; ++k)
+          add(frame.pointShadows, pointFace(localShadows[i], k),
+              l.lightClipFromWorld[static_cast<std::size_t>(k)]);
+      }
+    }
+  });
 
   MethodOutput result = runMethod(method, frame, settings);
   timings.append(result.timings.rows());

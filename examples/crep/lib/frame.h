@@ -48,6 +48,15 @@ struct RectifiedGpuMap {
   std::vector<StageTimings::Row> cost;
 };
 
+/// A local light's perspective shadow map on the GPU: one per spot light, one per point-light face.
+struct LocalShadowMap {
+  gl::Handle texture; ///< depth-buffer values of lightClipFromWorld (R32F or depth)
+  int width = 0, height = 0;
+  glm::dmat4 lightClipFromWorld{1.0}; ///< perspective, centred at the light (GL conventions)
+  double bias = 0.0;                  ///< added to the stored depth by the world-space marches
+  Image image;                        ///< CPU copy (users' data; else empty)
+};
+
 /// One frame's inputs: what every method reads. GL names are owned here.
 struct FrameInputs {
   FrameInputs(const Camera& c, const DirectionalLight& l, const Medium& m) : camera(c), light(l), medium(m) {}
@@ -63,6 +72,16 @@ struct FrameInputs {
   double shadowBias = 2e-4;           ///< added to the stored depth by the reference march
   Image shadowImage;                  ///< CPU copy of the standard shadow map (users' data; else empty)
   scenes::SceneRenderer* renderer = nullptr; ///< built-in scene: rasterize rectified maps (not owned)
+  /// false: no directional light (a night frame with local lights only; `light` and the standard shadow
+  /// map are then unused)
+  bool directional = true;
+  /// Local lights (Klehm et al. 2014, Sec. 3.2), added to the directional light's result by every method,
+  /// with their perspective shadow maps: spotShadows[i] for spotLights[i], pointShadows[6 i + k] for face k
+  /// (+X, -X, +Y, -Y, +Z, -Z) of pointLights[i].
+  std::vector<SpotLight> spotLights;
+  std::vector<PointLight> pointLights;
+  std::vector<LocalShadowMap> spotShadows, pointShadows;
+  bool hasLocalLights() const { return !spotLights.empty() || !pointLights.empty(); }
 
   /// The rectified map for these settings (made on first use, then shared while the map size and the
   /// rectify options stay the same), or nullptr when the rectification is not projective (`rect` then

@@ -226,6 +226,209 @@ std::string formatMat(const glm::dmat4& m) {
   return s + "]";
 }
 
+std::string formatSize(const glm::ivec2& v) {
+  return "[" + std::to_string(v.x) + ", " + std::to_string(v.y) + "]";
+}
+
+std::string indexPath(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+/// light.type / lights[i].type: "directional" (default where absent and allowed), "spot" or "point".
+LightType parseLightType(const Reader& r, const Json& light, const std::string& path, bool inLights) {
+  const Json* t = r.find(light, "type");
+  if (!t) {
+    if (inLights) r.fail(Reader::join(path, "type"), "missing (\"spot\" or \"point\")");
+    return LightType::Directional;
+  }
+  if (t->is_string()) {
+    if (*t == "directional" && !inLights) return LightType::Directional;
+    if (*t == "spot") return LightType::Spot;
+    if (*t == "point") return LightType::Point;
+  }
+  if (inLights && t->is_string() && *t == "directional")
+    r.fail(Reader::join(path, "type"),
+           "\"directional\" is not allowed here: \"lights\" holds spot and point lights (the directional "
+           "light is the main \"light\")");
+  r.fail(Reader::join(path, "type"),
+         std::string("must be ") +
+             (inLights ? "\"spot\" or \"point\"" : "\"directional\", \"spot\" or \"point\"") + ", got " +
+             t->dump());
+}
+
+/// The fields of a spot or point light (frame_json.h "Local lights"), without its shadow map.
+LocalLightDescription parseLocalLight(const Reader& r, const Json& j, const std::string& path, LightType type,
+                                      bool inLights) {
+  if (type == LightType::Spot) {
+    if (inLights)
+      r.requireObject(j, path,
+                      {"type", "position", "direction", "innerConeDeg", "outerConeDeg", "color", "intensity",
+                       "nearPlane", "range", "shadowMap"});
+    else
+      r.requireObject(j, path,
+                      {"type", "position", "direction", "innerConeDeg", "outerConeDeg", "color", "intensity",
+                       "nearPlane", "range"});
+  } else if (inLights) {
+    r.requireObject(j, path, {"type", "position", "color", "intensity", "nearPlane", "range", "shadowMap"});
+  } else {
+    r.requireObject(j, path, {"type", "position", "color", "intensity", "nearPlane", "range"});
+  }
+  const auto field = [&](const char* key) { return Reader::join(path, key); };
+  LocalLightDescription d;
+  d.type = type;
+  d.position = r.vec3(r.get(j, path, "position"), field("position"), "x, y, z: the light's position");
+  if (type == LightType::Spot) {
+    d.direction = r.vec3(r.get(j, path, "direction"), field("direction"), "x, y, z: the cone's axis");
+    d.innerConeDeg = r.number(r.get(j, path, "innerConeDeg"), field("innerConeDeg"));
+    d.outerConeDeg = r.number(r.get(j, path, "outerConeDeg"), field("outerConeDeg"));
+  }
+  d.color = r.vec3(r.get(j, path, "color"), field("color"), "linear r, g, b");
+  d.intensity = r.number(r.get(j, path, "intensity"), field("intensity"));
+  if (const Json* n = r.find(j, "nearPlane")) d.nearPlane = r.number(*n, field("nearPlane"));
+  if (const Json* n = r.find(j, "range")) d.range = r.number(*n, field("range"));
+  return d;
+}
+
+/// The shadowMap object of a local light: the top-level one of the main light (no "file") or lights[i]'s.
+void parseLocalShadow(const Reader& r, const Json& j, const std::string& path, LocalLightDescription& d,
+                      bool inLights) {
+  const bool spot = d.type == LightType::Spot;
+  if (inLights)
+    r.requireObject(j, path, {"file", spot ? "lightClipFromWorld" : "faceClipFromWorld", "size", "bias"});
+  else
+    r.requireObject(j, path, {spot ? "lightClipFromWorld" : "faceClipFromWorld", "size", "bias"});
+  const auto field = [&](const char* key) { return Reader::join(path, key); };
+  if (inLights) {
+    const Json& file = r.get(j, path, "file");
+    if (!file.is_string() || file.get<std::string>().empty())
+      r.fail(field("file"), "expected a non-empty file name (relative to the JSON file), got " + file.dump());
+    d.shadowFile = file.get<std::string>();
+  }
+  if (spot) {
+    d.lightClipFromWorld = r.mat4(r.get(j, path, "lightClipFromWorld"), field("lightClipFromWorld"));
+  } else if (const Json* faces = r.find(j, "faceClipFromWorld")) {
+    if (!faces->is_array() || faces->size() != 6)
+      r.fail(field("faceClipFromWorld"),
+             "expected an array of 6 matrices (faces +X, -X, +Y, -Y, +Z, -Z), got " +
+                 (faces->is_array() ? std::to_string(faces->size()) + " elements"
+                                    : std::string(typeName(*faces))));
+    std::array<glm::dmat4, 6> m;
+    for (std::size_t k = 0; k < 6; ++k)
+      m[k] = r.mat4((*faces)[k], indexPath(field("faceClipFromWorld"), k));
+    d.faceClipFromWorld = m;
+  }
+  if (const Json* s = r.find(j, "size")) d.shadowSize = r.size(*s, field("size"));
+  if (const Json* b = r.find(j, "bias")) d.shadowBias = r.number(*b, field("bias"));
+}
+
+/// Row i of m (m[column][row]).
+glm::dvec4 row(const glm::dmat4& m, int i) {
+  return {m[0][i], m[1][i], m[2][i], m[3][i]};
+}
+
+/// The centre of projection of a perspective matrix: the point c with clip x = y = w = 0, i.e. rows 0, 1 and
+/// 3 of m applied to (c, 1) vanish (the light's position for a perspective shadow matrix); none for an
+/// orthographic or singular matrix.
+std::optional<glm::dvec3> centreOfProjection(const glm::dmat4& m) {
+  glm::dmat3 a; // a[column][row]: rows 0, 1, 3 of m without the translation
+  glm::dvec3 b;
+  const int rows[3] = {0, 1, 3};
+  double scale = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec4 rw = row(m, rows[i]);
+    for (int c = 0; c < 3; ++c)
+      a[c][i] = rw[c];
+    b[i] = -rw.w;
+    scale = std::max(scale, glm::length(glm::dvec3(rw)));
+  }
+  const double det = glm::determinant(a);
+  if (!(std::abs(det) > 1e-12 * scale * scale * scale)) return std::nullopt;
+  const glm::dvec3 c = glm::inverse(a) * b;
+  if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z)) return std::nullopt;
+  return c;
+}
+
+/// Distance from p to the plane where the depth-buffer value of m is `depth` (0: near, 1: far; GL clip z in
+/// [-w, w]); infinity when the plane is at infinity.
+double depthPlaneDistance(const glm::dmat4& m, const glm::dvec3& p, double depth) {
+  // NDC z = 2 depth - 1: clip z - (2 depth - 1) w = 0.
+  const glm::dvec4 plane = row(m, 2) - (2.0 * depth - 1.0) * row(m, 3);
+  const double n = glm::length(glm::dvec3(plane));
+  if (!(n > 1e-12 * glm::length(glm::dvec3(row(m, 3))))) return std::numeric_limits<double>::infinity();
+  return std::abs(glm::dot(plane, glm::dvec4(p, 1.0))) / n;
+}
+
+/// Checks a local light's perspective shadow matrix at `path`: a perspective projection centred at `position`
+/// with `towards` (a direction the light shines in) in front; returns its near and far plane distances.
+glm::dvec2 checkLocalMatrix(const Reader& r, const glm::dmat4& m, const std::string& path,
+                            const glm::dvec3& position, const glm::dvec3& towards,
+                            const std::string& positionPath) {
+  const std::optional<glm::dvec3> c = centreOfProjection(m);
+  if (!c)
+    r.fail(path,
+           "not a perspective projection (no centre of projection: an orthographic or singular matrix); "
+           "a local light's shadow matrix is a perspective one centred at the light");
+  const double tolerance = 1e-4 * std::max(1.0, glm::length(position));
+  if (!(glm::length(*c - position) <= tolerance))
+    r.fail(path, "its centre of projection (" + Reader::format(c->x) + ", " + Reader::format(c->y) + ", " +
+                     Reader::format(c->z) + ") is not " + positionPath + " (" + Reader::format(position.x) +
+                     ", " + Reader::format(position.y) + ", " + Reader::format(position.z) + ")");
+  if (!(glm::dot(row(m, 3), glm::dvec4(position + glm::normalize(towards), 1.0)) > 0.0))
+    r.fail(path, "the light's direction is behind its centre of projection (clip w <= 0 along it)");
+  const double near = depthPlaneDistance(m, position, 0.0), far = depthPlaneDistance(m, position, 1.0);
+  if (!(near > 0.0 && near < far))
+    r.fail(path, "near plane " + Reader::format(near) + ", far plane " + Reader::format(far) +
+                     ": expected OpenGL depth conventions (depth-buffer value 0 at the near plane, 1 at the "
+                     "far plane, 0 < near < far)");
+  return {near, far};
+}
+
+/// Every domain check of a local light description at `path` (its shadow map at `shadowPath`).
+void checkLocalLight(const Reader& r, const LocalLightDescription& d, const std::string& path,
+                     const std::string& shadowPath) {
+  const auto field = [&](const char* key) { return Reader::join(path, key); };
+  for (int c = 0; c < 3; ++c)
+    if (d.color[c] < 0.0) r.fail(field("color"), "components must be >= 0");
+  if (!(std::max({d.color.x, d.color.y, d.color.z}) > 0.0))
+    r.fail(field("color"), "at least one component must be > 0 for a local light");
+  if (!(d.intensity > 0.0)) r.fail(field("intensity"), "must be > 0 for a local light");
+  for (int c = 0; c < 3; ++c)
+    if (d.color[c] * d.intensity > kMaxMagnitude)
+      r.fail(field("intensity"), "color * intensity = " + Reader::format(d.color[c] * d.intensity) +
+                                     " is beyond " + Reader::format(kMaxMagnitude));
+  if (d.type == LightType::Spot) {
+    if (d.direction == glm::dvec3(0.0)) r.fail(field("direction"), "must not be zero");
+    if (!(d.innerConeDeg > 0.0 && d.innerConeDeg < 90.0))
+      r.fail(field("innerConeDeg"), Reader::format(d.innerConeDeg) + " is not in (0, 90) degrees");
+    if (!(d.outerConeDeg > 0.0 && d.outerConeDeg < 90.0))
+      r.fail(field("outerConeDeg"), Reader::format(d.outerConeDeg) + " is not in (0, 90) degrees");
+    if (!(d.innerConeDeg < d.outerConeDeg))
+      r.fail(field("outerConeDeg"), Reader::format(d.outerConeDeg) + " must be greater than innerConeDeg (" +
+                                        Reader::format(d.innerConeDeg) + ")");
+  }
+  if (d.nearPlane && !(*d.nearPlane > 0.0)) r.fail(field("nearPlane"), "must be > 0");
+  if (d.range && !(*d.range > 0.0)) r.fail(field("range"), "must be > 0");
+  if (d.nearPlane && d.range && !(*d.nearPlane < *d.range))
+    r.fail(field("nearPlane"),
+           Reader::format(*d.nearPlane) + " must be below range (" + Reader::format(*d.range) + ")");
+  if (d.type == LightType::Spot) {
+    checkLocalMatrix(r, d.lightClipFromWorld, Reader::join(shadowPath, "lightClipFromWorld"), d.position,
+                     d.direction, field("position"));
+  } else if (d.faceClipFromWorld) {
+    for (std::size_t k = 0; k < 6; ++k)
+      checkLocalMatrix(r, (*d.faceClipFromWorld)[k],
+                       indexPath(Reader::join(shadowPath, "faceClipFromWorld"), k), d.position,
+                       PointLight::faceAxis(static_cast<int>(k)), field("position"));
+  } else if (!d.range) {
+    r.fail(field("range"), "missing: required for a point light without shadowMap.faceClipFromWorld (the "
+                           "default face matrices are built from it)");
+  }
+  if (d.type == LightType::Point && d.shadowSize && d.shadowSize->y != 6 * d.shadowSize->x)
+    r.fail(Reader::join(shadowPath, "size"),
+           formatSize(*d.shadowSize) +
+               ": a point light's shadow EXR is S wide and 6 S high (six faces stacked)");
+}
+
 } // namespace
 
 FrameDescription parseFrameDescription(const std::string& text, const std::string& source) {
@@ -238,7 +441,7 @@ FrameDescription parseFrameDescription(const std::string& text, const std::strin
   } catch (const Json::exception& e) {
     throw FormatError(source + ": not valid JSON: " + e.what());
   }
-  r.requireObject(root, "", {"version", "camera", "light", "shadowMap", "medium"});
+  r.requireObject(root, "", {"version", "camera", "light", "shadowMap", "medium", "lights"});
   if (const Json* v = r.find(root, "version"); v && r.number(*v, "version") != 1.0)
     r.fail("version", "unsupported version " + v->dump() + " (this crep reads version 1)");
 
@@ -257,26 +460,47 @@ FrameDescription parseFrameDescription(const std::string& text, const std::strin
   if (const Json* m = r.find(camera, "maxDistance")) f.maxDistance = r.number(*m, "camera.maxDistance");
 
   const Json& light = r.get(root, "", "light");
-  r.requireObject(light, "light", {"direction", "color", "intensity"});
-  f.lightDirection =
-      r.vec3(r.get(light, "light", "direction"), "light.direction", "x, y, z: the direction light travels");
-  f.lightColor = r.vec3(r.get(light, "light", "color"), "light.color", "linear r, g, b");
-  f.lightIntensity = r.number(r.get(light, "light", "intensity"), "light.intensity");
-  if (f.lightDirection == glm::dvec3(0.0)) r.fail("light.direction", "must not be zero");
-  for (int c = 0; c < 3; ++c)
-    if (f.lightColor[c] < 0.0) r.fail("light.color", "components must be >= 0");
-  if (f.lightIntensity < 0.0) r.fail("light.intensity", "must be >= 0");
-  for (int c = 0; c < 3; ++c)
-    if (f.lightColor[c] * f.lightIntensity > kMaxMagnitude)
-      r.fail("light.intensity", "color * intensity = " + Reader::format(f.lightColor[c] * f.lightIntensity) +
-                                    " is beyond " + Reader::format(kMaxMagnitude));
+  f.lightType = parseLightType(r, light, "light", false);
+  if (f.lightType != LightType::Directional) {
+    f.localLight = parseLocalLight(r, light, "light", f.lightType, false);
+    parseLocalShadow(r, r.get(root, "", "shadowMap"), "shadowMap", f.localLight, false);
+    checkLocalLight(r, f.localLight, "light", "shadowMap");
+  } else {
+    r.requireObject(light, "light", {"type", "direction", "color", "intensity"});
+    f.lightDirection =
+        r.vec3(r.get(light, "light", "direction"), "light.direction", "x, y, z: the direction light travels");
+    f.lightColor = r.vec3(r.get(light, "light", "color"), "light.color", "linear r, g, b");
+    f.lightIntensity = r.number(r.get(light, "light", "intensity"), "light.intensity");
+    if (f.lightDirection == glm::dvec3(0.0)) r.fail("light.direction", "must not be zero");
+    for (int c = 0; c < 3; ++c)
+      if (f.lightColor[c] < 0.0) r.fail("light.color", "components must be >= 0");
+    if (f.lightIntensity < 0.0) r.fail("light.intensity", "must be >= 0");
+    for (int c = 0; c < 3; ++c)
+      if (f.lightColor[c] * f.lightIntensity > kMaxMagnitude)
+        r.fail("light.intensity",
+               "color * intensity = " + Reader::format(f.lightColor[c] * f.lightIntensity) + " is beyond " +
+                   Reader::format(kMaxMagnitude));
 
-  const Json& shadow = r.get(root, "", "shadowMap");
-  r.requireObject(shadow, "shadowMap", {"lightClipFromWorld", "size", "bias"});
-  f.lightClipFromWorld =
-      r.mat4(r.get(shadow, "shadowMap", "lightClipFromWorld"), "shadowMap.lightClipFromWorld");
-  if (const Json* s = r.find(shadow, "size")) f.shadowSize = r.size(*s, "shadowMap.size");
-  if (const Json* b = r.find(shadow, "bias")) f.shadowBias = r.number(*b, "shadowMap.bias");
+    const Json& shadow = r.get(root, "", "shadowMap");
+    r.requireObject(shadow, "shadowMap", {"lightClipFromWorld", "size", "bias"});
+    f.lightClipFromWorld =
+        r.mat4(r.get(shadow, "shadowMap", "lightClipFromWorld"), "shadowMap.lightClipFromWorld");
+    if (const Json* s = r.find(shadow, "size")) f.shadowSize = r.size(*s, "shadowMap.size");
+    if (const Json* b = r.find(shadow, "bias")) f.shadowBias = r.number(*b, "shadowMap.bias");
+  }
+  if (const Json* lights = r.find(root, "lights")) {
+    if (!lights->is_array())
+      r.fail("lights", std::string("expected an array of spot / point lights, got ") + typeName(*lights));
+    for (std::size_t i = 0; i < lights->size(); ++i) {
+      const std::string path = indexPath("lights", i);
+      const Json& entry = (*lights)[i];
+      if (!entry.is_object()) r.fail(path, std::string("expected an object, got ") + typeName(entry));
+      LocalLightDescription d = parseLocalLight(r, entry, path, parseLightType(r, entry, path, true), true);
+      parseLocalShadow(r, r.get(entry, path, "shadowMap"), Reader::join(path, "shadowMap"), d, true);
+      checkLocalLight(r, d, path, Reader::join(path, "shadowMap"));
+      f.lights.push_back(std::move(d));
+    }
+  }
 
   const Json& medium = r.get(root, "", "medium");
   r.requireObject(medium, "medium", {"mieScattering", "hgG", "rayleighScattering", "absorption"});
@@ -312,6 +536,55 @@ FrameDescription readFrameDescription(const std::filesystem::path& path) {
   return parseFrameDescription(text, path.string());
 }
 
+const char* lightTypeToken(LightType type) {
+  switch (type) {
+  case LightType::Directional:
+    return "directional";
+  case LightType::Spot:
+    return "spot";
+  case LightType::Point:
+    return "point";
+  }
+  return "?";
+}
+
+namespace {
+
+/// The fields of a local light (frame_json.h), each line indented by `pad`, without a final newline.
+std::string localLightFields(const LocalLightDescription& d, const std::string& pad) {
+  std::string s = pad + "\"type\": \"" + lightTypeToken(d.type) + "\",\n";
+  s += pad + "\"position\": " + formatVec(d.position) + ",\n";
+  if (d.type == LightType::Spot) {
+    s += pad + "\"direction\": " + formatVec(d.direction) + ",\n";
+    s += pad + "\"innerConeDeg\": " + Reader::format(d.innerConeDeg) + ",\n";
+    s += pad + "\"outerConeDeg\": " + Reader::format(d.outerConeDeg) + ",\n";
+  }
+  s += pad + "\"color\": " + formatVec(d.color) + ",\n";
+  s += pad + "\"intensity\": " + Reader::format(d.intensity);
+  if (d.nearPlane) s += ",\n" + pad + "\"nearPlane\": " + Reader::format(*d.nearPlane);
+  if (d.range) s += ",\n" + pad + "\"range\": " + Reader::format(*d.range);
+  return s;
+}
+
+/// The shadowMap fields of a local light (with "file" when it has one), each line indented by `pad`.
+std::string localShadowFields(const LocalLightDescription& d, const std::string& pad) {
+  std::string s;
+  if (!d.shadowFile.empty()) s += pad + "\"file\": " + Json(d.shadowFile).dump() + ",\n";
+  if (d.type == LightType::Spot) {
+    s += pad + "\"lightClipFromWorld\": " + formatMat(d.lightClipFromWorld) + ",\n";
+  } else if (d.faceClipFromWorld) {
+    s += pad + "\"faceClipFromWorld\": [\n";
+    for (std::size_t k = 0; k < 6; ++k)
+      s += pad + "  " + formatMat((*d.faceClipFromWorld)[k]) + (k < 5 ? ",\n" : "\n");
+    s += pad + "],\n";
+  }
+  if (d.shadowSize) s += pad + "\"size\": " + formatSize(*d.shadowSize) + ",\n";
+  s += pad + "\"bias\": " + Reader::format(d.shadowBias);
+  return s;
+}
+
+} // namespace
+
 std::string toJson(const FrameDescription& f) {
   std::string s = "{\n  \"version\": 1,\n  \"camera\": {\n";
   s += "    \"viewFromWorld\": " + formatMat(f.viewFromWorld) + ",\n";
@@ -322,14 +595,31 @@ std::string toJson(const FrameDescription& f) {
   if (f.clipDepth == ClipDepth::ZeroToOne) s += ",\n    \"clipDepth\": \"zeroToOne\"";
   if (f.maxDistance != 0.0) s += ",\n    \"maxDistance\": " + Reader::format(f.maxDistance);
   s += "\n  },\n  \"light\": {\n";
-  s += "    \"direction\": " + formatVec(f.lightDirection) + ",\n";
-  s += "    \"color\": " + formatVec(f.lightColor) + ",\n";
-  s += "    \"intensity\": " + Reader::format(f.lightIntensity) + "\n  },\n  \"shadowMap\": {\n";
-  s += "    \"lightClipFromWorld\": " + formatMat(f.lightClipFromWorld);
-  if (f.shadowSize)
-    s +=
-        ",\n    \"size\": [" + std::to_string(f.shadowSize->x) + ", " + std::to_string(f.shadowSize->y) + "]";
-  s += ",\n    \"bias\": " + Reader::format(f.shadowBias) + "\n  },\n  \"medium\": {\n";
+  if (f.lightType == LightType::Directional) {
+    s += "    \"direction\": " + formatVec(f.lightDirection) + ",\n";
+    s += "    \"color\": " + formatVec(f.lightColor) + ",\n";
+    s += "    \"intensity\": " + Reader::format(f.lightIntensity) + "\n  },\n  \"shadowMap\": {\n";
+    s += "    \"lightClipFromWorld\": " + formatMat(f.lightClipFromWorld);
+    if (f.shadowSize)
+      s += ",\n    \"size\": [" + std::to_string(f.shadowSize->x) + ", " + std::to_string(f.shadowSize->y) +
+           "]";
+    s += ",\n    \"bias\": " + Reader::format(f.shadowBias) + "\n  },\n";
+  } else {
+    LocalLightDescription main = f.localLight;
+    main.shadowFile.clear(); // the main light's map is --shadow
+    s += localLightFields(main, "    ") + "\n  },\n  \"shadowMap\": {\n";
+    s += localShadowFields(main, "    ") + "\n  },\n";
+  }
+  if (!f.lights.empty()) {
+    s += "  \"lights\": [\n";
+    for (std::size_t i = 0; i < f.lights.size(); ++i) {
+      s += "    {\n" + localLightFields(f.lights[i], "      ") + ",\n      \"shadowMap\": {\n";
+      s += localShadowFields(f.lights[i], "        ") + "\n      }\n    }" +
+           (i + 1 < f.lights.size() ? ",\n" : "\n");
+    }
+    s += "  ],\n";
+  }
+  s += "  \"medium\": {\n";
   s += "    \"mieScattering\": " + formatVec(f.mieScattering) + ",\n";
   s += "    \"hgG\": " + Reader::format(f.hgG) + ",\n";
   s += "    \"rayleighScattering\": " + formatVec(f.rayleighScattering) + ",\n";
@@ -379,6 +669,9 @@ Camera cameraOf(const FrameDescription& f, const std::string& source) {
 }
 
 DirectionalLight lightOf(const FrameDescription& f, const std::string& source) {
+  if (f.lightType != LightType::Directional)
+    Reader(source).fail("light.type", std::string("\"") + lightTypeToken(f.lightType) +
+                                          "\": not a directional light (see localLightsOf)");
   try {
     return DirectionalLight(f.lightDirection, f.lightColor * f.lightIntensity);
   } catch (const InvalidArgument& e) {
@@ -389,9 +682,98 @@ DirectionalLight lightOf(const FrameDescription& f, const std::string& source) {
 
 namespace {
 
+/// A local light's nearPlane and range: the description's, else its shadow matrices' (frame_json.h top).
+glm::dvec2 nearAndRange(const Reader& r, const LocalLightDescription& d, const std::string& path,
+                        const std::string& shadowPath) {
+  double near = std::numeric_limits<double>::infinity(), far = 0.0;
+  if (d.type == LightType::Spot) {
+    const glm::dvec2 p =
+        checkLocalMatrix(r, d.lightClipFromWorld, Reader::join(shadowPath, "lightClipFromWorld"), d.position,
+                         d.direction, Reader::join(path, "position"));
+    near = p.x;
+    far = p.y;
+  } else if (d.faceClipFromWorld) {
+    for (std::size_t k = 0; k < 6; ++k) {
+      const glm::dvec2 p = checkLocalMatrix(
+          r, (*d.faceClipFromWorld)[k], indexPath(Reader::join(shadowPath, "faceClipFromWorld"), k),
+          d.position, PointLight::faceAxis(static_cast<int>(k)), Reader::join(path, "position"));
+      near = std::min(near, p.x);
+      far = std::max(far, p.y);
+    }
+  }
+  const double range = d.range ? *d.range : far;
+  if (!std::isfinite(range))
+    r.fail(Reader::join(path, "range"),
+           "missing: required when the shadow matrix has an infinite far plane (the light's reach)");
+  double nearPlane = d.nearPlane ? *d.nearPlane : std::isfinite(near) ? near : range * 1e-3;
+  if (!d.nearPlane && !(nearPlane < range)) nearPlane = range * 1e-3;
+  if (!(nearPlane < range))
+    r.fail(Reader::join(path, d.nearPlane ? "nearPlane" : "range"),
+           "nearPlane " + Reader::format(nearPlane) + " must be below range " + Reader::format(range));
+  return {nearPlane, range};
+}
+
+/// One local light of the frame as the library's light (localLightsOf).
+FrameLocalLight resolveLocalLight(const Reader& r, const LocalLightDescription& d, const std::string& path,
+                                  const std::string& shadowPath) {
+  FrameLocalLight out;
+  out.path = path;
+  out.shadowPath = shadowPath;
+  out.shadowBias = d.shadowBias;
+  out.shadowSize = d.shadowSize;
+  out.shadowFile = d.shadowFile;
+  const glm::dvec2 nr = nearAndRange(r, d, path, shadowPath);
+  try {
+    if (d.type == LightType::Spot) {
+      const double toRad = std::numbers::pi / 180.0;
+      out.spot.emplace(SpotLightParams{.position = d.position,
+                                       .direction = d.direction,
+                                       .innerConeAngle = d.innerConeDeg * toRad,
+                                       .outerConeAngle = d.outerConeDeg * toRad,
+                                       .color = d.color,
+                                       .intensity = d.intensity,
+                                       .range = nr.y,
+                                       .nearPlane = nr.x});
+      out.lightClipFromWorld = {d.lightClipFromWorld};
+    } else {
+      out.point.emplace(PointLightParams{.position = d.position,
+                                         .color = d.color,
+                                         .intensity = d.intensity,
+                                         .range = nr.y,
+                                         .nearPlane = nr.x});
+      for (int k = 0; k < 6; ++k)
+        out.lightClipFromWorld.push_back(d.faceClipFromWorld
+                                             ? (*d.faceClipFromWorld)[static_cast<std::size_t>(k)]
+                                             : out.point->faceClipFromWorld(k));
+    }
+  } catch (const InvalidArgument& e) {
+    // "SpotLight.innerConeAngle" -> "<path>.innerConeDeg", ...
+    std::string key = e.parameter().substr(e.parameter().find('.') + 1);
+    if (key == "innerConeAngle") key = "innerConeDeg";
+    if (key == "outerConeAngle") key = "outerConeDeg";
+    r.fail(Reader::join(path, key), e.what());
+  }
+  return out;
+}
+
+} // namespace
+
+std::vector<FrameLocalLight> localLightsOf(const FrameDescription& f, const std::string& source) {
+  const Reader r(source);
+  std::vector<FrameLocalLight> lights;
+  if (f.lightType != LightType::Directional)
+    lights.push_back(resolveLocalLight(r, f.localLight, "light", "shadowMap"));
+  for (std::size_t i = 0; i < f.lights.size(); ++i)
+    lights.push_back(
+        resolveLocalLight(r, f.lights[i], indexPath("lights", i), indexPath("lights", i) + ".shadowMap"));
+  return lights;
+}
+
+namespace {
+
 /// Upper bound of the in-scattered radiance of any pixel (Klehm et al. 2014, Eq. 1 with V = 1 and the
 /// largest phase value): E_c (sigma_mie,c HG_max + sigma_rayleigh,c 3 / (8 pi)) min(s_max, 1 / sigma_t,c).
-double radianceBound(const FrameDescription& f, const Medium& m) {
+double radianceBound(const FrameDescription& f, const Medium& m, const std::vector<FrameLocalLight>& local) {
   const double g = std::abs(f.hgG);
   const double hgMax = (1.0 + g) / (4.0 * std::numbers::pi * (1.0 - g) * (1.0 - g));
   const double rayleighMax = 3.0 / (8.0 * std::numbers::pi);
@@ -403,11 +785,20 @@ double radianceBound(const FrameDescription& f, const Medium& m) {
       std::isfinite(far) && far > 0.0 ? far * corner : std::numeric_limits<double>::infinity();
   const glm::dvec3 sigma = m.extinction();
   double bound = 0.0;
+  const bool directional = f.lightType == LightType::Directional;
   for (int c = 0; c < 3; ++c) {
-    const double C = f.lightColor[c] * f.lightIntensity *
-                     (f.mieScattering[c] * hgMax + f.rayleighScattering[c] * rayleighMax);
+    const double scattering = f.mieScattering[c] * hgMax + f.rayleighScattering[c] * rayleighMax;
+    const double C = directional ? f.lightColor[c] * f.lightIntensity * scattering : 0.0;
     const double length = sigma[c] > 0.0 ? std::min(sMax, 1.0 / sigma[c]) : sMax;
-    if (C > 0.0) bound = std::max(bound, C * length);
+    double channel = C > 0.0 ? C * length : 0.0;
+    // Local lights: I exp(-sigma d) / d^2 <= I / d^2, and the integral of 1 / d^2 along a line at distance h
+    // >= nearPlane from the light is at most pi / nearPlane.
+    for (const FrameLocalLight& light : local) {
+      const glm::dvec3 I = light.spot ? light.spot->intensity() : light.point->intensity();
+      const double near = light.spot ? light.spot->nearPlane() : light.point->nearPlane();
+      channel += I[c] * scattering * std::numbers::pi / near;
+    }
+    bound = std::max(bound, channel);
   }
   return bound;
 }
@@ -420,13 +811,15 @@ Medium mediumOf(const FrameDescription& f, const std::string& source) {
               .hgG = f.hgG,
               .rayleighScattering = f.rayleighScattering,
               .absorption = f.absorption});
-    const double bound = radianceBound(f, m);
+    const std::vector<FrameLocalLight> local = localLightsOf(f, source);
+    const double bound = radianceBound(f, m, local);
     if (!(bound <= kMaxRadiance))
-      Reader(source).fail("light.intensity",
-                          "with this medium the in-scattered radiance can reach " + Reader::format(bound) +
-                              " (irradiance x scattering x phase x path length), beyond " +
-                              Reader::format(kMaxRadiance) +
-                              ": lower light.intensity / light.color or medium.mieScattering / hgG");
+      Reader(source).fail(
+          f.lightType != LightType::Directional || f.lights.empty() ? "light.intensity"
+                                                                    : "light.intensity / lights[i].intensity",
+          "with this medium the in-scattered radiance can reach " + Reader::format(bound) +
+              " (irradiance x scattering x phase x path length), beyond " + Reader::format(kMaxRadiance) +
+              ": lower light.intensity / light.color or medium.mieScattering / hgG");
     return m;
   } catch (const InvalidArgument& e) {
     std::string field = "medium (extinction = mieScattering + rayleighScattering + absorption)";

@@ -103,6 +103,22 @@ gl::Handle compositeImage(const FrameInputs& frame, std::uint32_t surfaceColor, 
   return out;
 }
 
+void addScattering(const FrameInputs& frame, std::uint32_t sum, std::uint32_t addend) {
+  static gl::Handle* program = nullptr; // built once per process, lives with the context
+  if (!program)
+    program = new gl::Handle(buildProgram({{ShaderStage::Compute, "passes/add_scattering.comp", {}}}));
+  glUseProgram(program->get());
+  glBindImageTexture(0, sum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(1, addend, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((frame.width + 7) / 8), static_cast<GLuint>((frame.height + 7) / 8),
+                    1);
+  glMemoryBarrier(GL_ALL_BARRIER_BITS);
+  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glUseProgram(0);
+  gl::checkError("add scattering");
+}
+
 void requireFinite(const Image& image, const std::string& what) {
   long long nonFinite = 0;
   for (float v : image.data())

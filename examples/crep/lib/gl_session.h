@@ -32,6 +32,10 @@ Image readRgba(std::uint32_t texture, int width, int height);
 /// surface * exp(-sigma_t s) + in-scattering (glsl/passes/composite.comp), a new RGBA32F texture.
 gl::Handle compositeImage(const FrameInputs& frame, std::uint32_t surfaceColor, std::uint32_t scattering);
 
+/// sum.rgb += addend.rgb, sum.a kept (glsl/passes/add_scattering.comp): the lights of a frame add. Both
+/// RGBA32F textures of the frame's size.
+void addScattering(const FrameInputs& frame, std::uint32_t sum, std::uint32_t addend);
+
 /// Throws crep::Error when `image` holds NaN or infinity (refuse to write a silently wrong image).
 void requireFinite(const Image& image, const std::string& what);
 

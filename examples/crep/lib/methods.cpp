@@ -6,20 +6,25 @@
 #include "methods.h"
 
 #include "args.h"
+#include "gl_session.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/resample.h>
 #include <crep/pipeline/scattering.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scatter/gpu_world_march.h>
+#include <crep/scatter/ray_scattering.h>
 #include <crep/scenes/scene_renderer.h>
 
 #include <epoxy/gl.h>
 
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <vector>
 
 namespace crep::tool {
 
@@ -50,15 +55,95 @@ void runWorldMarch(const FrameInputs& frame, const MethodSettings& settings, std
   glFinish();
 }
 
+/// One local light as the marches see it: a spot, or one face of a point light, with its perspective map.
+struct LocalLightView {
+  LocalLight light;
+  const LocalShadowMap* shadow = nullptr;
+  int spot = -1;             ///< index into spotLights, or -1
+  int point = -1, face = -1; ///< index into pointLights and its face, or -1
+  std::string name() const {
+    return spot >= 0 ? "spot " + std::to_string(spot)
+                     : "point " + std::to_string(point) + " face " + std::to_string(face);
+  }
+};
+
+/// Every spot and every point-light face of the frame (Klehm et al. 2014, Sec. 3.2: six spot faces per
+/// point).
+std::vector<LocalLightView> localLightViews(const FrameInputs& frame) {
+  std::vector<LocalLightView> views;
+  for (std::size_t i = 0; i < frame.spotLights.size(); ++i)
+    views.push_back(
+        {LocalLight::spot(frame.spotLights[i]), &frame.spotShadows.at(i), static_cast<int>(i), -1, -1});
+  for (std::size_t i = 0; i < frame.pointLights.size(); ++i)
+    for (int k = 0; k < 6; ++k)
+      views.push_back({LocalLight::pointFace(frame.pointLights[i], k),
+                       &frame.pointShadows.at(6 * i + static_cast<std::size_t>(k)), -1, static_cast<int>(i),
+                       k});
+  return views;
+}
+
+/// The world-space march of one local light against its perspective shadow map (WorldMarchPass with
+/// localLight; crep/scatter/world_march.h) into `output`.
+void marchLocalLight(const FrameInputs& frame, WorldMarchPass& pass, const LocalLightView& view,
+                     std::uint32_t output) {
+  WorldMarchPass::FrameAttribs a;
+  a.camera = &frame.camera;
+  a.localLight = &view.light;
+  a.medium = &frame.medium;
+  a.cameraDepth = frame.cameraDepth.get();
+  a.shadowMap = view.shadow->texture.get();
+  a.lightClipFromWorld = view.shadow->lightClipFromWorld;
+  a.bias = view.shadow->bias;
+  a.output = output;
+  pass.run(a);
+  glFinish();
+}
+
+/// Adds `light`'s result to the method's output: computed by `compute` into the output itself when it holds
+/// nothing yet (`empty`), else into a scratch texture and added (the lights' contributions add).
+void addLight(const FrameInputs& frame, MethodOutput& out, bool& empty, gl::Handle& scratch,
+              const std::function<void(std::uint32_t)>& compute) {
+  if (empty) {
+    compute(out.scattering.get());
+    empty = false;
+    return;
+  }
+  if (!scratch) scratch = newScatteringTexture(frame);
+  compute(scratch.get());
+  addScattering(frame, out.scattering.get(), scratch.get());
+  glFinish();
+}
+
 /// The world-space reference: every pixel's view ray marched against the standard shadow map
-/// (crep/scatter/world_march.h), independent of any rectification.
+/// (crep/scatter/world_march.h), independent of any rectification; each local light against its own
+/// perspective map (each point-light face against its face's map), the results summed.
 MethodOutput runReference(FrameInputs& frame, const MethodSettings& settings) {
   MethodOutput out;
   out.used = "reference";
-  out.detail = std::to_string(settings.steps) + " march steps, standard map " +
-               std::to_string(frame.shadowWidth) + "x" + std::to_string(frame.shadowHeight);
+  out.detail = std::to_string(settings.steps) + " march steps";
+  if (frame.directional)
+    out.detail +=
+        ", standard map " + std::to_string(frame.shadowWidth) + "x" + std::to_string(frame.shadowHeight);
   out.scattering = newScatteringTexture(frame);
-  out.timings.time("reference march", [&] { runWorldMarch(frame, settings, out.scattering.get()); });
+  bool empty = true;
+  if (frame.directional) {
+    out.timings.time("reference march", [&] { runWorldMarch(frame, settings, out.scattering.get()); });
+    empty = false;
+  }
+  const std::vector<LocalLightView> views = localLightViews(frame);
+  if (!views.empty()) {
+    out.detail += (frame.directional ? " + " : ", ") + std::to_string(frame.spotLights.size()) + " spot, " +
+                  std::to_string(frame.pointLights.size()) + " point lights (perspective maps)";
+    WorldMarchPass::CreateInfo info;
+    info.options.steps = settings.steps;
+    WorldMarchPass pass(info);
+    gl::Handle scratch;
+    for (const LocalLightView& v : views)
+      out.timings.time("reference march (local lights)", [&] {
+        addLight(frame, out, empty, scratch,
+                 [&](std::uint32_t target) { marchLocalLight(frame, pass, v, target); });
+      });
+  }
   return out;
 }
 
@@ -105,9 +190,17 @@ void marchEpipoleBlock(const FrameInputs& frame, const MethodSettings& settings,
 
 /// The min/max tree (tree = true) or brute-force march of every pixel's view ray along its row of the
 /// rectified map (projective), or of the epipolar fallback map (plus the epipole block).
+void addLocalLightsRectified(FrameInputs& frame, const MethodSettings& settings, bool tree, MethodOutput& out,
+                             bool empty);
+
 MethodOutput runRectifiedMarch(FrameInputs& frame, const MethodSettings& settings, bool tree) {
   MethodOutput out;
   out.used = tree ? "minmax" : "brute";
+  if (!frame.directional) {
+    out.scattering = newScatteringTexture(frame);
+    addLocalLightsRectified(frame, settings, tree, out, true);
+    return out;
+  }
   Rectification rect;
   const RectifiedGpuMap* map = frame.rectified(settings, out.timings, &rect);
   std::optional<EpipolarMap> epipolar;
@@ -162,7 +255,112 @@ MethodOutput runRectifiedMarch(FrameInputs& frame, const MethodSettings& setting
     glFinish();
   });
   if (epipolar) marchEpipoleBlock(frame, settings, *epipolar->layout, out.scattering.get(), out.timings);
+  addLocalLightsRectified(frame, settings, tree, out, false);
   return out;
+}
+
+/// The min/max tree or brute-force march of one local light (Klehm et al. 2014, Sec. 3.2) into `target`,
+/// as crep::Scattering decides: its rectification for the camera; projective (the light off screen) -> its
+/// rectified map, rasterized with the scene's casters or point-resampled from its perspective map
+/// (ShadowResamplePass, Sec. 4.1's rule on the light's layout), marched along the rows with `localLight`; in
+/// or near the view -> the world-space march against its perspective map; outside the view -> nothing
+/// (returns false, `target` untouched).
+bool marchLocalRectified(FrameInputs& frame, const MethodSettings& settings, const LocalLightView& v,
+                         bool tree, WorldMarchPass& world, std::uint32_t target, StageTimings& timings,
+                         std::string& summary) {
+  const Rectification rect = timings.time("rectify (local lights)", [&] {
+    return v.spot >= 0
+               ? rectify(frame.camera, frame.spotLights[static_cast<std::size_t>(v.spot)], settings.rectify)
+               : rectifyPointLight(frame.camera, frame.pointLights[static_cast<std::size_t>(v.point)],
+                                   settings.rectify)[static_cast<std::size_t>(v.face)];
+  });
+  if (rect.status == RectifyStatus::Empty) return false;
+  if (!rect.projective()) {
+    summary += " " + v.name() + ": world march;";
+    timings.time("world-space march (local lights)", [&] { marchLocalLight(frame, world, v, target); });
+    return true;
+  }
+  summary += " " + v.name() + ": rectified;";
+  const auto layout = std::make_shared<const ProjectiveLayout>(rect);
+  const int size = settings.mapSize;
+  gl::Handle map;
+  if (frame.renderer) {
+    map = scenes::createDepthTexture(size, size, "--map-size");
+    timings.time("shadow pass (local lights, rectified)", [&] {
+      frame.renderer->renderRectified(rect, map.get(), size, size);
+      glFinish();
+    });
+  } else {
+    map = gl::createTexture2D(GL_R32F, size, size, "--map-size");
+    timings.time("resample (local lights)", [&] {
+      ShadowResamplePass pass({size, size});
+      ShadowResamplePass::FrameAttribs a;
+      a.layout = layout.get();
+      a.shadowMap = v.shadow->texture.get();
+      a.lightClipFromWorld = v.shadow->lightClipFromWorld;
+      a.output = map.get();
+      pass.run(a);
+      glFinish();
+    });
+  }
+  const RectifiedMarchPass::Mode mode =
+      tree ? RectifiedMarchPass::Mode::MinMaxTree : RectifiedMarchPass::Mode::BruteForce;
+  RectifiedMarchPass pass({size, size, mode});
+  std::unique_ptr<MinMaxTreePass> trees;
+  if (tree) {
+    trees = std::make_unique<MinMaxTreePass>(MinMaxTreePass::CreateInfo{size, size});
+    timings.time("min/max trees (local lights)", [&] {
+      trees->run(map.get());
+      glFinish();
+    });
+  }
+  timings.time(tree ? "min/max march (local lights)" : "brute-force march (local lights)", [&] {
+    RectifiedMarchPass::FrameAttribs a;
+    a.layout = layout.get();
+    a.camera = &frame.camera;
+    a.localLight = &v.light;
+    a.medium = &frame.medium;
+    a.cameraDepth = frame.cameraDepth.get();
+    a.rectifiedDepth = map.get();
+    a.minMaxBuffer = trees ? trees->treeBuffer() : 0;
+    a.output = target;
+    pass.run(a);
+    glFinish();
+  });
+  return true;
+}
+
+/// The local lights of the frame marched by marchLocalRectified and added to `out` (`empty`: out holds
+/// nothing yet).
+void addLocalLightsRectified(FrameInputs& frame, const MethodSettings& settings, bool tree, MethodOutput& out,
+                             bool empty) {
+  const std::vector<LocalLightView> views = localLightViews(frame);
+  if (views.empty()) return;
+  WorldMarchPass::CreateInfo info;
+  info.options.steps = settings.steps;
+  WorldMarchPass world(info);
+  gl::Handle scratch;
+  std::string summary;
+  for (const LocalLightView& v : views) {
+    if (empty) {
+      if (marchLocalRectified(frame, settings, v, tree, world, out.scattering.get(), out.timings, summary))
+        empty = false;
+      continue;
+    }
+    if (!scratch) scratch = newScatteringTexture(frame);
+    if (marchLocalRectified(frame, settings, v, tree, world, scratch.get(), out.timings, summary)) {
+      addScattering(frame, out.scattering.get(), scratch.get());
+      glFinish();
+    }
+  }
+  if (empty) {
+    // No light reaches the view: zero radiance, and the transmittance from an unlit world march.
+    const LocalLightView& v = views.front();
+    LocalLightView dark = v;
+    dark.light.intensity = glm::dvec3(0.0);
+    marchLocalLight(frame, world, dark, out.scattering.get());
+  }
+  out.detail += (out.detail.empty() ? "" : "; ") + std::string("local lights:") + summary;
 }
 
 MethodOutput runMinMax(FrameInputs& frame, const MethodSettings& settings) {
@@ -191,8 +389,13 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
   const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.lightClipFromWorld, frame.shadowBias};
   Scattering::FrameAttribs a;
   a.camera = &frame.camera;
-  a.light = &frame.light;
+  if (!frame.renderer && frame.hasLocalLights())
+    throw UsageError("option --method: prefilter does not take users' local-light shadow maps yet (use "
+                     "--method reference)");
+  a.light = &frame.light; // a night frame: the directional light has zero irradiance
   a.medium = &frame.medium;
+  a.spotLights = frame.spotLights;
+  a.pointLights = frame.pointLights;
   a.cameraDepth = frame.cameraDepth.get();
   out.scattering = newScatteringTexture(frame);
   a.output = out.scattering.get();
@@ -205,6 +408,19 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
   const PrefilterOptions& options = settings.prefilter;
   const std::string basis =
       "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
+  std::string local;
+  if (!r.localLights.empty()) {
+    int counts[3] = {0, 0, 0}; // prefiltered, marched, outside the view
+    for (const Scattering::LightResult& l : r.localLights)
+      ++counts[l.status == RectifyStatus::Projective ? 0 : l.status == RectifyStatus::Fallback ? 1 : 2];
+    local = "; local lights: " + std::to_string(counts[0]) + " prefiltered, " + std::to_string(counts[1]) +
+            " marched in world space, " + std::to_string(counts[2]) + " outside the view";
+  }
+  if (!frame.directional) {
+    out.detail =
+        "no directional light, " + basis + ", map " + std::to_string(settings.mapSize) + "^2" + local;
+    return out;
+  }
   if (r.layout == Scattering::Layout::Projective) {
     out.detail = "projective layout, " + basis + ", " + std::to_string(r.rectification.splitCount()) +
                  " splits, map " + std::to_string(settings.mapSize) + "^2 " +
@@ -219,6 +435,7 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
                  "), epipole block radius " + blockText + " px, " + basis + ", " +
                  std::to_string(settings.mapSize) + " slices x " + std::to_string(settings.mapSize);
   }
+  out.detail += local;
   return out;
 }
 
