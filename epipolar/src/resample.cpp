@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace crep {
@@ -39,6 +40,61 @@ void validateLightMatrix(const glm::dmat4& M, const glm::dvec3& lightDirection) 
                               detail::formatValue(d.y) + ", " + detail::formatValue(d.z) + ")",
                           "must look along the light direction: (0, 0, > 0) expected");
 }
+
+// A perspective projection centred at the light (Klehm et al. 2014, Sec. 3.2 "Local Lights": the light's
+// own shadow frustum): clip x = y = w = 0 at the light position.
+void validateLocalLightMatrix(const glm::dmat4& M, const glm::dvec3& lightPosition) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(M[c][r]))
+        throw InvalidArgument("lightClipFromWorld", detail::formatValue(M[c][r]), "must be finite");
+  if (!std::isfinite(lightPosition.x) || !std::isfinite(lightPosition.y) || !std::isfinite(lightPosition.z))
+    throw InvalidArgument("lightPosition", "not finite", "must be finite");
+  if (std::abs(glm::determinant(M)) < 1e-300)
+    throw InvalidArgument("lightClipFromWorld", "a singular matrix", "must be invertible");
+  // Each of rows x, y, w must vanish at the light: the light is the centre of projection, every light ray
+  // from it is one texel. The tolerance is relative to the terms the row sums, which bound the rounding of
+  // a matrix stored in float (about 1e-7 of them).
+  const glm::dvec4 q = M * glm::dvec4(lightPosition, 1.0);
+  const double distance = glm::length(lightPosition);
+  for (const int r : {0, 1, 3}) {
+    const double terms = glm::length(glm::dvec3(M[0][r], M[1][r], M[2][r])) * distance + std::abs(M[3][r]);
+    if (!(std::abs(q[r]) <= 1e-4 * terms))
+      throw InvalidArgument("lightClipFromWorld",
+                            "light position maps to clip (" + detail::formatValue(q.x) + ", " +
+                                detail::formatValue(q.y) + ", " + detail::formatValue(q.z) + ", " +
+                                detail::formatValue(q.w) + ")",
+                            "must be a perspective projection centred at the light position (clip x = y = "
+                            "w = 0 there expected, up to 1e-4 of the terms summed)");
+  }
+}
+
+std::optional<glm::dvec3> localLightPosition(const RectifiedLayout& layout) {
+  if (const auto* p = dynamic_cast<const ProjectiveLayout*>(&layout);
+      p && p->rectification().frame.inverseLightDistance > 0.0)
+    return p->rectification().frame.lightPosition;
+  return std::nullopt;
+}
+
+void validateLayoutLightMatrix(const RectifiedLayout& layout, const glm::dmat4& lightClipFromWorld) {
+  if (const std::optional<glm::dvec3> position = localLightPosition(layout))
+    validateLocalLightMatrix(lightClipFromWorld, *position);
+  else
+    validateLightMatrix(lightClipFromWorld, layout.lightRay(0.5, 0.5).direction);
+}
+
+namespace {
+
+/// How far along a layout's light ray the projected point lies (rule in resample.h): 0 for a directional
+/// light (the ray origin), the light-camera distance 1 / rho for a local one.
+double projectedPointDistance(const RectifiedLayout& layout) {
+  if (const auto* p = dynamic_cast<const ProjectiveLayout*>(&layout);
+      p && p->rectification().frame.inverseLightDistance > 0.0)
+    return 1.0 / p->rectification().frame.inverseLightDistance;
+  return 0.0;
+}
+
+} // namespace
 
 // Sec. 4.1: point resampling over the texels of the rectified map, blockers clamped to the slice's range.
 RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, int width, int height,
@@ -68,15 +124,17 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
                               "texel (" + std::to_string(i) + ", " + std::to_string(j) + ") = NaN",
                               "depth-buffer values must not be NaN");
   const RectifiedLayout& L = *layout;
-  validateLightMatrix(lightClipFromWorld, L.lightRay(0.5, 0.5).direction);
+  validateLayoutLightMatrix(L, lightClipFromWorld);
   const glm::dmat4 worldFromClip = glm::inverse(lightClipFromWorld);
+  const double ahead = projectedPointDistance(L);
 
   Image depth(width, height, 1, 1.0f);
   parallelRows(height, options.threads, [&](int j) {
     const double row = (j + 0.5) / height;
     for (int i = 0; i < width; ++i) {
       const LightRay ray = L.lightRay((i + 0.5) / width, row);
-      const glm::dvec4 q = lightClipFromWorld * glm::dvec4(ray.origin, 1.0);
+      const glm::dvec4 q = lightClipFromWorld * glm::dvec4(ray.origin + ahead * ray.direction, 1.0);
+      if (ahead > 0.0 && !(q.w > 0.0)) continue; // behind the local light's map
       const double x = q.x / q.w, y = q.y / q.w;
       if (!(x >= -1.0 && x <= 1.0 && y >= -1.0 && y <= 1.0)) continue;
       const int si = std::min(static_cast<int>((x + 1.0) * 0.5 * Ws), Ws - 1);
@@ -117,7 +175,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   const gl::TextureLevel shadow =
       gl::requireTexture2D("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
   gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);
-  validateLightMatrix(f.lightClipFromWorld, f.layout->lightRay(0.5, 0.5).direction);
+  validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
 
   const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
   gl::Handle& program = programs_[static_cast<int>(kind)];
@@ -134,6 +192,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   const GLuint p = program.get();
   glUseProgram(p);
   glProgramUniformMatrix4fv(p, 0, 1, GL_FALSE, &worldFromClip[0][0]);
+  glProgramUniform1f(p, 1, static_cast<float>(projectedPointDistance(*f.layout)));
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
   layoutBuffers_.bind(1, 1);
   glBindTextureUnit(0, f.shadowMap);

@@ -109,11 +109,19 @@ float crep_projectiveZeta(float column) {
   return range.x + (scaled - float(k)) * (range.y - range.x);
 }
 
-// Directional lights only (rho = 0): the point of the light ray with Z = 0 and the light direction.
+// crep::Rectification::lightRay: a directional light (rho = 0): the point of the light ray with Z = 0 and
+// the light direction; a spot light or point-light face (rho > 0): the light position L = origin - axisZ /
+// rho and the unit direction axisX + y axisY + (zeta / rho) axisZ of the ray's points L + X (...), X >= 0.
 CrepLightRay crep_layoutLightRay(float column, float row) {
   vec4 s = crep_projective.slopes;
   float y = s.x + row * (s.y - s.x);
-  float X = 1.0 / crep_projectiveZeta(column);
+  float zeta = crep_projectiveZeta(column);
+  float rho = crep_projective.origin.w;
+  if (rho > 0.0)
+    return CrepLightRay(crep_projective.origin.xyz - crep_projective.axisZ.xyz / rho,
+                        normalize(crep_projective.axisX.xyz + y * crep_projective.axisY.xyz +
+                                  (zeta / rho) * crep_projective.axisZ.xyz));
+  float X = 1.0 / zeta;
   return CrepLightRay(crep_projective.origin.xyz + X * (crep_projective.axisX.xyz + y * crep_projective.axisY.xyz),
                       crep_projective.axisZ.xyz);
 }
