@@ -6,6 +6,7 @@
 #include <crep/core/error.h>
 #include <crep/core/parallel.h>
 #include <crep/prefilter/prefilter.h>
+#include <crep/scatter/light_texture.h>
 
 #include <algorithm>
 #include <array>
@@ -89,9 +90,12 @@ void validateBasis(const FilteredBasis& b) {
   if (b.regionsPerSplit < 1 || b.regions != b.layout->regionCount() * b.regionsPerSplit ||
       b.width % b.regions != 0)
     bad("regions " + std::to_string(b.regions));
-  if (b.texels.size() != static_cast<std::size_t>(b.layers) * static_cast<std::size_t>(b.height) *
-                             static_cast<std::size_t>(b.width) * 4)
+  if (b.texels.size() != static_cast<std::size_t>(b.colorBases() * b.layers) *
+                             static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.width) * 4)
     bad("texels size " + std::to_string(b.texels.size()));
+  if (b.meanColor.size() !=
+      (b.textured ? static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.width) * 3 : 0))
+    bad("meanColor size " + std::to_string(b.meanColor.size()));
   if (b.profiles.size() != static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.regions))
     bad("profiles size " + std::to_string(b.profiles.size()));
   if (!(b.extinction >= 0.0) || !std::isfinite(b.extinction))
@@ -102,7 +106,8 @@ void validateBasis(const FilteredBasis& b) {
 
 /// Samples the decoded filtered basis of region r at prefix boundary u and normalized row (see the
 /// header: x = clamp(u n - 1, 0, n - 1), y = clamp(row H - 0.5, 0, H - 1)).
-void sampleFiltered(const FilteredBasis& b, Sampling sampling, int r, double u, double row, double* out) {
+void sampleFiltered(const FilteredBasis& b, Sampling sampling, int r, double u, double row, double* out,
+                    int color = 0) {
   const int n = b.regionWidth();
   const double x = std::clamp(u * n - 1.0, 0.0, static_cast<double>(n - 1));
   const double y = std::clamp(row * b.height - 0.5, 0.0, static_cast<double>(b.height - 1));
@@ -111,18 +116,40 @@ void sampleFiltered(const FilteredBasis& b, Sampling sampling, int r, double u, 
     const int xi = base + static_cast<int>(std::floor(x + 0.5));
     const int yi = static_cast<int>(std::floor(y + 0.5));
     for (int j = 0; j < b.bases; ++j)
-      out[j] = b.filtered(xi, yi, j);
+      out[j] = b.filtered(xi, yi, j, color);
     return;
   }
   const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
   const int x1 = std::min(x0 + 1, n - 1), y1 = std::min(y0 + 1, b.height - 1);
   const double fx = x - x0, fy = y - y0;
   for (int j = 0; j < b.bases; ++j) {
-    const double e00 = b.stored(base + x0, y0, j), e10 = b.stored(base + x1, y0, j);
-    const double e01 = b.stored(base + x0, y1, j), e11 = b.stored(base + x1, y1, j);
+    const double e00 = b.stored(base + x0, y0, j, color), e10 = b.stored(base + x1, y0, j, color);
+    const double e01 = b.stored(base + x0, y1, j, color), e11 = b.stored(base + x1, y1, j, color);
     const double e = (1.0 - fy) * ((1.0 - fx) * e00 + fx * e10) + fy * ((1.0 - fx) * e01 + fx * e11);
     out[j] = 2.0 * e - 1.0;
   }
+}
+
+/// The prefix mean colour cbar of a textured basis at the same sample position as sampleFiltered.
+glm::dvec3 sampleMeanColor(const FilteredBasis& b, Sampling sampling, int r, double u, double row) {
+  const int n = b.regionWidth();
+  const double x = std::clamp(u * n - 1.0, 0.0, static_cast<double>(n - 1));
+  const double y = std::clamp(row * b.height - 0.5, 0.0, static_cast<double>(b.height - 1));
+  const int base = r * n;
+  glm::dvec3 out;
+  if (sampling == Sampling::Nearest) {
+    const int xi = base + static_cast<int>(std::floor(x + 0.5)), yi = static_cast<int>(std::floor(y + 0.5));
+    for (int c = 0; c < 3; ++c)
+      out[c] = b.mean(xi, yi, c);
+    return out;
+  }
+  const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+  const int x1 = std::min(x0 + 1, n - 1), y1 = std::min(y0 + 1, b.height - 1);
+  const double fx = x - x0, fy = y - y0;
+  for (int c = 0; c < 3; ++c)
+    out[c] = (1.0 - fy) * ((1.0 - fx) * b.mean(base + x0, y0, c) + fx * b.mean(base + x1, y0, c)) +
+             fy * ((1.0 - fx) * b.mean(base + x0, y1, c) + fx * b.mean(base + x1, y1, c));
+  return out;
 }
 
 } // namespace
@@ -233,25 +260,36 @@ FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const Pre
 namespace {
 
 FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const PrefilterOptions& options,
-                            const LocalLight* light, const Medium* medium);
+                            const LocalLight* light, const Medium* medium, const Image* colors);
 
 } // namespace
 
 FilteredBasis prefilter(const RectifiedMap& map, double extinction, const PrefilterOptions& options) {
-  return prefilterImpl(map, extinction, options, nullptr, nullptr);
+  return prefilterImpl(map, extinction, options, nullptr, nullptr, nullptr);
 }
 
 FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const LocalLight& light,
                         const PrefilterOptions& options) {
-  return prefilterImpl(map, weightExtinction(medium), options, &light, &medium);
+  return prefilterImpl(map, weightExtinction(medium), options, &light, &medium, nullptr);
+}
+
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const Image& lightColors,
+                        const PrefilterOptions& options) {
+  return prefilterImpl(map, weightExtinction(medium), options, nullptr, &medium, &lightColors);
+}
+
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const LocalLight& light,
+                        const Image& lightColors, const PrefilterOptions& options) {
+  return prefilterImpl(map, weightExtinction(medium), options, &light, &medium, &lightColors);
 }
 
 namespace {
 
 FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const PrefilterOptions& options,
-                            const LocalLight* light, const Medium* medium) {
+                            const LocalLight* light, const Medium* medium, const Image* colors) {
   validate(map);
   validate(options);
+  if (colors) validateLightColors(*colors, map.width(), map.height(), "lightColors");
   if (!(extinction >= 0.0) || !std::isfinite(extinction))
     throw InvalidArgument("extinction", detail::formatValue(extinction), "must be finite and >= 0");
   const int W = map.width(), H = map.height(), M = options.bases;
@@ -276,17 +314,21 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
                           "must be exact with a local light (its factor is sampled at exact distances)");
   b.layout = map.layout;
   b.localLight = light != nullptr;
+  b.textured = colors != nullptr;
   b.profiles = referenceProfiles(*map.layout, H, options.regionsPerSplit);
-  b.texels.assign(static_cast<std::size_t>(b.layers) * static_cast<std::size_t>(H) *
+  const int C = b.colorBases();
+  b.texels.assign(static_cast<std::size_t>(C * b.layers) * static_cast<std::size_t>(H) *
                       static_cast<std::size_t>(W) * 4,
                   storeFiltered(0.0, options.format));
+  if (colors) b.meanColor.assign(static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 3, 0.0f);
 
   const int n = W / R;
   const std::size_t layerStride = static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 4;
   parallelRows(H, options.threads, [&](int j) {
     std::vector<double> mix(static_cast<std::size_t>(n));
     std::vector<double> lightSamples(light ? 2 * static_cast<std::size_t>(n) + 1 : 0);
-    std::array<double, kMaxBases> F{}, B{};
+    std::array<std::array<double, kMaxBases>, 3> Fc{};
+    std::array<double, kMaxBases> B{};
     const std::span<double> basisSpan(B.data(), static_cast<std::size_t>(M));
     const double row = (j + 0.5) / H;
     const glm::dvec3 origin = map.layout->origin();
@@ -305,20 +347,34 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
                                            : 0.0;
       }
       regionMixFactors(options.weights, extinction, profile, n, lightSamples, mix);
-      std::fill(F.begin(), F.end(), 0.0);
+      for (auto& F : Fc)
+        std::fill(F.begin(), F.end(), 0.0);
+      glm::dvec3 cbar(0.0); // light textures: the prefix mean colour (prefilter.h, "Light textures")
       for (int i = 0; i < n; ++i) {
         const int x = r * n + i;
         fourierBasis(texelBasisDepth(map.depth.at(x, j), options.depthMargin), basisSpan);
         const double m = mix[static_cast<std::size_t>(i)];
-        // Listing 2: the normalized weighted prefix, F_i = F_{i-1} + m_i (B_i - F_{i-1}).
-        for (int k = 0; k < M; ++k)
-          F[static_cast<std::size_t>(k)] +=
-              m * (B[static_cast<std::size_t>(k)] - F[static_cast<std::size_t>(k)]);
         const std::size_t texel =
             (static_cast<std::size_t>(j) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x)) * 4;
-        for (int k = 0; k < M; ++k)
-          b.texels[static_cast<std::size_t>(k / 4) * layerStride + texel + static_cast<std::size_t>(k % 4)] =
-              storeFiltered(F[static_cast<std::size_t>(k)], options.format);
+        for (int c = 0; c < C; ++c) {
+          // Light textures: the weights w_i c_i of channel c as mix factors, m_i c_i / cbar_i.
+          double mc = m;
+          if (colors) {
+            const double ci = colors->at(x, j, c);
+            cbar[c] += m * (ci - cbar[c]);
+            if (cbar[c] > 0.0) mc = std::clamp(m * (ci / cbar[c]), 0.0, 1.0);
+            b.meanColor[texel / 4 * 3 + static_cast<std::size_t>(c)] = roundToHalf(cbar[c]);
+          }
+          std::array<double, kMaxBases>& F = Fc[static_cast<std::size_t>(c)];
+          // Listing 2: the normalized weighted prefix, F_i = F_{i-1} + m_i (B_i - F_{i-1}).
+          for (int k = 0; k < M; ++k)
+            F[static_cast<std::size_t>(k)] +=
+                mc * (B[static_cast<std::size_t>(k)] - F[static_cast<std::size_t>(k)]);
+          for (int k = 0; k < M; ++k)
+            b.texels[static_cast<std::size_t>(c * b.layers + k / 4) * layerStride + texel +
+                     static_cast<std::size_t>(k % 4)] =
+                storeFiltered(F[static_cast<std::size_t>(k)], options.format);
+        }
       }
     }
   });
@@ -345,21 +401,28 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
     throw InvalidArgument("visibilityTable.samples", detail::formatValue(samples),
                           "must be in [2, " + std::to_string(kMaxVisibilityTableSamples) + "]");
   const int H = basis.height, R = basis.regions, M = basis.bases, n = basis.regionWidth();
+  const int C = basis.colorBases();
   std::vector<double> table(static_cast<std::size_t>(H) * static_cast<std::size_t>(R) *
-                            static_cast<std::size_t>(samples));
+                            static_cast<std::size_t>(samples) * static_cast<std::size_t>(C));
   const std::vector<double> a = visibilityTableCoefficients(samples, M, basis.depthMargin, ringing);
   for (int j = 0; j < H; ++j)
     for (int r = 0; r < R; ++r) {
       const int x = r * n + n - 1; // the region's last texel: its whole weighted average
-      for (int s = 0; s < samples; ++s) {
-        double dot = 0.0;
-        for (int k = 0; k < M; ++k)
-          dot += a[static_cast<std::size_t>(s) * static_cast<std::size_t>(M) + static_cast<std::size_t>(k)] *
-                 basis.filtered(x, j, k);
-        table[(static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
-                  static_cast<std::size_t>(samples) +
-              static_cast<std::size_t>(s)] = std::clamp(0.5 + dot, 0.0, 1.0);
-      }
+      for (int s = 0; s < samples; ++s)
+        for (int c = 0; c < C; ++c) {
+          double dot = 0.0;
+          for (int k = 0; k < M; ++k)
+            dot +=
+                a[static_cast<std::size_t>(s) * static_cast<std::size_t>(M) + static_cast<std::size_t>(k)] *
+                basis.filtered(x, j, k, c);
+          double V = std::clamp(0.5 + dot, 0.0, 1.0);
+          if (basis.textured) V *= basis.mean(x, j, c); // light textures: V_c = cbar_c clamp(...)
+          table[((static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
+                     static_cast<std::size_t>(samples) +
+                 static_cast<std::size_t>(s)) *
+                    static_cast<std::size_t>(C) +
+                static_cast<std::size_t>(c)] = V;
+        }
     }
   return table;
 }
@@ -375,7 +438,8 @@ std::vector<double> prefixTable(const FilteredBasis& basis, const std::vector<do
   const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
   const std::size_t cells =
       static_cast<std::size_t>(H) * static_cast<std::size_t>(R) * static_cast<std::size_t>(Z);
-  if (samples < 2 || samples > kMaxVisibilityTableSamples || visibility.size() != cells)
+  const std::size_t perCell = static_cast<std::size_t>(basis.colorBases());
+  if (samples < 2 || samples > kMaxVisibilityTableSamples || visibility.size() != cells * perCell)
     throw InvalidArgument("scatteringPrefixTable.visibility", "size " + std::to_string(visibility.size()),
                           "must be visibilityTable(basis, samples) with samples in [2, " +
                               std::to_string(kMaxVisibilityTableSamples) + "]");
@@ -396,7 +460,10 @@ std::vector<double> prefixTable(const FilteredBasis& basis, const std::vector<do
         for (int c = 0; c < C; ++c)
           table[cell * C + static_cast<std::size_t>(c)] = sum[c];
         const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
-        if (std::isfinite(tb)) sum += visibility[cell] * section(ta, tb);
+        const glm::dvec3 V = perCell == 1 ? glm::dvec3(visibility[cell])
+                                          : glm::dvec3(visibility[cell * 3], visibility[cell * 3 + 1],
+                                                       visibility[cell * 3 + 2]);
+        if (std::isfinite(tb)) sum += V * section(ta, tb);
         ta = tb;
       }
     }
@@ -427,7 +494,7 @@ namespace {
 /// The in-scattering of a region segment of one view ray for a directional light: C V TI (Eq. 1, 3, 11).
 struct DirectionalSegments {
   glm::dvec3 C, sigma;
-  glm::dvec3 weighted(double V, double ta, double tb) const {
+  glm::dvec3 weighted(const glm::dvec3& V, double ta, double tb) const {
     return C * V * transmittanceIntegral(sigma, ta, tb);
   }
   glm::dvec3 prefix(const glm::dvec3& S) const { return C * S; }
@@ -436,7 +503,7 @@ struct DirectionalSegments {
 /// The same for a local light: V times the ray's own unoccluded in-scattering of the segment.
 struct LocalSegments {
   RayScattering ray;
-  glm::dvec3 weighted(double V, double ta, double tb) const { return V * ray.segment(ta, tb); }
+  glm::dvec3 weighted(const glm::dvec3& V, double ta, double tb) const { return V * ray.segment(ta, tb); }
   glm::dvec3 prefix(const glm::dvec3& S) const { return S; }
 };
 
@@ -481,9 +548,7 @@ Image evaluateImpl(const FilteredBasis& basis, const Image& cameraDepth, const C
     return (1.0 - fy) * ((1.0 - fx) * at(x0, y0) + fx * at(x1, y0)) +
            fy * ((1.0 - fx) * at(x0, y1) + fx * at(x1, y1));
   };
-  const auto tableAt = [&](int r, double depth, double row) {
-    return lerpTable(tableValues, 1, 0, r, depth, row);
-  };
+  const int C = basis.colorBases(); // light textures: one basis per colour channel
   Image out(w, h, 4);
   parallelRows(h, options.threads, [&](int y) {
     std::array<double, kMaxBases> a{}, Fa{}, Fb{};
@@ -494,7 +559,7 @@ Image evaluateImpl(const FilteredBasis& basis, const Image& cameraDepth, const C
       glm::dvec3 L(0.0);
       MappedRay m;
       if (!mapRay(layout, origin, ray, basis.regionsPerSplit, options.nearPlaneCorrection, m)) {
-        L = segment.weighted(1.0, ray.start, ray.surface);
+        L = segment.weighted(glm::dvec3(1.0), ray.start, ray.surface);
       } else {
         fourierCoefficients(rayBasisDepth(m.depth, basis.depthMargin), aSpan);
         applyRingingFilter(options.ringing, aSpan);
@@ -515,37 +580,51 @@ Image evaluateImpl(const FilteredBasis& basis, const Image& cameraDepth, const C
           m.first = {m.last.region, 0.0};
         }
         forEachSegment(layout, segments, m, R, [&](int r, double ua, double ub, double ta, double tb) {
+          glm::dvec3 V(0.0);
           if (table && r < m.last.region) { // a region crossed whole: the table (see EvaluateOptions)
-            L += segment.weighted(tableAt(r, m.depth, m.row), ta, tb);
+            for (int c = 0; c < C; ++c)
+              V[c] = lerpTable(tableValues, C, c, r, m.depth, m.row);
+            L += segment.weighted(C == 1 ? glm::dvec3(V[0]) : V, ta, tb);
             return;
           }
-          sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data());
-          double dot = 0.0;
           bool plain = ua <= 0.0;
+          double wa = 0.0, wb = 0.0;
           if (!plain) {
             // Near-plane correction: the prefix difference of one region, each prefix restored by its own
             // weight total (Appendix A), then renormalized by the segment's total.
             const DistanceProfile& p =
                 basis.profiles[static_cast<std::size_t>(nearestRow) * static_cast<std::size_t>(R) +
                                static_cast<std::size_t>(r)];
-            const double wa = regionWeightTotal(basis.weights, basis.extinction, p, n, ua);
-            const double wb = regionWeightTotal(basis.weights, basis.extinction, p, n, ub);
-            if (wb - wa > 1e-12 * wb) {
-              sampleFiltered(basis, options.sampling, r, ua, m.row, Fa.data());
-              for (int k = 0; k < M; ++k) {
-                const auto kk = static_cast<std::size_t>(k);
-                dot += a[kk] * (wb * Fb[kk] - wa * Fa[kk]);
-              }
-              dot /= wb - wa;
-            } else {
-              plain = true;
-            }
+            wa = regionWeightTotal(basis.weights, basis.extinction, p, n, ua);
+            wb = regionWeightTotal(basis.weights, basis.extinction, p, n, ub);
+            plain = !(wb - wa > 1e-12 * wb);
           }
-          if (plain)
-            for (int k = 0; k < M; ++k)
-              dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
-          const double V = std::clamp(0.5 + dot, 0.0, 1.0);
-          L += segment.weighted(V, ta, tb);
+          // Light textures (prefilter.h): each channel's basis, its prefix weighted by W cbar.
+          const glm::dvec3 cb =
+              basis.textured ? sampleMeanColor(basis, options.sampling, r, ub, m.row) : glm::dvec3(1.0);
+          const glm::dvec3 ca = basis.textured && !plain
+                                    ? sampleMeanColor(basis, options.sampling, r, ua, m.row)
+                                    : glm::dvec3(1.0);
+          for (int c = 0; c < C; ++c) {
+            sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data(), c);
+            double dot = 0.0;
+            if (plain) {
+              for (int k = 0; k < M; ++k)
+                dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
+              V[c] = std::clamp(0.5 + dot, 0.0, 1.0) * cb[c];
+              continue;
+            }
+            const double wbc = wb * cb[c], wac = wa * ca[c];
+            if (!(wbc - wac > 0.0)) continue; // no weighted light in the segment: V = 0
+            sampleFiltered(basis, options.sampling, r, ua, m.row, Fa.data(), c);
+            for (int k = 0; k < M; ++k) {
+              const auto kk = static_cast<std::size_t>(k);
+              dot += a[kk] * (wbc * Fb[kk] - wac * Fa[kk]);
+            }
+            dot /= wbc - wac;
+            V[c] = (wbc - wac) / (wb - wa) * std::clamp(0.5 + dot, 0.0, 1.0);
+          }
+          L += segment.weighted(C == 1 ? glm::dvec3(V[0]) : V, ta, tb);
         });
       }
       storeScattering(out, x, y, L, std::exp(-greySigma * ray.surface));

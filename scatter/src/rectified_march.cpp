@@ -54,8 +54,9 @@ double RowDistances::at(int i) const {
 namespace {
 template <class Light>
 MarchResult bruteForce(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                       const Light& light, const Medium& medium, const MarchOptions& options) {
-  return marchRectifiedRows(map, cameraDepth, camera, light, medium, options,
+                       const Light& light, const Medium& medium, const MarchOptions& options,
+                       const Image* lightColors = nullptr) {
+  return marchRectifiedRows(map, cameraDepth, camera, light, medium, options, lightColors,
                             [&](const RowRay& r, const RowDistances& T, const auto& litSection, int& steps) {
                               for (int i = 0; i <= r.last; ++i) {
                                 ++steps;
@@ -74,6 +75,19 @@ MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, c
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const LocalLight& light, const Medium& medium, const MarchOptions& options) {
   return bruteForce(map, cameraDepth, camera, light, medium, options);
+}
+
+// Light textures: each lit texel's section times the texel's colour (Klehm et al. 2014, Sec. 3.2).
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const DirectionalLight& light, const Medium& medium, const Image& lightColors,
+                            const MarchOptions& options) {
+  return bruteForce(map, cameraDepth, camera, light, medium, options, &lightColors);
+}
+
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const LocalLight& light, const Medium& medium, const Image& lightColors,
+                            const MarchOptions& options) {
+  return bruteForce(map, cameraDepth, camera, light, medium, options, &lightColors);
 }
 
 } // namespace crep

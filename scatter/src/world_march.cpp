@@ -97,34 +97,48 @@ namespace {
 
 /// One pixel ray's march with the light's rule for a lit section, its radiance and its lookups: C times
 /// the transmittance integrals for the directional light, RayScattering's section integrals for a local one.
+/// A lit part's integral times the light texture's colour at its midpoint's light ray (world_march.h,
+/// "Light textures"), or the integral alone without a texture.
+template <class Section>
+auto coloured(const LightTexture* texture, const Camera& camera, const PixelRay& ray,
+              const Section& section) {
+  return [=, &camera, &ray, &section](double ta, double tb) {
+    const glm::dvec3 v = section(ta, tb);
+    if (!texture) return v;
+    return v * lightTextureColor(*texture, camera.position() + (0.5 * (ta + tb)) * ray.direction);
+  };
+}
+
 int marchRadiance(const Image& shadowDepth, const glm::dmat4& M, const Camera& camera, const PixelRay& ray,
                   const DirectionalLight& light, const Medium& medium, const WorldMarchOptions& options,
-                  glm::dvec3& radiance) {
+                  const LightTexture* texture, glm::dvec3& radiance) {
   const glm::dvec3 sigma = medium.extinction();
   glm::dvec3 L;
-  const int lookups = worldMarchPixel(
-      shadowDepth, M, camera.position(), ray,
-      [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); }, options, L);
+  const auto section = [&](double ta, double tb) { return transmittanceIntegral(sigma, ta, tb); };
+  const int lookups = worldMarchPixel(shadowDepth, M, camera.position(), ray,
+                                      coloured(texture, camera, ray, section), options, L);
   radiance = scatteringConstant(light, medium, ray.direction) * L;
   return lookups;
 }
 
 int marchRadiance(const Image& shadowDepth, const glm::dmat4& M, const Camera& camera, const PixelRay& ray,
                   const LocalLight& light, const Medium& medium, const WorldMarchOptions& options,
-                  glm::dvec3& radiance) {
+                  const LightTexture* texture, glm::dvec3& radiance) {
   const RayScattering rs(light, medium, camera.position(), ray.direction);
-  return worldMarchPixel(
-      shadowDepth, M, camera.position(), ray, [&](double ta, double tb) { return rs.segment(ta, tb); },
-      options, radiance);
+  const auto section = [&](double ta, double tb) { return rs.segment(ta, tb); };
+  return worldMarchPixel(shadowDepth, M, camera.position(), ray, coloured(texture, camera, ray, section),
+                         options, radiance);
 }
 
 template <class Light>
 MarchResult marchImage(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
                        const Image& cameraDepth, const Camera& camera, const Light& light,
-                       const Medium& medium, const WorldMarchOptions& options) {
+                       const Medium& medium, const WorldMarchOptions& options,
+                       const LightTexture* texture = nullptr) {
   validateShadowMap(shadowDepth, lightClipFromWorld);
   validateCameraDepth(cameraDepth);
   validate(options);
+  if (texture) validateLightTexture(*texture, light, "lightTexture");
   const int w = cameraDepth.width(), h = cameraDepth.height();
   MarchResult out{Image(w, h, 4), Image(w, h, 1)};
   const double grey = weightExtinction(medium);
@@ -133,7 +147,7 @@ MarchResult marchImage(const Image& shadowDepth, const glm::dmat4& lightClipFrom
       const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
       glm::dvec3 L;
       const int lookups =
-          marchRadiance(shadowDepth, lightClipFromWorld, camera, ray, light, medium, options, L);
+          marchRadiance(shadowDepth, lightClipFromWorld, camera, ray, light, medium, options, texture, L);
       storeScattering(out.scattering, x, y, L, std::exp(-grey * ray.surface));
       out.steps.at(x, y) = static_cast<float>(lookups);
     }
@@ -156,6 +170,23 @@ MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightCli
                             const Image& cameraDepth, const Camera& camera, const LocalLight& light,
                             const Medium& medium, const WorldMarchOptions& options) {
   return marchImage(shadowDepth, lightClipFromWorld, cameraDepth, camera, light, medium, options);
+}
+
+// Light textures (Klehm et al. 2014, Sec. 3.2): each lit part times the texture at its light ray.
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                            const Medium& medium, const LightTexture& lightTexture,
+                            const WorldMarchOptions& options) {
+  return marchImage(shadowDepth, lightClipFromWorld, cameraDepth, camera, light, medium, options,
+                    &lightTexture);
+}
+
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const LocalLight& light,
+                            const Medium& medium, const LightTexture& lightTexture,
+                            const WorldMarchOptions& options) {
+  return marchImage(shadowDepth, lightClipFromWorld, cameraDepth, camera, light, medium, options,
+                    &lightTexture);
 }
 
 void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
@@ -184,7 +215,7 @@ void worldSpaceMarchPixels(const Image& shadowDepth, const glm::dmat4& lightClip
     const PixelRay ray = pixelRay(camera, cameraDepth, x, y);
     glm::dvec3 L;
     const int lookups =
-        marchRadiance(shadowDepth, lightClipFromWorld, camera, ray, light, medium, options, L);
+        marchRadiance(shadowDepth, lightClipFromWorld, camera, ray, light, medium, options, nullptr, L);
     storeScattering(scattering, x, y, L, std::exp(-grey * ray.surface));
     if (steps) steps->at(x, y) = static_cast<float>(lookups);
   });

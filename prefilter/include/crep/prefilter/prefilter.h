@@ -53,6 +53,27 @@
 //   (composite: surface * A + L; per-channel transmittance is exp(-sigma_c s)).
 //
 // ---------------------------------------------------------------------------------------------------
+// Light textures (crep/scatter/light_texture.h; Klehm et al. 2014, Sec. 3.2 "Angular-dependency for
+// Sources": a coloured light texture is a light-side factor per colour component, "stored per component").
+// With a colour c_i per texel (the texture at the texel's light ray, lightColorMap()), the light reaching a
+// view ray section in texel i is c_i times the untextured one, so the region average of Eq. 5 becomes per
+// channel sum_i w_i c_i V_i / sum_i w_i = cbar (sum_i w_i c_i V_i / sum_i w_i c_i) with the prefix mean
+// colour cbar = sum w_i c_i / sum w_i. The second factor is an ordinary normalized prefix with the weights
+// w_i c_i, so per channel c and texel i of a region (m_i the untextured mix factors):
+//   cbar_i = cbar_{i-1} + m_i (c_i - cbar_{i-1}),  cbar_{-1} = 0        (the same filter as F)
+//   m^c_i = m_i (c_i / cbar_i)   (= w_i c_i / sum_{l<=i} w_l c_l, clamped to [0, 1]; m_i where cbar_i = 0)
+//   F^c_i = F^c_{i-1} + m^c_i (B(z_i) - F^c_{i-1})
+// stored as three bases (3 ceil(M / 4) layers, colour c in layers [c L, (c + 1) L): 3x the storage and the
+// filter work, the tripled storage of Sec. 3.2) and cbar per texel, rounded to binary16 (one RGBA16F
+// texture). A constant texture c gives cbar = c and m^c = m (c / c = 1) exactly, so F^c = F bit for bit.
+// Evaluation per channel: V_c = cbar_c(u_b) clamp(0.5 + a . F^c(u_b), 0, 1) (cbar sampled like F), 0
+// where cbar = 0 (no weighted light); with the near-plane correction the prefix difference weighs each
+// prefix by W cbar: V_c = cseg clamp(0.5 + a . (W_b cbar_b F^c_b - W_a cbar_a F^c_a) / (W_b cbar_b - W_a
+// cbar_a)), cseg = (W_b cbar_b - W_a cbar_a) / (W_b - W_a) (0 where the numerator is <= 0). The region
+// visibility table then holds 3 values per cell (V_c at the region's last texel) and the scattering prefix
+// table multiplies each channel's section integral by its own V_c.
+//
+// ---------------------------------------------------------------------------------------------------
 // References. The method's own error is evaluate() against bruteForceMarch() (crep/scatter/
 // rectified_march.h) on the same map: the same rays, start and end rules and output, but the visibility
 // integrated exactly per texel (no Fourier truncation, no reference-ray weights, no quantization, no
@@ -182,19 +203,34 @@ struct FilteredBasis {
   std::shared_ptr<const RectifiedLayout> layout;
   /// Prefiltered for a local light (its light-side factor in the weights): evaluate with that light.
   bool localLight = false;
+  /// Prefiltered with a light texture's colour map (see "Light textures" at the top): `texels` holds three
+  /// bases, colour channel c in layers [c layers, (c + 1) layers), and `meanColor` the prefix mean colours.
+  bool textured = false;
+  /// Textured only: cbar_c of every texel, height * width * 3, index (y * width + x) * 3 + c, each rounded
+  /// to binary16 (roundToHalf; the GPU's GL_RGBA16F texture). Empty otherwise.
+  std::vector<float> meanColor;
 
   int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
-  float stored(int x, int y, int basis) const {
-    return texels[((static_cast<std::size_t>(basis / 4) * static_cast<std::size_t>(height) +
+  int colorBases() const noexcept { return textured ? 3 : 1; } ///< bases stored: 3 with a texture, else 1
+  /// Stored value e of basis j at texel (x, y), of colour channel `color`'s basis (0 untextured).
+  float stored(int x, int y, int basis, int color = 0) const {
+    return texels[((static_cast<std::size_t>(color * layers + basis / 4) * static_cast<std::size_t>(height) +
                     static_cast<std::size_t>(y)) *
                        static_cast<std::size_t>(width) +
                    static_cast<std::size_t>(x)) *
                       4 +
                   static_cast<std::size_t>(basis % 4)];
   }
-  /// Decoded F = 2 e - 1 of basis j at texel (x, y).
-  double filtered(int x, int y, int basis) const {
-    return 2.0 * static_cast<double>(stored(x, y, basis)) - 1.0;
+  /// Decoded F = 2 e - 1 of basis j at texel (x, y) (of colour channel `color`'s basis when textured).
+  double filtered(int x, int y, int basis, int color = 0) const {
+    return 2.0 * static_cast<double>(stored(x, y, basis, color)) - 1.0;
+  }
+  /// cbar_c at texel (x, y) (textured only).
+  float mean(int x, int y, int color) const {
+    return meanColor[(static_cast<std::size_t>(y) * static_cast<std::size_t>(width) +
+                      static_cast<std::size_t>(x)) *
+                         3 +
+                     static_cast<std::size_t>(color)];
   }
 };
 
@@ -210,6 +246,15 @@ FilteredBasis prefilter(const RectifiedMap& map, double extinction, const Prefil
 /// per region (RayScattering), so the weights only shape the visibility average within a region.
 FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const LocalLight& light,
                         const PrefilterOptions& options = {});
+/// Light textures (see "Light textures" at the top): the prefilter per colour channel with the texel
+/// colours of `lightColors` (lightColorMap() of crep/scatter/light_texture.h: the map's size, RGB, finite,
+/// >= 0; InvalidArgument "lightColors" naming the texel otherwise) in the weights, for the directional light
+/// with the medium's weight extinction ...
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const Image& lightColors,
+                        const PrefilterOptions& options = {});
+/// ... and for a local light (its light-side factor and the colours in the weights).
+FilteredBasis prefilter(const RectifiedMap& map, const Medium& medium, const LocalLight& light,
+                        const Image& lightColors, const PrefilterOptions& options = {});
 
 struct EvaluateOptions {
   Sampling sampling = Sampling::Bilinear;
@@ -259,7 +304,8 @@ std::vector<double> visibilityTableCoefficients(int samples, int bases, double d
 
 /// The region visibility table of `basis` (see visibilityTableSamples), in double from the stored values:
 /// index (row * R + region) * Z + s, sample s at normalized ray depth s / (Z - 1), ray coefficients with
-/// `ringing`. What EvaluatePass builds on the GPU in float (glsl/passes/visibility_table.comp).
+/// `ringing`; a textured basis holds 3 values per cell (index ((row * R + region) * Z + s) * 3 + c, V_c of
+/// "Light textures" above). What EvaluatePass builds on the GPU in float (glsl/passes/visibility_table.comp).
 std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing);
 
 /// The scattering prefix table (see EvaluateOptions::scatteringPrefix) of `basis` and its region

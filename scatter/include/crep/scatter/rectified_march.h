@@ -18,6 +18,10 @@
 // With the near-plane correction every section is clipped to [t_n, s] (texels in front of the near plane
 // contribute nothing). Pixels whose end point the layout cannot map (toRectified throws) are unshadowed.
 // Steps (MarchResult::steps) of the brute-force march: texels visited (e + 1); unmapped pixels: 0.
+// Light textures (crep/scatter/light_texture.h): with a colour map (lightColorMap(): one RGB colour per
+// texel, the texture at the texel's light ray) every lit section is split at the texel boundaries T(i) and
+// each part [max(ta, T(i)), min(tb, T(i + 1))] of positive length is integrated times the colour of texel
+// (i, j). Unmapped pixels stay unshadowed and uncoloured.
 #pragma once
 
 #include <algorithm>
@@ -34,6 +38,7 @@
 #include <crep/core/medium.h>
 #include <crep/core/parallel.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/light_texture.h>
 #include <crep/scatter/ray.h>
 #include <crep/scatter/ray_scattering.h>
 
@@ -70,14 +75,17 @@ private:
 /// Unmapped pixels are unshadowed. Rows of the camera image run in parallel. `Light` is DirectionalLight
 /// (sections integrated as transmittance integrals, times C) or LocalLight (sections integrated by
 /// RayScattering: the same integrand as every other method, exactly per section).
+/// With `lightColors` (a colour map of the map's size, validated: InvalidArgument "lightColors") each lit
+/// section is coloured per texel (rule at the top).
 template <class Light, class Walk>
 MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                                const Light& light, const Medium& medium, const MarchOptions& options,
-                               const Walk& walk) {
+                               const Image* lightColors, const Walk& walk) {
   constexpr bool kLocal = std::is_same_v<Light, LocalLight>;
   validate(map);
   validateCameraDepth(cameraDepth);
   validate(options);
+  if (lightColors) validateLightColors(*lightColors, map.width(), map.height(), "lightColors");
   const RectifiedLayout& layout = *map.layout;
   const int w = cameraDepth.width(), h = cameraDepth.height(), W = map.width(), H = map.height();
   const glm::dvec3 sigma = medium.extinction();
@@ -102,8 +110,35 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
         L = section(ray.start, ray.surface);
       } else {
         const RowDistances T(layout, r, W, ray.surface);
-        walk(
-            r, T, [&](double ta, double tb) { L += section(std::max(ta, ray.start), tb); }, steps);
+        if (lightColors) {
+          // Light textures: the section's parts per texel, each times its texel's colour.
+          walk(
+              r, T,
+              [&](double ta, double tb) {
+                ta = std::max(ta, ray.start);
+                if (!(tb > ta)) return;
+                int lo = 0, hi = r.last; // the first texel i with T(i + 1) > ta
+                while (lo < hi) {
+                  const int mid = (lo + hi) / 2;
+                  if (T.at(mid + 1) > ta)
+                    hi = mid;
+                  else
+                    lo = mid + 1;
+                }
+                for (int i = lo; i <= r.last; ++i) {
+                  const double a = std::max(ta, T.at(i)), b = std::min(tb, T.at(i + 1));
+                  if (a >= tb) break;
+                  if (!(b > a)) continue;
+                  const glm::dvec3 c(lightColors->at(i, r.texelRow, 0), lightColors->at(i, r.texelRow, 1),
+                                     lightColors->at(i, r.texelRow, 2));
+                  L += c * section(a, b);
+                }
+              },
+              steps);
+        } else {
+          walk(
+              r, T, [&](double ta, double tb) { L += section(std::max(ta, ray.start), tb); }, steps);
+        }
       }
       if constexpr (!kLocal) L = scatteringConstant(light, medium, ray.direction) * L;
       storeScattering(out.scattering, x, y, L, std::exp(-grey * ray.surface));
@@ -111,6 +146,14 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
     }
   });
   return out;
+}
+
+/// marchRectifiedRows without a light texture.
+template <class Light, class Walk>
+MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                               const Light& light, const Medium& medium, const MarchOptions& options,
+                               const Walk& walk) {
+  return marchRectifiedRows(map, cameraDepth, camera, light, medium, options, nullptr, walk);
 }
 
 /// The brute-force march (rule at the top), texel by texel: the reference of every method on the same map.
@@ -122,5 +165,14 @@ MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, c
 /// The same for a local light (a spot, or one point-light face, on a map of its rectification).
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const LocalLight& light, const Medium& medium, const MarchOptions& options = {});
+/// The brute-force march with a light texture's colour map (lightColorMap() of the map's layout and size;
+/// rule at the top), for the directional light ...
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const DirectionalLight& light, const Medium& medium, const Image& lightColors,
+                            const MarchOptions& options = {});
+/// ... and a local light.
+MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                            const LocalLight& light, const Medium& medium, const Image& lightColors,
+                            const MarchOptions& options = {});
 
 } // namespace crep

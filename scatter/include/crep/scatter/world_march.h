@@ -14,6 +14,9 @@
 // take the visibility of their end. Each lit part is integrated exactly (transmittanceIntegral), so the
 // result is exact for visibility with at most one change per section, up to s / (N 2^refinements) at
 // each change. Steps (MarchResult::steps) = visibility lookups.
+// Light textures (crep/scatter/light_texture.h): each lit part [ta, tb] is multiplied by the texture's
+// colour at its midpoint, lightTextureColor(texture, camera + (ta + tb) / 2 v) (the colour of the light ray
+// through it), so a colour edge inside a part is located to that part's length (at most s / N).
 #pragma once
 
 #include <span>
@@ -24,6 +27,7 @@
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/scatter/light_texture.h>
 #include <crep/scatter/ray.h>
 #include <crep/scatter/ray_scattering.h>
 
@@ -57,6 +61,17 @@ MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightCli
 MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
                             const Image& cameraDepth, const Camera& camera, const LocalLight& light,
                             const Medium& medium, const WorldMarchOptions& options = {});
+/// The world march with a light texture (rule at the top) for the directional light and a local light.
+/// Throws InvalidArgument naming "lightTexture.rgb" / "lightTexture.textureClipFromWorld"
+/// (validateLightTexture: also a projection that is not along the light's rays).
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                            const Medium& medium, const LightTexture& lightTexture,
+                            const WorldMarchOptions& options = {});
+MarchResult worldSpaceMarch(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld,
+                            const Image& cameraDepth, const Camera& camera, const LocalLight& light,
+                            const Medium& medium, const LightTexture& lightTexture,
+                            const WorldMarchOptions& options = {});
 /// The same for the pixels of `pixels` only (indices y * w + x), written into `scattering` (RGBA,
 /// cameraDepth's size, e.g. the output of another method) and, if given, `steps` (1 channel, same size);
 /// other pixels are left untouched. What the epipole block uses (Klehm et al. 2014, Fig. 8: brute-force
