@@ -19,9 +19,12 @@
 #include <crep/support/exr.h>
 #include <crep/support/png.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -30,6 +33,67 @@ namespace crep::tool {
 
 namespace {
 
+/// The files --export-frame writes besides depth.exr, shadow.exr and frame.json: one shadow EXR per local
+/// light after the first when there is no sun (the first is then shadow.exr), per local light otherwise.
+std::vector<std::string> localLightFiles(const scenes::Scene& scene) {
+  std::vector<std::string> files;
+  const std::size_t count = scene.spotLights.size() + scene.pointLights.size();
+  for (std::size_t i = scene.hasSun ? 0 : 1; i < count; ++i)
+    files.push_back("light" + std::to_string(i) + ".exr");
+  return files;
+}
+
+/// A local light of the scene as the frame description holds it (frame_json.h), with its shadow map read
+/// back: a spot's map, or a point light's six faces stacked top to bottom (+X first; face k in image rows
+/// (5 - k) S .. (6 - k) S - 1 from the bottom, the EXR writer's flip puts +X at the top of the file).
+LocalLightDescription describeLocal(const FrameInputs& f, std::size_t index, Image& shadow) {
+  LocalLightDescription d;
+  const auto split = [&](const glm::dvec3& colorTimesIntensity) {
+    const double peak = std::max({colorTimesIntensity.x, colorTimesIntensity.y, colorTimesIntensity.z});
+    d.color = colorTimesIntensity / peak;
+    d.intensity = peak;
+  };
+  if (index < f.spotLights.size()) {
+    const SpotLight& spot = f.spotLights[index];
+    const LocalShadowMap& map = f.spotShadows[index];
+    d.type = LightType::Spot;
+    d.position = spot.position();
+    d.direction = spot.direction();
+    d.innerConeDeg = spot.innerConeAngle() * 180.0 / std::numbers::pi;
+    d.outerConeDeg = spot.outerConeAngle() * 180.0 / std::numbers::pi;
+    split(spot.intensity());
+    d.nearPlane = spot.nearPlane();
+    d.range = spot.range();
+    d.lightClipFromWorld = map.lightClipFromWorld;
+    d.shadowSize = glm::ivec2(map.width, map.height);
+    d.shadowBias = map.bias;
+    shadow = scenes::readDepthTexture(map.texture.get(), map.width, map.height);
+    return d;
+  }
+  const std::size_t i = index - f.spotLights.size();
+  const PointLight& point = f.pointLights[i];
+  d.type = LightType::Point;
+  d.position = point.position();
+  split(point.intensity());
+  d.nearPlane = point.nearPlane();
+  d.range = point.range();
+  std::array<glm::dmat4, 6> faces;
+  const int S = f.pointShadows[6 * i].width;
+  shadow = Image(S, 6 * S, 1);
+  for (int k = 0; k < 6; ++k) {
+    const LocalShadowMap& map = f.pointShadows[6 * i + static_cast<std::size_t>(k)];
+    faces[static_cast<std::size_t>(k)] = map.lightClipFromWorld;
+    const Image face = scenes::readDepthTexture(map.texture.get(), S, S);
+    for (int y = 0; y < S; ++y)
+      for (int x = 0; x < S; ++x)
+        shadow.at(x, (5 - k) * S + y) = face.at(x, y);
+  }
+  d.faceClipFromWorld = faces;
+  d.shadowSize = glm::ivec2(S, 6 * S);
+  d.shadowBias = f.pointShadows[6 * i].bias;
+  return d;
+}
+
 void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTimings& timings) {
   const FrameInputs& f = *s.frame;
   timings.time("export frame", [&] {
@@ -37,11 +101,27 @@ void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTim
     std::filesystem::create_directories(dir, ec);
     if (ec) throw IoError("--export-frame: cannot create directory '" + dir.string() + "': " + ec.message());
     const Image depth = scenes::readDepthTexture(f.cameraDepth.get(), f.width, f.height);
-    const Image shadow = scenes::readDepthTexture(f.shadowMap.get(), f.shadowWidth, f.shadowHeight);
     // Float: half precision would move depth-buffer values by up to 2^-11.
     writeExr(dir / "depth.exr", depth, ExrPixelType::Float);
-    writeExr(dir / "shadow.exr", shadow, ExrPixelType::Float);
     FrameDescription d;
+    const std::size_t localCount = f.spotLights.size() + f.pointLights.size();
+    const std::vector<std::string> files = localLightFiles(*s.scene);
+    for (std::size_t i = 0; i < localCount; ++i) {
+      Image shadow;
+      LocalLightDescription light = describeLocal(f, i, shadow);
+      if (i == 0 && !f.directional) {
+        d.lightType = light.type; // the main light: its map is shadow.exr (--shadow)
+        d.localLight = light;
+        writeExr(dir / "shadow.exr", shadow, ExrPixelType::Float);
+        continue;
+      }
+      light.shadowFile = files[d.lights.size()];
+      writeExr(dir / light.shadowFile, shadow, ExrPixelType::Float);
+      d.lights.push_back(light);
+    }
+    if (f.directional)
+      writeExr(dir / "shadow.exr", scenes::readDepthTexture(f.shadowMap.get(), f.shadowWidth, f.shadowHeight),
+               ExrPixelType::Float);
     d.viewFromWorld = f.camera.viewFromWorld();
     d.clipFromView = f.camera.clipFromView();
     d.cameraSize = glm::ivec2(f.width, f.height);
@@ -82,7 +162,10 @@ int renderCommand(const std::vector<std::string>& argv) {
   std::vector<PathOption> outputs = {{"--out", out + ".exr"}, {"--out", out + ".png"}};
   if (args.has("export-frame")) {
     requireNonEmpty({"--export-frame", exportDir});
-    for (const char* name : {"depth.exr", "shadow.exr", "frame.json"})
+    std::vector<std::string> names = {"depth.exr", "shadow.exr", "frame.json"};
+    for (const std::string& name : localLightFiles(scenes::makeScene(sceneName, double(size.x) / size.y)))
+      names.push_back(name);
+    for (const std::string& name : names)
       outputs.push_back({"--export-frame", (std::filesystem::path(exportDir) / name).string()});
   }
   requireDistinctFiles(outputs);
@@ -122,9 +205,13 @@ int renderCommand(const std::vector<std::string>& argv) {
               result.used.c_str(), result.detail.c_str());
   timings.print(stdout);
   std::printf("wrote %s (layers composite.RGBA, scattering.RGBA) and %s\n", exrPath.c_str(), pngPath.c_str());
-  if (args.has("export-frame"))
-    std::printf("exported the frame for crep scatter: %s/{depth.exr, shadow.exr, frame.json}\n",
-                exportDir.c_str());
+  if (args.has("export-frame")) {
+    std::string extra;
+    for (const std::string& name : localLightFiles(*s.scene))
+      extra += ", " + name;
+    std::printf("exported the frame for crep scatter: %s/{depth.exr, shadow.exr%s, frame.json}\n",
+                exportDir.c_str(), extra.c_str());
+  }
   return 0;
 }
 

@@ -147,6 +147,21 @@ int scatterCommand(const std::vector<std::string>& argv) {
       throw FormatError(framePath + ": shadowMap.lightClipFromWorld: " + strip(e));
     }
   }
+  for (const FrameLocalLight& l : localLights)
+    for (std::size_t k = 0; k < l.lightClipFromWorld.size(); ++k) {
+      // The library's own check (crep::Scattering applies it to the maps it is given), after the JSON's.
+      try {
+        validateLocalLightMatrix(l.lightClipFromWorld[k], l.spot ? l.spot->position() : l.point->position());
+      } catch (const InvalidArgument& e) {
+        const std::string field = l.spot ? l.shadowPath + ".lightClipFromWorld"
+                                         : l.shadowPath + ".faceClipFromWorld[" + std::to_string(k) + "]" +
+                                               (desc.lightType == LightType::Point && l.path == "light" &&
+                                                        !desc.localLight.faceClipFromWorld
+                                                    ? " (default)"
+                                                    : "");
+        throw FormatError(framePath + ": " + field + ": " + strip(e));
+      }
+    }
   // The additional lights' shadow EXRs, relative to the JSON file; they must not be outputs either.
   std::vector<PathOption> lightFiles;
   for (const FrameLocalLight& l : localLights)

@@ -41,6 +41,30 @@ SceneFrame makeSceneFrame(const std::string& name, int width, int height, int sh
                             {.depthClamp = true});
     glFinish();
   });
+  // Local lights: their perspective shadow maps (one per spot, six per point light; the reference's and
+  // what --export-frame writes), shadowMapSize^2 each, with depth clamping like the library's.
+  f.directional = scene.hasSun;
+  f.spotLights = scene.spotLights;
+  f.pointLights = scene.pointLights;
+  const auto localMap = [&](const glm::dmat4& matrix) {
+    LocalShadowMap m;
+    m.width = m.height = shadowMapSize;
+    m.lightClipFromWorld = matrix;
+    m.bias = kLocalShadowBias;
+    m.texture = scenes::createDepthTexture(shadowMapSize, shadowMapSize, "--map-size");
+    s.renderer->renderDepth(matrix, m.texture.get(), 0, 0, 0, shadowMapSize, shadowMapSize,
+                            {.depthClamp = true});
+    return m;
+  };
+  if (f.hasLocalLights())
+    timings.time("shadow pass (local lights, perspective)", [&] {
+      for (const SpotLight& spot : f.spotLights)
+        f.spotShadows.push_back(localMap(spot.lightClipFromWorld()));
+      for (const PointLight& point : f.pointLights)
+        for (int k = 0; k < 6; ++k)
+          f.pointShadows.push_back(localMap(point.faceClipFromWorld(k)));
+      glFinish();
+    });
   s.color = gl::createTexture2D(GL_RGBA32F, width, height, "--size");
   f.cameraDepth = scenes::createDepthTexture(width, height, "--size");
   timings.time("camera pass", [&] {
@@ -50,6 +74,9 @@ SceneFrame makeSceneFrame(const std::string& name, int width, int height, int sh
     in.shadowMap = f.shadowMap.get();
     in.lightDirection = scene.sun.direction();
     in.lightIrradiance = scene.sun.irradiance();
+    for (std::size_t i = 0; i < f.spotLights.size() && i < scenes::SceneRenderer::kMaxShadeSpots; ++i)
+      in.spots.push_back(
+          {&f.spotLights[i], f.spotShadows[i].lightClipFromWorld, f.spotShadows[i].texture.get()});
     s.renderer->renderShaded(in, s.color.get(), f.cameraDepth.get(), width, height);
     glFinish();
   });

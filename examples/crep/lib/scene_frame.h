@@ -28,6 +28,10 @@ struct SceneFrame {
   SceneFrame& operator=(SceneFrame&&) noexcept;
 };
 
+/// Depth bias of the built-in scenes' local-light perspective maps (depth-buffer units; crep::Scattering's
+/// ownShadowMapBias).
+inline constexpr double kLocalShadowBias = 1e-4;
+
 /// Builds scene `name` for a width x height camera and renders its passes (stages to `timings`).
 SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,
                           StageTimings& timings);

@@ -151,11 +151,33 @@ void SceneRenderer::renderShaded(const ShadeInputs& in, std::uint32_t colorTextu
   glSamplerParameteri(sampler.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   glBindTextureUnit(0, in.shadowMap);
   glBindSampler(0, sampler.get());
+  if (in.spots.size() > static_cast<std::size_t>(kMaxShadeSpots))
+    throw InvalidArgument("SceneRenderer::ShadeInputs.spots", std::to_string(in.spots.size()),
+                          "at most " + std::to_string(kMaxShadeSpots) + " spot lights");
+  const int spotCount = static_cast<int>(in.spots.size());
+  glProgramUniform1i(p, 6, spotCount);
+  for (int i = 0; i < spotCount; ++i) {
+    const ShadeInputs::Spot& spot = in.spots[static_cast<std::size_t>(i)];
+    setVec3(p, 7 + i, spot.light->position());
+    setVec3(p, 11 + i, spot.light->direction());
+    glProgramUniform2f(p, 15 + i, static_cast<float>(spot.light->cosInner()),
+                       static_cast<float>(spot.light->cosOuter()));
+    setVec3(p, 19 + i, spot.light->intensity());
+    setMatrix(p, 23 + i, spot.shadowClipFromWorld);
+  }
+  // Every sampler of the array bound (unused ones to the sun's map) so no unit is left incomplete.
+  for (int i = 0; i < kMaxShadeSpots; ++i) {
+    glBindTextureUnit(static_cast<GLuint>(1 + i),
+                      i < spotCount ? in.spots[static_cast<std::size_t>(i)].shadowMap : in.shadowMap);
+    glBindSampler(static_cast<GLuint>(1 + i), sampler.get());
+  }
   glBindVertexArray(d.vao.get());
   glDrawElements(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT, nullptr);
   glBindVertexArray(0);
-  glBindSampler(0, 0);
-  glBindTextureUnit(0, 0);
+  for (GLuint unit = 0; unit <= static_cast<GLuint>(kMaxShadeSpots); ++unit) {
+    glBindSampler(unit, 0);
+    glBindTextureUnit(unit, 0);
+  }
   glUseProgram(0);
   glDisable(GL_DEPTH_TEST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);

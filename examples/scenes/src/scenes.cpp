@@ -155,6 +155,10 @@ std::vector<std::string> sceneNames() {
   return {"colonnade", "forest", "terrain", "boxes", "sunset"};
 }
 
+std::vector<std::string> localLightSceneNames() {
+  return {"colonnade-night"};
+}
+
 Scene makeScene(std::string_view name, double aspect) {
   const double fov = 60.0 * std::numbers::pi / 180.0;
   if (name == "colonnade") {
@@ -165,6 +169,9 @@ Scene makeScene(std::string_view name, double aspect) {
         DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(5.0, 4.6, 4.0)),
         Medium(
             {.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}),
+        {},
+        {},
+        true,
         {},
         {}};
     computeBounds(s);
@@ -178,6 +185,9 @@ Scene makeScene(std::string_view name, double aspect) {
         DirectionalLight(glm::dvec3(-0.45, -0.6, -0.65), glm::dvec3(4.0, 3.8, 3.4)),
         Medium(
             {.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}),
+        {},
+        {},
+        true,
         {},
         {}};
     computeBounds(s);
@@ -193,6 +203,9 @@ Scene makeScene(std::string_view name, double aspect) {
                     .rayleighScattering = glm::dvec3(0.002, 0.004, 0.008),
                     .absorption = glm::dvec3(0.002)}),
             {},
+            {},
+            true,
+            {},
             {}};
     computeBounds(s);
     return s;
@@ -203,6 +216,9 @@ Scene makeScene(std::string_view name, double aspect) {
             Camera::lookAt({0.0, 3.0, 10.0}, {0.0, 1.5, -5.0}, {0, 1, 0}, fov, aspect, 0.1, 60.0),
             DirectionalLight(glm::dvec3(0.5, -0.8, -0.3), glm::dvec3(3.0)),
             defaultMedium(),
+            {},
+            {},
+            true,
             {},
             {}};
     computeBounds(s);
@@ -219,12 +235,47 @@ Scene makeScene(std::string_view name, double aspect) {
         Medium(
             {.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}),
         {},
+        {},
+        true,
+        {},
         {}};
     computeBounds(s);
     return s;
   }
+  if (name == "colonnade-night") {
+    // The colonnade at night (Klehm et al. 2014, Sec. 3.2 "Local Lights"): no sun; three warm spot lamps
+    // outside the view, each projective: two outside the rows of pillars behind the camera shining in
+    // through them, one above and behind the camera shining down the hall past the roof beams.
+    Scene s{
+        "colonnade-night",
+        colonnadeMesh(),
+        Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
+        DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(0.0)),
+        Medium(
+            {.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}),
+        {},
+        {},
+        false,
+        {},
+        {}};
+    const auto lamp = [](const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& color) {
+      return SpotLight({.position = position,
+                        .direction = target - position,
+                        .innerConeAngle = 20.0 * std::numbers::pi / 180.0,
+                        .outerConeAngle = 30.0 * std::numbers::pi / 180.0,
+                        .color = color,
+                        .intensity = 1000.0,
+                        .range = 70.0,
+                        .nearPlane = 0.3});
+    };
+    s.spotLights.push_back(lamp({-11.0, 7.5, 16.0}, {0.0, 0.0, 0.0}, {1.0, 0.75, 0.45}));
+    s.spotLights.push_back(lamp({9.0, 8.5, 20.0}, {2.0, 0.0, 0.0}, {1.0, 0.8, 0.55}));
+    s.spotLights.push_back(lamp({0.0, 8.8, 26.0}, {0.0, 0.0, 6.0}, {0.7, 0.8, 1.0}));
+    computeBounds(s);
+    return s;
+  }
   throw InvalidArgument("scene", std::string(name),
-                        "must be one of colonnade, forest, terrain, boxes, sunset");
+                        "must be one of colonnade, forest, terrain, boxes, sunset, colonnade-night");
 }
 
 } // namespace crep::scenes

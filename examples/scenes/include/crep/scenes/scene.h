@@ -37,12 +37,20 @@ struct Scene {
   DirectionalLight sun;
   Medium medium;
   glm::dvec3 boundsMin, boundsMax; ///< world-space bounds of the mesh
+  /// false: a night scene without a directional light (`sun` has zero irradiance and is unused)
+  bool hasSun = true;
+  /// Local lights (Klehm et al. 2014, Sec. 3.2), added to the sun's scattering.
+  std::vector<SpotLight> spotLights;
+  std::vector<PointLight> pointLights;
 };
 
-/// Names accepted by makeScene: "colonnade" (default), "forest", "terrain", "boxes" (an analytic
-/// arrangement: a ground plane and a few boxes, for exact tests), "sunset" (the forest looking toward a
-/// low sun behind the canopy: the sun in view, an epipolar-layout frame).
+/// The sunlit scenes accepted by makeScene: "colonnade" (default), "forest", "terrain", "boxes" (an
+/// analytic arrangement: a ground plane and a few boxes, for exact tests), "sunset" (the forest looking
+/// toward a low sun behind the canopy: the sun in view, an epipolar-layout frame).
 std::vector<std::string> sceneNames();
+/// The scenes with local lights, also accepted by makeScene: "colonnade-night" (the colonnade without a
+/// sun, three spot lamps outside the view shining through the pillars and along the hall).
+std::vector<std::string> localLightSceneNames();
 /// Builds a scene. `aspect` sets the default camera's aspect ratio. Throws InvalidArgument naming
 /// "scene" for an unknown name.
 Scene makeScene(std::string_view name, double aspect = 16.0 / 9.0);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <crep/core/gl.h>
 #include <crep/core/image.h>
@@ -53,7 +54,16 @@ public:
     glm::dvec3 lightIrradiance{1.0};
     glm::dvec3 ambient{0.05};
     glm::dvec3 albedo{0.5};
+    /// Spot lights lighting the surfaces (at most kMaxShadeSpots; the night scenes' lamps), each with its
+    /// perspective shadow map (GL_DEPTH_COMPONENT32F) rendered with its shadowClipFromWorld.
+    struct Spot {
+      const SpotLight* light = nullptr;
+      glm::dmat4 shadowClipFromWorld{1.0};
+      std::uint32_t shadowMap = 0;
+    };
+    std::vector<Spot> spots;
   };
+  static constexpr int kMaxShadeSpots = 4;
   /// Renders lit surfaces into the caller's colour texture (RGBA16F or RGBA32F) and depth texture
   /// (GL_DEPTH_COMPONENT32F), both width x height. Background: colour 0, depth 1.
   void renderShaded(const ShadeInputs& inputs, std::uint32_t colorTexture, std::uint32_t depthTexture,
