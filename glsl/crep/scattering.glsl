@@ -51,6 +51,13 @@
 //                              segment with crep_localSegment (crep/local_light.glsl) times its
 //                              visibility; the basis must be prefiltered with the same light. Projective
 //                              frame only, no near-plane correction.
+//   CREP_LIGHT_TEXTURE         1: a basis prefiltered with a light texture's colour map (crep/prefilter/
+//                              prefilter.h, "Light textures"; Klehm et al. 2014, Sec. 3.2): the array holds
+//                              three bases (colour c in layers [c L, (c + 1) L), L = ceil(M / 4)) and the
+//                              prefix mean colour is bound as a sampler2D (GL_RGBA16F, GL_LINEAR) at
+//                              CREP_MEAN_COLOR_UNIT (default 2); each region's visibility is per channel,
+//                              V_c = cbar_c clamp(0.5 + a . F_c, 0, 1). Not with CREP_NEAR_PLANE_CORRECTION
+//                              nor with the visibility table alone (use the scattering prefix or no table).
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
 //   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
 //                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
@@ -332,6 +339,21 @@ float crep_regionWeightTotal(CrepRegionWeights w, int mode, float s, int n, floa
 
 layout(std140, binding = CREP_SCATTERING_BINDING) uniform CrepScatteringBlock { CrepScatteringParams crep_scattering; };
 layout(binding = CREP_FILTERED_BASIS_UNIT) uniform sampler2DArray crep_filteredBasis;
+#ifndef CREP_LIGHT_TEXTURE
+#define CREP_LIGHT_TEXTURE 0
+#endif
+#if CREP_LIGHT_TEXTURE
+#ifndef CREP_MEAN_COLOR_UNIT
+#define CREP_MEAN_COLOR_UNIT 2
+#endif
+layout(binding = CREP_MEAN_COLOR_UNIT) uniform sampler2D crep_meanColor; // cbar, rgb
+#if CREP_NEAR_PLANE_CORRECTION
+#error "CREP_LIGHT_TEXTURE: the near-plane correction is not supported with a light texture"
+#endif
+#if defined(CREP_VISIBILITY_TABLE_SAMPLES) && !CREP_SCATTERING_PREFIX
+#error "CREP_LIGHT_TEXTURE: use the scattering prefix table (CREP_SCATTERING_PREFIX 1) or no table"
+#endif
+#endif
 #ifdef CREP_VISIBILITY_TABLE_SAMPLES
 #ifndef CREP_VISIBILITY_TABLE_UNIT
 #define CREP_VISIBILITY_TABLE_UNIT 6
@@ -517,6 +539,29 @@ vec4 crep_filteredBasisAt(int region, float u, float row, int layer) {
   return 2.0 * textureLod(crep_filteredBasis, coord, 0.0) - 1.0;
 }
 
+#if CREP_LIGHT_TEXTURE
+// The prefix mean colour cbar at the same sample position as crep_filteredBasisAt.
+vec3 crep_meanColorAt(int region, float u, float row) {
+  int W = crep_scattering.mapSize.x, H = crep_scattering.mapSize.y, n = W / crep_scattering.mapSize.z;
+  float x = clamp(u * float(n) - 1.0, 0.0, float(n - 1));
+  float y = clamp(row * float(H) - 0.5, 0.0, float(H - 1));
+  return textureLod(crep_meanColor, vec2((float(region * n) + x + 0.5) / float(W), (y + 0.5) / float(H)), 0.0).rgb;
+}
+
+// Light textures: the region's visibility per colour channel at prefix boundary u, V_c = cbar_c clamp(0.5 +
+// a . F_c, 0, 1) (crep::evaluate of a textured basis), F_c in layers [c L, (c + 1) L).
+vec3 crep_texturedVisibility(vec4 a[CREP_EVAL_MAX_LAYERS], int region, float u, float row) {
+  vec3 V;
+  for (int c = 0; c < 3; ++c) {
+    float dotF = 0.0;
+    for (int l = 0; l < CREP_EVAL_LAYERS; ++l)
+      dotF += dot(a[l], crep_filteredBasisAt(region, u, row, c * CREP_EVAL_LAYERS + l));
+    V[c] = clamp(0.5 + dotF, 0.0, 1.0);
+  }
+  return V * crep_meanColorAt(region, u, row);
+}
+#endif
+
 #ifdef CREP_VISIBILITY_TABLE_SAMPLES
 // The region visibility table (crep::evaluate's rule): GL_LINEAR in the texel row, y = clamp(row H - 0.5,
 // 0, H - 1) as for the basis, and in the depth sample d (Z - 1) inside the region's Z samples. The
@@ -624,9 +669,13 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
       ta = tb;
     }
 #endif
+#if CREP_LIGHT_TEXTURE
+    L += crep_texturedVisibility(a, lastRegion, lastU, hit.row) * crep_sectionIntegral(origin, dir, sigma, ta, surface);
+#else
     float dotF = 0.0;
     for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(lastRegion, lastU, hit.row, l));
     L += clamp(0.5 + dotF, 0.0, 1.0) * crep_sectionIntegral(origin, dir, sigma, ta, surface);
+#endif
     return vec4(C * L, transmittance);
   }
 #endif
@@ -650,10 +699,14 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
       }
     }
 #endif
+#if CREP_LIGHT_TEXTURE
+    L += C * crep_texturedVisibility(a, r, ub, hit.row) * crep_sectionIntegral(origin, dir, sigma, ta, tb);
+#else
     if (plain)
       for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(r, ub, hit.row, l));
     float V = clamp(0.5 + dotF, 0.0, 1.0);
     L += C * V * crep_sectionIntegral(origin, dir, sigma, ta, tb);
+#endif
     ta = tb;
   }
   return vec4(L, transmittance);

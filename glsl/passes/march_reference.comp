@@ -12,9 +12,21 @@
 // the pixels within block.z pixels of block.xy (pixel centres) are written: the epipole block of Klehm
 // et al. 2014, Fig. 8. Resources: params block (binding 0), camera depth (unit 0), shadow map (unit 1, texelFetch),
 // outputs: RGBA32F scattering (image 0), R32F steps (image 1).
+// CREP_LIGHT_TEXTURE 1: a light texture (crep/scatter/light_texture.h) at texture unit 2 with its block
+// (CrepLightTextureParams) at uniform binding 1; each lit part times the texture's colour at its midpoint
+// (crep::worldSpaceMarch with a LightTexture).
 #include "crep/local_light.glsl"
 #include "crep/march.glsl"
 #include "crep/phase.glsl"
+
+#ifndef CREP_LIGHT_TEXTURE
+#define CREP_LIGHT_TEXTURE 0
+#endif
+#if CREP_LIGHT_TEXTURE
+#include "crep/light_texture.glsl"
+layout(std140, binding = 1) uniform CrepLightTextureBlock { CrepLightTextureParams crep_lightTextureParams; };
+layout(binding = 2) uniform sampler2D crep_lightTexture;
+#endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -43,8 +55,12 @@ bool crep_lit(vec3 p) {
 // The lit part [ta, tb] of the ray: the transmittance integral (directional, times C in main) or the
 // local light's in-scattering.
 vec3 crep_section(bool local, CrepLocalLight light, CrepLocalMedium medium, vec3 origin, vec3 dir, float ta, float tb) {
-  if (local) return crep_localSegment(light, medium, origin, dir, ta, tb);
-  return crep_transmittanceIntegral(medium.extinction, ta, tb);
+  vec3 v = local ? crep_localSegment(light, medium, origin, dir, ta, tb)
+                 : crep_transmittanceIntegral(medium.extinction, ta, tb);
+#if CREP_LIGHT_TEXTURE
+  v *= crep_lightTextureColor(crep_lightTexture, crep_lightTextureParams, origin + (0.5 * (ta + tb)) * dir);
+#endif
+  return v;
 }
 
 void main() {

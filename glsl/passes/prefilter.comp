@@ -7,6 +7,8 @@
 // One invocation filters one row j (x), one group of CREP_BASES_PER_INVOCATION bases (y) and one
 // prefilter region r (z), left to right over the region's n texels (Table 1's two parallelization
 // factors: bases per invocation, regions per row). Driven by crep::PrefilterPass (gpu_pass.h).
+// CREP_LIGHT_TEXTURE 1: a light texture's colour map in the weights, one basis per colour channel and the
+// prefix mean colour (crep/prefilter/prefilter.h, "Light textures"; Klehm et al. 2014, Sec. 3.2).
 #define CREP_SCATTERING_NO_EVALUATION
 #include "crep/scattering.glsl"
 
@@ -37,6 +39,9 @@
 #ifndef CREP_LOCAL_LIGHT
 #define CREP_LOCAL_LIGHT 0 // 1: a local light's factor in the weights (crep::prefilter(map, medium, LocalLight))
 #endif
+#ifndef CREP_LIGHT_TEXTURE
+#define CREP_LIGHT_TEXTURE 0 // 1: a light texture's colour map (crep::prefilter(map, medium, lightColors))
+#endif
 
 #define CREP_GROUP_VEC4S (CREP_BASES_PER_INVOCATION / 4)
 
@@ -46,6 +51,12 @@ layout(binding = 0) uniform sampler2D crep_rectifiedDepth; // W x H depth-buffer
 layout(binding = 0, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray crep_filteredBasisOut;
 layout(std140, binding = 0) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
 layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
+#if CREP_LIGHT_TEXTURE
+// Light textures (crep/prefilter/prefilter.h, "Light textures"): the colour map (W x H, rgb) in, the prefix
+// mean colour cbar out (RGBA16F, A = 1); the basis array holds 3 ceil(M / 4) layers, colour c from layer c L.
+layout(binding = 1) uniform sampler2D crep_lightColors;
+layout(binding = 1, rgba16f) uniform writeonly restrict image2D crep_meanColorOut;
+#endif
 #if CREP_LOCAL_LIGHT
 layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
 layout(std430, binding = 1) readonly restrict buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; };
@@ -61,16 +72,21 @@ float crep_lightFactorAt(vec4 ray, float tau) {
 // The stored value e = 0.5 + 0.5 F, rounded by crep::storeFiltered's rule of the format, so that the
 // store itself is exact (the GL leaves the rounding of float -> unorm / half conversions open; Mesa
 // llvmpipe truncates to half).
+// The nearest binary16 value (ties to even; crep::roundToHalf for values below 65504): binary16 keeps 11
+// significant bits (quantum 2^(exponent - 11)), and a fixed quantum 2^-24 below 2^-14.
+vec4 crep_roundToHalf(vec4 e) {
+  ivec4 exponent;
+  frexp(e, exponent);
+  vec4 quantum = ldexp(vec4(1.0), max(exponent - 11, ivec4(-24)));
+  return roundEven(e / quantum) * quantum;
+}
+
 vec4 crep_encodeFiltered(vec4 F) {
   vec4 e = 0.5 + 0.5 * F;
 #if CREP_BASIS_UNORM8
   e = floor(clamp(e, 0.0, 1.0) * 255.0 + 0.5) / 255.0; // round half up
 #elif CREP_BASIS_HALF
-  // binary16 keeps 11 significant bits (quantum 2^(exponent - 11)), and a fixed quantum 2^-24 below 2^-14.
-  ivec4 exponent;
-  frexp(e, exponent);
-  vec4 quantum = ldexp(vec4(1.0), max(exponent - 11, ivec4(-24)));
-  e = roundEven(e / quantum) * quantum;
+  e = crep_roundToHalf(e);
 #endif
   return e;
 }
@@ -88,8 +104,15 @@ void main() {
   int firstHarmonic = group * (CREP_BASES_PER_INVOCATION / 2);
   int firstLayer = group * CREP_GROUP_VEC4S;
 
-  vec4 F[CREP_GROUP_VEC4S];
-  for (int v = 0; v < CREP_GROUP_VEC4S; ++v) F[v] = vec4(0.0);
+#if CREP_LIGHT_TEXTURE
+#define CREP_COLOR_BASES 3
+  vec3 cbar = vec3(0.0);
+#else
+#define CREP_COLOR_BASES 1
+#endif
+  // F[c * CREP_GROUP_VEC4S + v]: colour channel c's basis (one basis without a light texture).
+  vec4 F[CREP_COLOR_BASES * CREP_GROUP_VEC4S];
+  for (int v = 0; v < CREP_COLOR_BASES * CREP_GROUP_VEC4S; ++v) F[v] = vec4(0.0);
 #if CREP_LOCAL_LIGHT
   // Sec. 3.2 "Angular-dependency for Sources": w_i = gbar_i (exp(-s tau_i) - exp(-s tau_{i+1})), gbar_i the
   // light-side factor by Simpson's rule over the texel, m_i = w_i / sum_{j<=i} w_j (crep::regionMixFactors
@@ -136,14 +159,31 @@ void main() {
 #else
     float m = crep_mixFactor(w, mode, s, i, n);
 #endif
+#if CREP_LIGHT_TEXTURE
+    // The weights w_i c_i per channel as mix factors m_i c_i / cbar_i, cbar the same prefix filter of the
+    // colours (crep::prefilter with lightColors); m_i where cbar_i = 0 (no weighted light yet).
+    vec3 ci = texelFetch(crep_lightColors, ivec2(x, row), 0).rgb;
+    cbar += m * (ci - cbar);
+    vec3 mc = vec3(m);
+    for (int c = 0; c < 3; ++c)
+      if (cbar[c] > 0.0) mc[c] = clamp(m * (ci[c] / cbar[c]), 0.0, 1.0);
+    if (group == 0) imageStore(crep_meanColorOut, ivec2(x, row), vec4(crep_roundToHalf(vec4(cbar, 1.0)).rgb, 1.0));
+#endif
     for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
       int layer = firstLayer + v;
       if (layer >= layers) break;
       vec2 second = crep_rotate(sc, stepSC);
       // M % 4 == 2: the last layer holds one harmonic; its other channels stay F = 0 (stored 0.5).
       vec4 B = 2 * layer + 1 < M / 2 ? vec4(sc, second) : vec4(sc, 0.0, 0.0);
+#if CREP_LIGHT_TEXTURE
+      for (int c = 0; c < 3; ++c) {
+        F[c * CREP_GROUP_VEC4S + v] += mc[c] * (B - F[c * CREP_GROUP_VEC4S + v]);
+        imageStore(crep_filteredBasisOut, ivec3(x, row, c * layers + layer), crep_encodeFiltered(F[c * CREP_GROUP_VEC4S + v]));
+      }
+#else
       F[v] += m * (B - F[v]);
       imageStore(crep_filteredBasisOut, ivec3(x, row, layer), crep_encodeFiltered(F[v]));
+#endif
       sc = crep_rotate(second, stepSC);
     }
   }

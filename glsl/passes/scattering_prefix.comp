@@ -18,6 +18,9 @@
 // two). The ray coefficients a(z_s) come precomputed (in double
 // on the CPU, with the ringing filter) from a storage buffer.
 // Layouts as the evaluation: the scattering block's projective frame, or CREP_EVAL_LAYOUT.
+// CREP_LIGHT_TEXTURE 1 (a basis prefiltered with a light texture, crep/scattering.glsl): V_r' per colour
+// channel, cbar_c clamp(0.5 + a(z_s) . F_c, 0, 1) with F_c in layers [c L, (c + 1) L) and cbar at the
+// region's last texel (crep::visibilityTable of a textured basis).
 // Driven by crep::EvaluatePass.
 #ifndef CREP_BASES
 #define CREP_BASES 32
@@ -32,6 +35,9 @@
 #define CREP_TABLE_COEFFICIENTS_BINDING 0
 #endif
 #include "crep/scattering.glsl"
+#if CREP_LIGHT_TEXTURE && CREP_MEMORY_LIMIT
+#error "CREP_MEMORY_LIMIT is a variant of the untextured pass"
+#endif
 
 #define CREP_PREFIX_LAYERS ((CREP_BASES + 3) / 4)
 
@@ -55,8 +61,20 @@ void main() {
   float ta = 0.0;
   for (int r = 0; r < R; ++r) {
     imageStore(crep_prefixOut, ivec2(r * Z + s, j), vec4(sum, 0.0));
+#if CREP_LIGHT_TEXTURE
+    vec3 V;
+    for (int c = 0; c < 3; ++c) {
+      float dotC = 0.0;
+      for (int l = 0; l < L; ++l)
+        dotC += dot(a[l], 2.0 * texelFetch(crep_filteredBasis, ivec3(r * n + n - 1, j, c * L + l), 0) - 1.0);
+      V[c] = clamp(0.5 + dotC, 0.0, 1.0);
+    }
+    V *= texelFetch(crep_meanColor, ivec2(r * n + n - 1, j), 0).rgb;
+#else
     float dotF = 0.0;
     for (int l = 0; l < L; ++l) dotF += dot(a[l], 2.0 * texelFetch(crep_filteredBasis, ivec3(r * n + n - 1, j, l), 0) - 1.0);
+    vec3 V = vec3(clamp(0.5 + dotF, 0.0, 1.0));
+#endif
 #if CREP_MEMORY_LIMIT
     sum += vec3(dotF > 1e30 ? 0.0 : 1.0); // counts the regions (memory-limit test), keeps the reads
 #else
@@ -66,7 +84,7 @@ void main() {
     // LocalLight): the ray of slopes (y, z) in the scattering block's frame.
     vec3 dir = normalize(crep_scattering.frameAxisX.xyz + ray.data.x * crep_scattering.frameAxisY.xyz +
                          ray.data.y * crep_scattering.frameAxisZ.xyz);
-    sum += clamp(0.5 + dotF, 0.0, 1.0) * crep_sectionIntegral(crep_scattering.frameOrigin.xyz, dir, sigma, ta, tb);
+    sum += V * crep_sectionIntegral(crep_scattering.frameOrigin.xyz, dir, sigma, ta, tb);
     ta = tb;
     continue;
 #endif
@@ -76,7 +94,7 @@ void main() {
     float len = tb - ta;
     vec3 x = sigma * len;
     vec3 integral = mix((Ea - Eb) / sigma, Ea * len * crep_oneMinusExpOverXSeries(x), lessThan(x, vec3(0.25)));
-    sum += clamp(0.5 + dotF, 0.0, 1.0) * integral;
+    sum += V * integral;
     Ea = Eb;
     ta = tb;
 #endif

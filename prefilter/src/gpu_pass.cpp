@@ -41,6 +41,9 @@ constexpr GLuint kPrefixUnit = 7;
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 // The local-light block (CREP_LOCAL_LIGHT) of the evaluation and scattering prefix programs.
 constexpr GLuint kLocalLightBinding = 3;
+// Light textures (CREP_LIGHT_TEXTURE): the prefix mean colour in the evaluation and scattering prefix
+// programs.
+constexpr GLuint kMeanColorUnit = 2;
 
 std::string str(long long v) {
   return std::to_string(v);
@@ -237,7 +240,8 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 // PrefilterPass
 
 /// The prefilter program's sources: the options compiled in; `local` the local-light variant.
-std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& info, bool local) {
+std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& info, bool local,
+                                               bool textured = false) {
   const PrefilterOptions& o = info.options;
   return {{ShaderStage::Compute,
            "passes/prefilter.comp",
@@ -249,7 +253,8 @@ std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& 
             {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
             {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)},
             {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"},
-            {"CREP_LOCAL_LIGHT", local ? "1" : "0"}}}};
+            {"CREP_LOCAL_LIGHT", local ? "1" : "0"},
+            {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"}}}};
 }
 
 /// The local-light block of a light and medium (gpu::LocalLightParams) seen from `origin`.
@@ -350,6 +355,33 @@ void PrefilterPass::run(const FrameAttribs& frame) {
                 str(W));
   const int n = W / R;
   const bool local = frame.localLight != nullptr;
+  const bool textured = frame.lightColors != 0;
+  if (textured) {
+    gl::requireTexture2D("PrefilterPass::FrameAttribs.lightColors", frame.lightColors, W, H);
+    if (info_.memoryLimit)
+      invalid("PrefilterPass::FrameAttribs.lightColors", str(frame.lightColors),
+              "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
+    if (!texturedTexture_) {
+      // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
+      const int maxLayers = gl::maxArrayTextureLayers();
+      if (3 * layers() > maxLayers)
+        throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(info_.options.bases) + " needs " +
+                      str(3 * layers()) +
+                      " layers with a light texture, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
+      texturedTexture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
+      glTextureStorage3D(texturedTexture_.get(), 1, internalFormat(info_.options.format), W, H, 3 * layers());
+      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+      meanColor_ = gl::createTexture2D(GL_RGBA16F, W, H, "PrefilterPass: mean colour (light textures)");
+      glTextureParameteri(meanColor_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+      glTextureParameteri(meanColor_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+      gl::checkError("PrefilterPass: light-texture basis array and mean colour");
+    }
+    gl::Handle& variant = programTextured_[local ? 1 : 0];
+    if (!variant) variant = buildProgram(prefilterStages(info_, local, true));
+  }
   if (local && frame.medium == nullptr)
     invalid("PrefilterPass::FrameAttribs.medium", "null", "must be set with a localLight");
   if (local && info_.options.weights != WeightMode::Exact)
@@ -390,14 +422,22 @@ void PrefilterPass::run(const FrameAttribs& frame) {
       glm::vec4(static_cast<float>(s), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
   glNamedBufferSubData(paramsBuffer_.get(), 0, sizeof params, &params);
 
-  glUseProgram(local ? programLocal_.get() : program_.get());
+  glUseProgram(textured ? programTextured_[local ? 1 : 0].get()
+               : local  ? programLocal_.get()
+                        : program_.get());
+  if (textured) {
+    glBindTextureUnit(1, frame.lightColors);
+    glBindSampler(1, sampler_.get());
+    glBindImageTexture(1, meanColor_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+  }
   if (local) {
     glBindBufferBase(GL_UNIFORM_BUFFER, 1, localBuffer_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, raysBuffer_.get());
   }
   glBindTextureUnit(0, frame.rectifiedDepth);
   glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, internalFormat(info_.options.format));
+  glBindImageTexture(0, textured ? texturedTexture_.get() : texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
+                     internalFormat(info_.options.format));
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, paramsBuffer_.get());
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes));
   glDispatchCompute(static_cast<GLuint>(ceilDiv(H, info_.workgroupRows)),
@@ -412,10 +452,16 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
   glBindSampler(0, 0);
   glBindTextureUnit(0, 0);
+  if (textured) {
+    glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    glBindSampler(1, 0);
+    glBindTextureUnit(1, 0);
+  }
   glUseProgram(0);
   gl::checkError("PrefilterPass::run");
 
   ran_ = true;
+  lastTextured_ = textured;
   lastLayoutRegions_ = K;
   lastExtinction_ = s;
   lastLocal_ = local;
@@ -424,7 +470,9 @@ void PrefilterPass::run(const FrameAttribs& frame) {
 FilteredBasisView PrefilterPass::filteredBasis() const {
   if (!ran_) throw Error("PrefilterPass::filteredBasis: run() has not been called yet");
   FilteredBasisView v;
-  v.texture = texture_.get();
+  v.texture = filteredBasisTexture();
+  v.textured = lastTextured_;
+  v.meanColor = lastTextured_ ? meanColor_.get() : 0;
   v.regionWeights = weightsBuffer_.get();
   v.width = info_.mapWidth;
   v.height = info_.mapHeight;
@@ -454,7 +502,7 @@ void addLayoutDefines(std::vector<ShaderDefine>& defines, int layoutKind) {
 /// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
 /// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
 std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind,
-                                              bool local = false) {
+                                              bool local = false, bool textured = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/evaluate.comp",
@@ -473,13 +521,17 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
   }
+  if (textured) {
+    stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
+    stages[0].defines.push_back({"CREP_MEAN_COLOR_UNIT", str(kMeanColorUnit)});
+  }
   return stages;
 }
 
 /// The scattering prefix table's program (EvaluateOptions::scatteringPrefix), on the same layout block as
 /// evaluateStages(info, layoutKind).
 std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info, int layoutKind,
-                                            bool local = false) {
+                                            bool local = false, bool textured = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/scattering_prefix.comp",
@@ -491,6 +543,11 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
   if (local) {
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
+  }
+  if (textured) {
+    stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
+    stages[0].defines.push_back({"CREP_SCATTERING_PREFIX", "1"}); // the table this program builds
+    stages[0].defines.push_back({"CREP_MEAN_COLOR_UNIT", str(kMeanColorUnit)});
   }
   return stages;
 }
@@ -544,7 +601,14 @@ EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
 
 std::size_t PrefilterPass::memoryBytes() const noexcept {
-  return filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
+  const std::size_t textured =
+      texturedTexture_
+          ? 3 * filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases,
+                                   info_.options.format) +
+                static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight) * 8
+          : 0;
+  return textured +
+         filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
          weightsCapacity_ + sizeof(gpu::PrefilterParams) + raysCapacity_ +
          (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }
@@ -561,12 +625,30 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   if (basis.bases != info_.bases)
     invalid("EvaluatePass::FrameAttribs.basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info_.bases));
+  const bool textured = basis.textured;
+  const int basisLayers = (textured ? 3 : 1) * layerCount(basis.bases);
   const gl::TextureLevel b = gl::textureLevel("EvaluatePass::FrameAttribs.basis.texture", basis.texture);
   if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
-      b.depth < layerCount(basis.bases))
+      b.depth < basisLayers)
     invalid("EvaluatePass::FrameAttribs.basis.texture", "texture " + str(basis.texture),
             "must be a GL_TEXTURE_2D_ARRAY of " + sizeString(basis.width, basis.height) + " x " +
-                str(layerCount(basis.bases)) + " layers");
+                str(basisLayers) + " layers");
+  if (textured) {
+    // Light textures (prefilter.h): the textured variants exist for the scattering prefix table (the
+    // default) and the direct path without a table.
+    gl::requireTexture2D("EvaluatePass::FrameAttribs.basis.meanColor", basis.meanColor, basis.width,
+                         basis.height);
+    if (info_.options.nearPlaneCorrection)
+      invalid("EvaluatePass::FrameAttribs.basis.textured", "true",
+              "a light texture is not supported with CreateInfo.options.nearPlaneCorrection");
+    if (usesVisibilityTable(info_.options) && !usesScatteringPrefix(info_.options))
+      invalid("EvaluatePass::FrameAttribs.basis.textured", "true",
+              "a light texture needs CreateInfo.options.scatteringPrefix or visibilityTableSamples = 0 (no "
+              "textured variant of the visibility table alone)");
+    if (info_.memoryLimit)
+      invalid("EvaluatePass::FrameAttribs.basis.textured", "true",
+              "not with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
+  }
   if (info_.options.nearPlaneCorrection &&
       (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
     invalid("EvaluatePass::FrameAttribs.basis.regionWeights", str(basis.regionWeights),
@@ -606,7 +688,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       scatteringParamsOf(basis, *frame.layout, local ? unusedLight : *frame.light, *frame.medium);
   GLuint program = program_.get();
   if (local) {
-    if (!localProgram_) localProgram_ = buildProgram(evaluateStages(info_, -1, true));
+    if (!localProgram_ && !textured) localProgram_ = buildProgram(evaluateStages(info_, -1, true));
     program = localProgram_.get();
     if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
     const gpu::LocalLightParams lp = localLightParams(
@@ -619,8 +701,19 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     const gpu::LayoutKind kind =
         layoutBuffers_.upload(*layoutData, basis.height, "EvaluatePass::FrameAttribs.layout");
     layoutKind = kind;
-    gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
-    if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
+    if (!textured) {
+      gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
+      if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
+      program = variant.get();
+    }
+  }
+  // Light textures: the CREP_LIGHT_TEXTURE variants (projective frame, layouts, local light), on first use.
+  const int variantIndex = local ? 3 : projective ? 0 : 1 + static_cast<int>(layoutKind);
+  if (textured) {
+    gl::Handle& variant = texturedPrograms_[variantIndex];
+    if (!variant)
+      variant =
+          buildProgram(evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), local, true));
     program = variant.get();
   }
   gpu::EvaluateParams params;
@@ -663,14 +756,18 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, tableCoefficients_.get());
     glBindTextureUnit(kTableBasisUnit, basis.texture);
-    glBindSampler(kTableBasisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
+    if (textured)
+      glBindTextureUnit(kMeanColorUnit, basis.meanColor); // texelFetch at the regions' last texels
+    glBindSampler(kTableBasisUnit, depthSampler_.get());  // nearest, clamped: texelFetch ignores it anyway
     if (prefix) {
       // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
-      gl::Handle& prefixProgram =
-          local ? localPrefixProgram_ : prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
+      gl::Handle& prefixProgram = textured ? texturedPrefixPrograms_[variantIndex]
+                                  : local
+                                      ? localPrefixProgram_
+                                      : prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
       if (!prefixProgram)
-        prefixProgram =
-            buildProgram(prefixStages(info_, projective ? -1 : static_cast<int>(layoutKind), local));
+        prefixProgram = buildProgram(
+            prefixStages(info_, projective ? -1 : static_cast<int>(layoutKind), local, textured));
       glUseProgram(prefixProgram.get());
       if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
       glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
@@ -696,6 +793,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glBindSampler(kBasisUnit, basisSampler_.get());
   glBindTextureUnit(kCameraDepthUnit, frame.cameraDepth);
   glBindSampler(kCameraDepthUnit, depthSampler_.get());
+  if (textured) {
+    glBindTextureUnit(kMeanColorUnit, basis.meanColor);
+    glBindSampler(kMeanColorUnit, basisSampler_.get()); // sampled as the basis is (EvaluateOptions::sampling)
+  }
   glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, evaluateBuffer_.get());
@@ -719,6 +820,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glBindTextureUnit(kCameraDepthUnit, 0);
   glBindSampler(kBasisUnit, 0);
   glBindTextureUnit(kBasisUnit, 0);
+  if (textured) {
+    glBindSampler(kMeanColorUnit, 0);
+    glBindTextureUnit(kMeanColorUnit, 0);
+  }
   if (table) {
     glBindSampler(kTableUnit, 0);
     glBindTextureUnit(kTableUnit, 0);

@@ -134,6 +134,11 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   }
   if (!std::isfinite(f.bias))
     throw InvalidArgument("WorldMarchPass::FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
+  const bool textured = f.lightTexture.texture != 0;
+  gl::TextureLevel textureLevel;
+  if (textured)
+    textureLevel = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight,
+                                                "WorldMarchPass::FrameAttribs.lightTexture");
   if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
     throw InvalidArgument("WorldMarchPass::FrameAttribs.blockCenter/blockRadius",
                           detail::formatValue(f.blockRadius), "must be finite");
@@ -163,9 +168,31 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
                                                                  GL_R32F, width, height);
-  gpu::bindMarchResources(program_.get(), params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,
+  GLuint program = program_.get();
+  if (textured) {
+    // Light textures (Klehm et al. 2014, Sec. 3.2): the CREP_LIGHT_TEXTURE variant and its block.
+    if (!texturedProgram_) {
+      texturedProgram_ = buildProgram(
+          {{ShaderStage::Compute, "passes/march_reference.comp", {{"CREP_LIGHT_TEXTURE", "1"}}}});
+      textureParams_ = gl::createDynamicBuffer(sizeof(gpu::LightTextureParams));
+    }
+    program = texturedProgram_.get();
+    const gpu::LightTextureParams tp =
+        gpu::makeLightTextureParams(f.lightTexture, textureLevel, 0, 0, f.localLight);
+    glNamedBufferSubData(textureParams_.get(), 0, sizeof tp, &tp);
+  }
+  gpu::bindMarchResources(program, params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,
                           steps);
+  if (textured) {
+    glBindBufferBase(GL_UNIFORM_BUFFER, 1, textureParams_.get());
+    glBindTextureUnit(2, f.lightTexture.texture);
+    glBindSampler(2, sampler_.get());
+  }
   gpu::dispatchMarch(region.z, region.w, "WorldMarchPass::run");
+  if (textured) {
+    glBindSampler(2, 0);
+    glBindTextureUnit(2, 0);
+  }
 }
 
 } // namespace crep

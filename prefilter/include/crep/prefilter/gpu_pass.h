@@ -52,6 +52,10 @@ struct FilteredBasisView {
   double extinction = 0.0;                ///< scalar weight extinction s used (1/world unit)
   double depthMargin = 0.0625;            ///< m of fourier.h used
   bool localLight = false;                ///< prefiltered with a local light's factor in the weights
+  /// Prefiltered with a light texture's colour map (prefilter.h, "Light textures"): `texture` has 3 ceil(M /
+  /// 4) layers (colour c from layer c ceil(M / 4)) and `meanColor` is the prefix mean colour.
+  bool textured = false;
+  std::uint32_t meanColor = 0; ///< textured: GL_TEXTURE_2D, width x height, GL_RGBA16F (rgb cbar)
 
   int regions() const noexcept { return layoutRegions * regionsPerSplit; } ///< R
 };
@@ -104,6 +108,14 @@ public:
     /// goes into the weights as crep::prefilter(map, medium, light) does (CREP_LOCAL_LIGHT variant, built on
     /// first use; needs `medium` and options.weights = Exact). Null: a directional light.
     const LocalLight* localLight = nullptr;
+    /// Light textures (prefilter.h, "Light textures"; crep/scatter/light_texture.h): the colour map of the
+    /// rectified map, a GL_TEXTURE_2D of width x height whose rgb is each texel's light-ray colour (e.g.
+    /// LightColorMapPass::colorMapTexture(), read with texelFetch), or 0 (no texture: the untextured
+    /// program, nothing else bound). With it the pass runs its CREP_LIGHT_TEXTURE variant (built on first
+    /// use) into a second basis array of 3 ceil(M / 4) layers and a GL_RGBA16F mean-colour texture, both
+    /// allocated on first use (3x the basis memory and filter work, + 8 bytes per texel); filteredBasis()
+    /// then describes them (FilteredBasisView::textured).
+    std::uint32_t lightColors = 0;
   };
 
   /// Validates `info` (InvalidArgument naming the field, e.g. "PrefilterPass::CreateInfo.options.bases";
@@ -126,8 +138,14 @@ public:
   int layers() const noexcept { return layerCount(info_.options.bases); }
   /// GPU memory it owns, bytes: the filtered basis (filteredBasisBytes) and its buffers.
   std::size_t memoryBytes() const noexcept;
-  /// GL_TEXTURE_2D_ARRAY of the filtered basis (GL_LINEAR, clamp to edge), valid after run().
-  std::uint32_t filteredBasisTexture() const noexcept { return texture_.get(); }
+  /// GL_TEXTURE_2D_ARRAY of the filtered basis (GL_LINEAR, clamp to edge), valid after run(); after a run
+  /// with lightColors the textured array (3 bases).
+  std::uint32_t filteredBasisTexture() const noexcept {
+    return lastTextured_ ? texturedTexture_.get() : texture_.get();
+  }
+  /// GL_TEXTURE_2D of the prefix mean colour (GL_RGBA16F, GL_LINEAR, clamp to edge) of the last textured
+  /// run, or 0.
+  std::uint32_t meanColorTexture() const noexcept { return meanColor_.get(); }
   /// GL buffer of gpu::RegionWeights of the last run (for the near-plane correction).
   std::uint32_t regionWeightsBuffer() const noexcept { return weightsBuffer_.get(); }
   /// The filtered basis of the last run. Throws Error before the first run().
@@ -137,8 +155,11 @@ private:
   CreateInfo info_;
   gl::Handle program_, programLocal_, texture_, sampler_, paramsBuffer_, weightsBuffer_, localBuffer_,
       raysBuffer_;
+  /// Light textures: the CREP_LIGHT_TEXTURE programs (directional, local), the 3-basis array and the mean
+  /// colour, built on the first textured run.
+  gl::Handle programTextured_[2], texturedTexture_, meanColor_;
   std::size_t weightsCapacity_ = 0, raysCapacity_ = 0;
-  bool ran_ = false, lastLocal_ = false;
+  bool ran_ = false, lastLocal_ = false, lastTextured_ = false;
   int lastLayoutRegions_ = 1;
   double lastExtinction_ = 0.0;
 };
@@ -171,7 +192,12 @@ public:
     /// The layout the basis was prefiltered from: a ProjectiveLayout, or any layout with a GPU mapping
     /// (an EpipolarLayout: the fallback of Klehm et al. 2014, Sec. 4.1), evaluated through its layout block.
     const RectifiedLayout* layout = nullptr;
-    FilteredBasisView basis; ///< e.g. PrefilterPass::filteredBasis()
+    /// e.g. PrefilterPass::filteredBasis(). A textured basis (FilteredBasisView::textured: prefiltered with a
+    /// light texture's colour map) runs the CREP_LIGHT_TEXTURE variants (built on first use; the mean colour
+    /// at texture unit 2): with the scattering prefix table (the default) or without a table; the
+    /// near-plane correction and the visibility table alone reject it (InvalidArgument naming
+    /// "EvaluatePass::FrameAttribs.basis.textured").
+    FilteredBasisView basis;
     /// Instead of `light`: a local light (a spot, or one point-light face) whose rectification the basis
     /// was prefiltered from with PrefilterPass::FrameAttribs::localLight. Every region segment of a pixel
     /// ray contributes its visibility times the ray's own in-scattering (crep_localSegment of
@@ -211,6 +237,9 @@ private:
   /// built by prefixPrograms_ (projective frame, then per gpu::LayoutKind, built on first use).
   gl::Handle tableProgram_, tableTexture_, tableSampler_;
   gl::Handle prefixPrograms_[3];
+  /// Light textures (CREP_LIGHT_TEXTURE): evaluation and scattering prefix programs, index 0 projective
+  /// frame, 1 + gpu::LayoutKind for layouts, 3 local light; built on first use.
+  gl::Handle texturedPrograms_[4], texturedPrefixPrograms_[4];
   gl::Handle tableCoefficients_; ///< a(z_s) of the table's samples (storage buffer), for tableMargin_
   double tableMargin_ = -1.0;
   int tableWidth_ = 0, tableHeight_ = 0;

@@ -25,6 +25,7 @@
 #include <crep/core/gl.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scatter/world_march.h>
 
@@ -142,6 +143,12 @@ public:
     /// blockCenter (pixel coordinates, origin at the bottom-left corner of the image) are marched.
     glm::dvec2 blockCenter{0.0};
     double blockRadius = -1.0;
+    /// Light textures (crep/scatter/light_texture.h): texture 0 = none (the untextured program, nothing
+    /// more bound); else each lit part times the texture's colour at its midpoint (worldSpaceMarch with a
+    /// LightTexture), the CREP_LIGHT_TEXTURE program built on first use, the texture at texture unit 2 and
+    /// its block at uniform binding 1 (unbound afterwards). The projection must follow the light's rays
+    /// (InvalidArgument naming "WorldMarchPass::FrameAttribs.lightTexture.textureClipFromWorld").
+    GpuLightTexture lightTexture;
   };
   /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
   explicit WorldMarchPass(const CreateInfo& info);
@@ -152,6 +159,7 @@ public:
 private:
   CreateInfo info_;
   gl::Handle program_, params_, sampler_, dummySteps_;
+  gl::Handle texturedProgram_, textureParams_; ///< light textures, on first use
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 

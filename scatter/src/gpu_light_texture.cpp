@@ -1,0 +1,99 @@
+// Light textures on the GPU (Klehm et al. 2014, Sec. 3.2 coloured light textures): validation of the
+// caller's texture and projection, and the colour map pass (glsl/passes/light_colors.comp). Rules in
+// crep/scatter/light_texture.h.
+#include <crep/core/error.h>
+#include <crep/core/shader_library.h>
+#include <crep/scatter/gpu_light_texture.h>
+#include <crep/scatter/light_texture.h>
+
+#include <epoxy/gl.h>
+
+#include <string>
+
+namespace crep {
+
+namespace gpu {
+
+gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
+                                         const LocalLight* localLight, std::string_view field) {
+  const std::string f(field);
+  const std::string textureField = f + ".texture";
+  const gl::TextureLevel level = gl::requireTexture2D(textureField.c_str(), texture.texture);
+  if (level.width <= 0 || level.height <= 0)
+    throw InvalidArgument(textureField, std::to_string(level.width) + " x " + std::to_string(level.height),
+                          "must have a level 0");
+  if (localLight)
+    validateLightProjection(texture.textureClipFromWorld, *localLight, f + ".textureClipFromWorld");
+  else if (light)
+    validateLightProjection(texture.textureClipFromWorld, *light, f + ".textureClipFromWorld");
+  return level;
+}
+
+LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gl::TextureLevel& level,
+                                          int mapWidth, int mapHeight, const LocalLight* localLight) {
+  LightTextureParams p;
+  p.textureClipFromWorld = glm::mat4(texture.textureClipFromWorld);
+  p.size = glm::ivec4(level.width, level.height, mapWidth, mapHeight);
+  if (localLight) p.lightPosition = glm::vec4(glm::vec3(localLight->position), 1.0f);
+  return p;
+}
+
+} // namespace gpu
+
+LightColorMapPass::LightColorMapPass(const CreateInfo& info) : info_(info) {
+  if (info.mapWidth <= 0)
+    throw InvalidArgument("LightColorMapPass::CreateInfo.mapWidth", detail::formatValue(info.mapWidth),
+                          "must be > 0");
+  if (info.mapHeight <= 0)
+    throw InvalidArgument("LightColorMapPass::CreateInfo.mapHeight", detail::formatValue(info.mapHeight),
+                          "must be > 0");
+  colors_ = gl::createTexture2D(GL_RGBA32F, info.mapWidth, info.mapHeight, "LightColorMapPass::CreateInfo");
+  params_ = gl::createDynamicBuffer(sizeof(gpu::LightTextureParams));
+  sampler_ = gl::createClampSampler(GL_NEAREST);
+  gl::checkError("LightColorMapPass");
+}
+
+std::size_t LightColorMapPass::memoryBytes() const noexcept {
+  return static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight) * 16 +
+         sizeof(gpu::LightTextureParams);
+}
+
+// The colour of each map texel's light ray (Klehm et al. 2014, Sec. 3.2: the light-side factor per colour
+// component), crep::lightColorMap in float.
+void LightColorMapPass::run(const FrameAttribs& f) {
+  if (f.layout == nullptr)
+    throw InvalidArgument("LightColorMapPass::FrameAttribs.layout", "null", "must be set");
+  if ((f.light != nullptr) == (f.localLight != nullptr))
+    throw InvalidArgument("LightColorMapPass::FrameAttribs.light/localLight",
+                          f.light ? "both set" : "both null", "exactly one must be set");
+  const bool projective = dynamic_cast<const ProjectiveLayout*>(f.layout) != nullptr;
+  if (f.localLight && !projective)
+    throw InvalidArgument("LightColorMapPass::FrameAttribs.layout", "not projective",
+                          "a local light's map has a ProjectiveLayout");
+  const gl::TextureLevel level = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight,
+                                                              "LightColorMapPass::FrameAttribs.lightTexture");
+  const gpu::LayoutKind kind =
+      layout_.upload(*f.layout, info_.mapHeight, "LightColorMapPass::FrameAttribs.layout");
+  gl::Handle& program = programs_[static_cast<int>(kind)];
+  if (!program)
+    program = buildProgram({{ShaderStage::Compute,
+                             "passes/light_colors.comp",
+                             {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
+  const gpu::LightTextureParams params =
+      gpu::makeLightTextureParams(f.lightTexture, level, info_.mapWidth, info_.mapHeight, f.localLight);
+  glNamedBufferSubData(params_.get(), 0, sizeof params, &params);
+
+  glUseProgram(program.get());
+  layout_.bind(1, 1);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindTextureUnit(0, f.lightTexture.texture);
+  glBindSampler(0, sampler_.get());
+  glBindImageTexture(0, colors_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((info_.mapWidth + 7) / 8),
+                    static_cast<GLuint>((info_.mapHeight + 7) / 8), 1);
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+  gl::checkError("LightColorMapPass::run");
+}
+
+} // namespace crep
