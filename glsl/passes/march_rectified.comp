@@ -7,6 +7,10 @@
 // Resources: params block (binding 0), layout block (crep/epipolar.glsl, binding 1), camera depth
 // (unit 0), rectified map depth (unit 1, texelFetch), min/max nodes (storage buffer 0, tree variant),
 // outputs: RGBA32F scattering (image 0), R32F steps (image 1).
+// CREP_LIGHT_TEXTURE 1: a light texture's colour map of the rectified map (crep::lightColorMap,
+// LightColorMapPass; texelFetch at texture unit 2): each lit texel's section times its colour
+// (crep::bruteForceMarch with lightColors); the tree variant walks a lit node texel by texel (the colours
+// differ inside it), so only shadowed nodes are skipped whole.
 #include "crep/epipolar.glsl"
 #include "crep/local_light.glsl"
 #include "crep/phase.glsl"
@@ -15,6 +19,9 @@
 #define CREP_MARCH_TREE 1
 #endif
 #define CREP_MAX_TREE_LEVELS 16
+#ifndef CREP_LIGHT_TEXTURE
+#define CREP_LIGHT_TEXTURE 0
+#endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -23,6 +30,9 @@ layout(binding = 0) uniform sampler2D cameraDepth;
 layout(binding = 1) uniform sampler2D rectifiedDepth;
 #if CREP_MARCH_TREE
 layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+#endif
+#if CREP_LIGHT_TEXTURE
+layout(binding = 2) uniform sampler2D crep_lightColors; // W x H, rgb: each texel's light-ray colour
 #endif
 layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
 layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
@@ -99,7 +109,18 @@ void main() {
       int next = min(i + (1 << level), end);
       float tb = next > r.last ? s : min(crep_rowRayDistance(r, next, mapSize), s);
       tb = max(tb, ta);
+#if CREP_LIGHT_TEXTURE
+      if (lit) {
+        float a = ta;
+        for (int k = i; k < next; ++k) { // the node's texels, each with its own colour
+          float b = k + 1 >= next ? tb : clamp(min(crep_rowRayDistance(r, k + 1, mapSize), s), a, tb);
+          L += texelFetch(crep_lightColors, ivec2(k, j), 0).rgb * crep_section(sigma, a, b);
+          a = b;
+        }
+      }
+#else
       if (lit) L += crep_section(sigma, ta, tb);
+#endif
       ta = tb;
       i = next;
     }
@@ -109,7 +130,12 @@ void main() {
       ++steps;
       float tb = i + 1 > r.last ? s : min(crep_rowRayDistance(r, i + 1, mapSize), s);
       tb = max(tb, ta);
+#if CREP_LIGHT_TEXTURE
+      if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z)
+        L += texelFetch(crep_lightColors, ivec2(i, j), 0).rgb * crep_section(sigma, ta, tb);
+#else
       if (texelFetch(rectifiedDepth, ivec2(i, j), 0).r >= z) L += crep_section(sigma, ta, tb);
+#endif
       ta = tb;
     }
 #endif

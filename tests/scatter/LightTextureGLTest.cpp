@@ -12,13 +12,16 @@
 #include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
+#include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/gpu_layout_buffers.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/light_texture.h>
+#include <crep/scatter/rectified_march.h>
 #include <crep/scatter/world_march.h>
 
 #include <doctest/doctest.h>
@@ -326,5 +329,48 @@ TEST_CASE("light texture GL: the textured world march equals the CPU world march
     CHECK_THROWS_WITH_AS(pass.run(a),
                          doctest::Contains("WorldMarchPass::FrameAttribs.lightTexture.textureClipFromWorld"),
                          InvalidArgument);
+  }
+}
+
+TEST_CASE("light texture GL: march_rectified.comp's textured brute force equals the CPU brute-force march") {
+  // RectifiedMarchPass (epipolar/) does not bind a colour map yet: the shader's CREP_LIGHT_TEXTURE variant
+  // is dispatched here with the march passes' own resource helpers (gpu::bindMarchResources) and the
+  // colour map at texture unit 2.
+  CREP_REQUIRE_GL();
+  const Image tex = twoColourTexture();
+  const gl::Handle program =
+      buildProgram({{ShaderStage::Compute,
+                     "passes/march_rectified.comp",
+                     {{"CREP_MARCH_TREE", "0"}, {"CREP_LAYOUT", "0"}, {"CREP_LIGHT_TEXTURE", "1"}}}});
+  const gl::Handle sampler = gl::createClampSampler(GL_NEAREST);
+  for (const bool spot : {false, true}) {
+    CAPTURE(spot);
+    const Frame f = spot ? spotFrame() : sunFrame();
+    const Image colors = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
+    const gl::Handle map = uploadR32F(f.map.depth), cameraDepth = uploadR32F(f.depth),
+                     colorTexture = uploadRgb(colors);
+    const gl::Handle out = createTexture2D(GL_RGBA32F, kW, kH), steps = createTexture2D(GL_R32F, kW, kH);
+    const gpu::MarchParams params =
+        spot ? gpu::makeMarchParams(f.camera, *f.local, f.medium, kW, kH, kMapW, kMapH)
+             : gpu::makeMarchParams(f.camera, f.sun, f.medium, kW, kH, kMapW, kMapH);
+    const gl::Handle paramsBuffer = gl::createDynamicBuffer(sizeof params);
+    glNamedBufferSubData(paramsBuffer.get(), 0, sizeof params, &params);
+    gpu::LayoutBuffers layoutBuffers;
+    layoutBuffers.upload(*f.layout, kMapH);
+    gpu::bindMarchResources(program.get(), paramsBuffer.get(), cameraDepth.get(), map.get(), sampler.get(),
+                            out.get(), steps.get());
+    layoutBuffers.bind(1, 1);
+    glBindTextureUnit(2, colorTexture.get());
+    glBindSampler(2, sampler.get());
+    gpu::dispatchMarch(kW, kH, "march_rectified.comp (CREP_LIGHT_TEXTURE)");
+    glBindSampler(2, 0);
+    glBindTextureUnit(2, 0);
+    const Image cpu = (spot ? bruteForceMarch(f.map, f.depth, f.camera, *f.local, f.medium, colors)
+                            : bruteForceMarch(f.map, f.depth, f.camera, f.sun, f.medium, colors))
+                          .scattering;
+    const ImageMetrics m = rgbMetrics(readRgbaTexture(out.get(), kW, kH), cpu);
+    report(std::string(spot ? "spot gobo" : "sun window") + ": GPU vs CPU textured brute-force march", m);
+    CHECK(m.nanCount == 0);
+    CHECK(m.relativeRmse < 1e-4); // float section distances and integrals against double
   }
 }
