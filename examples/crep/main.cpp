@@ -31,14 +31,16 @@ commands:
 
 const char* const kRender =
     R"(  render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
-            --scene NAME        colonnade (default) | forest | terrain | boxes | sunset (sun in view)
+            --scene NAME        colonnade (default) | forest | terrain | boxes | sunset (sun in view) |
+                                colonnade-night (three spot lamps, no sun)
             --size WxH          image size (default 1280x720)
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
                                 against a standard shadow map) | the other methods listed below
 @METHOD_OPTIONS@            --exposure X        PNG exposure in [1e-30, 1e30] (default 1)
             --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
             --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
-                                DIR/shadow.exr (float depth-buffer values), DIR/frame.json
+                                DIR/shadow.exr (float depth-buffer values), DIR/frame.json, and
+                                DIR/lightN.exr for a scene's local lights
             --debug-gl          debug GL context; GL errors abort the command
 )";
 
@@ -46,9 +48,11 @@ const char* const kScatter =
     R"(  scatter   single scattering for your own data; writes a scattering EXR (RGB in-scattered radiance,
             A transmittance)
             --depth FILE.exr    camera depth: OpenGL depth-buffer values in [0, 1] (1 = sky)
-            --shadow FILE.exr   standard shadow map: depth-buffer values of shadowMap.lightClipFromWorld
-            --frame FILE.json   camera, light, shadow matrix and medium (schema: README, example:
-                                examples/data/frame.json)
+            --shadow FILE.exr   the main light's map: depth-buffer values of shadowMap.lightClipFromWorld
+                                (a point light: its six faces stacked, +X at the top; README)
+            --frame FILE.json   camera, light (directional, spot or point; optional additional spot /
+                                point lights with their own maps), shadow matrix and medium (schema:
+                                README, example: examples/data/frame.json)
             --method M          prefilter (default: the standard map is resampled into the projective
                                 rectification on the CPU) | reference | the other methods below
 @METHOD_OPTIONS@            --out FILE.exr      output (default scattering.exr); never one of the inputs
