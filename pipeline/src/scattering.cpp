@@ -15,10 +15,14 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <optional>
+#include <span>
+#include <string>
 
 namespace crep {
 
@@ -79,6 +83,77 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
             "must be in [0, 0.5] (a fraction of the screen diagonal)");
   return info;
+}
+
+/// Throws unless every direction of `directions` from `position` is inside the map of M (in front of it, NDC
+/// x and y in [-1, 1] up to 1e-3): the map covers the light's cone or face sector.
+void requireCovers(const std::string& field, const glm::dmat4& M, const glm::dvec3& position,
+                   std::span<const glm::dvec3> directions, const std::string& what) {
+  // Points max(1, |position|) away: seen from a centre within validateLocalLightMatrix's tolerance of the
+  // position, their directions change by about 2e-4 radians at most.
+  const double t = std::max(1.0, glm::length(position));
+  for (const glm::dvec3& d : directions) {
+    const glm::dvec4 q = M * glm::dvec4(position + t * glm::normalize(d), 1.0);
+    if (!(q.w > 0.0) || !(std::abs(q.x / q.w) <= 1.001 && std::abs(q.y / q.w) <= 1.001))
+      invalid(field,
+              "direction (" + detail::formatValue(d.x) + ", " + detail::formatValue(d.y) + ", " +
+                  detail::formatValue(d.z) + ") outside the map",
+              "must cover " + what);
+  }
+}
+
+/// One local light's given perspective map: texture, bias, matrix centred at `position`, coverage.
+void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map, const glm::dvec3& position,
+                      std::span<const glm::dvec3> directions, const std::string& what) {
+  gl::requireTexture2D((field + ".texture").c_str(), map.texture);
+  if (!std::isfinite(map.bias)) invalid(field + ".bias", detail::formatValue(map.bias), "must be finite");
+  try {
+    validateLocalLightMatrix(map.lightClipFromWorld, position);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(field + ".lightClipFromWorld", e.what(),
+                          "a perspective shadow matrix centred at the light's position");
+  }
+  requireCovers(field + ".lightClipFromWorld", map.lightClipFromWorld, position, directions, what);
+}
+
+/// The local lights' shadow inputs (Klehm et al. 2014, Sec. 3.2 "Local Lights"; scattering.h): span sizes,
+/// each given map, drawCasters for the lights without maps.
+void validateLocalShadowMaps(const Scattering::FrameAttribs& f) {
+  const std::string prefix = "Scattering::FrameAttribs.";
+  if (!f.spotShadowMaps.empty() && f.spotShadowMaps.size() != f.spotLights.size())
+    invalid(prefix + "spotShadowMaps", "size " + std::to_string(f.spotShadowMaps.size()),
+            "must be 0 or spotLights.size() = " + std::to_string(f.spotLights.size()));
+  if (!f.pointShadowMaps.empty() && f.pointShadowMaps.size() != 6 * f.pointLights.size())
+    invalid(prefix + "pointShadowMaps", "size " + std::to_string(f.pointShadowMaps.size()),
+            "must be 0 or 6 * pointLights.size() = " + std::to_string(6 * f.pointLights.size()));
+  if (!f.drawCasters && !f.spotLights.empty() && f.spotShadowMaps.empty())
+    invalid(prefix + "drawCasters", "empty", "spot lights without spotShadowMaps render their maps with it");
+  if (!f.drawCasters && !f.pointLights.empty() && f.pointShadowMaps.empty())
+    invalid(prefix + "drawCasters", "empty",
+            "point lights without pointShadowMaps render their maps with it");
+  for (std::size_t i = 0; i < f.spotShadowMaps.size(); ++i) {
+    const SpotLight& spot = f.spotLights[i];
+    // Eight directions on the outer cone: nothing is emitted beyond it.
+    const glm::dvec3 a = spot.direction(), u = anyOrthogonal(a), v = glm::cross(a, u);
+    std::array<glm::dvec3, 8> cone;
+    for (int k = 0; k < 8; ++k) {
+      const double phi = 0.25 * std::numbers::pi * k;
+      cone[std::size_t(k)] = std::cos(spot.outerConeAngle()) * a +
+                             std::sin(spot.outerConeAngle()) * (std::cos(phi) * u + std::sin(phi) * v);
+    }
+    validateLocalMap(prefix + "spotShadowMaps[" + std::to_string(i) + "]", f.spotShadowMaps[i],
+                     spot.position(), cone, "the spot's outer cone");
+  }
+  for (std::size_t j = 0; j < f.pointShadowMaps.size(); ++j) {
+    const int face = static_cast<int>(j % 6);
+    // The four corners of the face's sector (PointLight::faceOf): axis +- the two other axes.
+    const glm::dvec3 A = PointLight::faceAxis(face), B = PointLight::faceAxis((face / 2 * 2 + 2) % 6),
+                     C = PointLight::faceAxis((face / 2 * 2 + 4) % 6);
+    const std::array<glm::dvec3, 4> corners{A + B + C, A + B - C, A - B + C, A - B - C};
+    validateLocalMap(prefix + "pointShadowMaps[" + std::to_string(j) + "]", f.pointShadowMaps[j],
+                     f.pointLights[j / 6].position(), corners,
+                     "face " + std::to_string(face) + "'s sector of directions (PointLight::faceOf)");
+  }
 }
 
 /// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
@@ -143,6 +218,27 @@ struct Scattering::Impl {
   gl::Handle localScattering, accumulate;
   std::optional<DepthTarget> localShadowMap;
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
+  gl::Handle localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
+  /// Night frames (no directional light): the transmittance pass, its parameters and sampler.
+  gl::Handle transmittance, transmittanceParams, transmittanceSampler;
+
+  /// A night frame's output before the local lights are added: RGB 0, A the transmittance to the surface
+  /// (the surface radiance's factor in Klehm et al. 2014, Eq. 1).
+  void writeTransmittance(const FrameAttribs& f) {
+    if (!transmittance) {
+      transmittance = buildProgram({{ShaderStage::Compute, "passes/transmittance.comp", {}}});
+      transmittanceParams = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
+      transmittanceSampler = gl::createClampSampler(GL_NEAREST);
+    }
+    // The pass reads the camera and the medium's extinction only: any light fills the rest.
+    const gpu::MarchParams params =
+        gpu::makeMarchParams(*f.camera, DirectionalLight(glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(0.0)),
+                             *f.medium, info.width, info.height, 1, 1);
+    glNamedBufferSubData(transmittanceParams.get(), 0, sizeof(params), &params);
+    gpu::bindMarchResources(transmittance.get(), transmittanceParams.get(), f.cameraDepth, f.cameraDepth,
+                            transmittanceSampler.get(), f.output, 0);
+    gpu::dispatchMarch(info.width, info.height, "Scattering::run (transmittance)");
+  }
 
   /// Runs `work` as one stage: with stageTimings, its GL_TIME_ELAPSED and wall clock (ended by glFinish).
   template <class Work>
@@ -180,6 +276,7 @@ std::size_t Scattering::memoryBytes() const noexcept {
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
   if (m.localRectified) bytes += m.localRectified->memoryBytes();
+  if (m.localResampled) bytes += map;
   if (m.localScattering)
     bytes += static_cast<std::size_t>(m.info.width) * static_cast<std::size_t>(m.info.height) * 16;
   if (m.localShadowMap)
@@ -194,15 +291,24 @@ std::size_t Scattering::memoryBytes() const noexcept {
 Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   Impl& m = *impl_;
   const CreateInfo& info = m.info;
+  const bool local = !f.spotLights.empty() || !f.pointLights.empty();
   if (!f.camera) invalid("Scattering::FrameAttribs.camera", "null", "must be set");
-  if (!f.light) invalid("Scattering::FrameAttribs.light", "null", "must be set");
+  if (!f.light && !local)
+    invalid("Scattering::FrameAttribs.light", "null", "must be set unless local lights are given");
   if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
   gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
   gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
-  if (!f.drawCasters && !f.shadowMap)
+  if (f.light && !f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
-  if ((!f.spotLights.empty() || !f.pointLights.empty()) && !f.drawCasters)
-    invalid("Scattering::FrameAttribs.drawCasters", "empty", "local lights render their maps with it");
+  validateLocalShadowMaps(f);
+  if (!f.light) {
+    // A night frame: the transmittance, then the local lights added.
+    FrameResult r;
+    r.stages.push_back(m.timedStage("transmittance", [&] { m.writeTransmittance(f); }));
+    runLocalLights(f, r);
+    gl::checkError("Scattering::run");
+    return r;
+  }
   if (f.shadowMap) {
     gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
     if (!std::isfinite(f.shadowMap->bias))
@@ -327,8 +433,6 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     m.localScattering = gl::createTexture2D(GL_RGBA32F, info.width, info.height, "Scattering: local light");
     m.accumulate = buildProgram({{ShaderStage::Compute, "passes/accumulate.comp", {}}});
   }
-  if (!m.localRectified)
-    m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
   const auto timed = [&](LightResult& result, const char* name, const auto& work) {
     const Stage s = m.timedStage(name, work);
     r.stages.push_back(s);
@@ -345,24 +449,38 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     gl::unbindPassState(2);
   };
   const auto one = [&](const LocalLight& light, const Rectification& rect,
-                       const glm::dmat4& lightClipFromWorld, LightResult result) {
+                       const glm::dmat4& lightClipFromWorld, const ShadowMap* given, LightResult result) {
     result.status = rect.status;
     result.message = rect.message;
+    result.preRenderedMap = given != nullptr;
     if (rect.status == RectifyStatus::Empty) {
       r.localLights.push_back(result);
       return;
     }
     if (rect.projective()) {
       const auto layout = std::make_shared<const ProjectiveLayout>(rect);
-      timed(result, "local light: shadow pass (rectified)", [&] {
-        m.localRectified->run(
-            {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
-      });
+      std::uint32_t map = 0;
+      if (given) {
+        // Sec. 4.1's point resampling on the light's layout: the engine's perspective map, no casters drawn.
+        if (!m.localResampled)
+          m.localResampled =
+              gl::createTexture2D(GL_R32F, info.mapSize, info.mapSize, "Scattering: local map");
+        timed(result, "local light: resample (projective)", [&] {
+          m.resample.run({layout.get(), given->texture, given->lightClipFromWorld, m.localResampled.get()});
+        });
+        map = m.localResampled.get();
+      } else {
+        if (!m.localRectified)
+          m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
+        timed(result, "local light: shadow pass (rectified)", [&] {
+          m.localRectified->run(
+              {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
+        });
+        map = m.localRectified->depthTexture();
+      }
       timed(result, "local light: prefilter", [&] {
-        m.prefilter.run({.rectifiedDepth = m.localRectified->depthTexture(),
-                         .layout = layout.get(),
-                         .medium = f.medium,
-                         .localLight = &light});
+        m.prefilter.run(
+            {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .localLight = &light});
       });
       timed(result, "local light: evaluate", [&] {
         EvaluatePass::FrameAttribs e;
@@ -377,19 +495,26 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         addToOutput();
       });
     } else {
-      // In or near the view: the world-space march against the light's own perspective shadow map.
-      if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
-      timed(result, "local light: shadow pass (perspective)",
-            [&] { m.localShadowMap->render(1, [&](int) { f.drawCasters(lightClipFromWorld); }); });
+      // In or near the view: the world-space march against the light's perspective shadow map (the given
+      // one, else its own matrix's rendered with drawCasters).
+      ShadowMap shadow;
+      if (given) {
+        shadow = *given;
+      } else {
+        if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
+        timed(result, "local light: shadow pass (perspective)",
+              [&] { m.localShadowMap->render(1, [&](int) { f.drawCasters(lightClipFromWorld); }); });
+        shadow = {m.localShadowMap->texture.get(), lightClipFromWorld, info.ownShadowMapBias};
+      }
       timed(result, "local light: world-space march", [&] {
         WorldMarchPass::FrameAttribs b;
         b.camera = f.camera;
         b.localLight = &light;
         b.medium = f.medium;
         b.cameraDepth = f.cameraDepth;
-        b.shadowMap = m.localShadowMap->texture.get();
-        b.lightClipFromWorld = lightClipFromWorld;
-        b.bias = info.ownShadowMapBias;
+        b.shadowMap = shadow.texture;
+        b.lightClipFromWorld = shadow.lightClipFromWorld;
+        b.bias = shadow.bias;
         b.output = m.localScattering.get();
         m.block.run(b);
         addToOutput();
@@ -402,7 +527,8 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     LightResult result;
     result.kind = LightResult::Kind::Spot;
     result.index = static_cast<int>(i);
-    one(LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify), spot.lightClipFromWorld(), result);
+    one(LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify), spot.lightClipFromWorld(),
+        f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i], result);
   }
   for (std::size_t i = 0; i < f.pointLights.size(); ++i) {
     const PointLight& point = f.pointLights[i];
@@ -413,7 +539,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       result.index = static_cast<int>(i);
       result.face = face;
       one(LocalLight::pointFace(point, face), faces[static_cast<std::size_t>(face)],
-          point.faceClipFromWorld(face), result);
+          point.faceClipFromWorld(face),
+          f.pointShadowMaps.empty() ? nullptr : &f.pointShadowMaps[6 * i + static_cast<std::size_t>(face)],
+          result);
     }
   }
 }

@@ -13,7 +13,7 @@
 //   crep::Scattering::FrameResult r = scattering.run(f);                  // r.layout, r.stages
 //   color = surface * output.a + output.rgb                                // your composite
 //
-// Shadow inputs (at least one):
+// Shadow inputs of the directional light (at least one when FrameAttribs::light is set):
 //   - drawCasters: a callback that draws the shadow casters with the given clip-from-world matrix (your
 //     depth-only shaders, your geometry). Scattering binds its own framebuffer and depth texture, sets
 //     the viewport of each split, GL_DEPTH_TEST with GL_LESS, depth writes, GL_DEPTH_CLAMP (casters between
@@ -25,13 +25,23 @@
 //     fallback frames always resample it into the epipolar layout.
 //
 // Local lights (Klehm et al. 2014, Sec. 3.2 "Local Lights"): FrameAttribs::spotLights and pointLights
-// (six faces each) are added to the directional light's result (pass a zero-irradiance light for a night
-// without sun or moon). Each is rectified for the camera; a projective light (the light off screen) is
-// rendered with drawCasters into its rectified map (RectifiedShadowPass), prefiltered with its light-side
-// factor in the weights and evaluated with every ray's exact in-scattering; a light whose rectification is
-// not projective (in or near the view) is marched in world space against a perspective shadow map rendered
-// with drawCasters (WorldMarchPass, epipoleBlock's steps: the reference's cost, not the prefiltered one);
-// one that does not reach the camera frustum costs nothing. Local lights are evaluated at full resolution.
+// (six faces each) are added to the directional light's result. Without a directional light (a night
+// frame) FrameAttribs::light may be null when at least one local light is given: the output is then the
+// local lights' sum and the transmittance (A) as usual. Each light is rectified for the camera; its
+// shadow input is either
+//   - drawCasters: a projective light (the light off screen) is rendered into its rectified map
+//     (RectifiedShadowPass); a light whose rectification is not projective (in or near the view) gets a
+//     perspective shadow map rendered with its own matrix (SpotLight::lightClipFromWorld,
+//     PointLight::faceClipFromWorld);
+//   - or your pre-rendered perspective maps, FrameAttribs::spotShadowMaps (one per spot) and pointShadowMaps
+//     (six per point light, GL cube-map face order): any perspective matrix centred at the light
+//     (validateLocalLightMatrix) covering the spot's cone or the face's sector (PointLight::faceOf), e.g. an
+//     engine's cube-map face matrices. A projective light's rectified map is then point-resampled from it
+//     (ShadowResamplePass, Sec. 4.1's rule on the light's layout), a fallback light marches it directly.
+// A projective light is prefiltered with its light-side factor in the weights and evaluated with every
+// ray's exact in-scattering; a fallback light is marched in world space against its perspective map
+// (WorldMarchPass, epipoleBlock's steps: the reference's cost, not the prefiltered one); one that does not
+// reach the camera frustum costs nothing. Local lights are evaluated at full resolution.
 //
 // GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
 // clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
@@ -118,11 +128,15 @@ public:
     double ownShadowMapBias = 1e-4;
   };
 
-  /// The engine's standard shadow map (depth-buffer values of lightClipFromWorld, cleared to 1).
+  /// The engine's shadow map of a light (depth-buffer values of lightClipFromWorld in GL conventions,
+  /// glDepthRange(0, 1) of NDC z in [-1, 1], cleared to 1).
   struct ShadowMap {
     std::uint32_t texture = 0; ///< GL_TEXTURE_2D depth (or R32F) texture, any size (read from the texture)
-    glm::dmat4 lightClipFromWorld{1.0}; ///< orthographic, looking along the light (validateLightMatrix)
-    double bias = 0.0;                  ///< added to the stored depth by the epipole block march
+    /// The directional light's: orthographic, looking along the light (validateLightMatrix). A spot light's
+    /// or point-light face's: perspective, centred at the light (validateLocalLightMatrix).
+    glm::dmat4 lightClipFromWorld{1.0};
+    double bias =
+        0.0; ///< added to the stored depth by the world-space marches (epipole block, local fallback)
   };
 
   struct FrameAttribs {
@@ -130,6 +144,8 @@ public:
     /// clipDepth, maxDistance) (reversed-Z, [0, 1] clip depth, infinite far plane, jitter, asymmetric
     /// frusta; crep/core/camera.h). The scattering is integrated up to camera->far().
     const Camera* camera = nullptr;
+    /// The directional light; may be null when at least one local light is given (a night frame: no
+    /// directional shadow input needed; shadowMap is then ignored, drawCasters serves the local lights).
     const DirectionalLight* light = nullptr;
     const Medium* medium = nullptr;
     /// GL_TEXTURE_2D, width x height, depth-buffer values of `camera` in its convention: D32F, D24S8 / D24
@@ -138,9 +154,12 @@ public:
     std::uint32_t output = 0; ///< GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance
     std::function<void(const glm::dmat4& clipFromWorld)> drawCasters; ///< see the top; may be empty
     const ShadowMap* shadowMap = nullptr;                             ///< see the top; may be null
-    /// Local lights added to the result (see the top); they need drawCasters.
+    /// Local lights added to the result (see the top); they need drawCasters unless their maps are given.
     std::span<const SpotLight> spotLights;
-    std::span<const PointLight> pointLights; ///< six cube-map faces each
+    std::span<const PointLight> pointLights;    ///< six cube-map faces each
+    std::span<const ShadowMap> spotShadowMaps;  ///< empty, or one per spotLights entry
+    std::span<const ShadowMap> pointShadowMaps; ///< empty, or six per pointLights entry (face k of light i
+                                                ///< at 6 i + k; faces +X, -X, +Y, -Y, +Z, -Z)
   };
 
   /// What a local light (or one point-light face) cost and how it was computed.
@@ -150,6 +169,9 @@ public:
     int face = -1; ///< point light face 0-5 (+X, -X, +Y, -Y, +Z, -Z), -1 for a spot
     /// Projective: prefiltered; Fallback: marched in world space; Empty: outside the view, nothing done.
     RectifyStatus status = RectifyStatus::Empty;
+    /// Its shadow input: the given perspective map (FrameAttribs::spotShadowMaps / pointShadowMaps,
+    /// resampled when projective) rather than drawCasters.
+    bool preRenderedMap = false;
     std::string message;           ///< the rectification's explanation
     double wallMilliseconds = 0.0; ///< CPU wall clock of its stages (0 without stageTimings)
     double gpuMilliseconds = 0.0;  ///< GL_TIME_ELAPSED of its stages
@@ -163,6 +185,9 @@ public:
     double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by glFinish
   };
 
+  /// Without a directional light (FrameAttribs::light null) the directional members keep their defaults
+  /// (rectification not projective, rectifiedMap and shadowMap texture 0) and stages start with
+  /// "transmittance".
   struct FrameResult {
     Layout layout = Layout::Projective;
     Rectification rectification;     ///< the decision (reason, measure, threshold when not projective)
@@ -193,13 +218,15 @@ public:
   Scattering& operator=(const Scattering&) = delete;
 
   /// One frame. Throws InvalidArgument naming the FrameAttribs field (null pointers, textures of the
-  /// wrong size or format, no shadow input).
+  /// wrong size or format, no shadow input, span sizes, bad local maps, e.g.
+  /// "Scattering::FrameAttribs.spotShadowMaps[0].lightClipFromWorld").
   FrameResult run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept;
   /// GPU memory it owns now, bytes: the filtered basis and the region visibility table, the rasterized
   /// (D32F) and resampled (R32F) rectified maps, its own standard shadow map once a fallback frame needed
-  /// it, the reduced-resolution depth and scattering (evaluationScale < 1) and the passes' buffers.
+  /// it, the reduced-resolution depth and scattering (evaluationScale < 1), the local lights' targets once
+  /// used (scattering, rasterized and resampled rectified maps, perspective map) and the passes' buffers.
   std::size_t memoryBytes() const noexcept;
 
 private:
