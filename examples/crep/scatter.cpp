@@ -7,6 +7,8 @@
 // shadow map; `prefilter` builds the projective rectification of the JSON camera and light, point-
 // resamples the standard map into it on the CPU (crep::resampleShadowMap; Klehm et al. 2014, Sec. 4.1's
 // rule on the projective layout) and runs the GPU prefilter and evaluation passes on it.
+// Spot and point lights (light.type, "lights"; Klehm et al. 2014, Sec. 3.2) come with their perspective
+// maps (a point light's six faces stacked in one EXR): every method adds them (lib/methods.cpp).
 #include "args.h"
 #include "commands.h"
 #include "gl_session.h"

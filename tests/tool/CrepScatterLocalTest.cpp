@@ -9,6 +9,7 @@
 #include <crep/support/exr.h>
 
 #include <doctest/doctest.h>
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -158,6 +159,19 @@ TEST_CASE("crep scatter local lights: every domain check names the JSON path") {
            j["light"]["direction"][k] = -j["light"]["direction"][k].get<double>();
        },
        "shadowMap.lightClipFromWorld: the light's direction is behind"},
+      {"spot matrix narrower than the outer cone", [](Json& j) { j["light"]["outerConeDeg"] = 40; },
+       "shadowMap.lightClipFromWorld: does not cover the outer cone (light.outerConeDeg)"},
+      {"face matrix narrower than its sector",
+       [&](Json& j) {
+         const crep::PointLight narrow({.position = {4.0, 3.0, -2.0}, .range = 50.0});
+         Json faces = Json::array();
+         for (int k = 0; k < 6; ++k)
+           faces.push_back(
+               matrixJson(k == 4 ? glm::perspectiveRH_NO(1.2, 1.0, 0.05, 50.0) * narrow.faceViewFromWorld(4)
+                                 : narrow.faceClipFromWorld(k)));
+         j["lights"][0]["shadowMap"]["faceClipFromWorld"] = faces;
+       },
+       "lights[0].shadowMap.faceClipFromWorld[4]: does not cover face 4's sector"},
       {"spot with face matrices", [&](Json& j) { j["shadowMap"]["faceClipFromWorld"] = Json::array(); },
        "shadowMap.faceClipFromWorld: unknown field"},
       {"five face matrices",

@@ -383,6 +383,44 @@ glm::dvec2 checkLocalMatrix(const Reader& r, const glm::dmat4& m, const std::str
   return {near, far};
 }
 
+/// The map of `m` covers `directions` from `position` (in front, NDC x and y within [-1, 1] up to 1e-3, as
+/// crep::Scattering requires of the maps it is given): FormatError at `path` naming `what` otherwise.
+void checkCoverage(const Reader& r, const glm::dmat4& m, const std::string& path, const glm::dvec3& position,
+                   const std::vector<glm::dvec3>& directions, const std::string& what) {
+  const double t = std::max(1.0, glm::length(position));
+  for (const glm::dvec3& d : directions) {
+    const glm::dvec4 q = m * glm::dvec4(position + t * glm::normalize(d), 1.0);
+    if (!(q.w > 0.0) || !(std::abs(q.x / q.w) <= 1.001 && std::abs(q.y / q.w) <= 1.001))
+      r.fail(path, "does not cover " + what + ": direction " + formatVec(glm::normalize(d)) +
+                       " from the light is outside the map");
+  }
+}
+
+/// Directions a local light's map must cover: a spot's outer cone (its axis and 32 directions on the cone),
+/// point-light face k's sector (its axis and the four corners, |w_j| <= |w_axis|).
+std::vector<glm::dvec3> coverageDirections(const LocalLightDescription& d, int face) {
+  std::vector<glm::dvec3> dirs;
+  if (d.type == LightType::Spot) {
+    const glm::dvec3 axis = glm::normalize(d.direction), u = anyOrthogonal(axis), v = glm::cross(axis, u);
+    const double a = d.outerConeDeg * std::numbers::pi / 180.0;
+    dirs.push_back(axis);
+    for (int j = 0; j < 32; ++j) {
+      const double phi = 2.0 * std::numbers::pi * j / 32.0;
+      dirs.push_back(std::cos(a) * axis + std::sin(a) * (std::cos(phi) * u + std::sin(phi) * v));
+    }
+    return dirs;
+  }
+  const glm::dvec3 axis = PointLight::faceAxis(face);
+  glm::dvec3 e1(0.0), e2(0.0);
+  e1[(face / 2 + 1) % 3] = 1.0;
+  e2[(face / 2 + 2) % 3] = 1.0;
+  dirs.push_back(axis);
+  for (const double s1 : {-1.0, 1.0})
+    for (const double s2 : {-1.0, 1.0})
+      dirs.push_back(axis + s1 * e1 + s2 * e2);
+  return dirs;
+}
+
 /// Every domain check of a local light description at `path` (its shadow map at `shadowPath`).
 void checkLocalLight(const Reader& r, const LocalLightDescription& d, const std::string& path,
                      const std::string& shadowPath) {
@@ -412,13 +450,19 @@ void checkLocalLight(const Reader& r, const LocalLightDescription& d, const std:
     r.fail(field("nearPlane"),
            Reader::format(*d.nearPlane) + " must be below range (" + Reader::format(*d.range) + ")");
   if (d.type == LightType::Spot) {
-    checkLocalMatrix(r, d.lightClipFromWorld, Reader::join(shadowPath, "lightClipFromWorld"), d.position,
-                     d.direction, field("position"));
+    const std::string matrix = Reader::join(shadowPath, "lightClipFromWorld");
+    checkLocalMatrix(r, d.lightClipFromWorld, matrix, d.position, d.direction, field("position"));
+    checkCoverage(r, d.lightClipFromWorld, matrix, d.position, coverageDirections(d, -1),
+                  "the outer cone (" + field("outerConeDeg") + ")");
   } else if (d.faceClipFromWorld) {
-    for (std::size_t k = 0; k < 6; ++k)
-      checkLocalMatrix(r, (*d.faceClipFromWorld)[k],
-                       indexPath(Reader::join(shadowPath, "faceClipFromWorld"), k), d.position,
+    for (std::size_t k = 0; k < 6; ++k) {
+      const std::string matrix = indexPath(Reader::join(shadowPath, "faceClipFromWorld"), k);
+      checkLocalMatrix(r, (*d.faceClipFromWorld)[k], matrix, d.position,
                        PointLight::faceAxis(static_cast<int>(k)), field("position"));
+      checkCoverage(r, (*d.faceClipFromWorld)[k], matrix, d.position,
+                    coverageDirections(d, static_cast<int>(k)),
+                    "face " + std::to_string(k) + "'s sector (+X, -X, +Y, -Y, +Z, -Z)");
+    }
   } else if (!d.range) {
     r.fail(field("range"), "missing: required for a point light without shadowMap.faceClipFromWorld (the "
                            "default face matrices are built from it)");

@@ -389,19 +389,27 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
   const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.lightClipFromWorld, frame.shadowBias};
   Scattering::FrameAttribs a;
   a.camera = &frame.camera;
-  if (!frame.renderer && frame.hasLocalLights())
-    throw UsageError("option --method: prefilter does not take users' local-light shadow maps yet (use "
-                     "--method reference)");
-  a.light = &frame.light; // a night frame: the directional light has zero irradiance
+  a.light = frame.directional ? &frame.light : nullptr; // a night frame: the local lights alone
   a.medium = &frame.medium;
+  // Local lights (Klehm et al. 2014, Sec. 3.2): drawn with the scene's casters, or users' perspective maps
+  // (resampled into each projective light's rectified map, marched directly by a light in view).
   a.spotLights = frame.spotLights;
   a.pointLights = frame.pointLights;
+  std::vector<Scattering::ShadowMap> spotMaps, pointMaps;
+  if (!frame.renderer) {
+    for (const LocalShadowMap& m : frame.spotShadows)
+      spotMaps.push_back({m.texture.get(), m.lightClipFromWorld, m.bias});
+    for (const LocalShadowMap& m : frame.pointShadows)
+      pointMaps.push_back({m.texture.get(), m.lightClipFromWorld, m.bias});
+    a.spotShadowMaps = spotMaps;
+    a.pointShadowMaps = pointMaps;
+  }
   a.cameraDepth = frame.cameraDepth.get();
   out.scattering = newScatteringTexture(frame);
   a.output = out.scattering.get();
   if (frame.renderer)
     a.drawCasters = [&](const glm::dmat4& clipFromWorld) { frame.renderer->drawDepth(clipFromWorld); };
-  a.shadowMap = &shadow;
+  if (frame.directional) a.shadowMap = &shadow;
   const Scattering::FrameResult r = scattering->run(a);
   for (const Scattering::Stage& stage : r.stages)
     out.timings.append({{stage.name, stage.wallMilliseconds}}); // comparable with the other methods' stages
