@@ -53,7 +53,7 @@
 //          Shadow map: "lightClipFromWorld" is a perspective matrix (GL conventions: NDC z in [-1, 1],
 //          depth-buffer value = z / w * 0.5 + 0.5, 0 at its near plane) whose centre of projection is
 //          "position" (within 1e-4 max(1, |position|)) and that has the axis in front; any field of view
-//          or aspect (it should cover the outer cone). The EXR holds its depth-buffer values, any size.
+//          or aspect (it must cover the outer cone). The EXR holds its depth-buffer values, any size.
 //   point: "position", "color", "intensity" as above, "nearPlane" and "range" optional (default: the
 //          nearest near plane and the farthest far plane of the six face matrices; without
 //          faceClipFromWorld, range is required and nearPlane defaults to range * 1e-3).
