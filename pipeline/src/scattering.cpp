@@ -9,6 +9,7 @@
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/pipeline/scattering.h>
+#include <crep/prefilter/fourier.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -52,6 +53,8 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
             "must be SplitLayout::Regions (the splits side by side in one map)");
   validate(info.prefilter, "Scattering::CreateInfo.prefilter");
   validate(info.evaluate, "Scattering::CreateInfo.evaluate");
+  if (info.localLightBases != 0)
+    validateBases(info.localLightBases, "Scattering::CreateInfo.localLightBases");
   validate(info.epipoleBlock);
   const int regions = info.rectify.splits * info.prefilter.regionsPerSplit;
   if (info.mapSize % regions != 0)
@@ -219,6 +222,25 @@ struct Scattering::Impl {
   std::optional<DepthTarget> localShadowMap;
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
   gl::Handle localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
+  /// CreateInfo::localLightBases when it differs from prefilter.bases: the local lights' own passes.
+  std::optional<PrefilterPass> localPrefilter;
+  std::optional<EvaluatePass> localEvaluate;
+  /// The prefilter and evaluation of local lights (their own passes, or the directional light's).
+  PrefilterPass& localLightPrefilter() {
+    const int M = info.localLightBases;
+    if (M == 0 || M == info.prefilter.bases) return prefilter;
+    if (!localPrefilter) {
+      PrefilterOptions options = info.prefilter;
+      options.bases = M;
+      localPrefilter.emplace(PrefilterPass::CreateInfo{info.mapSize, info.mapSize, options});
+      localEvaluate.emplace(EvaluatePass::CreateInfo{M, info.evaluate});
+    }
+    return *localPrefilter;
+  }
+  EvaluatePass& localLightEvaluate() {
+    localLightPrefilter();
+    return localEvaluate ? *localEvaluate : evaluate;
+  }
   /// Night frames (no directional light): the transmittance pass, its parameters and sampler.
   gl::Handle transmittance, transmittanceParams, transmittanceSampler;
 
@@ -276,6 +298,7 @@ std::size_t Scattering::memoryBytes() const noexcept {
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
   if (m.localRectified) bytes += m.localRectified->memoryBytes();
+  if (m.localPrefilter) bytes += m.localPrefilter->memoryBytes() + m.localEvaluate->memoryBytes();
   if (m.localResampled) bytes += map;
   if (m.localScattering)
     bytes += static_cast<std::size_t>(m.info.width) * static_cast<std::size_t>(m.info.height) * 16;
@@ -479,7 +502,7 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         map = m.localRectified->depthTexture();
       }
       timed(result, "local light: prefilter", [&] {
-        m.prefilter.run(
+        m.localLightPrefilter().run(
             {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .localLight = &light});
       });
       timed(result, "local light: evaluate", [&] {
@@ -489,9 +512,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         e.camera = f.camera;
         e.medium = f.medium;
         e.layout = layout.get();
-        e.basis = m.prefilter.filteredBasis();
+        e.basis = m.localLightPrefilter().filteredBasis();
         e.localLight = &light;
-        m.evaluate.run(e);
+        m.localLightEvaluate().run(e);
         addToOutput();
       });
     } else {

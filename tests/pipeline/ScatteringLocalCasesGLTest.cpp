@@ -158,3 +158,46 @@ TEST_CASE("Scattering, point light at the camera's position: finite and equal to
   CHECK(m.peak > 0.0);
   CHECK(m.relativeRmse < 0.02);
 }
+
+TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad values named") {
+  CREP_REQUIRE_GL();
+  ScatteringFixture f("colonnade");
+  f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0)));
+  const Camera c = f.scene.camera;
+  const SpotLight spot({.position = c.position() - 2.0 * c.forward() - 8.0 * c.right() + 6.0 * c.up(),
+                        .direction = 17.0 * c.forward() + 11.0 * c.right() - 6.0 * c.up(),
+                        .innerConeAngle = 0.3,
+                        .outerConeAngle = 0.5,
+                        .intensity = 100.0,
+                        .range = 80.0});
+  const auto image = [&](int localBases) {
+    Scattering::CreateInfo info = caseInfo();
+    info.localLightBases = localBases;
+    Scattering scattering(info);
+    Scattering::FrameAttribs a = f.attribs(true, false);
+    a.spotLights = std::span<const SpotLight>(&spot, 1);
+    const Scattering::FrameResult r = scattering.run(a);
+    REQUIRE(r.localLights.size() == 1);
+    CHECK(r.localLights[0].status == RectifyStatus::Projective);
+    return std::make_pair(f.read(), scattering.memoryBytes());
+  };
+  const int M = caseInfo().prefilter.bases;
+  const auto [same, sameBytes] = image(0);
+  const auto [explicitSame, explicitBytes] = image(M);
+  const auto [own, ownBytes] = image(2 * M);
+  // 0 and prefilter.bases share the directional light's passes: the same image, the same memory.
+  CHECK(rgbMetrics(same, explicitSame).maxAbsError == 0.0);
+  CHECK(sameBytes == explicitBytes);
+  // Another M runs its own passes (more memory) on the same map: a different image of the same light.
+  CHECK(ownBytes > sameBytes);
+  const ImageMetrics m = rgbMetrics(own, same);
+  report("localLightBases 2M vs M", m);
+  CHECK(m.maxAbsError > 0.0);
+  CHECK(m.relativeRmse < 0.02);
+  for (const int bad : {-2, 3, 130}) {
+    Scattering::CreateInfo info = caseInfo();
+    info.localLightBases = bad;
+    CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.localLightBases"),
+                         crep::InvalidArgument);
+  }
+}

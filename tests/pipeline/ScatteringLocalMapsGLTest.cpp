@@ -245,10 +245,10 @@ TEST_CASE(
     report(std::string("point light ") + k.name + ": drawCasters vs world-space references", ma);
     report(std::string("point light ") + k.name + ": GL cube-map face maps vs world-space references", mb);
     CHECK(mb.peak > 0.0);
-    // The prefiltered faces' own error on this scene is open (ScatteringLocalGLTest: 2.7%, goal 2%); the
-    // maps must not add to it beyond the point resampling. Measured: 2.67% (a), 2.73% (b).
+    // The maps must not add to the prefiltered faces' own error beyond the point resampling, and the sum
+    // stays within the built-in scenes' 2% goal. Measured (localLightBases = 64): 1.08% (a), 1.16% (b).
     CHECK(mb.relativeRmse < ma.relativeRmse + 0.01);
-    CHECK(mb.relativeRmse < 0.04);
+    CHECK(mb.relativeRmse < 0.02);
   }
 }
 
