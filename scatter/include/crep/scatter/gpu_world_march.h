@@ -126,7 +126,7 @@ public:
     /// own map and add the outputs) is set. For a local light, lightClipFromWorld is its perspective
     /// shadow map's matrix (SpotLight::lightClipFromWorld, PointLight::faceClipFromWorld), points with
     /// clip w <= 0 count as lit, each lit part is integrated with crep_localSegment
-    /// (glsl/crep/local_light.glsl, the float twin of RayScattering::segment) and the output RGB is
+    /// (glsl/crep/local_light.glsl, the float counterpart of RayScattering::segment) and the output RGB is
     /// the radiance itself, as worldSpaceMarch with a LocalLight.
     const DirectionalLight* light = nullptr;
     const LocalLight* localLight = nullptr;
