@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <unistd.h>
 
@@ -176,6 +177,27 @@ int scatterCommand(const std::vector<std::string>& argv) {
       requireInputFile(lightFiles.back());
     }
   requireDistinctFiles(outputs, lightFiles);
+  // Light textures (frame_json.h "Light textures"): the directional light's and the spots', their
+  // projections checked along the light's rays, the EXRs relative to the JSON file read and checked here,
+  // before any GL work. textures[i] is localLights[i]'s (or empty).
+  const std::filesystem::path jsonDir = std::filesystem::path(framePath).parent_path();
+  std::vector<PathOption> textureFiles;
+  const auto readTexture = [&](const FrameLightTexture& t) {
+    const std::string field = t.path + ".texture";
+    const std::filesystem::path file = jsonDir / t.file;
+    textureFiles.push_back({field, file.string()});
+    requireDistinctFiles(outputs, {textureFiles.back()});
+    return timings.time("read light texture", [&] { return readLightTexture(file, field, framePath); });
+  };
+  std::optional<FrameLightTexture> sunTexture = lightTextureOf(desc, framePath);
+  Image sunTextureImage;
+  if (sunTexture) sunTextureImage = readTexture(*sunTexture);
+  std::vector<std::optional<FrameLightTexture>> localTextures;
+  std::vector<Image> localTextureImages;
+  for (const FrameLocalLight& l : localLights) {
+    localTextures.push_back(lightTextureOf(l, framePath));
+    localTextureImages.push_back(localTextures.back() ? readTexture(*localTextures.back()) : Image());
+  }
   const Image depth =
       timings.time("read depth exr", [&] { return readDepthExr("--depth", depthPath, "camera depth"); });
   const Image shadow =
@@ -232,6 +254,9 @@ int scatterCommand(const std::vector<std::string>& argv) {
   frame.shadowBias = desc.shadowBias;
   frame.directional = directional;
   if (directional) frame.shadowImage = shadow;
+  if (sunTexture)
+    frame.lightTexture =
+        makeLightTextureMap(std::move(sunTextureImage), sunTexture->textureClipFromWorld, "light.texture");
   timings.time("upload (local lights)", [&] {
     for (std::size_t i = 0; i < localLights.size(); ++i) {
       const FrameLocalLight& l = localLights[i];
@@ -246,6 +271,12 @@ int scatterCommand(const std::vector<std::string>& argv) {
         maps.push_back(std::move(m));
       };
       if (l.spot) {
+        if (localTextures[i]) {
+          frame.spotTextures.resize(frame.spotLights.size() + 1);
+          frame.spotTextures.back() =
+              makeLightTextureMap(std::move(localTextureImages[i]), localTextures[i]->textureClipFromWorld,
+                                  "texture of a spot light");
+        }
         frame.spotLights.push_back(*l.spot);
         add(frame.spotShadows, localShadows[i], l.lightClipFromWorld[0]);
       } else {
@@ -257,6 +288,7 @@ int scatterCommand(const std::vector<std::string>& argv) {
     }
   });
 
+  if (!frame.spotTextures.empty()) frame.spotTextures.resize(frame.spotLights.size());
   MethodOutput result = runMethod(method, frame, settings);
   timings.append(result.timings.rows());
   const Image scattering =

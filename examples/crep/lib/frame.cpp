@@ -8,7 +8,28 @@
 
 #include <epoxy/gl.h>
 
+#include <vector>
+
 namespace crep::tool {
+
+LightTextureMap makeLightTextureMap(Image rgb, const glm::dmat4& textureClipFromWorld,
+                                    const char* parameter) {
+  if (rgb.channels() < 3) throw InvalidArgument(parameter, std::to_string(rgb.channels()), "must be RGB");
+  LightTextureMap m;
+  m.textureClipFromWorld = textureClipFromWorld;
+  m.texture = gl::createTexture2D(GL_RGBA32F, rgb.width(), rgb.height(), parameter);
+  std::vector<float> rgba(rgb.pixelCount() * 4, 1.0f);
+  for (int y = 0; y < rgb.height(); ++y)
+    for (int x = 0; x < rgb.width(); ++x)
+      for (int c = 0; c < 3; ++c)
+        rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(rgb.width()) +
+              static_cast<std::size_t>(x)) *
+                 4 +
+             static_cast<std::size_t>(c)] = rgb.at(x, y, c);
+  glTextureSubImage2D(m.texture.get(), 0, 0, 0, rgb.width(), rgb.height(), GL_RGBA, GL_FLOAT, rgba.data());
+  m.image = std::move(rgb);
+  return m;
+}
 
 const RectifiedGpuMap* FrameInputs::rectified(const MethodSettings& settings, StageTimings& timings,
                                               Rectification* rectOut) {

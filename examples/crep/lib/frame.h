@@ -14,6 +14,7 @@
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/gpu_light_texture.h>
 
 #include <memory>
 #include <optional>
@@ -57,6 +58,18 @@ struct LocalShadowMap {
   Image image;                        ///< CPU copy (users' data; else empty)
 };
 
+/// A light texture on the GPU (frame_json.h "Light textures"; crep/scatter/light_texture.h): the texture
+/// and its projection. texture 0 = none.
+struct LightTextureMap {
+  gl::Handle texture; ///< GL_RGBA32F, RGB the texture (A = 1), row 0 at the bottom (v = 0)
+  glm::dmat4 textureClipFromWorld{1.0};
+  Image image; ///< CPU copy, RGB
+  bool present() const { return texture.get() != 0; }
+  GpuLightTexture gpu() const { return {texture.get(), textureClipFromWorld}; }
+};
+/// Uploads an RGB(A) image (channels 0-2) as a LightTextureMap; `parameter` names it in size errors.
+LightTextureMap makeLightTextureMap(Image rgb, const glm::dmat4& textureClipFromWorld, const char* parameter);
+
 /// One frame's inputs: what every method reads. GL names are owned here.
 struct FrameInputs {
   FrameInputs(const Camera& c, const DirectionalLight& l, const Medium& m) : camera(c), light(l), medium(m) {}
@@ -82,6 +95,20 @@ struct FrameInputs {
   std::vector<PointLight> pointLights;
   std::vector<LocalShadowMap> spotShadows, pointShadows;
   bool hasLocalLights() const { return !spotLights.empty() || !pointLights.empty(); }
+  /// Light textures (crep/scatter/light_texture.h): the directional light's (texture 0 = none), and empty
+  /// or one per spot light (texture 0 = that spot has none).
+  LightTextureMap lightTexture;
+  std::vector<LightTextureMap> spotTextures;
+  /// The texture of spot i, or nullptr.
+  const LightTextureMap* spotTexture(std::size_t i) const {
+    return i < spotTextures.size() && spotTextures[i].present() ? &spotTextures[i] : nullptr;
+  }
+  bool textured() const {
+    if (lightTexture.present()) return true;
+    for (const LightTextureMap& t : spotTextures)
+      if (t.present()) return true;
+    return false;
+  }
 
   /// The rectified map for these settings (made on first use, then shared while the map size and the
   /// rectify options stay the same), or nullptr when the rectification is not projective (`rect` then

@@ -2,6 +2,8 @@
 
 #include <crep/core/error.h>
 #include <crep/core/image.h>
+#include <crep/scatter/light_texture.h>
+#include <crep/support/exr.h>
 
 #include <nlohmann/json.hpp>
 
@@ -256,18 +258,40 @@ LightType parseLightType(const Reader& r, const Json& light, const std::string& 
              t->dump());
 }
 
+/// "texture" and "textureClipFromWorld" of a light object at `path` (frame_json.h "Light textures").
+void parseTexture(const Reader& r, const Json& j, const std::string& path, std::string& file,
+                  std::optional<glm::dmat4>& matrix) {
+  if (const Json* t = r.find(j, "texture")) {
+    if (!t->is_string() || t->get<std::string>().empty())
+      r.fail(Reader::join(path, "texture"),
+             "expected a non-empty EXR file name (relative to the JSON file), got " + t->dump());
+    file = t->get<std::string>();
+  }
+  if (const Json* m = r.find(j, "textureClipFromWorld")) {
+    matrix = r.mat4(*m, Reader::join(path, "textureClipFromWorld"));
+    if (file.empty())
+      r.fail(Reader::join(path, "textureClipFromWorld"),
+             "given without " + Reader::join(path, "texture") + " (the texture it projects)");
+  }
+}
+
 /// The fields of a spot or point light (frame_json.h "Local lights"), without its shadow map.
 LocalLightDescription parseLocalLight(const Reader& r, const Json& j, const std::string& path, LightType type,
                                       bool inLights) {
+  if (type == LightType::Point && j.is_object())
+    for (const char* key : {"texture", "textureClipFromWorld"})
+      if (r.find(j, key))
+        r.fail(Reader::join(path, key), "light textures are not supported for point lights (only for the "
+                                        "directional light and spot lights)");
   if (type == LightType::Spot) {
     if (inLights)
       r.requireObject(j, path,
                       {"type", "position", "direction", "innerConeDeg", "outerConeDeg", "color", "intensity",
-                       "nearPlane", "range", "shadowMap"});
+                       "nearPlane", "range", "shadowMap", "texture", "textureClipFromWorld"});
     else
       r.requireObject(j, path,
                       {"type", "position", "direction", "innerConeDeg", "outerConeDeg", "color", "intensity",
-                       "nearPlane", "range"});
+                       "nearPlane", "range", "texture", "textureClipFromWorld"});
   } else if (inLights) {
     r.requireObject(j, path, {"type", "position", "color", "intensity", "nearPlane", "range", "shadowMap"});
   } else {
@@ -286,6 +310,7 @@ LocalLightDescription parseLocalLight(const Reader& r, const Json& j, const std:
   d.intensity = r.number(r.get(j, path, "intensity"), field("intensity"));
   if (const Json* n = r.find(j, "nearPlane")) d.nearPlane = r.number(*n, field("nearPlane"));
   if (const Json* n = r.find(j, "range")) d.range = r.number(*n, field("range"));
+  if (type == LightType::Spot) parseTexture(r, j, path, d.texture, d.textureClipFromWorld);
   return d;
 }
 
@@ -510,7 +535,9 @@ FrameDescription parseFrameDescription(const std::string& text, const std::strin
     parseLocalShadow(r, r.get(root, "", "shadowMap"), "shadowMap", f.localLight, false);
     checkLocalLight(r, f.localLight, "light", "shadowMap");
   } else {
-    r.requireObject(light, "light", {"type", "direction", "color", "intensity"});
+    r.requireObject(light, "light",
+                    {"type", "direction", "color", "intensity", "texture", "textureClipFromWorld"});
+    parseTexture(r, light, "light", f.lightTexture, f.lightTextureClipFromWorld);
     f.lightDirection =
         r.vec3(r.get(light, "light", "direction"), "light.direction", "x, y, z: the direction light travels");
     f.lightColor = r.vec3(r.get(light, "light", "color"), "light.color", "linear r, g, b");
@@ -594,6 +621,15 @@ const char* lightTypeToken(LightType type) {
 
 namespace {
 
+/// ",\n" + the "texture" and "textureClipFromWorld" fields of a light, when it has a texture.
+std::string textureFields(const std::string& file, const std::optional<glm::dmat4>& matrix,
+                          const std::string& pad) {
+  if (file.empty()) return "";
+  std::string s = ",\n" + pad + "\"texture\": " + Json(file).dump();
+  if (matrix) s += ",\n" + pad + "\"textureClipFromWorld\": " + formatMat(*matrix);
+  return s;
+}
+
 /// The fields of a local light (frame_json.h), each line indented by `pad`, without a final newline.
 std::string localLightFields(const LocalLightDescription& d, const std::string& pad) {
   std::string s = pad + "\"type\": \"" + lightTypeToken(d.type) + "\",\n";
@@ -607,7 +643,7 @@ std::string localLightFields(const LocalLightDescription& d, const std::string& 
   s += pad + "\"intensity\": " + Reader::format(d.intensity);
   if (d.nearPlane) s += ",\n" + pad + "\"nearPlane\": " + Reader::format(*d.nearPlane);
   if (d.range) s += ",\n" + pad + "\"range\": " + Reader::format(*d.range);
-  return s;
+  return s + textureFields(d.texture, d.textureClipFromWorld, pad);
 }
 
 /// The shadowMap fields of a local light (with "file" when it has one), each line indented by `pad`.
@@ -642,7 +678,9 @@ std::string toJson(const FrameDescription& f) {
   if (f.lightType == LightType::Directional) {
     s += "    \"direction\": " + formatVec(f.lightDirection) + ",\n";
     s += "    \"color\": " + formatVec(f.lightColor) + ",\n";
-    s += "    \"intensity\": " + Reader::format(f.lightIntensity) + "\n  },\n  \"shadowMap\": {\n";
+    s += "    \"intensity\": " + Reader::format(f.lightIntensity);
+    s += textureFields(f.lightTexture, f.lightTextureClipFromWorld, "    ");
+    s += "\n  },\n  \"shadowMap\": {\n";
     s += "    \"lightClipFromWorld\": " + formatMat(f.lightClipFromWorld);
     if (f.shadowSize)
       s += ",\n    \"size\": [" + std::to_string(f.shadowSize->x) + ", " + std::to_string(f.shadowSize->y) +
@@ -766,6 +804,9 @@ FrameLocalLight resolveLocalLight(const Reader& r, const LocalLightDescription& 
   out.shadowBias = d.shadowBias;
   out.shadowSize = d.shadowSize;
   out.shadowFile = d.shadowFile;
+  out.texture = d.texture;
+  out.textureClipFromWorld = d.textureClipFromWorld ? *d.textureClipFromWorld : d.lightClipFromWorld;
+  out.textureDefaultProjection = !d.textureClipFromWorld;
   const glm::dvec2 nr = nearAndRange(r, d, path, shadowPath);
   try {
     if (d.type == LightType::Spot) {
@@ -802,6 +843,25 @@ FrameLocalLight resolveLocalLight(const Reader& r, const LocalLightDescription& 
 
 } // namespace
 
+namespace {
+
+/// Runs `check` (crep::validateLightProjection at the field) and turns its InvalidArgument into FormatError
+/// naming <path>.textureClipFromWorld (and, when it was absent, the shadow matrix it defaulted to).
+template <class Check>
+void checkProjection(const Reader& r, const FrameLightTexture& t, const Check& check) {
+  const std::string field = Reader::join(t.path, "textureClipFromWorld");
+  try {
+    check(field);
+  } catch (const InvalidArgument& e) {
+    std::string what = e.what();
+    if (const std::size_t at = what.find(" = "); at != std::string::npos) what = what.substr(at + 3);
+    r.fail(field + (t.defaultProjection ? " (default: the light's shadow matrix)" : ""),
+           "not along the light's rays: " + what);
+  }
+}
+
+} // namespace
+
 std::vector<FrameLocalLight> localLightsOf(const FrameDescription& f, const std::string& source) {
   const Reader r(source);
   std::vector<FrameLocalLight> lights;
@@ -811,6 +871,63 @@ std::vector<FrameLocalLight> localLightsOf(const FrameDescription& f, const std:
     lights.push_back(
         resolveLocalLight(r, f.lights[i], indexPath("lights", i), indexPath("lights", i) + ".shadowMap"));
   return lights;
+}
+
+std::optional<FrameLightTexture> lightTextureOf(const FrameDescription& f, const std::string& source) {
+  if (f.lightType != LightType::Directional || f.lightTexture.empty()) return std::nullopt;
+  FrameLightTexture t{"light", f.lightTexture,
+                      f.lightTextureClipFromWorld ? *f.lightTextureClipFromWorld : f.lightClipFromWorld,
+                      !f.lightTextureClipFromWorld};
+  const DirectionalLight light = lightOf(f, source);
+  checkProjection(Reader(source), t, [&](const std::string& field) {
+    validateLightProjection(t.textureClipFromWorld, light, field);
+  });
+  return t;
+}
+
+std::optional<FrameLightTexture> lightTextureOf(const FrameLocalLight& l, const std::string& source) {
+  if (l.texture.empty()) return std::nullopt;
+  if (!l.spot)
+    Reader(source).fail(Reader::join(l.path, "texture"), "light textures are not supported for point lights");
+  FrameLightTexture t{l.path, l.texture, l.textureClipFromWorld, false};
+  t.defaultProjection = l.textureDefaultProjection;
+  const LocalLight light = LocalLight::spot(*l.spot);
+  checkProjection(Reader(source), t, [&](const std::string& field) {
+    validateLightProjection(t.textureClipFromWorld, light, field);
+  });
+  return t;
+}
+
+Image readLightTexture(const std::filesystem::path& file, const std::string& field,
+                       const std::string& source) {
+  const std::string where = source + ": " + field + ": '" + file.string() + "'";
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw IoError(where + " does not exist");
+  if (std::filesystem::is_directory(file, ec)) throw IoError(where + " is a directory");
+  Image image;
+  try {
+    image = readExr(file);
+  } catch (const IoError& e) {
+    throw IoError(where + ": " + e.what());
+  } catch (const FormatError& e) {
+    throw FormatError(where + ": " + e.what());
+  }
+  if (image.channels() != 3 && image.channels() != 4)
+    throw FormatError(where + ": has " + std::to_string(image.channels()) +
+                      " channel(s); a light texture is linear RGB (channels R, G, B, optionally A)");
+  Image rgb(image.width(), image.height(), 3);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float v = image.at(x, y, c);
+        if (!(v >= 0.0f && std::isfinite(v)))
+          throw FormatError(where + ": texel (" + std::to_string(x) + ", " +
+                            std::to_string(image.height() - 1 - y) + ") from the top-left, channel " +
+                            "RGB"[c] + ", is " + Reader::format(v) + (std::isnan(v) ? " (NaN)" : "") +
+                            "; expected finite values >= 0 (linear RGB)");
+        rgb.at(x, y, c) = v;
+      }
+  return rgb;
 }
 
 namespace {

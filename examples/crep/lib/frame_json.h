@@ -18,7 +18,9 @@
 //       "type": "directional",                       optional: "directional" (default), "spot", "point"
 //       "direction": [x, y, z],                      the direction light travels (sun -> scene), non-zero
 //       "color": [r, g, b],                          linear RGB, >= 0
-//       "intensity": s                               >= 0; irradiance = color * intensity
+//       "intensity": s,                              >= 0; irradiance = color * intensity
+//       "texture": "window.exr",                     optional light texture (below)
+//       "textureClipFromWorld": [16 numbers]         optional (below)
 //     },
 //     "shadowMap": {                                 the standard shadow map EXR
 //       "lightClipFromWorld": [16 numbers],          orthographic, looking along light.direction
@@ -72,6 +74,23 @@
 //                   "faceClipFromWorld" (point, optional), "size" (optional), "bias" (optional, default 0)}.
 //   A shadow map whose every texel is 0 (the light inside an occluder) is an error naming its file.
 //
+// Light textures (optional; crep/scatter/light_texture.h; Klehm et al. 2014, Sec. 3.2): an RGB texture
+// projected from the light multiplies its colour per light ray (a stained-glass window over the sun, a gobo
+// on a spot). In "light" (directional or spot) and in a spot entry of "lights":
+//   "texture": "file.exr"        an EXR path relative to the JSON file's directory: linear RGB (channels R,
+//                                G, B, optionally A, which is ignored), every value finite and >= 0 (values
+//                                above 1 brighten). Row convention as the tool's other EXRs: the file's
+//                                first (top) row is the texture's top, texture coordinate v = 1 (OpenGL
+//                                texel row H - 1), its last row v = 0; column 0 is u = 0.
+//   "textureClipFromWorld": [16] optional, column-major: world -> the texture's clip space (NDC x, y in
+//                                [-1, 1] cover the texture; behind a projector, clip w <= 0, no light;
+//                                outside [-1, 1] the edge texels continue). It must project along the
+//                                light's rays (crep::validateLightProjection): orthographic along
+//                                light.direction for the directional light, perspective centred at
+//                                "position" for a spot. Default: the light's shadow matrix
+//                                (shadowMap.lightClipFromWorld, or the entry's), which does.
+//   A point light with "texture" or "textureClipFromWorld" is an error naming the field (not supported).
+//
 // Ranges: every number is finite and at most 1e30 in magnitude, and so is light.color * light.intensity;
 // the inputs must keep the in-scattered radiance below 1e30 (irradiance x scattering x the largest phase
 // value x the longest path, 1 / extinction or the far-plane corner distance): the GPU passes compute in
@@ -86,6 +105,7 @@
 #pragma once
 
 #include <crep/core/camera.h>
+#include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 
@@ -124,6 +144,9 @@ struct LocalLightDescription {
   std::optional<std::array<glm::dmat4, 6>> faceClipFromWorld; ///< point: shadowMap.faceClipFromWorld
   std::optional<glm::ivec2> shadowSize;                       ///< shadowMap.size
   double shadowBias = 0.0;                                    ///< shadowMap.bias
+  std::string texture; ///< spot: "texture" as written (relative to the JSON file), empty = none
+  /// spot: "textureClipFromWorld" (absent: the shadow matrix)
+  std::optional<glm::dmat4> textureClipFromWorld;
 };
 
 struct FrameDescription {
@@ -142,6 +165,9 @@ struct FrameDescription {
   double hgG = 0.0;
   glm::dvec3 rayleighScattering{0.0};
   glm::dvec3 absorption{0.0};
+  /// light.texture (directional main light) as written, empty = none; a spot main light's is in localLight.
+  std::string lightTexture;
+  std::optional<glm::dmat4> lightTextureClipFromWorld; ///< light.textureClipFromWorld (directional)
   /// light.type. For Spot / Point the main light is `localLight` (and the directional fields above, with
   /// lightClipFromWorld, shadowSize and shadowBias, are unused: its shadow fields are in localLight).
   LightType lightType = LightType::Directional;
@@ -159,7 +185,18 @@ struct FrameLocalLight {
   std::vector<glm::dmat4> lightClipFromWorld; ///< 1 (spot) or 6 (point) matrices
   double shadowBias = 0.0;
   std::optional<glm::ivec2> shadowSize;
-  std::string shadowFile; ///< as written in the JSON (empty for the main light: --shadow)
+  std::string shadowFile;                ///< as written in the JSON (empty for the main light: --shadow)
+  std::string texture;                   ///< spot: its light texture as written in the JSON (empty = none)
+  glm::dmat4 textureClipFromWorld{1.0};  ///< spot: the texture's projection (given, or the shadow matrix)
+  bool textureDefaultProjection = false; ///< textureClipFromWorld was absent (the shadow matrix)
+};
+
+/// A light texture of the frame (frame_json.h "Light textures"): the directional light's or a spot's.
+struct FrameLightTexture {
+  std::string path;                     ///< JSON path of the light: "light" or "lights[i]"
+  std::string file;                     ///< "texture" as written (relative to the JSON file)
+  glm::dmat4 textureClipFromWorld{1.0}; ///< given, or the light's shadow matrix
+  bool defaultProjection = false;       ///< textureClipFromWorld was absent (the shadow matrix)
 };
 
 /// Parses `text`; throws crep::FormatError "<source>: <field>: <problem>" for malformed JSON (with line
@@ -181,6 +218,19 @@ DirectionalLight lightOf(const FrameDescription& frame, const std::string& sourc
 /// The spot and point lights of the frame, the main light first when it is one, then "lights" in order;
 /// nearPlane and range defaulted from the shadow matrices (frame_json.h top). FormatError naming the field.
 std::vector<FrameLocalLight> localLightsOf(const FrameDescription& frame, const std::string& source);
+/// The directional main light's texture (frame_json.h "Light textures"), if any; FormatError naming
+/// light.textureClipFromWorld when its projection is not along light.direction.
+std::optional<FrameLightTexture> lightTextureOf(const FrameDescription& frame, const std::string& source);
+/// A spot's texture (localLightsOf's `light`), if any; FormatError naming <path>.textureClipFromWorld when
+/// its projection is not centred at the spot.
+std::optional<FrameLightTexture> lightTextureOf(const FrameLocalLight& light, const std::string& source);
+/// Reads a light texture EXR (frame_json.h "Light textures"): an RGB image (3 channels, the alpha of an RGBA
+/// file dropped), row 0 at the bottom (Image convention). IoError / FormatError naming `field` (the JSON
+/// path, e.g. "light.texture") and the file: missing, unreadable, not an EXR, not R, G, B channels, a texel
+/// NaN, infinite or negative (its position from the top-left, as a viewer shows it).
+Image readLightTexture(const std::filesystem::path& file, const std::string& field,
+                       const std::string& source);
+
 /// The medium; FormatError naming the field (e.g. medium.hgG outside (-1, 1), zero extinction).
 Medium mediumOf(const FrameDescription& frame, const std::string& source);
 
