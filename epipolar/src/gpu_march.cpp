@@ -110,6 +110,8 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (f.stepsOutput != 0)
     gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, width, height,
                          GL_R32F);
+  if (f.lightColors != 0)
+    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.lightColors", f.lightColors, W, H);
   const bool tree = info_.mode == Mode::MinMaxTree;
   if (tree && (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer)))
     throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
@@ -124,12 +126,14 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
                                 " map (" + std::to_string(needed) + " bytes)");
   }
 
-  gl::Handle& program = programs_[static_cast<int>(kind)];
+  const bool textured = f.lightColors != 0;
+  gl::Handle& program = programs_[textured ? 1 : 0][static_cast<int>(kind)];
   if (!program)
-    program = buildProgram(
-        {{ShaderStage::Compute,
-          "passes/march_rectified.comp",
-          {{"CREP_MARCH_TREE", tree ? "1" : "0"}, {"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
+    program = buildProgram({{ShaderStage::Compute,
+                             "passes/march_rectified.comp",
+                             {{"CREP_MARCH_TREE", tree ? "1" : "0"},
+                              {"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
+                              {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"}}}});
 
   gpu::MarchParams params =
       f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
@@ -145,7 +149,15 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
                           f.output, steps);
   layoutBuffers_.bind(1, 1);
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
+  if (textured) { // Klehm et al. 2014, Sec. 3.2: the light texture's colour per texel
+    glBindTextureUnit(2, f.lightColors);
+    glBindSampler(2, sampler_.get());
+  }
   gpu::dispatchMarch(width, height, "RectifiedMarchPass::run");
+  if (textured) {
+    glBindSampler(2, 0);
+    glBindTextureUnit(2, 0);
+  }
 }
 
 } // namespace crep

@@ -101,14 +101,14 @@ namespace {
 template <class Light>
 MarchResult minMaxMarchImpl(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
                             const Camera& camera, const Light& light, const Medium& medium,
-                            const MarchOptions& options) {
+                            const MarchOptions& options, const Image* lightColors = nullptr) {
   requireSameSize(map, trees);
   const int W = map.width(), L = trees.levels(), stride = trees.rowStride();
   std::vector<int> offsets(static_cast<std::size_t>(L) + 1, 0);
   for (int l = 1; l <= L; ++l)
     offsets[static_cast<std::size_t>(l)] = MinMaxTrees::levelOffset(W, l);
   const float* nodes = trees.data().data();
-  return marchRectifiedRows(map, cameraDepth, camera, light, medium, options,
+  return marchRectifiedRows(map, cameraDepth, camera, light, medium, options, lightColors,
                             [&](const RowRay& r, const RowDistances& T, const auto& litSection, int& steps) {
                               const double z = r.depth;
                               const int j = r.texelRow, end = r.last + 1;
@@ -162,11 +162,12 @@ namespace {
 /// minMaxMarch after building the trees of the map.
 template <class Light>
 MarchResult minMaxMarchBuildingTrees(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                                     const Light& light, const Medium& medium, const MarchOptions& options) {
+                                     const Light& light, const Medium& medium, const MarchOptions& options,
+                                     const Image* lightColors = nullptr) {
   validate(map);
   validate(options);
   const MinMaxTrees trees(map.depth, options.threads);
-  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options);
+  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options, lightColors);
 }
 } // namespace
 
@@ -178,6 +179,31 @@ MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const
 MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                         const LocalLight& light, const Medium& medium, const MarchOptions& options) {
   return minMaxMarchBuildingTrees(map, cameraDepth, camera, light, medium, options);
+}
+
+// Light textures (Klehm et al. 2014, Sec. 3.2): marchRectifiedRows splits each lit node's section per texel.
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                        const Image& lightColors, const MarchOptions& options) {
+  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options, &lightColors);
+}
+
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const DirectionalLight& light, const Medium& medium, const Image& lightColors,
+                        const MarchOptions& options) {
+  return minMaxMarchBuildingTrees(map, cameraDepth, camera, light, medium, options, &lightColors);
+}
+
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const LocalLight& light, const Medium& medium,
+                        const Image& lightColors, const MarchOptions& options) {
+  return minMaxMarchImpl(map, trees, cameraDepth, camera, light, medium, options, &lightColors);
+}
+
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const LocalLight& light, const Medium& medium, const Image& lightColors,
+                        const MarchOptions& options) {
+  return minMaxMarchBuildingTrees(map, cameraDepth, camera, light, medium, options, &lightColors);
 }
 
 } // namespace crep

@@ -9,7 +9,7 @@
 // Conventions: depth textures hold depth-buffer values in [0, 1] (GL_DEPTH_COMPONENT32F or GL_R32F, read
 // with texelFetch through the pass's own nearest sampler, so the texture's compare mode does not matter);
 // outputs are GL_RGBA32F (scattering: RGB radiance, A grey transmittance) and GL_R32F (steps per pixel).
-// A pass leaves GL state as follows: program 0; texture units 0-1 with no texture and no sampler; image
+// A pass leaves GL state as follows: program 0; texture units 0-2 with no texture and no sampler; image
 // units 0-1, uniform buffer bindings 0-1 and storage buffer bindings 0-1 unbound. It issues the memory
 // barriers its outputs need for texture fetches, image loads, readback and buffer reads.
 // NaN in a GPU input is not checked (it would cost a readback): a NaN camera depth is treated as the sky
@@ -94,6 +94,12 @@ public:
     /// each lit section is integrated by crep_localSegment (crep::bruteForceMarch / minMaxMarch with a
     /// LocalLight on the CPU).
     const LocalLight* localLight = nullptr;
+    /// A light texture's colour map of the map (LightColorMapPass::colorMapTexture(), as
+    /// PrefilterPass::FrameAttribs::lightColors takes it: a mapWidth x mapHeight GL_TEXTURE_2D, RGB read
+    /// with texelFetch) or 0 (untextured: the untextured program, no extra binding). Each lit texel's
+    /// section times its colour (crep::bruteForceMarch / minMaxMarch with lightColors; the tree walks lit
+    /// nodes texel by texel, skipping only shadowed nodes whole). Bound at texture unit 2 (left unbound).
+    std::uint32_t lightColors = 0;
   };
   /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
   /// MinMaxTreePass.
@@ -105,7 +111,7 @@ public:
 private:
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2], params_, sampler_, dummySteps_;
+  gl::Handle programs_[2][2], params_, sampler_, dummySteps_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 

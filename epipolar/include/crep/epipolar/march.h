@@ -84,5 +84,22 @@ MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const
                         const MarchOptions& options = {});
 MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                         const LocalLight& light, const Medium& medium, const MarchOptions& options = {});
+/// The tree march with a light texture's colour map (lightColorMap() of the map's layout and size; the
+/// rule of crep/scatter/rectified_march.h, validated: InvalidArgument "lightColors"): each lit node's
+/// section is split at its texels' boundaries and each part times its texel's colour, exactly the parts
+/// and order of bruteForceMarch with the same colours. Directional light and local light, with prebuilt
+/// trees or building them.
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                        const Image& lightColors, const MarchOptions& options = {});
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const DirectionalLight& light, const Medium& medium, const Image& lightColors,
+                        const MarchOptions& options = {});
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
+                        const Camera& camera, const LocalLight& light, const Medium& medium,
+                        const Image& lightColors, const MarchOptions& options = {});
+MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                        const LocalLight& light, const Medium& medium, const Image& lightColors,
+                        const MarchOptions& options = {});
 
 } // namespace crep
