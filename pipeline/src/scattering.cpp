@@ -11,6 +11,7 @@
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/fourier.h>
 #include <crep/prefilter/gpu_pass.h>
+#include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>
 
 #include <epoxy/gl.h>
@@ -159,6 +160,39 @@ void validateLocalShadowMaps(const Scattering::FrameAttribs& f) {
   }
 }
 
+/// The light textures (scattering.h "Light textures"): the directional light's and the spots' (span size,
+/// each texture and projection), and the evaluation options without a textured variant.
+void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOptions& evaluate) {
+  const std::string prefix = "Scattering::FrameAttribs.";
+  if (!f.spotLightTextures.empty() && f.spotLightTextures.size() != f.spotLights.size())
+    invalid(prefix + "spotLightTextures", "size " + std::to_string(f.spotLightTextures.size()),
+            "must be 0 or spotLights.size() = " + std::to_string(f.spotLights.size()));
+  bool any = false;
+  if (f.lightTexture) {
+    if (!f.light)
+      invalid(prefix + "lightTexture", "set without a directional light", "must be null when light is null");
+    gpu::validateGpuLightTexture(*f.lightTexture, f.light, nullptr, prefix + "lightTexture");
+    any = true;
+  }
+  for (std::size_t i = 0; i < f.spotLightTextures.size(); ++i) {
+    if (f.spotLightTextures[i].texture == 0) continue; // untextured entry
+    const LocalLight light = LocalLight::spot(f.spotLights[i]);
+    gpu::validateGpuLightTexture(f.spotLightTextures[i], nullptr, &light,
+                                 prefix + "spotLightTextures[" + std::to_string(i) + "]");
+    any = true;
+  }
+  if (!any) return;
+  const std::string field = f.lightTexture ? prefix + "lightTexture" : prefix + "spotLightTextures";
+  if (evaluate.nearPlaneCorrection)
+    invalid(field, "a light texture",
+            "has no textured evaluation with Scattering::CreateInfo.evaluate.nearPlaneCorrection (set it "
+            "false)");
+  if (usesVisibilityTable(evaluate) && !usesScatteringPrefix(evaluate))
+    invalid(field, "a light texture",
+            "has no textured evaluation with the visibility table alone (Scattering::CreateInfo.evaluate: "
+            "scatteringPrefix true, or visibilityTableSamples = 0)");
+}
+
 /// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
 struct DepthTarget {
   gl::Handle texture, framebuffer;
@@ -241,6 +275,15 @@ struct Scattering::Impl {
     localLightPrefilter();
     return localEvaluate ? *localEvaluate : evaluate;
   }
+  /// Light textures: the colour map of a rectified map (mapSize^2), made on the first textured frame.
+  std::optional<LightColorMapPass> colorMap;
+  /// Runs the colour map pass for `layout` and returns its texture.
+  std::uint32_t lightColors(const RectifiedLayout& layout, const GpuLightTexture& texture,
+                            const DirectionalLight* light, const LocalLight* localLight) {
+    if (!colorMap) colorMap.emplace(LightColorMapPass::CreateInfo{info.mapSize, info.mapSize});
+    colorMap->run({.layout = &layout, .lightTexture = texture, .light = light, .localLight = localLight});
+    return colorMap->colorMapTexture();
+  }
   /// Night frames (no directional light): the transmittance pass, its parameters and sampler.
   gl::Handle transmittance, transmittanceParams, transmittanceSampler;
 
@@ -300,6 +343,7 @@ std::size_t Scattering::memoryBytes() const noexcept {
   if (m.localRectified) bytes += m.localRectified->memoryBytes();
   if (m.localPrefilter) bytes += m.localPrefilter->memoryBytes() + m.localEvaluate->memoryBytes();
   if (m.localResampled) bytes += map;
+  if (m.colorMap) bytes += m.colorMap->memoryBytes();
   if (m.localScattering)
     bytes += static_cast<std::size_t>(m.info.width) * static_cast<std::size_t>(m.info.height) * 16;
   if (m.localShadowMap)
@@ -324,6 +368,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   if (f.light && !f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
   validateLocalShadowMaps(f);
+  validateLightTextures(f, info.evaluate);
   if (!f.light) {
     // A night frame: the transmittance, then the local lights added.
     FrameResult r;
@@ -401,7 +446,15 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     map = m.resampled.get();
   }
   r.rectifiedMap = {layout, map, info.mapSize, info.mapSize};
-  stage("prefilter", [&] { m.prefilter.run({map, layout.get(), f.medium}); });
+  // Light textures (Klehm et al. 2014, Sec. 3.2): the colour of every texel's light ray on this frame's
+  // layout (projective or epipolar), prefiltered per colour channel.
+  std::uint32_t colors = 0;
+  if (f.lightTexture)
+    stage("light colours", [&] { colors = m.lightColors(*layout, *f.lightTexture, f.light, nullptr); });
+  stage("prefilter", [&] {
+    m.prefilter.run(
+        {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .lightColors = colors});
+  });
   if (m.reduced) stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
   stage("evaluate", [&] {
     EvaluatePass::FrameAttribs e;
@@ -437,6 +490,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
         b.output = f.output;
         b.blockCenter = *centre;
         b.blockRadius = radius;
+        if (f.lightTexture) b.lightTexture = *f.lightTexture;
         m.block.run(b);
       });
     }
@@ -472,7 +526,8 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     gl::unbindPassState(2);
   };
   const auto one = [&](const LocalLight& light, const Rectification& rect,
-                       const glm::dmat4& lightClipFromWorld, const ShadowMap* given, LightResult result) {
+                       const glm::dmat4& lightClipFromWorld, const ShadowMap* given,
+                       const GpuLightTexture* texture, LightResult result) {
     result.status = rect.status;
     result.message = rect.message;
     result.preRenderedMap = given != nullptr;
@@ -501,9 +556,16 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         });
         map = m.localRectified->depthTexture();
       }
+      std::uint32_t colors = 0;
+      if (texture)
+        timed(result, "local light: light colours",
+              [&] { colors = m.lightColors(*layout, *texture, nullptr, &light); });
       timed(result, "local light: prefilter", [&] {
-        m.localLightPrefilter().run(
-            {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .localLight = &light});
+        m.localLightPrefilter().run({.rectifiedDepth = map,
+                                     .layout = layout.get(),
+                                     .medium = f.medium,
+                                     .localLight = &light,
+                                     .lightColors = colors});
       });
       timed(result, "local light: evaluate", [&] {
         EvaluatePass::FrameAttribs e;
@@ -539,6 +601,7 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         b.lightClipFromWorld = shadow.lightClipFromWorld;
         b.bias = shadow.bias;
         b.output = m.localScattering.get();
+        if (texture) b.lightTexture = *texture;
         m.block.run(b);
         addToOutput();
       });
@@ -550,8 +613,11 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     LightResult result;
     result.kind = LightResult::Kind::Spot;
     result.index = static_cast<int>(i);
+    const GpuLightTexture* texture = i < f.spotLightTextures.size() && f.spotLightTextures[i].texture != 0
+                                         ? &f.spotLightTextures[i]
+                                         : nullptr;
     one(LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify), spot.lightClipFromWorld(),
-        f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i], result);
+        f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i], texture, result);
   }
   for (std::size_t i = 0; i < f.pointLights.size(); ++i) {
     const PointLight& point = f.pointLights[i];
@@ -564,7 +630,7 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       one(LocalLight::pointFace(point, face), faces[static_cast<std::size_t>(face)],
           point.faceClipFromWorld(face),
           f.pointShadowMaps.empty() ? nullptr : &f.pointShadowMaps[6 * i + static_cast<std::size_t>(face)],
-          result);
+          nullptr, result);
     }
   }
 }

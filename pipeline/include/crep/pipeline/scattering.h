@@ -43,6 +43,18 @@
 // (WorldMarchPass, epipoleBlock's steps: the reference's cost, not the prefiltered one); one that does not
 // reach the camera frustum costs nothing. Local lights are evaluated at full resolution.
 //
+// Light textures (README "Light textures"; Klehm et al. 2014, Sec. 3.2: a coloured light texture is a
+// light-side factor stored per colour channel): FrameAttribs::lightTexture (the directional light's, e.g. a
+// stained-glass window; an orthographic projection along the light) and spotLightTextures (one per spot, a
+// gobo; a perspective projection centred at the spot). A textured light's colour map is made for the
+// layout its frame uses (LightColorMapPass: the projective or the epipolar layout) and prefiltered with it
+// (three bases, PrefilterPass::FrameAttribs::lightColors), the evaluation follows the textured basis; the
+// world-space marches (the epipole block, a spot in or near the view) take the texture itself
+// (WorldMarchPass::FrameAttribs::lightTexture). A constant white texture gives the untextured result bit
+// for bit. Not with CreateInfo::evaluate.nearPlaneCorrection or the visibility table alone (scatteringPrefix
+// false with visibilityTableSamples > 0): those have no textured variant (InvalidArgument). Point lights
+// take no texture. Without textures nothing of this runs or is allocated.
+//
 // GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
 // clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
 #pragma once
@@ -62,6 +74,7 @@
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/world_march.h>
 
 namespace crep {
@@ -169,6 +182,12 @@ public:
     std::span<const ShadowMap> spotShadowMaps;  ///< empty, or one per spotLights entry
     std::span<const ShadowMap> pointShadowMaps; ///< empty, or six per pointLights entry (face k of light i
                                                 ///< at 6 i + k; faces +X, -X, +Y, -Y, +Z, -Z)
+    /// Light textures (see the top): the directional light's texture (its projection orthographic along
+    /// the light), or null (untextured, no cost). Requires `light`.
+    const GpuLightTexture* lightTexture = nullptr;
+    /// Empty, or one per spotLights entry (its projection perspective from the spot's position); an entry
+    /// whose texture is 0 is untextured.
+    std::span<const GpuLightTexture> spotLightTextures;
   };
 
   /// What a local light (or one point-light face) cost and how it was computed.
@@ -201,7 +220,9 @@ public:
     Layout layout = Layout::Projective;
     Rectification rectification;     ///< the decision (reason, measure, threshold when not projective)
     double epipoleBlockRadius = 0.0; ///< pixels; 0 without a block (projective, or epipole off screen)
-    std::vector<Stage> stages;       ///< in order: shadow / resample, prefilter, evaluate, epipole block
+    /// In order: shadow / resample, light colours (with FrameAttribs::lightTexture), prefilter, evaluate,
+    /// epipole block.
+    std::vector<Stage> stages;
     /// Epipolar frames: the standard shadow map resampled and marched (the engine's, or the one rendered
     /// with drawCasters, valid until the next run()); texture 0 on projective frames.
     ShadowMap shadowMap;
@@ -218,7 +239,8 @@ public:
   };
 
   /// Validates (InvalidArgument naming the field, e.g. "Scattering::CreateInfo.mapSize"; GlError beyond
-  /// the GL limits) and builds the passes.
+  /// the GL limits) and builds the passes (the light textures' colour map pass on the first textured
+  /// frame).
   explicit Scattering(const CreateInfo& info);
   ~Scattering();
   Scattering(Scattering&&) noexcept;
@@ -228,14 +250,17 @@ public:
 
   /// One frame. Throws InvalidArgument naming the FrameAttribs field (null pointers, textures of the
   /// wrong size or format, no shadow input, span sizes, bad local maps, e.g.
-  /// "Scattering::FrameAttribs.spotShadowMaps[0].lightClipFromWorld").
+  /// "Scattering::FrameAttribs.spotShadowMaps[0].lightClipFromWorld", bad light textures, e.g.
+  /// "Scattering::FrameAttribs.spotLightTextures[0].textureClipFromWorld").
   FrameResult run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept;
   /// GPU memory it owns now, bytes: the filtered basis and the region visibility table, the rasterized
   /// (D32F) and resampled (R32F) rectified maps, its own standard shadow map once a fallback frame needed
   /// it, the reduced-resolution depth and scattering (evaluationScale < 1), the local lights' targets once
-  /// used (scattering, rasterized and resampled rectified maps, perspective map) and the passes' buffers.
+  /// used (scattering, rasterized and resampled rectified maps, perspective map), the light textures' colour
+  /// map once used (and the prefilters' textured bases: PrefilterPass::memoryBytes) and the passes'
+  /// buffers.
   std::size_t memoryBytes() const noexcept;
 
 private:
