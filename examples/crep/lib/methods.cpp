@@ -14,6 +14,7 @@
 #include <crep/epipolar/resample.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scenes/scene_renderer.h>
@@ -51,6 +52,7 @@ void runWorldMarch(const FrameInputs& frame, const MethodSettings& settings, std
   a.output = scattering;
   a.blockCenter = blockCenter;
   a.blockRadius = blockRadius;
+  a.lightTexture = frame.lightTexture.gpu(); // texture 0: untextured
   pass.run(a);
   glFinish();
 }
@@ -95,6 +97,9 @@ void marchLocalLight(const FrameInputs& frame, WorldMarchPass& pass, const Local
   a.lightClipFromWorld = view.shadow->lightClipFromWorld;
   a.bias = view.shadow->bias;
   a.output = output;
+  if (const LightTextureMap* t =
+          view.spot >= 0 ? frame.spotTexture(static_cast<std::size_t>(view.spot)) : nullptr)
+    a.lightTexture = t->gpu();
   pass.run(a);
   glFinish();
 }
@@ -240,6 +245,16 @@ MethodOutput runRectifiedMarch(FrameInputs& frame, const MethodSettings& setting
       glFinish();
     });
   }
+  // A light texture: the colour of every texel's light ray (LightColorMapPass), which the march multiplies
+  // each lit section by (RectifiedMarchPass::FrameAttribs::lightColors).
+  std::unique_ptr<LightColorMapPass> colors;
+  if (frame.lightTexture.present())
+    colors = out.timings.time("light colour map", [&] {
+      auto colorMap = std::make_unique<LightColorMapPass>(LightColorMapPass::CreateInfo{width, height});
+      colorMap->run({.layout = layout, .lightTexture = frame.lightTexture.gpu(), .light = &frame.light});
+      glFinish();
+      return colorMap;
+    });
   out.scattering = newScatteringTexture(frame);
   out.timings.time(tree ? "min/max march" : "brute-force march", [&] {
     RectifiedMarchPass::FrameAttribs a;
@@ -251,6 +266,7 @@ MethodOutput runRectifiedMarch(FrameInputs& frame, const MethodSettings& setting
     a.rectifiedDepth = texture;
     a.minMaxBuffer = trees ? trees->treeBuffer() : 0;
     a.output = out.scattering.get();
+    a.lightColors = colors ? colors->colorMapTexture() : 0;
     pass->run(a);
     glFinish();
   });
@@ -314,6 +330,14 @@ bool marchLocalRectified(FrameInputs& frame, const MethodSettings& settings, con
       glFinish();
     });
   }
+  std::unique_ptr<LightColorMapPass> colors;
+  if (const LightTextureMap* t = v.spot >= 0 ? frame.spotTexture(static_cast<std::size_t>(v.spot)) : nullptr)
+    colors = timings.time("light colour map (local lights)", [&] {
+      auto colorMap = std::make_unique<LightColorMapPass>(LightColorMapPass::CreateInfo{size, size});
+      colorMap->run({.layout = layout.get(), .lightTexture = t->gpu(), .localLight = &v.light});
+      glFinish();
+      return colorMap;
+    });
   timings.time(tree ? "min/max march (local lights)" : "brute-force march (local lights)", [&] {
     RectifiedMarchPass::FrameAttribs a;
     a.layout = layout.get();
@@ -324,6 +348,7 @@ bool marchLocalRectified(FrameInputs& frame, const MethodSettings& settings, con
     a.rectifiedDepth = map.get();
     a.minMaxBuffer = trees ? trees->treeBuffer() : 0;
     a.output = target;
+    a.lightColors = colors ? colors->colorMapTexture() : 0;
     pass.run(a);
     glFinish();
   });
@@ -404,6 +429,15 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
     a.spotShadowMaps = spotMaps;
     a.pointShadowMaps = pointMaps;
   }
+  // Light textures (Klehm et al. 2014, Sec. 3.2): the sun's and the spots' (an untextured spot: texture 0).
+  const GpuLightTexture sunTexture = frame.lightTexture.gpu();
+  if (frame.directional && frame.lightTexture.present()) a.lightTexture = &sunTexture;
+  std::vector<GpuLightTexture> spotTextures;
+  if (!frame.spotTextures.empty()) {
+    for (std::size_t i = 0; i < frame.spotLights.size(); ++i)
+      spotTextures.push_back(frame.spotTexture(i) ? frame.spotTexture(i)->gpu() : GpuLightTexture{});
+    a.spotLightTextures = spotTextures;
+  }
   a.cameraDepth = frame.cameraDepth.get();
   out.scattering = newScatteringTexture(frame);
   a.output = out.scattering.get();
@@ -476,7 +510,9 @@ const Method& findMethod(const std::string& name, const std::string& option) {
 }
 
 MethodOutput runMethod(const std::string& name, FrameInputs& frame, const MethodSettings& settings) {
-  return findMethod(name).run(frame, settings);
+  MethodOutput out = findMethod(name).run(frame, settings);
+  if (frame.textured()) out.detail += "; light textures";
+  return out;
 }
 
 } // namespace crep::tool
