@@ -32,7 +32,8 @@ commands:
 const char* const kRender =
     R"(  render    render a built-in scene with volumetric scattering to EXR + PNG, print per-stage timings
             --scene NAME        colonnade (default) | forest | terrain | boxes | sunset (sun in view) |
-                                colonnade-night (three spot lamps, no sun)
+                                colonnade-night (three spot lamps, no sun) | stained-glass (the sun
+                                through a window, a light texture)
             --size WxH          image size (default 1280x720)
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
                                 against a standard shadow map) | the other methods listed below

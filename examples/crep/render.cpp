@@ -2,7 +2,8 @@
 // computes single scattering with the chosen method (lib/frame.h registry) and writes the scattering
 // and composited images to EXR plus a tone-mapped PNG, with a table of per-stage timings.
 // --export-frame DIR also writes the frame as users' data for `crep scatter`: DIR/depth.exr,
-// DIR/shadow.exr (float depth-buffer values) and DIR/frame.json.
+// DIR/shadow.exr (float depth-buffer values) and DIR/frame.json (and DIR/light-texture.exr for a scene whose
+// sun has a light texture).
 #include "args.h"
 #include "commands.h"
 #include "frame_json.h"
@@ -33,10 +34,15 @@ namespace crep::tool {
 
 namespace {
 
-/// The files --export-frame writes besides depth.exr, shadow.exr and frame.json: one shadow EXR per local
-/// light after the first when there is no sun (the first is then shadow.exr), per local light otherwise.
+/// The sun's light texture as --export-frame writes it (light.texture; RGB float, the top row first).
+constexpr const char* kLightTextureFile = "light-texture.exr";
+
+/// The files --export-frame writes besides depth.exr, shadow.exr and frame.json: the sun's light texture
+/// first when the scene has one, then one shadow EXR per local light after the first when there is no sun
+/// (the first is then shadow.exr), per local light otherwise.
 std::vector<std::string> localLightFiles(const scenes::Scene& scene) {
   std::vector<std::string> files;
+  if (scene.sunTexture) files.push_back(kLightTextureFile);
   const std::size_t count = scene.spotLights.size() + scene.pointLights.size();
   for (std::size_t i = scene.hasSun ? 0 : 1; i < count; ++i)
     files.push_back("light" + std::to_string(i) + ".exr");
@@ -105,7 +111,13 @@ void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTim
     writeExr(dir / "depth.exr", depth, ExrPixelType::Float);
     FrameDescription d;
     const std::size_t localCount = f.spotLights.size() + f.pointLights.size();
-    const std::vector<std::string> files = localLightFiles(*s.scene);
+    std::vector<std::string> files = localLightFiles(*s.scene);
+    if (f.lightTexture.present()) {
+      writeExr(dir / kLightTextureFile, f.lightTexture.image, ExrPixelType::Float);
+      d.lightTexture = kLightTextureFile;
+      d.lightTextureClipFromWorld = f.lightTexture.textureClipFromWorld;
+      files.erase(files.begin());
+    }
     for (std::size_t i = 0; i < localCount; ++i) {
       Image shadow;
       LocalLightDescription light = describeLocal(f, i, shadow);

@@ -65,6 +65,13 @@ SceneFrame makeSceneFrame(const std::string& name, int width, int height, int sh
           f.pointShadows.push_back(localMap(point.faceClipFromWorld(k)));
       glFinish();
     });
+  // The sun's light texture (a stained-glass window): every method's and the surfaces'.
+  if (scene.sunTexture)
+    timings.time("light texture upload", [&] {
+      f.lightTexture =
+          makeLightTextureMap(scene.sunTexture->rgb, scene.sunTexture->textureClipFromWorld, "light texture");
+      glFinish();
+    });
   s.color = gl::createTexture2D(GL_RGBA32F, width, height, "--size");
   f.cameraDepth = scenes::createDepthTexture(width, height, "--size");
   timings.time("camera pass", [&] {
@@ -77,6 +84,8 @@ SceneFrame makeSceneFrame(const std::string& name, int width, int height, int sh
     for (std::size_t i = 0; i < f.spotLights.size() && i < scenes::SceneRenderer::kMaxShadeSpots; ++i)
       in.spots.push_back(
           {&f.spotLights[i], f.spotShadows[i].lightClipFromWorld, f.spotShadows[i].texture.get()});
+    in.sunTexture = f.lightTexture.texture.get();
+    in.sunTextureClipFromWorld = f.lightTexture.textureClipFromWorld;
     s.renderer->renderShaded(in, s.color.get(), f.cameraDepth.get(), width, height);
     glFinish();
   });

@@ -1,6 +1,7 @@
 #version 450 core
 // Built-in scenes, lit pass: Lambert with a standard shadow map (3x3 PCF) plus ambient, plus up to four
-// spot lights (intensity x the smooth cone falloff / d^2, each with its perspective shadow map, 3x3 PCF).
+// spot lights (intensity x the smooth cone falloff / d^2, each with its perspective shadow map, 3x3 PCF),
+// the sun optionally through its light texture.
 layout(location = 0) in vec3 worldPosition;
 layout(location = 1) in vec3 worldNormal;
 layout(location = 1) uniform mat4 shadowClipFromWorld;
@@ -17,6 +18,11 @@ layout(location = 15) uniform vec2 spotCone[MAX_SPOTS]; // cos inner, cos outer
 layout(location = 19) uniform vec3 spotIntensity[MAX_SPOTS];
 layout(location = 23) uniform mat4 spotClipFromWorld[MAX_SPOTS];
 layout(binding = 1) uniform sampler2DShadow spotShadow[MAX_SPOTS];
+// The sun's light texture (crep/scatter/light_texture.h's rule, bilinear, clamp to edge): its colour
+// multiplies the sun's irradiance (a stained-glass window's coloured patches on the floor).
+layout(location = 27) uniform int sunTextured;
+layout(location = 28) uniform mat4 sunTextureClipFromWorld;
+layout(binding = 5) uniform sampler2D sunTexture;
 layout(location = 0) out vec4 outColor;
 
 float shadowVisibility(vec3 p, float bias) {
@@ -68,7 +74,12 @@ void main() {
   float cosine = max(dot(n, toLight), 0.0);
   float bias = 0.0015 + 0.003 * (1.0 - cosine);
   float v = cosine > 0.0 ? shadowVisibility(worldPosition + n * 0.02, bias) : 0.0;
-  vec3 radiance = albedo / 3.14159265358979 * (lightIrradiance * cosine * v + spotIrradiance(worldPosition, n)) +
+  vec3 sunColor = vec3(1.0);
+  if (sunTextured != 0) {
+    vec4 q = sunTextureClipFromWorld * vec4(worldPosition, 1.0);
+    sunColor = q.w > 0.0 ? texture(sunTexture, 0.5 * q.xy / q.w + 0.5).rgb : vec3(0.0);
+  }
+  vec3 radiance = albedo / 3.14159265358979 * (lightIrradiance * sunColor * cosine * v + spotIrradiance(worldPosition, n)) +
                   albedo * ambient;
   outColor = vec4(radiance, 1.0);
 }

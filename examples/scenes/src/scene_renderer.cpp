@@ -171,10 +171,20 @@ void SceneRenderer::renderShaded(const ShadeInputs& in, std::uint32_t colorTextu
                       i < spotCount ? in.spots[static_cast<std::size_t>(i)].shadowMap : in.shadowMap);
     glBindSampler(static_cast<GLuint>(1 + i), sampler.get());
   }
+  // The sun's light texture at unit 5 (linear filtering, clamp to edge).
+  glProgramUniform1i(p, 27, in.sunTexture != 0 ? 1 : 0);
+  setMatrix(p, 28, in.sunTextureClipFromWorld);
+  gl::Handle linear = gl::createSampler();
+  glSamplerParameteri(linear.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glSamplerParameteri(linear.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glSamplerParameteri(linear.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(linear.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindTextureUnit(5, in.sunTexture);
+  glBindSampler(5, linear.get());
   glBindVertexArray(d.vao.get());
   glDrawElements(GL_TRIANGLES, d.indexCount, GL_UNSIGNED_INT, nullptr);
   glBindVertexArray(0);
-  for (GLuint unit = 0; unit <= static_cast<GLuint>(kMaxShadeSpots); ++unit) {
+  for (GLuint unit = 0; unit <= static_cast<GLuint>(kMaxShadeSpots) + 1; ++unit) {
     glBindSampler(unit, 0);
     glBindTextureUnit(unit, 0);
   }

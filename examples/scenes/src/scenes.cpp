@@ -3,7 +3,9 @@
 #include <crep/core/error.h>
 #include <crep/scenes/scene.h>
 
+#include <algorithm>
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <numbers>
 
@@ -144,6 +146,94 @@ Mesh boxesMesh() {
   return m;
 }
 
+/// The stained-glass hall: a side wall at x = 6 with a large window (z in [-16, 0], y in [2.5, 12.5]) split
+/// by a mullion and a transom, a roof, a far wall and a back wall, on a ground plane.
+constexpr double kWindowX = 6.0, kWindowZ0 = -16.0, kWindowZ1 = 0.0, kWindowY0 = 2.5, kWindowY1 = 12.5;
+
+Mesh stainedGlassMesh() {
+  Mesh m;
+  appendGround(m, 60.0);
+  const double t = 0.6, height = 14.0, z0 = -32.0, z1 = 24.0;
+  const double x0 = kWindowX, x1 = kWindowX + t;
+  // The window wall, around the opening.
+  appendBox(m, {{x0, 0, z0}, {x1, height, kWindowZ0}});
+  appendBox(m, {{x0, 0, kWindowZ1}, {x1, height, z1}});
+  appendBox(m, {{x0, 0, kWindowZ0}, {x1, kWindowY0, kWindowZ1}});
+  appendBox(m, {{x0, kWindowY1, kWindowZ0}, {x1, height, kWindowZ1}});
+  // Mullion and transom (the shafts' dark crosses, also in the shadow map).
+  const double zm = 0.5 * (kWindowZ0 + kWindowZ1), ym = 0.5 * (kWindowY0 + kWindowY1);
+  appendBox(m, {{x0, kWindowY0, zm - 0.2}, {x1, kWindowY1, zm + 0.2}});
+  appendBox(m, {{x0, ym - 0.15, kWindowZ0}, {x1, ym + 0.15, kWindowZ1}});
+  // Roof, far wall, back wall: the window is the hall's only opening toward the sun.
+  appendBox(m, {{-12.0, height, z0}, {x1, height + 0.6, z1}});
+  appendBox(m, {{-12.6, 0, z0}, {-12.0, height, z1}});
+  appendBox(m, {{-12.6, 0, z0 - 0.6}, {x1, height + 0.6, z0}});
+  // Two pillars in the hall, in the shafts.
+  appendBox(m, {{-3.0, 0, -10.0}, {-2.2, height, -9.2}});
+  appendBox(m, {{-3.0, 0, -2.0}, {-2.2, height, -1.2}});
+  return m;
+}
+
+/// A procedural stained-glass window (size x size, linear RGB, row 0 at the bottom): Voronoi panes in
+/// saturated glass colours, dark lead lines between them (about 2.5% of the window wide) and a lead frame;
+/// coarse enough for the reference march's 512 steps per ray (finer lead lines alias in its midpoint
+/// samples).
+Image stainedGlassTexture(int size) {
+  Rng rng(0x57a1ed);
+  const int cells = 24;
+  std::vector<glm::dvec2> sites;
+  std::vector<glm::dvec3> colors;
+  const glm::dvec3 palette[] = {{1.0, 0.12, 0.08}, {0.12, 0.25, 1.0}, {1.0, 0.78, 0.15}, {0.15, 0.85, 0.3},
+                                {0.6, 0.15, 0.95}, {0.1, 0.8, 0.9},   {1.0, 0.45, 0.1},  {0.95, 0.95, 0.8}};
+  for (int i = 0; i < cells; ++i) {
+    sites.emplace_back(rng.uniform(), rng.uniform());
+    colors.push_back(palette[rng.next() % std::size(palette)]);
+  }
+  const double lead = 0.012, frame = 0.03;
+  Image image(size, size, 3);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const glm::dvec2 p((x + 0.5) / size, (y + 0.5) / size);
+      double d1 = 1e9, d2 = 1e9;
+      int nearest = 0;
+      for (int i = 0; i < cells; ++i) {
+        const double d = glm::length(p - sites[static_cast<std::size_t>(i)]);
+        if (d < d1) {
+          d2 = d1;
+          d1 = d;
+          nearest = i;
+        } else if (d < d2) {
+          d2 = d;
+        }
+      }
+      // Distance to the pane's border: half the difference of the two nearest sites' distances (a lower
+      // bound of the distance to the bisector, close enough for lead lines).
+      const double border = 0.5 * (d2 - d1);
+      const double edge = std::min({p.x, p.y, 1.0 - p.x, 1.0 - p.y});
+      const bool leaded = border < lead || edge < frame;
+      const glm::dvec3 c = leaded ? glm::dvec3(0.02) : colors[static_cast<std::size_t>(nearest)];
+      for (int k = 0; k < 3; ++k)
+        image.at(x, y, k) = static_cast<float>(c[k]);
+    }
+  return image;
+}
+
+/// The window's texture projection: orthographic along `sun`, its NDC square the window's silhouette seen
+/// along the sun (the bounds of the opening's four corners in the light's view).
+glm::dmat4 windowTextureClipFromWorld(const DirectionalLight& sun) {
+  const glm::dvec3 d = sun.direction();
+  const glm::dvec3 centre(kWindowX, 0.5 * (kWindowY0 + kWindowY1), 0.5 * (kWindowZ0 + kWindowZ1));
+  const glm::dmat4 view = glm::lookAt(centre - 100.0 * d, centre, glm::dvec3(0.0, 1.0, 0.0));
+  glm::dvec2 lo(1e30), hi(-1e30);
+  for (const double y : {kWindowY0, kWindowY1})
+    for (const double z : {kWindowZ0, kWindowZ1}) {
+      const glm::dvec4 v = view * glm::dvec4(kWindowX, y, z, 1.0);
+      lo = glm::min(lo, glm::dvec2(v));
+      hi = glm::max(hi, glm::dvec2(v));
+    }
+  return glm::ortho(lo.x, hi.x, lo.y, hi.y, 1.0, 300.0) * view;
+}
+
 Medium defaultMedium() {
   return Medium(
       {.mieScattering = glm::dvec3(0.02, 0.022, 0.025), .hgG = 0.6, .absorption = glm::dvec3(0.004)});
@@ -157,6 +247,10 @@ std::vector<std::string> sceneNames() {
 
 std::vector<std::string> localLightSceneNames() {
   return {"colonnade-night"};
+}
+
+std::vector<std::string> lightTextureSceneNames() {
+  return {"stained-glass"};
 }
 
 Scene makeScene(std::string_view name, double aspect) {
@@ -173,6 +267,7 @@ Scene makeScene(std::string_view name, double aspect) {
         {},
         true,
         {},
+        {},
         {}};
     computeBounds(s);
     return s;
@@ -188,6 +283,7 @@ Scene makeScene(std::string_view name, double aspect) {
         {},
         {},
         true,
+        {},
         {},
         {}};
     computeBounds(s);
@@ -206,6 +302,7 @@ Scene makeScene(std::string_view name, double aspect) {
             {},
             true,
             {},
+            {},
             {}};
     computeBounds(s);
     return s;
@@ -219,6 +316,7 @@ Scene makeScene(std::string_view name, double aspect) {
             {},
             {},
             true,
+            {},
             {},
             {}};
     computeBounds(s);
@@ -237,6 +335,7 @@ Scene makeScene(std::string_view name, double aspect) {
         {},
         {},
         true,
+        {},
         {},
         {}};
     computeBounds(s);
@@ -257,6 +356,7 @@ Scene makeScene(std::string_view name, double aspect) {
         {},
         false,
         {},
+        {},
         {}};
     const auto lamp = [](const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& color) {
       return SpotLight({.position = position,
@@ -274,8 +374,31 @@ Scene makeScene(std::string_view name, double aspect) {
     computeBounds(s);
     return s;
   }
+  if (name == "stained-glass") {
+    // Light textures (Klehm et al. 2014, Sec. 3.2; Yusov 2012's coloured shafts): a hall lit only through a
+    // large window in its side wall; the sun, low and from the side, textured with a procedural
+    // stained-glass pattern projected orthographically over the window, paints coloured shafts across
+    // the hall and coloured patches on its floor and far wall.
+    Scene s{
+        "stained-glass",
+        stainedGlassMesh(),
+        Camera::lookAt({-9.0, 2.0, 9.0}, {2.0, 6.0, -10.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
+        DirectionalLight(glm::dvec3(-0.75, -0.5, -0.22), glm::dvec3(10.0, 9.5, 8.5)),
+        Medium(
+            {.mieScattering = glm::dvec3(0.05, 0.052, 0.055), .hgG = 0.55, .absorption = glm::dvec3(0.004)}),
+        {},
+        {},
+        true,
+        {},
+        {},
+        {}};
+    s.sunTexture = SceneLightTexture{stainedGlassTexture(128), windowTextureClipFromWorld(s.sun)};
+    computeBounds(s);
+    return s;
+  }
   throw InvalidArgument("scene", std::string(name),
-                        "must be one of colonnade, forest, terrain, boxes, sunset, colonnade-night");
+                        "must be one of colonnade, forest, terrain, boxes, sunset, colonnade-night, "
+                        "stained-glass");
 }
 
 } // namespace crep::scenes

@@ -30,6 +30,13 @@ struct Box {
   glm::dvec3 min, max;
 };
 
+/// A light texture of a scene (crep/scatter/light_texture.h): linear RGB, row 0 at the bottom, and its
+/// projection along the light's rays.
+struct SceneLightTexture {
+  Image rgb;
+  glm::dmat4 textureClipFromWorld{1.0};
+};
+
 struct Scene {
   std::string name;
   Mesh mesh;
@@ -42,6 +49,8 @@ struct Scene {
   /// Local lights (Klehm et al. 2014, Sec. 3.2), added to the sun's scattering.
   std::vector<SpotLight> spotLights;
   std::vector<PointLight> pointLights;
+  /// The sun's light texture (a stained-glass window), if any.
+  std::optional<SceneLightTexture> sunTexture;
 };
 
 /// The sunlit scenes accepted by makeScene: "colonnade" (default), "forest", "terrain", "boxes" (an
@@ -51,6 +60,10 @@ std::vector<std::string> sceneNames();
 /// The scenes with local lights, also accepted by makeScene: "colonnade-night" (the colonnade without a
 /// sun, three spot lamps outside the view shining through the pillars and along the hall).
 std::vector<std::string> localLightSceneNames();
+/// The scenes with a light texture, also accepted by makeScene: "stained-glass" (a hall whose side wall has a
+/// large window; the sun shines through it, textured with a procedural stained-glass pattern projected
+/// orthographically over the window).
+std::vector<std::string> lightTextureSceneNames();
 /// Builds a scene. `aspect` sets the default camera's aspect ratio. Throws InvalidArgument naming
 /// "scene" for an unknown name.
 Scene makeScene(std::string_view name, double aspect = 16.0 / 9.0);

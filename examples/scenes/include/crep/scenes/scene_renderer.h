@@ -62,6 +62,10 @@ public:
       std::uint32_t shadowMap = 0;
     };
     std::vector<Spot> spots;
+    /// The sun's light texture (crep/scatter/light_texture.h), a GL_TEXTURE_2D whose RGB multiplies the
+    /// sun's irradiance, projected with sunTextureClipFromWorld; 0 = none.
+    std::uint32_t sunTexture = 0;
+    glm::dmat4 sunTextureClipFromWorld{1.0};
   };
   static constexpr int kMaxShadeSpots = 4;
   /// Renders lit surfaces into the caller's colour texture (RGBA16F or RGBA32F) and depth texture
