@@ -709,6 +709,59 @@ void localLightScene(const BenchOptions& o) {
   if (prefilterMs > 0.0) std::printf("minmax / prefilter on the spot scene: %.2f\n", minmaxMs / prefilterMs);
 }
 
+/// Light textures (README "Light textures"; Klehm et al. 2014, Sec. 3.2): the stained-glass scene's
+/// prefiltered frame (crep::Scattering, the tool's `prefilter` method) with the sun's stained-glass texture
+/// and without it, on the same SceneFrame, measured side by side in one run: the two variants alternate
+/// (textured, untextured, textured, ...) after one warm-up each, so load on the shared machine falls on
+/// both alike; per-frame ms = the sum of the median per-frame stages (as in "methods side by side").
+void lightTextures(const BenchOptions& o) {
+  if (!squareMapOk(o, "light textures", Scattering::CreateInfo{}.mapSizeMultiple())) return;
+  const int repeat = std::max(1, std::min(o.repeat, 5));
+  tool::StageTimings setupTimings;
+  tool::SceneFrame s =
+      tool::makeSceneFrame("stained-glass", o.screenWidth, o.screenHeight, o.mapWidth, setupTimings);
+  tool::MethodSettings settings;
+  settings.mapSize = o.mapWidth;
+  settings.prefilter.bases = o.bases;
+  const tool::Method& prefilterMethod = tool::findMethod("prefilter");
+  tool::LightTextureMap texture = std::move(s.frame->lightTexture);
+  std::map<std::string, std::vector<double>> stageMs[2]; // [0] textured, [1] untextured
+  std::vector<std::string> order[2];
+  for (int i = 0; i < repeat + 1; ++i)
+    for (int variant = 0; variant < 2; ++variant) {
+      if (variant == 0) s.frame->lightTexture = std::move(texture);
+      const tool::MethodOutput out = prefilterMethod.run(*s.frame, settings);
+      if (variant == 0) texture = std::move(s.frame->lightTexture);
+      if (i == 0) continue; // warm-up: shader builds, the textured passes on first use
+      std::map<std::string, double> run;
+      for (const auto& r : out.timings.rows()) {
+        if (!run.count(r.stage) && !stageMs[variant].count(r.stage)) order[variant].push_back(r.stage);
+        run[r.stage] += r.ms;
+      }
+      for (const auto& [stage, ms] : run)
+        stageMs[variant][stage].push_back(ms);
+    }
+  double frameMs[2] = {0.0, 0.0};
+  std::string stages[2];
+  for (int variant = 0; variant < 2; ++variant)
+    for (const std::string& stage : order[variant]) {
+      if (!perFrameStage(stage)) continue;
+      const double ms = median(stageMs[variant][stage]);
+      frameMs[variant] += ms;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s %.2f", stages[variant].empty() ? "" : ", ", stage.c_str(), ms);
+      stages[variant] += buf;
+    }
+  std::printf("\nlight textures (stained-glass: the sun through a window, a %dx%d stained-glass texture; "
+              "%dx%d, map %d^2, M = %d;\ncrep::Scattering per-frame ms, textured and untextured alternating "
+              "in one run, median of %d each after a warm-up):\n",
+              texture.image.width(), texture.image.height(), o.screenWidth, o.screenHeight, o.mapWidth,
+              o.bases, repeat);
+  std::printf("  textured    %10.2f ms   %s\n", frameMs[0], stages[0].c_str());
+  std::printf("  untextured  %10.2f ms   %s\n", frameMs[1], stages[1].c_str());
+  if (frameMs[1] > 0.0) std::printf("textured / untextured: %.2f\n", frameMs[0] / frameMs[1]);
+}
+
 void runBenchSuite(const BenchOptions& o) {
   scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
   tool::StageTimings contextTimings;
@@ -796,6 +849,7 @@ void runBenchSuite(const BenchOptions& o) {
   memoryTable(o);
   localLights(o);
   localLightScene(o);
+  lightTextures(o);
   constantCost(o);
   reducedResolution(o);
   methodsSideBySide(o);
