@@ -56,6 +56,11 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   validate(info.evaluate, "Scattering::CreateInfo.evaluate");
   if (info.localLightBases != 0)
     validateBases(info.localLightBases, "Scattering::CreateInfo.localLightBases");
+  if (info.localLightTableSamples != 0 &&
+      (info.localLightTableSamples < 2 || info.localLightTableSamples > kMaxVisibilityTableSamples))
+    invalid("Scattering::CreateInfo.localLightTableSamples", std::to_string(info.localLightTableSamples),
+            "must be 0 (evaluate.visibilityTableSamples) or in [2, " +
+                std::to_string(kMaxVisibilityTableSamples) + "]");
   validate(info.epipoleBlock);
   const int regions = info.rectify.splits * info.prefilter.regionsPerSplit;
   if (info.mapSize % regions != 0)
@@ -256,24 +261,34 @@ struct Scattering::Impl {
   std::optional<DepthTarget> localShadowMap;
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
   gl::Handle localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
-  /// CreateInfo::localLightBases when it differs from prefilter.bases: the local lights' own passes.
+  /// CreateInfo::localLightBases / localLightTableSamples when they differ from the directional light's:
+  /// the local lights' own passes.
   std::optional<PrefilterPass> localPrefilter;
   std::optional<EvaluatePass> localEvaluate;
+  int localBases() const { return info.localLightBases == 0 ? info.prefilter.bases : info.localLightBases; }
+  int localTableSamples() const {
+    const int Z = info.evaluate.visibilityTableSamples;
+    return Z == 0 || info.localLightTableSamples == 0 ? Z : info.localLightTableSamples;
+  }
   /// The prefilter and evaluation of local lights (their own passes, or the directional light's).
   PrefilterPass& localLightPrefilter() {
-    const int M = info.localLightBases;
-    if (M == 0 || M == info.prefilter.bases) return prefilter;
+    if (localBases() == info.prefilter.bases) return prefilter;
     if (!localPrefilter) {
       PrefilterOptions options = info.prefilter;
-      options.bases = M;
+      options.bases = localBases();
       localPrefilter.emplace(PrefilterPass::CreateInfo{info.mapSize, info.mapSize, options});
-      localEvaluate.emplace(EvaluatePass::CreateInfo{M, info.evaluate});
     }
     return *localPrefilter;
   }
   EvaluatePass& localLightEvaluate() {
-    localLightPrefilter();
-    return localEvaluate ? *localEvaluate : evaluate;
+    if (localBases() == info.prefilter.bases && localTableSamples() == info.evaluate.visibilityTableSamples)
+      return evaluate;
+    if (!localEvaluate) {
+      EvaluateOptions options = info.evaluate;
+      options.visibilityTableSamples = localTableSamples();
+      localEvaluate.emplace(EvaluatePass::CreateInfo{localBases(), options});
+    }
+    return *localEvaluate;
   }
   /// Light textures: the colour map of a rectified map (mapSize^2), made on the first textured frame.
   std::optional<LightColorMapPass> colorMap;
@@ -341,7 +356,8 @@ std::size_t Scattering::memoryBytes() const noexcept {
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
   if (m.localRectified) bytes += m.localRectified->memoryBytes();
-  if (m.localPrefilter) bytes += m.localPrefilter->memoryBytes() + m.localEvaluate->memoryBytes();
+  if (m.localPrefilter) bytes += m.localPrefilter->memoryBytes();
+  if (m.localEvaluate) bytes += m.localEvaluate->memoryBytes();
   if (m.localResampled) bytes += map;
   if (m.colorMap) bytes += m.colorMap->memoryBytes();
   if (m.localScattering)

@@ -159,7 +159,8 @@ TEST_CASE("Scattering, point light at the camera's position: finite and equal to
   CHECK(m.relativeRmse < 0.02);
 }
 
-TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad values named") {
+TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad values of it and of "
+          "localLightTableSamples named") {
   CREP_REQUIRE_GL();
   ScatteringFixture f("colonnade");
   f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0)));
@@ -194,6 +195,12 @@ TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad val
   report("localLightBases 2M vs M", m);
   CHECK(m.maxAbsError > 0.0);
   CHECK(m.relativeRmse < 0.02);
+  for (const int bad : {-1, 1, 5000}) {
+    Scattering::CreateInfo info = caseInfo();
+    info.localLightTableSamples = bad;
+    CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.localLightTableSamples"),
+                         crep::InvalidArgument);
+  }
   for (const int bad : {-2, 3, 130}) {
     Scattering::CreateInfo info = caseInfo();
     info.localLightBases = bad;
