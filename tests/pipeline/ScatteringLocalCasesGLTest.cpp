@@ -23,28 +23,9 @@ namespace {
 
 /// World-space reference of the lights `faces` (a spot: one), each with its own perspective shadow map.
 Image reference(ScatteringFixture& f, const std::vector<std::pair<LocalLight, glm::dmat4>>& faces) {
-  static WorldMarchPass march({{.steps = 256, .refinements = 12}});
   Image sum(kWidth, kHeight, 4);
-  const gl::Handle shadow = scenes::createDepthTexture(1024, 1024);
-  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
-  for (const auto& [light, clipFromWorld] : faces) {
-    f.renderer.renderDepth(clipFromWorld, shadow.get(), 0, 0, 0, 1024, 1024, {.depthClamp = true});
-    WorldMarchPass::FrameAttribs b;
-    b.camera = &f.scene.camera;
-    b.localLight = &light;
-    b.medium = &f.scene.medium;
-    b.cameraDepth = f.cameraDepth.get();
-    b.shadowMap = shadow.get();
-    b.lightClipFromWorld = clipFromWorld;
-    b.bias = 1e-4;
-    b.output = out.get();
-    march.run(b);
-    const Image one = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
-    for (int y = 0; y < kHeight; ++y)
-      for (int x = 0; x < kWidth; ++x)
-        for (int c = 0; c < 3; ++c)
-          sum.at(x, y, c) += one.at(x, y, c);
-  }
+  for (const auto& [light, clipFromWorld] : faces)
+    addInto(sum, localReference(f, light, clipFromWorld));
   return sum;
 }
 

@@ -27,33 +27,6 @@ namespace {
 
 constexpr int kLocalShadow = 1024; // the engine's perspective maps (Scattering's own: ownShadowMapSize, 1024)
 
-/// The world-space reference of one local light (as in ScatteringLocalGLTest): its perspective shadow map
-/// rendered from the scene (1024^2), the GPU march with 256 steps.
-Image localReference(ScatteringFixture& f, const LocalLight& light, const glm::dmat4& lightClipFromWorld) {
-  static WorldMarchPass march({{.steps = 256, .refinements = 12}});
-  const gl::Handle shadow = scenes::createDepthTexture(1024, 1024);
-  f.renderer.renderDepth(lightClipFromWorld, shadow.get(), 0, 0, 0, 1024, 1024, {.depthClamp = true});
-  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
-  WorldMarchPass::FrameAttribs b;
-  b.camera = &f.scene.camera;
-  b.localLight = &light;
-  b.medium = &f.scene.medium;
-  b.cameraDepth = f.cameraDepth.get();
-  b.shadowMap = shadow.get();
-  b.lightClipFromWorld = lightClipFromWorld;
-  b.bias = 1e-4;
-  b.output = out.get();
-  march.run(b);
-  return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
-}
-
-void addInto(Image& sum, const Image& add) {
-  for (int y = 0; y < sum.height(); ++y)
-    for (int x = 0; x < sum.width(); ++x)
-      for (int c = 0; c < 3; ++c)
-        sum.at(x, y, c) += add.at(x, y, c);
-}
-
 /// Largest |difference| of the A channels (the transmittance).
 double alphaDifference(const Image& a, const Image& b) {
   double worst = 0.0;

@@ -11,6 +11,7 @@
 #include <crep/epipolar/gpu_march.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_world_march.h>
+#include <crep/scatter/ray_scattering.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 
@@ -148,6 +149,35 @@ inline double discRelativeRmse(const Image& actual, const Image& reference, cons
       }
     }
   return n == 0 ? -1.0 : std::sqrt(e2 / std::max(r2, 1e-300));
+}
+
+/// The world-space reference of one local light (a spot or a point-light face): its perspective shadow map
+/// rendered from the scene (1024^2, depth clamp), the GPU march with 256 steps against it.
+inline Image localReference(ScatteringFixture& f, const LocalLight& light,
+                            const glm::dmat4& lightClipFromWorld) {
+  static WorldMarchPass march({{.steps = 256, .refinements = 12}});
+  const gl::Handle shadow = scenes::createDepthTexture(1024, 1024);
+  f.renderer.renderDepth(lightClipFromWorld, shadow.get(), 0, 0, 0, 1024, 1024, {.depthClamp = true});
+  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+  WorldMarchPass::FrameAttribs b;
+  b.camera = &f.scene.camera;
+  b.localLight = &light;
+  b.medium = &f.scene.medium;
+  b.cameraDepth = f.cameraDepth.get();
+  b.shadowMap = shadow.get();
+  b.lightClipFromWorld = lightClipFromWorld;
+  b.bias = 1e-4;
+  b.output = out.get();
+  march.run(b);
+  return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
+}
+
+/// sum.rgb += add.rgb.
+inline void addInto(Image& sum, const Image& add) {
+  for (int y = 0; y < sum.height(); ++y)
+    for (int x = 0; x < sum.width(); ++x)
+      for (int c = 0; c < 3; ++c)
+        sum.at(x, y, c) += add.at(x, y, c);
 }
 
 } // namespace crep::test
