@@ -6,6 +6,7 @@
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 #include "support/tool_runner.h"
+#include "tool/frame_json_util.h"
 
 #include <crep/core/camera.h>
 #include <crep/core/light.h>
@@ -31,7 +32,7 @@
 
 namespace {
 
-using Json = nlohmann::json;
+using namespace crep::test::frame_json;
 
 constexpr int kWidth = 160, kHeight = 90;
 // Reference march sections (the tool's --steps and the CPU reference's). With 64 the pillars' shadows change
@@ -47,16 +48,6 @@ glm::dmat4 matrix(const Json& j) {
 glm::dvec3 vec3(const Json& j) {
   return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
 }
-Json matrixJson(const glm::dmat4& m) {
-  Json j = Json::array();
-  for (int k = 0; k < 16; ++k)
-    j.push_back(m[k / 4][k % 4]);
-  return j;
-}
-Json vecJson(const glm::dvec3& v) {
-  return Json::array({v.x, v.y, v.z});
-}
-
 Json readJson(const std::filesystem::path& path) {
   std::ifstream in(path);
   std::stringstream s;

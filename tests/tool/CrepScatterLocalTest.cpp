@@ -3,6 +3,7 @@
 // file, never a crash. The valid frames themselves run in CrepScatterLocalGLTest.
 #include "support/image_check.h"
 #include "support/tool_runner.h"
+#include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
 #include <crep/core/light.h>
@@ -20,38 +21,7 @@
 
 namespace {
 
-using Json = nlohmann::json;
-const std::string kExample = std::string(CREP_SOURCE_DIR) + "/examples/data/frame.json";
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Json matrixJson(const glm::dmat4& m) {
-  Json j = Json::array();
-  for (int k = 0; k < 16; ++k)
-    j.push_back(m[k / 4][k % 4]);
-  return j;
-}
-
-Json vecJson(const glm::dvec3& v) {
-  return Json::array({v.x, v.y, v.z});
-}
-
-/// The spot light of these frames (in front of the example camera's ground, off screen above it).
-crep::SpotLight spot() {
-  return crep::SpotLight({.position = {-6.0, 8.0, 4.0},
-                          .direction = {6.0, -8.0, -8.0},
-                          .innerConeAngle = 20.0 * 3.14159265358979 / 180.0,
-                          .outerConeAngle = 30.0 * 3.14159265358979 / 180.0,
-                          .color = {1.0, 0.9, 0.8},
-                          .intensity = 30.0,
-                          .range = 60.0,
-                          .nearPlane = 0.1});
-}
+using namespace crep::test::frame_json;
 
 /// A directory with a spot-light frame (the example's camera and medium, light.type "spot") plus one
 /// additional point light in "lights": depth.exr (160x90, 0.9), shadow.exr (the spot's, 128x128, empty),
@@ -64,7 +34,7 @@ struct SpotInputs {
     crep::writeExr(dir / "shadow.exr", crep::Image(128, 128, 1, 1.0f), crep::ExrPixelType::Float);
     crep::writeExr(dir / "point.exr", crep::Image(32, 192, 1, 1.0f), crep::ExrPixelType::Float);
     frame = Json::parse(readText(kExample));
-    const crep::SpotLight s = spot();
+    const crep::SpotLight s = exampleSpot();
     frame["light"] = {{"type", "spot"},
                       {"position", vecJson(s.position())},
                       {"direction", vecJson(s.direction())},

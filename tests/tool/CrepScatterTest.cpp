@@ -3,6 +3,7 @@
 // field or the file, never crash.
 #include "support/image_check.h"
 #include "support/tool_runner.h"
+#include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
 #include <crep/support/exr.h>
@@ -22,15 +23,7 @@
 
 namespace {
 
-using Json = nlohmann::json;
-const std::string kExample = std::string(CREP_SOURCE_DIR) + "/examples/data/frame.json";
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using namespace crep::test::frame_json;
 
 void writeText(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;

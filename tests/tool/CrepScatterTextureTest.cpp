@@ -3,6 +3,7 @@
 // 1 and a message naming the JSON path, never a crash. The valid frames run in CrepScatterTextureGLTest.
 #include "support/image_check.h"
 #include "support/tool_runner.h"
+#include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
 #include <crep/core/light.h>
@@ -22,37 +23,7 @@
 
 namespace {
 
-using Json = nlohmann::json;
-const std::string kExample = std::string(CREP_SOURCE_DIR) + "/examples/data/frame.json";
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-Json matrixJson(const glm::dmat4& m) {
-  Json j = Json::array();
-  for (int k = 0; k < 16; ++k)
-    j.push_back(m[k / 4][k % 4]);
-  return j;
-}
-
-Json vecJson(const glm::dvec3& v) {
-  return Json::array({v.x, v.y, v.z});
-}
-
-crep::SpotLight spot() {
-  return crep::SpotLight({.position = {-6.0, 8.0, 4.0},
-                          .direction = {6.0, -8.0, -8.0},
-                          .innerConeAngle = 20.0 * 3.14159265358979 / 180.0,
-                          .outerConeAngle = 30.0 * 3.14159265358979 / 180.0,
-                          .color = {1.0, 0.9, 0.8},
-                          .intensity = 30.0,
-                          .range = 60.0,
-                          .nearPlane = 0.1});
-}
+using namespace crep::test::frame_json;
 
 /// The example frame (a directional light) with light.texture "window.exr" (8x8 RGB), plus the inputs:
 /// depth.exr (160x90, 0.9), shadow.exr (256x256, empty), and bad textures: grey.exr (1 channel),
@@ -89,7 +60,7 @@ struct TextureInputs {
 
 /// A spot entry of "lights" (its map spot.exr) with a texture.
 Json spotEntry() {
-  const crep::SpotLight s = spot();
+  const crep::SpotLight s = exampleSpot();
   return Json{
       {"type", "spot"},
       {"position", vecJson(s.position())},
@@ -200,7 +171,7 @@ TEST_CASE("crep scatter light textures: every check names the JSON path") {
       {"spot projection not centred at the spot",
        [](Json& j) {
          Json e = spotEntry();
-         const crep::SpotLight s = spot();
+         const crep::SpotLight s = exampleSpot();
          e["textureClipFromWorld"] = matrixJson(
              glm::perspective(1.2, 1.0, 0.1, 60.0) *
              glm::lookAt(s.position() + glm::dvec3(0.5, 0.0, 0.0), glm::dvec3(0.0), glm::dvec3(0, 1, 0)));
