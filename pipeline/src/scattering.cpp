@@ -380,7 +380,17 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     invalid("Scattering::FrameAttribs.light", "null", "must be set unless local lights are given");
   if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
   gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
-  gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
+  if (f.output != 0 || !f.froxels)
+    gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
+  if (f.froxels) {
+    if (!f.light)
+      invalid("Scattering::FrameAttribs.froxels", "set without a directional light",
+              "needs FrameAttribs::light (local lights are not added to froxel volumes)");
+    if (f.output == 0 && local)
+      invalid("Scattering::FrameAttribs.output", "0",
+              "must be set with local lights (they are added to the per-pixel output only)");
+    invalid("Scattering::FrameAttribs.froxels", "set", "froxel volumes are not implemented yet");
+  }
   if (f.light && !f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
   validateLocalShadowMaps(f);

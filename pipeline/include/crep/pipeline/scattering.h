@@ -55,6 +55,14 @@
 // false with visibilityTableSamples > 0): those have no textured variant (InvalidArgument). Point lights
 // take no texture. Without textures nothing of this runs or is allocated.
 //
+// Froxel volumes (Wronski 2014's frustum-aligned volume for transparent surfaces and particles at any depth;
+// crep/scatter/froxel_grid.h): FrameAttribs::froxels fills a caller's 3D texture with the same frame's
+// prefiltered evaluation (EvaluatePass::FrameAttribs::froxels), texel (x, y, z) = the evaluation of the ray
+// through the cell's (u, v) up to its sample view depth, no accumulation pass and no exponential-shadow-map
+// light leaking. `output` may then be 0 (only the volume). Directional light only: local lights are not
+// added to the volume, and on epipolar frames the cells inside the epipole block are evaluated by the
+// prefiltered method too (not marched: WorldMarchPass has no 3D target); the stage "froxels" times it.
+//
 // GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
 // clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
 #pragma once
@@ -74,6 +82,7 @@
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
+#include <crep/scatter/froxel_grid.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/world_march.h>
 
@@ -169,6 +178,17 @@ public:
         0.0; ///< added to the stored depth by the world-space marches (epipole block, local fallback)
   };
 
+  /// A froxel volume filled by the same frame's prefiltered evaluation (see "Froxel volumes" at the top).
+  struct FroxelTarget {
+    /// GL_TEXTURE_3D of grid.width x grid.height x grid.depth texels, GL_RGBA16F or GL_RGBA32F: texel (x, y,
+    /// z) = RGB in-scattered radiance from the camera to the cell's sample point along the pixel ray
+    /// through its (u, v), A = grey transmittance exp(-sbar d) to it (crep/scatter/ray.h's convention).
+    std::uint32_t volume = 0;
+    FroxelGrid grid; ///< the volume's cells and depth range (crep/scatter/froxel_grid.h)
+    /// The sample point's offset in cells, each component in [-0.5, 0.5] (e.g. froxelJitter(frame)).
+    glm::dvec3 jitter{0.0};
+  };
+
   struct FrameAttribs {
     /// The camera of cameraDepth, in your conventions: Camera::fromMatrices(viewFromWorld, clipFromView,
     /// clipDepth, maxDistance) (reversed-Z, [0, 1] clip depth, infinite far plane, jitter, asymmetric
@@ -181,7 +201,10 @@ public:
     /// GL_TEXTURE_2D, width x height, depth-buffer values of `camera` in its convention: D32F, D24S8 / D24
     /// (read as depth) or R32F.
     std::uint32_t cameraDepth = 0;
-    std::uint32_t output = 0; ///< GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance
+    /// GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance. May be 0 when `froxels` is
+    /// given and no local light is (only the volume is filled; the per-pixel evaluation and the epipole
+    /// block are skipped).
+    std::uint32_t output = 0;
     std::function<void(const glm::dmat4& clipFromWorld)> drawCasters; ///< see the top; may be empty
     const ShadowMap* shadowMap = nullptr;                             ///< see the top; may be null
     /// Local lights added to the result (see the top); they need drawCasters unless their maps are given.
@@ -196,6 +219,9 @@ public:
     /// Empty, or one per spotLights entry (its projection perspective from the spot's position); an entry
     /// whose texture is 0 is untextured.
     std::span<const GpuLightTexture> spotLightTextures;
+    /// Froxel volumes (see the top): null, or a volume to fill with this frame's basis; needs `light`. At
+    /// least one of `output` and `froxels` must be given.
+    const FroxelTarget* froxels = nullptr;
   };
 
   /// What a local light (or one point-light face) cost and how it was computed.
