@@ -1,0 +1,25 @@
+#version 450 core
+// Exponential shadow map, step 2 (Wronski 2014: a separable box filter in two passes; crep::buildEsm, rule
+// 1 of crep/postfx/froxel_fog.h): the mean of the 2r + 1 texels along `crep_direction` (0: x, 1: y),
+// clamped to the edge, of the stored values exp(c (d - 1)) themselves (linear space).
+// Resources: params block (binding 0), input ESM (unit 0, texelFetch), output R32F (image 0).
+#include "crep/froxel.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(location = 0) uniform int crep_direction;
+layout(binding = 0) uniform sampler2D esmIn;
+layout(binding = 0, r32f) uniform writeonly image2D esmOut;
+
+void main() {
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = crep_froxel.sizes.zw;
+  if (any(greaterThanEqual(texel, size))) return;
+  int r = crep_froxel.info.y;
+  ivec2 axis = crep_direction == 0 ? ivec2(1, 0) : ivec2(0, 1);
+  float sum = 0.0;
+  for (int k = -r; k <= r; ++k)
+    sum += texelFetch(esmIn, clamp(texel + k * axis, ivec2(0), size - 1), 0).r;
+  imageStore(esmOut, texel, vec4(sum / float(2 * r + 1)));
+}

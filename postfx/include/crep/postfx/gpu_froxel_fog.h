@@ -1,0 +1,285 @@
+// The froxel fog on the GPU (Wronski 2014, "Volumetric Fog"): the GL passes of the stages whose CPU
+// references and rules are in crep/postfx/froxel_fog.h (rules 1-5), and the front door FroxelFog that runs
+// them once per frame and owns the volumes.
+//
+//   EsmPass              esm_downsample.comp + esm_blur.comp (x, then y)   rule 1   -> R32F ESM
+//   FroxelLightingPass   froxel_light.comp, one thread per cell            rule 2   -> lighting volume
+//   FroxelAccumulatePass froxel_accumulate.comp, one thread per column     rule 3   (in place) -> integrated
+//   FroxelTemporalPass   froxel_temporal.comp, one thread per cell         rule 5   -> blended volume
+//   FroxelApplyPass      froxel_apply.comp, one thread per pixel           rule 4   -> RGBA32F image
+//
+// Volumes are GL_TEXTURE_3D of the grid's size in GL_RGBA16F (default: 8 bytes per cell, 7.4 MB at 160 x 90
+// x 64) or GL_RGBA32F (16 bytes per cell, for tests against the CPU references). An integrated volume holds
+// at texel (x, y, z), for the cell's sample point, RGB = the in-scattered radiance from the camera to that
+// point along the pixel ray through it, A = the grey transmittance exp(-sbar d) to it: the format shared
+// with the prefiltered fill of crep::Scattering (Scattering::FrameAttribs::froxels). Float precision.
+//
+// Every pass requires a current OpenGL 4.5 context and never creates or owns one; it owns its programs,
+// buffers and samplers (RAII); the textures of FrameAttribs are the caller's. Each leaves program 0, texture
+// units, samplers, image units and uniform buffer bindings 0-1 unbound (gl::unbindPassState(2)) and issues
+// gl::passOutputBarrier(). NaN inputs never crash a pass: a NaN shadow-map texel counts as empty (lit), a
+// NaN camera depth as the sky, non-finite lighting is stored as 0 and the temporal pass never lets a
+// non-finite value through (rule 5). Sizes are the textures' own, checked against the grid; a grid beyond
+// GL_MAX_3D_TEXTURE_SIZE is an InvalidArgument naming the grid field.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/gl.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/postfx/froxel_fog.h>
+#include <crep/scatter/froxel_grid.h>
+
+namespace crep {
+namespace gpu {
+
+/// std140 twin of CrepFroxelCamera (glsl/crep/froxel.glsl): gpu::GpuCamera's vectors.
+struct FroxelCamera {
+  glm::vec4 position{0.0f}; ///< xyz world; w near
+  glm::vec4 forward{0.0f};  ///< xyz unit; w integration far
+  glm::vec4 right{0.0f};    ///< xyz right * half width at unit distance
+  glm::vec4 up{0.0f};       ///< xyz up * half height at unit distance
+  glm::vec4 center{0.0f};   ///< xyz the image centre's offset from forward
+};
+static_assert(sizeof(FroxelCamera) == 80, "std140 CrepFroxelCamera");
+
+/// std140 block CrepFroxelBlock { CrepFroxelParams crep_froxel; } of every froxel and ESM pass.
+struct FroxelParams {
+  FroxelCamera camera;
+  FroxelCamera previous;
+  glm::vec4 cameraDepth{0.0f};    ///< near, projection far (0 = infinite), far, 1 = reversed-Z
+  glm::vec4 range{0.0f};          ///< x near, y far of the volume; zw the previous frame's
+  glm::ivec4 grid{0};             ///< xyz cells; w 1 = history valid
+  glm::vec4 jitter{0.0f};         ///< xyz sample offset (cells); w history weight
+  glm::vec4 lightDirection{0.0f}; ///< xyz
+  glm::vec4 lightIrradiance{0.0f};
+  glm::vec4 mieScattering{0.0f}; ///< rgb; w g
+  glm::vec4 rayleighScattering{0.0f};
+  glm::vec4 extinction{0.0f}; ///< rgb sigma_t; w sbar
+  glm::vec4 ambient{0.0f};
+  glm::vec4 density{0.0f};     ///< height base, height falloff, noise amplitude, noise frequency
+  glm::vec4 noiseOffset{0.0f}; ///< xyz
+  glm::vec4 esm{0.0f};         ///< x exponent, y bias, z 1 = ESM shadowing on
+  glm::ivec4 sizes{0};         ///< xy shadow map (ESM passes) or camera image (apply), zw ESM
+  glm::ivec4 info{0};          ///< x downsample, y blur radius
+  glm::mat4 lightClipFromWorld{1.0f};
+};
+static_assert(sizeof(FroxelParams) == 2 * 80 + 15 * 16 + 64, "std140 CrepFroxelParams");
+
+/// The camera members of FroxelParams (gpuCamera's vectors).
+FroxelCamera froxelCamera(const Camera& camera);
+
+} // namespace gpu
+
+/// Throws InvalidArgument naming `owner`.format unless `format` is GL_RGBA16F or GL_RGBA32F.
+void validateFroxelFormat(std::uint32_t format, const char* owner);
+/// A GL_TEXTURE_3D of the grid's size in `format`, after checking the grid (validate) and
+/// GL_MAX_3D_TEXTURE_SIZE (InvalidArgument naming `owner`.grid.width / height / depth).
+gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, const char* owner);
+
+/// Rule 1 on the GPU: the ESM of a standard shadow map (downsample, then the separable box blur). Owns
+/// its R32F textures (reallocated when the map's size changes).
+class EsmPass {
+public:
+  struct CreateInfo {
+    EsmOptions options;
+  };
+  struct FrameAttribs {
+    /// GL_TEXTURE_2D of depth-buffer values in [0, 1] (a depth format or GL_R32F), read with texelFetch
+    std::uint32_t shadowMap = 0;
+  };
+  /// Throws InvalidArgument naming "EsmPass::CreateInfo.options.<field>".
+  explicit EsmPass(const CreateInfo& info);
+  void run(const FrameAttribs& frame);
+  std::uint32_t esm() const noexcept { return esm_.get(); } ///< R32F, ceil(W / f) x ceil(H / f)
+  int width() const noexcept { return width_; }
+  int height() const noexcept { return height_; }
+  std::size_t memoryBytes() const noexcept; ///< both R32F textures
+
+private:
+  CreateInfo info_;
+  gl::Handle downsample_, blur_, params_, sampler_, esm_, scratch_;
+  int width_ = 0, height_ = 0;
+};
+
+/// Rule 2 on the GPU: the lighting volume.
+class FroxelLightingPass {
+public:
+  struct CreateInfo {
+    FroxelGrid grid;
+    FroxelDensity density;
+    glm::dvec3 ambient{0.0};
+    EsmOptions esm;                ///< exponent and bias of the test (the ESM's own build is EsmPass's)
+    std::uint32_t format = 0x881A; ///< GL_RGBA16F or GL_RGBA32F (0x8814)
+  };
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    const DirectionalLight* light = nullptr;
+    const Medium* medium = nullptr;
+    std::uint32_t esm = 0; ///< EsmPass::esm(), or 0: every point lit
+    glm::dmat4 lightClipFromWorld{1.0};
+    glm::dvec3 jitter{0.0}; ///< cells, each in [-0.5, 0.5]
+    glm::dvec3 noiseOffset{0.0};
+    std::uint32_t output = 0; ///< GL_TEXTURE_3D, grid size, CreateInfo::format
+  };
+  explicit FroxelLightingPass(const CreateInfo& info);
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, params_, sampler_;
+};
+
+/// Rule 3 on the GPU: the lighting volume integrated front to back, in place.
+class FroxelAccumulatePass {
+public:
+  struct CreateInfo {
+    FroxelGrid grid;
+    std::uint32_t format = 0x881A; ///< GL_RGBA16F or GL_RGBA32F
+  };
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    const Medium* medium = nullptr; ///< its extinction ratios sigma_c / sbar
+    glm::dvec3 jitter{0.0};         ///< the jitter the volume was lit with
+    std::uint32_t volume = 0;       ///< GL_TEXTURE_3D, grid size, CreateInfo::format: read and written
+  };
+  explicit FroxelAccumulatePass(const CreateInfo& info);
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, params_;
+};
+
+/// Rule 5 on the GPU: the history reprojected, clamped and blended with the current volume.
+class FroxelTemporalPass {
+public:
+  struct CreateInfo {
+    FroxelGrid grid;
+    std::uint32_t format = 0x881A; ///< of the output (GL_RGBA16F or GL_RGBA32F)
+  };
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    /// The camera of `history`; nullptr = no history (first frame, camera cut): the current volume with its
+    /// non-finite values replaced.
+    const Camera* previousCamera = nullptr;
+    double historyWeight = 0.9; ///< in [0, 1)
+    std::uint32_t current = 0;  ///< integrated GL_TEXTURE_3D, grid size
+    std::uint32_t history = 0;  ///< last frame's output (grid size), or 0 with previousCamera nullptr
+    std::uint32_t output = 0;   ///< GL_TEXTURE_3D, grid size, CreateInfo::format; not current or history
+  };
+  explicit FroxelTemporalPass(const CreateInfo& info);
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, params_, nearest_, linear_;
+};
+
+/// Rule 4 on the GPU: one trilinear fetch per pixel.
+class FroxelApplyPass {
+public:
+  struct CreateInfo {
+    FroxelGrid grid;
+  };
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    std::uint32_t cameraDepth = 0; ///< GL_TEXTURE_2D of depth-buffer values; the image size is its size
+    std::uint32_t volume = 0;      ///< integrated GL_TEXTURE_3D, grid size
+    glm::dvec3 offset{0.0};        ///< the volume's sample offset (its jitter; 0 after the temporal pass)
+    std::uint32_t output = 0;      ///< GL_RGBA32F, cameraDepth's size
+  };
+  explicit FroxelApplyPass(const CreateInfo& info);
+  void run(const FrameAttribs& frame);
+
+private:
+  CreateInfo info_;
+  gl::Handle program_, params_, nearest_, linear_;
+};
+
+/// The froxel fog of one view (Wronski 2014): one run() per frame. Esm mode: ESM from the standard shadow
+/// map, lighting, accumulation; Prefiltered mode: the integrated volume filled by crep::Scattering (Klehm et
+/// al. 2014's prefiltered scattering at every sample point; Scattering::FrameAttribs::froxels with volume =
+/// currentVolume(), grid = CreateInfo::grid, jitter = jitter(frameIndex)). Both then: the temporal pass
+/// (when historyWeight > 0) and the per-pixel apply (when an output is given). The blended volume stays
+/// readable by the engine (volume()) for forward-shaded transparent surfaces and particles: composite
+/// surface * A + RGB at the surface's own (u, v, w).
+///
+/// Memory (memoryBytes()): the current volume, plus two ping-pong history volumes when historyWeight > 0,
+/// at 8 (RGBA16F) or 16 (RGBA32F) bytes per cell, plus the ESM (two R32F textures of ceil(W/f) x ceil(H/f)).
+/// Default 160 x 90 x 64 in RGBA16F with temporal: 3 x 7,372,800 = 22,118,400 bytes plus the ESM.
+class FroxelFog {
+public:
+  enum class Mode { Esm, Prefiltered };
+  struct TemporalOptions {
+    /// Weight of the reprojected history in [0, 1); 0 = off (no jitter, no history volumes).
+    double historyWeight = 0.9;
+    /// Jitter the sample points by froxelJitter(frameIndex) when historyWeight > 0.
+    bool jitter = true;
+  };
+  struct CreateInfo {
+    FroxelGrid grid;
+    EsmOptions esm;
+    FroxelDensity density;
+    glm::dvec3 ambient{0.0}; ///< isotropic ambient radiance per channel, >= 0 (default 0)
+    TemporalOptions temporal;
+    std::uint32_t format = 0x881A; ///< GL_RGBA16F (default) or GL_RGBA32F
+    /// Per-stage GPU times with GL_TIME_ELAPSED queries (waits for each stage: a stall, for tools only).
+    bool timings = false;
+  };
+  struct FrameAttribs {
+    Mode mode = Mode::Esm;
+    const Camera* camera = nullptr;
+    const DirectionalLight* light = nullptr; ///< Esm mode
+    const Medium* medium = nullptr;          ///< Esm mode
+    std::uint32_t cameraDepth = 0;           ///< GL_TEXTURE_2D depth-buffer values (needed with output)
+    std::uint32_t shadowMap = 0;             ///< Esm mode: the standard shadow map, or 0 = unshadowed
+    glm::dmat4 lightClipFromWorld{1.0};      ///< its matrix
+    std::uint32_t output = 0;                ///< GL_RGBA32F, cameraDepth's size, or 0 (volume only)
+    int frameIndex = 0;                      ///< selects the jitter froxelJitter(frameIndex)
+    /// Last frame's camera (reprojection); nullptr = no history this frame (first frame, camera cut).
+    const Camera* previousCamera = nullptr;
+    glm::dvec3 noiseOffset{0.0}; ///< Esm mode, world units (wind)
+  };
+  /// Throws InvalidArgument naming "FroxelFog::CreateInfo.<field>" (grid, esm, density, ambient,
+  /// temporal.historyWeight, format; a grid beyond GL_MAX_3D_TEXTURE_SIZE).
+  explicit FroxelFog(const CreateInfo& info);
+  /// Throws InvalidArgument naming "FroxelFog::FrameAttribs.<field>".
+  void run(const FrameAttribs& frame);
+
+  /// The sample offset of frame `frameIndex` in cells: froxelJitter(frameIndex) with temporal jitter, else 0.
+  glm::dvec3 jitter(int frameIndex) const;
+  /// The volume the lighting and accumulation (or crep::Scattering's fill) write: GL_TEXTURE_3D.
+  std::uint32_t currentVolume() const noexcept { return current_.get(); }
+  /// The integrated volume of the last run() (the blended one with temporal), for the engine's own lookups:
+  /// sample offset 0 with temporal, jitter(frameIndex) = 0 without.
+  std::uint32_t volume() const noexcept { return volume_; }
+  std::size_t memoryBytes() const noexcept;
+  /// GPU milliseconds of the last run's stages (CreateInfo::timings; 0 for stages not run).
+  struct Timings {
+    double esm = 0.0, lighting = 0.0, accumulate = 0.0, temporal = 0.0, apply = 0.0;
+  };
+  const Timings& timings() const noexcept { return timings_; }
+
+private:
+  CreateInfo info_;
+  EsmPass esm_;
+  FroxelLightingPass lighting_;
+  FroxelAccumulatePass accumulate_;
+  FroxelTemporalPass temporal_;
+  FroxelApplyPass apply_;
+  gl::Handle current_;
+  std::array<gl::Handle, 2> history_;
+  int latest_ = -1; ///< index of history_ written last, -1 = none
+  std::uint32_t volume_ = 0;
+  Timings timings_;
+  gl::GpuTimer timer_;
+};
+
+} // namespace crep

@@ -1,0 +1,482 @@
+// The froxel fog's GL passes and front door (crep/postfx/gpu_froxel_fog.h; Wronski 2014, "Volumetric
+// Fog"). Shaders: passes/esm_downsample.comp, passes/esm_blur.comp, passes/froxel_light.comp,
+// passes/froxel_accumulate.comp, passes/froxel_temporal.comp, passes/froxel_apply.comp, crep/froxel.glsl.
+#include <crep/postfx/gpu_froxel_fog.h>
+
+#include <crep/core/error.h>
+#include <crep/core/shader_library.h>
+#include <crep/scatter/gpu_world_march.h>
+#include <crep/scatter/ray.h>
+
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <string>
+
+namespace crep {
+
+namespace gpu {
+
+FroxelCamera froxelCamera(const Camera& camera) {
+  const GpuCamera c = gpuCamera(camera);
+  return {c.position, c.forward, c.right, c.up, c.center};
+}
+
+} // namespace gpu
+
+namespace {
+
+std::string name(const char* owner, const char* field) {
+  return std::string(owner) + "." + field;
+}
+
+const char* formatQualifier(std::uint32_t format) {
+  return format == GL_RGBA32F ? "rgba32f" : "rgba16f";
+}
+
+gl::Handle buildFroxelProgram(const char* path, std::uint32_t format) {
+  return buildProgram({{ShaderStage::Compute, path, {{"CREP_FROXEL_FORMAT", formatQualifier(format)}}}});
+}
+
+void requireFinite3(const glm::dvec3& v, const std::string& parameter) {
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(v[c])) throw InvalidArgument(parameter, detail::formatValue(v[c]), "must be finite");
+}
+
+void requireJitter(const glm::dvec3& j, const std::string& parameter) {
+  for (int c = 0; c < 3; ++c)
+    if (!(j[c] >= -0.5 && j[c] <= 0.5))
+      throw InvalidArgument(parameter, detail::formatValue(j[c]), "cells, each component in [-0.5, 0.5]");
+}
+
+void requireMatrix(const glm::dmat4& m, const std::string& parameter) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r]))
+        throw InvalidArgument(parameter, detail::formatValue(m[c][r]), "must be finite");
+}
+
+/// A caller's volume: an existing GL_TEXTURE_3D of the grid's size (and `format` when not 0).
+void requireVolume(const std::string& parameter, std::uint32_t texture, const FroxelGrid& grid,
+                   std::uint32_t format) {
+  const gl::TextureLevel l = gl::textureLevel(parameter.c_str(), texture);
+  if (l.target != GL_TEXTURE_3D)
+    throw InvalidArgument(parameter, std::to_string(texture), "must be a GL_TEXTURE_3D");
+  if (l.width != grid.width || l.height != grid.height || l.depth != grid.depth)
+    throw InvalidArgument(
+        parameter, std::to_string(l.width) + "x" + std::to_string(l.height) + "x" + std::to_string(l.depth),
+        "must be the grid's size " + std::to_string(grid.width) + "x" + std::to_string(grid.height) + "x" +
+            std::to_string(grid.depth));
+  if (format != 0 && l.internalFormat != format)
+    throw InvalidArgument(parameter, "internal format " + std::to_string(l.internalFormat),
+                          std::string("must be ") + (format == GL_RGBA32F ? "GL_RGBA32F" : "GL_RGBA16F"));
+  if (format == 0 && l.internalFormat != GL_RGBA16F && l.internalFormat != GL_RGBA32F)
+    throw InvalidArgument(parameter, "internal format " + std::to_string(l.internalFormat),
+                          "must be GL_RGBA16F or GL_RGBA32F");
+}
+
+/// Checks the grid (validate) and the driver's 3D texture limit.
+void requireGrid(const FroxelGrid& grid, const char* owner) {
+  validate(grid, owner);
+  GLint limit = 0;
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &limit);
+  const int sizes[3] = {grid.width, grid.height, grid.depth};
+  const char* fields[3] = {"width", "height", "depth"};
+  for (int i = 0; i < 3; ++i)
+    if (sizes[i] > limit)
+      throw InvalidArgument(std::string(owner) + ".grid." + fields[i], detail::formatValue(sizes[i]),
+                            "cells, must be <= GL_MAX_3D_TEXTURE_SIZE (" + std::to_string(limit) + ")");
+}
+
+/// The medium, light and camera members of the block.
+void assignFrame(gpu::FroxelParams& p, const Camera& camera, const FroxelGrid& grid) {
+  p.camera = gpu::froxelCamera(camera);
+  p.previous = p.camera;
+  p.cameraDepth = gpu::gpuCamera(camera).depth;
+  const FroxelDepthRange r = froxelDepthRange(grid, camera, "FroxelGrid");
+  p.range = glm::vec4(static_cast<float>(r.near), static_cast<float>(r.far), static_cast<float>(r.near),
+                      static_cast<float>(r.far));
+  p.grid = glm::ivec4(grid.width, grid.height, grid.depth, 0);
+}
+
+void assignMedium(gpu::FroxelParams& p, const Medium& medium) {
+  p.mieScattering = glm::vec4(glm::vec3(medium.mieScattering()), static_cast<float>(medium.hgG()));
+  p.rayleighScattering = glm::vec4(glm::vec3(medium.rayleighScattering()), 0.0f);
+  p.extinction = glm::vec4(glm::vec3(medium.extinction()), static_cast<float>(weightExtinction(medium)));
+}
+
+void dispatch3D(const FroxelGrid& g, const char* what) {
+  // 4 x 4 x 4 cells per workgroup: 64 invocations, a multiple of every GPU's SIMD width (32 / 64).
+  glDispatchCompute(static_cast<GLuint>((g.width + 3) / 4), static_cast<GLuint>((g.height + 3) / 4),
+                    static_cast<GLuint>((g.depth + 3) / 4));
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+  gl::checkError(what);
+}
+
+void dispatch2D(int width, int height, const char* what) {
+  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+  gl::checkError(what);
+}
+
+gl::Handle linearClampSampler() {
+  gl::Handle s = gl::createClampSampler(GL_LINEAR);
+  glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  return s;
+}
+
+} // namespace
+
+void validateFroxelFormat(std::uint32_t format, const char* owner) {
+  if (format != GL_RGBA16F && format != GL_RGBA32F)
+    throw InvalidArgument(name(owner, "format"), std::to_string(format),
+                          "must be GL_RGBA16F (0x881A) or GL_RGBA32F (0x8814)");
+}
+
+gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, const char* owner) {
+  requireGrid(grid, owner);
+  validateFroxelFormat(format, owner);
+  gl::Handle t = gl::createTexture(GL_TEXTURE_3D);
+  glTextureStorage3D(t.get(), 1, format, grid.width, grid.height, grid.depth);
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  gl::checkError("createFroxelVolume");
+  return t;
+}
+
+// ---- EsmPass: Annen et al. 2008 downsampled and box-blurred as Wronski 2014 (rule 1) ----
+
+EsmPass::EsmPass(const CreateInfo& info) : info_(info) {
+  validate(info.options, "EsmPass::CreateInfo.options");
+  downsample_ = buildProgram({{ShaderStage::Compute, "passes/esm_downsample.comp", {}}});
+  blur_ = buildProgram({{ShaderStage::Compute, "passes/esm_blur.comp", {}}});
+  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
+  sampler_ = gl::createClampSampler(GL_NEAREST);
+  gl::checkError("EsmPass");
+}
+
+std::size_t EsmPass::memoryBytes() const noexcept {
+  return 2 * sizeof(float) * static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+}
+
+void EsmPass::run(const FrameAttribs& f) {
+  const gl::TextureLevel map = gl::requireTexture2D("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
+  const int factor = info_.options.downsample;
+  const int w = (map.width + factor - 1) / factor, h = (map.height + factor - 1) / factor;
+  if (w != width_ || h != height_) {
+    esm_ = gl::createTexture2D(GL_R32F, w, h, "EsmPass::FrameAttribs.shadowMap");
+    scratch_ = gl::createTexture2D(GL_R32F, w, h, "EsmPass::FrameAttribs.shadowMap");
+    width_ = w;
+    height_ = h;
+  }
+  gpu::FroxelParams p;
+  p.esm = glm::vec4(static_cast<float>(info_.options.exponent), static_cast<float>(info_.options.bias), 1.0f,
+                    0.0f);
+  p.sizes = glm::ivec4(map.width, map.height, w, h);
+  p.info = glm::ivec4(factor, info_.options.blurRadius, 0, 0);
+  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
+  // Downsample into the ESM, blur x into the scratch texture, blur y back into the ESM.
+  glUseProgram(downsample_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindTextureUnit(0, f.shadowMap);
+  glBindSampler(0, sampler_.get());
+  glBindImageTexture(0, esm_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glDispatchCompute(static_cast<GLuint>((w + 7) / 8), static_cast<GLuint>((h + 7) / 8), 1);
+  if (info_.options.blurRadius > 0) {
+    glUseProgram(blur_.get());
+    for (int direction = 0; direction < 2; ++direction) {
+      glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+      glProgramUniform1i(blur_.get(), 0, direction);
+      glBindTextureUnit(0, direction == 0 ? esm_.get() : scratch_.get());
+      glBindImageTexture(0, direction == 0 ? scratch_.get() : esm_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                         GL_R32F);
+      glDispatchCompute(static_cast<GLuint>((w + 7) / 8), static_cast<GLuint>((h + 7) / 8), 1);
+    }
+  }
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+  gl::checkError("EsmPass::run");
+}
+
+// ---- FroxelLightingPass: Wronski 2014, "Density estimation and volume lighting" (rule 2) ----
+
+FroxelLightingPass::FroxelLightingPass(const CreateInfo& info) : info_(info) {
+  const char* owner = "FroxelLightingPass::CreateInfo";
+  requireGrid(info.grid, owner);
+  validate(info.density, "FroxelLightingPass::CreateInfo.density");
+  validate(info.esm, "FroxelLightingPass::CreateInfo.esm");
+  validateFroxelFormat(info.format, owner);
+  for (int c = 0; c < 3; ++c)
+    if (!(info.ambient[c] >= 0.0) || !std::isfinite(info.ambient[c]))
+      throw InvalidArgument(name(owner, "ambient"), detail::formatValue(info.ambient[c]),
+                            "must be finite and >= 0");
+  program_ = buildFroxelProgram("passes/froxel_light.comp", info.format);
+  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
+  sampler_ = gl::createClampSampler(GL_NEAREST);
+  gl::checkError("FroxelLightingPass");
+}
+
+void FroxelLightingPass::run(const FrameAttribs& f) {
+  const char* owner = "FroxelLightingPass::FrameAttribs";
+  if (!f.camera || !f.light || !f.medium)
+    throw InvalidArgument(name(owner, "camera/light/medium"), "null", "must be set");
+  requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
+  requireJitter(f.jitter, name(owner, "jitter"));
+  requireFinite3(f.noiseOffset, name(owner, "noiseOffset"));
+  gl::TextureLevel esm;
+  if (f.esm != 0) {
+    esm = gl::requireTexture2D(name(owner, "esm").c_str(), f.esm);
+    if (esm.internalFormat != GL_R32F)
+      throw InvalidArgument(name(owner, "esm"), "internal format " + std::to_string(esm.internalFormat),
+                            "must be GL_R32F (EsmPass::esm())");
+    requireMatrix(f.lightClipFromWorld, name(owner, "lightClipFromWorld"));
+  }
+  gpu::FroxelParams p;
+  assignFrame(p, *f.camera, info_.grid);
+  assignMedium(p, *f.medium);
+  p.jitter = glm::vec4(glm::vec3(f.jitter), 0.0f);
+  p.lightDirection = glm::vec4(glm::vec3(f.light->direction()), 0.0f);
+  p.lightIrradiance = glm::vec4(glm::vec3(f.light->irradiance()), 0.0f);
+  p.ambient = glm::vec4(glm::vec3(info_.ambient), 0.0f);
+  const FroxelDensity& d = info_.density;
+  p.density = glm::vec4(static_cast<float>(d.heightBase), static_cast<float>(d.heightFalloff),
+                        static_cast<float>(d.noiseAmplitude), static_cast<float>(d.noiseFrequency));
+  p.noiseOffset = glm::vec4(glm::vec3(f.noiseOffset), 0.0f);
+  p.esm = glm::vec4(static_cast<float>(info_.esm.exponent), static_cast<float>(info_.esm.bias),
+                    f.esm != 0 ? 1.0f : 0.0f, 0.0f);
+  p.sizes = glm::ivec4(0, 0, esm.width, esm.height);
+  p.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
+  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
+  glUseProgram(program_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindTextureUnit(0, f.esm);
+  glBindSampler(0, sampler_.get());
+  glBindImageTexture(0, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
+  dispatch3D(info_.grid, "FroxelLightingPass::run");
+}
+
+// ---- FroxelAccumulatePass: Wronski 2014, "Solving scattering equation" (rule 3) ----
+
+FroxelAccumulatePass::FroxelAccumulatePass(const CreateInfo& info) : info_(info) {
+  requireGrid(info.grid, "FroxelAccumulatePass::CreateInfo");
+  validateFroxelFormat(info.format, "FroxelAccumulatePass::CreateInfo");
+  program_ = buildFroxelProgram("passes/froxel_accumulate.comp", info.format);
+  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
+  gl::checkError("FroxelAccumulatePass");
+}
+
+void FroxelAccumulatePass::run(const FrameAttribs& f) {
+  const char* owner = "FroxelAccumulatePass::FrameAttribs";
+  if (!f.camera || !f.medium) throw InvalidArgument(name(owner, "camera/medium"), "null", "must be set");
+  requireVolume(name(owner, "volume"), f.volume, info_.grid, info_.format);
+  requireJitter(f.jitter, name(owner, "jitter"));
+  gpu::FroxelParams p;
+  assignFrame(p, *f.camera, info_.grid);
+  assignMedium(p, *f.medium);
+  p.jitter = glm::vec4(glm::vec3(f.jitter), 0.0f);
+  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
+  glUseProgram(program_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindImageTexture(0, f.volume, 0, GL_TRUE, 0, GL_READ_WRITE, info_.format);
+  dispatch2D(info_.grid.width, info_.grid.height, "FroxelAccumulatePass::run");
+}
+
+// ---- FroxelTemporalPass: Wronski 2014, "Temporal reprojection" (rule 5) ----
+
+FroxelTemporalPass::FroxelTemporalPass(const CreateInfo& info) : info_(info) {
+  requireGrid(info.grid, "FroxelTemporalPass::CreateInfo");
+  validateFroxelFormat(info.format, "FroxelTemporalPass::CreateInfo");
+  program_ = buildFroxelProgram("passes/froxel_temporal.comp", info.format);
+  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
+  nearest_ = gl::createClampSampler(GL_NEAREST);
+  linear_ = linearClampSampler();
+  gl::checkError("FroxelTemporalPass");
+}
+
+void FroxelTemporalPass::run(const FrameAttribs& f) {
+  const char* owner = "FroxelTemporalPass::FrameAttribs";
+  if (!f.camera) throw InvalidArgument(name(owner, "camera"), "null", "must be set");
+  if (!(f.historyWeight >= 0.0 && f.historyWeight < 1.0))
+    throw InvalidArgument(name(owner, "historyWeight"), detail::formatValue(f.historyWeight),
+                          "must be in [0, 1)");
+  requireVolume(name(owner, "current"), f.current, info_.grid, 0);
+  requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
+  const bool useHistory = f.previousCamera != nullptr && f.historyWeight > 0.0;
+  if (useHistory) requireVolume(name(owner, "history"), f.history, info_.grid, 0);
+  if (f.output == f.current || (useHistory && f.output == f.history))
+    throw InvalidArgument(name(owner, "output"), std::to_string(f.output),
+                          "must differ from current and history");
+  gpu::FroxelParams p;
+  assignFrame(p, *f.camera, info_.grid);
+  if (useHistory) {
+    p.previous = gpu::froxelCamera(*f.previousCamera);
+    const FroxelDepthRange r =
+        froxelDepthRange(info_.grid, *f.previousCamera, "FroxelTemporalPass::CreateInfo");
+    p.range.z = static_cast<float>(r.near);
+    p.range.w = static_cast<float>(r.far);
+    p.grid.w = 1;
+  }
+  p.jitter = glm::vec4(0.0f, 0.0f, 0.0f, static_cast<float>(useHistory ? f.historyWeight : 0.0));
+  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
+  glUseProgram(program_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindTextureUnit(0, f.current);
+  glBindSampler(0, nearest_.get());
+  glBindTextureUnit(1, useHistory ? f.history : f.current); // unused without history (weight 0)
+  glBindSampler(1, linear_.get());
+  glBindImageTexture(0, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
+  dispatch3D(info_.grid, "FroxelTemporalPass::run");
+}
+
+// ---- FroxelApplyPass: Wronski 2014, "Applying effect" (rule 4) ----
+
+FroxelApplyPass::FroxelApplyPass(const CreateInfo& info) : info_(info) {
+  requireGrid(info.grid, "FroxelApplyPass::CreateInfo");
+  program_ = buildProgram({{ShaderStage::Compute, "passes/froxel_apply.comp", {}}});
+  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
+  nearest_ = gl::createClampSampler(GL_NEAREST);
+  linear_ = linearClampSampler();
+  gl::checkError("FroxelApplyPass");
+}
+
+void FroxelApplyPass::run(const FrameAttribs& f) {
+  const char* owner = "FroxelApplyPass::FrameAttribs";
+  if (!f.camera) throw InvalidArgument(name(owner, "camera"), "null", "must be set");
+  const gl::TextureLevel depth = gl::requireTexture2D(name(owner, "cameraDepth").c_str(), f.cameraDepth);
+  gl::requireTexture2D(name(owner, "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
+  requireVolume(name(owner, "volume"), f.volume, info_.grid, 0);
+  requireJitter(f.offset, name(owner, "offset"));
+  gpu::FroxelParams p;
+  assignFrame(p, *f.camera, info_.grid);
+  p.jitter = glm::vec4(glm::vec3(f.offset), 0.0f);
+  p.sizes = glm::ivec4(depth.width, depth.height, 0, 0);
+  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
+  glUseProgram(program_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
+  glBindTextureUnit(0, f.cameraDepth);
+  glBindSampler(0, nearest_.get());
+  glBindTextureUnit(1, f.volume);
+  glBindSampler(1, linear_.get());
+  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  dispatch2D(depth.width, depth.height, "FroxelApplyPass::run");
+}
+
+// ---- FroxelFog ----
+
+namespace {
+
+const FroxelFog::CreateInfo& validated(const FroxelFog::CreateInfo& info) {
+  const char* owner = "FroxelFog::CreateInfo";
+  requireGrid(info.grid, owner);
+  validate(info.esm, "FroxelFog::CreateInfo.esm");
+  validate(info.density, "FroxelFog::CreateInfo.density");
+  validateFroxelFormat(info.format, owner);
+  for (int c = 0; c < 3; ++c)
+    if (!(info.ambient[c] >= 0.0) || !std::isfinite(info.ambient[c]))
+      throw InvalidArgument(name(owner, "ambient"), detail::formatValue(info.ambient[c]),
+                            "must be finite and >= 0");
+  if (!(info.temporal.historyWeight >= 0.0 && info.temporal.historyWeight < 1.0))
+    throw InvalidArgument(name(owner, "temporal.historyWeight"),
+                          detail::formatValue(info.temporal.historyWeight), "must be in [0, 1) (0 = off)");
+  return info;
+}
+
+} // namespace
+
+FroxelFog::FroxelFog(const CreateInfo& info)
+    : info_(validated(info)), esm_({info.esm}),
+      lighting_({info.grid, info.density, info.ambient, info.esm, info.format}),
+      accumulate_({info.grid, info.format}), temporal_({info.grid, info.format}), apply_({info.grid}) {
+  current_ = createFroxelVolume(info.grid, info.format, "FroxelFog::CreateInfo");
+  if (info.temporal.historyWeight > 0.0)
+    for (gl::Handle& h : history_)
+      h = createFroxelVolume(info.grid, info.format, "FroxelFog::CreateInfo");
+  volume_ = current_.get();
+}
+
+glm::dvec3 FroxelFog::jitter(int frameIndex) const {
+  return info_.temporal.historyWeight > 0.0 && info_.temporal.jitter ? froxelJitter(frameIndex)
+                                                                     : glm::dvec3(0.0);
+}
+
+std::size_t FroxelFog::memoryBytes() const noexcept {
+  const std::size_t cells = static_cast<std::size_t>(info_.grid.width) *
+                            static_cast<std::size_t>(info_.grid.height) *
+                            static_cast<std::size_t>(info_.grid.depth);
+  const std::size_t perCell = info_.format == GL_RGBA32F ? 16 : 8;
+  const std::size_t volumes = info_.temporal.historyWeight > 0.0 ? 3 : 1;
+  return volumes * cells * perCell + esm_.memoryBytes();
+}
+
+void FroxelFog::run(const FrameAttribs& f) {
+  const char* owner = "FroxelFog::FrameAttribs";
+  if (!f.camera) throw InvalidArgument(name(owner, "camera"), "null", "must be set");
+  if (f.mode == Mode::Esm && (!f.light || !f.medium))
+    throw InvalidArgument(name(owner, "light/medium"), "null", "must be set in Mode::Esm");
+  if (f.output != 0) {
+    const gl::TextureLevel depth = gl::requireTexture2D(name(owner, "cameraDepth").c_str(), f.cameraDepth);
+    gl::requireTexture2D(name(owner, "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
+  }
+  if (f.mode == Mode::Esm && f.shadowMap != 0) {
+    gl::requireTexture2D(name(owner, "shadowMap").c_str(), f.shadowMap);
+    requireMatrix(f.lightClipFromWorld, name(owner, "lightClipFromWorld"));
+  }
+  if (f.mode == Mode::Prefiltered)
+    requireVolume(name(owner, "mode"), current_.get(), info_.grid, info_.format);
+  requireFinite3(f.noiseOffset, name(owner, "noiseOffset"));
+  froxelDepthRange(info_.grid, *f.camera, "FroxelFog::CreateInfo");
+  if (f.previousCamera) froxelDepthRange(info_.grid, *f.previousCamera, "FroxelFog::CreateInfo");
+  timings_ = Timings{};
+  const auto stage = [&](double& ms, const auto& body) {
+    if (info_.timings) timer_.begin();
+    body();
+    if (info_.timings) {
+      timer_.end();
+      ms = timer_.milliseconds();
+    }
+  };
+  const glm::dvec3 j = jitter(f.frameIndex);
+  if (f.mode == Mode::Esm) {
+    if (f.shadowMap != 0) stage(timings_.esm, [&] { esm_.run({f.shadowMap}); });
+    stage(timings_.lighting, [&] {
+      FroxelLightingPass::FrameAttribs a;
+      a.camera = f.camera;
+      a.light = f.light;
+      a.medium = f.medium;
+      a.esm = f.shadowMap != 0 ? esm_.esm() : 0;
+      a.lightClipFromWorld = f.lightClipFromWorld;
+      a.jitter = j;
+      a.noiseOffset = f.noiseOffset;
+      a.output = current_.get();
+      lighting_.run(a);
+    });
+    stage(timings_.accumulate, [&] { accumulate_.run({f.camera, f.medium, j, current_.get()}); });
+  }
+  glm::dvec3 offset = j;
+  volume_ = current_.get();
+  if (info_.temporal.historyWeight > 0.0) {
+    const int out = latest_ == 0 ? 1 : 0;
+    stage(timings_.temporal, [&] {
+      FroxelTemporalPass::FrameAttribs a;
+      a.camera = f.camera;
+      a.previousCamera = latest_ >= 0 ? f.previousCamera : nullptr;
+      a.historyWeight = info_.temporal.historyWeight;
+      a.current = current_.get();
+      a.history = latest_ >= 0 ? history_[static_cast<std::size_t>(latest_)].get() : 0;
+      a.output = history_[static_cast<std::size_t>(out)].get();
+      temporal_.run(a);
+    });
+    latest_ = out;
+    volume_ = history_[static_cast<std::size_t>(out)].get();
+    offset = glm::dvec3(0.0); // the blended volume holds its values at the cell centres
+  }
+  if (f.output != 0)
+    stage(timings_.apply, [&] { apply_.run({f.camera, f.cameraDepth, volume_, offset, f.output}); });
+}
+
+} // namespace crep
