@@ -502,7 +502,8 @@ void addLayoutDefines(std::vector<ShaderDefine>& defines, int layoutKind) {
 /// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
 /// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
 std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind,
-                                              bool local = false, bool textured = false) {
+                                              bool local = false, bool textured = false,
+                                              bool froxels = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/evaluate.comp",
@@ -525,6 +526,7 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
     stages[0].defines.push_back({"CREP_MEAN_COLOR_UNIT", str(kMeanColorUnit)});
   }
+  if (froxels) stages[0].defines.push_back({"CREP_FROXELS", "1"});
   return stages;
 }
 
@@ -653,19 +655,56 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
     invalid("EvaluatePass::FrameAttribs.basis.regionWeights", str(basis.regionWeights),
             "must name the region-weights buffer (near-plane correction)");
-  const gl::TextureLevel depth =
-      gl::textureLevel("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
-  if (depth.target != GL_TEXTURE_2D)
-    invalid("EvaluatePass::FrameAttribs.cameraDepth", "texture " + str(frame.cameraDepth),
-            "must be a GL_TEXTURE_2D");
-  const gl::TextureLevel out = gl::textureLevel("EvaluatePass::FrameAttribs.output", frame.output);
+  // Froxel volumes (prefilter.h, "Froxel volumes"): the directional light's evaluation at the cells.
+  const bool froxels = frame.froxels.volume != 0;
+  const bool pixels = frame.output != 0 || !froxels;
+  FroxelDepthRange froxelRange;
+  GLenum volumeFormat = GL_RGBA32F;
+  if (froxels) {
+    const char* owner = "EvaluatePass::FrameAttribs.froxels";
+    validate(frame.froxels.grid, owner);
+    validateFroxelJitter(frame.froxels.jitter, "EvaluatePass::FrameAttribs.froxels.jitter");
+    froxelRange = froxelDepthRange(frame.froxels.grid, *frame.camera, owner);
+    if (local)
+      invalid("EvaluatePass::FrameAttribs.froxels", "with localLight",
+              "froxel volumes are filled for the directional light only");
+    if (info_.memoryLimit)
+      invalid("EvaluatePass::FrameAttribs.froxels", "a volume",
+              "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the per-pixel pass)");
+    const gl::TextureLevel v =
+        gl::textureLevel("EvaluatePass::FrameAttribs.froxels.volume", frame.froxels.volume);
+    const FroxelGrid& g = frame.froxels.grid;
+    if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
+      invalid("EvaluatePass::FrameAttribs.froxels.volume", "texture " + str(frame.froxels.volume),
+              "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
+    if (v.width != g.width || v.height != g.height || v.depth != g.depth)
+      invalid("EvaluatePass::FrameAttribs.froxels.volume",
+              sizeString(v.width, v.height) + " x " + str(v.depth),
+              "must have the grid's size " + sizeString(g.width, g.height) + " x " + str(g.depth));
+    volumeFormat = v.internalFormat;
+    const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
+                            "EvaluatePass::CreateInfo.workgroupHeight",
+                            "EvaluatePass::FrameAttribs.froxels.grid.depth"};
+    const int localSize[3] = {info_.workgroupWidth, info_.workgroupHeight, 1};
+    const int groups[3] = {ceilDiv(g.width, info_.workgroupWidth), ceilDiv(g.height, info_.workgroupHeight),
+                           g.depth};
+    checkWorkgroup(names, localSize, groups);
+  }
+  gl::TextureLevel depth, out;
   const GLenum outFormat = internalFormat(info_.outputFormat);
-  if (out.target != GL_TEXTURE_2D || out.internalFormat != outFormat)
-    invalid("EvaluatePass::FrameAttribs.output", "texture " + str(frame.output),
-            std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info_.outputFormat));
-  if (out.width != depth.width || out.height != depth.height)
-    invalid("EvaluatePass::FrameAttribs.output", sizeString(out.width, out.height),
-            "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
+  if (pixels) {
+    depth = gl::textureLevel("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
+    if (depth.target != GL_TEXTURE_2D)
+      invalid("EvaluatePass::FrameAttribs.cameraDepth", "texture " + str(frame.cameraDepth),
+              "must be a GL_TEXTURE_2D");
+    out = gl::textureLevel("EvaluatePass::FrameAttribs.output", frame.output);
+    if (out.target != GL_TEXTURE_2D || out.internalFormat != outFormat)
+      invalid("EvaluatePass::FrameAttribs.output", "texture " + str(frame.output),
+              std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info_.outputFormat));
+    if (out.width != depth.width || out.height != depth.height)
+      invalid("EvaluatePass::FrameAttribs.output", sizeString(out.width, out.height),
+              "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
+  }
 
   // A projective layout is evaluated from the scattering block's frame (the default program); any other
   // layout with a GPU mapping through its own block (Klehm et al. 2014, Sec. 4.1 for the epipolar one),
@@ -701,7 +740,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     const gpu::LayoutKind kind =
         layoutBuffers_.upload(*layoutData, basis.height, "EvaluatePass::FrameAttribs.layout");
     layoutKind = kind;
-    if (!textured) {
+    if (!textured && pixels) {
       gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
       if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
       program = variant.get();
@@ -709,7 +748,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   }
   // Light textures: the CREP_LIGHT_TEXTURE variants (projective frame, layouts, local light), on first use.
   const int variantIndex = local ? 3 : projective ? 0 : 1 + static_cast<int>(layoutKind);
-  if (textured) {
+  if (textured && pixels) {
     gl::Handle& variant = texturedPrograms_[variantIndex];
     if (!variant)
       variant =
@@ -718,13 +757,19 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   }
   gpu::EvaluateParams params;
   gpu::assignCamera(params, *frame.camera);
-  params.imageSize = glm::ivec4(depth.width, depth.height, 0, 0);
+  params.imageSize = glm::ivec4(pixels ? depth.width : 0, pixels ? depth.height : 0, 0, 0);
   glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
 
   const bool table = usesVisibilityTable(info_.options);
   const bool prefix = usesScatteringPrefix(info_.options);
-  if (table) {
+  const bool reuse = table && frame.reuseTable;
+  if (reuse &&
+      (tableBasis_ != basis.texture || tableVariant_ != variantIndex + 4 * int(textured) ||
+       tableWidth_ != basis.regions() * info_.options.visibilityTableSamples || tableHeight_ != basis.height))
+    invalid("EvaluatePass::FrameAttribs.reuseTable", "true",
+            "the previous run() built no table for this basis (texture, size, regions, layout kind)");
+  if (table && !reuse) {
     // The per-frame table of this basis (EvaluateOptions::visibilityTableSamples / scatteringPrefix): the
     // scattering prefix table (RGBA32F, the default) or the region visibility table (R32F), rebuilt every
     // run; both R Z x H texels.
@@ -783,6 +828,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, 0);
     glBindSampler(kTableBasisUnit, 0);
     glBindTextureUnit(kTableBasisUnit, 0);
+    tableBasis_ = basis.texture;
+    tableVariant_ = variantIndex + 4 * int(textured);
+  }
+  if (table) {
     const GLuint unit = prefix ? kPrefixUnit : kTableUnit;
     glBindTextureUnit(unit, tableTexture_.get());
     glBindSampler(unit, tableSampler_.get());
@@ -797,13 +846,37 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindTextureUnit(kMeanColorUnit, basis.meanColor);
     glBindSampler(kMeanColorUnit, basisSampler_.get()); // sampled as the basis is (EvaluateOptions::sampling)
   }
-  glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, evaluateBuffer_.get());
   if (info_.options.nearPlaneCorrection)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, basis.regionWeights);
-  glDispatchCompute(static_cast<GLuint>(ceilDiv(depth.width, info_.workgroupWidth)),
-                    static_cast<GLuint>(ceilDiv(depth.height, info_.workgroupHeight)), 1);
+  if (pixels) {
+    glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(depth.width, info_.workgroupWidth)),
+                      static_cast<GLuint>(ceilDiv(depth.height, info_.workgroupHeight)), 1);
+  }
+  if (froxels) {
+    // The froxel variant of the same program (CREP_FROXELS) on the same bindings; the evaluate block's
+    // imageSize holds the grid's size.
+    const FroxelGrid& g = frame.froxels.grid;
+    gl::Handle& variant =
+        froxelPrograms_[textured ? 1 : 0][projective ? 0 : 1 + static_cast<int>(layoutKind)];
+    if (!variant)
+      variant = buildProgram(
+          evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), false, textured, true));
+    params.imageSize = glm::ivec4(g.width, g.height, g.depth, 0);
+    glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
+    glProgramUniform4f(variant.get(), 0, static_cast<float>(frame.froxels.jitter.x),
+                       static_cast<float>(frame.froxels.jitter.y), static_cast<float>(frame.froxels.jitter.z),
+                       0.0f);
+    glProgramUniform2f(variant.get(), 1, static_cast<float>(froxelRange.near),
+                       static_cast<float>(froxelRange.far));
+    glUseProgram(variant.get());
+    glBindImageTexture(0, frame.froxels.volume, 0, GL_TRUE, 0, GL_WRITE_ONLY, volumeFormat);
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(g.width, info_.workgroupWidth)),
+                      static_cast<GLuint>(ceilDiv(g.height, info_.workgroupHeight)),
+                      static_cast<GLuint>(g.depth));
+  }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   if (info_.options.nearPlaneCorrection)

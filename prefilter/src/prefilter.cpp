@@ -509,15 +509,16 @@ struct LocalSegments {
 
 /// The evaluation (see prefilter.h) with `segmentsFor(direction)` giving the light's segment rule and
 /// `prefixTable(visibility)` the scattering prefix table.
-template <class SegmentsFor, class PrefixTable>
-Image evaluateImpl(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
+/// `rayAt(x, y)` gives the PixelRay of output pixel (x, y) of a w x h image (the camera image's pixel rays,
+/// or the froxel volume's sample rays).
+template <class RayAt, class SegmentsFor, class PrefixTable>
+Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt, const Camera& camera,
                    const Medium& medium, const EvaluateOptions& options, const SegmentsFor& segmentsFor,
                    const PrefixTable& prefixTable) {
   validateBasis(basis);
-  validateCameraDepth(cameraDepth);
   validate(options);
   const RectifiedLayout& layout = *basis.layout;
-  const int w = cameraDepth.width(), h = cameraDepth.height(), M = basis.bases, R = basis.regions;
+  const int M = basis.bases, R = basis.regions;
   const int n = basis.regionWidth();
   const double greySigma = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
@@ -554,7 +555,7 @@ Image evaluateImpl(const FilteredBasis& basis, const Image& cameraDepth, const C
     std::array<double, kMaxBases> a{}, Fa{}, Fb{};
     const std::span<double> aSpan(a.data(), static_cast<std::size_t>(M));
     for (int x = 0; x < w; ++x) {
-      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      const PixelRay ray = rayAt(x, y);
       const auto segment = segmentsFor(ray.direction);
       glm::dvec3 L(0.0);
       MappedRay m;
@@ -640,10 +641,63 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
   if (basis.localLight)
     throw InvalidArgument("FilteredBasis.localLight", "true",
                           "the basis was prefiltered for a local light: evaluate it with that LocalLight");
+  validateCameraDepth(cameraDepth);
   const glm::dvec3 sigma = medium.extinction();
   const int Z = options.visibilityTableSamples;
   return evaluateImpl(
-      basis, cameraDepth, camera, medium, options,
+      basis, cameraDepth.width(), cameraDepth.height(),
+      [&](int x, int y) { return pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection); }, camera,
+      medium, options,
+      [&](const glm::dvec3& v) {
+        return DirectionalSegments{scatteringConstant(light, medium, v), sigma};
+      },
+      [&](const std::vector<double>& visibility) {
+        return scatteringPrefixTable(basis, visibility, Z, sigma);
+      });
+}
+
+// The froxel fill (prefilter.h, "Froxel volumes"): Klehm et al. 2014's per-ray evaluation (Sec. 3.3,
+// Listing 4) at the sample points of Wronski 2014's frustum-aligned volume.
+PixelRay froxelSampleRay(const Camera& camera, const FroxelDepthRange& range, const FroxelGrid& grid,
+                         const glm::dvec3& jitter, int x, int y, int z, bool nearPlaneCorrection) {
+  const glm::dvec3 uvw((x + 0.5 + jitter.x) / grid.width, (y + 0.5 + jitter.y) / grid.height,
+                       (z + 0.5 + jitter.z) / grid.depth);
+  PixelRay r;
+  r.direction = camera.rayDirection(2.0 * uvw.x - 1.0, 2.0 * uvw.y - 1.0);
+  const double cosForward = glm::dot(r.direction, camera.forward());
+  // Beyond the camera's integration far the map has no information: the far plane's value (the sky's).
+  r.surface = std::min(froxelViewDepth(range, uvw.z), camera.far()) / cosForward;
+  r.start = nearPlaneCorrection ? std::min(camera.near() / cosForward, r.surface) : 0.0;
+  return r;
+}
+
+void validateFroxelJitter(const glm::dvec3& jitter, const std::string& field) {
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(jitter[c]) <= 0.5))
+      throw InvalidArgument(field,
+                            "(" + detail::formatValue(jitter.x) + ", " + detail::formatValue(jitter.y) +
+                                ", " + detail::formatValue(jitter.z) + ")",
+                            "cells, each component finite and in [-0.5, 0.5]");
+}
+
+Image evaluateFroxels(const FilteredBasis& basis, const FroxelGrid& grid, const glm::dvec3& jitter,
+                      const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                      const EvaluateOptions& options) {
+  if (basis.localLight)
+    throw InvalidArgument("FilteredBasis.localLight", "true",
+                          "froxel volumes are filled for the directional light only");
+  validate(grid, "evaluateFroxels");
+  validateFroxelJitter(jitter, "evaluateFroxels.jitter");
+  const FroxelDepthRange range = froxelDepthRange(grid, camera, "evaluateFroxels");
+  const glm::dvec3 sigma = medium.extinction();
+  const int Z = options.visibilityTableSamples;
+  return evaluateImpl(
+      basis, grid.width, grid.height * grid.depth,
+      [&](int x, int y) {
+        return froxelSampleRay(camera, range, grid, jitter, x, y % grid.height, y / grid.height,
+                               options.nearPlaneCorrection);
+      },
+      camera, medium, options,
       [&](const glm::dvec3& v) {
         return DirectionalSegments{scatteringConstant(light, medium, v), sigma};
       },
@@ -659,9 +713,12 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
                           "the basis was prefiltered for a directional light: prefilter(map, medium, light)");
   if (options.nearPlaneCorrection)
     throw InvalidArgument("EvaluateOptions.nearPlaneCorrection", "true", "not supported for local lights");
+  validateCameraDepth(cameraDepth);
   const int Z = options.visibilityTableSamples;
   return evaluateImpl(
-      basis, cameraDepth, camera, medium, options,
+      basis, cameraDepth.width(), cameraDepth.height(),
+      [&](int x, int y) { return pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection); }, camera,
+      medium, options,
       [&](const glm::dvec3& v) { return LocalSegments{RayScattering(light, medium, camera.position(), v)}; },
       [&](const std::vector<double>& visibility) {
         return scatteringPrefixTable(basis, visibility, Z, light, medium);

@@ -14,8 +14,9 @@
 // binding points below and unbinds them (0) before returning; it does not restore the caller's bindings
 // there. It issues glMemoryBarrier so that the results can be sampled / image-loaded afterwards.
 //   PrefilterPass::run: texture unit 0 (+ sampler), image unit 0, uniform buffer 0, storage buffer 0.
-//   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0, uniform buffers 0 and 1,
-//                       storage buffer 1 (near-plane correction); for a non-projective layout also
+//   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0 (the output, then the froxel
+//                       volume), uniform buffers 0 and 1, storage buffer 1 (near-plane correction), the
+//                       froxel program's uniforms (locations 0, 1); for a non-projective layout also
 //                       uniform buffer 2 and storage buffer 2 (its layout block and row table); with the
 //                       scattering prefix table (EvaluateOptions::scatteringPrefix, the default) texture
 //                       unit 7, or with the region visibility table alone texture unit 6 (+ sampler), and
@@ -34,6 +35,7 @@
 #include <crep/prefilter/gpu_structs.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/froxel_grid.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 
 namespace crep {
@@ -183,10 +185,23 @@ public:
     bool memoryLimit = false;
   };
 
+  /// A froxel volume to fill (prefilter.h, "Froxel volumes"; crep::evaluateFroxels is its CPU reference).
+  struct FroxelTarget {
+    /// Caller's GL_TEXTURE_3D of grid.width x grid.height x grid.depth, GL_RGBA16F or GL_RGBA32F (any
+    /// CreateInfo::outputFormat), or 0 (no volume). Texel (x, y, z): RGB in-scattered radiance from the
+    /// camera to the cell's sample point, A grey transmittance to it.
+    std::uint32_t volume = 0;
+    FroxelGrid grid;        ///< cells and depth range (crep/scatter/froxel_grid.h)
+    glm::dvec3 jitter{0.0}; ///< sample offset in cells, each component in [-0.5, 0.5] (froxelJitter())
+  };
+
   struct FrameAttribs {
-    std::uint32_t cameraDepth = 0;  ///< caller's GL_TEXTURE_2D, depth-buffer values of `camera` in [0, 1]
-    std::uint32_t output = 0;       ///< caller's GL_TEXTURE_2D of the same size in outputFormat: RGB L, A T
-    const Camera* camera = nullptr; ///< the camera of cameraDepth (normally the rectified one)
+    /// caller's GL_TEXTURE_2D, depth-buffer values of `camera` in [0, 1]; may be 0 when output is 0
+    std::uint32_t cameraDepth = 0;
+    /// caller's GL_TEXTURE_2D of cameraDepth's size in outputFormat: RGB L, A T; may be 0 with a froxel
+    /// volume
+    std::uint32_t output = 0;
+    const Camera* camera = nullptr;          ///< the camera of cameraDepth (normally the rectified one)
     const DirectionalLight* light = nullptr; ///< the light of the rectification (or null with localLight)
     const Medium* medium = nullptr;          ///< the medium (C of Eq. 1, per-channel extinction)
     /// The layout the basis was prefiltered from: a ProjectiveLayout, or any layout with a GPU mapping
@@ -204,6 +219,18 @@ public:
     /// crep/local_light.glsl; crep::evaluate(..., LocalLight) on the CPU). Projective layouts only, no
     /// near-plane correction (InvalidArgument naming the field).
     const LocalLight* localLight = nullptr;
+    /// Froxel volumes (prefilter.h, "Froxel volumes"): one more dispatch over width x height x depth cells
+    /// (workgroups of CreateInfo::workgroupWidth x workgroupHeight x 1 cells: neighbouring cells of one
+    /// slice map to neighbouring rows and columns of the basis, so a GPU's texture cache serves their
+    /// fetches), writing the volume with imageStore after the per-pixel output (if any), from the same
+    /// per-frame table. Directional light only (InvalidArgument "EvaluatePass::FrameAttribs.froxels" with
+    /// localLight); every layout and option of the per-pixel evaluation, textured bases included.
+    FroxelTarget froxels{};
+    /// Skip the per-frame table pass and use the table of the previous run(), which must have been built
+    /// for this basis (same texture, size, regions and layout kind; its contents unchanged since: the
+    /// caller's promise), e.g. a second run of the same frame that fills a froxel volume alone. Ignored
+    /// without a table (EvaluateOptions::visibilityTableSamples 0 or the direct path).
+    bool reuseTable = false;
   };
 
   /// Validates `info` (InvalidArgument naming the field, GlError beyond the workgroup limits) and
@@ -215,8 +242,10 @@ public:
   EvaluatePass(const EvaluatePass&) = delete;
   EvaluatePass& operator=(const EvaluatePass&) = delete;
 
-  /// Writes the scattering image into frame.output. Throws InvalidArgument naming the FrameAttribs field
-  /// (null pointers, texture 0, wrong target / format / size, bases mismatch, layout not projective).
+  /// Writes the scattering image into frame.output and / or the froxel volume (at least one). Throws
+  /// InvalidArgument naming the FrameAttribs field (null pointers, texture 0, wrong target / format / size,
+  /// bases mismatch, layout not projective, froxels.grid / froxels.jitter / froxels.volume, reuseTable
+  /// without a matching table).
   void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
@@ -240,6 +269,12 @@ private:
   /// Light textures (CREP_LIGHT_TEXTURE): evaluation and scattering prefix programs, index 0 projective
   /// frame, 1 + gpu::LayoutKind for layouts, 3 local light; built on first use.
   gl::Handle texturedPrograms_[4], texturedPrefixPrograms_[4];
+  /// Froxel volumes (CREP_FROXELS): index [textured][0 projective frame, 1 + gpu::LayoutKind], built on
+  /// first use.
+  gl::Handle froxelPrograms_[2][3];
+  /// What the table was last built for (FrameAttribs::reuseTable): basis texture, program variant.
+  std::uint32_t tableBasis_ = 0;
+  int tableVariant_ = -1;
   gl::Handle tableCoefficients_; ///< a(z_s) of the table's samples (storage buffer), for tableMargin_
   double tableMargin_ = -1.0;
   int tableWidth_ = 0, tableHeight_ = 0;

@@ -74,6 +74,18 @@
 // table multiplies each channel's section integral by its own V_c.
 //
 // ---------------------------------------------------------------------------------------------------
+// Froxel volumes (evaluateFroxels(); EvaluatePass::FrameAttribs::froxels). The in-scattering from the camera
+// to any point of a pixel ray is the evaluation above with that point's distance as the surface distance,
+// so one basis fills a frustum-aligned volume (Wronski 2014; crep/scatter/froxel_grid.h) directly, one
+// evaluation per cell: cell (x, y, z) of a W x H x D grid with jitter j (cells, each in [-0.5, 0.5]) samples
+//   uvw = ((x + 0.5 + j.x) / W, (y + 0.5 + j.y) / H, (z + 0.5 + j.z) / D), v = camera.rayDirection(2 u - 1,
+//   2 v - 1), Z = min(froxelViewDepth(range, w), camera.far()), s = Z / dot(v, forward)
+// (beyond the camera's integration far the map has no information: the sky's value, as per pixel), the
+// near-plane correction's start as per pixel, and stores the pixel's output rule there (RGB = L, A =
+// exp(-sbar s)). So the volume at a cell centre equals the per-pixel output of a camera image of W x H pixels
+// whose depth buffer holds that slice's depth. Directional light only.
+//
+// ---------------------------------------------------------------------------------------------------
 // References. The method's own error is evaluate() against bruteForceMarch() (crep/scatter/
 // rectified_march.h) on the same map: the same rays, start and end rules and output, but the visibility
 // integrated exactly per texel (no Fourier truncation, no reference-ray weights, no quantization, no
@@ -84,6 +96,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -96,6 +109,7 @@
 #include <crep/prefilter/fourier.h>
 #include <crep/prefilter/weights.h>
 #include <crep/rectify/rectified_map.h>
+#include <crep/scatter/froxel_grid.h>
 #include <crep/scatter/ray.h>
 #include <crep/scatter/ray_scattering.h>
 
@@ -338,6 +352,21 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
 /// local lights ("EvaluateOptions.nearPlaneCorrection").
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
                const LocalLight& light, const Medium& medium, const EvaluateOptions& options = {});
+/// The sample ray of froxel cell (x, y, z) of `grid` (depth range `range`) with `jitter` (see "Froxel
+/// volumes" at the top): direction, distance to the sample point, start (near-plane correction).
+PixelRay froxelSampleRay(const Camera& camera, const FroxelDepthRange& range, const FroxelGrid& grid,
+                         const glm::dvec3& jitter, int x, int y, int z, bool nearPlaneCorrection);
+/// Throws InvalidArgument naming `field` unless each component of `jitter` is finite and in [-0.5, 0.5].
+void validateFroxelJitter(const glm::dvec3& jitter, const std::string& field);
+/// The froxel fill (see "Froxel volumes" at the top) of `basis` for the directional light: an RGBA image of
+/// grid.width x (grid.height grid.depth), slice z in rows [z height, (z + 1) height) (the memory order of the
+/// 3D texture: x, then y, then z), RGB in-scattered radiance, A grey transmittance. Throws InvalidArgument
+/// naming "evaluateFroxels.grid.*" / "evaluateFroxels.jitter", ("FilteredBasis.localLight") for a local
+/// light's basis, and as evaluate().
+Image evaluateFroxels(const FilteredBasis& basis, const FroxelGrid& grid, const glm::dvec3& jitter,
+                      const Camera& camera, const DirectionalLight& light, const Medium& medium,
+                      const EvaluateOptions& options = {});
+
 /// scatteringPrefixTable for a local light: the in-scattering itself (RayScattering along each sample ray
 /// from layout.origin() in the direction layout.viewRayDirection(row, depth)).
 std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
