@@ -1,0 +1,112 @@
+// The GL tone-mapping pass: auto exposure from the log-average luminance, temporal light adaptation and
+// the operators of crep/postfx/tone_mapping.h (its rule and CPU reference: luminanceStats,
+// LightAdaptation, toneMapImage), in float. Shaders: passes/luminance_reduce.comp,
+// passes/luminance_adapt.comp, passes/tone_map.comp, the curves in crep/tone_mapping.glsl (public).
+//
+// One run() per frame:
+//   1. (autoExposure only) luminance_reduce.comp: one partial sum of log(delta + Y) and one count of
+//      finite pixels per 64 x 64 block of the input (16 x 16 workgroups, 4 x 4 pixels per invocation,
+//      shared-memory tree reduction);
+//   2. (autoExposure only) luminance_adapt.comp: one workgroup adds the partials, takes the log-average
+//      and steps the adapted luminance and exposure scale in the pass's state buffer (gpu::ToneMapState);
+//   3. tone_map.comp: every pixel through the operator with that scale (or the manual exposure).
+// GPU choice: a two-pass reduction into a storage buffer rather than Yusov's mip chain of a 64 x 64
+// luminance image: it reads the full-resolution input once (no resampling, so it is the exact CPU sum up
+// to float order) and its cost is one pass over the input plus a dispatch of one workgroup. The state
+// never leaves the GPU: auto exposure costs no readback (readState() exists for tests and debugging).
+//
+// The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
+// buffers and sampler (RAII); FrameAttribs' textures are the caller's (non-owning GL names). It leaves
+// program 0, texture unit 0 with no texture and no sampler, image unit 0, uniform buffer binding 0 and
+// storage buffer bindings 0-1 unbound (gl::unbindPassState(2)) and issues gl::passOutputBarrier().
+#pragma once
+
+#include <cstdint>
+#include <map>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/gl.h>
+#include <crep/postfx/tone_mapping.h>
+
+namespace crep {
+namespace gpu {
+
+/// std140 block CrepToneMapBlock { CrepToneMapParams crep_toneMap; } (glsl/crep/tone_mapping.glsl).
+struct ToneMapParams {
+  glm::vec4 curve{0.0f};      ///< x middleGrey, y whitePoint, z saturation, w manual exposure
+  glm::vec4 adaptation{0.0f}; ///< x 1 - exp(-dt / tau) (double on the CPU, then float); yzw 0
+  glm::ivec4 flags{0};        ///< x 1 = auto exposure, y 1 = reset adaptation, z partial sums; w 0
+  glm::ivec4 sizes{0};        ///< xy input size (pixels), zw workgroups of the reduction
+};
+static_assert(sizeof(ToneMapParams) == 64, "std140 CrepToneMapParams");
+
+/// std430 element of the reduction's storage buffer (CrepLuminancePartial): one 64 x 64 block.
+struct LuminancePartial {
+  float logSum = 0.0f;     ///< sum of log(kLogAverageDelta + Y) over its finite pixels
+  std::uint32_t count = 0; ///< its finite pixels
+};
+static_assert(sizeof(LuminancePartial) == 8, "std430 CrepLuminancePartial");
+
+/// std430 block of the adaptation state (CrepToneMapState), ToneMapPass::stateBuffer(); an engine may
+/// bind it in its own shaders (e.g. a bloom threshold relative to the exposure).
+struct ToneMapState {
+  float adaptedLuminance = 0.0f; ///< La, the luminance the exposure follows
+  float targetLuminance = 0.0f;  ///< the last frame's log-average (La when it had no finite pixel)
+  float exposureScale = 0.0f;    ///< middleGrey / La
+  std::int32_t valid = 0;        ///< 0 until a frame with a finite pixel was reduced (then 1)
+};
+static_assert(sizeof(ToneMapState) == 16, "std430 CrepToneMapState");
+
+} // namespace gpu
+
+/// Tone mapping with auto exposure and light adaptation on the GPU.
+class ToneMapPass {
+public:
+  /// Edge of the input block one reduction workgroup sums (16 x 16 invocations x 4 x 4 pixels).
+  static constexpr int kReductionTile = 64;
+
+  struct CreateInfo {
+    /// Operator and knobs (validated: InvalidArgument naming "ToneMapPass::CreateInfo.options.<field>").
+    ToneMapOptions options;
+    /// Write encoded values (crep_srgbEncode, IEC 61966-2-1; for an 8-bit texture shown as is) instead of
+    /// linear.
+    bool encodeSrgb = false;
+  };
+  struct FrameAttribs {
+    /// GL_TEXTURE_2D, GL_RGBA32F or GL_RGBA16F: linear HDR RGB (A ignored); its size is the frame's.
+    std::uint32_t input = 0;
+    /// GL_TEXTURE_2D, GL_RGBA8 or GL_RGBA32F, the input's size, not the input: display RGB, A = 1.
+    std::uint32_t output = 0;
+    /// Seconds since the previous frame (finite, >= 0): the adaptation step.
+    double dt = 0.0;
+    /// Forget the adaptation state: the adapted luminance jumps to this frame's log-average (e.g. a
+    /// camera cut). The first frame with a finite pixel after construction always starts this way.
+    bool resetAdaptation = false;
+  };
+
+  explicit ToneMapPass(const CreateInfo& info);
+  /// Tone-maps one frame (steps 1-3 of the file comment; 1-2 only with autoExposure). Throws
+  /// InvalidArgument naming the FrameAttribs field ("ToneMapPass::FrameAttribs.input", ".output", ".dt").
+  void run(const FrameAttribs& frame);
+
+  /// Changes the operator and knobs between frames (validated as in the constructor, naming
+  /// "ToneMapPass::options"); the adaptation state is kept. A new operator's program is built on first use.
+  void setOptions(const ToneMapOptions& options);
+  const ToneMapOptions& options() const { return info_.options; }
+
+  /// The GL storage buffer holding gpu::ToneMapState (owned by the pass).
+  std::uint32_t stateBuffer() const { return state_.get(); }
+  /// Reads the state back (glGetNamedBufferSubData: a pipeline stall; for tests and debugging).
+  gpu::ToneMapState readState() const;
+
+private:
+  std::uint32_t toneMapProgram(std::uint32_t outputFormat);
+
+  CreateInfo info_;
+  gl::Handle reduceProgram_, adaptProgram_, params_, partials_, state_, sampler_;
+  std::size_t partialsCapacity_ = 0;
+  std::map<int, gl::Handle> toneMapPrograms_; ///< by operator x 2 + (output is RGBA8)
+};
+
+} // namespace crep
