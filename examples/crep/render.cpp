@@ -6,6 +6,7 @@
 // sun has a light texture).
 #include "args.h"
 #include "commands.h"
+#include "contact_sheet.h"
 #include "frame_json.h"
 #include "gl_session.h"
 #include "methods.h"
@@ -15,10 +16,13 @@
 #include "timings.h"
 
 #include <crep/core/error.h>
+#include <crep/postfx/gpu_tone_mapping.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/support/exr.h>
 #include <crep/support/png.h>
+
+#include <epoxy/gl.h>
 
 #include <algorithm>
 #include <array>
@@ -155,15 +159,54 @@ void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTim
   });
 }
 
+/// --tonemap: the composite (GL_RGBA32F) through ToneMapPass (crep/postfx/gpu_tone_mapping.h): one
+/// operator's linear display image, or with --tonemap all a sheet of every operator plus the default
+/// clamp(v * exposure), labelled with their names. Auto exposure from this single frame's log-average.
+Image toneMappedPng(const ToneMapSettings& settings, std::uint32_t composite, const Image& compositeImg,
+                    double exposure) {
+  const int width = compositeImg.width(), height = compositeImg.height();
+  const gl::Handle output = gl::createTexture2D(GL_RGBA32F, width, height, "--size");
+  // One pass for every operator (setOptions); each run resets the adaptation: a single frame.
+  ToneMapPass pass({settings.options, false});
+  const auto run = [&](const ToneMapOptions& options) {
+    pass.setOptions(options);
+    pass.run({composite, output.get(), 0.0, true});
+    return readRgba(output.get(), width, height);
+  };
+  if (!settings.all) return run(settings.options);
+  std::vector<SheetTile> tiles;
+  for (const ToneMapOperator op : kToneMapOperators) {
+    ToneMapOptions options = settings.options;
+    options.op = op;
+    tiles.push_back({toneMapOperatorName(op), run(options)});
+  }
+  Image clamped(width, height, 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int c = 0; c < 3; ++c)
+        clamped.at(x, y, c) = static_cast<float>(std::clamp(compositeImg.at(x, y, c) * exposure, 0.0, 1.0));
+  tiles.push_back({"clamp (no --tonemap)", clamped});
+  char exposureText[64];
+  std::snprintf(exposureText, sizeof exposureText, "exposure %g", exposure);
+  char header[256];
+  std::snprintf(header, sizeof header,
+                "crep render --tonemap all: %s, middle grey %g, white point %g, saturation %g",
+                settings.options.autoExposure ? "auto exposure" : exposureText, settings.options.middleGrey,
+                settings.options.whitePoint, settings.options.saturation);
+  return composeGridSheet(header, tiles, std::min(width, 480), 4);
+}
+
 } // namespace
 
 int renderCommand(const std::vector<std::string>& argv) {
   std::set<std::string> valued = {"scene", "size", "out", "exposure", "export-frame"};
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
-  const Args args(argv, valued, {"debug-gl"});
+  valued.insert(kToneMapValuedOptions.begin(), kToneMapValuedOptions.end());
+  const Args args(argv, valued, {"debug-gl", kAutoExposureFlag});
   const std::string sceneName = args.string("scene", "colonnade");
   const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension, Image::kMaxPixels);
   const double exposure = exposureOption(args);
+  const ToneMapSettings toneMap = toneMapSettings(args, exposure);
   const std::string method = args.string("method", "prefilter");
   findMethod(method); // usage error before any GL work
   const MethodSettings settings = methodSettings(args);
@@ -210,13 +253,25 @@ int renderCommand(const std::vector<std::string>& argv) {
     const ExrLayer layers[] = {{"composite", &compositeImg}, {"scattering", &scatteringImage}};
     writeExrLayers(exrPath, layers, ExrPixelType::Half); // the tool's picture file, as it always was
   });
-  timings.time("write png", [&] { writePng(pngPath, compositeImg, ToneMap{static_cast<float>(exposure)}); });
+  Image png;
+  if (toneMap.enabled)
+    timings.time("tone map", [&] { png = toneMappedPng(toneMap, composite.get(), compositeImg, exposure); });
+  // Tone-mapped images are display-referred linear in [0, 1]: writePng's sRGB encoding at exposure 1.
+  timings.time("write png", [&] {
+    writePng(pngPath, toneMap.enabled ? png : compositeImg,
+             ToneMap{toneMap.enabled ? 1.0f : static_cast<float>(exposure)});
+  });
   if (args.has("export-frame")) exportFrame(exportDir, s, timings);
 
   std::printf("crep render: scene %s, %dx%d, method %s (%s)\n", s.scene->name.c_str(), size.x, size.y,
               result.used.c_str(), result.detail.c_str());
   timings.print(stdout);
   std::printf("wrote %s (layers composite.RGBA, scattering.RGBA) and %s\n", exrPath.c_str(), pngPath.c_str());
+  if (toneMap.enabled)
+    std::printf("tone mapping: %s%s\n",
+                toneMap.all ? ("all: " + toneMapOperatorNames() + ", clamp").c_str()
+                            : toneMapOperatorName(toneMap.options.op),
+                toneMap.options.autoExposure ? ", auto exposure" : "");
   if (args.has("export-frame")) {
     std::string extra;
     for (const std::string& name : localLightFiles(*s.scene))

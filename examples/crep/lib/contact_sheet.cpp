@@ -259,4 +259,36 @@ Image composeSheet(const std::string& header, const std::vector<SheetColumn>& co
   return sheet;
 }
 
+Image composeGridSheet(const std::string& header, const std::vector<SheetTile>& tiles, int tileWidth,
+                       int columns) {
+  if (tiles.empty()) throw InvalidArgument("composeGridSheet.tiles", "none", "must not be empty");
+  if (tileWidth < 1)
+    throw InvalidArgument("composeGridSheet.tileWidth", std::to_string(tileWidth), "must be >= 1");
+  if (columns < 1) throw InvalidArgument("composeGridSheet.columns", std::to_string(columns), "must be >= 1");
+  const int margin = kMargin, lineHeight = 10, titleHeight = 20;
+  const Image& first = tiles.front().image;
+  const int tileHeight = sheetTileHeight(tileWidth, {first.width(), first.height()});
+  const int count = static_cast<int>(tiles.size());
+  columns = std::min(columns, count);
+  const int rows = (count + columns - 1) / columns;
+  const int width = margin + columns * (tileWidth + margin);
+  const std::vector<std::string> headerLines = wrap(header, width - 2 * margin);
+  const int headerHeight = 2 * margin + static_cast<int>(headerLines.size()) * lineHeight;
+  const int cellHeight = tileHeight + margin / 2 + titleHeight + margin;
+  Image sheet(width, headerHeight + rows * cellHeight, 3, srgbToLinear(0.12f));
+  int y = margin;
+  for (const std::string& line : headerLines) {
+    drawText(sheet, margin, y, line, 1, glm::vec3(1.0f));
+    y += lineHeight;
+  }
+  for (int i = 0; i < count; ++i) {
+    const SheetTile& tile = tiles[static_cast<std::size_t>(i)];
+    const int x0 = margin + (i % columns) * (tileWidth + margin),
+              y0 = headerHeight + (i / columns) * cellHeight;
+    blit(sheet, resizeImage(tile.image, tileWidth, tileHeight), x0, y0, 1.0);
+    drawText(sheet, x0, y0 + tileHeight + margin / 2 + 2, tile.title, 2, glm::vec3(1.0f));
+  }
+  return sheet;
+}
+
 } // namespace crep::tool

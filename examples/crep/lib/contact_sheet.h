@@ -57,4 +57,16 @@ constexpr int kSheetTextBound = 2048;
 Image composeSheet(const std::string& header, const std::vector<SheetColumn>& columns, int tileWidth,
                    double exposure, double amplification);
 
+/// One labelled image of a grid sheet (composeGridSheet).
+struct SheetTile {
+  std::string title; ///< drawn under the image
+  Image image;       ///< RGB(A) linear display values, clamped to [0, 1] (non-finite -> magenta)
+};
+
+/// A grid sheet (`crep render --tonemap all`): a header on top, then the tiles, `columns` per row, each
+/// resized to tileWidth wide keeping the first tile's aspect ratio, its title underneath. RGB linear.
+/// Throws InvalidArgument for no tiles, tileWidth < 1 or columns < 1.
+Image composeGridSheet(const std::string& header, const std::vector<SheetTile>& tiles, int tileWidth,
+                       int columns);
+
 } // namespace crep::tool

@@ -53,4 +53,43 @@ MethodSettings methodSettings(const Args& args) {
   return s;
 }
 
+const std::set<std::string> kToneMapValuedOptions = {"tonemap", "middle-grey", "white-point", "saturation"};
+
+const char* const kToneMapOptionsHelp =
+    R"(            --tonemap NAME      tone-map the PNG with an operator: exp | reinhard | reinhard-mod |
+                                uncharted2 | filmic-alu | log | adaptive-log, or `all` (a sheet with
+                                one tile per operator); default: clamp(v * exposure)
+            --auto-exposure     exposure middle-grey / log-average luminance (else --exposure)
+            --middle-grey K     key, in (0, 1000] (default 0.18)
+            --white-point W     in [0.001, 1e6] (default 3)
+            --saturation S      colour saturation of the luminance operators, in [0, 8] (default 1)
+)";
+
+ToneMapSettings toneMapSettings(const Args& args, double exposure) {
+  ToneMapSettings s;
+  s.enabled = args.has("tonemap");
+  if (!s.enabled) {
+    for (const char* name : {"middle-grey", "white-point", "saturation", kAutoExposureFlag})
+      if (args.has(name)) throw UsageError(std::string("option --") + name + " needs --tonemap");
+    return s;
+  }
+  const std::string name = args.string("tonemap", "");
+  s.all = name == "all";
+  if (!s.all) {
+    const auto op = findToneMapOperator(name);
+    if (!op)
+      throw UsageError("option --tonemap: '" + name + "' is not one of " + toneMapOperatorNames() + ", all");
+    s.options.op = *op;
+  }
+  s.options.middleGrey = args.number("middle-grey", s.options.middleGrey);
+  if (!(s.options.middleGrey > 0.0 && s.options.middleGrey <= 1e3))
+    throw UsageError("option --middle-grey: must be in (0, 1000]");
+  s.options.whitePoint = args.number("white-point", s.options.whitePoint, 1e-3, 1e6);
+  s.options.saturation = args.number("saturation", s.options.saturation, 0.0, 8.0);
+  s.options.autoExposure = args.has(kAutoExposureFlag);
+  s.options.exposure = exposure;
+  validate(s.options, "crep render tone mapping"); // the ranges above are ToneMapOptions' own
+  return s;
+}
+
 } // namespace crep::tool

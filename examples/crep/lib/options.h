@@ -5,6 +5,8 @@
 #include "frame.h"
 #include "methods.h"
 
+#include <crep/postfx/tone_mapping.h>
+
 #include <set>
 #include <string>
 
@@ -33,5 +35,21 @@ double exposureOption(const Args& args);
 
 /// Help text of those options (indented for `crep help`).
 extern const char* const kMethodOptionsHelp;
+
+/// crep render's tone mapping of its PNG: --tonemap NAME|all (crep/postfx/tone_mapping.h operator names),
+/// --middle-grey, --white-point, --saturation (ToneMapOptions' ranges), --auto-exposure (flag).
+extern const std::set<std::string> kToneMapValuedOptions;
+constexpr const char* kAutoExposureFlag = "auto-exposure";
+struct ToneMapSettings {
+  bool enabled = false; ///< --tonemap given (else the PNG is clamp(v * exposure), as without it)
+  bool all = false;     ///< --tonemap all: a sheet with one tile per operator
+  ToneMapOptions options;
+};
+/// The settings of those options; `exposure` is --exposure, the manual scale without --auto-exposure.
+/// UsageError naming the option for an unknown name (listing the names), values out of range, or a
+/// tone-mapping option without --tonemap.
+ToneMapSettings toneMapSettings(const Args& args, double exposure);
+/// Help text of those options.
+extern const char* const kToneMapOptionsHelp;
 
 } // namespace crep::tool
