@@ -22,6 +22,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 using namespace crep;
@@ -357,6 +358,66 @@ TEST_CASE("ToneMapPass: bad options and frame attributes name the field") {
   pass.setOptions(log);
   CHECK(pass.options().op == ToneMapOperator::Logarithmic);
   CHECK(run({input.get(), output.get(), 0.0, false}) == "(no InvalidArgument)");
+}
+
+TEST_CASE(
+    "tone_mapping.glsl: an engine's shader calls crep_toneMapColor with the operator chosen at run time") {
+  CREP_REQUIRE_GL();
+  // An engine's own shader (registered like an application's embedded set): the operator is a uniform,
+  // not the pass's compile-time define, so every branch of crep_toneMapCurve is compiled and selected.
+  static constexpr std::string_view kSource = R"(#version 450 core
+#include "crep/tone_mapping.glsl"
+layout(local_size_x = 64) in;
+layout(location = 0) uniform int op;
+layout(std430, binding = 0) readonly buffer In { vec4 inputs[]; };
+layout(std430, binding = 1) writeonly buffer Out { vec4 outputs[]; };
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  outputs[i] = vec4(crep_srgbEncode(crep_toneMapColor(inputs[i].rgb, inputs[i].w, op, 3.0, 1.3)), 1.0);
+}
+)";
+  static const ShaderLibrary::File files[] = {{"tests/postfx/engine_tone_map.comp", kSource}};
+  ShaderLibrary::addFiles(files);
+  const gl::Handle program = buildProgram({{ShaderStage::Compute, "tests/postfx/engine_tone_map.comp", {}}});
+  // rgb and the exposure scale (w) of each sample: black, grey, colours, bright, a NaN.
+  std::vector<glm::vec4> inputs;
+  for (int i = 0; i < 64; ++i) {
+    const float L = std::pow(10.0f, -3.0f + 6.0f * static_cast<float>(i) / 63.0f);
+    inputs.push_back(glm::vec4(L, 0.5f * L, 0.1f * L, i % 2 == 0 ? 1.0f : 0.37f));
+  }
+  inputs[0] = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  inputs[1] = glm::vec4(std::numeric_limits<float>::quiet_NaN(), 1.0f, 1.0f, 1.0f);
+  gl::Handle in = gl::createBuffer(), out = gl::createBuffer();
+  glNamedBufferStorage(in.get(), static_cast<GLsizeiptr>(inputs.size() * sizeof(glm::vec4)), inputs.data(),
+                       0);
+  glNamedBufferStorage(out.get(), static_cast<GLsizeiptr>(inputs.size() * sizeof(glm::vec4)), nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+  ToneMapOptions o;
+  o.whitePoint = 3.0;
+  o.saturation = 1.3;
+  for (const ToneMapOperator op : kToneMapOperators) {
+    const std::string opName = toneMapOperatorName(op);
+    CAPTURE(opName);
+    o.op = op;
+    glUseProgram(program.get());
+    glUniform1i(0, static_cast<int>(op));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.get());
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<glm::vec4> result(inputs.size());
+    glGetNamedBufferSubData(out.get(), 0, static_cast<GLsizeiptr>(result.size() * sizeof(glm::vec4)),
+                            result.data());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const glm::dvec3 expected = toneMapColor(glm::dvec3(inputs[i]), inputs[i].w, o);
+      for (int c = 0; c < 3; ++c)
+        worst = std::max(worst, std::abs(double(result[i][c]) - srgbEncode(expected[c])));
+    }
+    // The operator case's float tolerance (2e-5) through the sRGB curve's slope (at most 12.92).
+    CHECK(worst <= 12.92 * 2e-5);
+  }
+  gl::unbindPassState(2);
 }
 
 TEST_CASE("ToneMapPass: cost at 1280x720 (llvmpipe figure for the README)") {
