@@ -3,14 +3,18 @@
 // n + 1 terms, Sec. 13.4): per camera pixel, n + 1 bilinear reads of the source image along the screen
 // segment toward the sun, weighted decay^i, times fade exposure weight / (n + 1); A = exp(-sbar s) of the
 // pixel ray (crep/scatter/ray.h's output convention).
+// CREP_RADIAL_FRACTION 1 (RadialBlurMode::OcclusionFraction, Mitchell 2007, Eq. 2): the sum reads the
+// source's A (sky fraction) and is multiplied by the pixel's own unshadowed in-scattering.
 // Resources: CrepMarchBlock (binding 0: camera, medium; sizes.xy = camera image), CrepRadialBlurBlock
 // (binding 1), camera depth (texture unit 0, texelFetch), source (texture unit 1, bilinear, clamp to edge),
 // output RGBA32F (image unit 0).
-#include "crep/march.glsl"
 #include "crep/radial_blur.glsl"
 
 #ifndef CREP_RADIAL_GROUP
 #define CREP_RADIAL_GROUP 8
+#endif
+#ifndef CREP_RADIAL_FRACTION
+#define CREP_RADIAL_FRACTION 0
 #endif
 layout(local_size_x = CREP_RADIAL_GROUP, local_size_y = CREP_RADIAL_GROUP) in;
 
@@ -35,11 +39,19 @@ void main() {
     // The hardware bilinear filter (Mitchell 2007, Sec. 13.3.1): one fetch per sample; on GPUs its weights
     // have about 8 fractional bits, which the averaging over n + 1 samples hides.
     for (int i = 0; i <= n; ++i) {
-      L += decay * textureLod(radialSource, (p - float(i) * delta) * toSource, 0.0).rgb;
+      vec4 v = textureLod(radialSource, (p - float(i) * delta) * toSource, 0.0);
+#if CREP_RADIAL_FRACTION
+      L += vec3(decay * v.a);
+#else
+      L += decay * v.rgb;
+#endif
       decay *= crep_radial.shape.x;
     }
     L *= crep_radial.light.z * crep_radial.light.w;
   }
   vec4 ray = crep_pixelRay(crep_march, pixel, texelFetch(cameraDepth, pixel, 0).r);
+#if CREP_RADIAL_FRACTION
+  L *= crep_radialUnshadowed(crep_march, ray);
+#endif
   imageStore(scatteringOut, pixel, vec4(L, exp(-crep_march.extinction.w * ray.w)));
 }

@@ -6,8 +6,6 @@
 // plane, the closed form of crep::unshadowedScattering; geometry: 0), A = the sky fraction.
 // Resources: CrepMarchBlock (binding 0: camera, light, medium; sizes.xy = camera image), CrepRadialBlurBlock
 // (binding 1), camera depth (texture unit 0, texelFetch), source output RGBA32F (image unit 0).
-#include "crep/march.glsl"
-#include "crep/phase.glsl"
 #include "crep/radial_blur.glsl"
 
 #ifndef CREP_RADIAL_GROUP
@@ -30,12 +28,7 @@ void main() {
     for (int x = first.x; x < last.x; ++x) {
       float depth = texelFetch(cameraDepth, ivec2(x, y), 0).r;
       if (!crep_radialIsSky(depth, crep_march.cameraDepth)) continue;
-      vec4 ray = crep_pixelRay(crep_march, ivec2(x, y), depth);
-      float cosTheta = dot(crep_march.lightDirection.xyz, -ray.xyz);
-      vec3 C = crep_march.lightIrradiance.rgb *
-               (crep_march.mieScattering.rgb * crep_henyeyGreenstein(crep_march.mieScattering.w, cosTheta) +
-                crep_march.rayleighScattering.rgb * crep_rayleighPhase(cosTheta));
-      sum += vec4(C * crep_transmittanceIntegral(crep_march.extinction.rgb, 0.0, ray.w), 1.0);
+      sum += vec4(crep_radialUnshadowed(crep_march, crep_pixelRay(crep_march, ivec2(x, y), depth)), 1.0);
     }
   ivec2 count = last - first;
   imageStore(sourceOut, texel, sum / float(count.x * count.y));

@@ -57,8 +57,11 @@ RadialBlurPass::RadialBlurPass(const CreateInfo& info) : info_(info) {
     throw InvalidArgument("RadialBlurPass::CreateInfo.workgroupSize", detail::formatValue(info.workgroupSize),
                           "must be in [1, 32]");
   const std::vector<ShaderDefine> defines = {{"CREP_RADIAL_GROUP", std::to_string(info.workgroupSize)}};
+  std::vector<ShaderDefine> blurDefines = defines;
+  if (info.options.mode == RadialBlurMode::OcclusionFraction)
+    blurDefines.push_back({"CREP_RADIAL_FRACTION", "1"});
   sourceProgram_ = buildProgram({{ShaderStage::Compute, "passes/radial_source.comp", defines}});
-  blurProgram_ = buildProgram({{ShaderStage::Compute, "passes/radial_blur.comp", defines}});
+  blurProgram_ = buildProgram({{ShaderStage::Compute, "passes/radial_blur.comp", blurDefines}});
   marchParams_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   radialParams_ = gl::createDynamicBuffer(sizeof(gpu::RadialBlurParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);

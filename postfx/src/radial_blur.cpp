@@ -45,6 +45,9 @@ void validate(const RadialBlurOptions& o, const char* owner) {
                           "must be finite and > 0");
   if (o.threads < 0)
     throw InvalidArgument(field(owner, "threads"), detail::formatValue(o.threads), "must be >= 0");
+  if (o.mode != RadialBlurMode::SourceRadiance && o.mode != RadialBlurMode::OcclusionFraction)
+    throw InvalidArgument(field(owner, "mode"), detail::formatValue(static_cast<int>(o.mode)),
+                          "must be SourceRadiance or OcclusionFraction");
 }
 
 // Mitchell 2007, Sec. 13.4 (the light's screen position) and Sec. 13.6 (fade toward the perpendicular).
@@ -70,12 +73,11 @@ glm::ivec2 radialSourceSize(int width, int height, int sourceScale) {
 
 // Mitchell 2007, Sec. 13.5.1 (occlusion pre-pass: occluders black) with the sky's unshadowed
 // in-scattering (Eq. 1) as the bright value, box-downsampled by sourceScale (Sec. 13.3.1).
-Image radialBlurSource(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
-                       const Medium& medium, const RadialBlurOptions& options) {
-  validate(options);
-  MarchOptions march;
-  march.threads = options.threads;
-  const Image sky = unshadowedScattering(cameraDepth, camera, light, medium, march); // validates the depth
+namespace {
+
+/// The source image from the camera depth and its unshadowed in-scattering `sky` (rule at the top).
+Image sourceFrom(const Image& cameraDepth, const Image& sky, const Camera& camera,
+                 const RadialBlurOptions& options) {
   const int w = cameraDepth.width(), h = cameraDepth.height(), k = options.sourceScale;
   const glm::ivec2 size = radialSourceSize(w, h, k);
   Image out(size.x, size.y, 4);
@@ -97,6 +99,21 @@ Image radialBlurSource(const Image& cameraDepth, const Camera& camera, const Dir
   return out;
 }
 
+Image unshadowed(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                 const Medium& medium, const RadialBlurOptions& options) {
+  validate(options);
+  MarchOptions march;
+  march.threads = options.threads;
+  return unshadowedScattering(cameraDepth, camera, light, medium, march); // validates the depth
+}
+
+} // namespace
+
+Image radialBlurSource(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
+                       const Medium& medium, const RadialBlurOptions& options) {
+  return sourceFrom(cameraDepth, unshadowed(cameraDepth, camera, light, medium, options), camera, options);
+}
+
 // The bilinear filter of Mitchell 2007, Sec. 13.3.1, with GL's CLAMP_TO_EDGE.
 glm::dvec4 radialBilinear(const Image& source, double sx, double sy) {
   const int w = source.width(), h = source.height(), channels = std::min(source.channels(), 4);
@@ -116,10 +133,13 @@ glm::dvec4 radialBilinear(const Image& source, double sx, double sy) {
   return r;
 }
 
-// Mitchell 2007, Eq. 4 (averaged over its n + 1 terms) along the screen ray toward the sun (Sec. 13.4).
+// Mitchell 2007, Eq. 4 (averaged over its n + 1 terms) along the screen ray toward the sun (Sec. 13.4); in
+// mode OcclusionFraction Eq. 2 with 1 - D from the same sum over the sky mask.
 Image radialBlur(const Image& cameraDepth, const Camera& camera, const DirectionalLight& light,
                  const Medium& medium, const RadialBlurOptions& options) {
-  const Image source = radialBlurSource(cameraDepth, camera, light, medium, options);
+  const Image own = unshadowed(cameraDepth, camera, light, medium, options);
+  const Image source = sourceFrom(cameraDepth, own, camera, options);
+  const bool fraction = options.mode == RadialBlurMode::OcclusionFraction;
   const RadialLight sun = radialLight(camera, light, options.fadeMargin);
   const int w = cameraDepth.width(), h = cameraDepth.height(), n = options.samples;
   const double k = options.sourceScale;
@@ -135,10 +155,12 @@ Image radialBlur(const Image& cameraDepth, const Camera& camera, const Direction
         double decay = 1.0;
         for (int i = 0; i <= n; ++i) {
           const glm::dvec2 pi = p - static_cast<double>(i) * delta;
-          L += decay * glm::dvec3(radialBilinear(source, pi.x * w / k - 0.5, pi.y * h / k - 0.5));
+          const glm::dvec4 v = radialBilinear(source, pi.x * w / k - 0.5, pi.y * h / k - 0.5);
+          L += decay * (fraction ? glm::dvec3(v.a) : glm::dvec3(v));
           decay *= options.decay;
         }
         L *= scale;
+        if (fraction) L *= glm::dvec3(own.at(x, y, 0), own.at(x, y, 1), own.at(x, y, 2));
       }
       storeScattering(out, x, y, L, std::exp(-grey * pixelRay(camera, cameraDepth, x, y).surface));
     }

@@ -1,7 +1,7 @@
 // RadialBlurPass (crep/postfx/gpu_radial_blur.h) against its CPU reference crep::radialBlur on a small
 // analytic frame (a ground plane with a row of pillars, the sun in view), full and reduced source
-// resolution, odd workgroup sizes; a sun behind the camera adds exactly nothing; NaN depth stays finite;
-// the block's std140 offsets; bad input names the field.
+// resolution, odd workgroup sizes, both modes; a sun behind the camera adds exactly nothing; NaN depth stays
+// finite; the block's std140 offsets; bad input names the field.
 #include "support/analytic_scene.h"
 #include "support/gl_fixture.h"
 
@@ -88,9 +88,13 @@ TEST_CASE("RadialBlurPass: GPU equals the CPU reference on a pillar frame with t
     double sunX, sunY;
     int sourceScale, workgroup, samples;
     double decay;
+    RadialBlurMode mode;
   };
-  for (const Case c : {Case{0.2, 0.4, 1, 8, 48, 0.97}, Case{-0.5, 0.1, 2, 5, 33, 1.0},
-                       Case{1.2, 0.6, 3, 16, 20, 0.9}}) { // the last: off screen, fade 1/2 margin
+  const RadialBlurMode source = RadialBlurMode::SourceRadiance, fraction = RadialBlurMode::OcclusionFraction;
+  for (const Case c : {Case{0.2, 0.4, 1, 8, 48, 0.97, source}, Case{-0.5, 0.1, 2, 5, 33, 1.0, source},
+                       Case{1.2, 0.6, 3, 16, 20, 0.9, source}, // off screen: fade 0.648
+                       Case{0.2, 0.4, 1, 8, 48, 0.97, fraction}, Case{-0.3, 0.2, 2, 8, 24, 1.0, fraction}}) {
+    CAPTURE(static_cast<int>(c.mode));
     CAPTURE(c.sunX);
     CAPTURE(c.sourceScale);
     const DirectionalLight light = sunAt(camera, c.sunX, c.sunY);
@@ -101,6 +105,7 @@ TEST_CASE("RadialBlurPass: GPU equals the CPU reference on a pillar frame with t
     info.options.exposure = 1.2;
     info.options.weight = 0.8;
     info.options.sourceScale = c.sourceScale;
+    info.options.mode = c.mode;
     info.workgroupSize = c.workgroup;
     const Image gpu = runGpu(info, depth, camera, light, medium);
     const Image cpu = radialBlur(depth, camera, light, medium, info.options);

@@ -152,6 +152,39 @@ TEST_CASE("RadialBlur: a half-occluded segment gives the visible fraction of its
   }
 }
 
+TEST_CASE("RadialBlur: OcclusionFraction is the visible fraction times the pixel's own in-scattering") {
+  // The layout of the previous case with the sun on the centre of sky pixel (48, 4) and the geometry
+  // pixel (16, 4): 17 of its 33 samples (pixels 32..48) see the sky; its own ray ends at depth 0.5.
+  const int w = 64, h = 8;
+  const Camera camera = smallCamera(w, h);
+  const DirectionalLight light = sunAt(camera, {2.0 * 48.5 / w - 1.0, 2.0 * 4.5 / h - 1.0});
+  Image depth(w, h, 1, 1.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w / 2; ++x)
+      depth.at(x, y) = 0.5f;
+  RadialBlurOptions o;
+  o.samples = 32;
+  o.mode = RadialBlurMode::OcclusionFraction;
+  const Image out = radialBlur(depth, camera, light, denseIsotropic(), o);
+  // U = C (1 - exp(-sigma_t s)) / sigma_t, C = E sigma_s / (4 pi) (isotropic), s = Z / cos, Z the view
+  // depth of the GL depth value 0.5: n f / (f - 0.5 (f - n)).
+  const double n = camera.near(), f = camera.far();
+  const double Z = n * f / (f - 0.5 * (f - n));
+  const glm::dvec3 v = camera.rayDirection(2.0 * 16.5 / w - 1.0, 2.0 * 4.5 / h - 1.0);
+  const double s = Z / glm::dot(v, camera.forward());
+  const glm::dvec3 sigmaS(20.0, 15.0, 10.0), sigmaT(25.0, 20.0, 15.0);
+  for (int c = 0; c < 3; ++c) {
+    const double U =
+        light.irradiance()[c] * sigmaS[c] / (4.0 * kPi) * (1.0 - std::exp(-sigmaT[c] * s)) / sigmaT[c];
+    CHECK(out.at(16, 4, c) == doctest::Approx(17.0 / 33.0 * U).epsilon(1e-6));
+  }
+  // The default mode gives the sky's radiance instead (saturated: E sigma_s / (4 pi sigma_t)), larger.
+  o.mode = RadialBlurMode::SourceRadiance;
+  const Image sky = radialBlur(depth, camera, light, denseIsotropic(), o);
+  for (int c = 0; c < 3; ++c)
+    CHECK(sky.at(16, 4, c) == doctest::Approx(17.0 / 33.0 * saturatedSky(light)[c]).epsilon(1e-6));
+}
+
 TEST_CASE("RadialBlur: the sun's screen position and fade") {
   const Camera camera = smallCamera(32, 18);
   const double margin = 0.5;
@@ -293,6 +326,9 @@ TEST_CASE("RadialBlur: bad options and inputs name the field") {
     RadialBlurOptions o;
     o.threads = -1;
     expectField(o, "threads");
+    o = {};
+    o.mode = static_cast<RadialBlurMode>(7);
+    expectField(o, "mode");
   }
   // The edges are accepted.
   RadialBlurOptions ok;

@@ -43,7 +43,8 @@ RadialBlurParams makeRadialBlurParams(const RadialBlurOptions& options, const Ra
 class RadialBlurPass {
 public:
   struct CreateInfo {
-    /// The blur's knobs (crep/postfx/radial_blur.h); `threads` is not used by the pass.
+    /// The blur's knobs (crep/postfx/radial_blur.h); `threads` is not used by the pass; `mode` is compiled
+    /// in (OcclusionFraction: the CREP_RADIAL_FRACTION variant of the blur shader).
     RadialBlurOptions options;
     /// Both shaders run workgroupSize x workgroupSize invocations per workgroup, in [1, 32]. 8 (64
     /// invocations) is a multiple of every GPU's SIMD width (32 / 64); neighbouring pixels' samples read

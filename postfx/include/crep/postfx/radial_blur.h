@@ -38,6 +38,13 @@
 // sun times the sky's unshadowed in-scattering along it (Mitchell 2007, Eq. 2-3): exactly the unshadowed
 // in-scattering of the sky when nothing occludes a uniform sky. The in-scattering of a geometry pixel is
 // the sky's along its segment, not its own shorter ray's (the method's bias near the camera).
+// Mode OcclusionFraction (Mitchell 2007, Eq. 2 with the occlusion D estimated as in Sec. 13.3 by the
+// proportion of samples that reach the bright region): the same sum over the source's A (the sky
+// fraction) instead of its RGB, times the pixel's own unshadowed in-scattering U(x, y) (the closed form of
+// crep::unshadowedScattering on its own ray, to its surface):
+//   RGB = fade exposure weight / (n + 1) sum_{i=0}^{n} decay^i sourceA(p_i) U(x, y).
+// With the defaults: the visible fraction of the screen segment times the pixel's own in-scattering, so
+// geometry pixels keep their shorter rays' in-scattering instead of the sky's.
 // Only the directional light; local lights and light textures are not modelled.
 #pragma once
 
@@ -49,6 +56,12 @@
 #include <crep/core/medium.h>
 
 namespace crep {
+
+/// What the radial sum accumulates (rules at the top).
+enum class RadialBlurMode {
+  SourceRadiance,    ///< Mitchell 2007, Eq. 3-4: the source's radiance (the sky's in-scattering)
+  OcclusionFraction, ///< Mitchell 2007, Eq. 2: the sky fraction times the pixel's own in-scattering
+};
 
 /// The knobs of Mitchell 2007, Eq. 4 and Sec. 13.3.1, and the fade. The defaults are the physically
 /// anchored setting (the blur is the sky-fraction estimate of Eq. 2-3 times the sky's in-scattering);
@@ -62,6 +75,7 @@ struct RadialBlurOptions {
   int sourceScale = 1;     ///< k in [1, 16]: the source image is downsampled by k (box filter)
   double fadeMargin = 0.5; ///< NDC units outside the screen where the fade reaches 0, finite, > 0
   int threads = 0;         ///< CPU worker threads (reference only), 0 = hardware concurrency, >= 0
+  RadialBlurMode mode = RadialBlurMode::SourceRadiance;
 };
 
 /// Throws InvalidArgument naming `owner` + ".exposure" etc. (e.g. owner
