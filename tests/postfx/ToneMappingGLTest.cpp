@@ -277,7 +277,8 @@ TEST_CASE("ToneMapPass: adaptation reaches exp(-1) of the gap after tau, indepen
   CHECK(at30.adaptedLuminance == doctest::Approx(adapted).epsilon(1e-5));
 }
 
-TEST_CASE("ToneMapPass: NaN / Inf pixels are skipped by the log-average and written black; reset") {
+TEST_CASE("ToneMapPass: NaN / Inf pixels are skipped by the log-average and written black, reset jumps to "
+          "the target") {
   CREP_REQUIRE_GL();
   Image hdr = hdrImage(100, 70, 3);
   const LuminanceStats clean = luminanceStats(hdr);
