@@ -198,6 +198,23 @@ void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOpti
             "scatteringPrefix true, or visibilityTableSamples = 0)");
 }
 
+/// FrameAttribs::froxels (scattering.h "Froxel volumes"): grid, jitter, the volume's target, format, size.
+void validateFroxelTarget(const Scattering::FroxelTarget& t, const Camera& camera) {
+  const char* owner = "Scattering::FrameAttribs.froxels";
+  validate(t.grid, owner);
+  froxelDepthRange(t.grid, camera, owner);
+  validateFroxelJitter(t.jitter, "Scattering::FrameAttribs.froxels.jitter");
+  const gl::TextureLevel v = gl::textureLevel("Scattering::FrameAttribs.froxels.volume", t.volume);
+  if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
+    invalid("Scattering::FrameAttribs.froxels.volume", "texture " + std::to_string(t.volume),
+            "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
+  if (v.width != t.grid.width || v.height != t.grid.height || v.depth != t.grid.depth)
+    invalid("Scattering::FrameAttribs.froxels.volume",
+            std::to_string(v.width) + " x " + std::to_string(v.height) + " x " + std::to_string(v.depth),
+            "must have the grid's size " + std::to_string(t.grid.width) + " x " +
+                std::to_string(t.grid.height) + " x " + std::to_string(t.grid.depth));
+}
+
 /// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
 struct DepthTarget {
   gl::Handle texture, framebuffer;
@@ -389,7 +406,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     if (f.output == 0 && local)
       invalid("Scattering::FrameAttribs.output", "0",
               "must be set with local lights (they are added to the per-pixel output only)");
-    invalid("Scattering::FrameAttribs.froxels", "set", "froxel volumes are not implemented yet");
+    validateFroxelTarget(*f.froxels, *f.camera);
   }
   if (f.light && !f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
@@ -481,23 +498,40 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
     m.prefilter.run(
         {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .lightColors = colors});
   });
-  if (m.reduced) stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
-  stage("evaluate", [&] {
-    EvaluatePass::FrameAttribs e;
-    e.cameraDepth = m.reduced ? m.lowDepth.get() : f.cameraDepth;
-    e.output = m.reduced ? m.lowOutput.get() : f.output;
-    e.camera = f.camera;
-    e.light = f.light;
-    e.medium = f.medium;
-    e.layout = layout.get();
-    e.basis = m.prefilter.filteredBasis();
-    m.evaluate.run(e);
-  });
-  if (m.reduced)
+  const bool pixels = f.output != 0;
+  if (m.reduced && pixels)
+    stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
+  if (pixels)
+    stage("evaluate", [&] {
+      EvaluatePass::FrameAttribs e;
+      e.cameraDepth = m.reduced ? m.lowDepth.get() : f.cameraDepth;
+      e.output = m.reduced ? m.lowOutput.get() : f.output;
+      e.camera = f.camera;
+      e.light = f.light;
+      e.medium = f.medium;
+      e.layout = layout.get();
+      e.basis = m.prefilter.filteredBasis();
+      m.evaluate.run(e);
+    });
+  if (m.reduced && pixels)
     stage("upsample", [&] {
       m.reduced->upsample(m.lowOutput.get(), m.lowDepth.get(), f.cameraDepth, f.output, *f.camera);
     });
-  if (r.layout == Layout::Epipolar) {
+  if (f.froxels)
+    stage("froxels", [&] {
+      // The same basis evaluated at the volume's cells (EvaluatePass::FrameAttribs::froxels), from the
+      // scattering prefix table the per-pixel evaluation built (reuseTable), so the stage times the fill.
+      EvaluatePass::FrameAttribs e;
+      e.camera = f.camera;
+      e.light = f.light;
+      e.medium = f.medium;
+      e.layout = layout.get();
+      e.basis = m.prefilter.filteredBasis();
+      e.froxels = {f.froxels->volume, f.froxels->grid, f.froxels->jitter};
+      e.reuseTable = pixels;
+      m.evaluate.run(e);
+    });
+  if (r.layout == Layout::Epipolar && pixels) {
     const auto& epipolar = static_cast<const EpipolarLayout&>(*layout);
     const auto centre = epipolar.epipolePixel();
     const double radius = epipolar.epipoleBlockRadiusPixels();

@@ -254,8 +254,9 @@ public:
     Layout layout = Layout::Projective;
     Rectification rectification;     ///< the decision (reason, measure, threshold when not projective)
     double epipoleBlockRadius = 0.0; ///< pixels; 0 without a block (projective, or epipole off screen)
-    /// In order: shadow / resample, light colours (with FrameAttribs::lightTexture), prefilter, evaluate,
-    /// epipole block.
+    /// In order: shadow / resample, light colours (with FrameAttribs::lightTexture), prefilter, evaluate
+    /// (with an output), froxels (with FrameAttribs::froxels: the volume's fill alone, from the per-frame
+    /// table the evaluation built), epipole block.
     std::vector<Stage> stages;
     /// Epipolar frames: the standard shadow map resampled and marched (the engine's, or the one rendered
     /// with drawCasters, valid until the next run()); texture 0 on projective frames.
