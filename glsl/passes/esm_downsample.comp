@@ -1,8 +1,8 @@
 #version 450 core
 // Exponential shadow map, step 1 (Annen et al. 2008 as used by Wronski 2014: the shadow map downsampled in
-// exponent space; crep::buildEsm, rule 1 of crep/postfx/froxel_fog.h): ESM texel (i, j) = the mean of
-// exp(c (d - 1)) over its f x f block of shadow-map texels (clipped at the map's edge). Stored shifted by -c
-// so every value is in (exp(-c), 1]: no float overflow for c <= 80. A NaN texel counts as empty (d = 1).
+// exponent space; crep::buildEsm, rule 1 of crep/postfx/froxel_fog.h): ESM texel (i, j) = log(mean exp(c d))
+// / c over its f x f block of shadow-map texels (clipped at the map's edge), evaluated around the block's
+// largest d (log-space filtering: no float overflow for any c). A NaN texel counts as empty (d = 1).
 // Resources: params block (binding 0), shadow map (unit 0, texelFetch), output R32F (image 0).
 #include "crep/froxel.glsl"
 
@@ -19,13 +19,19 @@ void main() {
   int f = crep_froxel.info.x;
   float c = crep_froxel.esm.x;
   ivec2 lo = texel * f, hi = min(lo + f, mapSize);
+  float m = 0.0;
+  for (int y = lo.y; y < hi.y; ++y)
+    for (int x = lo.x; x < hi.x; ++x) {
+      float d = texelFetch(shadowMap, ivec2(x, y), 0).r;
+      m = max(m, d >= 0.0 ? min(d, 1.0) : (d < 0.0 ? 0.0 : 1.0));
+    }
   float sum = 0.0;
   for (int y = lo.y; y < hi.y; ++y)
     for (int x = lo.x; x < hi.x; ++x) {
       float d = texelFetch(shadowMap, ivec2(x, y), 0).r;
       d = d >= 0.0 ? min(d, 1.0) : (d < 0.0 ? 0.0 : 1.0); // NaN -> 1 (empty)
-      sum += exp(c * (d - 1.0));
+      sum += exp(c * (d - m));
     }
   ivec2 n = hi - lo;
-  imageStore(esmOut, texel, vec4(sum / float(n.x * n.y)));
+  imageStore(esmOut, texel, vec4(m + log(sum / float(n.x * n.y)) / c));
 }

@@ -20,7 +20,8 @@ layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_frox
 layout(binding = 0) uniform sampler2D esm;
 layout(binding = 0, CREP_FROXEL_FORMAT) uniform writeonly image3D lightingOut;
 
-// crep::esmVisibility: clamp(esm(u, v) exp(c (1 + bias - d_r)), 0, 1); lit outside the map.
+// crep::esmVisibility: clamp(exp(c (z + bias - d_r)), 0, 1) with z the bilinear mean of exp(c z_i) taken
+// in log space around the largest texel; lit outside the map.
 float crep_esmVisibility(vec3 p) {
   vec4 q = crep_froxel.lightClipFromWorld * vec4(p, 1.0);
   if (!(q.w > 0.0)) return 1.0;
@@ -30,13 +31,18 @@ float crep_esmVisibility(vec3 p) {
   vec2 f = uvd.xy * vec2(size) - 0.5;
   vec2 f0 = floor(f), a = f - f0;
   ivec2 i0 = ivec2(f0);
-  float t00 = texelFetch(esm, clamp(i0, ivec2(0), size - 1), 0).r;
-  float t10 = texelFetch(esm, clamp(i0 + ivec2(1, 0), ivec2(0), size - 1), 0).r;
-  float t01 = texelFetch(esm, clamp(i0 + ivec2(0, 1), ivec2(0), size - 1), 0).r;
-  float t11 = texelFetch(esm, clamp(i0 + ivec2(1, 1), ivec2(0), size - 1), 0).r;
-  float occluder = mix(mix(t00, t10, a.x), mix(t01, t11, a.x), a.y);
+  vec4 z = vec4(texelFetch(esm, clamp(i0, ivec2(0), size - 1), 0).r,
+                texelFetch(esm, clamp(i0 + ivec2(1, 0), ivec2(0), size - 1), 0).r,
+                texelFetch(esm, clamp(i0 + ivec2(0, 1), ivec2(0), size - 1), 0).r,
+                texelFetch(esm, clamp(i0 + ivec2(1, 1), ivec2(0), size - 1), 0).r);
+  vec4 w = vec4((1.0 - a.x) * (1.0 - a.y), a.x * (1.0 - a.y), (1.0 - a.x) * a.y, a.x * a.y);
+  float m = -3.0e38;
+  for (int i = 0; i < 4; ++i)
+    if (w[i] > 0.0) m = max(m, z[i]);
+  float c = crep_froxel.esm.x;
+  float occluder = m + log(dot(w, exp(c * min(z - m, vec4(0.0))))) / c; // zero-weight texels may exceed m
   float receiver = clamp(uvd.z, 0.0, 1.0);
-  return clamp(occluder * exp(crep_froxel.esm.x * (1.0 + crep_froxel.esm.y - receiver)), 0.0, 1.0);
+  return clamp(exp(c * (occluder + crep_froxel.esm.y - receiver)), 0.0, 1.0);
 }
 
 // crep::froxelDensity: exponential height fog times value noise.

@@ -59,9 +59,9 @@ double latticeValue(int i, int j, int k) {
 } // namespace
 
 void validate(const EsmOptions& o, const char* owner) {
-  if (!(o.exponent > 0.0 && o.exponent <= 80.0))
+  if (!(o.exponent > 0.0 && o.exponent <= 1e4))
     throw InvalidArgument(field(owner, "exponent"), detail::formatValue(o.exponent),
-                          "must be in (0, 80] (exp(-c) must stay a normal float)");
+                          "per world unit along the light, must be in (0, 1e4]");
   if (o.downsample < 1 || o.downsample > 64)
     throw InvalidArgument(field(owner, "downsample"), detail::formatValue(o.downsample),
                           "must be in [1, 64]");
@@ -73,23 +73,39 @@ void validate(const EsmOptions& o, const char* owner) {
                           "depth-buffer units, must be in [-1, 1]");
 }
 
-void validate(const FroxelDensity& d, const char* owner) {
-  if (!std::isfinite(d.heightBase))
-    throw InvalidArgument(field(owner, "heightBase"), detail::formatValue(d.heightBase), "must be finite");
-  if (!(d.heightFalloff >= 0.0) || !std::isfinite(d.heightFalloff))
-    throw InvalidArgument(field(owner, "heightFalloff"), detail::formatValue(d.heightFalloff),
-                          "world units, must be finite and >= 0 (0 = no height fog)");
-  if (!(d.noiseAmplitude >= 0.0 && d.noiseAmplitude <= 1.0))
-    throw InvalidArgument(field(owner, "noiseAmplitude"), detail::formatValue(d.noiseAmplitude),
-                          "must be in [0, 1] (0 = no noise)");
-  if (!(d.noiseFrequency > 0.0) || !std::isfinite(d.noiseFrequency))
-    throw InvalidArgument(field(owner, "noiseFrequency"), detail::formatValue(d.noiseFrequency),
-                          "lattice cells per world unit, must be finite and > 0");
+double esmDepthExponent(const EsmOptions& options, const glm::dmat4& lightClipFromWorld) {
+  // |grad NDC z| over world space (the orthographic sun map's depth is linear: d = 0.5 ndc.z + 0.5)
+  const double g =
+      glm::length(glm::dvec3(lightClipFromWorld[0][2], lightClipFromWorld[1][2], lightClipFromWorld[2][2]));
+  const double c = options.exponent * 2.0 / g;
+  if (!std::isfinite(c) || !(c > 0.0) || c > 1e7)
+    throw InvalidArgument(
+        "lightClipFromWorld", "depth gradient " + detail::formatValue(g),
+        "must give an ESM exponent in (0, 1e7] per depth unit (a finite, non-degenerate depth row)");
+  return c;
 }
 
-// Annen et al. 2008 (exponential shadow maps) as downsampled and box-blurred by Wronski 2014: rule 1.
-Image buildEsm(const Image& shadowDepth, const EsmOptions& options) {
+namespace {
+
+/// Log-space mean (Annen et al. 2008's log-space filtering): log(sum w_i exp(c z_i)) / c, evaluated
+/// around the largest z so that no term overflows.
+double logSpaceMean(const double* z, const double* w, int n, double c) {
+  double m = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < n; ++i)
+    if (w[i] > 0.0) m = std::max(m, z[i]);
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i)
+    if (w[i] > 0.0) sum += w[i] * std::exp(c * (z[i] - m));
+  return m + std::log(sum) / c;
+}
+
+} // namespace
+
+// Annen et al. 2008 (exponential shadow maps, log-space filtering) as downsampled and box-blurred by
+// Wronski 2014: rule 1.
+Image buildEsm(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld, const EsmOptions& options) {
   validate(options, "EsmOptions");
+  const double c = esmDepthExponent(options, lightClipFromWorld);
   if (shadowDepth.empty() || shadowDepth.channels() != 1)
     throw InvalidArgument("shadowDepth", shadowDepth.empty() ? "empty" : "several channels",
                           "must be a 1-channel depth image");
@@ -104,45 +120,48 @@ Image buildEsm(const Image& shadowDepth, const EsmOptions& options) {
                               "must be a depth-buffer value in [0, 1]");
     }
   const int w = (W + f - 1) / f, h = (H + f - 1) / f;
-  const double c = options.exponent;
   std::vector<double> a(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  std::vector<double> z, wt;
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
-      double sum = 0.0;
-      int n = 0;
+      z.clear();
       for (int y = j * f; y < std::min(H, (j + 1) * f); ++y)
-        for (int x = i * f; x < std::min(W, (i + 1) * f); ++x, ++n)
-          sum += std::exp(c * (static_cast<double>(shadowDepth.at(x, y)) - 1.0));
-      a[static_cast<std::size_t>(j * w + i)] = sum / n;
+        for (int x = i * f; x < std::min(W, (i + 1) * f); ++x)
+          z.push_back(shadowDepth.at(x, y));
+      wt.assign(z.size(), 1.0 / static_cast<double>(z.size()));
+      a[static_cast<std::size_t>(j * w + i)] =
+          logSpaceMean(z.data(), wt.data(), static_cast<int>(z.size()), c);
     }
-  // Separable box blur, horizontal then vertical, clamped to the edge.
-  const int r = options.blurRadius;
+  // Separable box blur, horizontal then vertical, clamped to the edge, in log space.
+  const int r = options.blurRadius, taps = 2 * r + 1;
+  wt.assign(static_cast<std::size_t>(taps), 1.0 / taps);
+  z.resize(static_cast<std::size_t>(taps));
   std::vector<double> b(a.size());
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
-      double sum = 0.0;
       for (int k = -r; k <= r; ++k)
-        sum += a[static_cast<std::size_t>(j * w + std::clamp(i + k, 0, w - 1))];
-      b[static_cast<std::size_t>(j * w + i)] = sum / (2 * r + 1);
+        z[static_cast<std::size_t>(k + r)] = a[static_cast<std::size_t>(j * w + std::clamp(i + k, 0, w - 1))];
+      b[static_cast<std::size_t>(j * w + i)] = logSpaceMean(z.data(), wt.data(), taps, c);
     }
   Image esm(w, h, 1);
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
-      double sum = 0.0;
       for (int k = -r; k <= r; ++k)
-        sum += b[static_cast<std::size_t>(std::clamp(j + k, 0, h - 1) * w + i)];
-      esm.at(i, j) = static_cast<float>(sum / (2 * r + 1));
+        z[static_cast<std::size_t>(k + r)] = b[static_cast<std::size_t>(std::clamp(j + k, 0, h - 1) * w + i)];
+      esm.at(i, j) = static_cast<float>(logSpaceMean(z.data(), wt.data(), taps, c));
     }
   return esm;
 }
 
-// Annen et al. 2008: the ESM test clamp(exp(-c d_r) esm, 0, 1) with Wronski 2014's bilinear lookup: rule 1.
+// Annen et al. 2008: the ESM test clamp(exp(c (z_occ - d_r)), 0, 1) with Wronski 2014's bilinear lookup
+// (bilinear in exp(c z), evaluated in log space): rule 1.
 double esmVisibility(const Image& esm, const glm::dmat4& lightClipFromWorld, const glm::dvec3& p,
                      const EsmOptions& options) {
   const glm::dvec4 q = lightClipFromWorld * glm::dvec4(p, 1.0);
   if (!(q.w > 0.0)) return 1.0;
   const glm::dvec3 uvd = glm::dvec3(q) / q.w * 0.5 + 0.5;
   if (!(uvd.x >= 0.0 && uvd.x <= 1.0 && uvd.y >= 0.0 && uvd.y <= 1.0)) return 1.0;
+  const double c = esmDepthExponent(options, lightClipFromWorld);
   const int w = esm.width(), h = esm.height();
   const double fx = uvd.x * w - 0.5, fy = uvd.y * h - 0.5;
   const double x0 = std::floor(fx), y0 = std::floor(fy);
@@ -151,10 +170,25 @@ double esmVisibility(const Image& esm, const glm::dmat4& lightClipFromWorld, con
     return static_cast<double>(
         esm.at(std::clamp(static_cast<int>(x), 0, w - 1), std::clamp(static_cast<int>(y), 0, h - 1)));
   };
-  const double occluder = (1.0 - ay) * ((1.0 - ax) * texel(x0, y0) + ax * texel(x0 + 1.0, y0)) +
-                          ay * ((1.0 - ax) * texel(x0, y0 + 1.0) + ax * texel(x0 + 1.0, y0 + 1.0));
+  const double z[4] = {texel(x0, y0), texel(x0 + 1.0, y0), texel(x0, y0 + 1.0), texel(x0 + 1.0, y0 + 1.0)};
+  const double wt[4] = {(1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay};
+  const double occluder = logSpaceMean(z, wt, 4, c);
   const double receiver = std::clamp(uvd.z, 0.0, 1.0);
-  return std::clamp(occluder * std::exp(options.exponent * (1.0 + options.bias - receiver)), 0.0, 1.0);
+  return std::clamp(std::exp(c * (occluder + options.bias - receiver)), 0.0, 1.0);
+}
+
+void validate(const FroxelDensity& d, const char* owner) {
+  if (!std::isfinite(d.heightBase))
+    throw InvalidArgument(field(owner, "heightBase"), detail::formatValue(d.heightBase), "must be finite");
+  if (!(d.heightFalloff >= 0.0) || !std::isfinite(d.heightFalloff))
+    throw InvalidArgument(field(owner, "heightFalloff"), detail::formatValue(d.heightFalloff),
+                          "world units, must be finite and >= 0 (0 = no height fog)");
+  if (!(d.noiseAmplitude >= 0.0 && d.noiseAmplitude <= 1.0))
+    throw InvalidArgument(field(owner, "noiseAmplitude"), detail::formatValue(d.noiseAmplitude),
+                          "must be in [0, 1] (0 = no noise)");
+  if (!(d.noiseFrequency > 0.0) || !std::isfinite(d.noiseFrequency))
+    throw InvalidArgument(field(owner, "noiseFrequency"), detail::formatValue(d.noiseFrequency),
+                          "lattice cells per world unit, must be finite and > 0");
 }
 
 // The noise of Wronski 2014's density ("Perlin noise animated by wind"), here value noise: see the header.

@@ -166,6 +166,8 @@ std::size_t EsmPass::memoryBytes() const noexcept {
 
 void EsmPass::run(const FrameAttribs& f) {
   const gl::TextureLevel map = gl::requireTexture2D("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
+  requireMatrix(f.lightClipFromWorld, "EsmPass::FrameAttribs.lightClipFromWorld");
+  const double c = esmDepthExponent(info_.options, f.lightClipFromWorld);
   const int factor = info_.options.downsample;
   const int w = (map.width + factor - 1) / factor, h = (map.height + factor - 1) / factor;
   if (w != width_ || h != height_) {
@@ -175,8 +177,7 @@ void EsmPass::run(const FrameAttribs& f) {
     height_ = h;
   }
   gpu::FroxelParams p;
-  p.esm = glm::vec4(static_cast<float>(info_.options.exponent), static_cast<float>(info_.options.bias), 1.0f,
-                    0.0f);
+  p.esm = glm::vec4(static_cast<float>(c), static_cast<float>(info_.options.bias), 1.0f, 0.0f);
   p.sizes = glm::ivec4(map.width, map.height, w, h);
   p.info = glm::ivec4(factor, info_.options.blurRadius, 0, 0);
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
@@ -247,8 +248,8 @@ void FroxelLightingPass::run(const FrameAttribs& f) {
   p.density = glm::vec4(static_cast<float>(d.heightBase), static_cast<float>(d.heightFalloff),
                         static_cast<float>(d.noiseAmplitude), static_cast<float>(d.noiseFrequency));
   p.noiseOffset = glm::vec4(glm::vec3(f.noiseOffset), 0.0f);
-  p.esm = glm::vec4(static_cast<float>(info_.esm.exponent), static_cast<float>(info_.esm.bias),
-                    f.esm != 0 ? 1.0f : 0.0f, 0.0f);
+  p.esm = glm::vec4(f.esm != 0 ? static_cast<float>(esmDepthExponent(info_.esm, f.lightClipFromWorld)) : 1.0f,
+                    static_cast<float>(info_.esm.bias), f.esm != 0 ? 1.0f : 0.0f, 0.0f);
   p.sizes = glm::ivec4(0, 0, esm.width, esm.height);
   p.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
@@ -442,7 +443,7 @@ void FroxelFog::run(const FrameAttribs& f) {
   };
   const glm::dvec3 j = jitter(f.frameIndex);
   if (f.mode == Mode::Esm) {
-    if (f.shadowMap != 0) stage(timings_.esm, [&] { esm_.run({f.shadowMap}); });
+    if (f.shadowMap != 0) stage(timings_.esm, [&] { esm_.run({f.shadowMap, f.lightClipFromWorld}); });
     stage(timings_.lighting, [&] {
       FroxelLightingPass::FrameAttribs a;
       a.camera = f.camera;

@@ -129,14 +129,16 @@ TEST_CASE("ESM: constant map, exponential test, step map") {
   o.downsample = 4;
   o.blurRadius = 1;
   Image map(16, 10, 1, 0.4f);
-  const Image esm = buildEsm(map, o);
+  // an orthographic light looking down -Z of the unit cube: NDC = 2 world - 1, so depth = world z and the
+  // exponent per world unit is the exponent per depth unit
+  const glm::dmat4 clip =
+      glm::translate(glm::dmat4(1.0), glm::dvec3(-1.0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(2.0));
+  CHECK(esmDepthExponent(o, clip) == doctest::Approx(40.0));
+  const Image esm = buildEsm(map, clip, o);
   CHECK(esm.width() == 4);
   CHECK(esm.height() == 3); // ceil(10 / 4)
   for (float v : esm.data())
-    CHECK(v == doctest::Approx(std::exp(40.0 * (0.4 - 1.0))).epsilon(1e-6));
-  // an orthographic light looking down -Z of the unit cube: NDC = 2 world - 1 in x, y; depth = z
-  const glm::dmat4 clip =
-      glm::translate(glm::dmat4(1.0), glm::dvec3(-1.0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(2.0));
+    CHECK(v == doctest::Approx(0.4).epsilon(1e-6)); // the log-space mean of a constant is the constant
   // receiver behind the occluder: exp(-c (d_r - d_o)); in front: 1 (clamped)
   CHECK(esmVisibility(esm, clip, glm::dvec3(0.5, 0.5, 0.45), o) == doctest::Approx(std::exp(-40.0 * 0.05)));
   CHECK(esmVisibility(esm, clip, glm::dvec3(0.5, 0.5, 0.3), o) == 1.0);
@@ -150,7 +152,8 @@ TEST_CASE("ESM: constant map, exponential test, step map") {
     for (int x = 0; x < 32; ++x)
       step.at(x, y) = 0.2f;
   EsmOptions s;
-  const Image e2 = buildEsm(step, s);
+  s.exponent = 80.0;
+  const Image e2 = buildEsm(step, clip, s);
   CHECK(esmVisibility(e2, clip, glm::dvec3(0.1, 0.5, 0.6), s) < 1e-12);
   CHECK(esmVisibility(e2, clip, glm::dvec3(0.9, 0.5, 0.6), s) == 1.0);
   // across the edge the filtered test rises monotonically from shadowed to lit
@@ -235,7 +238,7 @@ TEST_CASE("Froxel fog options: bad values are named") {
     }
   };
   EsmOptions o;
-  o.exponent = 100.0;
+  o.exponent = 2e4;
   named([&] { validate(o, "X.esm"); }, "X.esm.exponent");
   o = {};
   o.downsample = 0;
@@ -257,7 +260,8 @@ TEST_CASE("Froxel fog options: bad values are named") {
   named([&] { validate(d, "X.density"); }, "X.density.noiseFrequency");
   Image bad(4, 4, 1, 0.5f);
   bad.at(1, 1) = std::nanf("");
-  named([&] { buildEsm(bad, {}); }, "shadowDepth");
+  named([&] { buildEsm(bad, glm::dmat4(1.0), {}); }, "shadowDepth");
+  named([&] { esmDepthExponent({}, glm::dmat4(0.0)); }, "lightClipFromWorld");
   const Camera cam = fogCamera();
   FroxelGrid grid{4, 4, 4, 0.0, 0.0};
   FroxelVolume v(4, 4, 3);

@@ -5,21 +5,24 @@
 // (crep/scatter/ray.h, crep/core/medium.h), so the fog is compared with the other methods on the same rays.
 //
 // ---------------------------------------------------------------------------------------------------
-// 1. Exponential shadow map (Annen et al. 2008 as used by Wronski 2014, "Exponential shadow maps"): from a
-//    standard shadow map of depth-buffer values d in [0, 1] (rendered with lightClipFromWorld, the rule of
-//    crep/scatter/world_march.h), ESM texel (i, j) = the mean of exp(c (d - 1)) over the `downsample` x
+// 1. Exponential shadow map (Annen et al. 2008, with their log-space filtering, as used by Wronski 2014,
+//    "Exponential shadow maps"): the exponent is given per world unit along the light (c_w) and turned into
+//    depth-buffer units with the light matrix: c = c_w 2 / |grad_world NDC z| (exact for the orthographic sun
+//    map, whose depth is linear; esmDepthExponent). The test of a receiver at depth d_r against occluders
+//    z_i is exp(c (z - d_r)), and filtering averages exp(c z_i); the ESM stores z = log(mean exp(c z_i)) / c
+//    (a depth) evaluated around the largest z_i (log-space filtering), so no value overflows a float for
+//    any c (storing exp(c d) itself would overflow beyond c = 88 in depth units, and c must be large where
+//    the light's depth range is large: the shadow of an occluder fades over 1 / c_w world units behind it,
+//    default c_w = 4: visibility exp(-1) a quarter unit behind the occluder, exp(-8) two units behind).
+//    From a standard shadow map of depth-buffer values d in [0, 1] (rendered with lightClipFromWorld, the
+//    rule of crep/scatter/world_march.h): ESM texel (i, j) = the log-space mean over the `downsample` x
 //    `downsample` block of map texels it covers (blocks clipped at the map's edge: ceil(W / f) x ceil(H / f)
-//    texels), then a separable box blur of radius r (2r + 1 taps per axis, clamped at the edges), averaging
-//    the stored values themselves (linear space, not log space). Storing exp(c (d - 1)) in (exp(-c), 1]
-//    instead of exp(c d) keeps every value and product inside float range: with c <= 80, exp(-c) = 1.8e-35
-//    is above float's smallest normal (1.2e-38) and the receiver factor exp(c (1 - d_r)) <= exp(80) = 5.5e34
-//    below its largest (3.4e38). The unit of d is the map's own depth-buffer value (linear in the light's
-//    depth for the orthographic sun map): the shadow of an occluder fades over 1 / c of the map's depth
-//    range behind it (c = 80: visibility exp(-1) at 1.25% of the range, exp(-4) at 5%).
-//    Visibility of a world point p: q = lightClipFromWorld p; lit (1) when q.w <= 0 or (u, v) = q.xy / q.w
-//    * 0.5 + 0.5 falls outside [0, 1]^2; else V = clamp(esm(u, v) exp(c (1 + bias - d_r)), 0, 1) with d_r =
-//    clamp(q.z / q.w * 0.5 + 0.5, 0, 1) and esm(u, v) the bilinear interpolation of the ESM texels at their
-//    centres ((i + 0.5) / w, ...), clamped at the edges (Wronski 2014's bilinear ESM lookup).
+//    texels), then a separable box blur of radius r (2r + 1 taps per axis, clamped at the edges), also a
+//    log-space mean. Visibility of a world point p: q = lightClipFromWorld p; lit (1) when q.w <= 0 or
+//    (u, v) = q.xy / q.w * 0.5 + 0.5 falls outside [0, 1]^2; else V = clamp(exp(c (z(u, v) + bias - d_r)),
+//    0, 1) with d_r = clamp(q.z / q.w * 0.5 + 0.5, 0, 1) and z(u, v) the bilinear interpolation of exp(c z)
+//    at the texel centres ((i + 0.5) / w, ...), clamped at the edges, in log space (Wronski 2014's bilinear
+//    ESM lookup).
 // 2. Lighting (Wronski 2014, "Density estimation and volume lighting"), per cell (x, y, z) at its sample
 //    point uvw = ((x + 0.5 + j.x) / W, (y + 0.5 + j.y) / H, (z + 0.5 + j.z) / D) (j = the frame's jitter in
 //    cells, 0 without temporal jitter), p = froxelWorldPoint(camera, range, uvw), v = the unit ray
@@ -84,8 +87,9 @@ namespace crep {
 
 /// The exponential shadow map's knobs (rule 1 above).
 struct EsmOptions {
-  /// c, per depth-buffer unit of the shadow map, in (0, 80] (float range, see rule 1).
-  double exponent = 80.0;
+  /// c_w, per world unit along the light, in (0, 1e4] (rule 1): a receiver 1 / c_w behind an occluder is
+  /// exp(-1) lit.
+  double exponent = 4.0;
   /// Map texels per ESM texel along each axis, in [1, 64] (Wronski 2014: 4).
   int downsample = 4;
   /// Box blur radius r in ESM texels, in [0, 32]: 2r + 1 taps per axis (0 = no blur).
@@ -96,9 +100,13 @@ struct EsmOptions {
 /// Throws InvalidArgument naming `owner`.field (e.g. "FroxelFog::CreateInfo.esm.exponent").
 void validate(const EsmOptions& options, const char* owner);
 
-/// The ESM of a standard shadow map (rule 1): 1 channel, ceil(W / f) x ceil(H / f). Throws InvalidArgument
-/// ("shadowDepth") for an empty map, more than one channel or a value outside [0, 1] (NaN included).
-Image buildEsm(const Image& shadowDepth, const EsmOptions& options);
+/// The exponent c in depth-buffer units of the map of `lightClipFromWorld` (rule 1). Throws InvalidArgument
+/// ("lightClipFromWorld") unless it is finite and in (0, 1e7].
+double esmDepthExponent(const EsmOptions& options, const glm::dmat4& lightClipFromWorld);
+/// The ESM of a standard shadow map (rule 1): 1 channel, ceil(W / f) x ceil(H / f), log-space depths.
+/// Throws InvalidArgument ("shadowDepth") for an empty map, more than one channel or a value outside [0, 1]
+/// (NaN included).
+Image buildEsm(const Image& shadowDepth, const glm::dmat4& lightClipFromWorld, const EsmOptions& options);
 /// ESM visibility of world point p (rule 1), in [0, 1].
 double esmVisibility(const Image& esm, const glm::dmat4& lightClipFromWorld, const glm::dvec3& p,
                      const EsmOptions& options);

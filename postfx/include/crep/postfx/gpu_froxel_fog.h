@@ -65,7 +65,7 @@ struct FroxelParams {
   glm::vec4 ambient{0.0f};
   glm::vec4 density{0.0f};     ///< height base, height falloff, noise amplitude, noise frequency
   glm::vec4 noiseOffset{0.0f}; ///< xyz
-  glm::vec4 esm{0.0f};         ///< x exponent, y bias, z 1 = ESM shadowing on
+  glm::vec4 esm{0.0f};         ///< x exponent c (depth-buffer units), y bias, z 1 = ESM shadowing on
   glm::ivec4 sizes{0};         ///< xy shadow map (ESM passes) or camera image (apply), zw ESM
   glm::ivec4 info{0};          ///< x downsample, y blur radius
   glm::mat4 lightClipFromWorld{1.0f};
@@ -93,11 +93,13 @@ public:
   struct FrameAttribs {
     /// GL_TEXTURE_2D of depth-buffer values in [0, 1] (a depth format or GL_R32F), read with texelFetch
     std::uint32_t shadowMap = 0;
+    glm::dmat4 lightClipFromWorld{1.0}; ///< its matrix (turns the exponent into depth units)
   };
   /// Throws InvalidArgument naming "EsmPass::CreateInfo.options.<field>".
   explicit EsmPass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
-  std::uint32_t esm() const noexcept { return esm_.get(); } ///< R32F, ceil(W / f) x ceil(H / f)
+  /// R32F, ceil(W / f) x ceil(H / f): log-space depths (rule 1)
+  std::uint32_t esm() const noexcept { return esm_.get(); }
   int width() const noexcept { return width_; }
   int height() const noexcept { return height_; }
   std::size_t memoryBytes() const noexcept; ///< both R32F textures
