@@ -38,7 +38,7 @@ const char* const kRender =
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
                                 against a standard shadow map) | the other methods listed below
 @METHOD_OPTIONS@            --exposure X        PNG exposure in [1e-30, 1e30] (default 1)
-            --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
+@TONEMAP_OPTIONS@            --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
             --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
                                 DIR/shadow.exr (float depth-buffer values), DIR/frame.json, and
                                 DIR/lightN.exr for a scene's local lights
@@ -103,6 +103,9 @@ std::string withMethodOptions(std::string text) {
   const std::string marker = "@METHOD_OPTIONS@";
   if (const auto at = text.find(marker); at != std::string::npos)
     text.replace(at, marker.size(), crep::tool::kMethodOptionsHelp);
+  const std::string toneMapMarker = "@TONEMAP_OPTIONS@";
+  if (const auto at = text.find(toneMapMarker); at != std::string::npos)
+    text.replace(at, toneMapMarker.size(), crep::tool::kToneMapOptionsHelp);
   return text;
 }
 
