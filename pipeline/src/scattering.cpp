@@ -396,7 +396,8 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   if (!f.light && !local)
     invalid("Scattering::FrameAttribs.light", "null", "must be set unless local lights are given");
   if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
-  gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
+  if (f.output != 0 || !f.froxels) // a froxel volume alone reads no camera depth
+    gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
   if (f.output != 0 || !f.froxels)
     gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
   if (f.froxels) {

@@ -163,12 +163,14 @@ TEST_CASE("Scattering froxels: a projective frame fills the volume as the passes
   evaluate.run(e);
   CHECK(sameBits(withOutput, readVolume(byHandVolume.get(), grid)));
 
-  // output = 0: only the volume (no per-pixel stages), the same values; the output texture is untouched.
+  // output = 0: only the volume (no per-pixel stages, no camera depth read), the same values; the output
+  // texture is untouched.
   const float marker[4] = {-1.0f, -2.0f, -3.0f, -4.0f};
   glClearTexImage(f.output.get(), 0, GL_RGBA, GL_FLOAT, marker);
   const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   glClearTexImage(volume.get(), 0, GL_RGBA, GL_FLOAT, zero);
   a.output = 0;
+  a.cameraDepth = 0;
   const Scattering::FrameResult alone = scattering.run(a);
   CHECK_FALSE(hasStage(alone, "evaluate"));
   CHECK(hasStage(alone, "froxels"));
@@ -185,6 +187,7 @@ TEST_CASE("Scattering froxels: a projective frame fills the volume as the passes
   // map): the per-pixel output of this scene is within 5% (ScatteringGLTest.cpp), the same bound here.
   const Scattering::FroxelTarget centres{volume.get(), grid, glm::dvec3(0.0)};
   a.froxels = &centres;
+  a.cameraDepth = f.cameraDepth.get();
   scattering.run(a);
   const ImageMetrics m = rgbMetrics(readVolume(volume.get(), grid), worldReferenceVolume(f, grid, f.shadow));
   report("projective frame: froxel volume vs world-space reference at the cells", m);

@@ -199,7 +199,7 @@ public:
     const DirectionalLight* light = nullptr;
     const Medium* medium = nullptr;
     /// GL_TEXTURE_2D, width x height, depth-buffer values of `camera` in its convention: D32F, D24S8 / D24
-    /// (read as depth) or R32F.
+    /// (read as depth) or R32F. May be 0 when `output` is 0 (a froxel volume alone reads no camera depth).
     std::uint32_t cameraDepth = 0;
     /// GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance. May be 0 when `froxels` is
     /// given and no local light is (only the volume is filled; the per-pixel evaluation and the epipole
