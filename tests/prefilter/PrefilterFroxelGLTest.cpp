@@ -109,6 +109,15 @@ Image readVolume(std::uint32_t volume, const FroxelGrid& grid) {
   return out;
 }
 
+/// Number of samples that differ at all between two images of the same shape.
+long long differingSamples(const Image& a, const Image& b) {
+  REQUIRE(a.sameShape(b));
+  long long n = 0;
+  for (std::size_t i = 0; i < a.data().size(); ++i)
+    n += a.data()[i] != b.data()[i] ? 1 : 0;
+  return n;
+}
+
 /// Runs `pass` with a froxel target only.
 void fill(EvaluatePass& pass, const FroxelScene& s, const FilteredBasisView& basis, std::uint32_t volume,
           const FroxelGrid& grid, const glm::dvec3& jitter, const RectifiedLayout* layout = nullptr) {
@@ -374,6 +383,56 @@ TEST_CASE(
     check(readVolume(texturedVolume.get(), grid), expected, 1e-6, 1e-6,
           "froxel_textured_constant_" + std::to_string(samples));
   }
+}
+
+TEST_CASE(
+    "prefilter froxels: one run with both targets, and a reused table, give the separate runs' results") {
+  CREP_REQUIRE_GL();
+  const FroxelScene& s = boxes();
+  const FilteredBasis cpu = prefilter(s.map, s.scene.medium, prefilterOptions());
+  const UploadedBasis basis = uploadBasis(cpu, StorageFormat::RGBA32F);
+  const FroxelGrid grid = smallGrid();
+  const glm::dvec3 jitter = froxelJitter(5);
+  const Image depth(kGridW, kGridH, 1, static_cast<float>(s.camera.depthBufferValue(3.0)));
+  const gl::Handle depthTexture = uploadR32F(depth);
+  EvaluatePass pass(EvaluatePass::CreateInfo{});
+  EvaluatePass::FrameAttribs f;
+  f.cameraDepth = depthTexture.get();
+  f.camera = &s.camera;
+  f.light = &s.scene.sun;
+  f.medium = &s.scene.medium;
+  f.layout = s.layout.get();
+  f.basis = basis.view;
+  // Separately: the per-pixel image, then the volume alone (building its own table).
+  const gl::Handle outputAlone = gl::createTexture2D(GL_RGBA32F, kGridW, kGridH);
+  const gl::Handle volumeAlone = createVolume(grid);
+  f.output = outputAlone.get();
+  pass.run(f);
+  fill(pass, s, basis.view, volumeAlone.get(), grid, jitter);
+  // Together in one run (one table, two dispatches).
+  const gl::Handle outputBoth = gl::createTexture2D(GL_RGBA32F, kGridW, kGridH);
+  const gl::Handle volumeBoth = createVolume(grid);
+  f.output = outputBoth.get();
+  f.froxels = {volumeBoth.get(), grid, jitter};
+  pass.run(f);
+  // The volume again from the table of that run (FrameAttribs::reuseTable), without the per-pixel target.
+  const gl::Handle volumeReused = createVolume(grid);
+  f.output = 0;
+  f.cameraDepth = 0;
+  f.froxels = {volumeReused.get(), grid, jitter};
+  f.reuseTable = true;
+  pass.run(f);
+  // The same programs on the same inputs: bit for bit.
+  const Image alone = readVolume(volumeAlone.get(), grid);
+  CHECK(differingSamples(readVolume(volumeBoth.get(), grid), alone) == 0);
+  CHECK(differingSamples(readVolume(volumeReused.get(), grid), alone) == 0);
+  CHECK(differingSamples(readRgbaTexture(outputBoth.get(), kGridW, kGridH),
+                         readRgbaTexture(outputAlone.get(), kGridW, kGridH)) == 0);
+  // A reused table of another basis texture is refused.
+  const UploadedBasis other = uploadBasis(cpu, StorageFormat::RGBA32F);
+  f.basis = other.view;
+  CHECK_THROWS_WITH_AS(pass.run(f), doctest::Contains("EvaluatePass::FrameAttribs.reuseTable"),
+                       InvalidArgument);
 }
 
 TEST_CASE("prefilter froxels: bad targets throw errors naming the field") {
