@@ -59,9 +59,12 @@
 // crep/scatter/froxel_grid.h): FrameAttribs::froxels fills a caller's 3D texture with the same frame's
 // prefiltered evaluation (EvaluatePass::FrameAttribs::froxels), texel (x, y, z) = the evaluation of the ray
 // through the cell's (u, v) up to its sample view depth, no accumulation pass and no exponential-shadow-map
-// light leaking. `output` may then be 0 (only the volume). Directional light only: local lights are not
-// added to the volume, and on epipolar frames the cells inside the epipole block are evaluated by the
-// prefiltered method too (not marched: WorldMarchPass has no 3D target); the stage "froxels" times it.
+// light leaking. `output` (and cameraDepth) may then be 0 (only the volume). Directional light (and its
+// texture) only: local lights are not added to the volume, and on epipolar frames the cells inside the
+// epipole block are evaluated by the prefiltered method too (not marched: WorldMarchPass has no 3D target;
+// measured against the world-space reference at the cells with the sun in view: 1.9% / 3.3% relative RMSE
+// inside the block, 2.8% / 2.7% outside, forest / colonnade, tests/pipeline/ScatteringFroxelGLTest.cpp).
+// The stage "froxels" times the fill (it reuses the per-frame table the per-pixel evaluation built).
 //
 // GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
 // clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
