@@ -42,7 +42,7 @@
 // proportion of samples that reach the bright region): the same sum over the source's A (the sky
 // fraction) instead of its RGB, times the pixel's own unshadowed in-scattering U(x, y) (the closed form of
 // crep::unshadowedScattering on its own ray, to its surface):
-//   RGB = fade exposure weight / (n + 1) sum_{i=0}^{n} decay^i sourceA(p_i) U(x, y).
+//   RGB = fade exposure weight / (n + 1) sum_{i=0}^{n} decay^i a(p_i) U(x, y), a = the source's A.
 // With the defaults: the visible fraction of the screen segment times the pixel's own in-scattering, so
 // geometry pixels keep their shorter rays' in-scattering instead of the sky's.
 // Only the directional light; local lights and light textures are not modelled.
