@@ -678,3 +678,46 @@ TEST_CASE("FroxelFog GL: Mode::Prefiltered applies crep::Scattering's fill (empt
   CHECK(rmse <= 2e-2);
   CHECK(alpha <= 1e-2);
 }
+
+TEST_CASE("FroxelFog GL: the default grid's memory and per-stage GPU timings") {
+  CREP_REQUIRE_GL();
+  const Scene s;
+  const Image depth = test::groundDepth(s.camera, kW, kH);
+  const gl::Handle depthTexture = uploadR32F(depth), shadowTexture = uploadR32F(s.shadow);
+  const gl::Handle output = gl::createTexture2D(GL_RGBA32F, kW, kH);
+  FroxelFog::CreateInfo info; // 160 x 90 x 64, RGBA16F, temporal on
+  info.timings = true;
+  FroxelFog fog(info);
+  for (int i = 0; i < 2; ++i) {
+    FroxelFog::FrameAttribs f;
+    f.camera = &s.camera;
+    f.light = &s.light;
+    f.medium = &s.medium;
+    f.cameraDepth = depthTexture.get();
+    f.shadowMap = shadowTexture.get();
+    f.lightClipFromWorld = s.lightClipFromWorld;
+    f.output = output.get();
+    f.frameIndex = i;
+    f.previousCamera = i == 0 ? nullptr : &s.camera;
+    fog.run(f);
+  }
+  const FroxelFog::Timings& t = fog.timings();
+  // three 160 x 90 x 64 RGBA16F volumes (current + two history) and two R32F ESM textures of (128 / 4)^2
+  const std::size_t volume = std::size_t(160) * 90 * 64 * 8;
+  MESSAGE(std::string(std::string("default grid: ") + std::to_string(fog.memoryBytes()) +
+                      " bytes (one volume " + std::to_string(volume) + "); GPU ms: ESM " + fmt(t.esm) +
+                      ", lighting " + fmt(t.lighting) + ", accumulation " + fmt(t.accumulate) +
+                      ", temporal " + fmt(t.temporal) + ", apply " + fmt(t.apply) +
+                      " (llvmpipe reports about 1e-6 ms for every GL_TIME_ELAPSED query)"));
+  CHECK(fog.memoryBytes() == 3 * volume + 2 * 32 * 32 * 4);
+  CHECK(t.esm > 0.0);
+  CHECK(t.lighting > 0.0);
+  CHECK(t.accumulate > 0.0);
+  CHECK(t.temporal > 0.0);
+  CHECK(t.apply > 0.0);
+  const Image img = gl::readTexture(output.get(), kW, kH, gl::TexelData::Rgba);
+  int bad = 0;
+  for (float v : img.data())
+    bad += std::isfinite(v) ? 0 : 1;
+  CHECK(bad == 0);
+}
