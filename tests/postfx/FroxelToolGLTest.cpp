@@ -25,7 +25,7 @@ crep::Image scatteringLayer(const std::string& path) {
 
 } // namespace
 
-TEST_CASE("crep render --method froxel-esm / froxel-prefilter: sunlit fog; no sun adds nothing") {
+TEST_CASE("crep render --method froxel-esm and froxel-prefilter: sunlit fog, and no sun adds nothing") {
   CREP_REQUIRE_GL();
   crep::test::TempDir dir;
   for (const std::string method : {"froxel-esm", "froxel-prefilter"}) {
