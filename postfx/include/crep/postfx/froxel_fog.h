@@ -32,10 +32,10 @@
 //      isotropic ambient radiance: the in-scattered radiance of a uniform sky is L_amb sigma_s for any
 //      normalized phase function), stored RGB = S (in-scattered radiance per world unit), A = rho sbar
 //      (grey extinction, sbar = weightExtinction(medium)). Non-finite values are stored as 0.
-//    Density rho(p) = heightFactor(p) noiseFactor(p):
-//      heightFactor = exp(-(p.y - heightBase) / heightFalloff) with the exponent clamped to [-60, 20]
+//    Density rho(p) = (height factor) x (noise factor):
+//      height factor = exp(-(p.y - heightBase) / heightFalloff) with the exponent clamped to [-60, 20]
 //      (world +Y is up), 1 when heightFalloff = 0;
-//      noiseFactor = 1 + amplitude (2 n(frequency (p + noiseOffset)) - 1) with the value noise n in [0, 1]
+//      noise factor = 1 + amplitude (2 n(frequency (p + noiseOffset)) - 1) with the value noise n in [0, 1]
 //      (froxelValueNoise), 1 when amplitude = 0.
 // 3. Accumulation (Wronski 2014, "Solving scattering equation": a front-to-back scan of each (x, y) column).
 //    The column's samples lie on one ray (the jitter is the same for every cell of a frame) at distances
