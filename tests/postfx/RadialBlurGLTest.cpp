@@ -129,7 +129,7 @@ TEST_CASE("RadialBlurPass: GPU equals the CPU reference on a pillar frame with t
   }
 }
 
-TEST_CASE("RadialBlurPass: a sun behind the camera adds exactly nothing; NaN depth stays finite") {
+TEST_CASE("RadialBlurPass: a sun behind the camera adds exactly nothing and NaN depth stays finite") {
   CREP_REQUIRE_GL();
   const int w = 40, h = 24;
   const Camera camera = test::groundCamera(w, h);

@@ -26,7 +26,7 @@ crep::Image scatteringLayer(const std::string& path) {
 
 } // namespace
 
-TEST_CASE("crep render --method radial: the sun in view adds in-scattering; no sun adds nothing") {
+TEST_CASE("crep render --method radial: the sun in view adds in-scattering and no sun adds nothing") {
   CREP_REQUIRE_GL();
   crep::test::TempDir dir;
   {
