@@ -400,9 +400,17 @@ FroxelFog::FroxelFog(const CreateInfo& info)
   volume_ = current_.get();
 }
 
-glm::dvec3 FroxelFog::jitter(int frameIndex) const {
+glm::dvec3 FroxelFog::lightingJitter(int frameIndex) const {
   return info_.temporal.historyWeight > 0.0 && info_.temporal.jitter ? froxelJitter(frameIndex)
                                                                      : glm::dvec3(0.0);
+}
+
+glm::dvec3 FroxelFog::jitter(int frameIndex) const {
+  // The integral's end points stay on the slice centres: moving the end of an integral along the ray only
+  // adds noise (the integrated value grows across a slice); what the jitter anti-aliases is where the
+  // lighting is sampled (lightingJitter) and which rays are integrated (x, y).
+  const glm::dvec3 j = lightingJitter(frameIndex);
+  return {j.x, j.y, 0.0};
 }
 
 std::size_t FroxelFog::memoryBytes() const noexcept {
@@ -451,7 +459,7 @@ void FroxelFog::run(const FrameAttribs& f) {
       a.medium = f.medium;
       a.esm = f.shadowMap != 0 ? esm_.esm() : 0;
       a.lightClipFromWorld = f.lightClipFromWorld;
-      a.jitter = j;
+      a.jitter = lightingJitter(f.frameIndex);
       a.noiseOffset = f.noiseOffset;
       a.output = current_.get();
       lighting_.run(a);

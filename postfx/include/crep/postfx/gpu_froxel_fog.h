@@ -255,8 +255,15 @@ public:
   /// Throws InvalidArgument naming "FroxelFog::FrameAttribs.<field>".
   void run(const FrameAttribs& frame);
 
-  /// The sample offset of frame `frameIndex` in cells: froxelJitter(frameIndex) with temporal jitter, else 0.
+  /// The integrated volume's sample offset of frame `frameIndex` in cells (what the fill of Mode::Prefiltered
+  /// is given): with temporal jitter froxelJitter(frameIndex) across the image and 0 in depth (the end
+  /// points of the integrals stay on the slice centres: jittering them in depth adds noise, the integrated
+  /// value grows across a slice), else 0.
   glm::dvec3 jitter(int frameIndex) const;
+  /// Where Mode::Esm lights each cell: froxelJitter(frameIndex) in all three axes with temporal jitter (the
+  /// lighting is anti-aliased in depth too; the accumulation treats each cell's lighting as constant over
+  /// the cell and integrates to the cell centres' depth), else 0.
+  glm::dvec3 lightingJitter(int frameIndex) const;
   /// The volume the lighting and accumulation (or crep::Scattering's fill) write: GL_TEXTURE_3D.
   std::uint32_t currentVolume() const noexcept { return current_.get(); }
   /// The integrated volume of the last run() (the blended one with temporal), for the engine's own lookups:
