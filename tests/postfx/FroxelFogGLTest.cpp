@@ -730,3 +730,117 @@ TEST_CASE("FroxelFog GL: the default grid's memory and per-stage GPU timings") {
     bad += std::isfinite(v) ? 0 : 1;
   CHECK(bad == 0);
 }
+
+TEST_CASE("FroxelFog GL: Mode::Prefiltered with temporal reprojection converges and does not flicker") {
+  // The prefiltered path's temporal pass (the fill by crep::Scattering at jitter(i), then FroxelFog's
+  // reprojection and blend) on the barred scene: with a static camera the blended result converges to the
+  // unjittered fill's; under the slow pan of the ESM test the frame-to-frame change of its error against the
+  // world-space reference stays within the reference's own change plus half of it.
+  CREP_REQUIRE_GL();
+  const Scene base;
+  const gl::Handle shadowTexture = uploadR32F(base.shadow);
+  const Scattering::ShadowMap shadow{shadowTexture.get(), base.lightClipFromWorld, 0.0};
+  const gl::Handle output = gl::createTexture2D(GL_RGBA32F, kW, kH);
+  Scattering::CreateInfo si;
+  si.width = kW;
+  si.height = kH;
+  si.mapSize = 256;
+  Scattering scattering(si);
+  FroxelFog::CreateInfo info;
+  info.grid = kGrid;
+  info.format = GL_RGBA32F;
+  FroxelFog temporal(info);
+  info.temporal.historyWeight = 0.0;
+  FroxelFog plain(info);
+  const auto frame = [&](FroxelFog& fog, const Camera& cam, const Camera* previous, int i,
+                         std::uint32_t depthTexture) {
+    const Scattering::FroxelTarget target{fog.currentVolume(), info.grid, fog.jitter(i)};
+    Scattering::FrameAttribs a;
+    a.camera = &cam;
+    a.light = &base.light;
+    a.medium = &base.medium;
+    a.shadowMap = &shadow;
+    a.froxels = &target; // output = 0: the volume only
+    scattering.run(a);
+    FroxelFog::FrameAttribs f;
+    f.mode = FroxelFog::Mode::Prefiltered;
+    f.camera = &cam;
+    f.cameraDepth = depthTexture;
+    f.output = output.get();
+    f.frameIndex = i;
+    f.previousCamera = previous;
+    fog.run(f);
+    return gl::readTexture(output.get(), kW, kH, gl::TexelData::Rgba);
+  };
+  // Static camera.
+  {
+    const Image depth = test::groundDepth(base.camera, kW, kH);
+    const gl::Handle depthTexture = uploadR32F(depth);
+    const Image unjittered = frame(plain, base.camera, nullptr, 0, depthTexture.get());
+    double firstError = 0.0, lastError = 0.0;
+    const int frames = 30;
+    for (int i = 0; i < frames; ++i) {
+      const Image img = frame(temporal, base.camera, i == 0 ? nullptr : &base.camera, i, depthTexture.get());
+      const double e = relativeRmse(img, unjittered);
+      if (i == 0) firstError = e;
+      lastError = e;
+    }
+    MESSAGE(std::string(std::string("prefiltered fill, static camera: relative RMSE vs the unjittered fill, "
+                                    "frame 1 ") +
+                        fmt(firstError) + ", frame " + std::to_string(frames) + " " + fmt(lastError)));
+    // The blend averages the jitter positions across the cells (x, y only here: the fill's integrals end on
+    // the slice centres), which converges to the cell-averaged fog rather than the centre rays' (measured:
+    // 0.87% after one frame, 0.63% after 30: what remains is mostly that average, the bars being a few
+    // cells wide); stated bound 1%, and below the single frame's error.
+    CHECK(lastError < 0.01);
+    CHECK(lastError < firstError);
+  }
+  // Slow pan, after a warm-up of static frames (not measured).
+  const int frames = 16, warmUp = 16;
+  const double step = 0.3;
+  WorldMarchOptions march;
+  march.steps = 128;
+  std::vector<Image> ref, on, off;
+  for (int j = 0; j < warmUp + frames; ++j) {
+    const int i = std::max(0, j - warmUp);
+    const Camera cam = panned(step * i);
+    const Camera prev = panned(step * std::max(0, i - 1));
+    const Image depth = test::groundDepth(cam, kW, kH);
+    const gl::Handle depthTexture = uploadR32F(depth);
+    const Image t = frame(temporal, cam, &prev, 100 + j, depthTexture.get());
+    const Image p = frame(plain, cam, &prev, 100 + j, depthTexture.get());
+    if (j < warmUp) continue;
+    on.push_back(t);
+    off.push_back(p);
+    ref.push_back(
+        worldSpaceMarch(base.shadow, base.lightClipFromWorld, depth, cam, base.light, base.medium, march)
+            .scattering);
+  }
+  const auto errorImage = [](const Image& x, const Image& r) {
+    Image e(x.width(), x.height(), 4);
+    for (std::size_t i = 0; i < e.sampleCount(); ++i)
+      e.data()[i] = x.data()[i] - r.data()[i];
+    return e;
+  };
+  double flickerRef = 0, flickerOn = 0, flickerOff = 0, changeOn = 0, changeOff = 0;
+  for (int k = 1; k < frames; ++k) {
+    flickerRef += meanAbsDiff(ref[k], ref[k - 1]);
+    flickerOn += meanAbsDiff(on[k], on[k - 1]);
+    flickerOff += meanAbsDiff(off[k], off[k - 1]);
+    changeOn += meanAbsDiff(errorImage(on[k], ref[k]), errorImage(on[k - 1], ref[k - 1]));
+    changeOff += meanAbsDiff(errorImage(off[k], ref[k]), errorImage(off[k - 1], ref[k - 1]));
+  }
+  const double n = frames - 1;
+  MESSAGE(std::string(
+      std::string("prefiltered fill, pan ") + fmt(step) +
+      " deg/frame, mean |frame-to-frame change|: reference " + fmt(flickerRef / n) + ", temporal on " +
+      fmt(flickerOn / n) + ", off " + fmt(flickerOff / n) + "; change of the error vs the reference: on " +
+      fmt(changeOn / n) + ", off " + fmt(changeOff / n) + "; relative RMSE last frame: on " +
+      fmt(relativeRmse(on.back(), ref.back())) + ", off " + fmt(relativeRmse(off.back(), ref.back()))));
+  CHECK(changeOn / n <= 1.5 * flickerRef / n);
+  // Measured 4.9% with temporal (the history lags the pan by the blend's ~10 frames and averages the cells),
+  // 3.4% without (the 16 slices' interpolation): bound 8% with temporal, 5% without. The ESM path is at 24%
+  // on the same frames (its filtered shadow map leaks through the bars).
+  CHECK(relativeRmse(on.back(), ref.back()) < 0.08);
+  CHECK(relativeRmse(off.back(), ref.back()) < 0.05);
+}
