@@ -13,6 +13,7 @@
 #include <crep/epipolar/march.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/scattering.h>
+#include <crep/postfx/gpu_froxel_fog.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
@@ -318,9 +319,9 @@ double msOf(const std::vector<MethodRow>& rows, const std::string& name) {
 
 void printRows(const std::vector<MethodRow>& rows) {
   const double prefilterMs = msOf(rows, "prefilter");
-  std::printf("%-12s %12s %14s   %s\n", "method", "frame ms", "vs prefilter", "stages (ms)");
+  std::printf("%-16s %12s %14s   %s\n", "method", "frame ms", "vs prefilter", "stages (ms)");
   for (const MethodRow& r : rows)
-    std::printf("%-12s %12.2f %14.2f   %s%s\n", r.name.c_str(), r.ms,
+    std::printf("%-16s %12.2f %14.2f   %s%s\n", r.name.c_str(), r.ms,
                 prefilterMs > 0 ? r.ms / prefilterMs : 0.0, r.stages.c_str(),
                 r.used != r.name ? ("  [ran " + r.used + "]").c_str() : "");
 }
@@ -363,7 +364,7 @@ void sunInView(const BenchOptions& o) {
       o.screenWidth, o.screenHeight, o.mapWidth, o.bases);
   printRows(sun);
   const double fallbackMs = msOf(sun, "prefilter"), projectiveMs = msOf(forest, "prefilter");
-  std::printf("%-12s %12.2f %14s   %s  [forest: projective]\n", "prefilter", projectiveMs, "",
+  std::printf("%-16s %12.2f %14s   %s  [forest: projective]\n", "prefilter", projectiveMs, "",
               forest.empty() ? "" : forest.front().stages.c_str());
   const auto stage = [](const std::vector<MethodRow>& rows, const char* method, const char* name) {
     for (const MethodRow& r : rows)
@@ -379,6 +380,39 @@ void sunInView(const BenchOptions& o) {
         "with their shadow inputs (resampling %.2f ms / rectified shadow pass %.2f ms): %.2f\n",
         msOf(sun, "minmax") / fallbackMs, fallbackMs / projectiveMs, resampleMs, shadowMs,
         (fallbackMs + resampleMs) / (projectiveMs + shadowMs));
+}
+
+/// Post effects (issue "postfx"): Mitchell's radial blur and the froxel fog filled by Wronski's ESM path
+/// and by the prefiltered evaluation, beside the prefiltered per-pixel method on the same frame in one run:
+/// on "sunset" (the sun in view, where the radial blur has work to do) and on this run's scene; then the
+/// froxel fog's GPU memory (FroxelFog::memoryBytes of the default 160 x 90 x 64 grid).
+void postEffects(const BenchOptions& o) {
+  if (!squareMapOk(o, "post effects", Scattering::CreateInfo{}.mapSizeMultiple())) return;
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  const std::vector<std::string> methods = {"prefilter", "radial", "froxel-esm", "froxel-prefilter"};
+  std::vector<std::string> scenes = {"sunset"};
+  if (o.scene != "sunset") scenes.push_back(o.scene);
+  for (const std::string& scene : scenes) {
+    double mapMs = 0.0;
+    const std::vector<MethodRow> rows = runMethods(o, scene, methods, repeat, mapMs);
+    std::printf(
+        "\npost effects (scene %s, %dx%d, map %d^2; per-frame ms as above; the froxel volume is 160 x "
+        "90 x 64 at any screen size):\n",
+        scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth);
+    printRows(rows);
+  }
+  const auto mib = [](std::size_t b) { return double(b) / (1024.0 * 1024.0); };
+  FroxelFog::CreateInfo info; // the defaults: RGBA16F, temporal on (current + two history volumes)
+  const FroxelFog temporal(info);
+  info.temporal.historyWeight = 0.0;
+  const FroxelFog single(info);
+  info.format = GL_RGBA32F;
+  const FroxelFog single32(info);
+  std::printf(
+      "froxel fog GPU memory, 160 x 90 x 64 volumes (FroxelFog::memoryBytes before a frame; the ESM adds "
+      "two R32F textures of the downsampled map): RGBA16F with temporal %.1f MiB, without %.1f MiB, RGBA32F "
+      "without %.1f MiB\n",
+      mib(temporal.memoryBytes()), mib(single.memoryBytes()), mib(single32.memoryBytes()));
 }
 
 /// A built-in scene's frame as crep::Scattering input: the tool's frame (camera depth, standard shadow map)
@@ -854,6 +888,7 @@ void runBenchSuite(const BenchOptions& o) {
   reducedResolution(o);
   methodsSideBySide(o);
   sunInView(o);
+  postEffects(o);
 
   if (!o.quick) {
     // Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8).
