@@ -87,6 +87,16 @@ double imageError(const Image& a, const Image& b) {
   return worst;
 }
 
+/// max |a - b| / b over every pixel and channel (RGBA; b > 0 everywhere).
+double maxRelative(const Image& a, const Image& b) {
+  double worst = 0.0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c = 0; c < 4; ++c)
+        worst = std::max(worst, double(std::abs(a.at(x, y, c) - b.at(x, y, c)) / b.at(x, y, c)));
+  return worst;
+}
+
 /// Relative RMSE of RGB.
 double relativeRmse(const Image& a, const Image& ref) {
   double e = 0.0, r = 0.0;
@@ -373,11 +383,7 @@ TEST_CASE("FroxelFog GL: homogeneous unshadowed medium vs the closed form (RGBA1
   fog.run(f);
   const Image gpu = gl::readTexture(output.get(), kW, kH, gl::TexelData::Rgba);
   const Image closed = unshadowedScattering(depth, cam, light, medium);
-  double worst = 0.0;
-  for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x)
-      for (int c = 0; c < 4; ++c)
-        worst = std::max(worst, double(std::abs(gpu.at(x, y, c) - closed.at(x, y, c)) / closed.at(x, y, c)));
+  const double worst = maxRelative(gpu, closed);
   MESSAGE(std::string(std::string("FroxelFog (32 slices, RGBA16F) vs closed form: max relative ") +
                       fmt(worst) + "; memory " + std::to_string(fog.memoryBytes()) + " bytes"));
   // the CPU reference's interpolation error at 32 slices (0.43%, FroxelFogTest) + RGBA16F storage (2^-11 =
@@ -669,11 +675,7 @@ TEST_CASE("FroxelFog GL: Mode::Prefiltered applies crep::Scattering's fill (empt
   fog.run(f);
   const Image gpu = gl::readTexture(output.get(), kW, kH, gl::TexelData::Rgba);
   const Image closed = unshadowedScattering(depth, cam, light, medium);
-  double worst = 0.0;
-  for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x)
-      for (int c = 0; c < 4; ++c)
-        worst = std::max(worst, double(std::abs(gpu.at(x, y, c) - closed.at(x, y, c)) / closed.at(x, y, c)));
+  const double worst = maxRelative(gpu, closed);
   double peak = 0.0, maxAbs = 0.0, alpha = 0.0;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
