@@ -1,0 +1,40 @@
+// GPU work lists (crep/scatter/gpu_sample_list.h).
+#include <crep/core/error.h>
+#include <crep/scatter/gpu_sample_list.h>
+
+#include <epoxy/gl.h>
+
+#include <array>
+#include <string>
+
+namespace crep::gpu {
+
+gl::Handle createSampleListBuffer(int capacity) {
+  if (capacity <= 0)
+    throw InvalidArgument("SampleList.capacity", std::to_string(capacity), "must be > 0");
+  gl::Handle buffer = gl::createBuffer();
+  const GLsizeiptr bytes = kSampleListHeaderBytes + static_cast<GLsizeiptr>(capacity) * 4;
+  glNamedBufferStorage(buffer.get(), bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+  clearSampleList(buffer.get());
+  return buffer;
+}
+
+void clearSampleList(std::uint32_t buffer) {
+  const std::array<GLuint, 4> header{0u, 1u, 1u, 0u};
+  glNamedBufferSubData(buffer, 0, sizeof(header), header.data());
+}
+
+void dispatchSampleList(std::uint32_t buffer) {
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, buffer);
+  glDispatchComputeIndirect(0);
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+}
+
+int sampleListCount(std::uint32_t buffer) {
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  GLuint count = 0;
+  glGetNamedBufferSubData(buffer, 12, sizeof(count), &count);
+  return static_cast<int>(count);
+}
+
+} // namespace crep::gpu
