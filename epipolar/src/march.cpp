@@ -98,53 +98,73 @@ void requireSameSize(const RectifiedMap& map, const MinMaxTrees& trees) {
 // Yusov 2012, Algorithm 2 on a rectified row (Klehm et al. 2014, Sec. 2.2: the ray's depth is constant),
 // Eq. 16 sums.
 namespace {
+/// The tree walk of a row (marchRectifiedRays' `walk`) on prebuilt trees of the map.
+struct MinMaxWalk {
+  const RectifiedMap* map = nullptr;
+  const float* nodes = nullptr;
+  int L = 0, stride = 0;
+  std::vector<int> offsets;
+
+  MinMaxWalk(const RectifiedMap& m, const MinMaxTrees& trees)
+      : map(&m), nodes(trees.data().data()), L(trees.levels()), stride(trees.rowStride()),
+        offsets(static_cast<std::size_t>(trees.levels()) + 1, 0) {
+    for (int l = 1; l <= L; ++l)
+      offsets[static_cast<std::size_t>(l)] = MinMaxTrees::levelOffset(m.width(), l);
+  }
+
+  template <class Section>
+  void operator()(const RowRay& r, const RowDistances& T, const Section& litSection, int& steps) const {
+    const double z = r.depth;
+    const int j = r.texelRow, end = r.last + 1;
+    const float* row = nodes + static_cast<std::size_t>(j) * static_cast<std::size_t>(stride) * 2;
+    int i = 0, level = 0;
+    while (i < end) {
+      // Algorithm 2 step 5.1: one level up where the position is aligned to it.
+      if (level < L && (i & ((2 << level) - 1)) == 0) ++level;
+      bool lit = false;
+      for (;;) {
+        ++steps;
+        double mn, mx;
+        if (level == 0) {
+          mn = mx = map->depth.at(i, j);
+        } else {
+          const float* node = row + 2 * (offsets[static_cast<std::size_t>(level)] + (i >> level));
+          mn = node[0];
+          mx = node[1];
+        }
+        if (mn >= z) { // 5.2.4: every texel of the node is lit
+          lit = true;
+          break;
+        }
+        if (mx < z) break; // 5.2.3: every texel is shadowed
+        --level;           // 5.2.5 (never below 0: a texel always decides)
+      }
+      const int next = std::min(i + (1 << level), end);
+      if (lit) litSection(T.at(i), T.at(next));
+      i = next;
+    }
+  }
+};
+
 template <class Light>
 MarchResult minMaxMarchImpl(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
                             const Camera& camera, const Light& light, const Medium& medium,
                             const MarchOptions& options, const Image* lightColors = nullptr) {
   requireSameSize(map, trees);
-  const int W = map.width(), L = trees.levels(), stride = trees.rowStride();
-  std::vector<int> offsets(static_cast<std::size_t>(L) + 1, 0);
-  for (int l = 1; l <= L; ++l)
-    offsets[static_cast<std::size_t>(l)] = MinMaxTrees::levelOffset(W, l);
-  const float* nodes = trees.data().data();
   return marchRectifiedRows(map, cameraDepth, camera, light, medium, options, lightColors,
-                            [&](const RowRay& r, const RowDistances& T, const auto& litSection, int& steps) {
-                              const double z = r.depth;
-                              const int j = r.texelRow, end = r.last + 1;
-                              const float* row =
-                                  nodes + static_cast<std::size_t>(j) * static_cast<std::size_t>(stride) * 2;
-                              int i = 0, level = 0;
-                              while (i < end) {
-                                // Algorithm 2 step 5.1: one level up where the position is aligned to it.
-                                if (level < L && (i & ((2 << level) - 1)) == 0) ++level;
-                                bool lit = false;
-                                for (;;) {
-                                  ++steps;
-                                  double mn, mx;
-                                  if (level == 0) {
-                                    mn = mx = map.depth.at(i, j);
-                                  } else {
-                                    const float* node =
-                                        row + 2 * (offsets[static_cast<std::size_t>(level)] + (i >> level));
-                                    mn = node[0];
-                                    mx = node[1];
-                                  }
-                                  if (mn >= z) { // 5.2.4: every texel of the node is lit
-                                    lit = true;
-                                    break;
-                                  }
-                                  if (mx < z) break; // 5.2.3: every texel is shadowed
-                                  --level;           // 5.2.5 (never below 0: a texel always decides)
-                                }
-                                const int next = std::min(i + (1 << level), end);
-                                if (lit) litSection(T.at(i), T.at(next));
-                                i = next;
-                              }
-                            });
+                            MinMaxWalk(map, trees));
 }
 
 } // namespace
+
+// Yusov 2012, Sec. 6.4: the tree march of the marched samples' rays (screen samples).
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees,
+                        std::span<const ScreenSample> samples, int width, int height, const Camera& camera,
+                        const DirectionalLight& light, const Medium& medium, const MarchOptions& options) {
+  requireSameSize(map, trees);
+  return marchRectifiedSamples(map, samples, width, height, camera, light, medium, options, nullptr,
+                               MinMaxWalk(map, trees));
+}
 
 MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,
                         const Camera& camera, const DirectionalLight& light, const Medium& medium,

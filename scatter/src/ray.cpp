@@ -31,17 +31,39 @@ double MarchResult::maxSteps() const {
   return m;
 }
 
+// crep/scatter/ray.h "Rays and output" at a pixel centre (Klehm et al. 2014, Eq. 1 per pixel).
 PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y, bool nearPlaneCorrection) {
+  return screenRay(camera, depth.width(), depth.height(), x + 0.5, y + 0.5, depth.at(x, y, 0),
+                   nearPlaneCorrection);
+}
+
+// The same rule at a continuous screen position (Yusov 2012, Sec. 6.1: samples along epipolar lines).
+PixelRay screenRay(const Camera& camera, int width, int height, double x, double y, double depthValue,
+                   bool nearPlaneCorrection) {
   PixelRay r;
-  const double ndcX = 2.0 * (x + 0.5) / depth.width() - 1.0;
-  const double ndcY = 2.0 * (y + 0.5) / depth.height() - 1.0;
+  const double ndcX = 2.0 * x / width - 1.0;
+  const double ndcY = 2.0 * y / height - 1.0;
   r.direction = camera.rayDirection(ndcX, ndcY);
   const double cosForward = glm::dot(r.direction, camera.forward());
-  const double d = depth.at(x, y, 0);
-  const double viewDepth = camera.surfaceViewDepth(d); // the sky (cleared value) integrates to far()
+  const double viewDepth = camera.surfaceViewDepth(depthValue); // the sky (cleared value) integrates to far()
   r.surface = viewDepth / cosForward;
   r.start = nearPlaneCorrection ? std::min(camera.near() / cosForward, r.surface) : 0.0;
   return r;
+}
+
+void validateScreenSamples(std::span<const ScreenSample> samples, int width, int height) {
+  if (width <= 0) throw InvalidArgument("width", detail::formatValue(width), "must be > 0");
+  if (height <= 0) throw InvalidArgument("height", detail::formatValue(height), "must be > 0");
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const ScreenSample& s = samples[i];
+    const std::string name = "samples[" + std::to_string(i) + "]";
+    if (!std::isfinite(s.x) || !std::isfinite(s.y))
+      throw InvalidArgument(name, "(" + detail::formatValue(s.x) + ", " + detail::formatValue(s.y) + ")",
+                            "the position must be finite");
+    if (!(s.depth >= 0.0 && s.depth <= 1.0))
+      throw InvalidArgument(name, "depth " + detail::formatValue(s.depth),
+                            "must be a depth-buffer value in [0, 1]");
+  }
 }
 
 void validateCameraDepth(const Image& depth) {

@@ -52,17 +52,22 @@ double RowDistances::at(int i) const {
 // Yusov 2012, Eq. 16 texel by texel on a rectified row; Klehm et al. 2014, Eq. 5 with the exact
 // transmittance of Eq. 1.
 namespace {
+/// The texel-by-texel walk of a row (every texel tested).
+auto bruteForceWalk(const RectifiedMap& map) {
+  return [&map](const RowRay& r, const RowDistances& T, const auto& litSection, int& steps) {
+    for (int i = 0; i <= r.last; ++i) {
+      ++steps;
+      if (map.depth.at(i, r.texelRow) >= r.depth) litSection(T.at(i), T.at(i + 1));
+    }
+  };
+}
+
 template <class Light>
 MarchResult bruteForce(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                        const Light& light, const Medium& medium, const MarchOptions& options,
                        const Image* lightColors = nullptr) {
   return marchRectifiedRows(map, cameraDepth, camera, light, medium, options, lightColors,
-                            [&](const RowRay& r, const RowDistances& T, const auto& litSection, int& steps) {
-                              for (int i = 0; i <= r.last; ++i) {
-                                ++steps;
-                                if (map.depth.at(i, r.texelRow) >= r.depth) litSection(T.at(i), T.at(i + 1));
-                              }
-                            });
+                            bruteForceWalk(map));
 }
 } // namespace
 
@@ -75,6 +80,14 @@ MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, c
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const LocalLight& light, const Medium& medium, const MarchOptions& options) {
   return bruteForce(map, cameraDepth, camera, light, medium, options);
+}
+
+// Yusov 2012, Sec. 6.4: the same march on the rays of screen samples (epipolar sampling's marched samples).
+MarchResult bruteForceMarch(const RectifiedMap& map, std::span<const ScreenSample> samples, int width,
+                            int height, const Camera& camera, const DirectionalLight& light,
+                            const Medium& medium, const MarchOptions& options) {
+  return marchRectifiedSamples(map, samples, width, height, camera, light, medium, options, nullptr,
+                               bruteForceWalk(map));
 }
 
 // Light textures: each lit texel's section times the texel's colour (Klehm et al. 2014, Sec. 3.2).

@@ -77,6 +77,16 @@ MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const
 MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                         const DirectionalLight& light, const Medium& medium,
                         const MarchOptions& options = {});
+/// The tree march of the rays through screen samples of a width x height camera image (Yusov 2012,
+/// Sec. 6.4: epipolar sampling's marched samples; crep/scatter/rectified_march.h marchRectifiedSamples: ray
+/// i = screenRay at samples[i], result images samples.size() x 1, empty for no samples, at most
+/// Image::kMaxDimension samples). At pixel centres with the pixels' depth-buffer values it equals the
+/// per-pixel minMaxMarch bit for bit. Throws InvalidArgument for the map, "MinMaxTrees", "samples[i]",
+/// "width" / "height" or the options.
+MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees,
+                        std::span<const ScreenSample> samples, int width, int height, const Camera& camera,
+                        const DirectionalLight& light, const Medium& medium,
+                        const MarchOptions& options = {});
 /// The tree march for a local light (a spot, or one point-light face, on a map of its rectification):
 /// each lit section integrated by RayScattering, as bruteForceMarch does.
 MarchResult minMaxMarch(const RectifiedMap& map, const MinMaxTrees& trees, const Image& cameraDepth,

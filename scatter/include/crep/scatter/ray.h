@@ -18,6 +18,8 @@
 //   surface (composite: surface * A + L; per-channel transmittance is exp(-sigma_c s)).
 #pragma once
 
+#include <span>
+
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
@@ -53,8 +55,27 @@ struct PixelRay {
   double start = 0.0;        ///< 0, or t_n with the near-plane correction
 };
 
-/// The ray of pixel (x, y) of the depth image `depth` (channel 0; validated by validateCameraDepth).
+/// The ray of pixel (x, y) of the depth image `depth` (channel 0; validated by validateCameraDepth):
+/// screenRay at the pixel centre (x + 0.5, y + 0.5) with the pixel's depth-buffer value (bit-identical).
 PixelRay pixelRay(const Camera& camera, const Image& depth, int x, int y, bool nearPlaneCorrection = false);
+
+/// The ray through the continuous position (x, y) of a width x height camera image (pixel coordinates,
+/// origin at the bottom-left corner, pixel centres at + 0.5: ndc = 2 (x, y) / (width, height) - 1) ending
+/// at the surface of depth-buffer value `depthValue` (camera.surfaceViewDepth: >= 1 is the sky, far()):
+/// pixelRay's rule at any point of the screen (Yusov 2012, Sec. 6.1: epipolar samples lie between pixel
+/// centres). Not validated (width, height > 0 and a finite position are the caller's).
+PixelRay screenRay(const Camera& camera, int width, int height, double x, double y, double depthValue,
+                   bool nearPlaneCorrection = false);
+
+/// A point of the camera image to evaluate: its ray is screenRay(camera, width, height, x, y, depth).
+struct ScreenSample {
+  double x = 0, y = 0; ///< pixel coordinates (origin bottom-left, pixel centres at + 0.5)
+  double depth = 1;    ///< depth-buffer value of the ray's surface, in [0, 1]
+};
+
+/// Throws InvalidArgument ("samples[i]", with the value) unless every sample has a finite position and a
+/// depth-buffer value in [0, 1] (NaN included); "width" / "height" unless both are > 0.
+void validateScreenSamples(std::span<const ScreenSample> samples, int width, int height);
 
 /// Throws InvalidArgument ("cameraDepth", naming the pixel and value) unless `depth` is non-empty and
 /// every value of its first channel is a depth-buffer value in [0, 1] (NaN included).

@@ -27,12 +27,15 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <span>
+#include <string>
 #include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
+#include <crep/core/error.h>
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
@@ -69,32 +72,33 @@ private:
   std::vector<DistanceProfile> profiles_;
 };
 
-/// The per-pixel scaffolding of the rectified marches: validates the inputs (map, "cameraDepth",
-/// options), maps every pixel's ray and calls walk(const RowRay&, const RowDistances&, litSection, int&
-/// steps), where litSection(ta, tb) adds the lit section [ta, tb] (clipped to the integration range).
-/// Unmapped pixels are unshadowed. Rows of the camera image run in parallel. `Light` is DirectionalLight
-/// (sections integrated as transmittance integrals, times C) or LocalLight (sections integrated by
-/// RayScattering: the same integrand as every other method, exactly per section).
-/// With `lightColors` (a colour map of the map's size, validated: InvalidArgument "lightColors") each lit
-/// section is coloured per texel (rule at the top).
-template <class Light, class Walk>
-MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
-                               const Light& light, const Medium& medium, const MarchOptions& options,
-                               const Image* lightColors, const Walk& walk) {
+/// The scaffolding of the rectified marches over any ray source (no validation: the callers below
+/// validate first): `count` rays, ray i = rayOf(i) stored at texel (i % width, i / width) of the w x h
+/// result (count = width * height), in chunks of `chunk` consecutive rays run in parallel. Maps every ray
+/// and calls walk(const RowRay&, const RowDistances&, litSection, int& steps), where litSection(ta, tb) adds
+/// the lit section [ta, tb] (clipped to the integration range). Unmapped rays are unshadowed. `Light` is
+/// DirectionalLight (sections integrated as transmittance integrals, times C) or LocalLight (sections
+/// integrated by RayScattering: the same integrand as every other method, exactly per section). With
+/// `lightColors` (a colour map of the map's size) each lit section is coloured per texel (rule at the top).
+template <class Light, class RayOf, class Walk>
+MarchResult marchRectifiedRays(const RectifiedMap& map, int width, int height, int chunk,
+                               const Camera& camera, const Light& light, const Medium& medium,
+                               const MarchOptions& options, const Image* lightColors, const RayOf& rayOf,
+                               const Walk& walk) {
   constexpr bool kLocal = std::is_same_v<Light, LocalLight>;
-  validate(map);
-  validateCameraDepth(cameraDepth);
-  validate(options);
-  if (lightColors) validateLightColors(*lightColors, map.width(), map.height(), "lightColors");
   const RectifiedLayout& layout = *map.layout;
-  const int w = cameraDepth.width(), h = cameraDepth.height(), W = map.width(), H = map.height();
+  const int w = width, h = height, W = map.width(), H = map.height();
+  const long long count = static_cast<long long>(w) * h;
   const glm::dvec3 sigma = medium.extinction();
   const double grey = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
   MarchResult out{Image(w, h, 4), Image(w, h, 1)};
-  parallelRows(h, options.threads, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+  const int chunks = static_cast<int>((count + chunk - 1) / chunk);
+  parallelRows(chunks, options.threads, [&](int c) {
+    const long long first = static_cast<long long>(c) * chunk, last = std::min(first + chunk, count);
+    for (long long index = first; index < last; ++index) {
+      const int y = static_cast<int>(index / w), x = static_cast<int>(index - static_cast<long long>(y) * w);
+      const PixelRay ray = rayOf(index);
       std::optional<RayScattering> local;
       if constexpr (kLocal) local.emplace(light, medium, origin, ray.direction);
       const auto section = [&](double ta, double tb) {
@@ -129,9 +133,9 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
                   const double a = std::max(ta, T.at(i)), b = std::min(tb, T.at(i + 1));
                   if (a >= tb) break;
                   if (!(b > a)) continue;
-                  const glm::dvec3 c(lightColors->at(i, r.texelRow, 0), lightColors->at(i, r.texelRow, 1),
-                                     lightColors->at(i, r.texelRow, 2));
-                  L += c * section(a, b);
+                  const glm::dvec3 col(lightColors->at(i, r.texelRow, 0), lightColors->at(i, r.texelRow, 1),
+                                       lightColors->at(i, r.texelRow, 2));
+                  L += col * section(a, b);
                 }
               },
               steps);
@@ -146,6 +150,56 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
     }
   });
   return out;
+}
+
+/// The per-pixel scaffolding of the rectified marches: validates the inputs (map, "cameraDepth",
+/// options), then marchRectifiedRays on every pixel's ray (pixelRay), one image row per chunk.
+/// With `lightColors` (a colour map of the map's size, validated: InvalidArgument "lightColors") each lit
+/// section is coloured per texel (rule at the top).
+template <class Light, class Walk>
+MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
+                               const Light& light, const Medium& medium, const MarchOptions& options,
+                               const Image* lightColors, const Walk& walk) {
+  validate(map);
+  validateCameraDepth(cameraDepth);
+  validate(options);
+  if (lightColors) validateLightColors(*lightColors, map.width(), map.height(), "lightColors");
+  const int w = cameraDepth.width();
+  return marchRectifiedRays(
+      map, w, cameraDepth.height(), w, camera, light, medium, options, lightColors,
+      [&](long long i) {
+        const int y = static_cast<int>(i / w), x = static_cast<int>(i - static_cast<long long>(y) * w);
+        return pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      },
+      walk);
+}
+
+/// The same scaffolding at screen samples (Yusov 2012, Sec. 6.4: the marched samples of epipolar
+/// sampling): validates the map, the samples (validateScreenSamples: "samples[i]", "width", "height"),
+/// the options and `lightColors`, then marches ray i = screenRay(camera, width, height, samples[i]) into
+/// texel (i, 0) of a samples.size() x 1 result (an empty MarchResult for no samples; at most
+/// Image::kMaxDimension samples per call, else InvalidArgument "samples"). At pixel centres
+/// with the pixels' depth-buffer values it gives marchRectifiedRows' values bit for bit.
+template <class Light, class Walk>
+MarchResult marchRectifiedSamples(const RectifiedMap& map, std::span<const ScreenSample> samples, int width,
+                                  int height, const Camera& camera, const Light& light, const Medium& medium,
+                                  const MarchOptions& options, const Image* lightColors, const Walk& walk) {
+  validate(map);
+  validateScreenSamples(samples, width, height);
+  validate(options);
+  if (lightColors) validateLightColors(*lightColors, map.width(), map.height(), "lightColors");
+  if (samples.size() > static_cast<std::size_t>(Image::kMaxDimension))
+    throw InvalidArgument("samples", std::to_string(samples.size()) + " samples",
+                          "at most Image::kMaxDimension = " + std::to_string(Image::kMaxDimension) +
+                              " per call (the result is samples.size() x 1): split the list");
+  if (samples.empty()) return {};
+  return marchRectifiedRays(
+      map, static_cast<int>(samples.size()), 1, 256, camera, light, medium, options, lightColors,
+      [&](long long i) {
+        const ScreenSample& s = samples[static_cast<std::size_t>(i)];
+        return screenRay(camera, width, height, s.x, s.y, s.depth, options.nearPlaneCorrection);
+      },
+      walk);
 }
 
 /// marchRectifiedRows without a light texture.
@@ -174,5 +228,12 @@ MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, c
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const LocalLight& light, const Medium& medium, const Image& lightColors,
                             const MarchOptions& options = {});
+/// The brute-force march of the rays through screen samples of a width x height camera image
+/// (marchRectifiedSamples: ray i = screenRay at samples[i]; result images samples.size() x 1, empty for no
+/// samples): the reference of epipolar sampling's marched samples (Yusov 2012, Sec. 6.4). Throws
+/// InvalidArgument for the map, "samples[i]", "width" / "height" or the options.
+MarchResult bruteForceMarch(const RectifiedMap& map, std::span<const ScreenSample> samples, int width,
+                            int height, const Camera& camera, const DirectionalLight& light,
+                            const Medium& medium, const MarchOptions& options = {});
 
 } // namespace crep
