@@ -51,6 +51,7 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
+#include <crep/core/error.h> // InvalidArgument, thrown by every function here
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
