@@ -1,0 +1,160 @@
+// The GPU stage passes of Yusov's epipolar sampling (Yusov 2012, Sec. 6; the in-scattering refinement
+// criterion of Yusov 2013): sample placement along epipolar lines, refinement, interpolation, unwarping to
+// the (downscaled) screen and upscaling, as OpenGL 4.5 compute shaders in float precision. Their CPU
+// references (double) and the rules are in crep/epipolar/epipolar_sampling.h; the lines themselves are
+// computed there on the CPU each frame (epipolarLines) and uploaded.
+//
+// The pass does not evaluate any scattering: the samples to ray-march and the pixels to correct are
+// produced on the GPU as work lists (crep/scatter/gpu_sample_list.h) that the caller evaluates between the
+// stages with any evaluator (a min/max march, the prefiltered evaluation, ...) through an indirect
+// dispatch, without a read-back.
+//
+// Shaders: passes/epipolar_coordinates.comp, epipolar_refine.comp, epipolar_interpolate.comp,
+// epipolar_unwarp.comp, epipolar_upscale.comp. Resources of every stage: gpu::MarchParams at uniform
+// binding 0 (camera, light, medium: crep/march.glsl), gpu::EpipolarSamplingParams at uniform binding 1, the
+// line table (gpu::EpipolarSamplingLine[]) at storage binding 0, a work list at storage binding 2, the
+// camera depth at texture unit 0 (texelFetch through the pass's own nearest sampler), the pass's own
+// textures at image units 0-3.
+//
+// The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
+// buffers, textures and sampler (RAII); the textures of FrameAttribs are the caller's (non-owning GL
+// names). Every stage leaves program 0; texture units 0-3 with no texture and no sampler; image units 0-3,
+// uniform and storage buffer bindings 0-3 unbound (gl::unbindPassState(4)); and issues
+// gl::passOutputBarrier() plus GL_COMMAND_BARRIER_BIT, so its outputs and lists can be read by texture
+// fetches, image loads, storage reads, indirect dispatches and read-backs. Each stage that consumes an
+// evaluator's output (interpolate, unwarp, upscale) first issues the image / texture-fetch barriers for it.
+// A NaN camera depth is the sky (far plane), as in the other passes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/gl.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+#include <crep/epipolar/epipolar_sampling.h>
+#include <crep/scatter/gpu_sample_list.h>
+
+namespace crep {
+namespace gpu {
+
+/// std140 block CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; } (uniform binding 1)
+/// of the stage passes, declared in each of their shaders. Pixel coordinates, origin at the bottom-left.
+struct EpipolarSamplingParams {
+  /// xy: epipole e (pixels, full resolution); z: arcBegin, w: arcLength (border pixels)
+  glm::vec4 epipole{0.0f};
+  /// x: W, y: H (full resolution), z: perimeter P = 2 (W + H), w: 1 = epipole on screen
+  glm::vec4 border{0.0f};
+  glm::ivec4 counts{0}; ///< x: slices N, y: samples Ns, z: initial step S, w: downscale F
+  /// xy: target size (W / F, H / F); z: 1 = depth criterion, w: 1 = scattering criterion
+  glm::ivec4 target{0};
+  glm::vec4 thresholds{0.0f}; ///< x: depth threshold, y: scattering threshold, z: bilateral threshold; w: 0
+};
+static_assert(sizeof(EpipolarSamplingParams) == 16 * 5, "std140 CrepEpipolarSamplingParams");
+
+/// std430 element of CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; } (storage binding 0): one line.
+struct EpipolarSamplingLine {
+  glm::vec4 ends{0.0f};         ///< xy: entry, zw: exit (pixels)
+  glm::ivec4 info{-1, 0, 0, 0}; ///< x: lastValid (-1: no valid sample); yzw: 0
+};
+static_assert(sizeof(EpipolarSamplingLine) == 32, "std430 CrepEpipolarLine");
+
+/// The block of a frame's lines and options (floats of the lines' doubles).
+EpipolarSamplingParams makeEpipolarSamplingParams(const EpipolarLines& lines,
+                                                  const EpipolarSamplingOptions& options);
+
+} // namespace gpu
+
+/// Epipolar sampling on the GPU (see top): one object per camera image size and options.
+class EpipolarSamplingPass {
+public:
+  struct CreateInfo {
+    int width = 0, height = 0; ///< W x H camera image (multiples of options.downscale)
+    EpipolarSamplingOptions options;
+  };
+  /// Per-frame inputs: non-owning.
+  struct FrameAttribs {
+    const Camera* camera = nullptr;
+    const DirectionalLight* light = nullptr;
+    const Medium* medium = nullptr;
+    /// GL_TEXTURE_2D W x H of depth-buffer values of `camera` (GL_DEPTH_COMPONENT32F, _24,
+    /// GL_DEPTH24_STENCIL8, GL_DEPTH32F_STENCIL8 or GL_R32F), read with texelFetch
+    std::uint32_t cameraDepth = 0;
+    std::uint32_t output = 0; ///< GL_RGBA32F W x H: the in-scattering (RGB) and transmittance (A)
+  };
+  /// Throws InvalidArgument naming the field ("EpipolarSamplingPass::CreateInfo.width", "...height",
+  /// "EpipolarSamplingPass::CreateInfo.options.samples", ...), GlError beyond the GL limits (texture size,
+  /// compute work group size for options.samples, 65535 texels per list axis) or ShaderError.
+  explicit EpipolarSamplingPass(const CreateInfo& info);
+
+  // The stages of one frame in order; the caller evaluates each list between them.
+  /// Lines on the CPU (epipolarLines), uploaded; the coordinates pass (Ns x N coordinates and U).
+  /// Throws InvalidArgument naming the field of FrameAttribs (null pointers, sizes, formats).
+  void placeSamples(const FrameAttribs& frame);
+  /// The refinement pass (Yusov 2012, Sec. 6.2): sourcesTexture() and sampleList().
+  void refine();
+  /// coordinates = coordinatesTexture() (Ns x N), output = sampleTexture() (Ns x N).
+  const gpu::SampleList& sampleList() const noexcept { return sampleList_; }
+  /// Interpolates the samples that were not marched, in place in sampleTexture() (Yusov 2012, Sec. 6.5).
+  void interpolate();
+  /// Unwarps the samples (Yusov 2012, Sec. 6.6) into FrameAttribs::output (F = 1) or targetTexture()
+  /// (F > 1), the target coordinates into targetCoordinatesTexture(), the pixels to correct into
+  /// correctionList().
+  void unwarp(const FrameAttribs& frame);
+  /// coordinates = targetCoordinatesTexture(), output = FrameAttribs::output (F = 1; set by unwarp) or
+  /// targetTexture().
+  const gpu::SampleList& correctionList() const noexcept { return correctionList_; }
+  /// F > 1 only (a no-op for F = 1): the bilateral upscale of the target into FrameAttribs::output (Yusov
+  /// 2012, Sec. 6.8), the pixels to correct into upscaleCorrectionList().
+  void upscale(const FrameAttribs& frame);
+  /// coordinates = a W x H coordinate texture (written at the entries only), output = FrameAttribs::output.
+  const gpu::SampleList& upscaleCorrectionList() const noexcept { return upscaleList_; }
+
+  /// All of the above with one evaluator, called with sampleList(), correctionList() and (F > 1)
+  /// upscaleCorrectionList().
+  void run(const FrameAttribs& frame, const std::function<void(const gpu::SampleList&)>& evaluate);
+
+  struct Statistics {
+    int validSamples = 0, marchedSamples = 0, correctedPixels = 0, correctedFullPixels = 0;
+  };
+  /// Reads back the list counts of the last frame (a GPU sync): for tests and tools.
+  Statistics statistics() const;
+  const EpipolarLines& lines() const noexcept { return lines_; } ///< this frame's lines (CPU)
+  const CreateInfo& info() const noexcept { return info_; }
+
+  /// Ns x N RGBA32F (x, y, d, z) of every sample; (-1, -1, -1, -1) for invalid samples
+  std::uint32_t coordinatesTexture() const noexcept { return coordinates_.get(); }
+  /// Ns x N R32F: U, the luminance of each sample's unshadowed in-scattering (0 invalid)
+  std::uint32_t unshadowedTexture() const noexcept { return unshadowed_.get(); }
+  /// Ns x N RG32I: sources (left, right); (k, k) marched, (-1, -1) invalid
+  std::uint32_t sourcesTexture() const noexcept { return sources_.get(); }
+  /// Ns x N RGBA32F: the evaluator's values at the marched samples, then interpolated (invalid: 0)
+  std::uint32_t sampleTexture() const noexcept { return samples_.get(); }
+  /// (W/F) x (H/F) RGBA32F, F > 1 (0 for F = 1: the unwarp writes the output)
+  std::uint32_t targetTexture() const noexcept { return target_.get(); }
+  /// (W/F) x (H/F) RGBA32F (c.x, c.y, d, z) of every target pixel
+  std::uint32_t targetCoordinatesTexture() const noexcept { return targetCoordinates_.get(); }
+  /// W x H RGBA32F, F > 1 (0 for F = 1)
+  std::uint32_t fullCoordinatesTexture() const noexcept { return fullCoordinates_.get(); }
+  /// GPU memory it owns, bytes (textures, lists, line table, blocks).
+  std::size_t memoryBytes() const noexcept;
+
+private:
+  void checkFrame(const FrameAttribs& frame) const;
+  void bindCommon(std::uint32_t program) const;
+
+  CreateInfo info_;
+  int targetWidth_ = 0, targetHeight_ = 0;
+  EpipolarLines lines_;
+  gl::Handle coordinatesProgram_, refineProgram_, interpolateProgram_, unwarpProgram_, upscaleProgram_;
+  gl::Handle params_, samplingParams_, lineBuffer_, sampler_;
+  gl::Handle coordinates_, unshadowed_, sources_, samples_, target_, targetCoordinates_, fullCoordinates_;
+  gl::Handle sampleBuffer_, correctionBuffer_, upscaleBuffer_;
+  gpu::SampleList sampleList_, correctionList_, upscaleList_;
+};
+
+} // namespace crep

@@ -1,0 +1,60 @@
+#version 450 core
+// Epipolar sampling, stage 2: the samples of every epipolar line (Yusov 2012, Sec. 6.1; rules and CPU
+// reference: crep::epipolarSamples in crep/epipolar/epipolar_sampling.h). One thread per texel (k, i) of
+// the Ns x N coordinate texture: sample k of line i at p_k = entry + (exit - entry) k / (Ns - 1), its
+// depth-buffer value at the pixel containing p_k (point sampling: never a depth between two surfaces),
+// view depth, and U = the luminance of the unshadowed in-scattering of its ray (Yusov 2013's refinement
+// criterion). Invalid samples (k > lastValid): (-1, -1, -1, -1) and U = 0.
+//
+// Real GPUs: threads along x are consecutive samples of one line, so the depth fetches of a wave follow
+// the line through the depth texture (coherent reads); float only (no fp64).
+//
+// Resources: MarchParams (uniform 0), EpipolarSamplingParams (uniform 1), line table (storage 0), camera
+// depth (texture unit 0, texelFetch), outputs: coordinates RGBA32F (image 0), U R32F (image 1).
+#include "crep/radial_blur.glsl"
+
+layout(local_size_x = 64, local_size_y = 1) in;
+
+// gpu::EpipolarSamplingParams (crep/epipolar/gpu_epipolar_sampling.h).
+struct CrepEpipolarSamplingParams {
+  vec4 epipole;    // xy epipole (pixels), z arcBegin, w arcLength
+  vec4 border;     // x W, y H, z perimeter, w 1 = epipole on screen
+  ivec4 counts;    // x slices N, y samples Ns, z initial step S, w downscale F
+  ivec4 target;    // xy target size, z depth criterion, w scattering criterion
+  vec4 thresholds; // x depth, y scattering, z bilateral
+};
+struct CrepEpipolarLine {
+  vec4 ends;  // xy entry, zw exit
+  ivec4 info; // x lastValid
+};
+
+layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(std140, binding = 1) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
+layout(std430, binding = 0) readonly buffer CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; };
+layout(binding = 0) uniform sampler2D cameraDepth;
+layout(binding = 0, rgba32f) uniform writeonly image2D coordinatesOut;
+layout(binding = 1, r32f) uniform writeonly image2D unshadowedOut;
+
+void main() {
+  ivec2 t = ivec2(gl_GlobalInvocationID.xy); // (k, i)
+  int Ns = crep_sampling.counts.y;
+  if (t.x >= Ns || t.y >= crep_sampling.counts.x) return;
+  CrepEpipolarLine line = crep_lines[t.y];
+  if (t.x > line.info.x) {
+    imageStore(coordinatesOut, t, vec4(-1.0));
+    imageStore(unshadowedOut, t, vec4(0.0));
+    return;
+  }
+  vec2 size = crep_sampling.border.xy;
+  vec2 p = mix(line.ends.xy, line.ends.zw, float(t.x) / float(Ns - 1));
+  ivec2 q = clamp(min(ivec2(floor(p)), ivec2(size) - 1), ivec2(0), ivec2(size) - 1);
+  float d = texelFetch(cameraDepth, q, 0).r;
+  float z = crep_cameraViewDepth(d, crep_march.cameraDepth);
+  // The ray through the continuous position p (crep_pixelRay's rule; crep::pixelRay on the CPU).
+  vec2 ndc = 2.0 * p / size - 1.0;
+  vec3 dir = normalize(crep_march.cameraForward.xyz + crep_march.cameraCenter.xyz + ndc.x * crep_march.cameraRight.xyz +
+                       ndc.y * crep_march.cameraUp.xyz);
+  vec3 L = crep_radialUnshadowed(crep_march, vec4(dir, z / dot(dir, crep_march.cameraForward.xyz)));
+  imageStore(coordinatesOut, t, vec4(p, d, z));
+  imageStore(unshadowedOut, t, vec4(crep_luminance(L)));
+}
