@@ -74,6 +74,12 @@ std::vector<float> MinMaxTreePass::readNodes() const {
 // ---------------------------------------------------------------------------------------------------
 // RectifiedMarchPass
 
+namespace {
+/// Storage buffer binding of a work list (CREP_SAMPLE_LIST_BINDING): 0 holds the trees, 1 the layout's
+/// per-slice table.
+constexpr GLuint kListBinding = 2;
+} // namespace
+
 RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   if (MinMaxTrees::levelCount(info.mapWidth) > 16)
@@ -101,14 +107,41 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
     throw InvalidArgument("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", "height " + std::to_string(H),
                           "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
-  // The image size is the camera depth texture's own (gl::textureLevel).
-  const gl::TextureLevel depth =
-      gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  const int width = depth.width, height = depth.height;
+  // The image size is the camera depth texture's own (gl::textureLevel); with a work list, imageWidth x
+  // imageHeight when given, and the outputs are the list's.
+  const gpu::SampleList* list = f.list;
+  int width = 0, height = 0;
+  if (list && (f.imageWidth != 0 || f.imageHeight != 0)) {
+    if (f.imageWidth <= 0 || f.imageHeight <= 0)
+      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.imageWidth/imageHeight",
+                            std::to_string(f.imageWidth) + " x " + std::to_string(f.imageHeight),
+                            "must both be > 0 (or both 0: cameraDepth's size)");
+    width = f.imageWidth;
+    height = f.imageHeight;
+  } else {
+    const gl::TextureLevel depth =
+        gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
+    width = depth.width;
+    height = depth.height;
+  }
   gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-  gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
+  // The textures written: the image's, or the list's (its output and coordinates).
+  int outWidth = width, outHeight = height;
+  if (list) {
+    if (list->buffer == 0 || glIsBuffer(list->buffer) != GL_TRUE)
+      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.list.buffer", std::to_string(list->buffer),
+                            "must name the list's buffer (gpu::createSampleListBuffer)");
+    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.list.coordinates", list->coordinates, list->width,
+                         list->height, GL_RGBA32F);
+    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.list.output", list->output, list->width,
+                         list->height, GL_RGBA32F);
+    outWidth = list->width;
+    outHeight = list->height;
+  } else {
+    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
+  }
   if (f.stepsOutput != 0)
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, width, height,
+    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, outWidth, outHeight,
                          GL_R32F);
   if (f.lightColors != 0)
     gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.lightColors", f.lightColors, W, H);
@@ -127,13 +160,15 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   }
 
   const bool textured = f.lightColors != 0;
-  gl::Handle& program = programs_[textured ? 1 : 0][static_cast<int>(kind)];
+  gl::Handle& program = programs_[list ? 1 : 0][textured ? 1 : 0][static_cast<int>(kind)];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
                              "passes/march_rectified.comp",
                              {{"CREP_MARCH_TREE", tree ? "1" : "0"},
                               {"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
-                              {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"}}}});
+                              {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
+                              {"CREP_SAMPLE_LIST", list ? "1" : "0"},
+                              {"CREP_SAMPLE_LIST_BINDING", std::to_string(kListBinding)}}}});
 
   gpu::MarchParams params =
       f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
@@ -144,16 +179,26 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
 
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, width, height);
-  gpu::bindMarchResources(program.get(), params_.get(), f.cameraDepth, f.rectifiedDepth, sampler_.get(),
-                          f.output, steps);
+                                                                 GL_R32F, outWidth, outHeight);
+  // A work list reads its coordinates at the camera depth's unit and writes its own output.
+  gpu::bindMarchResources(program.get(), params_.get(), list ? list->coordinates : f.cameraDepth,
+                          f.rectifiedDepth, sampler_.get(), list ? list->output : f.output, steps);
   layoutBuffers_.bind(1, 1);
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
   if (textured) { // Klehm et al. 2014, Sec. 3.2: the light texture's colour per texel
     glBindTextureUnit(2, f.lightColors);
     glBindSampler(2, sampler_.get());
   }
-  gpu::dispatchMarch(width, height, "RectifiedMarchPass::run");
+  if (list) { // Yusov 2012, Sec. 6.4: the selected samples only, one invocation per entry
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kListBinding, list->buffer);
+    gpu::dispatchSampleList(list->buffer);
+    gl::passOutputBarrier();
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kListBinding, 0);
+    gl::unbindPassState(2);
+    gl::checkError("RectifiedMarchPass::run (list)");
+  } else {
+    gpu::dispatchMarch(width, height, "RectifiedMarchPass::run");
+  }
   if (textured) {
     glBindSampler(2, 0);
     glBindTextureUnit(2, 0);

@@ -34,13 +34,22 @@ struct CrepMarchParams {
   vec4 lightIntensity;     // rgb radiant intensity (on the axis for a spot); w 0
 };
 
-// The view ray of pixel p of a w x h camera image and its surface distance (crep/scatter/ray.h: sky
-// pixels end at the far plane). xyz = unit direction, w = distance.
-vec4 crep_pixelRay(CrepMarchParams m, ivec2 p, float depth) {
-  vec2 ndc = 2.0 * (vec2(p) + 0.5) / vec2(m.sizes.xy) - 1.0;
+// The view ray through the continuous position `position` (pixel coordinates, origin bottom-left, pixel
+// centres at + 0.5) of the w x h camera image m.sizes.xy, ending at the surface of depth-buffer value
+// `depth` (crep::screenRay, crep/scatter/ray.h: sky rays end at the far plane). xyz = unit direction,
+// w = distance.
+vec4 crep_screenRay(CrepMarchParams m, vec2 position, float depth) {
+  vec2 ndc = 2.0 * position / vec2(m.sizes.xy) - 1.0;
   vec3 dir = normalize(m.cameraForward.xyz + m.cameraCenter.xyz + ndc.x * m.cameraRight.xyz + ndc.y * m.cameraUp.xyz);
   float viewDepth = crep_cameraViewDepth(depth, m.cameraDepth);
   return vec4(dir, viewDepth / dot(dir, m.cameraForward.xyz));
+}
+
+// The view ray of pixel p of a w x h camera image and its surface distance (crep/scatter/ray.h: sky
+// pixels end at the far plane): crep_screenRay at the pixel centre (the same arithmetic, so a work list
+// entry at a pixel centre gets this ray bit for bit). xyz = unit direction, w = distance.
+vec4 crep_pixelRay(CrepMarchParams m, ivec2 p, float depth) {
+  return crep_screenRay(m, vec2(p) + 0.5, depth);
 }
 
 #endif // CREP_MARCH_GLSL

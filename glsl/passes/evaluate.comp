@@ -29,6 +29,13 @@
 // invocation per cell, the ray through the cell's sample (u, v) up to its sample view depth.
 #define CREP_FROXELS 0
 #endif
+#ifndef CREP_SAMPLE_LIST
+// 1: evaluate only the entries of a GPU work list (crep/scatter/gpu_sample_list.h; Yusov 2012, Sec. 6.4 and
+// 6.7: epipolar sampling's marched samples and corrections), one invocation per entry in work groups of 64
+// dispatched indirectly (a compacted list keeps a real GPU's waves full). The camera-depth unit holds the
+// list's coordinates (x, y, d, z); the ray goes through (x, y) to depth d; the output is RGBA32F.
+#define CREP_SAMPLE_LIST 0
+#endif
 #include "crep/scattering.glsl"
 
 layout(std140, binding = CREP_EVALUATE_BINDING) uniform CrepEvaluateBlock { CrepEvaluateParams crep_evaluate; };
@@ -42,6 +49,11 @@ layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y, local
 layout(binding = 0) uniform writeonly restrict image3D crep_froxelsOut;
 layout(location = 0) uniform vec4 crep_froxelJitter; // xyz: the sample's offset in cells
 layout(location = 1) uniform vec2 crep_froxelRange;  // the volume's (near, far) view depth (FroxelDepthRange)
+#elif CREP_SAMPLE_LIST
+#include "crep/sample_list.glsl"
+layout(local_size_x = CREP_SAMPLE_LIST_GROUP_SIZE) in;
+layout(binding = CREP_CAMERA_DEPTH_UNIT) uniform sampler2D crep_cameraDepth; // the list's (x, y, d, z)
+layout(binding = 0, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
 #else
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y) in;
 layout(binding = CREP_CAMERA_DEPTH_UNIT) uniform sampler2D crep_cameraDepth; // depth-buffer values in [0, 1]
@@ -113,11 +125,22 @@ void main() {
 }
 #else
 void main() {
+#if CREP_SAMPLE_LIST
+  // The entry's texel; its point (x, y) of the W x H camera image (imageSize) and its depth-buffer value:
+  // at a pixel centre the same arithmetic as below.
+  uint entry = gl_GlobalInvocationID.x;
+  if (entry >= crep_listCount()) return;
+  ivec2 pixel = crep_listEntry(entry);
+  vec4 coordinates = texelFetch(crep_cameraDepth, pixel, 0);
+  vec2 ndc = 2.0 * coordinates.xy / vec2(crep_evaluate.imageSize.xy) - 1.0;
+  float d = coordinates.z;
+#else
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = crep_evaluate.imageSize.xy;
   if (any(greaterThanEqual(pixel, size))) return;
   vec2 ndc = 2.0 * (vec2(pixel) + 0.5) / vec2(size) - 1.0;
   float d = texelFetch(crep_cameraDepth, pixel, 0).r;
+#endif
   // Sky (the cleared value, also NaN): integrate to the far distance; beyond the near plane's value: near.
   float viewDepth = crep_cameraViewDepth(d, crep_evaluate.cameraDepth);
 #if CREP_MEMORY_LIMIT

@@ -6,11 +6,17 @@
 //
 // Resources: params block (binding 0), layout block (crep/epipolar.glsl, binding 1), camera depth
 // (unit 0), rectified map depth (unit 1, texelFetch), min/max nodes (storage buffer 0, tree variant),
-// outputs: RGBA32F scattering (image 0), R32F steps (image 1).
+// outputs: RGBA32F scattering (image 0), R32F steps (image 1); CREP_SAMPLE_LIST: the list at storage
+// buffer CREP_SAMPLE_LIST_BINDING (2).
 // CREP_LIGHT_TEXTURE 1: a light texture's colour map of the rectified map (crep::lightColorMap,
 // LightColorMapPass; texelFetch at texture unit 2): each lit texel's section times its colour
 // (crep::bruteForceMarch with lightColors); the tree variant walks a lit node texel by texel (the colours
 // differ inside it), so only shadowed nodes are skipped whole.
+// CREP_SAMPLE_LIST 1: only the entries of a GPU work list (crep/scatter/gpu_sample_list.h; Yusov 2012,
+// Sec. 6.4: epipolar sampling's marched samples), one invocation per entry in work groups of 64 (a wave
+// or two on real GPUs, every lane busy: the list is compacted) dispatched indirectly; texture unit 0 holds
+// the list's coordinates (x, y, d, z) instead of the camera depth, the ray is crep_screenRay at (x, y) to
+// depth d, and the outputs are written at the entry's texel only.
 #include "crep/epipolar.glsl"
 #include "crep/local_light.glsl"
 #include "crep/phase.glsl"
@@ -23,10 +29,19 @@
 #define CREP_LIGHT_TEXTURE 0
 #endif
 
+#ifndef CREP_SAMPLE_LIST
+#define CREP_SAMPLE_LIST 0
+#endif
+
+#if CREP_SAMPLE_LIST
+#include "crep/sample_list.glsl"
+layout(local_size_x = CREP_SAMPLE_LIST_GROUP_SIZE) in;
+#else
 layout(local_size_x = 8, local_size_y = 8) in;
+#endif
 
 layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth;
+layout(binding = 0) uniform sampler2D cameraDepth; // CREP_SAMPLE_LIST: the list's coordinates (x, y, d, z)
 layout(binding = 1) uniform sampler2D rectifiedDepth;
 #if CREP_MARCH_TREE
 layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
@@ -50,9 +65,17 @@ vec3 crep_section(vec3 sigma, float ta, float tb) {
 }
 
 void main() {
+#if CREP_SAMPLE_LIST
+  uint entry = gl_GlobalInvocationID.x;
+  if (entry >= crep_listCount()) return;
+  ivec2 pixel = crep_listEntry(entry); // the texel of the coordinates and outputs
+  vec4 coordinates = texelFetch(cameraDepth, pixel, 0);
+  vec4 ray = crep_screenRay(crep_march, coordinates.xy, coordinates.z);
+#else
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, crep_march.sizes.xy))) return;
   vec4 ray = crep_pixelRay(crep_march, pixel, texelFetch(cameraDepth, pixel, 0).r);
+#endif
   vec3 dir = ray.xyz;
   float s = ray.w;
   vec3 sigma = crep_march.extinction.rgb;

@@ -41,6 +41,9 @@ constexpr GLuint kPrefixUnit = 7;
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 // The local-light block (CREP_LOCAL_LIGHT) of the evaluation and scattering prefix programs.
 constexpr GLuint kLocalLightBinding = 3;
+// Work lists (EvaluatePass::FrameAttribs::list): the list's storage buffer binding (0 table coefficients,
+// 1 region weights, 2 layout rows).
+constexpr GLuint kSampleListBinding = 3;
 // Light textures (CREP_LIGHT_TEXTURE): the prefix mean colour in the evaluation and scattering prefix
 // programs.
 constexpr GLuint kMeanColorUnit = 2;
@@ -502,13 +505,14 @@ void addLayoutDefines(std::vector<ShaderDefine>& defines, int layoutKind) {
 /// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
 /// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
 std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind,
-                                              bool local = false, bool textured = false,
-                                              bool froxels = false) {
+                                              bool local = false, bool textured = false, bool froxels = false,
+                                              bool list = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
        "passes/evaluate.comp",
        {{"CREP_BASES", str(info.bases)},
-        {"CREP_OUTPUT_FORMAT", storageFormatToken(info.outputFormat)},
+        // A work list's output is RGBA32F (crep/scatter/gpu_sample_list.h) whatever the pass's format.
+        {"CREP_OUTPUT_FORMAT", list ? "rgba32f" : storageFormatToken(info.outputFormat)},
         {"CREP_NEAR_PLANE_CORRECTION", info.options.nearPlaneCorrection ? "1" : "0"},
         {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
         {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
@@ -527,6 +531,10 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
     stages[0].defines.push_back({"CREP_MEAN_COLOR_UNIT", str(kMeanColorUnit)});
   }
   if (froxels) stages[0].defines.push_back({"CREP_FROXELS", "1"});
+  if (list) {
+    stages[0].defines.push_back({"CREP_SAMPLE_LIST", "1"});
+    stages[0].defines.push_back({"CREP_SAMPLE_LIST_BINDING", str(kSampleListBinding)});
+  }
   return stages;
 }
 
@@ -657,7 +665,9 @@ void EvaluatePass::run(const FrameAttribs& frame) {
             "must name the region-weights buffer (near-plane correction)");
   // Froxel volumes (prefilter.h, "Froxel volumes"): the directional light's evaluation at the cells.
   const bool froxels = frame.froxels.volume != 0;
-  const bool pixels = frame.output != 0 || !froxels;
+  // Work lists (Yusov 2012, Sec. 6.4 and 6.7): the list's entries instead of every pixel.
+  const gpu::SampleList* list = frame.list;
+  const bool pixels = !list && (frame.output != 0 || !froxels);
   FroxelDepthRange froxelRange;
   GLenum volumeFormat = GL_RGBA32F;
   if (froxels) {
@@ -692,6 +702,29 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   }
   gl::TextureLevel depth, out;
   const GLenum outFormat = internalFormat(info_.outputFormat);
+  int listWidth = 0, listHeight = 0; // the camera image's size for a list
+  if (list) {
+    if (frame.imageWidth != 0 || frame.imageHeight != 0) {
+      if (frame.imageWidth <= 0 || frame.imageHeight <= 0)
+        invalid("EvaluatePass::FrameAttribs.imageWidth/imageHeight",
+                sizeString(frame.imageWidth, frame.imageHeight),
+                "must both be > 0 (or both 0: cameraDepth's size)");
+      listWidth = frame.imageWidth;
+      listHeight = frame.imageHeight;
+    } else {
+      const gl::TextureLevel d =
+          gl::requireTexture2D("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
+      listWidth = d.width;
+      listHeight = d.height;
+    }
+    if (list->buffer == 0 || glIsBuffer(list->buffer) != GL_TRUE)
+      invalid("EvaluatePass::FrameAttribs.list.buffer", str(list->buffer),
+              "must name the list's buffer (gpu::createSampleListBuffer)");
+    gl::requireTexture2D("EvaluatePass::FrameAttribs.list.coordinates", list->coordinates, list->width,
+                         list->height, GL_RGBA32F);
+    gl::requireTexture2D("EvaluatePass::FrameAttribs.list.output", list->output, list->width, list->height,
+                         GL_RGBA32F);
+  }
   if (pixels) {
     depth = gl::textureLevel("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
     if (depth.target != GL_TEXTURE_2D)
@@ -755,9 +788,17 @@ void EvaluatePass::run(const FrameAttribs& frame) {
           buildProgram(evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), local, true));
     program = variant.get();
   }
+  if (list) { // the CREP_SAMPLE_LIST variant of the program chosen above
+    gl::Handle& variant = listPrograms_[textured ? 1 : 0][variantIndex];
+    if (!variant)
+      variant = buildProgram(evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), local,
+                                            textured, false, true));
+    program = variant.get();
+  }
   gpu::EvaluateParams params;
   gpu::assignCamera(params, *frame.camera);
-  params.imageSize = glm::ivec4(pixels ? depth.width : 0, pixels ? depth.height : 0, 0, 0);
+  params.imageSize = list ? glm::ivec4(listWidth, listHeight, 0, 0)
+                          : glm::ivec4(pixels ? depth.width : 0, pixels ? depth.height : 0, 0, 0);
   glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
 
@@ -840,7 +881,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
   glBindTextureUnit(kBasisUnit, basis.texture);
   glBindSampler(kBasisUnit, basisSampler_.get());
-  glBindTextureUnit(kCameraDepthUnit, frame.cameraDepth);
+  glBindTextureUnit(kCameraDepthUnit, list ? list->coordinates : frame.cameraDepth);
   glBindSampler(kCameraDepthUnit, depthSampler_.get());
   if (textured) {
     glBindTextureUnit(kMeanColorUnit, basis.meanColor);
@@ -854,6 +895,12 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
     glDispatchCompute(static_cast<GLuint>(ceilDiv(depth.width, info_.workgroupWidth)),
                       static_cast<GLuint>(ceilDiv(depth.height, info_.workgroupHeight)), 1);
+  }
+  if (list) { // one invocation per entry, groups of 64 (gpu::kSampleListGroupSize)
+    glBindImageTexture(0, list->output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, list->buffer);
+    gpu::dispatchSampleList(list->buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, 0);
   }
   if (froxels) {
     // The froxel variant of the same program (CREP_FROXELS) on the same bindings; the evaluate block's

@@ -10,8 +10,8 @@
 // with texelFetch through the pass's own nearest sampler, so the texture's compare mode does not matter);
 // outputs are GL_RGBA32F (scattering: RGB radiance, A grey transmittance) and GL_R32F (steps per pixel).
 // A pass leaves GL state as follows: program 0; texture units 0-2 with no texture and no sampler; image
-// units 0-1, uniform buffer bindings 0-1 and storage buffer bindings 0-1 unbound. It issues the memory
-// barriers its outputs need for texture fetches, image loads, readback and buffer reads.
+// units 0-1, uniform buffer bindings 0-1 and storage buffer bindings 0-1 (0-2 with a work list) unbound. It
+// issues the memory barriers its outputs need for texture fetches, image loads, readback and buffer reads.
 // NaN in a GPU input is not checked (it would cost a readback): a NaN camera depth is treated as the sky
 // (far plane), a NaN rectified-map texel as shadowing every ray (every comparison with it is false),
 // a NaN standard shadow-map texel as empty (lit). The CPU functions reject NaN with InvalidArgument.
@@ -30,6 +30,7 @@
 #include <crep/epipolar/gpu_layout.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
+#include <crep/scatter/gpu_sample_list.h>
 #include <crep/scatter/gpu_world_march.h>
 
 namespace crep {
@@ -100,6 +101,23 @@ public:
     /// section times its colour (crep::bruteForceMarch / minMaxMarch with lightColors; the tree walks lit
     /// nodes texel by texel, skipping only shadowed nodes whole). Bound at texture unit 2 (left unbound).
     std::uint32_t lightColors = 0;
+    /// A GPU work list (crep/scatter/gpu_sample_list.h; Yusov 2012, Sec. 6.4: epipolar sampling's marched
+    /// samples) or null. Set: the pass marches only the list's entries (the CREP_SAMPLE_LIST variant, work
+    /// groups of 64 entries dispatched indirectly with gpu::dispatchSampleList): entry texel t's ray is
+    /// crep_screenRay at list->coordinates(t).xy (continuous camera pixel coordinates) ending at its
+    /// depth-buffer value list->coordinates(t).z (.w, the view depth, is not read), and its result is
+    /// written to texel t of list->output (GL_RGBA32F, list->width x list->height) and of stepsOutput (0, or
+    /// GL_R32F of the list's size); no other texel is written. `output` is ignored and `cameraDepth` may be
+    /// 0. Every other field (layout, lights, maps, lightColors, localLight) composes with it. The producer
+    /// must have issued GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT (and the barriers its
+    /// coordinates texture needs). The list is bound at storage buffer binding 2 and the coordinates at
+    /// texture unit 0 (both left unbound).
+    const gpu::SampleList* list = nullptr;
+    /// With `list`: the camera image's full size W x H in pixels (ndc = 2 (x, y) / (W, H) - 1; not the list
+    /// texture's size). 0 x 0 (the default): cameraDepth's size (then cameraDepth must be set). Both > 0
+    /// or both 0, else InvalidArgument "RectifiedMarchPass::FrameAttribs.imageWidth/imageHeight". Ignored
+    /// without a list (the image is cameraDepth's).
+    int imageWidth = 0, imageHeight = 0;
   };
   /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
   /// MinMaxTreePass.
@@ -111,7 +129,7 @@ public:
 private:
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2][2], params_, sampler_, dummySteps_;
+  gl::Handle programs_[2][2][2], params_, sampler_, dummySteps_; ///< [list][textured][layout kind]
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 

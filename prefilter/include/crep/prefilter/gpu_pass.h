@@ -37,6 +37,7 @@
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/froxel_grid.h>
 #include <crep/scatter/gpu_layout_buffers.h>
+#include <crep/scatter/gpu_sample_list.h>
 
 namespace crep {
 
@@ -231,6 +232,23 @@ public:
     /// caller's promise), e.g. a second run of the same frame that fills a froxel volume alone. Ignored
     /// without a table (EvaluateOptions::visibilityTableSamples 0 or the direct path).
     bool reuseTable = false;
+    /// A GPU work list (crep/scatter/gpu_sample_list.h; Yusov 2012, Sec. 6.4 and 6.7: epipolar sampling's
+    /// marched samples and corrections) or null. Set: instead of the per-pixel dispatch the pass evaluates
+    /// only the list's entries (the CREP_SAMPLE_LIST variant of every program, work groups of 64 entries
+    /// dispatched indirectly with gpu::dispatchSampleList): entry texel t's ray goes through
+    /// list->coordinates(t).xy (continuous camera pixel coordinates: ndc = 2 (x, y) / (W, H) - 1) to the
+    /// surface of depth-buffer value list->coordinates(t).z (.w is not read), as crep::evaluate() does at a
+    /// pixel centre; its result goes to texel t of list->output (GL_RGBA32F whatever
+    /// CreateInfo::outputFormat, list->width x list->height) and nothing else is written. `output` is
+    /// ignored and `cameraDepth` may be 0. Composes with every layout, light, basis (textured, local) and
+    /// option, CreateInfo::memoryLimit included, and with a froxel volume (filled by its own dispatch after
+    /// the list's). The list is bound at storage buffer binding 3 and the coordinates at the camera-depth
+    /// texture unit (left unbound). The producer must have issued GL_COMMAND_BARRIER_BIT |
+    /// GL_SHADER_STORAGE_BARRIER_BIT.
+    const gpu::SampleList* list = nullptr;
+    /// With `list`: the camera image's full size W x H (both > 0, or both 0 for cameraDepth's size; else
+    /// InvalidArgument "EvaluatePass::FrameAttribs.imageWidth/imageHeight"). Ignored without a list.
+    int imageWidth = 0, imageHeight = 0;
   };
 
   /// Validates `info` (InvalidArgument naming the field, GlError beyond the workgroup limits) and
@@ -272,6 +290,9 @@ private:
   /// Froxel volumes (CREP_FROXELS): index [textured][0 projective frame, 1 + gpu::LayoutKind], built on
   /// first use.
   gl::Handle froxelPrograms_[2][3];
+  /// Work lists (CREP_SAMPLE_LIST): index [textured][0 projective frame, 1 + gpu::LayoutKind, 3 local
+  /// light], built on first use.
+  gl::Handle listPrograms_[2][4];
   /// What the table was last built for (FrameAttribs::reuseTable): basis texture, program variant.
   std::uint32_t tableBasis_ = 0;
   int tableVariant_ = -1;

@@ -1,0 +1,205 @@
+// EvaluatePass on GPU work lists (FrameAttribs::list, crep/scatter/gpu_sample_list.h): the prefiltered
+// evaluation of epipolar sampling's marched samples and corrections (Yusov 2012, Sec. 6.4 and 6.7). A list of
+// every pixel centre gives the per-pixel pass's output bit for bit (projective and epipolar layouts, default
+// options and the near-plane correction); a list of some pixels writes those texels only. The lists are
+// filled from the CPU here (header, then the entries).
+#include "epipolar/epipolar_test_util.h"
+#include "support/gl_fixture.h"
+
+#include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/resample.h>
+#include <crep/prefilter/gpu_pass.h>
+#include <crep/prefilter/prefilter.h>
+#include <crep/scatter/gpu_sample_list.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <doctest/doctest.h>
+#include <epoxy/gl.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace crep;
+using namespace crep::test;
+
+namespace {
+
+constexpr int kWidth = 160, kHeight = 90, kShadowSize = 512, kMapWidth = 256;
+
+/// The colonnade scene: camera depth and its light's shadow map rasterized, the shadow map read back for
+/// resampleShadowMap.
+struct Scene {
+  scenes::Scene scene = scenes::makeScene("colonnade", static_cast<double>(kWidth) / kHeight);
+  gl::Handle cameraTexture;
+  Image cameraDepth, shadow;
+  glm::dmat4 lightMatrix{1.0};
+
+  Scene() {
+    scenes::SceneRenderer renderer(scene.mesh);
+    cameraTexture = scenes::createDepthTexture(kWidth, kHeight);
+    renderer.renderDepth(scene.camera.clipFromWorld(), cameraTexture.get(), 0, 0, 0, kWidth, kHeight);
+    cameraDepth = scenes::readDepthTexture(cameraTexture.get(), kWidth, kHeight);
+    lightMatrix = scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
+    const gl::Handle shadowTexture = scenes::createDepthTexture(kShadowSize, kShadowSize);
+    renderer.renderDepth(lightMatrix, shadowTexture.get(), 0, 0, 0, kShadowSize, kShadowSize,
+                         {.depthClamp = true});
+    shadow = scenes::readDepthTexture(shadowTexture.get(), kShadowSize, kShadowSize);
+  }
+};
+
+/// A work list over a kWidth x kHeight coordinates texture (every pixel centre with its depth) whose entries
+/// are `texels`; the output starts as NaN.
+struct TestList {
+  gl::Handle buffer, coordinates, output;
+  gpu::SampleList list;
+};
+
+TestList makeList(const Image& depth, const std::vector<glm::ivec2>& texels) {
+  TestList t;
+  std::vector<float> c;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      c.insert(c.end(), {x + 0.5f, y + 0.5f, depth.at(x, y), 0.0f});
+  t.buffer = gpu::createSampleListBuffer(kWidth * kHeight);
+  t.coordinates = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+  glTextureSubImage2D(t.coordinates.get(), 0, 0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, c.data());
+  t.output = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float fill[4] = {nan, nan, nan, nan};
+  glClearTexImage(t.output.get(), 0, GL_RGBA, GL_FLOAT, fill);
+  const auto count = static_cast<std::uint32_t>(texels.size());
+  std::vector<std::uint32_t> data{(count + 63) / 64, 1, 1, count};
+  for (const glm::ivec2& p : texels)
+    data.push_back(static_cast<std::uint32_t>(p.x) | (static_cast<std::uint32_t>(p.y) << 16));
+  glNamedBufferSubData(t.buffer.get(), 0, static_cast<GLsizeiptr>(data.size() * 4), data.data());
+  t.list = {t.buffer.get(), t.coordinates.get(), t.output.get(), kWidth, kHeight, kWidth * kHeight};
+  return t;
+}
+
+/// The per-pixel output and the list's output of the same evaluation.
+struct Outputs {
+  Image perPixel, listed;
+};
+
+Outputs evaluateBoth(const Scene& s, const std::shared_ptr<const RectifiedLayout>& layout, int H,
+                     const EvaluateOptions& options, const TestList& list) {
+  const RectifiedMap map = resampleShadowMap(layout, kMapWidth, H, s.shadow, s.lightMatrix);
+  const gl::Handle mapTexture = gl::createTexture2D(GL_R32F, kMapWidth, H);
+  glTextureSubImage2D(mapTexture.get(), 0, 0, 0, kMapWidth, H, GL_RED, GL_FLOAT, map.depth.data().data());
+  PrefilterPass::CreateInfo pi;
+  pi.mapWidth = kMapWidth;
+  pi.mapHeight = H;
+  PrefilterPass prefilterPass(pi);
+  PrefilterPass::FrameAttribs pf;
+  pf.rectifiedDepth = mapTexture.get();
+  pf.layout = layout.get();
+  pf.medium = &s.scene.medium;
+  prefilterPass.run(pf);
+
+  EvaluatePass::CreateInfo ei;
+  ei.options = options;
+  EvaluatePass pass(ei);
+  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+  EvaluatePass::FrameAttribs f;
+  f.cameraDepth = s.cameraTexture.get();
+  f.output = out.get();
+  f.camera = &s.scene.camera;
+  f.light = &s.scene.sun;
+  f.medium = &s.scene.medium;
+  f.layout = layout.get();
+  f.basis = prefilterPass.filteredBasis();
+  pass.run(f);
+  // The list: no camera depth (the image size given instead), output ignored.
+  f.cameraDepth = 0;
+  f.list = &list.list;
+  f.imageWidth = kWidth;
+  f.imageHeight = kHeight;
+  pass.run(f);
+  return {gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba),
+          gl::readTexture(list.output.get(), kWidth, kHeight, gl::TexelData::Rgba)};
+}
+
+struct Layouts {
+  std::string name;
+  std::shared_ptr<const RectifiedLayout> layout;
+  int height;
+};
+
+std::vector<Layouts> layoutsOf(const Scene& s) {
+  RectifyOptions ro;
+  ro.splits = 4;
+  const auto projective = std::make_shared<const ProjectiveLayout>(rectify(s.scene.camera, s.scene.sun, ro));
+  const auto epipolar = std::make_shared<const EpipolarLayout>(s.scene.camera, s.scene.sun, kWidth, kHeight);
+  return {{"projective", projective, 128}, {"epipolar", epipolar, epipolar->sliceCount()}};
+}
+
+bool sameBits(float a, float b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+int bitDifferences(const Image& a, const Image& b) {
+  int differ = 0;
+  for (std::size_t i = 0; i < a.data().size(); ++i)
+    if (std::memcmp(&a.data()[i], &b.data()[i], sizeof(float)) != 0) ++differ;
+  return differ;
+}
+
+} // namespace
+
+TEST_CASE("evaluate list GL: a list of every pixel gives the per-pixel evaluation bit for bit") {
+  CREP_REQUIRE_GL();
+  const Scene s;
+  std::vector<glm::ivec2> all;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      all.push_back({x, y});
+  for (const Layouts& l : layoutsOf(s))
+    for (const bool near : {false, true}) { // the default table path and the direct near-plane path
+      CAPTURE(l.name);
+      CAPTURE(near);
+      EvaluateOptions o;
+      o.nearPlaneCorrection = near;
+      const TestList list = makeList(s.cameraDepth, all);
+      const Outputs r = evaluateBoth(s, l.layout, l.height, o, list);
+      int nan = 0;
+      for (const float v : r.perPixel.data())
+        if (std::isnan(v)) ++nan;
+      CHECK(nan == 0);
+      CHECK(bitDifferences(r.listed, r.perPixel) == 0);
+      CHECK(rgbMetrics(r.perPixel, r.perPixel).peak > 0.0);
+    }
+}
+
+TEST_CASE("evaluate list GL: a list writes its entries only") {
+  CREP_REQUIRE_GL();
+  const Scene s;
+  const auto entry = [](int x, int y) { return (x * 5 + y * 11) % 7 == 0; };
+  std::vector<glm::ivec2> some;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      if (entry(x, y)) some.push_back({x, y});
+  for (const Layouts& l : layoutsOf(s)) {
+    CAPTURE(l.name);
+    const TestList list = makeList(s.cameraDepth, some);
+    const Outputs r = evaluateBoth(s, l.layout, l.height, {}, list);
+    int nanAtEntries = 0, writtenElsewhere = 0, differ = 0;
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x)
+        for (int c = 0; c < 4; ++c) {
+          const float v = r.listed.at(x, y, c);
+          if (entry(x, y) && std::isnan(v)) ++nanAtEntries;
+          if (!entry(x, y) && !std::isnan(v)) ++writtenElsewhere;
+          if (entry(x, y) && !sameBits(v, r.perPixel.at(x, y, c))) ++differ;
+        }
+    MESSAGE(l.name << ": " << some.size() << " entries of " << kWidth * kHeight << " texels");
+    CHECK(nanAtEntries == 0);
+    CHECK(writtenElsewhere == 0);
+    CHECK(differ == 0);
+  }
+}
