@@ -50,11 +50,9 @@ void main() {
   ivec2 q = clamp(min(ivec2(floor(p)), ivec2(size) - 1), ivec2(0), ivec2(size) - 1);
   float d = texelFetch(cameraDepth, q, 0).r;
   float z = crep_cameraViewDepth(d, crep_march.cameraDepth);
-  // The ray through the continuous position p (crep_pixelRay's rule; crep::pixelRay on the CPU).
-  vec2 ndc = 2.0 * p / size - 1.0;
-  vec3 dir = normalize(crep_march.cameraForward.xyz + crep_march.cameraCenter.xyz + ndc.x * crep_march.cameraRight.xyz +
-                       ndc.y * crep_march.cameraUp.xyz);
-  vec3 L = crep_radialUnshadowed(crep_march, vec4(dir, z / dot(dir, crep_march.cameraForward.xyz)));
+  // The ray through the continuous position p (crep::screenRay on the CPU): the ray an evaluator of the
+  // work list gets for this texel.
+  vec3 L = crep_radialUnshadowed(crep_march, crep_screenRay(crep_march, p, d));
   imageStore(coordinatesOut, t, vec4(p, d, z));
   imageStore(unshadowedOut, t, vec4(crep_luminance(L)));
 }
