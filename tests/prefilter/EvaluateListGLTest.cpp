@@ -6,6 +6,7 @@
 #include "epipolar/epipolar_test_util.h"
 #include "support/gl_fixture.h"
 
+#include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
 #include <crep/prefilter/gpu_pass.h>
@@ -87,8 +88,10 @@ struct Outputs {
   Image perPixel, listed;
 };
 
+/// The list runs with `info`, the per-pixel pass with `pixelInfo` (default: `info`).
 Outputs evaluateBoth(const Scene& s, const std::shared_ptr<const RectifiedLayout>& layout, int H,
-                     const EvaluateOptions& options, const TestList& list) {
+                     const EvaluatePass::CreateInfo& info, const TestList& list,
+                     const EvaluatePass::CreateInfo* pixelInfo = nullptr, bool textured = false) {
   const RectifiedMap map = resampleShadowMap(layout, kMapWidth, H, s.shadow, s.lightMatrix);
   const gl::Handle mapTexture = gl::createTexture2D(GL_R32F, kMapWidth, H);
   glTextureSubImage2D(mapTexture.get(), 0, 0, 0, kMapWidth, H, GL_RED, GL_FLOAT, map.depth.data().data());
@@ -100,11 +103,19 @@ Outputs evaluateBoth(const Scene& s, const std::shared_ptr<const RectifiedLayout
   pf.rectifiedDepth = mapTexture.get();
   pf.layout = layout.get();
   pf.medium = &s.scene.medium;
+  gl::Handle colors;
+  if (textured) { // a light texture's colour map: a smooth colour gradient over the map's texels
+    std::vector<float> rgba;
+    for (int j = 0; j < H; ++j)
+      for (int i = 0; i < kMapWidth; ++i)
+        rgba.insert(rgba.end(), {0.5f + 0.5f * i / kMapWidth, 1.0f - 0.5f * j / H, 0.75f, 1.0f});
+    colors = gl::createTexture2D(GL_RGBA32F, kMapWidth, H);
+    glTextureSubImage2D(colors.get(), 0, 0, 0, kMapWidth, H, GL_RGBA, GL_FLOAT, rgba.data());
+    pf.lightColors = colors.get();
+  }
   prefilterPass.run(pf);
 
-  EvaluatePass::CreateInfo ei;
-  ei.options = options;
-  EvaluatePass pass(ei);
+  EvaluatePass pixelPass(pixelInfo ? *pixelInfo : info);
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
   EvaluatePass::FrameAttribs f;
   f.cameraDepth = s.cameraTexture.get();
@@ -114,7 +125,8 @@ Outputs evaluateBoth(const Scene& s, const std::shared_ptr<const RectifiedLayout
   f.medium = &s.scene.medium;
   f.layout = layout.get();
   f.basis = prefilterPass.filteredBasis();
-  pass.run(f);
+  pixelPass.run(f);
+  EvaluatePass pass(info);
   // The list: no camera depth (the image size given instead), output ignored.
   f.cameraDepth = 0;
   f.list = &list.list;
@@ -163,10 +175,10 @@ TEST_CASE("evaluate list GL: a list of every pixel gives the per-pixel evaluatio
     for (const bool near : {false, true}) { // the default table path and the direct near-plane path
       CAPTURE(l.name);
       CAPTURE(near);
-      EvaluateOptions o;
-      o.nearPlaneCorrection = near;
+      EvaluatePass::CreateInfo info;
+      info.options.nearPlaneCorrection = near;
       const TestList list = makeList(s.cameraDepth, all);
-      const Outputs r = evaluateBoth(s, l.layout, l.height, o, list);
+      const Outputs r = evaluateBoth(s, l.layout, l.height, info, list);
       int nan = 0;
       for (const float v : r.perPixel.data())
         if (std::isnan(v)) ++nan;
@@ -202,4 +214,100 @@ TEST_CASE("evaluate list GL: a list writes its entries only") {
     CHECK(writtenElsewhere == 0);
     CHECK(differ == 0);
   }
+}
+
+TEST_CASE("evaluate list GL: the list variant composes with the pass's options and formats") {
+  CREP_REQUIRE_GL();
+  const Scene s;
+  std::vector<glm::ivec2> all;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      all.push_back({x, y});
+  const Layouts projective = layoutsOf(s)[0];
+  struct Case {
+    const char* name;
+    EvaluatePass::CreateInfo info;
+  };
+  std::vector<Case> cases(6);
+  cases[0].name = "no table (direct path)";
+  cases[0].info.options.visibilityTableSamples = 0;
+  cases[1].name = "visibility table without the prefix";
+  cases[1].info.options.scatteringPrefix = false;
+  cases[2].name = "nearest sampling";
+  cases[2].info.options.sampling = Sampling::Nearest;
+  cases[3].name = "memory limit (benchmark variant)";
+  cases[3].info.memoryLimit = true;
+  cases[4].name = "RGBA16F output format (the list still writes RGBA32F)";
+  cases[4].info.outputFormat = StorageFormat::RGBA16F;
+  cases[5].name = "light texture (textured basis, scattering prefix table)";
+  for (const Case& c : cases) {
+    CAPTURE(c.name);
+    const bool textured = &c == &cases[5];
+    const TestList list = makeList(s.cameraDepth, all);
+    // The per-pixel reference in RGBA32F: the list's output format.
+    EvaluatePass::CreateInfo pixelInfo = c.info;
+    pixelInfo.outputFormat = StorageFormat::RGBA32F;
+    const Outputs r =
+        evaluateBoth(s, projective.layout, projective.height, c.info, list, &pixelInfo, textured);
+    CHECK(bitDifferences(r.listed, r.perPixel) == 0);
+    if (textured) CHECK(rgbMetrics(r.perPixel, r.perPixel).peak > 0.0);
+  }
+}
+
+TEST_CASE("evaluate list GL: bad list attributes get a named InvalidArgument") {
+  CREP_REQUIRE_GL();
+  const Scene s;
+  const Layouts projective = layoutsOf(s)[0];
+  const RectifiedMap map = resampleShadowMap(projective.layout, kMapWidth, 128, s.shadow, s.lightMatrix);
+  const gl::Handle mapTexture = gl::createTexture2D(GL_R32F, kMapWidth, 128);
+  glTextureSubImage2D(mapTexture.get(), 0, 0, 0, kMapWidth, 128, GL_RED, GL_FLOAT, map.depth.data().data());
+  PrefilterPass::CreateInfo pi;
+  pi.mapWidth = kMapWidth;
+  pi.mapHeight = 128;
+  PrefilterPass prefilterPass(pi);
+  PrefilterPass::FrameAttribs pf;
+  pf.rectifiedDepth = mapTexture.get();
+  pf.layout = projective.layout.get();
+  pf.medium = &s.scene.medium;
+  prefilterPass.run(pf);
+  const TestList list = makeList(s.cameraDepth, {{1, 2}});
+  EvaluatePass pass({});
+  EvaluatePass::FrameAttribs f;
+  f.camera = &s.scene.camera;
+  f.light = &s.scene.sun;
+  f.medium = &s.scene.medium;
+  f.layout = projective.layout.get();
+  f.basis = prefilterPass.filteredBasis();
+  f.list = &list.list;
+  const auto parameter = [&](const EvaluatePass::FrameAttribs& a) {
+    try {
+      pass.run(a);
+    } catch (const InvalidArgument& e) {
+      return e.parameter();
+    }
+    return std::string("no exception");
+  };
+  CHECK(parameter(f) == "EvaluatePass::FrameAttribs.cameraDepth"); // no image size from anywhere
+  f.imageHeight = kHeight;
+  CHECK(parameter(f) == "EvaluatePass::FrameAttribs.imageWidth/imageHeight");
+  f.imageWidth = kWidth;
+  CHECK(parameter(f) == "no exception");
+  gpu::SampleList wrong = list.list;
+  wrong.height = 7;
+  f.list = &wrong;
+  CHECK(parameter(f) == "EvaluatePass::FrameAttribs.list.coordinates");
+  wrong = list.list;
+  wrong.buffer = 0;
+  CHECK(parameter(f) == "EvaluatePass::FrameAttribs.list.buffer");
+  wrong = list.list;
+  wrong.output = 0;
+  CHECK(parameter(f) == "EvaluatePass::FrameAttribs.list.output");
+  // The image size of the camera depth instead.
+  f.list = &list.list;
+  f.imageWidth = f.imageHeight = 0;
+  f.cameraDepth = s.cameraTexture.get();
+  CHECK(parameter(f) == "no exception");
+  const Image out = gl::readTexture(list.output.get(), kWidth, kHeight, gl::TexelData::Rgba);
+  CHECK(std::isfinite(out.at(1, 2, 0)));
+  CHECK(std::isnan(out.at(2, 1, 0)));
 }
