@@ -103,7 +103,8 @@ std::vector<float> pixelCoordinates(const Image& depth) {
 }
 
 /// Runs the pass per pixel (list == null) or on `list`; returns the output (the list's when given).
-Image runMarch(const SceneMaps& s, const RectifiedMarchPass::Mode mode, const TestList* list) {
+Image runMarch(const SceneMaps& s, const RectifiedMarchPass::Mode mode, const TestList* list,
+               std::uint32_t lightColors = 0) {
   MinMaxTreePass trees({kMapWidth, kMapHeight});
   trees.run(s.mapTexture.get());
   RectifiedMarchPass pass({kMapWidth, kMapHeight, mode});
@@ -115,6 +116,7 @@ Image runMarch(const SceneMaps& s, const RectifiedMarchPass::Mode mode, const Te
   f.medium = &s.scene.medium;
   f.rectifiedDepth = s.mapTexture.get();
   f.minMaxBuffer = trees.treeBuffer();
+  f.lightColors = lightColors;
   if (list) {
     f.list = &list->list;
     f.imageWidth = kWidth;
@@ -282,4 +284,29 @@ TEST_CASE("march list GL: bad list attributes get a named InvalidArgument") {
   f.imageWidth = f.imageHeight = 0;
   f.cameraDepth = s.cameraTexture.get();
   CHECK(parameter(f) == "no exception");
+}
+
+TEST_CASE("march list GL: the list variant composes with a light texture's colour map") {
+  CREP_REQUIRE_GL();
+  const SceneMaps s = renderScene("terrain");
+  // A smooth colour gradient over the map's texels (crep::lightColorMap's role).
+  std::vector<float> rgba;
+  for (int j = 0; j < kMapHeight; ++j)
+    for (int i = 0; i < kMapWidth; ++i)
+      rgba.insert(rgba.end(), {0.5f + 0.5f * i / kMapWidth, 1.0f - 0.5f * j / kMapHeight, 0.75f, 1.0f});
+  const gl::Handle colors = gl::createTexture2D(GL_RGBA32F, kMapWidth, kMapHeight);
+  glTextureSubImage2D(colors.get(), 0, 0, 0, kMapWidth, kMapHeight, GL_RGBA, GL_FLOAT, rgba.data());
+  std::vector<glm::ivec2> all;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      all.push_back({x, y});
+  for (const auto mode : {RectifiedMarchPass::Mode::MinMaxTree, RectifiedMarchPass::Mode::BruteForce}) {
+    CAPTURE(static_cast<int>(mode));
+    const TestList list = makeList(kWidth, kHeight, pixelCoordinates(s.cameraDepth), all);
+    const Image perPixel = runMarch(s, mode, nullptr, colors.get());
+    const Image listed = runMarch(s, mode, &list, colors.get());
+    CHECK(bitDifferences(listed, perPixel) == 0);
+    // The colours do change the result.
+    CHECK(bitDifferences(perPixel, runMarch(s, mode, nullptr)) > 0);
+  }
 }
