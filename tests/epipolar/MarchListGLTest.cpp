@@ -5,6 +5,7 @@
 // MarchGLTest; only the entries' texels are written; an empty list writes nothing. The lists are filled
 // from the CPU here (header, then the entries).
 #include "epipolar_test_util.h"
+#include "scatter/local_light_util.h"
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 
@@ -12,6 +13,7 @@
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scatter/gpu_sample_list.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
@@ -308,5 +310,51 @@ TEST_CASE("march list GL: the list variant composes with a light texture's colou
     CHECK(bitDifferences(listed, perPixel) == 0);
     // The colours do change the result.
     CHECK(bitDifferences(perPixel, runMarch(s, mode, nullptr)) > 0);
+  }
+}
+
+TEST_CASE("march list GL: the list variant composes with a local light (spot)") {
+  CREP_REQUIRE_GL();
+  constexpr int W = 512, H = 256;
+  const Camera camera = groundCamera(kWidth, kHeight);
+  const Image depth = groundDepth(camera, kWidth, kHeight);
+  const Medium medium = colouredMedium();
+  RectifyOptions ro;
+  ro.splits = 8;
+  const SpotLight spot = analyticSpot();
+  const LocalLight light = LocalLight::spot(spot);
+  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
+  const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
+  const gl::Handle mapTexture = gl::createTexture2D(GL_R32F, W, H);
+  glTextureSubImage2D(mapTexture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
+  const gl::Handle depthTexture = gl::createTexture2D(GL_R32F, kWidth, kHeight);
+  glTextureSubImage2D(depthTexture.get(), 0, 0, 0, kWidth, kHeight, GL_RED, GL_FLOAT, depth.data().data());
+  MinMaxTreePass trees({W, H});
+  trees.run(mapTexture.get());
+  std::vector<glm::ivec2> all;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      all.push_back({x, y});
+  for (const auto mode : {RectifiedMarchPass::Mode::MinMaxTree, RectifiedMarchPass::Mode::BruteForce}) {
+    CAPTURE(static_cast<int>(mode));
+    RectifiedMarchPass pass({W, H, mode});
+    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+    RectifiedMarchPass::FrameAttribs a;
+    a.layout = layout.get();
+    a.camera = &camera;
+    a.medium = &medium;
+    a.cameraDepth = depthTexture.get();
+    a.rectifiedDepth = mapTexture.get();
+    a.minMaxBuffer = trees.treeBuffer();
+    a.output = out.get();
+    a.localLight = &light;
+    pass.run(a);
+    const TestList list = makeList(kWidth, kHeight, pixelCoordinates(depth), all);
+    a.list = &list.list; // the image size from cameraDepth
+    pass.run(a);
+    const Image perPixel = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
+    const Image listed = gl::readTexture(list.output.get(), kWidth, kHeight, gl::TexelData::Rgba);
+    CHECK(bitDifferences(listed, perPixel) == 0);
+    CHECK(rgbMetrics(perPixel, perPixel).peak > 0.0);
   }
 }

@@ -4,6 +4,7 @@
 // options and the near-plane correction); a list of some pixels writes those texels only. The lists are
 // filled from the CPU here (header, then the entries).
 #include "epipolar/epipolar_test_util.h"
+#include "scatter/local_light_util.h"
 #include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
@@ -11,6 +12,7 @@
 #include <crep/epipolar/resample.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scatter/gpu_sample_list.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
@@ -310,4 +312,60 @@ TEST_CASE("evaluate list GL: bad list attributes get a named InvalidArgument") {
   const Image out = gl::readTexture(list.output.get(), kWidth, kHeight, gl::TexelData::Rgba);
   CHECK(std::isfinite(out.at(1, 2, 0)));
   CHECK(std::isnan(out.at(2, 1, 0)));
+}
+
+TEST_CASE("evaluate list GL: the list variant composes with a local light (spot)") {
+  CREP_REQUIRE_GL();
+  constexpr int W = 512, H = 256;
+  const Camera camera = groundCamera(kWidth, kHeight);
+  const Image depth = groundDepth(camera, kWidth, kHeight);
+  const Medium medium = colouredMedium();
+  RectifyOptions ro;
+  ro.splits = 8;
+  const SpotLight spot = analyticSpot();
+  const LocalLight light = LocalLight::spot(spot);
+  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
+  const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
+  const gl::Handle mapTexture = gl::createTexture2D(GL_R32F, W, H);
+  glTextureSubImage2D(mapTexture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
+  const gl::Handle depthTexture = gl::createTexture2D(GL_R32F, kWidth, kHeight);
+  glTextureSubImage2D(depthTexture.get(), 0, 0, 0, kWidth, kHeight, GL_RED, GL_FLOAT, depth.data().data());
+  PrefilterPass::CreateInfo pi;
+  pi.mapWidth = W;
+  pi.mapHeight = H;
+  pi.options.regionsPerSplit = 2;
+  PrefilterPass prefilterPass(pi);
+  PrefilterPass::FrameAttribs pf;
+  pf.rectifiedDepth = mapTexture.get();
+  pf.layout = layout.get();
+  pf.medium = &medium;
+  pf.localLight = &light;
+  prefilterPass.run(pf);
+  std::vector<glm::ivec2> all;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x)
+      all.push_back({x, y});
+  for (const bool prefixTable : {true, false}) {
+    CAPTURE(prefixTable);
+    EvaluatePass::CreateInfo info;
+    info.options.scatteringPrefix = prefixTable;
+    EvaluatePass pass(info);
+    const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+    EvaluatePass::FrameAttribs f;
+    f.cameraDepth = depthTexture.get();
+    f.output = out.get();
+    f.camera = &camera;
+    f.medium = &medium;
+    f.layout = layout.get();
+    f.basis = prefilterPass.filteredBasis();
+    f.localLight = &light;
+    pass.run(f);
+    const TestList list = makeList(depth, all);
+    f.list = &list.list; // the image size from cameraDepth
+    pass.run(f);
+    const Image perPixel = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
+    const Image listed = gl::readTexture(list.output.get(), kWidth, kHeight, gl::TexelData::Rgba);
+    CHECK(bitDifferences(listed, perPixel) == 0);
+    CHECK(rgbMetrics(perPixel, perPixel).peak > 0.0);
+  }
 }
