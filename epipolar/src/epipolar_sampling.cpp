@@ -16,6 +16,8 @@ namespace {
 constexpr int kMaxSlices = 16384;
 constexpr double kMaxEpipoleDistance = 1e5;
 constexpr double kSlabEpsilon = 1e-12;
+/// Distance of the lines' first sample from an on-screen epipole, pixels (see epipolarLines).
+constexpr double kEpipoleOffset = 0.5;
 constexpr double kMinWeight = 1e-4;
 
 std::string sizeString(const Image& image) {
@@ -75,6 +77,9 @@ void validate(const EpipolarSamplingOptions& o, const std::string& owner) {
   if (!(o.bilateralThreshold >= 0.0) || !std::isfinite(o.bilateralThreshold))
     throw InvalidArgument(owner + ".bilateralThreshold", detail::formatValue(o.bilateralThreshold),
                           "must be finite and >= 0");
+  if (o.epipoleDensity < 1 || o.epipoleDensity > 64 || (o.epipoleDensity & (o.epipoleDensity - 1)) != 0)
+    throw InvalidArgument(owner + ".epipoleDensity", detail::formatValue(o.epipoleDensity),
+                          "must be a power of two in [1, 64] (1 = off)");
   if (o.downscale != 1 && o.downscale != 2 && o.downscale != 4)
     throw InvalidArgument(owner + ".downscale", detail::formatValue(o.downscale), "must be 1, 2 or 4");
 }
@@ -167,6 +172,15 @@ EpipolarLines epipolarLines(const Camera& camera, const DirectionalLight& light,
   out.epipole = e;
   out.epipoleOnScreen = e.x >= 0.0 && e.x <= W && e.y >= 0.0 && e.y <= H;
 
+  // Denser initial samples near the epipole (EpipolarSamplingOptions::epipoleDensity).
+  const double margin = 0.1 * std::hypot(double(W), double(H));
+  if (options.epipoleDensity > 1 && e.x >= -margin && e.x <= W + margin && e.y >= -margin &&
+      e.y <= H + margin) {
+    const int S = options.initialStep;
+    out.denseEnd = std::max(S, options.samples / 4 / S * S);
+    out.denseStep = std::max(S / options.epipoleDensity, 1);
+  }
+
   // The exit arc: the cyclic run of exit sides (left, bottom, right, top).
   if (out.epipoleOnScreen) {
     out.arcBegin = 0.0;
@@ -189,7 +203,12 @@ EpipolarLines epipolarLines(const Camera& camera, const DirectionalLight& light,
     const double sigma = positiveMod(out.arcBegin + (i + 0.5) / N * out.arcLength, P);
     const glm::dvec2 X = out.borderPoint(sigma);
     glm::dvec2 entry = e;
-    if (!out.epipoleOnScreen) {
+    if (out.epipoleOnScreen && glm::length(X - e) > kEpipoleOffset) {
+      // Not exactly at the epipole: that ray lies on the light axis, where no layout maps it (every
+      // line's sample 0 would be an unshadowed ray into or away from the light, interpolated over the
+      // first initialStep samples of every line). Half a pixel out, sample 0 is an ordinary ray.
+      entry = e + kEpipoleOffset * glm::normalize(X - e);
+    } else if (!out.epipoleOnScreen) {
       const glm::dvec2 d = X - e;
       double tEntry = 0.0;
       for (int c = 0; c < 2; ++c) {
@@ -272,13 +291,14 @@ std::vector<glm::ivec2> refineSamples(const EpipolarSamples& samples, const Epip
           (options.scatteringCriterion && std::abs(ua - ub) > options.scatteringThreshold * std::max(ua, ub));
     }
     for (int k = 0; k <= last; ++k) {
-      const int a = k / S * S, b = std::min(a + S, last);
+      const int step = lines.initialStepAt(k, S);
+      const int a = k / step * step, b = std::min(a + step, last);
       int left = k, right = k;
       while (left > a && !breaks[static_cast<std::size_t>(left - 1)])
         --left;
       while (right < b && !breaks[static_cast<std::size_t>(right)])
         ++right;
-      const bool marched = k % S == 0 || k == last || left == k || right == k;
+      const bool marched = k % step == 0 || k == last || left == k || right == k;
       sources[static_cast<std::size_t>(k) + static_cast<std::size_t>(i) * static_cast<std::size_t>(Ns)] =
           marched ? glm::ivec2(k) : glm::ivec2(left, right);
     }

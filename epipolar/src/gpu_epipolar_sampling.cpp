@@ -165,7 +165,7 @@ void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
   for (std::size_t i = 0; i < table.size(); ++i) {
     const EpipolarLines::Line& l = lines_.lines[i];
     table[i].ends = glm::vec4(glm::vec2(l.entry), glm::vec2(l.exit));
-    table[i].info = glm::ivec4(l.lastValid, 0, 0, 0);
+    table[i].info = glm::ivec4(l.lastValid, lines_.denseEnd, lines_.denseStep, 0);
   }
   glNamedBufferSubData(lineBuffer_.get(), 0, static_cast<GLsizeiptr>(table.size() * sizeof(table[0])),
                        table.data());

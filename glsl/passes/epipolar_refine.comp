@@ -5,7 +5,7 @@
 // k + 1 (depth and / or unshadowed in-scattering discontinuity), the flags are packed 32 per uint in
 // shared memory, and each sample finds its interpolation sources by scanning the packed words inside its
 // section [a, b] (findMSB to the left, findLSB to the right: at most S / 32 + 1 words, not S samples).
-// A sample that is initial (k % S == 0, k == lastValid) or next to a break is marched: sources (k, k),
+// A sample that is initial (k % S == 0 with S the line's step at k, k == lastValid) or next to a break is marched: sources (k, k),
 // appended to the sample list (crep/sample_list.glsl); the others get (left, right), both marched.
 // Invalid samples (k > lastValid): (-1, -1).
 //
@@ -33,7 +33,7 @@ struct CrepEpipolarSamplingParams {
 };
 struct CrepEpipolarLine {
   vec4 ends;  // xy entry, zw exit
-  ivec4 info; // x lastValid
+  ivec4 info; // x lastValid, y samples with the denser initial step, z that step
 };
 
 layout(std140, binding = 1) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
@@ -90,7 +90,8 @@ void main() {
     imageStore(sourcesOut, ivec2(k, i), ivec4(-1, -1, 0, 0));
     return;
   }
-  int S = crep_sampling.counts.z;
+  // The initial step: S, or the denser step on the samples nearest the epipole (info.y samples, step info.z).
+  int S = k < crep_lines[i].info.y ? crep_lines[i].info.z : crep_sampling.counts.z;
   int a = (k / S) * S, b = min(a + S, lastValid);
   int left = k, right = k;
   if (k > a) {

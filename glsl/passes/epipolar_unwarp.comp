@@ -32,7 +32,7 @@ struct CrepEpipolarSamplingParams {
 };
 struct CrepEpipolarLine {
   vec4 ends;  // xy entry, zw exit
-  ivec4 info; // x lastValid
+  ivec4 info; // x lastValid, y denseEnd, z denseStep (read by the refinement)
 };
 
 layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };

@@ -200,7 +200,12 @@ TEST_CASE("EpipolarSampling lines: valid samples fill the visible segment, exits
         const double expected = L >= Ns ? L / (Ns - 1) : double(Ns) / (Ns - 1);
         (L >= Ns ? longLines : shortLines)++;
         worstSpacing = std::max(worstSpacing, std::abs(spacing - expected));
-        if (lines.epipoleOnScreen) CHECK(line.entry == e);
+        // On screen: half a pixel from the epipole toward the exit (the ray at e itself is the light axis).
+        if (lines.epipoleOnScreen) {
+          CHECK(glm::length(line.entry - e) == doctest::Approx(0.5).epsilon(1e-12));
+          CHECK(glm::dot(glm::normalize(line.entry - e), glm::normalize(X - e)) ==
+                doctest::Approx(1.0).epsilon(1e-12));
+        }
       }
       CHECK(worstInside <= 1e-3);
       CHECK(worstNext > -1e-9);
@@ -468,6 +473,53 @@ TEST_CASE(
     for (int k = 0; k < Ns; ++k)
       CHECK(src[at(k, 2, Ns)] == glm::ivec2(-1));
   }
+}
+
+TEST_CASE("EpipolarSampling refinement: a denser initial step on the first quarter of each line near the "
+          "epipole") {
+  const int W = 160, H = 90, Ns = 128;
+  const Camera camera = groundCamera(W, H);
+  EpipolarSamplingOptions o;
+  o.slices = 32;
+  o.samples = Ns;
+  o.initialStep = 16;
+  o.depthCriterion = o.scatteringCriterion = false; // no breaks: only the initial samples are marched
+  struct Case {
+    glm::dvec2 ndc;
+    int density, denseEnd, denseStep;
+  };
+  // On screen, and within 10% of the diagonal outside it (0.2 NDC = 16 px of 160, the margin 18.4 px):
+  // the first 32 samples (a quarter of 128) at step 16 / D; far off screen, or D = 1: none.
+  for (const Case& c : {Case{{0.3, 0.2}, 8, 32, 2}, Case{{1.2, 0.0}, 4, 32, 4}, Case{{0.0, 0.0}, 64, 32, 1},
+                        Case{{3.0, 0.0}, 8, 0, 1}, Case{{0.3, 0.2}, 1, 0, 1}}) {
+    CAPTURE(c.ndc.x);
+    CAPTURE(c.density);
+    o.epipoleDensity = c.density;
+    const EpipolarLines lines = epipolarLines(camera, lightAt(camera, c.ndc, true), W, H, o);
+    CHECK(lines.denseEnd == c.denseEnd);
+    CHECK(lines.denseStep == c.denseStep);
+    const EpipolarSamples samples = handSamples(lines, 10.0, 1.0);
+    const std::vector<glm::ivec2> src = refineSamples(samples, lines, o);
+    int marched = 0, expected = 0;
+    for (int i = 0; i < o.slices; ++i) {
+      const int last = lines.lines[static_cast<std::size_t>(i)].lastValid;
+      for (int k = 0; k <= last; ++k) {
+        const int step = k < c.denseEnd ? c.denseStep : o.initialStep;
+        const bool initial = k % step == 0 || k == last;
+        expected += initial;
+        const glm::ivec2 s = src[at(k, i, Ns)];
+        marched += s == glm::ivec2(k);
+        if (!initial) { // interpolated between the ends of its own section
+          const int a = k / step * step;
+          CHECK(s == glm::ivec2(a, std::min(a + step, last)));
+        }
+      }
+    }
+    CHECK(marched == expected);
+  }
+  o.epipoleDensity = 3;
+  CHECK_THROWS_WITH_AS(validate(o), doctest::Contains("EpipolarSamplingOptions.epipoleDensity"),
+                       InvalidArgument);
 }
 
 TEST_CASE("EpipolarSampling interpolation: a field linear along each line is reproduced exactly") {

@@ -59,7 +59,8 @@ static_assert(sizeof(EpipolarSamplingParams) == 16 * 5, "std140 CrepEpipolarSamp
 /// std430 element of CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; } (storage binding 0): one line.
 struct EpipolarSamplingLine {
   glm::vec4 ends{0.0f};         ///< xy: entry, zw: exit (pixels)
-  glm::ivec4 info{-1, 0, 0, 0}; ///< x: lastValid (-1: no valid sample); yzw: 0
+  glm::ivec4 info{-1, 0, 1, 0}; ///< x: lastValid (-1: no valid sample); y: samples with the denser initial
+                                ///< step (EpipolarLines::denseEnd), z: that step; w: 0
 };
 static_assert(sizeof(EpipolarSamplingLine) == 32, "std430 CrepEpipolarLine");
 

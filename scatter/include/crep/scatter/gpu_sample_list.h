@@ -6,8 +6,8 @@
 // texels that are not selected). GLSL twin: glsl/crep/sample_list.glsl.
 //
 // Buffer layout (GL_SHADER_STORAGE_BUFFER, std430):
-//   uint groupsX, groupsY, groupsZ   glDispatchComputeIndirect arguments at offset 0 (groups of
-//                                    kSampleListGroupSize threads; groupsY = groupsZ = 1)
+//   uint x, y, z groups              glDispatchComputeIndirect arguments at offset 0 (groups of
+//                                    kSampleListGroupSize threads; y = z = 1)
 //   uint count                       entries appended
 //   uint entries[capacity]           texel x | y << 16 of `coordinates` and `output`
 // Texels: `coordinates` (GL_RGBA32F, width x height) holds per texel (x, y: the camera-image pixel
@@ -42,7 +42,8 @@ gl::Handle createSampleListBuffer(int capacity);
 /// Resets the header to (0, 1, 1, 0): an empty list, before the producer's pass.
 void clearSampleList(std::uint32_t buffer);
 /// Binds `buffer` as GL_DISPATCH_INDIRECT_BUFFER, issues glDispatchComputeIndirect(0) for the bound
-/// program and unbinds it. The producer must have issued GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT.
+/// program and unbinds it. The producer must have issued GL_COMMAND_BARRIER_BIT |
+/// GL_SHADER_STORAGE_BARRIER_BIT.
 void dispatchSampleList(std::uint32_t buffer);
 /// Reads `count` back (a GPU sync: for tests and statistics).
 int sampleListCount(std::uint32_t buffer);
