@@ -5,6 +5,8 @@
 #include <crep/core/gl.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/gpu_epipolar_sampling.h>
+#include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/resample.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/reduced_resolution.h>
@@ -91,6 +93,23 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (!(info.epipoleBlockRadius >= 0.0 && info.epipoleBlockRadius <= 0.5))
     invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
             "must be in [0, 0.5] (a fraction of the screen diagonal)");
+  if (info.method != Scattering::Method::Prefiltered && info.method != Scattering::Method::MinMaxMarch)
+    invalid("Scattering::CreateInfo.method", std::to_string(static_cast<int>(info.method)),
+            "must be Method::Prefiltered or Method::MinMaxMarch");
+  if (info.sampling != Scattering::Sampling::PerPixel && info.sampling != Scattering::Sampling::Epipolar)
+    invalid("Scattering::CreateInfo.sampling", std::to_string(static_cast<int>(info.sampling)),
+            "must be Sampling::PerPixel or Sampling::Epipolar");
+  if (info.sampling == Scattering::Sampling::Epipolar) {
+    validate(info.epipolarSampling, "Scattering::CreateInfo.epipolarSampling");
+    if (factor != 1)
+      invalid("Scattering::CreateInfo.evaluationScale", detail::formatValue(info.evaluationScale),
+              "must be 1 with Sampling::Epipolar (epipolarSampling.downscale reduces its resolution)");
+    const int F = info.epipolarSampling.downscale;
+    if (info.width % F != 0 || info.height % F != 0)
+      invalid("Scattering::CreateInfo.width/height",
+              std::to_string(info.width) + " x " + std::to_string(info.height),
+              "must be multiples of epipolarSampling.downscale = " + std::to_string(F));
+  }
   return info;
 }
 
@@ -252,6 +271,13 @@ struct Scattering::Impl {
         evaluate({i.prefilter.bases, i.evaluate}), resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}),
         rectified({i.mapSize, i.mapSize}) {
     resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
+    if (i.method == Method::MinMaxMarch) {
+      trees.emplace(MinMaxTreePass::CreateInfo{i.mapSize, i.mapSize});
+      march.emplace(
+          RectifiedMarchPass::CreateInfo{i.mapSize, i.mapSize, RectifiedMarchPass::Mode::MinMaxTree});
+    }
+    if (i.sampling == Sampling::Epipolar)
+      sampling.emplace(EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling});
     const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
     if (factor > 1) {
       reduced.emplace(DepthAwareResamplePass::CreateInfo{i.width, i.height, factor});
@@ -271,6 +297,9 @@ struct Scattering::Impl {
   std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
   gl::Handle lowDepth, lowOutput;                ///< its camera depth (R32F) and scattering (RGBA32F)
+  std::optional<MinMaxTreePass> trees;           ///< Method::MinMaxMarch: the map's trees ...
+  std::optional<RectifiedMarchPass> march;       ///< ... and the tree march
+  std::optional<EpipolarSamplingPass> sampling;  ///< Sampling::Epipolar
   gl::GpuTimer timer;
   /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
   /// made on the first frame with local lights; their fallback's perspective shadow map.
@@ -372,6 +401,8 @@ std::size_t Scattering::memoryBytes() const noexcept {
   if (m.reduced)
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
+  if (m.trees) bytes += m.trees->memoryBytes();
+  if (m.sampling) bytes += m.sampling->memoryBytes();
   if (m.localRectified) bytes += m.localRectified->memoryBytes();
   if (m.localPrefilter) bytes += m.localPrefilter->memoryBytes();
   if (m.localEvaluate) bytes += m.localEvaluate->memoryBytes();
@@ -408,6 +439,9 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
       invalid("Scattering::FrameAttribs.output", "0",
               "must be set with local lights (they are added to the per-pixel output only)");
     validateFroxelTarget(*f.froxels, *f.camera);
+    if (info.method != Method::Prefiltered)
+      invalid("Scattering::FrameAttribs.froxels", "set with CreateInfo.method = Method::MinMaxMarch",
+              "needs Method::Prefiltered (the fill evaluates the prefiltered basis)");
   }
   if (f.light && !f.drawCasters && !f.shadowMap)
     invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
@@ -495,25 +529,82 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   std::uint32_t colors = 0;
   if (f.lightTexture)
     stage("light colours", [&] { colors = m.lightColors(*layout, *f.lightTexture, f.light, nullptr); });
-  stage("prefilter", [&] {
-    m.prefilter.run(
-        {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .lightColors = colors});
-  });
-  const bool pixels = f.output != 0;
-  if (m.reduced && pixels)
-    stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
-  if (pixels)
-    stage("evaluate", [&] {
+  const bool marching = info.method == Method::MinMaxMarch;
+  if (marching)
+    stage("min/max trees", [&] { m.trees->run(map); });
+  else
+    stage("prefilter", [&] {
+      m.prefilter.run(
+          {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .lightColors = colors});
+    });
+  // The method on a camera depth image into `output`, or on a GPU work list (epipolar sampling's samples
+  // and corrections: EvaluatePass / RectifiedMarchPass FrameAttribs::list).
+  const auto evaluateRays = [&](std::uint32_t depth, std::uint32_t output, const gpu::SampleList* list,
+                                bool reuseTable) {
+    if (marching) {
+      RectifiedMarchPass::FrameAttribs a;
+      a.layout = layout.get();
+      a.camera = f.camera;
+      a.light = f.light;
+      a.medium = f.medium;
+      a.cameraDepth = depth;
+      a.rectifiedDepth = map;
+      a.minMaxBuffer = m.trees->treeBuffer();
+      a.output = output;
+      a.lightColors = colors;
+      a.list = list;
+      if (list) {
+        a.imageWidth = info.width;
+        a.imageHeight = info.height;
+      }
+      m.march->run(a);
+    } else {
       EvaluatePass::FrameAttribs e;
-      e.cameraDepth = m.reduced ? m.lowDepth.get() : f.cameraDepth;
-      e.output = m.reduced ? m.lowOutput.get() : f.output;
+      e.cameraDepth = depth;
+      e.output = output;
       e.camera = f.camera;
       e.light = f.light;
       e.medium = f.medium;
       e.layout = layout.get();
       e.basis = m.prefilter.filteredBasis();
+      e.list = list;
+      if (list) {
+        e.imageWidth = info.width;
+        e.imageHeight = info.height;
+      }
+      e.reuseTable = reuseTable;
       m.evaluate.run(e);
+    }
+  };
+  const bool pixels = f.output != 0;
+  if (m.reduced && pixels)
+    stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
+  if (pixels && !m.sampling)
+    stage(marching ? "march" : "evaluate", [&] {
+      evaluateRays(m.reduced ? m.lowDepth.get() : f.cameraDepth, m.reduced ? m.lowOutput.get() : f.output,
+                   nullptr, false);
     });
+  if (pixels && m.sampling) {
+    // Yusov 2012, Sec. 6: samples along epipolar lines, refined at breaks; the method evaluates the
+    // selected ones and the pixels the unwarp cannot serve (the lists, no read-back).
+    const EpipolarSamplingPass::FrameAttribs s{f.camera, f.light, f.medium, f.cameraDepth, f.output};
+    EpipolarSamplingPass& pass = *m.sampling;
+    stage("epipolar samples", [&] { pass.placeSamples(s); });
+    stage("refine samples", [&] { pass.refine(); });
+    stage(marching ? "march samples" : "evaluate samples",
+          [&] { evaluateRays(0, 0, &pass.sampleList(), false); });
+    stage("interpolate", [&] { pass.interpolate(); });
+    stage("unwarp", [&] { pass.unwarp(s); });
+    stage("correct", [&] { evaluateRays(0, 0, &pass.correctionList(), true); });
+    if (info.epipolarSampling.downscale > 1) {
+      stage("upscale", [&] { pass.upscale(s); });
+      stage("correct (full)", [&] { evaluateRays(0, 0, &pass.upscaleCorrectionList(), true); });
+    }
+    if (info.stageTimings) {
+      const EpipolarSamplingPass::Statistics st = pass.statistics();
+      r.sampling = {st.validSamples, st.marchedSamples, st.correctedPixels, st.correctedFullPixels};
+    }
+  }
   if (m.reduced && pixels)
     stage("upsample", [&] {
       m.reduced->upsample(m.lowOutput.get(), m.lowDepth.get(), f.cameraDepth, f.output, *f.camera);
@@ -532,7 +623,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
       e.reuseTable = pixels;
       m.evaluate.run(e);
     });
-  if (r.layout == Layout::Epipolar && pixels) {
+  if (r.layout == Layout::Epipolar && pixels && !marching) {
     const auto& epipolar = static_cast<const EpipolarLayout&>(*layout);
     const auto centre = epipolar.epipolePixel();
     const double radius = epipolar.epipoleBlockRadiusPixels();

@@ -66,6 +66,18 @@
 // inside the block, 2.8% / 2.7% outside, forest / colonnade, tests/pipeline/ScatteringFroxelGLTest.cpp).
 // The stage "froxels" times the fill (it reuses the per-frame table the per-pixel evaluation built).
 //
+// Epipolar sampling (Yusov 2012, Sec. 5-6; crep/epipolar/epipolar_sampling.h has the rules): with
+// CreateInfo::sampling = Sampling::Epipolar the method evaluates only samples along epipolar lines (lines
+// from the epipole to the screen border, CreateInfo::epipolarSampling.slices x samples): every
+// initialStep-th sample and the samples next to depth or in-scattering breaks; the others are interpolated
+// along their line, each pixel takes its two nearest lines' samples with depth-aware (bilateral) weights,
+// and the pixels without a valid sample near them are evaluated directly (the correction). With
+// Method::Prefiltered the samples and corrections are the prefiltered evaluation (a hybrid: the
+// prefiltered method's constant cost per ray on Yusov's reduced set of rays); with Method::MinMaxMarch
+// this is Yusov's method itself. The stages are named "epipolar samples", "refine samples", "evaluate
+// samples" / "march samples", "interpolate", "unwarp", "correct" and, with downscale > 1, "upscale" and
+// "correct (full)"; FrameResult::sampling counts the samples.
+//
 // GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
 // clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
 #pragma once
@@ -82,6 +94,7 @@
 #include <crep/core/camera.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/epipolar/epipolar_sampling.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
@@ -93,6 +106,16 @@ namespace crep {
 
 class Scattering {
 public:
+  /// How the directional light's in-scattering is computed from the frame's rectified map.
+  enum class Method {
+    Prefiltered, ///< Klehm et al. 2014: prefilter the map, evaluate each ray in constant time (default)
+    MinMaxMarch, ///< the peer (Chen et al. 2011, Yusov 2012 Algorithm 2): 1D min/max trees, march each ray
+  };
+  /// Which rays the method evaluates (see "Epipolar sampling" at the top).
+  enum class Sampling {
+    PerPixel, ///< every pixel's view ray (default)
+    Epipolar, ///< Yusov 2012: selected samples along epipolar lines, interpolated, unwarped, corrected
+  };
   struct CreateInfo {
     int width = 1280, height = 720; ///< camera image and output, pixels
     /// Rectified map: mapSize x mapSize texels on both layouts (the fallback uses mapSize epipolar slices),
@@ -158,6 +181,15 @@ public:
     /// resolution. width and height must then be multiples of 1 / evaluationScale. Cost and added error:
     /// README "Reduced resolution".
     double evaluationScale = 1.0;
+    /// The directional light's method and sampling (see "Epipolar sampling" at the top). MinMaxMarch skips
+    /// the prefilter and builds the map's min/max trees instead; it has no froxel fill and no epipole
+    /// block (the tree march over the epipolar map is exact there). Local lights are prefiltered either way.
+    Method method = Method::Prefiltered;
+    Sampling sampling = Sampling::PerPixel;
+    /// Slices, samples per slice, initial step, refinement criteria and thresholds, bilateral threshold and
+    /// downscale of Sampling::Epipolar (crep/epipolar/epipolar_sampling.h). evaluationScale must then be 1
+    /// (the sampling's downscale is its reduced resolution).
+    EpipolarSamplingOptions epipolarSampling;
     /// Measure every stage (FrameResult::stages): a GL_TIME_ELAPSED query and a glFinish per stage, which
     /// stalls the pipeline; turn off in production (stages then lists names with zero times).
     bool stageTimings = true;
@@ -269,6 +301,14 @@ public:
     /// running the peers of the prefiltered method (RectifiedMarchPass, MinMaxTreePass) on the same data.
     /// The local lights, in order (spots, then the faces of each point light).
     std::vector<LightResult> localLights;
+    /// Sampling::Epipolar with stageTimings: the frame's sample and correction counts (read back from the
+    /// GPU lists; zeros otherwise).
+    struct SamplingStatistics {
+      int validSamples = 0;        ///< epipolar samples on screen
+      int marchedSamples = 0;      ///< evaluated by the method (the rest interpolated)
+      int correctedPixels = 0;     ///< evaluated directly after the unwarp (no valid sample near them)
+      int correctedFullPixels = 0; ///< the same after the upscale (downscale > 1)
+    } sampling;
     struct RectifiedMapView {
       std::shared_ptr<const RectifiedLayout> layout;
       std::uint32_t texture = 0;
