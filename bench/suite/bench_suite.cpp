@@ -266,11 +266,13 @@ struct MethodRow {
 /// The methods named in `only` (every method of the registry when empty) on one built-in scene's frame:
 /// median per-frame milliseconds (sum of the median per-frame stages of `repeat` runs after a warm-up).
 /// `mapMs` receives the rectified shadow pass of the warm-up (shared by the methods).
+/// `base`: the settings to start from (map size and M are this run's), e.g. epipolar sampling's options.
 std::vector<MethodRow> runMethods(const BenchOptions& o, const std::string& scene,
-                                  const std::vector<std::string>& only, int repeat, double& mapMs) {
+                                  const std::vector<std::string>& only, int repeat, double& mapMs,
+                                  const tool::MethodSettings& base = {}) {
   tool::StageTimings setupTimings;
   tool::SceneFrame s = tool::makeSceneFrame(scene, o.screenWidth, o.screenHeight, o.mapWidth, setupTimings);
-  tool::MethodSettings settings;
+  tool::MethodSettings settings = base;
   settings.mapSize = o.mapWidth;
   settings.prefilter.bases = o.bases;
   std::vector<MethodRow> rows;
@@ -415,6 +417,63 @@ void postEffects(const BenchOptions& o) {
       mib(temporal.memoryBytes()), mib(single.memoryBytes()), mib(single32.memoryBytes()));
 }
 
+/// Epipolar sampling (issue "epipolar sampling"; Yusov 2012, Sec. 9's stage table): Yusov's method
+/// (epipolar-sampling: min/max march at the selected samples) and the hybrid (epipolar-prefilter) beside
+/// the per-pixel min/max march, the prefiltered method and the brute-force march on the same frame in one
+/// run, with each method's stages; at the run's size, plus 2560x1600 when that is the default 1920x1080
+/// (without --quick); then how
+/// the sampling's cost scales with the number of slices and of samples per slice (the run's size).
+void epipolarSamplingBench(const BenchOptions& o) {
+  if (!squareMapOk(o, "epipolar sampling", Scattering::CreateInfo{}.mapSizeMultiple())) return;
+  const std::vector<std::string> methods = {"epipolar-sampling", "epipolar-prefilter", "minmax", "prefilter",
+                                            "brute"};
+  // The seed's size (2560x1600) joins the default 1920x1080 run; a smaller --size runs at that size only.
+  std::vector<std::pair<int, int>> sizes = {{o.screenWidth, o.screenHeight}};
+  if (!o.quick && o.screenWidth == 1920 && o.screenHeight == 1080) sizes.push_back({2560, 1600});
+  const int repeat = o.quick ? 1 : std::max(1, std::min(o.repeat, 2));
+  std::vector<std::string> scenes = {o.scene};
+  if (o.scene != "sunset") scenes.push_back("sunset");
+  for (const auto& [w, h] : sizes)
+    for (const std::string& scene : scenes) {
+      BenchOptions sized = o;
+      sized.screenWidth = w;
+      sized.screenHeight = h;
+      double mapMs = 0.0;
+      const std::vector<MethodRow> rows = runMethods(sized, scene, methods, repeat, mapMs);
+      const EpipolarSamplingOptions d;
+      std::printf("\nepipolar sampling (scene %s, %dx%d, map %d^2, %d slices x %d samples, initial step %d; "
+                  "per-frame ms as above):\n",
+                  scene.c_str(), w, h, o.mapWidth, d.slices, d.samples, d.initialStep);
+      printRows(rows);
+      const double yusov = msOf(rows, "epipolar-sampling"), minmax = msOf(rows, "minmax"),
+                   brute = msOf(rows, "brute"), hybrid = msOf(rows, "epipolar-prefilter"),
+                   prefilter = msOf(rows, "prefilter");
+      if (yusov > 0.0 && hybrid > 0.0)
+        std::printf("ratios: minmax / epipolar-sampling %.2f, brute / epipolar-sampling %.2f, "
+                    "prefilter / epipolar-prefilter %.2f, epipolar-prefilter / epipolar-sampling %.2f\n",
+                    minmax / yusov, brute / yusov, prefilter / hybrid, hybrid / yusov);
+    }
+  // Scaling with slices and samples (the run's size and scene).
+  std::printf(
+      "\nepipolar sampling scaling (scene %s, %dx%d, map %d^2; per-frame ms, one run after a warm-up):\n",
+      o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth);
+  std::printf("%-8s %-8s %16s %18s   %s\n", "slices", "samples", "epipolar-sampling", "epipolar-prefilter",
+              "epipolar-sampling stages (ms)");
+  std::vector<std::pair<int, int>> grid = {{256, 256},  {512, 256},  {1024, 256}, {2048, 256},
+                                           {1024, 128}, {1024, 512}, {1024, 1024}};
+  if (o.quick) grid = {{256, 256}, {1024, 256}, {1024, 512}};
+  for (const auto& [slices, samples] : grid) {
+    tool::MethodSettings base;
+    base.sampling.slices = slices;
+    base.sampling.samples = samples;
+    double mapMs = 0.0;
+    const std::vector<MethodRow> rows =
+        runMethods(o, o.scene, {"epipolar-sampling", "epipolar-prefilter"}, 1, mapMs, base);
+    std::printf("%-8d %-8d %16.2f %18.2f   %s\n", slices, samples, msOf(rows, "epipolar-sampling"),
+                msOf(rows, "epipolar-prefilter"), rows.empty() ? "" : rows.front().stages.c_str());
+  }
+}
+
 /// A built-in scene's frame as crep::Scattering input: the tool's frame (camera depth, standard shadow map)
 /// and an output texture.
 struct ScatteringFrame {
@@ -533,7 +592,7 @@ void reducedResolution(const BenchOptions& o) {
 } // namespace
 
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
-  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot"}, {"quick"});
+  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot", "section"}, {"quick"});
   BenchOptions o;
   o.scene = args.string("scene", o.scene);
   o.quick = args.has("quick");
@@ -568,6 +627,11 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
   o.repeat = args.integer("repeat", o.repeat, 1, 1000);
   o.plot = args.string("plot", "");
+  o.section = args.string("section", "");
+  if (!o.section.empty() && o.section != "epipolar-sampling")
+    throw tool::UsageError("option --section: '" + o.section + "' is not epipolar-sampling");
+  if (!o.section.empty() && !o.plot.empty())
+    throw tool::UsageError("option --plot: needs the whole suite, not --section");
   if (!o.plot.empty() && o.quick)
     throw tool::UsageError("option --plot: needs the Table 1/2 rows, which --quick omits");
   if (!o.plot.empty() && !o.plot.ends_with(".svg")) throw tool::UsageError("option --plot: must end in .svg");
@@ -796,6 +860,13 @@ void lightTextures(const BenchOptions& o) {
   if (frameMs[1] > 0.0) std::printf("textured / untextured: %.2f\n", frameMs[0] / frameMs[1]);
 }
 
+void printHowMeasured(const BenchOptions& o) {
+  std::printf(
+      "\nhow measured: wall-clock median of %d runs, each ending with glFinish (GPU) or on return (CPU);\n"
+      "llvmpipe runs the GPU passes on the CPU cores, so CPU/GPU compares two CPU implementations here.\n",
+      o.repeat);
+}
+
 void runBenchSuite(const BenchOptions& o) {
   scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
   tool::StageTimings contextTimings;
@@ -803,6 +874,11 @@ void runBenchSuite(const BenchOptions& o) {
   const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases, repeat = o.repeat;
   std::printf("crep bench: scene %s | screen %dx%d | map %dx%d | M = %d | median of %d runs\n",
               o.scene.c_str(), o.screenWidth, o.screenHeight, mapW, mapH, bases, repeat);
+  if (o.section == "epipolar-sampling") { // one section alone (its own frames, its own sizes)
+    epipolarSamplingBench(o);
+    printHowMeasured(o);
+    return;
+  }
   const Setup s = makeSetup(o.scene, o.screenWidth, o.screenHeight, mapW, mapH);
 
   // Memory copy baselines over the bytes the prefilter writes (W x H x ceil(M / 4) RGBA8 texels).
@@ -889,6 +965,7 @@ void runBenchSuite(const BenchOptions& o) {
   methodsSideBySide(o);
   sunInView(o);
   postEffects(o);
+  epipolarSamplingBench(o);
 
   if (!o.quick) {
     // Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8).
@@ -981,10 +1058,7 @@ void runBenchSuite(const BenchOptions& o) {
       std::printf("\nwrote %s (the Table 1/2 rows above beside the paper's)\n", o.plot.c_str());
     }
   }
-  std::printf(
-      "\nhow measured: wall-clock median of %d runs, each ending with glFinish (GPU) or on return (CPU);\n"
-      "llvmpipe runs the GPU passes on the CPU cores, so CPU/GPU compares two CPU implementations here.\n",
-      repeat);
+  printHowMeasured(o);
 }
 
 } // namespace crep::bench

@@ -143,6 +143,50 @@ TEST_CASE("crep compare: images 1 pixel wide (--size 1x1, 1x2, 1x90) make a shee
   }
 }
 
+TEST_CASE(
+    "crep compare: epipolar-sampling and epipolar-prefilter on the sun-in-view scene, with their stages") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir("crep-compare-epipolar");
+  const std::string prefix = (dir / "sunset").string();
+  const auto r = crep::test::runCrep("compare --scene sunset --size 160x90 --map-size 256 --steps 256 "
+                                     "--methods epipolar-sampling,epipolar-prefilter,minmax --out '" +
+                                     prefix + "'");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::map<std::string, std::map<std::string, std::string>> byMethod;
+  for (const auto& row : readCsv(prefix + ".csv"))
+    byMethod[row.at("method")] = row;
+  for (const char* method : {"epipolar-sampling", "epipolar-prefilter"}) {
+    CAPTURE(method);
+    REQUIRE(byMethod.count(method) == 1);
+    const auto& row = byMethod[method];
+    const double rel = std::strtod(row.at("relative_rmse").c_str(), nullptr);
+    MESSAGE(method << " on sunset 160x90, map 256^2: relative RMSE " << rel * 100.0 << "%");
+    CHECK(rel > 0.0);
+    CHECK(rel < 0.03);
+    for (const char* stage :
+         {"ms epipolar samples", "ms refine samples", "ms interpolate", "ms unwarp", "ms correct"})
+      CHECK(!row.at(stage).empty());
+  }
+  CHECK(!byMethod["epipolar-sampling"]["ms march samples"].empty());
+  CHECK(!byMethod["epipolar-prefilter"]["ms evaluate samples"].empty());
+  // render reports the sample counts.
+  const auto one =
+      crep::test::runCrep("render --scene sunset --size 96x54 --map-size 256 --method epipolar-sampling "
+                          "--slices 256 --samples 64 --initial-step 8 --out '" +
+                          (dir / "one").string() + "'");
+  INFO(one.output);
+  CHECK(one.status == 0);
+  CHECK(one.output.find("epipolar sampling 256 x 64, step 8") != std::string::npos);
+  CHECK(one.output.find("samples on screen") != std::string::npos);
+  // A bad sampling option is a usage error naming it.
+  const auto bad = crep::test::runCrep("render --scene boxes --size 64x36 --method epipolar-sampling "
+                                       "--samples 48 --out '" +
+                                       (dir / "bad").string() + "'");
+  CHECK(bad.status != 0);
+  CHECK(bad.output.find("samples") != std::string::npos);
+}
+
 #if CREP_TOOL_HAS_BENCH // bench/ built: it adds `crep bench`
 TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
   CREP_REQUIRE_GL();
@@ -154,7 +198,8 @@ TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
     CHECK(r.output.find(text) != std::string::npos);
   CHECK(r.output.find("Table 1") == std::string::npos); // --quick: no tables
   for (const char* text : {"limits", "fetch-only", "write-only", "evaluation profile", "GPU memory",
-                           "reduced resolution", "sun in view", "constant cost"})
+                           "reduced resolution", "sun in view", "constant cost", "epipolar sampling",
+                           "epipolar sampling scaling", "minmax / epipolar-sampling"})
     CHECK(r.output.find(text) != std::string::npos);
 }
 

@@ -35,6 +35,8 @@ struct MethodSettings {
   RectifyOptions rectify = Scattering::CreateInfo{}.rectify; ///< splits (logarithmic; Scattering's defaults)
   int steps = 256;    ///< world-space reference march: sections per pixel
   double scale = 1.0; ///< prefiltered method: Scattering::CreateInfo::evaluationScale (1, 0.5 or 0.25)
+  /// epipolar-sampling, epipolar-prefilter: Scattering::CreateInfo::epipolarSampling
+  EpipolarSamplingOptions sampling;
 };
 
 /// A rectified depth map on the GPU with its rectification (projective).

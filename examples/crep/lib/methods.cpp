@@ -403,10 +403,17 @@ MethodOutput runBrute(FrameInputs& frame, const MethodSettings& settings) {
 /// rasterized with the scene's casters (built-in scenes) or resampled from the standard shadow map (users'
 /// data) when the rectification is projective, else the epipolar fallback with the epipole block. The
 /// stages are Scattering's wall-clock stage times (like every other method's).
-MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
+/// With `sampling` Epipolar (Yusov 2012, Sec. 5-6): the method evaluates the epipolar samples and the
+/// corrections only (epipolar-prefilter), or, with `method` MinMaxMarch, marches them along the map's
+/// min/max trees (epipolar-sampling: Yusov's method); the stages are the sampling's.
+MethodOutput runFrontDoor(FrameInputs& frame, const MethodSettings& settings, Scattering::Method method,
+                          Scattering::Sampling sampling, const char* name) {
   MethodOutput out;
-  out.used = "prefilter";
+  out.used = name;
   Scattering::CreateInfo info;
+  info.method = method;
+  info.sampling = sampling;
+  info.epipolarSampling = settings.sampling;
   info.width = frame.width;
   info.height = frame.height;
   info.mapSize = settings.mapSize;
@@ -453,7 +460,9 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
     out.timings.append({{stage.name, stage.wallMilliseconds}}); // comparable with the other methods' stages
   const PrefilterOptions& options = settings.prefilter;
   const std::string basis =
-      "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
+      method == Scattering::Method::MinMaxMarch
+          ? std::string("min/max tree march")
+          : "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
   std::string local;
   if (!r.localLights.empty()) {
     int counts[3] = {0, 0, 0}; // prefiltered, marched, outside the view
@@ -472,8 +481,7 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
                  " splits, map " + std::to_string(settings.mapSize) + "^2 " +
                  (frame.renderer ? "rasterized" : "resampled from the standard map");
   } else {
-    std::fprintf(stderr,
-                 "crep: prefilter: rectification is %s (%s); using the epipolar resampling fallback\n",
+    std::fprintf(stderr, "crep: %s: rectification is %s (%s); using the epipolar resampling fallback\n", name,
                  statusToken(r.rectification.status), r.rectification.message.c_str());
     char blockText[32];
     std::snprintf(blockText, sizeof blockText, "%.1f", r.epipoleBlockRadius);
@@ -482,7 +490,36 @@ MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
                  std::to_string(settings.mapSize) + " slices x " + std::to_string(settings.mapSize);
   }
   out.detail += local;
+  if (sampling == Scattering::Sampling::Epipolar) {
+    const EpipolarSamplingOptions& o = settings.sampling;
+    const Scattering::FrameResult::SamplingStatistics& st = r.sampling;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "; epipolar sampling %d x %d, step %d, downscale %d: %d samples on screen, %d evaluated "
+                  "(%.1f%%), %d + %d pixels corrected (%.2f%%)",
+                  o.slices, o.samples, o.initialStep, o.downscale, st.validSamples, st.marchedSamples,
+                  st.validSamples > 0 ? 100.0 * st.marchedSamples / st.validSamples : 0.0, st.correctedPixels,
+                  st.correctedFullPixels,
+                  100.0 * (st.correctedPixels * o.downscale * o.downscale + st.correctedFullPixels) /
+                      (double(frame.width) * frame.height));
+    out.detail += text;
+  }
   return out;
+}
+
+MethodOutput runPrefilter(FrameInputs& frame, const MethodSettings& settings) {
+  return runFrontDoor(frame, settings, Scattering::Method::Prefiltered, Scattering::Sampling::PerPixel,
+                      "prefilter");
+}
+/// Yusov 2012: epipolar sampling with the min/max tree march at the selected samples.
+MethodOutput runEpipolarSampling(FrameInputs& frame, const MethodSettings& settings) {
+  return runFrontDoor(frame, settings, Scattering::Method::MinMaxMarch, Scattering::Sampling::Epipolar,
+                      "epipolar-sampling");
+}
+/// The hybrid: epipolar sampling with the prefiltered evaluation at the selected samples.
+MethodOutput runEpipolarPrefilter(FrameInputs& frame, const MethodSettings& settings) {
+  return runFrontDoor(frame, settings, Scattering::Method::Prefiltered, Scattering::Sampling::Epipolar,
+                      "epipolar-prefilter");
 }
 
 /// Mitchell 2007's screen-space radial blur (crep/postfx/gpu_radial_blur.h) with its default, physically
@@ -671,6 +708,12 @@ const std::vector<Method>& methodRegistry() {
       {"minmax", "1D min/max tree march over the rectified rows (Chen et al. 2011, Yusov 2012)", false,
        runMinMax},
       {"brute", "brute-force march over the rectified rows, texel by texel", false, runBrute},
+      {"epipolar-sampling",
+       "Yusov 2012: epipolar sampling, refinement at breaks, min/max march at the samples, bilateral unwarp",
+       false, runEpipolarSampling},
+      {"epipolar-prefilter",
+       "epipolar sampling with the prefiltered evaluation at the samples (a hybrid of the two)", false,
+       runEpipolarPrefilter},
       {"froxel-esm",
        "Wronski 2014: froxel volume lit through a blurred exponential shadow map, one 3D lookup "
        "per pixel",

@@ -4,8 +4,9 @@ namespace crep::tool {
 
 static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
 
-const std::set<std::string> kMethodOptions = {"method", "map-size", "bases", "format",
-                                              "splits", "steps",    "scale"};
+const std::set<std::string> kMethodOptions = {"method",  "map-size",     "bases",    "format",
+                                              "splits",  "steps",        "scale",    "slices",
+                                              "samples", "initial-step", "downscale"};
 
 const char* const kMethodOptionsHelp =
     R"(            --map-size N        shadow map and rectified map size (default 1024, at most 16384)
@@ -16,6 +17,11 @@ const char* const kMethodOptionsHelp =
             --steps N           reference march: sections per view ray, changes bisected (default 256)
             --scale S           prefiltered method: evaluate at 1 (default), 0.5 or 0.25 of the image
                                 size per axis, depth-aware upsampling (the size a multiple of 1 / S)
+            --slices N          epipolar-sampling, epipolar-prefilter: epipolar lines (default 1024)
+            --samples N         samples per line, a multiple of 32 in [32, 1024] (default 256)
+            --initial-step N    every N-th sample evaluated before refinement, a power of two (default 16)
+            --downscale F       unwarp at 1 / F of the image per axis, F = 1 (default), 2 or 4, then a
+                                depth-aware upscale (the size a multiple of F)
 )";
 
 StorageFormat parseFormat(const std::string& text) {
@@ -40,6 +46,15 @@ MethodSettings methodSettings(const Args& args) {
   s.scale = args.number("scale", 1.0, 0.25, 1.0);
   if (s.scale != 1.0 && s.scale != 0.5 && s.scale != 0.25)
     throw UsageError("option --scale: must be 1, 0.5 or 0.25");
+  s.sampling.slices = args.integer("slices", s.sampling.slices, 1, 16384);
+  s.sampling.samples = args.integer("samples", s.sampling.samples, 32, 1024);
+  s.sampling.initialStep = args.integer("initial-step", s.sampling.initialStep, 1, 1024);
+  s.sampling.downscale = args.integer("downscale", s.sampling.downscale, 1, 4);
+  try {
+    validate(s.sampling, "EpipolarSamplingOptions");
+  } catch (const InvalidArgument& e) {
+    throw UsageError(std::string("options --slices/--samples/--initial-step/--downscale: ") + e.what());
+  }
   // Scattering's rule (crep/pipeline/scattering.h): a multiple of the prefilter regions of both layouts.
   Scattering::CreateInfo info;
   info.rectify = s.rectify;
