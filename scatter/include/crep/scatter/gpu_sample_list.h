@@ -23,9 +23,9 @@
 
 namespace crep::gpu {
 
-/// Threads per work group of a list consumer (and the producer's unit of groupsX).
+/// Threads per work group of a list consumer (and the unit of the header's x group count).
 inline constexpr int kSampleListGroupSize = 64;
-/// Bytes of the header (groupsX, groupsY, groupsZ, count).
+/// Bytes of the header (the three group counts and the entry count).
 inline constexpr int kSampleListHeaderBytes = 16;
 
 /// A list of texels to evaluate (see top). Non-owning GL names.
