@@ -12,25 +12,11 @@
 // Resources: MarchParams (uniform 0), EpipolarSamplingParams (uniform 1), line table (storage 0), camera
 // depth (texture unit 0, texelFetch), outputs: coordinates RGBA32F (image 0), U R32F (image 1).
 #include "crep/radial_blur.glsl"
+#include "crep/epipolar_sampling.glsl"
 
 layout(local_size_x = 64, local_size_y = 1) in;
 
-// gpu::EpipolarSamplingParams (crep/epipolar/gpu_epipolar_sampling.h).
-struct CrepEpipolarSamplingParams {
-  vec4 epipole;    // xy epipole (pixels), z arcBegin, w arcLength
-  vec4 border;     // x W, y H, z perimeter, w 1 = epipole on screen
-  ivec4 counts;    // x slices N, y samples Ns, z initial step S, w downscale F
-  ivec4 target;    // xy target size, z depth criterion, w scattering criterion
-  vec4 thresholds; // x depth, y scattering, z bilateral
-};
-struct CrepEpipolarLine {
-  vec4 ends;  // xy entry, zw exit
-  ivec4 info; // x lastValid, y denseEnd, z denseStep (read by the refinement)
-};
-
 layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(std140, binding = 1) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
-layout(std430, binding = 0) readonly buffer CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; };
 layout(binding = 0) uniform sampler2D cameraDepth;
 layout(binding = 0, rgba32f) uniform writeonly image2D coordinatesOut;
 layout(binding = 1, r32f) uniform writeonly image2D unshadowedOut;

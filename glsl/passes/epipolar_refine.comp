@@ -15,6 +15,7 @@
 // Resources: EpipolarSamplingParams (uniform 1), line table (storage 0), sample list (storage 2),
 // coordinates RGBA32F (image 0, read), U R32F (image 1, read), sources RG32I (image 2, written).
 #include "crep/sample_list.glsl"
+#include "crep/epipolar_sampling.glsl"
 
 #ifndef CREP_SAMPLES
 #define CREP_SAMPLES 256
@@ -23,21 +24,6 @@
 
 layout(local_size_x = CREP_SAMPLES) in;
 
-// gpu::EpipolarSamplingParams (crep/epipolar/gpu_epipolar_sampling.h).
-struct CrepEpipolarSamplingParams {
-  vec4 epipole;    // xy epipole (pixels), z arcBegin, w arcLength
-  vec4 border;     // x W, y H, z perimeter, w 1 = epipole on screen
-  ivec4 counts;    // x slices N, y samples Ns, z initial step S, w downscale F
-  ivec4 target;    // xy target size, z depth criterion, w scattering criterion
-  vec4 thresholds; // x depth, y scattering, z bilateral
-};
-struct CrepEpipolarLine {
-  vec4 ends;  // xy entry, zw exit
-  ivec4 info; // x lastValid, y samples with the denser initial step, z that step
-};
-
-layout(std140, binding = 1) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
-layout(std430, binding = 0) readonly buffer CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; };
 layout(binding = 0, rgba32f) uniform readonly image2D coordinatesIn;
 layout(binding = 1, r32f) uniform readonly image2D unshadowedIn;
 layout(binding = 2, rg32i) uniform writeonly iimage2D sourcesOut;

@@ -19,25 +19,11 @@
 // (image 3, written).
 #include "crep/march.glsl"
 #include "crep/sample_list.glsl"
+#include "crep/epipolar_sampling.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-// gpu::EpipolarSamplingParams (crep/epipolar/gpu_epipolar_sampling.h).
-struct CrepEpipolarSamplingParams {
-  vec4 epipole;    // xy epipole (pixels), z arcBegin, w arcLength
-  vec4 border;     // x W, y H, z perimeter, w 1 = epipole on screen
-  ivec4 counts;    // x slices N, y samples Ns, z initial step S, w downscale F
-  ivec4 target;    // xy target size, z depth criterion, w scattering criterion
-  vec4 thresholds; // x depth, y scattering, z bilateral
-};
-struct CrepEpipolarLine {
-  vec4 ends;  // xy entry, zw exit
-  ivec4 info; // x lastValid, y denseEnd, z denseStep (read by the refinement)
-};
-
 layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(std140, binding = 1) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
-layout(std430, binding = 0) readonly buffer CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; };
 layout(binding = 0) uniform sampler2D cameraDepth;
 layout(binding = 0, rgba32f) uniform readonly image2D coordinatesIn;
 layout(binding = 1, rgba32f) uniform readonly image2D samplesIn;
