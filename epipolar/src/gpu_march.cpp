@@ -128,13 +128,7 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   // The textures written: the image's, or the list's (its output and coordinates).
   int outWidth = width, outHeight = height;
   if (list) {
-    if (list->buffer == 0 || glIsBuffer(list->buffer) != GL_TRUE)
-      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.list.buffer", std::to_string(list->buffer),
-                            "must name the list's buffer (gpu::createSampleListBuffer)");
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.list.coordinates", list->coordinates, list->width,
-                         list->height, GL_RGBA32F);
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.list.output", list->output, list->width,
-                         list->height, GL_RGBA32F);
+    gpu::validateSampleList(*list, "RectifiedMarchPass::FrameAttribs.list");
     outWidth = list->width;
     outHeight = list->height;
   } else {

@@ -717,13 +717,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       listWidth = d.width;
       listHeight = d.height;
     }
-    if (list->buffer == 0 || glIsBuffer(list->buffer) != GL_TRUE)
-      invalid("EvaluatePass::FrameAttribs.list.buffer", str(list->buffer),
-              "must name the list's buffer (gpu::createSampleListBuffer)");
-    gl::requireTexture2D("EvaluatePass::FrameAttribs.list.coordinates", list->coordinates, list->width,
-                         list->height, GL_RGBA32F);
-    gl::requireTexture2D("EvaluatePass::FrameAttribs.list.output", list->output, list->width, list->height,
-                         GL_RGBA32F);
+    gpu::validateSampleList(*list, "EvaluatePass::FrameAttribs.list");
   }
   if (pixels) {
     depth = gl::textureLevel("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);

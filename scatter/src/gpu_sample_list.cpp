@@ -10,8 +10,7 @@
 namespace crep::gpu {
 
 gl::Handle createSampleListBuffer(int capacity) {
-  if (capacity <= 0)
-    throw InvalidArgument("SampleList.capacity", std::to_string(capacity), "must be > 0");
+  if (capacity <= 0) throw InvalidArgument("SampleList.capacity", std::to_string(capacity), "must be > 0");
   gl::Handle buffer = gl::createBuffer();
   const GLsizeiptr bytes = kSampleListHeaderBytes + static_cast<GLsizeiptr>(capacity) * 4;
   glNamedBufferStorage(buffer.get(), bytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -35,6 +34,15 @@ int sampleListCount(std::uint32_t buffer) {
   GLuint count = 0;
   glGetNamedBufferSubData(buffer, 12, sizeof(count), &count);
   return static_cast<int>(count);
+}
+
+void validateSampleList(const SampleList& list, const std::string& owner) {
+  if (list.buffer == 0 || glIsBuffer(list.buffer) != GL_TRUE)
+    throw InvalidArgument(owner + ".buffer", std::to_string(list.buffer),
+                          "must name the list's buffer (gpu::createSampleListBuffer)");
+  gl::requireTexture2D((owner + ".coordinates").c_str(), list.coordinates, list.width, list.height,
+                       GL_RGBA32F);
+  gl::requireTexture2D((owner + ".output").c_str(), list.output, list.width, list.height, GL_RGBA32F);
 }
 
 } // namespace crep::gpu

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include <crep/core/gl.h>
 
@@ -47,5 +48,9 @@ void clearSampleList(std::uint32_t buffer);
 void dispatchSampleList(std::uint32_t buffer);
 /// Reads `count` back (a GPU sync: for tests and statistics).
 int sampleListCount(std::uint32_t buffer);
+/// A consumer's check of the list it is given (e.g. owner = "EvaluatePass::FrameAttribs.list"): throws
+/// InvalidArgument naming owner + ".buffer" unless the buffer is an existing buffer object, owner +
+/// ".coordinates" / ".output" unless those are GL_RGBA32F textures of width x height.
+void validateSampleList(const SampleList& list, const std::string& owner);
 
 } // namespace crep::gpu
