@@ -4,6 +4,7 @@
 // (compute passes on llvmpipe): trees bit-identical to the CPU's, tree march = brute-force march, both
 // against the CPU reference; the world-space march pass against the CPU world-space march.
 #include "epipolar_test_util.h"
+#include "gl_scene_util.h"
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 
@@ -17,7 +18,6 @@
 #include <epoxy/gl.h>
 
 #include <map>
-#include <memory>
 #include <string>
 
 using namespace crep;
@@ -28,35 +28,9 @@ namespace {
 constexpr int kWidth = 160, kHeight = 90;        // camera image
 constexpr int kMapWidth = 256, kMapHeight = 128; // rectified map (4 splits of 64 columns)
 
-/// A scene with its projective rectified map rendered on the GPU (kept as a texture and read back).
-struct SceneMaps {
-  scenes::Scene scene;
-  std::shared_ptr<const ProjectiveLayout> layout;
-  gl::Handle mapTexture, cameraTexture;
-  RectifiedMap map;
-  Image cameraDepth;
-};
-
+/// The scene and its GPU-rendered map at the sizes above (gl_scene_util.h).
 SceneMaps renderScene(const std::string& name) {
-  SceneMaps s{scenes::makeScene(name, static_cast<double>(kWidth) / kHeight), {}, {}, {}, {}, {}};
-  RectifyOptions options;
-  options.splits = 4;
-  Rectification r = rectify(s.scene.camera, s.scene.sun, options);
-  INFO(name << ": " << r.message);
-  REQUIRE(r.projective());
-  scenes::SceneRenderer renderer(s.scene.mesh);
-  s.mapTexture = scenes::createDepthTexture(kMapWidth, kMapHeight);
-  for (int k = 0; k < r.splitCount(); ++k) {
-    const SplitViewport v = r.splitViewport(k, kMapWidth, kMapHeight);
-    renderer.renderDepth(r.splits[static_cast<std::size_t>(k)].rectClipFromWorld, s.mapTexture.get(), v.layer,
-                         v.x, v.y, v.width, v.height, {.depthClamp = true});
-  }
-  s.layout = std::make_shared<const ProjectiveLayout>(std::move(r));
-  s.map = makeRectifiedMap(s.layout, scenes::readDepthTexture(s.mapTexture.get(), kMapWidth, kMapHeight));
-  s.cameraTexture = scenes::createDepthTexture(kWidth, kHeight);
-  renderer.renderDepth(s.scene.camera.clipFromWorld(), s.cameraTexture.get(), 0, 0, 0, kWidth, kHeight);
-  s.cameraDepth = scenes::readDepthTexture(s.cameraTexture.get(), kWidth, kHeight);
-  return s;
+  return renderSceneMaps(name, kWidth, kHeight, kMapWidth, kMapHeight);
 }
 
 struct GpuMarch {
@@ -69,14 +43,8 @@ GpuMarch gpuMarch(const SceneMaps& s, RectifiedMarchPass::Mode mode) {
   RectifiedMarchPass pass({kMapWidth, kMapHeight, mode});
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight),
                    steps = gl::createTexture2D(GL_R32F, kWidth, kHeight);
-  RectifiedMarchPass::FrameAttribs f;
-  f.layout = s.layout.get();
-  f.camera = &s.scene.camera;
-  f.light = &s.scene.sun;
-  f.medium = &s.scene.medium;
+  RectifiedMarchPass::FrameAttribs f = marchAttribs(s, trees.treeBuffer());
   f.cameraDepth = s.cameraTexture.get();
-  f.rectifiedDepth = s.mapTexture.get();
-  f.minMaxBuffer = trees.treeBuffer();
   f.output = out.get();
   f.stepsOutput = steps.get();
   pass.run(f);

@@ -25,24 +25,6 @@ namespace {
 
 constexpr int kW = 96, kH = 54; // camera image
 
-/// Runs of random depths with empty stretches (as tests/epipolar/MarchTest.cpp).
-Image randomRunsDepth(int W, int H, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  Image d(W, H, 1, 1.0f);
-  for (int j = 0; j < H; ++j) {
-    int i = 0;
-    while (i < W) {
-      const int run = 1 + static_cast<int>(uni(rng) * 40.0);
-      const float v = uni(rng) < 0.4 ? 1.0f : static_cast<float>(uni(rng));
-      const double slope = (uni(rng) - 0.5) * 0.01;
-      for (int k = 0; k < run && i < W; ++k, ++i)
-        d.at(i, j) = static_cast<float>(std::clamp(v + slope * k, 0.0, 1.0));
-    }
-  }
-  return d;
-}
-
 /// The maps of the tests: the half-space occluder cast exactly and random runs, on a projective layout (4
 /// splits) and on the epipolar layout of the camera image.
 struct NamedMap {

@@ -14,33 +14,10 @@
 
 #include <cmath>
 #include <limits>
-#include <random>
 #include <vector>
 
 using namespace crep;
 using namespace crep::test;
-
-namespace {
-
-/// A synthetic map: runs of random depths (like the rows of real scenes) with empty stretches.
-Image randomRunsDepth(int W, int H, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  Image d(W, H, 1, 1.0f);
-  for (int j = 0; j < H; ++j) {
-    int i = 0;
-    while (i < W) {
-      const int run = 1 + static_cast<int>(uni(rng) * 40.0);
-      const float v = uni(rng) < 0.4 ? 1.0f : static_cast<float>(uni(rng));
-      const double slope = (uni(rng) - 0.5) * 0.01;
-      for (int k = 0; k < run && i < W; ++k, ++i)
-        d.at(i, j) = static_cast<float>(std::clamp(v + slope * k, 0.0, 1.0));
-    }
-  }
-  return d;
-}
-
-} // namespace
 
 TEST_CASE("epipolar march: every min/max tree node stores the min and max of the texels it covers") {
   for (const int W : {1, 2, 3, 7, 64, 100, 129}) {

@@ -1,6 +1,6 @@
 // Shared helpers of the epipolar/ tests: the analytic setup (a camera over a ground plane, an infinite
-// plane occluder) with closed-form single scattering that uses none of the code under test, and image
-// metrics helpers.
+// plane occluder) with closed-form single scattering that uses none of the code under test, synthetic
+// maps, and image metrics helpers.
 #pragma once
 
 #include <crep/core/camera.h>
@@ -18,8 +18,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 
 namespace crep::test {
@@ -93,6 +95,24 @@ inline Image closedForm(const Image& depth, const Camera& camera, const Directio
       out.at(x, y, 3) = static_cast<float>(std::exp(-grey * s));
     }
   return out;
+}
+
+/// A synthetic W x H map: runs of random depths (like the rows of real scenes) with empty stretches (1).
+inline Image randomRunsDepth(int W, int H, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  Image d(W, H, 1, 1.0f);
+  for (int j = 0; j < H; ++j) {
+    int i = 0;
+    while (i < W) {
+      const int run = 1 + static_cast<int>(uni(rng) * 40.0);
+      const float v = uni(rng) < 0.4 ? 1.0f : static_cast<float>(uni(rng));
+      const double slope = (uni(rng) - 0.5) * 0.01;
+      for (int k = 0; k < run && i < W; ++k, ++i)
+        d.at(i, j) = static_cast<float>(std::clamp(v + slope * k, 0.0, 1.0));
+    }
+  }
+  return d;
 }
 
 /// Metrics over the RGB channels.

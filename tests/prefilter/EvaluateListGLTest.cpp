@@ -2,10 +2,12 @@
 // evaluation of epipolar sampling's marched samples and corrections (Yusov 2012, Sec. 6.4 and 6.7). A list of
 // every pixel centre gives the per-pixel pass's output bit for bit (projective and epipolar layouts, default
 // options and the near-plane correction); a list of some pixels writes those texels only. The lists are
-// filled from the CPU here (header, then the entries).
+// filled from the CPU (support/sample_list_util.h: header, then the entries).
 #include "epipolar/epipolar_test_util.h"
+#include "epipolar/gl_scene_util.h"
 #include "scatter/local_light_util.h"
 #include "support/gl_fixture.h"
+#include "support/sample_list_util.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
@@ -21,9 +23,6 @@
 #include <epoxy/gl.h>
 
 #include <cmath>
-#include <cstdint>
-#include <cstring>
-#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -55,35 +54,6 @@ struct Scene {
     shadow = scenes::readDepthTexture(shadowTexture.get(), kShadowSize, kShadowSize);
   }
 };
-
-/// A work list over a kWidth x kHeight coordinates texture (every pixel centre with its depth) whose entries
-/// are `texels`; the output starts as NaN.
-struct TestList {
-  gl::Handle buffer, coordinates, output;
-  gpu::SampleList list;
-};
-
-TestList makeList(const Image& depth, const std::vector<glm::ivec2>& texels) {
-  TestList t;
-  std::vector<float> c;
-  for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      c.insert(c.end(), {x + 0.5f, y + 0.5f, depth.at(x, y), 0.0f});
-  t.buffer = gpu::createSampleListBuffer(kWidth * kHeight);
-  t.coordinates = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
-  glTextureSubImage2D(t.coordinates.get(), 0, 0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, c.data());
-  t.output = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const float fill[4] = {nan, nan, nan, nan};
-  glClearTexImage(t.output.get(), 0, GL_RGBA, GL_FLOAT, fill);
-  const auto count = static_cast<std::uint32_t>(texels.size());
-  std::vector<std::uint32_t> data{(count + 63) / 64, 1, 1, count};
-  for (const glm::ivec2& p : texels)
-    data.push_back(static_cast<std::uint32_t>(p.x) | (static_cast<std::uint32_t>(p.y) << 16));
-  glNamedBufferSubData(t.buffer.get(), 0, static_cast<GLsizeiptr>(data.size() * 4), data.data());
-  t.list = {t.buffer.get(), t.coordinates.get(), t.output.get(), kWidth, kHeight, kWidth * kHeight};
-  return t;
-}
 
 /// The per-pixel output and the list's output of the same evaluation.
 struct Outputs {
@@ -153,33 +123,19 @@ std::vector<Layouts> layoutsOf(const Scene& s) {
   return {{"projective", projective, 128}, {"epipolar", epipolar, epipolar->sliceCount()}};
 }
 
-bool sameBits(float a, float b) {
-  return std::memcmp(&a, &b, sizeof a) == 0;
-}
-
-int bitDifferences(const Image& a, const Image& b) {
-  int differ = 0;
-  for (std::size_t i = 0; i < a.data().size(); ++i)
-    if (std::memcmp(&a.data()[i], &b.data()[i], sizeof(float)) != 0) ++differ;
-  return differ;
-}
-
 } // namespace
 
 TEST_CASE("evaluate list GL: a list of every pixel gives the per-pixel evaluation bit for bit") {
   CREP_REQUIRE_GL();
   const Scene s;
-  std::vector<glm::ivec2> all;
-  for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      all.push_back({x, y});
+  const std::vector<glm::ivec2> all = texelsWhere(kWidth, kHeight);
   for (const Layouts& l : layoutsOf(s))
     for (const bool near : {false, true}) { // the default table path and the direct near-plane path
       CAPTURE(l.name);
       CAPTURE(near);
       EvaluatePass::CreateInfo info;
       info.options.nearPlaneCorrection = near;
-      const TestList list = makeList(s.cameraDepth, all);
+      const TestList list = makePixelList(s.cameraDepth, all);
       const Outputs r = evaluateBoth(s, l.layout, l.height, info, list);
       int nan = 0;
       for (const float v : r.perPixel.data())
@@ -194,37 +150,23 @@ TEST_CASE("evaluate list GL: a list writes its entries only") {
   CREP_REQUIRE_GL();
   const Scene s;
   const auto entry = [](int x, int y) { return (x * 5 + y * 11) % 7 == 0; };
-  std::vector<glm::ivec2> some;
-  for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      if (entry(x, y)) some.push_back({x, y});
+  const std::vector<glm::ivec2> some = texelsWhere(kWidth, kHeight, entry);
   for (const Layouts& l : layoutsOf(s)) {
     CAPTURE(l.name);
-    const TestList list = makeList(s.cameraDepth, some);
+    const TestList list = makePixelList(s.cameraDepth, some);
     const Outputs r = evaluateBoth(s, l.layout, l.height, {}, list);
-    int nanAtEntries = 0, writtenElsewhere = 0, differ = 0;
-    for (int y = 0; y < kHeight; ++y)
-      for (int x = 0; x < kWidth; ++x)
-        for (int c = 0; c < 4; ++c) {
-          const float v = r.listed.at(x, y, c);
-          if (entry(x, y) && std::isnan(v)) ++nanAtEntries;
-          if (!entry(x, y) && !std::isnan(v)) ++writtenElsewhere;
-          if (entry(x, y) && !sameBits(v, r.perPixel.at(x, y, c))) ++differ;
-        }
+    const ListWrites w = listWrites(r.listed, r.perPixel, entry);
     MESSAGE(l.name << ": " << some.size() << " entries of " << kWidth * kHeight << " texels");
-    CHECK(nanAtEntries == 0);
-    CHECK(writtenElsewhere == 0);
-    CHECK(differ == 0);
+    CHECK(w.nanAtEntries == 0);
+    CHECK(w.writtenElsewhere == 0);
+    CHECK(w.differ == 0);
   }
 }
 
 TEST_CASE("evaluate list GL: the list variant composes with the pass's options and formats") {
   CREP_REQUIRE_GL();
   const Scene s;
-  std::vector<glm::ivec2> all;
-  for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      all.push_back({x, y});
+  const std::vector<glm::ivec2> all = texelsWhere(kWidth, kHeight);
   const Layouts projective = layoutsOf(s)[0];
   struct Case {
     const char* name;
@@ -245,7 +187,7 @@ TEST_CASE("evaluate list GL: the list variant composes with the pass's options a
   for (const Case& c : cases) {
     CAPTURE(c.name);
     const bool textured = &c == &cases[5];
-    const TestList list = makeList(s.cameraDepth, all);
+    const TestList list = makePixelList(s.cameraDepth, all);
     // The per-pixel reference in RGBA32F: the list's output format.
     EvaluatePass::CreateInfo pixelInfo = c.info;
     pixelInfo.outputFormat = StorageFormat::RGBA32F;
@@ -272,7 +214,7 @@ TEST_CASE("evaluate list GL: bad list attributes get a named InvalidArgument") {
   pf.layout = projective.layout.get();
   pf.medium = &s.scene.medium;
   prefilterPass.run(pf);
-  const TestList list = makeList(s.cameraDepth, {{1, 2}});
+  const TestList list = makePixelList(s.cameraDepth, {{1, 2}});
   EvaluatePass pass({});
   EvaluatePass::FrameAttribs f;
   f.camera = &s.scene.camera;
@@ -317,34 +259,19 @@ TEST_CASE("evaluate list GL: bad list attributes get a named InvalidArgument") {
 TEST_CASE("evaluate list GL: the list variant composes with a local light (spot)") {
   CREP_REQUIRE_GL();
   constexpr int W = 512, H = 256;
-  const Camera camera = groundCamera(kWidth, kHeight);
-  const Image depth = groundDepth(camera, kWidth, kHeight);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
-  const SpotLight spot = analyticSpot();
-  const LocalLight light = LocalLight::spot(spot);
-  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
-  const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-  const gl::Handle mapTexture = gl::createTexture2D(GL_R32F, W, H);
-  glTextureSubImage2D(mapTexture.get(), 0, 0, 0, W, H, GL_RED, GL_FLOAT, map.depth.data().data());
-  const gl::Handle depthTexture = gl::createTexture2D(GL_R32F, kWidth, kHeight);
-  glTextureSubImage2D(depthTexture.get(), 0, 0, 0, kWidth, kHeight, GL_RED, GL_FLOAT, depth.data().data());
+  const SpotMaps spot = uploadSpotMaps(kWidth, kHeight, W, H);
   PrefilterPass::CreateInfo pi;
   pi.mapWidth = W;
   pi.mapHeight = H;
   pi.options.regionsPerSplit = 2;
   PrefilterPass prefilterPass(pi);
   PrefilterPass::FrameAttribs pf;
-  pf.rectifiedDepth = mapTexture.get();
-  pf.layout = layout.get();
-  pf.medium = &medium;
-  pf.localLight = &light;
+  pf.rectifiedDepth = spot.mapTexture.get();
+  pf.layout = spot.layout.get();
+  pf.medium = &spot.medium;
+  pf.localLight = &spot.light;
   prefilterPass.run(pf);
-  std::vector<glm::ivec2> all;
-  for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      all.push_back({x, y});
+  const std::vector<glm::ivec2> all = texelsWhere(kWidth, kHeight);
   for (const bool prefixTable : {true, false}) {
     CAPTURE(prefixTable);
     EvaluatePass::CreateInfo info;
@@ -352,15 +279,15 @@ TEST_CASE("evaluate list GL: the list variant composes with a local light (spot)
     EvaluatePass pass(info);
     const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
     EvaluatePass::FrameAttribs f;
-    f.cameraDepth = depthTexture.get();
+    f.cameraDepth = spot.depthTexture.get();
     f.output = out.get();
-    f.camera = &camera;
-    f.medium = &medium;
-    f.layout = layout.get();
+    f.camera = &spot.camera;
+    f.medium = &spot.medium;
+    f.layout = spot.layout.get();
     f.basis = prefilterPass.filteredBasis();
-    f.localLight = &light;
+    f.localLight = &spot.light;
     pass.run(f);
-    const TestList list = makeList(depth, all);
+    const TestList list = makePixelList(spot.depth, all);
     f.list = &list.list; // the image size from cameraDepth
     pass.run(f);
     const Image perPixel = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
