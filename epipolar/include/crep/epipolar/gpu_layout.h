@@ -1,8 +1,8 @@
 // Blocks shared between the epipolar/ GPU passes (gpu_march.h, resample.h) and their shaders. Each struct
 // has a GLSL twin with the same name prefixed "Crep" in glsl/crep/epipolar.glsl, laid out by std140 (uniform
 // blocks) or std430 (storage buffers): 16-byte vectors and matrices only, int instead of bool, a
-// static_assert on the size. tests/epipolar/EpipolarGLTest.cpp ("uniform and storage blocks match their C++ structs") compares every member offset with the
-// offsets the driver reports for the linked shaders.
+// static_assert on the size. tests/epipolar/EpipolarGLTest.cpp ("uniform and storage blocks match their C++
+// structs") compares every member offset with the offsets the driver reports for the linked shaders.
 //
 // A shader of an engine that maps pixels into a rectified map (e.g. to evaluate the prefiltered scattering
 // on the epipolar fallback layout) includes "crep/epipolar.glsl" with CREP_LAYOUT set, and binds a uniform
