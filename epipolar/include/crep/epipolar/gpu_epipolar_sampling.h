@@ -43,7 +43,8 @@ namespace crep {
 namespace gpu {
 
 /// std140 block CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; } (uniform binding 1)
-/// of the stage passes, declared in each of their shaders. Pixel coordinates, origin at the bottom-left.
+/// of the stage passes, declared in glsl/crep/epipolar_sampling.glsl (with the line table). Pixel
+/// coordinates, origin at the bottom-left.
 struct EpipolarSamplingParams {
   /// xy: epipole e (pixels, full resolution); z: arcBegin, w: arcLength (border pixels)
   glm::vec4 epipole{0.0f};
