@@ -110,20 +110,11 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   // The image size is the camera depth texture's own (gl::textureLevel); with a work list, imageWidth x
   // imageHeight when given, and the outputs are the list's.
   const gpu::SampleList* list = f.list;
-  int width = 0, height = 0;
-  if (list && (f.imageWidth != 0 || f.imageHeight != 0)) {
-    if (f.imageWidth <= 0 || f.imageHeight <= 0)
-      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.imageWidth/imageHeight",
-                            std::to_string(f.imageWidth) + " x " + std::to_string(f.imageHeight),
-                            "must both be > 0 (or both 0: cameraDepth's size)");
-    width = f.imageWidth;
-    height = f.imageHeight;
-  } else {
-    const gl::TextureLevel depth =
-        gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-    width = depth.width;
-    height = depth.height;
-  }
+  const gl::TextureLevel image =
+      list
+          ? gpu::listImageSize(f.imageWidth, f.imageHeight, f.cameraDepth, "RectifiedMarchPass::FrameAttribs")
+          : gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
+  const int width = image.width, height = image.height;
   gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
   // The textures written: the image's, or the list's (its output and coordinates).
   int outWidth = width, outHeight = height;

@@ -704,19 +704,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   const GLenum outFormat = internalFormat(info_.outputFormat);
   int listWidth = 0, listHeight = 0; // the camera image's size for a list
   if (list) {
-    if (frame.imageWidth != 0 || frame.imageHeight != 0) {
-      if (frame.imageWidth <= 0 || frame.imageHeight <= 0)
-        invalid("EvaluatePass::FrameAttribs.imageWidth/imageHeight",
-                sizeString(frame.imageWidth, frame.imageHeight),
-                "must both be > 0 (or both 0: cameraDepth's size)");
-      listWidth = frame.imageWidth;
-      listHeight = frame.imageHeight;
-    } else {
-      const gl::TextureLevel d =
-          gl::requireTexture2D("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
-      listWidth = d.width;
-      listHeight = d.height;
-    }
+    const gl::TextureLevel image = gpu::listImageSize(frame.imageWidth, frame.imageHeight, frame.cameraDepth,
+                                                      "EvaluatePass::FrameAttribs");
+    listWidth = image.width;
+    listHeight = image.height;
     gpu::validateSampleList(*list, "EvaluatePass::FrameAttribs.list");
   }
   if (pixels) {

@@ -45,4 +45,18 @@ void validateSampleList(const SampleList& list, const std::string& owner) {
   gl::requireTexture2D((owner + ".output").c_str(), list.output, list.width, list.height, GL_RGBA32F);
 }
 
+gl::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
+                               const std::string& owner) {
+  if (imageWidth == 0 && imageHeight == 0)
+    return gl::requireTexture2D((owner + ".cameraDepth").c_str(), cameraDepth);
+  if (imageWidth <= 0 || imageHeight <= 0)
+    throw InvalidArgument(owner + ".imageWidth/imageHeight",
+                          std::to_string(imageWidth) + " x " + std::to_string(imageHeight),
+                          "must both be > 0 (or both 0: cameraDepth's size)");
+  gl::TextureLevel size;
+  size.width = imageWidth;
+  size.height = imageHeight;
+  return size;
+}
+
 } // namespace crep::gpu

@@ -52,5 +52,10 @@ int sampleListCount(std::uint32_t buffer);
 /// InvalidArgument naming owner + ".buffer" unless the buffer is an existing buffer object, owner +
 /// ".coordinates" / ".output" unless those are GL_RGBA32F textures of width x height.
 void validateSampleList(const SampleList& list, const std::string& owner);
+/// The camera image size a list consumer maps its entries with: imageWidth x imageHeight when either is
+/// set (both must be > 0: InvalidArgument owner + ".imageWidth/imageHeight"), else the size of the
+/// cameraDepth texture (gl::requireTexture2D, owner + ".cameraDepth").
+gl::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
+                               const std::string& owner);
 
 } // namespace crep::gpu
