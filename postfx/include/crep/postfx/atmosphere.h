@@ -1,0 +1,307 @@
+// Earth's atmosphere: precomputed single and multiple scattering tables (Bruneton and Neyret 2008, with
+// the parameterisation and look-ups of Yusov's Outdoor Light Scattering demo, 2013), the sky, aerial
+// perspective and light shafts in the atmosphere. This header is the CPU reference in double precision;
+// AtmosphereTablesPass and AtmospherePass (crep/postfx/gpu_atmosphere.h) compute the same tables and
+// images on the GPU in float, with the look-ups of glsl/crep/atmosphere.glsl (a public include).
+//
+// ---------------------------------------------------------------------------------------------------
+// Units and frames. Tables are in metres, around a planet centred at the origin with the table's point
+// at (0, R + h, 0). A scene is placed on the planet by AtmospherePlacement: world +Y is the zenith at the
+// world origin, world y = 0 is at `originAltitude` metres above sea level, one world unit is
+// `metersPerUnit` metres; so the planet centre is at (0, -(R + originAltitude) / metersPerUnit, 0) in world
+// units. Radiances are per unit extraterrestrial sun irradiance (the DirectionalLight's irradiance scales
+// them); the sun direction is the direction the light travels (as DirectionalLight::direction()), l = -it.
+//
+// Media (Yusov 2012, Sec. 2; Bruneton and Neyret 2008, Sec. 2): Rayleigh scattering beta_R e^(-h/H_R)
+// with the Rayleigh phase, Mie scattering beta_M e^(-h/H_M) with the Henyey-Greenstein phase of g and
+// Mie extinction (beta_M + mieAbsorption) e^(-h/H_M). h is the altitude above sea level.
+//
+// The 4D table (Yusov 2013, "Look-up table parameterization"): a quantity of a point at altitude h looking
+// along v with the sun towards l, parameterised by u_h (Eq. 4), u_alpha (Eq. 5, c_alpha = v . zenith),
+// u_phi (Eq. 6, c_phi = l . zenith; Bruneton's form atan(max(c_phi, -0.1975) tan(1.26 * 1.1)) / 1.1) and
+// u_theta (Eq. 7, c_theta = v . l). Texel centres: for h, phi and theta, texel i of N sits at u = i / (N -
+// 1); for alpha, texels [0, N/2) are the rays below the horizon (texel 0 at the horizon, N/2 - 1 straight
+// down) and [N/2, N) the rays above it (N/2 at the horizon, N - 1 the zenith), each half with
+// u = k / (N/2 - 1) in Eq. 5's power-0.2 law. A ray of the lower half ends on the ground, a ray of the upper
+// half at the top of the atmosphere, decided by the half and never by a ray-sphere test (so the two horizon
+// texels are the limits from below and above, and a look-up that stays on one side is continuous).
+// Packing (Listing 1): a 3D texture of width N_h, height N_alpha and depth N_phi * N_theta; slice
+// z = q * N_phi + k holds u_theta texel q and u_phi texel k. Each texel is RGBA float, RGB the quantity
+// (A unused, 0).
+//
+// Look-ups (Listing 1 and 2): texture coordinates in [0, 1] (texel i's centre at (i + 0.5) / N); GL linear
+// filtering with clamp to edge in the three packed dimensions, clamped to the phi slice's texel centres,
+// and a manual linear interpolation between the two theta slices. u_alpha keeps the side of the horizon of
+// the previous look-up of the same ray (Listing 2), so every look-up of a view ray is on one side.
+//
+// Precomputation (Yusov 2013, "Multiple Scattering", steps 1-3), every table at texel centres:
+//   optical depth to the top of the atmosphere (Yusov's net density table): for altitude u = sqrt(h/H_Atm)
+//     and c = cos(zenith angle) in [-1, 1], the integrals of e^(-h/H_R) and e^(-h/H_M) along the ray to the
+//     top (metres), or kOccludedDensity when the ray hits the ground;
+//   L1 (single scattering, Listing 3): trapezoid rule with `singleSteps` steps from the point to the ground
+//     or the top, of (beta_R(h) p_R + beta_M(h) p_M) e^(-T(C->P)) e^(-T(P->sun));
+//   for n = 2..N: J_n (Eq. 1, `sphereSamples` directions of a Fibonacci sphere, each a look-up into
+//     L_(n-1)), then L_n (Eq. 2, Listing 5, trapezoid rule with `orderSteps` steps, look-ups into J_n);
+//   higher orders L_H = sum of L_n (n = 2..N), multiple scattering L_M = L1 + L_H;
+//   ambient sky light E_sky(c_phi) (Eq. 3, Listing 6) at 20 m above the ground: the upper hemisphere of
+//     the same Fibonacci directions (lower ones mirrored) times cos, from L_M; 1D, texel i at
+//     c_phi = 2 i / (N - 1) - 1.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/camera.h>
+#include <crep/core/image.h>
+#include <crep/core/light.h>
+#include <crep/core/medium.h>
+
+namespace crep {
+
+/// Earth and its air (defaults: Yusov 2012, Sec. 2 and Yusov 2013; Bruneton and Neyret 2008).
+struct AtmosphereParameters {
+  double earthRadius = 6360.0e3;    ///< R, metres
+  double atmosphereHeight = 80.0e3; ///< H_Atm, metres: the top of the atmosphere above sea level
+  glm::dvec3 rayleighScattering{5.8e-6, 13.5e-6, 33.1e-6}; ///< beta_R at sea level, 1/m
+  double rayleighScaleHeight = 7994.0;                     ///< H_R, metres
+  glm::dvec3 mieScattering{2.0e-5};                        ///< beta_M at sea level, 1/m
+  glm::dvec3 mieAbsorption{2.0e-5 / 9.0}; ///< Mie extinction = scattering / 0.9 (Bruneton and Neyret 2008)
+  double mieScaleHeight = 1200.0;         ///< H_M, metres
+  double mieG = 0.76;                     ///< Henyey-Greenstein g of the aerosols, |g| < 1
+};
+/// Throws InvalidArgument naming the field ("AtmosphereParameters.earthRadius", ...): radii and scale
+/// heights must be finite and > 0, coefficients finite and >= 0 with some Rayleigh or Mie scattering,
+/// |mieG| < 1.
+void validate(const AtmosphereParameters& p);
+
+/// The 4D table's size (Yusov 2013: 32 x 128 x 64 x 16).
+struct AtmosphereTableSize {
+  int height = 32;      ///< N_h
+  int viewZenith = 128; ///< N_alpha, even (two halves)
+  int sunZenith = 64;   ///< N_phi
+  int sunView = 16;     ///< N_theta
+};
+
+struct AtmospherePrecomputeOptions {
+  AtmosphereTableSize size;
+  int orders = 4;               ///< N: orders 1..N (1: single scattering only, L_H = 0)
+  int singleSteps = 100;        ///< trapezoid steps of L1 (Listing 3)
+  int orderSteps = 64;          ///< trapezoid steps of each L_n (Listing 5)
+  int sphereSamples = 128;      ///< directions of J_n and E_sky (Eq. 1, 3)
+  int opticalDepthHeight = 64;  ///< optical depth table: altitude texels (u = sqrt(h / H_Atm))
+  int opticalDepthZenith = 256; ///< optical depth table: cos zenith texels in [-1, 1]
+  int opticalDepthSteps = 256;  ///< trapezoid steps of each optical depth integral
+  int ambientSize = 64;         ///< E_sky texels over c_phi in [-1, 1]
+  bool keepOrders = false;      ///< keep each L_n in AtmosphereTables::orders (tests, analysis)
+};
+/// Throws InvalidArgument naming the field ("AtmospherePrecomputeOptions.size.viewZenith", ...): sizes >= 2
+/// (viewZenith even and >= 4), orders in [1, 16], steps and samples in [1, 4096], a packed depth
+/// sunZenith * sunView <= 2048 and every size <= 2048 (GL_MAX_3D_TEXTURE_SIZE's guaranteed minimum).
+void validate(const AtmospherePrecomputeOptions& o);
+
+/// The value a texel of the optical depth table holds for a ray that hits the ground (metres of sea-level
+/// density): large enough that every channel's transmittance is 0 in float.
+inline constexpr double kOccludedDensity = 1.0e9;
+
+/// A 4D table packed as described at the top: texels() = N_h * N_alpha * N_phi * N_theta RGBA floats,
+/// texel (ih, ia, ip, it) at index ((it * N_phi + ip) * N_alpha + ia) * N_h + ih (the 3D texture's order).
+struct AtmosphereTable4D {
+  AtmosphereTableSize size;
+  std::vector<float> rgba;
+  std::size_t texels() const;
+  glm::vec4 at(int ih, int ia, int ip, int it) const;
+  glm::vec4& at(int ih, int ia, int ip, int it);
+};
+
+/// Every table of one atmosphere (the result of precomputeAtmosphere, AtmosphereTablesPass::download and
+/// loadAtmosphereTables).
+struct AtmosphereTables {
+  AtmosphereParameters parameters;
+  AtmospherePrecomputeOptions options;
+  /// opticalDepthHeight x opticalDepthZenith, 2 channels: Rayleigh and Mie density integrals, metres.
+  Image opticalDepth;
+  AtmosphereTable4D single;              ///< L1
+  AtmosphereTable4D higherOrders;        ///< L_H = L2 + ... + LN
+  AtmosphereTable4D multiple;            ///< L_M = L1 + L_H
+  Image ambient;                         ///< ambientSize x 1, 3 channels: E_sky per unit sun irradiance
+  std::vector<AtmosphereTable4D> orders; ///< L1, L2, ..., LN when options.keepOrders, else empty
+};
+
+/// Yusov 2013, "Multiple Scattering" steps 1-3 and Eq. 3 on the CPU, in double (stored as float), rows in
+/// parallel on `threads` workers (0 = hardware concurrency). For tests and small tables: the default size
+/// takes minutes. Validates both arguments.
+AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
+                                      int threads = 0);
+
+// --- Parameterisation (Yusov 2013, Eq. 4-7) -------------------------------------------------------------
+
+/// cos of the horizon's zenith angle at altitude h: -sqrt(h (2R + h)) / (R + h).
+double cosHorizon(const AtmosphereParameters& p, double h);
+
+/// World parameters (h, c_alpha, c_phi, c_theta) -> texture coordinates (u_h, u_alpha, u_phi, u_theta) of
+/// the 4D table, each in [0, 1] with texel i's centre at (i + 0.5) / N. `previous` is the previous look-up's
+/// coordinates of the same view ray, or negative for the first (Listing 2: its u_alpha decides the side of
+/// the horizon). h is clamped to [0, H_Atm], the cosines to [-1, 1].
+glm::dvec4 atmosphereTableCoords(const AtmosphereParameters& p, const AtmosphereTableSize& size, double h,
+                                 double cosViewZenith, double cosSunZenith, double cosSunView,
+                                 const glm::dvec4& previous = glm::dvec4(-1.0));
+
+/// The world parameters at the centre of texel (ih, ia, ip, it): (h, c_alpha, c_phi, c_theta) (the inverse
+/// of Eq. 4-7 at the texel centres of the top of this header).
+glm::dvec4 atmosphereTexelParams(const AtmosphereParameters& p, const AtmosphereTableSize& size, int ih,
+                                 int ia, int ip, int it);
+
+/// The view and sun directions of the table's point (0, R + h, 0) for (c_alpha, c_phi, c_theta): v in the
+/// x-y plane (v = (sqrt(1 - c_alpha^2), c_alpha, 0)), l with l.y = c_phi and v . l = c_theta when the three
+/// cosines are compatible; otherwise l's component off the plane is 0 and the result is renormalized.
+void atmosphereDirections(double cosViewZenith, double cosSunZenith, double cosSunView, glm::dvec3& view,
+                          glm::dvec3& sun);
+
+/// Listing 1: the 4D table at texture coordinates `coords` (atmosphereTableCoords), trilinear in the
+/// packed dimensions (GL rules, clamp to edge) and linear between theta slices.
+glm::dvec3 sampleAtmosphereTable(const AtmosphereTable4D& table, const glm::dvec4& coords);
+
+/// Listing 1 end to end: the table's value for the point `position` (metres, planet centre at the origin)
+/// looking along unit `view` with the sun towards unit `toSun`. `coords` carries the previous look-up's
+/// coordinates of the same ray in (negative for the first) and this look-up's out.
+glm::dvec3 lookUpAtmosphere(const AtmosphereTables& tables, const AtmosphereTable4D& table,
+                            const glm::dvec3& position, const glm::dvec3& view, const glm::dvec3& toSun,
+                            glm::dvec4& coords);
+
+/// The optical depth table, bilinear (GL rules): (Rayleigh, Mie) density integrals from altitude h along
+/// a ray with cos zenith c to the top of the atmosphere.
+glm::dvec2 lookUpDensityToTop(const AtmosphereTables& tables, double h, double cosZenith);
+
+/// Transmittance from `position` to the sun (unit `toSun`) through the optical depth table.
+glm::dvec3 sunTransmittance(const AtmosphereTables& tables, const glm::dvec3& position,
+                            const glm::dvec3& toSun);
+
+/// RGB transmittance between two points a and b (metres, planet at the origin; b on the ray from a) through
+/// the optical depth table, D = lookUpDensityToTop, beta_e the extinctions: when the ray from a through b
+/// does not hit the ground, exp(-beta_e . (D(a, v) - D(b, v))); when it does (it descends all the way from a
+/// to b), exp(-beta_e . (D(b, -v) - D(a, -v))), v = normalize(b - a). Differences are clamped to >= 0.
+glm::dvec3 atmosphereTransmittance(const AtmosphereTables& tables, const glm::dvec3& a, const glm::dvec3& b);
+
+/// E_sky at the cosine of the sun's zenith angle (linear in the 1D table).
+glm::dvec3 lookUpAmbientSkyLight(const AtmosphereTables& tables, double cosSunZenith);
+
+/// Direction i of the n-direction Fibonacci sphere used by Eq. 1 and 3 (zenith +y):
+/// y = 1 - (2 i + 1) / n, r = sqrt(1 - y^2), angle = i pi (3 - sqrt(5)), (r cos(angle), y, r sin(angle)).
+glm::dvec3 fibonacciSphereDirection(int i, int n);
+
+// --- Exact integrals (no tables), the references of the tests --------------------------------------------
+
+/// (Rayleigh, Mie) density integrals along the segment a -> b (metres, planet at the origin) with
+/// `steps` trapezoid steps.
+glm::dvec2 densityIntegral(const AtmosphereParameters& p, const glm::dvec3& a, const glm::dvec3& b,
+                           int steps);
+
+// --- Per-frame use ----------------------------------------------------------------------------------------
+
+/// Where a scene sits on the planet (see the top of this header).
+struct AtmospherePlacement {
+  double metersPerUnit = 1.0;  ///< > 0
+  double originAltitude = 0.0; ///< metres above sea level of world y = 0, in [0, H_Atm)
+};
+/// Throws InvalidArgument ("AtmospherePlacement.metersPerUnit", ...).
+void validate(const AtmospherePlacement& placement, const AtmosphereParameters& p);
+
+/// World point -> metres around the planet centre.
+glm::dvec3 atmospherePosition(const AtmospherePlacement& placement, const AtmosphereParameters& p,
+                              const glm::dvec3& world);
+
+/// How light shafts (volumetric shadows of the scene's shadow map) enter the atmosphere's in-scattering.
+enum class AtmosphereShafts {
+  None,                  ///< no shadows: Eq. 8 with L_M from the camera to the surface (or the sky)
+  Integrated,            ///< (a) single scattering integrated along the ray over its lit sections, plus
+                         ///<     unoccluded higher orders (Eq. 8 with L_H): Yusov's SS-Int + MS-UnO
+  LitLengthTable,        ///< (b) lit length D_lit and first lit distance D_start, Eq. 8 with L1 over
+                         ///<     [D_start, D_start + D_lit], plus unoccluded higher orders: SS-LUT + MS-UnO
+  PrefilteredVisibility, ///< (c) the pixel's prefiltered visibility fraction times Eq. 8 with L1, plus
+                         ///<     unoccluded higher orders (not in the seeds)
+};
+
+/// One view ray's result: in-scattered radiance (per unit sun irradiance times the light's irradiance)
+/// and the RGB transmittance from the camera to the ray's end (0 for the sky: nothing behind it).
+struct AtmosphereRay {
+  glm::dvec3 inscattering{0.0};
+  glm::dvec3 transmittance{1.0};
+};
+
+/// What the shadow map says about one ray (world distances from the camera along the ray; `surface` is
+/// the distance to the visible surface or the far plane).
+struct AtmosphereShadowing {
+  std::vector<glm::dvec2> litSections; ///< (a): lit [ta, tb], ascending, within [0, surface]
+  double litLength = 0.0;              ///< (b): D_lit
+  double firstLit = 0.0;               ///< (b): D_start
+  double visibility = 1.0;             ///< (c): the visible fraction
+};
+
+struct AtmosphereRayOptions {
+  AtmosphereShafts shafts = AtmosphereShafts::None;
+  int integrationSteps = 64; ///< (a): trapezoid steps over [0, surface] (lit sections get their share)
+  int skySteps = 16;         ///< (a): steps of single scattering beyond the far plane, to the top
+};
+
+/// One view ray of a camera: from world point `origin` along unit world `direction` to world distance
+/// `surface` (the far plane for sky pixels: `sky` true, then the ray continues unshadowed to the ground or
+/// the top of the atmosphere and its transmittance is 0 where it hits the ground, else the sky's own).
+AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlacement& placement,
+                            const DirectionalLight& sun, const glm::dvec3& origin,
+                            const glm::dvec3& direction, double surface, bool sky,
+                            const AtmosphereShadowing& shadowing, const AtmosphereRayOptions& options);
+
+/// The shadowing of (b) from the lit sections of (a): D_lit = the sum of their lengths, D_start = the first
+/// section's start (0 and 0 without sections). Keeps the sections.
+AtmosphereShadowing shadowingFromSections(std::vector<glm::dvec2> litSections);
+
+/// (c): the visible fraction of a pixel's ray from a prefiltered (or any shadowed) homogeneous-medium
+/// result `shadowed` (RGB radiance of crep::Scattering / EvaluatePass for `light` in the proxy medium
+/// `proxy`): luminance(shadowed) / luminance(unshadowed closed form of the same ray, length `surface`
+/// world units), clamped to [0, 1]; 1 where the unshadowed value is 0.
+double prefilteredVisibility(const glm::dvec3& shadowed, const DirectionalLight& light, const Medium& proxy,
+                             const glm::dvec3& direction, double surface);
+
+/// The per-pixel image of a camera: RGBA, RGB the in-scattered radiance of atmosphereRay, A the mean of its
+/// RGB transmittance; `transmittance` RGB. The outputs every atmosphere method writes (AtmospherePass too).
+struct AtmosphereImage {
+  Image inscattering;  ///< RGBA
+  Image transmittance; ///< RGB
+};
+
+/// atmosphereRay for every pixel of `camera` (pixel rays and sky test of crep/scatter/ray.h: depth-buffer
+/// value 1 is the sky) with `shadowing` per pixel in row-major order (width * height entries; may be empty
+/// for AtmosphereShafts::None). Rows in parallel on `threads` workers (0 = hardware concurrency).
+AtmosphereImage atmosphereImage(const AtmosphereTables& tables, const AtmospherePlacement& placement,
+                                const Camera& camera, const DirectionalLight& sun, const Image& cameraDepth,
+                                const std::vector<AtmosphereShadowing>& shadowing,
+                                const AtmosphereRayOptions& options, int threads = 0);
+
+// --- Disk cache
+// ---------------------------------------------------------------------------------------------
+
+/// The cache key of (parameters, options): a hex digest of every field that changes the tables (threads
+/// and keepOrders excluded).
+std::string atmosphereCacheKey(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o);
+
+/// Writes every table to `path` (a documented binary, see the .cpp's top: magic, version, key, sizes,
+/// data, checksum). Throws IoError.
+void saveAtmosphereTables(const AtmosphereTables& tables, const std::filesystem::path& path);
+/// Reads `path`; throws IoError naming the file for a missing, truncated or corrupt file (bad magic,
+/// version, sizes or checksum).
+AtmosphereTables loadAtmosphereTables(const std::filesystem::path& path);
+
+/// The cache: loads `directory`/atmosphere-<key>.bin if it is valid for (p, o); else computes with
+/// `compute`, saves, and returns the result. A corrupt or mismatching file is reported through `warn`
+/// (a message naming the file and why) and recomputed, never used.
+AtmosphereTables cachedAtmosphereTables(const std::filesystem::path& directory, const AtmosphereParameters& p,
+                                        const AtmospherePrecomputeOptions& o,
+                                        const std::function<AtmosphereTables()>& compute,
+                                        const std::function<void(const std::string&)>& warn);
+
+} // namespace crep
