@@ -156,13 +156,7 @@ MethodOutput runReference(FrameInputs& frame, const MethodSettings& settings) {
   return out;
 }
 
-/// The epipolar fallback map of a frame: the layout of Klehm et al. 2014, Sec. 4.1 for the frame's
-/// camera, light and screen, and the standard shadow map resampled into it on the GPU.
-struct EpipolarMap {
-  std::shared_ptr<EpipolarLayout> layout;
-  gl::Handle texture; ///< R32F, width x sliceCount
-  int width = 0, height = 0;
-};
+} // namespace
 
 EpipolarMap makeEpipolarMap(const FrameInputs& frame, const MethodSettings& settings, StageTimings& timings) {
   EpipolarMap m;
@@ -186,6 +180,8 @@ EpipolarMap makeEpipolarMap(const FrameInputs& frame, const MethodSettings& sett
   });
   return m;
 }
+
+namespace {
 
 /// The world-space march of the pixels around the epipole (Klehm et al. 2014, Fig. 8), over `scattering`.
 void marchEpipoleBlock(const FrameInputs& frame, const MethodSettings& settings, const EpipolarLayout& layout,

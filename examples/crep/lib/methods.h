@@ -7,8 +7,10 @@
 #include "timings.h"
 
 #include <crep/core/gl.h>
+#include <crep/epipolar/epipolar.h>
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,15 @@ const std::vector<Method>& methodRegistry();
 const Method& findMethod(const std::string& name, const std::string& option = "--method");
 /// "prefilter | reference | ..." for help texts and errors.
 std::string methodNames();
+
+/// The epipolar fallback map of a frame: the layout of Klehm et al. 2014, Sec. 4.1 for the frame's
+/// camera, light and screen, and the standard shadow map resampled into it on the GPU.
+struct EpipolarMap {
+  std::shared_ptr<EpipolarLayout> layout;
+  gl::Handle texture; ///< R32F, width x sliceCount
+  int width = 0, height = 0;
+};
+EpipolarMap makeEpipolarMap(const FrameInputs& frame, const MethodSettings& settings, StageTimings& timings);
 
 /// Runs `name` and, when the rectification is not projective and the method needs it, the fallback
 /// (announced on stderr by the method).

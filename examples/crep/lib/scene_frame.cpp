@@ -14,13 +14,15 @@ SceneFrame::SceneFrame(SceneFrame&&) noexcept = default;
 SceneFrame& SceneFrame::operator=(SceneFrame&&) noexcept = default;
 
 SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,
-                          StageTimings& timings) {
+                          StageTimings& timings, const SceneOverrides& overrides) {
   SceneFrame s;
   s.scene = timings.time("scene build", [&] {
     return std::make_unique<scenes::Scene>(scenes::makeScene(name, double(width) / double(height)));
   });
   gl::checkTextureSize("--map-size", shadowMapSize, shadowMapSize);
   gl::checkTextureSize("--size", width, height);
+  if (overrides.sun) s.scene->sun = *overrides.sun;
+  if (overrides.camera) s.scene->camera = *overrides.camera;
   const scenes::Scene& scene = *s.scene;
   s.renderer = timings.time("scene upload + shaders", [&] {
     auto r = std::make_unique<scenes::SceneRenderer>(scene.mesh);
@@ -80,7 +82,8 @@ SceneFrame makeSceneFrame(const std::string& name, int width, int height, int sh
     in.shadowClipFromWorld = f.lightClipFromWorld;
     in.shadowMap = f.shadowMap.get();
     in.lightDirection = scene.sun.direction();
-    in.lightIrradiance = scene.sun.irradiance();
+    in.lightIrradiance = overrides.shadeIrradiance.value_or(scene.sun.irradiance());
+    if (overrides.shadeAmbient) in.ambient = *overrides.shadeAmbient;
     for (std::size_t i = 0; i < f.spotLights.size() && i < scenes::SceneRenderer::kMaxShadeSpots; ++i)
       in.spots.push_back(
           {&f.spotLights[i], f.spotShadows[i].lightClipFromWorld, f.spotShadows[i].texture.get()});

@@ -5,9 +5,12 @@
 #include "frame.h"
 #include "timings.h"
 
+#include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/light.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace crep::scenes {
@@ -32,8 +35,17 @@ struct SceneFrame {
 /// ownShadowMapBias).
 inline constexpr double kLocalShadowBias = 1e-4;
 
+/// What a command changes in a built-in scene before rendering it (`crep render --method atmosphere`).
+struct SceneOverrides {
+  std::optional<DirectionalLight> sun; ///< the sun of the shadow pass, the methods and the shading
+  std::optional<Camera> camera;        ///< the camera (its aspect must be the image's)
+  /// The surfaces' shading: the sun's irradiance at the ground (e.g. after the atmosphere's extinction)
+  /// and the ambient irradiance (SceneRenderer::ShadeInputs' ambient) instead of the sun's and the default.
+  std::optional<glm::dvec3> shadeIrradiance, shadeAmbient;
+};
+
 /// Builds scene `name` for a width x height camera and renders its passes (stages to `timings`).
 SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,
-                          StageTimings& timings);
+                          StageTimings& timings, const SceneOverrides& overrides = {});
 
 } // namespace crep::tool
