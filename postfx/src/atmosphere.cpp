@@ -1,0 +1,634 @@
+// CPU reference of the Earth atmosphere tables (crep/postfx/atmosphere.h): validation, the 4D table's
+// parameterisation and look-ups (Yusov 2013, Eq. 4-7, Listings 1-2), the optical depth table, and the
+// precomputation of single and multiple scattering and the ambient sky light (Yusov 2013, "Multiple
+// Scattering" steps 1-3, Eq. 1-3, Listings 3-6; Bruneton and Neyret 2008). Everything is computed in double
+// and stored as float; the look-ups during the precomputation read those float tables back, as the GPU
+// passes do.
+//
+// Conventions shared with the GPU passes (they must agree texel for texel):
+//  - a table texel's view ray ends on the ground for the lower alpha half and at the top of the atmosphere
+//    for the upper half (never decided by a ray-sphere test);
+//  - L_n's first sample (at the texel's own point C) reads J_n at the texel's own coordinates, and every
+//    later look-up along the ray gets those coordinates as `previous` (so the ray stays on its side);
+//  - J_n's and E_sky's look-ups into the previous order start fresh (previous = -1).
+#include <crep/postfx/atmosphere.h>
+
+#include <crep/core/error.h>
+#include <crep/core/parallel.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+namespace crep {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// Bruneton's sun zenith law (Yusov 2013, Eq. 6).
+constexpr double kPhiClamp = -0.1975;
+constexpr double kPhiScale = 1.1;
+constexpr double kPhiRange = 1.26;
+constexpr double kPhiOffset = 1.0 - 0.26;
+// Eq. 5's power law.
+constexpr double kAlphaPower = 0.2;
+
+std::string field(const char* owner, const char* name) {
+  return std::string(owner) + "." + name;
+}
+
+void requirePositiveField(const char* owner, const char* name, double v) {
+  if (!(std::isfinite(v) && v > 0.0))
+    throw InvalidArgument(field(owner, name), detail::formatValue(v), "must be finite and > 0");
+}
+
+void requireCoefficient(const char* name, const glm::dvec3& c) {
+  static const char* const kChannel[3] = {"r", "g", "b"};
+  for (int i = 0; i < 3; ++i)
+    if (!(std::isfinite(c[i]) && c[i] >= 0.0))
+      throw InvalidArgument(std::string("AtmosphereParameters.") + name + "." + kChannel[i],
+                            detail::formatValue(c[i]), "must be finite and >= 0 (1/m)");
+}
+
+void requireRange(const char* name, int v, int lo, int hi) {
+  if (v < lo || v > hi)
+    throw InvalidArgument(std::string("AtmospherePrecomputeOptions.") + name, detail::formatValue(v),
+                          "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+double tanPhiRange() {
+  return std::tan(kPhiRange * kPhiScale);
+}
+
+/// Texture coordinate of texel space u in [0, 1] for a dimension of n texels (texel i at u = i / (n - 1)).
+double texCoord(double u, int n) {
+  return (0.5 + u * (n - 1)) / n;
+}
+
+/// Yusov 2013, Eq. 6 (Bruneton's form): u_phi of c_phi.
+double phiParam(double c) {
+  const double u = 0.5 * (std::atan(std::max(c, kPhiClamp) * tanPhiRange()) / kPhiScale + kPhiOffset);
+  return std::clamp(u, 0.0, 1.0);
+}
+
+/// Inverse of Eq. 6: c_phi of u_phi.
+double phiFromParam(double u) {
+  return std::tan((2.0 * u - kPhiOffset) * kPhiScale) / tanPhiRange();
+}
+
+/// Yusov 2013, Eq. 7: u_theta of c_theta, gamma = acos(c_theta) / pi.
+double thetaParam(double c) {
+  const double gamma = std::acos(std::clamp(c, -1.0, 1.0)) / kPi;
+  const double u = gamma >= 0.5 ? 0.5 + 0.5 * std::pow(2.0 * (gamma - 0.5), 1.5)
+                                : 0.5 - 0.5 * std::pow(2.0 * (0.5 - gamma), 1.5);
+  return std::clamp(u, 0.0, 1.0);
+}
+
+/// Inverse of Eq. 7: c_theta of u_theta.
+double thetaFromParam(double u) {
+  const double gamma = u >= 0.5 ? 0.5 + 0.5 * std::pow(2.0 * (u - 0.5), 2.0 / 3.0)
+                                : 0.5 - 0.5 * std::pow(2.0 * (0.5 - u), 2.0 / 3.0);
+  return std::cos(kPi * gamma);
+}
+
+/// Sea-level-relative densities (d_R, d_M) at distance r from the planet centre (Yusov 2012, Sec. 2).
+glm::dvec2 densities(const AtmosphereParameters& p, double r) {
+  const double h = std::max(r - p.earthRadius, 0.0);
+  return {std::exp(-h / p.rayleighScaleHeight), std::exp(-h / p.mieScaleHeight)};
+}
+
+glm::dvec3 mieExtinction(const AtmosphereParameters& p) {
+  return p.mieScattering + p.mieAbsorption;
+}
+
+/// exp(-(beta_R D.x + beta_Me D.y)) (Yusov 2013, Listing 5's extinction from density integrals).
+glm::dvec3 transmittanceOf(const AtmosphereParameters& p, const glm::dvec2& d) {
+  const glm::dvec3 tau = p.rayleighScattering * d.x + mieExtinction(p) * d.y;
+  return glm::exp(-tau);
+}
+
+/// Far root of |C + t v| = radius for C = (0, r0, 0) and unit v with v.y = c (C inside the sphere).
+double farRoot(double r0, double c, double radius) {
+  const double disc = r0 * r0 * (c * c - 1.0) + radius * radius;
+  return std::max(-r0 * c + std::sqrt(std::max(disc, 0.0)), 0.0);
+}
+
+/// Nearest non-negative root of |C + t v| = R (the ground) for C = (0, r0, 0); the tangent point when the
+/// discriminant is negative through rounding.
+double groundRoot(double r0, double c, double radius) {
+  const double disc = r0 * r0 * (c * c - 1.0) + radius * radius;
+  if (disc < 0.0) return std::max(-r0 * c, 0.0);
+  return std::max(-r0 * c - std::sqrt(disc), 0.0);
+}
+
+/// GL linear filtering along one dimension of n texels at texture coordinate s (clamp to edge).
+struct Lerp1 {
+  int i0, i1;
+  double f;
+};
+Lerp1 glLerp(double s, int n) {
+  const double x = s * n - 0.5;
+  const double fl = std::floor(x);
+  const double f = x - fl;
+  const int i = static_cast<int>(fl);
+  return {std::clamp(i, 0, n - 1), std::clamp(i + 1, 0, n - 1), f};
+}
+
+glm::dvec3 texel3(const AtmosphereTable4D& t, int ih, int ia, int slice) {
+  const std::size_t idx = ((static_cast<std::size_t>(slice) * static_cast<std::size_t>(t.size.viewZenith) +
+                            static_cast<std::size_t>(ia)) *
+                               static_cast<std::size_t>(t.size.height) +
+                           static_cast<std::size_t>(ih)) *
+                          4;
+  return {t.rgba[idx], t.rgba[idx + 1], t.rgba[idx + 2]};
+}
+
+/// One GL trilinear fetch of the packed 3D texture (clamp to edge).
+glm::dvec3 fetchTrilinear(const AtmosphereTable4D& t, double s, double tc, double r) {
+  const int depth = t.size.sunZenith * t.size.sunView;
+  const Lerp1 x = glLerp(s, t.size.height);
+  const Lerp1 y = glLerp(tc, t.size.viewZenith);
+  const Lerp1 z = glLerp(r, depth);
+  const auto row = [&](int iy, int iz) {
+    return glm::mix(texel3(t, x.i0, iy, iz), texel3(t, x.i1, iy, iz), x.f);
+  };
+  const auto plane = [&](int iz) { return glm::mix(row(y.i0, iz), row(y.i1, iz), y.f); };
+  return glm::mix(plane(z.i0), plane(z.i1), z.f);
+}
+
+void store(AtmosphereTable4D& t, int ih, int ia, int ip, int it, const glm::dvec3& v) {
+  t.at(ih, ia, ip, it) = glm::vec4(glm::vec3(v), 0.0f);
+}
+
+AtmosphereTable4D emptyTable(const AtmosphereTableSize& size) {
+  AtmosphereTable4D t;
+  t.size = size;
+  t.rgba.assign(t.texels() * 4, 0.0f);
+  return t;
+}
+
+/// The texel's point C, view v and sun l in the table frame, and its own texture coordinates.
+struct TexelRay {
+  double h, cosView;
+  glm::dvec3 c, v, l;
+  glm::dvec4 coords;
+  double length; ///< to the ground (lower half) or the top (upper half)
+};
+
+TexelRay texelRay(const AtmosphereParameters& p, const AtmosphereTableSize& size, int ih, int ia, int ip,
+                  int it) {
+  const glm::dvec4 w = atmosphereTexelParams(p, size, ih, ia, ip, it);
+  TexelRay r;
+  r.h = w.x;
+  r.cosView = w.y;
+  r.c = glm::dvec3(0.0, p.earthRadius + w.x, 0.0);
+  atmosphereDirections(w.y, w.z, w.w, r.v, r.l);
+  r.coords = glm::dvec4((ih + 0.5) / size.height, (ia + 0.5) / size.viewZenith, (ip + 0.5) / size.sunZenith,
+                        (it + 0.5) / size.sunView);
+  const double r0 = p.earthRadius + w.x;
+  r.length = ia < size.viewZenith / 2 ? groundRoot(r0, w.y, p.earthRadius)
+                                      : farRoot(r0, w.y, p.earthRadius + p.atmosphereHeight);
+  return r;
+}
+
+/// Runs body(ih, ia, ip, it) for every texel of a 4D table, the (ia, ip, it) rows in parallel.
+template <class Body>
+void forEachTexel(const AtmosphereTableSize& size, int threads, const Body& body) {
+  const int rows = size.viewZenith * size.sunZenith * size.sunView;
+  parallelRows(rows, threads, [&](int row) {
+    const int ia = row % size.viewZenith;
+    const int ip = (row / size.viewZenith) % size.sunZenith;
+    const int it = row / (size.viewZenith * size.sunZenith);
+    for (int ih = 0; ih < size.height; ++ih)
+      body(ih, ia, ip, it);
+  });
+}
+
+/// Yusov 2013, Listing 3: single scattering of one texel by the trapezoid rule, T_sun from the table.
+glm::dvec3 singleScattering(const AtmosphereTables& tables, const TexelRay& r, int steps) {
+  const AtmosphereParameters& p = tables.parameters;
+  const double ct = glm::dot(r.v, r.l);
+  const double phaseR = rayleighPhase(ct);
+  const double phaseM = henyeyGreenstein(p.mieG, ct);
+  const double ds = r.length / steps;
+  glm::dvec2 camDensity(0.0);
+  glm::dvec2 prevD(0.0);
+  glm::dvec3 prevF(0.0), sum(0.0);
+  for (int k = 0; k <= steps; ++k) {
+    const glm::dvec3 pk = r.c + r.v * (r.length * k / steps);
+    const glm::dvec2 d = densities(p, glm::length(pk));
+    if (k > 0) camDensity += (prevD + d) * (0.5 * ds);
+    const glm::dvec3 tCam = transmittanceOf(p, camDensity);
+    const glm::dvec3 tSun = sunTransmittance(tables, pk, r.l);
+    const glm::dvec3 f =
+        (p.rayleighScattering * (d.x * phaseR) + p.mieScattering * (d.y * phaseM)) * tCam * tSun;
+    if (k > 0) sum += (prevF + f) * (0.5 * ds);
+    prevD = d;
+    prevF = f;
+  }
+  return sum;
+}
+
+/// Yusov 2013, Eq. 1 / Listing 4: J_n of one texel from L_(n-1) over the Fibonacci sphere.
+glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTable4D& prev, const TexelRay& r,
+                             int samples) {
+  const AtmosphereParameters& p = tables.parameters;
+  const glm::dvec2 d = densities(p, glm::length(r.c));
+  const glm::dvec3 betaR = p.rayleighScattering * d.x;
+  const glm::dvec3 betaM = p.mieScattering * d.y;
+  glm::dvec3 sum(0.0);
+  for (int i = 0; i < samples; ++i) {
+    const glm::dvec3 w = fibonacciSphereDirection(i, samples);
+    glm::dvec4 coords(-1.0);
+    const glm::dvec3 l = lookUpAtmosphere(tables, prev, r.c, w, r.l, coords);
+    const double c = glm::dot(w, r.v);
+    sum += (betaR * rayleighPhase(c) + betaM * henyeyGreenstein(p.mieG, c)) * l;
+  }
+  return sum * (4.0 * kPi / samples);
+}
+
+/// Yusov 2013, Eq. 2 / Listing 5: L_n of one texel, the trapezoid rule over J_n along the texel's ray.
+glm::dvec3 scatteringOrder(const AtmosphereTables& tables, const AtmosphereTable4D& j, const TexelRay& r,
+                           int steps) {
+  const AtmosphereParameters& p = tables.parameters;
+  const double ds = r.length / steps;
+  glm::dvec2 camDensity(0.0);
+  glm::dvec2 prevD = densities(p, glm::length(r.c));
+  glm::dvec3 prevF = sampleAtmosphereTable(j, r.coords);
+  glm::dvec3 sum(0.0);
+  for (int k = 1; k <= steps; ++k) {
+    const glm::dvec3 pk = r.c + r.v * (r.length * k / steps);
+    const glm::dvec2 d = densities(p, glm::length(pk));
+    camDensity += (prevD + d) * (0.5 * ds);
+    glm::dvec4 coords = r.coords;
+    const glm::dvec3 f = transmittanceOf(p, camDensity) * lookUpAtmosphere(tables, j, pk, r.v, r.l, coords);
+    sum += (prevF + f) * (0.5 * ds);
+    prevD = d;
+    prevF = f;
+  }
+  return sum;
+}
+
+} // namespace
+
+// --- Validation -------------------------------------------------------------------------------------------
+
+void validate(const AtmosphereParameters& p) {
+  const char* o = "AtmosphereParameters";
+  requirePositiveField(o, "earthRadius", p.earthRadius);
+  requirePositiveField(o, "atmosphereHeight", p.atmosphereHeight);
+  requirePositiveField(o, "rayleighScaleHeight", p.rayleighScaleHeight);
+  requirePositiveField(o, "mieScaleHeight", p.mieScaleHeight);
+  requireCoefficient("rayleighScattering", p.rayleighScattering);
+  requireCoefficient("mieScattering", p.mieScattering);
+  requireCoefficient("mieAbsorption", p.mieAbsorption);
+  const glm::dvec3 s = p.rayleighScattering + p.mieScattering;
+  if (!(std::max({s.x, s.y, s.z}) > 0.0))
+    throw InvalidArgument("AtmosphereParameters.rayleighScattering", "0",
+                          "some Rayleigh or Mie scattering is needed (mieScattering is 0 too)");
+  if (!(std::isfinite(p.mieG) && std::abs(p.mieG) < 1.0))
+    throw InvalidArgument("AtmosphereParameters.mieG", detail::formatValue(p.mieG), "must satisfy |g| < 1");
+}
+
+void validate(const AtmospherePrecomputeOptions& o) {
+  constexpr int kMaxSize = 2048;
+  constexpr int kMaxSteps = 4096;
+  requireRange("size.height", o.size.height, 2, kMaxSize);
+  requireRange("size.viewZenith", o.size.viewZenith, 4, kMaxSize);
+  if (o.size.viewZenith % 2 != 0)
+    throw InvalidArgument("AtmospherePrecomputeOptions.size.viewZenith",
+                          detail::formatValue(o.size.viewZenith), "must be even (two halves of the horizon)");
+  requireRange("size.sunZenith", o.size.sunZenith, 2, kMaxSize);
+  requireRange("size.sunView", o.size.sunView, 2, kMaxSize);
+  if (o.size.sunZenith * o.size.sunView > kMaxSize)
+    throw InvalidArgument("AtmospherePrecomputeOptions.size.sunView",
+                          detail::formatValue(o.size.sunZenith * o.size.sunView),
+                          "the packed depth sunZenith * sunView must be <= 2048");
+  requireRange("orders", o.orders, 1, 16);
+  requireRange("singleSteps", o.singleSteps, 1, kMaxSteps);
+  requireRange("orderSteps", o.orderSteps, 1, kMaxSteps);
+  requireRange("sphereSamples", o.sphereSamples, 1, kMaxSteps);
+  requireRange("opticalDepthHeight", o.opticalDepthHeight, 2, kMaxSize);
+  requireRange("opticalDepthZenith", o.opticalDepthZenith, 2, kMaxSize);
+  requireRange("opticalDepthSteps", o.opticalDepthSteps, 1, kMaxSteps);
+  requireRange("ambientSize", o.ambientSize, 2, kMaxSize);
+}
+
+void validate(const AtmospherePlacement& placement, const AtmosphereParameters& p) {
+  requirePositiveField("AtmospherePlacement", "metersPerUnit", placement.metersPerUnit);
+  if (!(std::isfinite(placement.originAltitude) && placement.originAltitude >= 0.0 &&
+        placement.originAltitude < p.atmosphereHeight))
+    throw InvalidArgument("AtmospherePlacement.originAltitude", detail::formatValue(placement.originAltitude),
+                          "metres, must be in [0, AtmosphereParameters.atmosphereHeight)");
+}
+
+// --- AtmosphereTable4D ------------------------------------------------------------------------------------
+
+std::size_t AtmosphereTable4D::texels() const {
+  if (size.height <= 0 || size.viewZenith <= 0 || size.sunZenith <= 0 || size.sunView <= 0) return 0;
+  return static_cast<std::size_t>(size.height) * static_cast<std::size_t>(size.viewZenith) *
+         static_cast<std::size_t>(size.sunZenith) * static_cast<std::size_t>(size.sunView);
+}
+
+namespace {
+std::size_t packedIndex(const AtmosphereTableSize& s, int ih, int ia, int ip, int it) {
+  return ((static_cast<std::size_t>(it) * static_cast<std::size_t>(s.sunZenith) +
+           static_cast<std::size_t>(ip)) *
+              static_cast<std::size_t>(s.viewZenith) +
+          static_cast<std::size_t>(ia)) *
+             static_cast<std::size_t>(s.height) +
+         static_cast<std::size_t>(ih);
+}
+} // namespace
+
+glm::vec4 AtmosphereTable4D::at(int ih, int ia, int ip, int it) const {
+  const std::size_t i = packedIndex(size, ih, ia, ip, it) * 4;
+  return {rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]};
+}
+
+glm::vec4& AtmosphereTable4D::at(int ih, int ia, int ip, int it) {
+  return *reinterpret_cast<glm::vec4*>(rgba.data() + packedIndex(size, ih, ia, ip, it) * 4);
+}
+
+// --- Parameterisation -------------------------------------------------------------------------------------
+
+// Yusov 2013, Eq. 5's c_h: the cosine of the horizon's zenith angle at altitude h.
+double cosHorizon(const AtmosphereParameters& p, double h) {
+  const double hh = std::max(h, 0.0);
+  return -std::sqrt(hh * (2.0 * p.earthRadius + hh)) / (p.earthRadius + hh);
+}
+
+// Yusov 2013, Eq. 4-7 with Listing 2's side choice and texel-centre mapping of u_alpha.
+glm::dvec4 atmosphereTableCoords(const AtmosphereParameters& p, const AtmosphereTableSize& size, double h,
+                                 double cosViewZenith, double cosSunZenith, double cosSunView,
+                                 const glm::dvec4& previous) {
+  const double hc = std::clamp(h, 0.0, p.atmosphereHeight);
+  const double ca = std::clamp(cosViewZenith, -1.0, 1.0);
+  const double cp = std::clamp(cosSunZenith, -1.0, 1.0);
+  const double ct = std::clamp(cosSunView, -1.0, 1.0);
+
+  const double uh = std::sqrt(hc / p.atmosphereHeight); // Eq. 4
+
+  const double ch = cosHorizon(p, hc);
+  const bool prevAbove = previous.y >= 0.5;
+  const bool prevBelow = previous.y >= 0.0 && previous.y < 0.5;
+  const int n = size.viewZenith;
+  double ua;
+  if (prevAbove || (!prevBelow && ca > ch)) {
+    const double t = std::pow(std::clamp((ca - ch) / (1.0 - ch), 0.0, 1.0), kAlphaPower);
+    ua = (n / 2 + 0.5 + t * (n / 2 - 1)) / n;
+  } else {
+    const double t = std::pow(std::clamp((ch - ca) / (ch + 1.0), 0.0, 1.0), kAlphaPower);
+    ua = (0.5 + t * (n / 2 - 1)) / n;
+  }
+  return {texCoord(uh, size.height), ua, texCoord(phiParam(cp), size.sunZenith),
+          texCoord(thetaParam(ct), size.sunView)};
+}
+
+// The inverse of Eq. 4-7 at the texel centres (the top of crep/postfx/atmosphere.h).
+glm::dvec4 atmosphereTexelParams(const AtmosphereParameters& p, const AtmosphereTableSize& size, int ih,
+                                 int ia, int ip, int it) {
+  const double uh = static_cast<double>(ih) / (size.height - 1);
+  const double h = p.atmosphereHeight * uh * uh;
+  const double ch = cosHorizon(p, h);
+  const int half = size.viewZenith / 2;
+  double ca;
+  if (ia < half) {
+    const double t = static_cast<double>(ia) / (half - 1);
+    ca = ch - std::pow(t, 5.0) * (ch + 1.0);
+  } else {
+    const double t = static_cast<double>(ia - half) / (half - 1);
+    ca = ch + std::pow(t, 5.0) * (1.0 - ch);
+  }
+  const double cp = phiFromParam(static_cast<double>(ip) / (size.sunZenith - 1));
+  const double ct = thetaFromParam(static_cast<double>(it) / (size.sunView - 1));
+  return {h, ca, cp, ct};
+}
+
+// Listing 3's ComputeViewDir / ComputeLightDir: v in the x-y plane, l from c_phi and c_theta.
+void atmosphereDirections(double cosViewZenith, double cosSunZenith, double cosSunView, glm::dvec3& view,
+                          glm::dvec3& sun) {
+  const double ca = std::clamp(cosViewZenith, -1.0, 1.0);
+  const double sa = std::sqrt(std::max(0.0, 1.0 - ca * ca));
+  view = glm::dvec3(sa, ca, 0.0);
+  const double ly = cosSunZenith;
+  const double lx = sa < 1e-6 ? 0.0 : (cosSunView - ca * cosSunZenith) / sa;
+  const double lz = std::sqrt(std::max(0.0, 1.0 - lx * lx - ly * ly));
+  sun = glm::normalize(glm::dvec3(lx, ly, lz));
+}
+
+// Yusov 2013, Listing 1: trilinear in the packed 3D texture, linear between the two theta slices.
+glm::dvec3 sampleAtmosphereTable(const AtmosphereTable4D& table, const glm::dvec4& coords) {
+  const int nTheta = table.size.sunView;
+  const int depth = table.size.sunZenith * nTheta;
+  const double q = coords.w * nTheta - 0.5;
+  const double q0 = std::clamp(std::floor(q), 0.0, static_cast<double>(nTheta - 1));
+  const double weight = std::clamp(q - q0, 0.0, 1.0);
+  const double q1 = std::min(q0 + 1.0, static_cast<double>(nTheta - 1));
+  const double zMin = q0 / nTheta + 0.5 / depth;
+  const double zMax = (q0 + 1.0) / nTheta - 0.5 / depth;
+  const double z0 = std::clamp((q0 + coords.z) / nTheta, zMin, zMax);
+  const double z1 = z0 + (q1 - q0) / nTheta;
+  const glm::dvec3 a = fetchTrilinear(table, coords.x, coords.y, z0);
+  const glm::dvec3 b = fetchTrilinear(table, coords.x, coords.y, z1);
+  return glm::mix(a, b, weight);
+}
+
+// Yusov 2013, Listing 1 end to end.
+glm::dvec3 lookUpAtmosphere(const AtmosphereTables& tables, const AtmosphereTable4D& table,
+                            const glm::dvec3& position, const glm::dvec3& view, const glm::dvec3& toSun,
+                            glm::dvec4& coords) {
+  const double r = glm::length(position);
+  const glm::dvec3 up = position / r;
+  coords = atmosphereTableCoords(tables.parameters, table.size, r - tables.parameters.earthRadius,
+                                 glm::dot(up, view), glm::dot(up, toSun), glm::dot(view, toSun), coords);
+  return sampleAtmosphereTable(table, coords);
+}
+
+// Yusov 2013, the net density table look-up (bilinear, clamp to edge).
+glm::dvec2 lookUpDensityToTop(const AtmosphereTables& tables, double h, double cosZenith) {
+  const Image& img = tables.opticalDepth;
+  const int w = img.width();
+  const int hgt = img.height();
+  const double uh = std::sqrt(std::clamp(h / tables.parameters.atmosphereHeight, 0.0, 1.0));
+  const double uc = (std::clamp(cosZenith, -1.0, 1.0) + 1.0) * 0.5;
+  const Lerp1 x = glLerp(texCoord(uh, w), w);
+  const Lerp1 y = glLerp(texCoord(uc, hgt), hgt);
+  const auto at = [&](int i, int j) { return glm::dvec2(img.at(i, j, 0), img.at(i, j, 1)); };
+  return glm::mix(glm::mix(at(x.i0, y.i0), at(x.i1, y.i0), x.f),
+                  glm::mix(at(x.i0, y.i1), at(x.i1, y.i1), x.f), y.f);
+}
+
+// Yusov 2013, "Terrain shaders": the sun's extinction from the net density to the top.
+glm::dvec3 sunTransmittance(const AtmosphereTables& tables, const glm::dvec3& position,
+                            const glm::dvec3& toSun) {
+  const double r = glm::length(position);
+  const glm::dvec2 d =
+      lookUpDensityToTop(tables, r - tables.parameters.earthRadius, glm::dot(position / r, toSun));
+  return transmittanceOf(tables.parameters, d);
+}
+
+// Transmittance between two points as the difference of two net densities to the top (header comment).
+glm::dvec3 atmosphereTransmittance(const AtmosphereTables& tables, const glm::dvec3& a, const glm::dvec3& b) {
+  const glm::dvec3 ab = b - a;
+  const double len = glm::length(ab);
+  if (!(len > 0.0)) return glm::dvec3(1.0);
+  const glm::dvec3 v = ab / len;
+  const double R = tables.parameters.earthRadius;
+  const double ra = glm::length(a);
+  const double rb = glm::length(b);
+  const double ca = glm::dot(a / ra, v);
+  const bool hitsGround = ca < 0.0 && ra * ra * (ca * ca - 1.0) + R * R >= 0.0;
+  glm::dvec2 d;
+  if (!hitsGround) {
+    d = lookUpDensityToTop(tables, ra - R, ca) - lookUpDensityToTop(tables, rb - R, glm::dot(b / rb, v));
+  } else {
+    d = lookUpDensityToTop(tables, rb - R, -glm::dot(b / rb, v)) - lookUpDensityToTop(tables, ra - R, -ca);
+  }
+  return transmittanceOf(tables.parameters, glm::max(d, glm::dvec2(0.0)));
+}
+
+// Yusov 2013, "Terrain shaders": E_sky linear in the 1D table (texel i at c = 2 i / (N - 1) - 1).
+glm::dvec3 lookUpAmbientSkyLight(const AtmosphereTables& tables, double cosSunZenith) {
+  const Image& img = tables.ambient;
+  const int n = img.width();
+  const Lerp1 x = glLerp(texCoord((std::clamp(cosSunZenith, -1.0, 1.0) + 1.0) * 0.5, n), n);
+  const auto at = [&](int i) { return glm::dvec3(img.at(i, 0, 0), img.at(i, 0, 1), img.at(i, 0, 2)); };
+  return glm::mix(at(x.i0), at(x.i1), x.f);
+}
+
+// The Fibonacci sphere of Eq. 1 and 3 (the header's formula).
+glm::dvec3 fibonacciSphereDirection(int i, int n) {
+  const double y = 1.0 - (2.0 * i + 1.0) / n;
+  const double r = std::sqrt(std::max(0.0, 1.0 - y * y));
+  const double angle = i * kPi * (3.0 - std::sqrt(5.0));
+  return {r * std::cos(angle), y, r * std::sin(angle)};
+}
+
+// Trapezoid rule of (d_R, d_M) along a segment (Yusov 2013, Listing 5's net density).
+glm::dvec2 densityIntegral(const AtmosphereParameters& p, const glm::dvec3& a, const glm::dvec3& b,
+                           int steps) {
+  const int n = std::max(steps, 1);
+  const double ds = glm::length(b - a) / n;
+  glm::dvec2 sum(0.0);
+  glm::dvec2 prev = densities(p, glm::length(a));
+  for (int k = 1; k <= n; ++k) {
+    const glm::dvec2 d = densities(p, glm::length(glm::mix(a, b, static_cast<double>(k) / n)));
+    sum += (prev + d) * (0.5 * ds);
+    prev = d;
+  }
+  return sum;
+}
+
+// World point -> metres around the planet centre (the header's placement rule).
+glm::dvec3 atmospherePosition(const AtmospherePlacement& placement, const AtmosphereParameters& p,
+                              const glm::dvec3& world) {
+  return world * placement.metersPerUnit + glm::dvec3(0.0, p.earthRadius + placement.originAltitude, 0.0);
+}
+
+// --- Precomputation ---------------------------------------------------------------------------------------
+
+// Yusov 2013, "Multiple Scattering" steps 1-3 and Eq. 3.
+AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
+                                      int threads) {
+  validate(p);
+  validate(o);
+  AtmosphereTables t;
+  t.parameters = p;
+  t.options = o;
+  const double R = p.earthRadius;
+  const double top = R + p.atmosphereHeight;
+
+  // Net density to the top of the atmosphere (occluded rays: kOccludedDensity).
+  {
+    const int w = o.opticalDepthHeight;
+    const int hgt = o.opticalDepthZenith;
+    t.opticalDepth = Image(w, hgt, 2);
+    parallelRows(hgt, threads, [&](int j) {
+      const double c = -1.0 + 2.0 * j / (hgt - 1);
+      const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
+      for (int i = 0; i < w; ++i) {
+        const double u = static_cast<double>(i) / (w - 1);
+        const double r0 = R + p.atmosphereHeight * u * u;
+        glm::dvec2 d(kOccludedDensity);
+        if (!(c < 0.0 && r0 * r0 * (c * c - 1.0) + R * R >= 0.0)) {
+          const glm::dvec3 a(0.0, r0, 0.0);
+          const glm::dvec3 b = a + glm::dvec3(s, c, 0.0) * farRoot(r0, c, top);
+          d = densityIntegral(p, a, b, o.opticalDepthSteps);
+        }
+        t.opticalDepth.at(i, j, 0) = static_cast<float>(d.x);
+        t.opticalDepth.at(i, j, 1) = static_cast<float>(d.y);
+      }
+    });
+  }
+
+  const AtmosphereTableSize& size = o.size;
+  const std::size_t n = emptyTable(size).texels();
+  std::vector<glm::dvec3> single(n), higher(n, glm::dvec3(0.0));
+
+  // Step 1: single scattering.
+  AtmosphereTable4D previous = emptyTable(size);
+  forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
+    const TexelRay r = texelRay(p, size, ih, ia, ip, it);
+    const glm::dvec3 v = singleScattering(t, r, o.singleSteps);
+    single[packedIndex(size, ih, ia, ip, it)] = v;
+    store(previous, ih, ia, ip, it, v);
+  });
+  if (o.keepOrders) t.orders.push_back(previous);
+
+  // Step 2: J_n from L_(n-1), then L_n from J_n; L_H accumulates.
+  for (int order = 2; order <= o.orders; ++order) {
+    AtmosphereTable4D j = emptyTable(size);
+    forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
+      const TexelRay r = texelRay(p, size, ih, ia, ip, it);
+      store(j, ih, ia, ip, it, scatteredRadiance(t, previous, r, o.sphereSamples));
+    });
+    AtmosphereTable4D ln = emptyTable(size);
+    forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
+      const TexelRay r = texelRay(p, size, ih, ia, ip, it);
+      const glm::dvec3 v = scatteringOrder(t, j, r, o.orderSteps);
+      higher[packedIndex(size, ih, ia, ip, it)] += v;
+      store(ln, ih, ia, ip, it, v);
+    });
+    previous = std::move(ln);
+    if (o.keepOrders) t.orders.push_back(previous);
+  }
+
+  // Step 3: L_1, L_H and L_M = L_1 + L_H.
+  t.single = emptyTable(size);
+  t.higherOrders = emptyTable(size);
+  t.multiple = emptyTable(size);
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::vec4 a(glm::vec3(single[i]), 0.0f);
+    const glm::vec4 b(glm::vec3(higher[i]), 0.0f);
+    const glm::vec4 m(glm::vec3(single[i] + higher[i]), 0.0f);
+    std::copy(&a.x, &a.x + 4, t.single.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
+    std::copy(&b.x, &b.x + 4, t.higherOrders.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
+    std::copy(&m.x, &m.x + 4, t.multiple.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
+  }
+
+  // Eq. 3 / Listing 6: ambient sky light at 20 m from L_M.
+  {
+    const int na = o.ambientSize;
+    t.ambient = Image(na, 1, 3);
+    const glm::dvec3 c(0.0, R + 20.0, 0.0);
+    parallelRows(na, threads, [&](int i) {
+      const double cp = -1.0 + 2.0 * i / (na - 1);
+      const glm::dvec3 l(std::sqrt(std::max(0.0, 1.0 - cp * cp)), cp, 0.0);
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < o.sphereSamples; ++k) {
+        glm::dvec3 w = fibonacciSphereDirection(k, o.sphereSamples);
+        w.y = std::abs(w.y);
+        glm::dvec4 coords(-1.0);
+        sum += lookUpAtmosphere(t, t.multiple, c, w, l, coords) * w.y;
+      }
+      sum *= 2.0 * kPi / o.sphereSamples;
+      for (int ch = 0; ch < 3; ++ch)
+        t.ambient.at(i, 0, ch) = static_cast<float>(sum[ch]);
+    });
+  }
+  return t;
+}
+
+} // namespace crep
