@@ -92,6 +92,20 @@ double thetaFromParam(double u) {
   return std::cos(kPi * gamma);
 }
 
+/// Yusov 2013, Eq. 5 with Listing 2: u_alpha's texture coordinate (h already clamped, c_alpha in [-1, 1]),
+/// the side of the horizon from the previous look-up's u_alpha (negative: the first look-up).
+double alphaCoord(const AtmosphereParameters& p, int n, double h, double ca, double previous) {
+  const double ch = -std::sqrt(h * (2.0 * p.earthRadius + h)) / (p.earthRadius + h);
+  const bool prevAbove = previous >= 0.5;
+  const bool prevBelow = previous >= 0.0 && previous < 0.5;
+  if (prevAbove || (!prevBelow && ca > ch)) {
+    const double t = std::pow(std::clamp((ca - ch) / (1.0 - ch), 0.0, 1.0), kAlphaPower);
+    return (n / 2 + 0.5 + t * (n / 2 - 1)) / n;
+  }
+  const double t = std::pow(std::clamp((ch - ca) / (ch + 1.0), 0.0, 1.0), kAlphaPower);
+  return (0.5 + t * (n / 2 - 1)) / n;
+}
+
 /// Sea-level-relative densities (d_R, d_M) at distance r from the planet centre (Yusov 2012, Sec. 2).
 glm::dvec2 densities(const AtmosphereParameters& p, double r) {
   const double h = std::max(r - p.earthRadius, 0.0);
@@ -230,18 +244,49 @@ glm::dvec3 singleScattering(const AtmosphereTables& tables, const TexelRay& r, i
   return sum;
 }
 
-/// Yusov 2013, Eq. 1 / Listing 4: J_n of one texel from L_(n-1) over the Fibonacci sphere.
+/// The Fibonacci directions of Eq. 1 and 3 and, per table altitude, their u_alpha coordinates for a
+/// fresh look-up at the texel's point (the same numbers lookUpAtmosphere computes there: the point is on
+/// the +y axis, so c_alpha = w.y exactly).
+struct SphereSamples {
+  std::vector<glm::dvec3> dirs;
+  std::vector<double> alpha;  ///< [ih * samples + i]
+  std::vector<double> height; ///< [ih]: u_h's texture coordinate
+};
+
+SphereSamples sphereSamples(const AtmosphereParameters& p, const AtmosphereTableSize& size, int samples) {
+  SphereSamples s;
+  s.dirs.resize(static_cast<std::size_t>(samples));
+  for (int i = 0; i < samples; ++i)
+    s.dirs[static_cast<std::size_t>(i)] = fibonacciSphereDirection(i, samples);
+  for (int ih = 0; ih < size.height; ++ih) {
+    const glm::dvec4 w = atmosphereTexelParams(p, size, ih, 0, 0, 0);
+    const double r = glm::length(glm::dvec3(0.0, p.earthRadius + w.x, 0.0));
+    const double h = std::clamp(r - p.earthRadius, 0.0, p.atmosphereHeight);
+    s.height.push_back(texCoord(std::sqrt(h / p.atmosphereHeight), size.height));
+    for (const glm::dvec3& d : s.dirs)
+      s.alpha.push_back(alphaCoord(p, size.viewZenith, h, std::clamp(d.y, -1.0, 1.0), -1.0));
+  }
+  return s;
+}
+
+/// Yusov 2013, Eq. 1 / Listing 4: J_n of one texel from L_(n-1) over the Fibonacci sphere (each a fresh
+/// Listing 1 look-up at C; u_h, u_alpha and u_phi do not depend on the texel's view).
 glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTable4D& prev, const TexelRay& r,
-                             int samples) {
+                             int ih, const SphereSamples& sphere) {
   const AtmosphereParameters& p = tables.parameters;
+  const AtmosphereTableSize& size = prev.size;
   const glm::dvec2 d = densities(p, glm::length(r.c));
   const glm::dvec3 betaR = p.rayleighScattering * d.x;
   const glm::dvec3 betaM = p.mieScattering * d.y;
+  const double uPhi = texCoord(phiParam(std::clamp(r.l.y, -1.0, 1.0)), size.sunZenith);
+  const int samples = static_cast<int>(sphere.dirs.size());
+  const double* alpha = sphere.alpha.data() + static_cast<std::size_t>(ih) * sphere.dirs.size();
   glm::dvec3 sum(0.0);
   for (int i = 0; i < samples; ++i) {
-    const glm::dvec3 w = fibonacciSphereDirection(i, samples);
-    glm::dvec4 coords(-1.0);
-    const glm::dvec3 l = lookUpAtmosphere(tables, prev, r.c, w, r.l, coords);
+    const glm::dvec3& w = sphere.dirs[static_cast<std::size_t>(i)];
+    const double uTheta = texCoord(thetaParam(std::clamp(glm::dot(w, r.l), -1.0, 1.0)), size.sunView);
+    const glm::dvec3 l = sampleAtmosphereTable(
+        prev, glm::dvec4(sphere.height[static_cast<std::size_t>(ih)], alpha[i], uPhi, uTheta));
     const double c = glm::dot(w, r.v);
     sum += (betaR * rayleighPhase(c) + betaM * henyeyGreenstein(p.mieG, c)) * l;
   }
@@ -370,20 +415,8 @@ glm::dvec4 atmosphereTableCoords(const AtmosphereParameters& p, const Atmosphere
 
   const double uh = std::sqrt(hc / p.atmosphereHeight); // Eq. 4
 
-  const double ch = cosHorizon(p, hc);
-  const bool prevAbove = previous.y >= 0.5;
-  const bool prevBelow = previous.y >= 0.0 && previous.y < 0.5;
-  const int n = size.viewZenith;
-  double ua;
-  if (prevAbove || (!prevBelow && ca > ch)) {
-    const double t = std::pow(std::clamp((ca - ch) / (1.0 - ch), 0.0, 1.0), kAlphaPower);
-    ua = (n / 2 + 0.5 + t * (n / 2 - 1)) / n;
-  } else {
-    const double t = std::pow(std::clamp((ch - ca) / (ch + 1.0), 0.0, 1.0), kAlphaPower);
-    ua = (0.5 + t * (n / 2 - 1)) / n;
-  }
-  return {texCoord(uh, size.height), ua, texCoord(phiParam(cp), size.sunZenith),
-          texCoord(thetaParam(ct), size.sunView)};
+  return {texCoord(uh, size.height), alphaCoord(p, size.viewZenith, hc, ca, previous.y),
+          texCoord(phiParam(cp), size.sunZenith), texCoord(thetaParam(ct), size.sunView)};
 }
 
 // The inverse of Eq. 4-7 at the texel centres (the top of crep/postfx/atmosphere.h).
@@ -578,11 +611,12 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
   if (o.keepOrders) t.orders.push_back(previous);
 
   // Step 2: J_n from L_(n-1), then L_n from J_n; L_H accumulates.
+  const SphereSamples sphere = sphereSamples(p, size, o.sphereSamples);
   for (int order = 2; order <= o.orders; ++order) {
     AtmosphereTable4D j = emptyTable(size);
     forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
       const TexelRay r = texelRay(p, size, ih, ia, ip, it);
-      store(j, ih, ia, ip, it, scatteredRadiance(t, previous, r, o.sphereSamples));
+      store(j, ih, ia, ip, it, scatteredRadiance(t, previous, r, ih, sphere));
     });
     AtmosphereTable4D ln = emptyTable(size);
     forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
@@ -618,7 +652,7 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
       const glm::dvec3 l(std::sqrt(std::max(0.0, 1.0 - cp * cp)), cp, 0.0);
       glm::dvec3 sum(0.0);
       for (int k = 0; k < o.sphereSamples; ++k) {
-        glm::dvec3 w = fibonacciSphereDirection(k, o.sphereSamples);
+        glm::dvec3 w = sphere.dirs[static_cast<std::size_t>(k)];
         w.y = std::abs(w.y);
         glm::dvec4 coords(-1.0);
         sum += lookUpAtmosphere(t, t.multiple, c, w, l, coords) * w.y;
