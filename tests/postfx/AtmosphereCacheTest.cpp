@@ -503,3 +503,37 @@ TEST_CASE("AtmosphereCache: a failure to save is a warning, not an error") {
     CHECK(std::string(e.what()).find(target.string()) != std::string::npos);
   }
 }
+
+TEST_CASE("AtmosphereCache: precomputed tables round-trip through the cache bit-identically") {
+  TempDir dir;
+  AtmospherePrecomputeOptions o;
+  o.size = {4, 8, 4, 4};
+  o.orders = 2;
+  o.singleSteps = 16;
+  o.orderSteps = 8;
+  o.sphereSamples = 16;
+  o.opticalDepthHeight = 8;
+  o.opticalDepthZenith = 16;
+  o.opticalDepthSteps = 32;
+  o.ambientSize = 8;
+  const AtmosphereParameters p;
+  int computed = 0;
+  auto compute = [&] {
+    ++computed;
+    return precomputeAtmosphere(p, o, 1);
+  };
+  std::vector<std::string> warnings;
+  auto warn = [&](const std::string& m) { warnings.push_back(m); };
+  const AtmosphereTables first = cachedAtmosphereTables(dir.path, p, o, compute, warn);
+  const AtmosphereTables second = cachedAtmosphereTables(dir.path, p, o, compute, warn);
+  CHECK(computed == 1);
+  CHECK(warnings.empty());
+  CHECK(sameTables(first, second));
+  CHECK(sameParameters(second.parameters, p));
+  CHECK(sameOptions(second.options, o));
+  // The occluded rays' optical depth (kOccludedDensity) survives as the same float.
+  bool occluded = false;
+  for (float v : second.opticalDepth.data())
+    occluded = occluded || v == static_cast<float>(kOccludedDensity);
+  CHECK(occluded);
+}
