@@ -226,4 +226,47 @@ MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const
   return minMaxMarchBuildingTrees(map, cameraDepth, camera, light, medium, options, &lightColors);
 }
 
+// The lit sections of the tree walk (Yusov 2012, Algorithm 2), the ones marchRectifiedRays integrates:
+// clipped to [start, surface], empty ones left out, touching ones merged.
+std::vector<std::vector<glm::dvec2>> minMaxLitSections(const RectifiedMap& map, const MinMaxTrees& trees,
+                                                       const Image& cameraDepth, const Camera& camera,
+                                                       const MarchOptions& options) {
+  validate(map);
+  validateCameraDepth(cameraDepth);
+  validate(options);
+  requireSameSize(map, trees);
+  const int w = cameraDepth.width(), h = cameraDepth.height(), W = map.width(), H = map.height();
+  const RectifiedLayout& layout = *map.layout;
+  const glm::dvec3 origin = camera.position();
+  const MinMaxWalk walk(map, trees);
+  std::vector<std::vector<glm::dvec2>> out(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  parallelRows(h, options.threads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      std::vector<glm::dvec2>& sections =
+          out[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)];
+      const PixelRay ray = pixelRay(camera, cameraDepth, x, y, options.nearPlaneCorrection);
+      RowRay r;
+      if (!mapRowRay(layout, origin, ray, W, H, r)) {
+        sections.emplace_back(ray.start, ray.surface);
+        continue;
+      }
+      const RowDistances T(layout, r, W, ray.surface);
+      int steps = 0;
+      walk(
+          r, T,
+          [&](double ta, double tb) {
+            ta = std::max(ta, ray.start);
+            tb = std::min(tb, ray.surface);
+            if (!(tb > ta)) return;
+            if (!sections.empty() && sections.back().y == ta)
+              sections.back().y = tb;
+            else
+              sections.emplace_back(ta, tb);
+          },
+          steps);
+    }
+  });
+  return out;
+}
+
 } // namespace crep

@@ -112,4 +112,14 @@ MarchResult minMaxMarch(const RectifiedMap& map, const Image& cameraDepth, const
                         const LocalLight& light, const Medium& medium, const Image& lightColors,
                         const MarchOptions& options = {});
 
+/// The lit sections [ta, tb] (world distances, ascending, clipped to [ray.start, ray.surface]) of every
+/// pixel ray of `cameraDepth` from the min/max tree walk: exactly the sections minMaxMarch integrates;
+/// an unmapped ray is one section [start, surface]. Row-major, width * height entries. Sections of zero
+/// length are left out and adjacent sections (one's tb equal to the next one's ta) are merged into one,
+/// so the sections of a ray are disjoint with gaps between them (the shadowed parts). Throws
+/// InvalidArgument as minMaxMarch does (the map, "MinMaxTrees", "cameraDepth", the options).
+std::vector<std::vector<glm::dvec2>> minMaxLitSections(const RectifiedMap& map, const MinMaxTrees& trees,
+                                                       const Image& cameraDepth, const Camera& camera,
+                                                       const MarchOptions& options = {});
+
 } // namespace crep
