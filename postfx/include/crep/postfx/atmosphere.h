@@ -217,11 +217,12 @@ glm::dvec3 atmospherePosition(const AtmospherePlacement& placement, const Atmosp
 
 /// How light shafts (volumetric shadows of the scene's shadow map) enter the atmosphere's in-scattering.
 enum class AtmosphereShafts {
-  None,                  ///< no shadows: Eq. 8 with L_M from the camera to the surface (or the sky)
-  Integrated,            ///< (a) single scattering integrated along the ray over its lit sections, plus
-                         ///<     unoccluded higher orders (Eq. 8 with L_H): Yusov's SS-Int + MS-UnO
-  LitLengthTable,        ///< (b) lit length D_lit and first lit distance D_start, Eq. 8 with L1 over
-                         ///<     [D_start, D_start + D_lit], plus unoccluded higher orders: SS-LUT + MS-UnO
+  None,       ///< no shadows: Eq. 8 with L_M from the camera to the surface (or the sky)
+  Integrated, ///< (a) single scattering integrated along the ray over its lit sections, plus
+              ///<     unoccluded higher orders (Eq. 8 with L_H): the demo's integration mode with unoccluded
+              ///<     higher orders
+  LitLengthTable, ///< (b) lit length D_lit and first lit distance D_start, Eq. 8 with L1 over
+                  ///<     [D_start, D_start + D_lit], plus unoccluded higher orders: the demo's table mode
   PrefilteredVisibility, ///< (c) the pixel's prefiltered visibility fraction times Eq. 8 with L1, plus
                          ///<     unoccluded higher orders (not in the seeds)
 };

@@ -48,7 +48,7 @@ AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const Atmospher
 ///   single/higherOrders/multipleTexture(): GL_TEXTURE_3D GL_RGBA32F, N_h x N_alpha x (N_phi N_theta)
 ///     (the packing of atmosphere.h), linear filtering, clamp to edge;
 ///   ambientTexture(): GL_TEXTURE_2D GL_RGBA32F, ambientSize x 1.
-/// 4D tables take 16 bytes per texel: 64 MiB each at the default size (three, plus two of the same size
+/// 4D tables take 16 bytes per texel: 64 mebibytes each at the default size (three, plus two of the same size
 /// while computing).
 class AtmosphereTablesPass {
 public:
