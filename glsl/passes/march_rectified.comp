@@ -24,7 +24,6 @@
 #ifndef CREP_MARCH_TREE
 #define CREP_MARCH_TREE 1
 #endif
-#define CREP_MAX_TREE_LEVELS 16
 #ifndef CREP_LIGHT_TEXTURE
 #define CREP_LIGHT_TEXTURE 0
 #endif
@@ -64,6 +63,26 @@ vec3 crep_section(vec3 sigma, float ta, float tb) {
   return crep_transmittanceIntegral(sigma, ta, tb);
 }
 
+#if CREP_MARCH_TREE
+// The walk of crep/minmax_walk.glsl (shared with passes/atmosphere.comp) adds each lit node here.
+vec3 litSum = vec3(0.0);
+vec3 litSigma = vec3(0.0);
+float litSurface = 0.0;
+void crep_walkLitNode(CrepRowRay r, int i, int next, float ta, float tb) {
+#if CREP_LIGHT_TEXTURE
+  float a = ta;
+  for (int k = i; k < next; ++k) { // the node's texels, each with its own colour
+    float b = k + 1 >= next ? tb : clamp(min(crep_rowRayDistance(r, k + 1, crep_march.sizes.zw), litSurface), a, tb);
+    litSum += texelFetch(crep_lightColors, ivec2(k, r.texelRow), 0).rgb * crep_section(litSigma, a, b);
+    a = b;
+  }
+#else
+  litSum += crep_section(litSigma, ta, tb);
+#endif
+}
+#include "crep/minmax_walk.glsl"
+#endif
+
 void main() {
 #if CREP_SAMPLE_LIST
   uint entry = gl_GlobalInvocationID.x;
@@ -98,56 +117,14 @@ void main() {
   if (!crep_mapRowRay(dir, s, mapSize, r)) {
     L = crep_section(sigma, 0.0, s);
   } else {
+#if CREP_MARCH_TREE
+    litSigma = sigma;
+    litSurface = s;
+    steps = crep_minMaxWalk(r, s, mapSize, crep_march.info.x, crep_march.info.y);
+    L = litSum;
+#else
     int j = r.texelRow, end = r.last + 1;
     float z = r.depth;
-#if CREP_MARCH_TREE
-    int levels = crep_march.info.x;
-    int rowBase = j * crep_march.info.y;
-    int offsets[CREP_MAX_TREE_LEVELS + 1];
-    offsets[0] = 0;
-    offsets[1] = 0;
-    for (int l = 1; l < levels && l < CREP_MAX_TREE_LEVELS; ++l)
-      offsets[l + 1] = offsets[l] + ((mapSize.x + (1 << l) - 1) >> l);
-    int i = 0, level = 0;
-    float ta = 0.0;
-    while (i < end) {
-      // Algorithm 2 step 5.1: one level up where the position is aligned to it.
-      if (level < levels && (i & ((2 << level) - 1)) == 0) ++level;
-      bool lit = false;
-      for (;;) {
-        ++steps;
-        vec2 mm;
-        if (level == 0) {
-          mm = vec2(texelFetch(rectifiedDepth, ivec2(i, j), 0).r);
-        } else {
-          mm = crep_minMax[rowBase + offsets[level] + (i >> level)];
-        }
-        if (mm.x >= z) { // every texel of the node is lit
-          lit = true;
-          break;
-        }
-        if (mm.y < z) break; // every texel is shadowed
-        --level;
-      }
-      int next = min(i + (1 << level), end);
-      float tb = next > r.last ? s : min(crep_rowRayDistance(r, next, mapSize), s);
-      tb = max(tb, ta);
-#if CREP_LIGHT_TEXTURE
-      if (lit) {
-        float a = ta;
-        for (int k = i; k < next; ++k) { // the node's texels, each with its own colour
-          float b = k + 1 >= next ? tb : clamp(min(crep_rowRayDistance(r, k + 1, mapSize), s), a, tb);
-          L += texelFetch(crep_lightColors, ivec2(k, j), 0).rgb * crep_section(sigma, a, b);
-          a = b;
-        }
-      }
-#else
-      if (lit) L += crep_section(sigma, ta, tb);
-#endif
-      ta = tb;
-      i = next;
-    }
-#else
     float ta = 0.0;
     for (int i = 0; i < end; ++i) {
       ++steps;
