@@ -1,0 +1,235 @@
+#version 450 core
+// The atmosphere of each camera pixel's view ray (AtmospherePass, crep/postfx/gpu_atmosphere_pass.h): the
+// sky, aerial perspective and light shafts of crep::atmosphereRay (crep/postfx/atmosphere.h; the full
+// rule is at the top of postfx/src/atmosphere_ray.cpp) in float, with the table look-ups of
+// crep/atmosphere.glsl (Yusov 2013, Listings 1-2; Bruneton and Neyret 2008).
+//
+// CREP_ATMOSPHERE_SHAFTS (crep::AtmosphereShafts):
+//   0 None: Eq. 8 (Yusov 2013) with L_M from the camera to the surface (the sky: L_M at the camera);
+//   1 (a) Integrated: the min/max tree walk over the pixel's row of the rectified map
+//     (crep/minmax_walk.glsl); single scattering integrated with the trapezoid rule over each lit section
+//     (touching sections merged, as crep::minMaxLitSections), plus the unshadowed part beyond the far plane
+//     for the sky; higher orders unoccluded (Eq. 8 with L_H);
+//   2 (b) LitLengthTable: the same walk only accumulates the lit length D_lit and the first lit distance
+//     D_start (two floats instead of the integrand's state: fewer registers, no look-ups inside the walk),
+//     then Eq. 8 with L1 over [D_start, D_start + D_lit]; higher orders as (a);
+//   3 (c) PrefilteredVisibility: the prefiltered texel's visible fraction (crep::prefilteredVisibility)
+//     times Eq. 8 with L1; higher orders as (a).
+//
+// Resources: march block (crep/march.glsl, uniform binding 0: camera, sun; (c): the proxy medium; info.x
+// tree levels, info.y tree row stride, info.z integrationSteps, info.w skySteps), layout block
+// (crep/epipolar.glsl, uniform binding 1, and the epipolar row table at storage binding 1; (a), (b)),
+// atmosphere block (uniform binding 2), camera depth (unit 0), rectified depth (unit 1, (a), (b)),
+// optical depth table (unit 2), L1 (unit 3), L_H (unit 4), L_M (unit 5), prefiltered radiance (unit 6,
+// (c)), min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance
+// (image 0), RGBA32F transmittance (image 1).
+#ifndef CREP_ATMOSPHERE_SHAFTS
+#define CREP_ATMOSPHERE_SHAFTS 0
+#endif
+#define CREP_SHAFTS_WALK (CREP_ATMOSPHERE_SHAFTS == 1 || CREP_ATMOSPHERE_SHAFTS == 2)
+
+// (The shader library includes each file once, where it first appears, whatever the #if around it: the
+// includes below are unconditional or appear once.)
+#include "crep/march.glsl"
+#if CREP_SHAFTS_WALK
+#include "crep/epipolar.glsl"
+#endif
+#include "crep/atmosphere.glsl"
+#include "crep/phase.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(std140, binding = 2) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = 0) uniform sampler2D cameraDepth;
+layout(binding = 2) uniform sampler2D opticalDepthTable;
+layout(binding = 3) uniform sampler3D singleTable;
+layout(binding = 4) uniform sampler3D higherOrdersTable;
+layout(binding = 5) uniform sampler3D multipleTable;
+#if CREP_SHAFTS_WALK
+layout(binding = 1) uniform sampler2D rectifiedDepth;
+layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+#endif
+#if CREP_ATMOSPHERE_SHAFTS == 3
+layout(binding = 6) uniform sampler2D prefiltered;
+#endif
+layout(binding = 0, rgba32f) uniform writeonly image2D inscatteringOut;
+layout(binding = 1, rgba32f) uniform writeonly image2D transmittanceOut;
+
+// The ray of this invocation, in metres around the planet centre (atmosphere.h's table frame).
+vec3 rayC = vec3(0.0);    // the (restrained) camera position C
+vec3 rayV = vec3(0.0);    // unit view direction v
+vec3 rayL = vec3(0.0);    // unit direction towards the sun l
+float metres = 1.0;       // metres per world unit
+float cameraShift = 0.0;  // metres C was moved along v into the atmosphere (Yusov's restrained camera)
+float surfaceM = 0.0;     // s_m: the surface (or far plane) distance from C, metres
+vec3 rayleighPhaseBeta = vec3(0.0), miePhaseBeta = vec3(0.0); // beta_R p_R(c_theta), beta_M p_HG(c_theta)
+
+// T(C -> C + v t) through the optical depth table (crep::atmosphereTransmittance); 1 at t = 0.
+vec3 transmittanceTo(float t) {
+  if (!(t > 0.0)) return vec3(1.0);
+  return crep_atmosphereTransmittance(opticalDepthTable, crep_atmosphere, rayC, rayC + t * rayV);
+}
+
+// A table at C + v t, with the ray's look-up coordinates (Listing 2: every look-up on the first's side).
+vec3 lookUp(sampler3D table, float t, vec4 first) {
+  vec4 coords = first;
+  return crep_lookUpAtmosphere(table, crep_atmosphere, rayC + t * rayV, rayV, rayL, coords);
+}
+
+#if CREP_ATMOSPHERE_SHAFTS == 1
+// Single scattering integrand at C + v t (metres): (beta_R d_R p_R + beta_M d_M p_HG) T(C->P) T_sun(P).
+vec3 singleIntegrand(float t) {
+  vec3 P = rayC + t * rayV;
+  vec2 d = crep_atmosphereDensity(crep_atmosphere, length(P) - crep_atmosphere.radii.x);
+  return (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) * transmittanceTo(t) *
+         crep_sunTransmittance(opticalDepthTable, crep_atmosphere, P, rayL);
+}
+
+// The trapezoid rule with n steps over [ta, tb] metres.
+vec3 trapezoid(float ta, float tb, int n) {
+  float h = (tb - ta) / float(n);
+  vec3 sum = 0.5 * (singleIntegrand(ta) + singleIntegrand(tb));
+  for (int k = 1; k < n; ++k) sum += singleIntegrand(ta + float(k) * h);
+  return sum * h;
+}
+
+vec3 singleSum = vec3(0.0);
+float pendingA = -1.0, pendingB = -1.0; // the lit section being merged (world units from the camera)
+float sectionEnd = 0.0;                 // s_E (surface) or s_F (sky), metres
+
+// One lit section [ta, tb] (world units from the camera) clipped to [0, sectionEnd] metres:
+// min(integrationSteps, max(1, ceil(integrationSteps (tb - ta) / s_m))) trapezoid steps.
+void integrateSection(float ta, float tb) {
+  float a = clamp(ta * metres - cameraShift, 0.0, sectionEnd), b = clamp(tb * metres - cameraShift, 0.0, sectionEnd);
+  if (!(b > a)) return;
+  int steps = crep_march.info.z;
+  int n = clamp(int(ceil(float(steps) * (b - a) / surfaceM)), 1, steps);
+  singleSum += trapezoid(a, b, n);
+}
+
+void crep_walkLitNode(CrepRowRay r, int i, int next, float ta, float tb) {
+  if (!(tb > ta)) return;
+  if (pendingB == ta) { // touching the previous lit node: one section (crep::minMaxLitSections)
+    pendingB = tb;
+    return;
+  }
+  if (pendingB > pendingA) integrateSection(pendingA, pendingB);
+  pendingA = ta;
+  pendingB = tb;
+}
+#elif CREP_ATMOSPHERE_SHAFTS == 2
+float litLength = 0.0;   // D_lit, world units
+float firstLit = -1.0;   // D_start, world units (-1: no lit section yet)
+void crep_walkLitNode(CrepRowRay r, int i, int next, float ta, float tb) {
+  if (!(tb > ta)) return;
+  if (firstLit < 0.0) firstLit = ta;
+  litLength += tb - ta;
+}
+#endif
+#if CREP_SHAFTS_WALK
+#include "crep/minmax_walk.glsl"
+#endif
+
+void main() {
+  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(pixel, crep_march.sizes.xy))) return;
+  float depth = texelFetch(cameraDepth, pixel, 0).r;
+  bool sky = !(depth < 1.0); // the sky test of crep::atmosphereImage (NaN: the sky)
+  vec4 ray = crep_pixelRay(crep_march, pixel, depth);
+  float s = ray.w;
+  rayV = ray.xyz;
+  rayL = -crep_march.lightDirection.xyz;
+  metres = crep_atmosphere.placement.x;
+  float Rg = crep_atmosphere.radii.x, Rt = crep_atmosphere.radii.y;
+  vec3 C0 = crep_atmospherePosition(crep_atmosphere, crep_march.cameraPosition.xyz);
+  rayC = C0;
+  if (length(C0) > Rt) { // above the top: start where the ray enters the atmosphere
+    vec2 top = crep_raySphere(C0, rayV, Rt);
+    if (!(top.y > 0.0)) { // misses the atmosphere: nothing in-scattered, everything transmitted
+      imageStore(inscatteringOut, pixel, vec4(0.0, 0.0, 0.0, 1.0));
+      imageStore(transmittanceOut, pixel, vec4(1.0));
+      return;
+    }
+    cameraShift = max(top.x, 0.0);
+    rayC = C0 + cameraShift * rayV;
+  }
+  surfaceM = max(s * metres - cameraShift, 0.0);
+  float exitTop = max(crep_raySphere(rayC, rayV, Rt).y, 0.0);
+  vec2 ground = crep_raySphere(rayC, rayV, Rg);
+  bool hitsGround = ground.x > 0.0;
+  float rayEnd = hitsGround ? min(ground.x, exitTop) : exitTop;   // t_X: the ray's end X
+  float tE = sky ? min(surfaceM, rayEnd) : min(surfaceM, exitTop); // s_F (sky: the far plane) or s_E
+
+  float cosTheta = dot(rayV, rayL);
+  rayleighPhaseBeta = crep_atmosphere.rayleighScattering.rgb * crep_rayleighPhase(cosTheta);
+  miePhaseBeta = crep_atmosphere.mieScattering.rgb * crep_henyeyGreenstein(crep_atmosphere.mieExtinction.w, cosTheta);
+
+  // The first look-up (at C) fixes the side of the horizon of every later one (Listing 2).
+  vec4 first = vec4(-1.0);
+  vec3 TE = transmittanceTo(tE);
+  vec3 L;
+#if CREP_ATMOSPHERE_SHAFTS == 0
+  vec3 multipleC = crep_lookUpAtmosphere(multipleTable, crep_atmosphere, rayC, rayV, rayL, first);
+  L = sky ? multipleC : multipleC - TE * lookUp(multipleTable, tE, first); // Eq. 8
+#else
+  vec3 higherC = crep_lookUpAtmosphere(higherOrdersTable, crep_atmosphere, rayC, rayV, rayL, first);
+  vec3 H = sky ? higherC : higherC - TE * lookUp(higherOrdersTable, tE, first); // unoccluded, Eq. 8
+  vec3 single = vec3(0.0);
+#if CREP_SHAFTS_WALK
+  ivec2 mapSize = crep_march.sizes.zw;
+  CrepRowRay r;
+  bool mapped = crep_mapRowRay(rayV, s, mapSize, r);
+#endif
+#if CREP_ATMOSPHERE_SHAFTS == 1
+  sectionEnd = tE;
+  if (!mapped) {
+    integrateSection(0.0, s);
+  } else {
+    crep_minMaxWalk(r, s, mapSize, crep_march.info.x, crep_march.info.y);
+    if (pendingB > pendingA) integrateSection(pendingA, pendingB);
+  }
+  single = singleSum;
+  if (sky && rayEnd > tE) single += trapezoid(tE, rayEnd, max(crep_march.info.w, 1)); // unshadowed
+#elif CREP_ATMOSPHERE_SHAFTS == 2
+  if (!mapped) {
+    if (s > 0.0) {
+      firstLit = 0.0;
+      litLength = s;
+    }
+  } else {
+    crep_minMaxWalk(r, s, mapSize, crep_march.info.x, crep_march.info.y);
+  }
+  if (litLength > 0.0) { // Eq. 8 with L1 over [D_start, D_start + D_lit], clipped to [0, s_E] (sky s_F)
+    float start = firstLit * metres - cameraShift;
+    float t1 = clamp(start, 0.0, tE);
+    float t2 = clamp(start + litLength * metres, t1, tE);
+    single = max(transmittanceTo(t1) * lookUp(singleTable, t1, first) -
+                     transmittanceTo(t2) * lookUp(singleTable, t2, first),
+                 vec3(0.0));
+  }
+  if (sky) single += TE * lookUp(singleTable, tE, first); // unshadowed beyond the far plane
+#elif CREP_ATMOSPHERE_SHAFTS == 3
+  // crep::prefilteredVisibility: Rec. 709 luminance of the shadowed texel over the unshadowed closed form.
+  vec3 shadowed = texelFetch(prefiltered, pixel, 0).rgb;
+  float g = crep_march.mieScattering.w;
+  float c = dot(crep_march.lightDirection.xyz, -rayV);
+  vec3 constant = crep_march.lightIrradiance.rgb *
+                  (crep_march.mieScattering.rgb * crep_henyeyGreenstein(g, c) +
+                   crep_march.rayleighScattering.rgb * crep_rayleighPhase(c));
+  vec3 unshadowed = constant * crep_transmittanceIntegral(crep_march.extinction.rgb, 0.0, s);
+  const vec3 rec709 = vec3(0.2126, 0.7152, 0.0722);
+  float den = dot(rec709, unshadowed);
+  float visibility = den > 0.0 ? clamp(dot(rec709, shadowed) / den, 0.0, 1.0) : 1.0;
+  vec3 singleC = lookUp(singleTable, 0.0, first);
+  vec3 singleE = TE * lookUp(singleTable, tE, first);
+  single = visibility * (singleC - singleE);
+  if (sky) single += singleE;
+#endif
+  L = single + H;
+#endif
+  vec3 T = sky ? (hitsGround ? vec3(0.0) : transmittanceTo(rayEnd)) : TE;
+  vec3 inscattering = crep_march.lightIrradiance.rgb * L;
+  imageStore(inscatteringOut, pixel, vec4(inscattering, (T.r + T.g + T.b) / 3.0));
+  imageStore(transmittanceOut, pixel, vec4(T, 1.0));
+}
