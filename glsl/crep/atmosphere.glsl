@@ -69,11 +69,12 @@ float crep_atmosphereAlphaCoord(int nAlpha, bool below, float ratio) {
 
 // u_phi (Yusov 2013, Eq. 6, Bruneton's form) and u_theta (Eq. 7), each in [0, 1].
 float crep_atmosphereSunZenithU(float cosSunZenith) {
-  return 0.5 * (atan(max(cosSunZenith, -0.1975) * tan(1.26 * 1.1)) / 1.1 + (1.0 - 0.26));
+  return clamp(0.5 * (atan(max(cosSunZenith, -0.1975) * tan(1.26 * 1.1)) / 1.1 + (1.0 - 0.26)), 0.0, 1.0);
 }
 float crep_atmosphereSunViewU(float cosSunView) {
   float gamma = acos(clamp(cosSunView, -1.0, 1.0)) * float(CREP_INV_PI);
-  return gamma >= 0.5 ? 0.5 + 0.5 * pow(2.0 * (gamma - 0.5), 1.5) : 0.5 - 0.5 * pow(2.0 * (0.5 - gamma), 1.5);
+  float u = gamma >= 0.5 ? 0.5 + 0.5 * pow(2.0 * (gamma - 0.5), 1.5) : 0.5 - 0.5 * pow(2.0 * (0.5 - gamma), 1.5);
+  return clamp(u, 0.0, 1.0);
 }
 
 // World parameters -> texture coordinates of the 4D table (Yusov 2013, Eq. 4-7, Listing 2;
@@ -267,6 +268,10 @@ CrepAtmosphereTexelRay crep_atmosphereTexelRay(CrepAtmosphereParams a, ivec4 tex
     c = ch + s * (1.0 - ch);
     ray.disc = r0 * r0 * (s * (1.0 - ch)) * (2.0 * ch + s * (1.0 - ch));
   }
+  // The last texel of each half is exactly straight down / up (as in double): v's horizontal part is 0
+  // there, and l is then decided by c_phi alone (crep_atmosphereDirections' degenerate case), which a
+  // float rounding of c away from -1 / 1 would not reproduce.
+  if (k == halfN - 1) c = ray.below ? -1.0 : 1.0;
   float uPhi = float(texel.z) / float(n.z - 1);
   float cPhi = tan((2.0 * uPhi - 0.74) * 1.1) / tan(1.26 * 1.1);
   float uTheta = float(texel.w) / float(n.w - 1);

@@ -1,0 +1,32 @@
+#version 450 core
+// AtmosphereTablesPass, J_n stage (Yusov 2013, Eq. 1, n >= 2): each texel of the 4D table sums over the
+// CREP_ATMOSPHERE_SAMPLES directions w of the Fibonacci sphere (beta_R d_R(h) p_R(w . v) + beta_M d_M(h)
+// p_HG(w . v)) L_(n-1)(C, w, l) times 4 pi / samples, L_(n-1) looked up (Listing 1) at the texel's point with
+// fresh coordinates.
+#include "crep/atmosphere.glsl"
+
+#ifndef CREP_ATMOSPHERE_SAMPLES
+#define CREP_ATMOSPHERE_SAMPLES 128
+#endif
+
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+
+layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = 0) uniform sampler3D crep_previousOrder;
+layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
+
+void main() {
+  ivec3 p = ivec3(gl_GlobalInvocationID);
+  ivec4 n = crep_atmosphere.tableSize;
+  if (any(greaterThanEqual(p, ivec3(n.x, n.y, n.z * n.w)))) return;
+  CrepAtmosphereTexelRay ray = crep_atmosphereTexelRay(crep_atmosphere, ivec4(p.xy, p.z % n.z, p.z / n.z));
+  vec2 dens = crep_atmosphereDensity(crep_atmosphere, ray.h);
+  vec3 sum = vec3(0.0);
+  for (int i = 0; i < CREP_ATMOSPHERE_SAMPLES; ++i) {
+    vec3 w = crep_fibonacciSphereDirection(i, CREP_ATMOSPHERE_SAMPLES);
+    vec4 coords = crep_atmosphereTableCoords(crep_atmosphere, ray.h, w.y, ray.sun.y, dot(w, ray.sun), vec4(-1.0));
+    vec3 radiance = crep_sampleAtmosphereTable(crep_previousOrder, crep_atmosphere, coords);
+    sum += crep_atmosphereScattering(crep_atmosphere, dens, dot(w, ray.view)) * radiance;
+  }
+  imageStore(crep_output, p, vec4(sum * float(CREP_FOUR_PI / float(CREP_ATMOSPHERE_SAMPLES)), 0.0));
+}

@@ -1,0 +1,13 @@
+#version 450 core
+// AtmosphereTablesPass, table sums: accumulator += addend, texel by texel (L_H = L2 + ... + LN and
+// L_M = L1 + L_H).
+layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
+
+layout(binding = 0, rgba32f) uniform restrict image3D crep_accumulator;
+layout(binding = 1, rgba32f) uniform restrict readonly image3D crep_addend;
+
+void main() {
+  ivec3 p = ivec3(gl_GlobalInvocationID);
+  if (any(greaterThanEqual(p, imageSize(crep_accumulator)))) return;
+  imageStore(crep_accumulator, p, vec4(imageLoad(crep_accumulator, p).rgb + imageLoad(crep_addend, p).rgb, 0.0));
+}

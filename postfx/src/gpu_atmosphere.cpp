@@ -1,0 +1,295 @@
+// The atmosphere's tables on the GPU (crep/postfx/gpu_atmosphere.h: gpu::atmosphereParams and
+// AtmosphereTablesPass; the CPU reference and the algorithm are crep/postfx/atmosphere.h's). Stages, one
+// compute shader each (one texel per invocation): passes/atmosphere_optical_depth.comp,
+// atmosphere_single.comp (L1), atmosphere_scattered.comp (J_n), atmosphere_order.comp (L_n),
+// atmosphere_sum.comp (L_H and L_M) and atmosphere_ambient.comp (E_sky); look-ups of
+// glsl/crep/atmosphere.glsl.
+#include <crep/core/error.h>
+#include <crep/core/shader_library.h>
+#include <crep/postfx/gpu_atmosphere.h>
+
+#include <epoxy/gl.h>
+
+#include <chrono>
+#include <cstring>
+#include <string>
+
+namespace crep {
+
+namespace gpu {
+
+AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
+                                  const AtmospherePlacement& placement) {
+  AtmosphereParams a;
+  a.radii =
+      glm::vec4(static_cast<float>(p.earthRadius), static_cast<float>(p.earthRadius + p.atmosphereHeight),
+                static_cast<float>(p.atmosphereHeight), static_cast<float>(kOccludedDensity));
+  a.rayleighScattering =
+      glm::vec4(glm::vec3(p.rayleighScattering), static_cast<float>(p.rayleighScaleHeight));
+  a.mieScattering = glm::vec4(glm::vec3(p.mieScattering), static_cast<float>(p.mieScaleHeight));
+  a.mieExtinction = glm::vec4(glm::vec3(p.mieScattering + p.mieAbsorption), static_cast<float>(p.mieG));
+  a.tableSize = glm::ivec4(o.size.height, o.size.viewZenith, o.size.sunZenith, o.size.sunView);
+  a.auxSizes = glm::ivec4(o.opticalDepthHeight, o.opticalDepthZenith, o.ambientSize, o.orders);
+  a.placement = glm::vec4(static_cast<float>(placement.metersPerUnit),
+                          static_cast<float>(placement.originAltitude), 0.0f, 0.0f);
+  return a;
+}
+
+} // namespace gpu
+
+namespace {
+
+constexpr const char* kOptions = "AtmospherePrecomputeOptions";
+
+int max3DTextureSize() {
+  GLint v = 0;
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &v);
+  return v;
+}
+
+void requireAtMost(const std::string& parameter, int value, int limit, const char* limitName) {
+  if (value > limit)
+    throw InvalidArgument(parameter, std::to_string(value),
+                          "must be <= " + std::string(limitName) + " (" + std::to_string(limit) + ")");
+}
+
+// A GL_TEXTURE_3D RGBA32F of the packed 4D table, linear filtering and clamp to edge (the look-ups').
+gl::Handle createTable3D(const AtmosphereTableSize& s) {
+  gl::Handle t = gl::createTexture(GL_TEXTURE_3D);
+  glTextureStorage3D(t.get(), 1, GL_RGBA32F, s.height, s.viewZenith, s.sunZenith * s.sunView);
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  return t;
+}
+
+gl::Handle createLinearTexture2D(std::uint32_t format, int width, int height) {
+  gl::Handle t = gl::createTexture2D(format, width, height);
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return t;
+}
+
+GLuint groups(int n, int local) {
+  return static_cast<GLuint>((n + local - 1) / local);
+}
+
+} // namespace
+
+AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info) {
+  validate(info.parameters);
+  validate(info.options);
+  const AtmospherePrecomputeOptions& o = info.options;
+  const std::string size = std::string(kOptions) + ".size.";
+  const int max3D = max3DTextureSize();
+  requireAtMost(size + "height", o.size.height, max3D, "GL_MAX_3D_TEXTURE_SIZE");
+  requireAtMost(size + "viewZenith", o.size.viewZenith, max3D, "GL_MAX_3D_TEXTURE_SIZE");
+  requireAtMost(size + "sunView", o.size.sunZenith * o.size.sunView, max3D, "GL_MAX_3D_TEXTURE_SIZE");
+  const int max2D = gl::maxTextureSize();
+  requireAtMost(std::string(kOptions) + ".opticalDepthHeight", o.opticalDepthHeight, max2D,
+                "GL_MAX_TEXTURE_SIZE");
+  requireAtMost(std::string(kOptions) + ".opticalDepthZenith", o.opticalDepthZenith, max2D,
+                "GL_MAX_TEXTURE_SIZE");
+  requireAtMost(std::string(kOptions) + ".ambientSize", o.ambientSize, max2D, "GL_MAX_TEXTURE_SIZE");
+  gl::checkError("AtmosphereTablesPass (before allocation)");
+  opticalDepth_ = createLinearTexture2D(GL_RG32F, o.opticalDepthHeight, o.opticalDepthZenith);
+  single_ = createTable3D(o.size);
+  higher_ = createTable3D(o.size);
+  multiple_ = createTable3D(o.size);
+  ambient_ = createLinearTexture2D(GL_RGBA32F, o.ambientSize, 1);
+  gl::checkError("AtmosphereTablesPass: allocating the tables");
+}
+
+void AtmosphereTablesPass::compute() {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  const AtmosphereTableSize& s = o.size;
+  const int depth = s.sunZenith * s.sunView;
+  times_.clear();
+
+  const gpu::AtmosphereParams params = gpu::atmosphereParams(info_.parameters, o);
+  gl::Handle block = gl::createDynamicBuffer(sizeof params);
+  glNamedBufferSubData(block.get(), 0, sizeof params, &params);
+
+  const auto steps = [](int n) {
+    return std::vector<ShaderDefine>{{"CREP_ATMOSPHERE_STEPS", std::to_string(n)}};
+  };
+  const std::vector<ShaderDefine> samples{{"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)}};
+  gl::Handle opticalProgram = buildProgram(
+      {{ShaderStage::Compute, "passes/atmosphere_optical_depth.comp", steps(o.opticalDepthSteps)}});
+  gl::Handle singleProgram =
+      buildProgram({{ShaderStage::Compute, "passes/atmosphere_single.comp", steps(o.singleSteps)}});
+  gl::Handle sumProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere_sum.comp", {}}});
+  gl::Handle ambientProgram =
+      buildProgram({{ShaderStage::Compute, "passes/atmosphere_ambient.comp", samples}});
+  gl::Handle scatteredProgram, orderProgram;
+  if (o.orders > 1) {
+    scatteredProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere_scattered.comp", samples}});
+    orderProgram =
+        buildProgram({{ShaderStage::Compute, "passes/atmosphere_order.comp", steps(o.orderSteps)}});
+  }
+
+  // Each stage ends with glFinish and is timed on the wall clock (GL_TIME_ELAPSED reads ~0 on llvmpipe).
+  glFinish();
+  auto start = std::chrono::steady_clock::now();
+  const auto endStage = [&](std::string name) {
+    glFinish();
+    const auto now = std::chrono::steady_clock::now();
+    times_.emplace_back(std::move(name), std::chrono::duration<double, std::milli>(now - start).count());
+    start = now;
+  };
+  // One dispatch covers a whole table (32 x 128 x 1024 texels at the default size). On a real GPU with a
+  // watchdog (Windows TDR, ~2 s) a J_n dispatch of many sphere samples at a large size may have to be split
+  // into slabs of z; llvmpipe has no watchdog.
+  const auto dispatchTable = [&] {
+    glDispatchCompute(groups(s.height, 4), groups(s.viewZenith, 4), groups(depth, 4));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+  };
+  const auto sum = [&](GLuint accumulator, GLuint addend) {
+    glUseProgram(sumProgram.get());
+    glBindImageTexture(0, accumulator, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, addend, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    dispatchTable();
+  };
+  const auto copy = [&](GLuint from, GLuint to) {
+    glCopyImageSubData(from, GL_TEXTURE_3D, 0, 0, 0, 0, to, GL_TEXTURE_3D, 0, 0, 0, 0, s.height, s.viewZenith,
+                       depth);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  };
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, block.get());
+  // Samplers of the texture units: none (each texture's own linear, clamp-to-edge state).
+  glBindSampler(0, 0);
+
+  // Optical depth.
+  glUseProgram(opticalProgram.get());
+  glBindImageTexture(0, opticalDepth_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+  glDispatchCompute(groups(o.opticalDepthHeight, 8), groups(o.opticalDepthZenith, 8), 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  endStage("optical depth");
+
+  // L1.
+  glUseProgram(singleProgram.get());
+  glBindTextureUnit(0, opticalDepth_.get());
+  glBindImageTexture(0, single_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  dispatchTable();
+  if (o.orders == 1) {
+    // L_H = 0, L_M = L1 (timed with single scattering).
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    glClearTexImage(higher_.get(), 0, GL_RGBA, GL_FLOAT, zero);
+    copy(single_.get(), multiple_.get());
+  }
+  endStage("single scattering");
+
+  if (o.orders > 1) {
+    // J_n and L_n ping-pong through two scratch tables: J_n reads L_(n-1) (L1 or the previous L_n), L_n reads
+    // J_n and overwrites the previous L_n, already added to L_H.
+    gl::Handle scattered = createTable3D(s);
+    gl::Handle order = createTable3D(s);
+    gl::checkError("AtmosphereTablesPass::compute: allocating the scratch tables");
+    for (int n = 2; n <= o.orders; ++n) {
+      const std::string name = "order " + std::to_string(n) + ": ";
+      glUseProgram(scatteredProgram.get());
+      glBindTextureUnit(0, n == 2 ? single_.get() : order.get());
+      glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      dispatchTable();
+      endStage(name + "J");
+      glUseProgram(orderProgram.get());
+      glBindTextureUnit(0, scattered.get());
+      glBindImageTexture(0, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      dispatchTable();
+      // L_H += L_n; after the last order L_M = L1 + L_H (both timed with this L stage).
+      if (n == 2)
+        copy(order.get(), higher_.get());
+      else
+        sum(higher_.get(), order.get());
+      if (n == o.orders) {
+        copy(single_.get(), multiple_.get());
+        sum(multiple_.get(), higher_.get());
+      }
+      endStage(name + "L");
+    }
+  }
+
+  // E_sky.
+  glUseProgram(ambientProgram.get());
+  glBindTextureUnit(0, multiple_.get());
+  glBindImageTexture(0, ambient_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(groups(o.ambientSize, 64), 1, 1);
+  gl::passOutputBarrier();
+  endStage("ambient");
+
+  gl::unbindPassState(2);
+  gl::checkError("AtmosphereTablesPass::compute");
+}
+
+namespace {
+
+bool sameSize(const AtmosphereTableSize& a, const AtmosphereTableSize& b) {
+  return a.height == b.height && a.viewZenith == b.viewZenith && a.sunZenith == b.sunZenith &&
+         a.sunView == b.sunView;
+}
+
+} // namespace
+
+void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  const auto fail = [](const std::string& why) {
+    throw InvalidArgument("AtmosphereTablesPass::upload.tables", "(tables)", why);
+  };
+  if (atmosphereCacheKey(tables.parameters, tables.options) != atmosphereCacheKey(info_.parameters, o))
+    fail("must have the parameters and options of the pass's CreateInfo");
+  const AtmosphereTable4D* tables4D[] = {&tables.single, &tables.higherOrders, &tables.multiple};
+  for (const AtmosphereTable4D* t : tables4D)
+    if (!sameSize(t->size, o.size) || t->rgba.size() != t->texels() * 4)
+      fail("4D tables must be of the CreateInfo's size");
+  if (tables.opticalDepth.width() != o.opticalDepthHeight ||
+      tables.opticalDepth.height() != o.opticalDepthZenith || tables.opticalDepth.channels() != 2)
+    fail("opticalDepth must be opticalDepthHeight x opticalDepthZenith with 2 channels");
+  if (tables.ambient.width() != o.ambientSize || tables.ambient.height() != 1 ||
+      tables.ambient.channels() != 3)
+    fail("ambient must be ambientSize x 1 with 3 channels");
+
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTextureSubImage2D(opticalDepth_.get(), 0, 0, 0, o.opticalDepthHeight, o.opticalDepthZenith, GL_RG,
+                      GL_FLOAT, tables.opticalDepth.data().data());
+  const int depth = o.size.sunZenith * o.size.sunView;
+  const std::pair<GLuint, const AtmosphereTable4D*> targets[] = {{single_.get(), &tables.single},
+                                                                 {higher_.get(), &tables.higherOrders},
+                                                                 {multiple_.get(), &tables.multiple}};
+  for (const auto& [texture, table] : targets)
+    glTextureSubImage3D(texture, 0, 0, 0, 0, o.size.height, o.size.viewZenith, depth, GL_RGBA, GL_FLOAT,
+                        table->rgba.data());
+  glTextureSubImage2D(ambient_.get(), 0, 0, 0, o.ambientSize, 1, GL_RGB, GL_FLOAT,
+                      tables.ambient.data().data());
+  gl::passOutputBarrier();
+  gl::checkError("AtmosphereTablesPass::upload");
+}
+
+AtmosphereTables AtmosphereTablesPass::download() const {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  AtmosphereTables t;
+  t.parameters = info_.parameters;
+  t.options = o;
+  t.options.keepOrders = false;
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  t.opticalDepth = Image(o.opticalDepthHeight, o.opticalDepthZenith, 2);
+  glGetTextureImage(opticalDepth_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(t.opticalDepth.byteSize()),
+                    t.opticalDepth.data().data());
+  const std::pair<GLuint, AtmosphereTable4D*> sources[] = {
+      {single_.get(), &t.single}, {higher_.get(), &t.higherOrders}, {multiple_.get(), &t.multiple}};
+  for (const auto& [texture, table] : sources) {
+    table->size = o.size;
+    table->rgba.assign(table->texels() * 4, 0.0f);
+    glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(table->rgba.size() * sizeof(float)),
+                      table->rgba.data());
+  }
+  t.ambient = Image(o.ambientSize, 1, 3);
+  glGetTextureImage(ambient_.get(), 0, GL_RGB, GL_FLOAT, static_cast<GLsizei>(t.ambient.byteSize()),
+                    t.ambient.data().data());
+  gl::checkError("AtmosphereTablesPass::download");
+  return t;
+}
+
+} // namespace crep
