@@ -54,6 +54,10 @@ void requireAtMost(const std::string& parameter, int value, int limit, const cha
 }
 
 // A GL_TEXTURE_3D RGBA32F of the packed 4D table, linear filtering and clamp to edge (the look-ups').
+// RGBA32F so that imageStore and the float look-ups match the CPU's float tables; on a real GPU an engine
+// that is short of memory could store RGBA16F (Yusov 2013 does: 32 MB at the default size) at ~1e-3
+// relative precision. Filtering is the hardware's (float weights on llvmpipe; 8-bit fractions on many
+// GPUs, which blur the comparison with the CPU reference, not the image).
 gl::Handle createTable3D(const AtmosphereTableSize& s) {
   gl::Handle t = gl::createTexture(GL_TEXTURE_3D);
   glTextureStorage3D(t.get(), 1, GL_RGBA32F, s.height, s.viewZenith, s.sunZenith * s.sunView);
