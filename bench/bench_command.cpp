@@ -17,7 +17,8 @@ const crep::tool::CommandRegistrar kBenchCommand({
     "            --scene NAME (forest) --size WxH (1920x1080) --map WxH (1024x1024) --bases M (32)\n"
     "            --repeat N (5) --quick (one size, no tables); the --map width is a multiple of 32\n"
     "            (16 with --quick); --plot FILE.svg writes the Table 1/2 rows as a chart beside the\n"
-    "            paper's (not with --quick); --section epipolar-sampling runs that section alone\n",
+    "            paper's (not with --quick); --section epipolar-sampling | atmosphere runs that section "
+    "alone\n",
     [](const std::vector<std::string>& args) {
       crep::bench::runBenchSuite(crep::bench::parseBenchOptions(args));
       return 0;

@@ -2,6 +2,7 @@
 #include "plot.h"
 
 #include "args.h"
+#include "atmosphere_frame.h"
 #include "gl_session.h"
 #include "methods.h"
 #include "scene_frame.h"
@@ -474,6 +475,87 @@ void epipolarSamplingBench(const BenchOptions& o) {
   }
 }
 
+/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per table
+/// and scattering order at the default size (16x64x32x8 with --quick), then the per-frame cost of the sky,
+/// aerial perspective and shafts with each shaft method on the terrain at the run's size, side by side in
+/// one run (median of the per-frame sums of `repeat` runs after a warm-up; "setup" stages excluded).
+void atmosphereBench(const BenchOptions& o) {
+  tool::AtmosphereSettings s;
+  s.cacheDirectory.clear(); // always compute: the precomputation's cost is the point
+  if (o.quick) s.tables.size = {16, 64, 32, 8};
+  tool::StageTimings tableTimings;
+  const tool::AtmosphereTableSet tables = tool::atmosphereTables(s, tableTimings);
+  const AtmosphereTableSize& n = s.tables.size;
+  std::printf("\natmosphere tables (%dx%dx%dx%d, %d orders, %d sphere samples; optical depth %dx%d; ms, one "
+              "run, glFinish + wall clock per stage):\n",
+              n.height, n.viewZenith, n.sunZenith, n.sunView, s.tables.orders, s.tables.sphereSamples,
+              s.tables.opticalDepthHeight, s.tables.opticalDepthZenith);
+  double total = 0.0;
+  for (const auto& [stage, ms] : tables.pass->stageTimes()) {
+    std::printf("  %-28s %10.1f\n", stage.c_str(), ms);
+    total += ms;
+  }
+  std::printf("  %-28s %10.1f\n", "total", total);
+
+  // Per frame: the terrain at 20 degrees of sun elevation, the scene's sun azimuth.
+  const std::string scene = "terrain";
+  s.sunElevation = 20.0;
+  const scenes::Scene base = scenes::makeScene(scene, double(o.screenWidth) / o.screenHeight);
+  tool::SceneOverrides overrides;
+  overrides.sun = tool::atmosphereSun(s, base.sun);
+  tool::StageTimings sceneTimings;
+  tool::SceneFrame frame =
+      tool::makeSceneFrame(scene, o.screenWidth, o.screenHeight, o.mapWidth, sceneTimings, overrides);
+  tool::MethodSettings settings;
+  settings.mapSize = o.mapWidth;
+  settings.prefilter.bases = o.bases;
+  const int repeat = o.quick ? 1 : std::max(1, std::min(o.repeat, 3));
+  std::printf(
+      "\natmosphere per frame (scene %s, %dx%d, map %d^2, sun elevation %g; ms: median of %d runs after "
+      "a warm-up):\n",
+      scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, s.sunElevation, repeat);
+  std::printf("  %-12s %10s   %s\n", "shafts", "ms", "stages (ms)");
+  std::map<AtmosphereShafts, double> perFrame;
+  for (const AtmosphereShafts shafts :
+       {AtmosphereShafts::None, AtmosphereShafts::Integrated, AtmosphereShafts::LitLengthTable,
+        AtmosphereShafts::PrefilteredVisibility}) {
+    s.shafts = shafts;
+    std::vector<double> sums;
+    std::map<std::string, std::vector<double>> stages;
+    for (int run = 0; run <= repeat; ++run) {
+      tool::StageTimings t;
+      (void)tool::runAtmosphere(*frame.frame, settings, s, *tables.pass, t);
+      if (run == 0) continue; // warm-up: programs, textures
+      double sum = 0.0;
+      for (const auto& row : t.rows()) {
+        if (row.stage.find("setup") != std::string::npos) continue;
+        sum += row.ms;
+        stages[row.stage].push_back(row.ms);
+      }
+      sums.push_back(sum);
+    }
+    const auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    std::string breakdown;
+    for (const auto& [stage, ms] : stages) {
+      char buffer[160];
+      std::snprintf(buffer, sizeof buffer, "%s%s %.1f", breakdown.empty() ? "" : ", ", stage.c_str(),
+                    median(ms));
+      breakdown += buffer;
+    }
+    perFrame[shafts] = median(sums);
+    std::printf("  %-12s %10.1f   %s\n", tool::atmosphereShaftsName(shafts), perFrame[shafts],
+                breakdown.c_str());
+  }
+  const double a = perFrame[AtmosphereShafts::Integrated];
+  if (a > 0.0)
+    std::printf("ratios to (a) integrated: none %.2f, (b) lut %.2f, (c) prefiltered %.2f\n",
+                perFrame[AtmosphereShafts::None] / a, perFrame[AtmosphereShafts::LitLengthTable] / a,
+                perFrame[AtmosphereShafts::PrefilteredVisibility] / a);
+}
+
 /// A built-in scene's frame as crep::Scattering input: the tool's frame (camera depth, standard shadow map)
 /// and an output texture.
 struct ScatteringFrame {
@@ -628,8 +710,8 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.repeat = args.integer("repeat", o.repeat, 1, 1000);
   o.plot = args.string("plot", "");
   o.section = args.string("section", "");
-  if (!o.section.empty() && o.section != "epipolar-sampling")
-    throw tool::UsageError("option --section: '" + o.section + "' is not epipolar-sampling");
+  if (!o.section.empty() && o.section != "epipolar-sampling" && o.section != "atmosphere")
+    throw tool::UsageError("option --section: '" + o.section + "' is not epipolar-sampling or atmosphere");
   if (!o.section.empty() && !o.plot.empty())
     throw tool::UsageError("option --plot: needs the whole suite, not --section");
   if (!o.plot.empty() && o.quick)
@@ -879,6 +961,11 @@ void runBenchSuite(const BenchOptions& o) {
     printHowMeasured(o);
     return;
   }
+  if (o.section == "atmosphere") {
+    atmosphereBench(o);
+    printHowMeasured(o);
+    return;
+  }
   const Setup s = makeSetup(o.scene, o.screenWidth, o.screenHeight, mapW, mapH);
 
   // Memory copy baselines over the bytes the prefilter writes (W x H x ceil(M / 4) RGBA8 texels).
@@ -966,6 +1053,7 @@ void runBenchSuite(const BenchOptions& o) {
   sunInView(o);
   postEffects(o);
   epipolarSamplingBench(o);
+  atmosphereBench(o);
 
   if (!o.quick) {
     // Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8).

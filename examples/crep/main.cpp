@@ -1,5 +1,6 @@
 // crep: the command-line tool of crepuscular. See `crep help`.
 #include "args.h"
+#include "atmosphere_frame.h"
 #include "command_registry.h"
 #include "commands.h"
 #include "methods.h"
@@ -36,8 +37,10 @@ const char* const kRender =
                                 through a window, a light texture)
             --size WxH          image size (default 1280x720)
             --method M          prefilter (default: Klehm et al., GPU) | reference (world-space march
-                                against a standard shadow map) | the other methods listed below
-@METHOD_OPTIONS@            --exposure X        PNG exposure in [1e-30, 1e30] (default 1)
+                                against a standard shadow map) | atmosphere (the Earth's sky,
+                                aerial perspective and shafts; options below) | the other methods listed
+                                below
+@METHOD_OPTIONS@@ATMOSPHERE_OPTIONS@            --exposure X        PNG exposure in [1e-30, 1e30] (default 1)
 @TONEMAP_OPTIONS@            --out PREFIX        output path prefix (default crep-<scene>): writes PREFIX.exr, PREFIX.png
             --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
                                 DIR/shadow.exr (float depth-buffer values), DIR/frame.json, and
@@ -106,6 +109,9 @@ std::string withMethodOptions(std::string text) {
   const std::string toneMapMarker = "@TONEMAP_OPTIONS@";
   if (const auto at = text.find(toneMapMarker); at != std::string::npos)
     text.replace(at, toneMapMarker.size(), crep::tool::kToneMapOptionsHelp);
+  const std::string atmosphereMarker = "@ATMOSPHERE_OPTIONS@";
+  if (const auto at = text.find(atmosphereMarker); at != std::string::npos)
+    text.replace(at, atmosphereMarker.size(), crep::tool::kAtmosphereOptionsHelp);
   return text;
 }
 

@@ -5,6 +5,7 @@
 // DIR/shadow.exr (float depth-buffer values) and DIR/frame.json (and DIR/light-texture.exr for a scene whose
 // sun has a light texture).
 #include "args.h"
+#include "atmosphere_frame.h"
 #include "commands.h"
 #include "contact_sheet.h"
 #include "frame_json.h"
@@ -16,6 +17,7 @@
 #include "timings.h"
 
 #include <crep/core/error.h>
+#include <crep/postfx/atmosphere.h>
 #include <crep/postfx/gpu_tone_mapping.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
@@ -196,11 +198,88 @@ Image toneMappedPng(const ToneMapSettings& settings, std::uint32_t composite, co
   return composeGridSheet(header, tiles, std::min(width, 480), 4);
 }
 
+/// `crep render --method atmosphere`: the scene on the Earth (atmosphere_frame.h), lit by the sun after the
+/// atmosphere's extinction plus the ambient sky light (Yusov 2013, "Terrain shaders"), composited with the
+/// atmosphere's transmittance and in-scattering, tone mapped (default: uncharted2 with auto exposure).
+int renderAtmosphere(const Args& args, const std::string& sceneName, glm::ivec2 size, double exposure) {
+  ToneMapSettings toneMap = toneMapSettings(args, exposure);
+  if (!args.has("tonemap")) {
+    toneMap.enabled = true;
+    toneMap.options.op = ToneMapOperator::Uncharted2;
+    toneMap.options.autoExposure = true;
+  }
+  const MethodSettings settings = methodSettings(args);
+  const AtmosphereSettings atmosphere = atmosphereSettings(args);
+  const std::string out = args.string("out", "crep-" + sceneName);
+  requireOutputPrefix({"--out", out});
+  if (args.has("export-frame"))
+    throw UsageError("option --export-frame: not available with --method atmosphere");
+  const std::vector<PathOption> outputs = {{"--out", out + ".exr"}, {"--out", out + ".png"}};
+  requireDistinctFiles(outputs);
+  requireOutputFile(outputs[0]);
+  requireOutputFile(outputs[1]);
+  const scenes::Scene base = scenes::makeScene(sceneName, double(size.x) / size.y);
+
+  StageTimings timings;
+  if (isatty(2)) timings.setProgress("crep render");
+  ensureGlContext("render", args.has("debug-gl"), timings);
+  AtmosphereTableSet tables = atmosphereTables(atmosphere, timings);
+  SceneOverrides overrides;
+  overrides.sun = atmosphereSun(atmosphere, base.sun);
+  overrides.camera = atmosphereCamera(atmosphere, base.camera);
+  // The surfaces: the sun's transmittance and the ambient sky light at the camera (one value for the
+  // scene, which spans a few kilometres; Yusov evaluates them per vertex).
+  const glm::dvec3 toSun = -overrides.sun->direction();
+  const glm::dvec3 at =
+      atmospherePosition(atmosphere.placement, atmosphere.parameters, overrides.camera->position());
+  overrides.shadeIrradiance = overrides.sun->irradiance() * sunTransmittance(tables.cpu, at, toSun);
+  overrides.shadeAmbient =
+      overrides.sun->irradiance() * lookUpAmbientSkyLight(tables.cpu, glm::dot(glm::normalize(at), toSun));
+  SceneFrame s = makeSceneFrame(sceneName, size.x, size.y, settings.mapSize, timings, overrides);
+  FrameInputs& frame = *s.frame;
+  const AtmosphereOutput result = runAtmosphere(frame, settings, atmosphere, *tables.pass, timings);
+  gl::Handle composite =
+      timings.time("composite", [&] { return compositeAtmosphere(frame, s.color.get(), result); });
+  Image inscattering, transmittance, compositeImg;
+  timings.time("readback", [&] {
+    inscattering = readRgba(result.inscattering.get(), size.x, size.y);
+    transmittance = readRgba(result.transmittance.get(), size.x, size.y);
+    compositeImg = readRgba(composite.get(), size.x, size.y);
+  });
+  checkGlErrors("rendering");
+  requireFinite(compositeImg, "the composited image");
+  requireFinite(inscattering, "the atmosphere's in-scattering");
+  const std::string exrPath = out + ".exr", pngPath = out + ".png";
+  timings.time("write exr", [&] {
+    const ExrLayer layers[] = {
+        {"composite", &compositeImg}, {"scattering", &inscattering}, {"transmittance", &transmittance}};
+    writeExrLayers(exrPath, layers, ExrPixelType::Float); // linear radiance for measurements
+  });
+  Image png;
+  timings.time("tone map", [&] { png = toneMappedPng(toneMap, composite.get(), compositeImg, exposure); });
+  timings.time("write png", [&] { writePng(pngPath, png, ToneMap{1.0f}); });
+  const glm::dvec3 sunDir = toSun;
+  std::printf("crep render: scene %s, %dx%d, method atmosphere (%s; sun elevation %g deg, azimuth %g deg; "
+              "tables %dx%dx%dx%d, %d orders, %s)\n",
+              s.scene->name.c_str(), size.x, size.y, result.detail.c_str(), atmosphere.sunElevation,
+              std::atan2(sunDir.x, -sunDir.z) * 180.0 / std::numbers::pi, atmosphere.tables.size.height,
+              atmosphere.tables.size.viewZenith, atmosphere.tables.size.sunZenith,
+              atmosphere.tables.size.sunView, atmosphere.tables.orders,
+              tables.loaded ? "loaded from the cache" : "computed");
+  timings.print(stdout);
+  std::printf("wrote %s (layers composite.RGBA, scattering.RGBA, transmittance.RGBA) and %s\n",
+              exrPath.c_str(), pngPath.c_str());
+  std::printf("tone mapping: %s%s\n", toneMap.all ? "all" : toneMapOperatorName(toneMap.options.op),
+              toneMap.options.autoExposure ? ", auto exposure" : "");
+  return 0;
+}
+
 } // namespace
 
 int renderCommand(const std::vector<std::string>& argv) {
   std::set<std::string> valued = {"scene", "size", "out", "exposure", "export-frame"};
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
+  valued.insert(kAtmosphereOptions.begin(), kAtmosphereOptions.end());
   valued.insert(kToneMapValuedOptions.begin(), kToneMapValuedOptions.end());
   const Args args(argv, valued, {"debug-gl", kAutoExposureFlag});
   const std::string sceneName = args.string("scene", "colonnade");
@@ -208,6 +287,9 @@ int renderCommand(const std::vector<std::string>& argv) {
   const double exposure = exposureOption(args);
   const ToneMapSettings toneMap = toneMapSettings(args, exposure);
   const std::string method = args.string("method", "prefilter");
+  if (method == "atmosphere") return renderAtmosphere(args, sceneName, size, exposure);
+  if (hasAtmosphereOptions(args))
+    throw UsageError("options --sun-elevation, --shafts, ... need --method atmosphere");
   findMethod(method); // usage error before any GL work
   const MethodSettings settings = methodSettings(args);
   const std::string out = args.string("out", "crep-" + sceneName);
