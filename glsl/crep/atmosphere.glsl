@@ -55,6 +55,18 @@ float crep_cosHorizon(CrepAtmosphereParams a, float h) {
   return -sqrt(h * (2.0 * R + h)) / (R + h);
 }
 
+// crep::horizonBlendWidth: the half-width in cos zenith of the band around the horizon where Eq. 8's
+// segment values are blended from a ray just below and one just above it (Bruneton and Neyret 2008's fix):
+// the spread of the horizon cosine between the two altitude texels around h, plus 0.004.
+float crep_horizonBlendWidth(CrepAtmosphereParams a, float h) {
+  int N = a.tableSize.x;
+  float H = a.radii.z;
+  float u = sqrt(clamp(h / H, 0.0, 1.0)) * float(N - 1);
+  int i0 = clamp(int(floor(u)), 0, N - 2);
+  float x = float(i0) / float(N - 1), y = float(i0 + 1) / float(N - 1);
+  return 2.0 * abs(crep_cosHorizon(a, H * y * y) - crep_cosHorizon(a, H * x * x)) + 0.004;
+}
+
 // Texture coordinate of u in [0, 1] for a dimension of n texels (texel i's centre at u = i / (n - 1)).
 float crep_atmosphereTexCoord(float u, int n) { return (0.5 + u * float(n - 1)) / float(n); }
 

@@ -9,9 +9,12 @@
 //   void crep_walkLitNode(CrepRowRay r, int i, int next, float ta, float tb)
 //       called once per lit node, in ascending order: texels [i, next) of row r.texelRow are all lit and
 //       the ray's distances over them are [ta, tb] (clipped to [0, s], ascending; tb == the next node's ta)
-// and includes crep/epipolar.glsl (CrepRowRay, crep_rowRayDistance).
+// and defines CREP_MINMAX_WALK_INPUTS to say so. Without it this file declares nothing (so it compiles on its
+// own, as every public include must).
 #ifndef CREP_MINMAX_WALK_GLSL
 #define CREP_MINMAX_WALK_GLSL
+#include "crep/epipolar.glsl"
+#ifdef CREP_MINMAX_WALK_INPUTS
 
 #ifndef CREP_MAX_TREE_LEVELS
 #define CREP_MAX_TREE_LEVELS 16
@@ -61,4 +64,5 @@ int crep_minMaxWalk(CrepRowRay r, float s, ivec2 mapSize, int levels, int rowStr
   return steps;
 }
 
+#endif // CREP_MINMAX_WALK_INPUTS
 #endif // CREP_MINMAX_WALK_GLSL

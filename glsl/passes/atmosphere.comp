@@ -110,6 +110,20 @@ vec3 transmittanceTo(float t) {
   return exp(-crep_atmosphereExtinction(crep_atmosphere, max(D, vec2(0.0))));
 }
 
+// crep::atmosphereRay's segment transmittance T(C -> C + v t) for Eq. 8 and a surface's output: the
+// trapezoid rule with CREP_SEGMENT_STEPS steps of the densities along the segment (the optical depth
+// table's difference of two large values steps by several percent near the horizon); 1 at t = 0.
+#define CREP_SEGMENT_STEPS 16
+vec3 segmentTransmittance(float t) {
+  if (!(t > 0.0)) return vec3(1.0);
+  float dt = t / float(CREP_SEGMENT_STEPS);
+  vec2 sum = 0.5 * (crep_atmosphereDensity(crep_atmosphere, rayPoint(0.0).h) +
+                    crep_atmosphereDensity(crep_atmosphere, rayPoint(t).h));
+  for (int k = 1; k < CREP_SEGMENT_STEPS; ++k)
+    sum += crep_atmosphereDensity(crep_atmosphere, rayPoint(float(k) * dt).h);
+  return exp(-crep_atmosphereExtinction(crep_atmosphere, sum * dt));
+}
+
 // A table at C + v t, with the ray's look-up coordinates (Listing 2: every look-up on the first's side).
 vec3 lookUp(sampler3D table, float t, vec4 first) {
   vec4 coords = first;
@@ -168,8 +182,43 @@ void crep_walkLitNode(CrepRowRay r, int i, int next, float ta, float tb) {
 }
 #endif
 #if CREP_SHAFTS_WALK
+#define CREP_MINMAX_WALK_INPUTS 1
 #include "crep/minmax_walk.glsl"
 #endif
+
+float visibility = 1.0; // (c): the prefiltered visible fraction of the ray
+
+// Everything but (a)'s integrated single scattering, for the current ray (rayV, rayCV, rayVL): Eq. 8 with
+// L_M (None), or the unoccluded higher orders (Eq. 8 with L_H) plus (b)'s or (c)'s single scattering. The
+// first look-up (at C) fixes the side of the horizon of every later one (Listing 2).
+vec3 tablePart(bool sky, float tE) {
+  vec4 first = vec4(-1.0);
+  vec3 TE = segmentTransmittance(tE);
+#if CREP_ATMOSPHERE_SHAFTS == 0
+  vec3 multipleC = lookUpAt(multipleTable, 0.0, first);
+  return sky ? multipleC : multipleC - TE * lookUp(multipleTable, tE, first); // Eq. 8
+#else
+  vec3 higherC = lookUpAt(higherOrdersTable, 0.0, first);
+  vec3 part = sky ? higherC : higherC - TE * lookUp(higherOrdersTable, tE, first); // unoccluded, Eq. 8
+#if CREP_ATMOSPHERE_SHAFTS == 2
+  if (litLength > 0.0) { // Eq. 8 with L1 over [D_start, D_start + D_lit], clipped to [0, s_E] (sky s_F)
+    float start = firstLit * metres - cameraShift;
+    float t1 = clamp(start, 0.0, tE);
+    float t2 = clamp(start + litLength * metres, t1, tE);
+    part += max(segmentTransmittance(t1) * lookUp(singleTable, t1, first) -
+                    segmentTransmittance(t2) * lookUp(singleTable, t2, first),
+                vec3(0.0));
+  }
+  if (sky) part += TE * lookUp(singleTable, tE, first); // unshadowed beyond the far plane
+#elif CREP_ATMOSPHERE_SHAFTS == 3
+  vec3 singleC = lookUp(singleTable, 0.0, first);
+  vec3 singleE = TE * lookUp(singleTable, tE, first);
+  part += visibility * (singleC - singleE);
+  if (sky) part += singleE;
+#endif
+  return part;
+#endif
+}
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -214,16 +263,6 @@ void main() {
   rayleighPhaseBeta = crep_atmosphere.rayleighScattering.rgb * crep_rayleighPhase(cosTheta);
   miePhaseBeta = crep_atmosphere.mieScattering.rgb * crep_henyeyGreenstein(crep_atmosphere.mieExtinction.w, cosTheta);
 
-  // The first look-up (at C) fixes the side of the horizon of every later one (Listing 2).
-  vec4 first = vec4(-1.0);
-  vec3 TE = transmittanceTo(tE);
-  vec3 L;
-#if CREP_ATMOSPHERE_SHAFTS == 0
-  vec3 multipleC = lookUpAt(multipleTable, 0.0, first);
-  L = sky ? multipleC : multipleC - TE * lookUp(multipleTable, tE, first); // Eq. 8
-#else
-  vec3 higherC = lookUpAt(higherOrdersTable, 0.0, first);
-  vec3 H = sky ? higherC : higherC - TE * lookUp(higherOrdersTable, tE, first); // unoccluded, Eq. 8
   vec3 single = vec3(0.0);
 #if CREP_SHAFTS_WALK
   ivec2 mapSize = crep_march.sizes.zw;
@@ -249,15 +288,6 @@ void main() {
   } else {
     crep_minMaxWalk(r, s, mapSize, crep_march.info.x, crep_march.info.y);
   }
-  if (litLength > 0.0) { // Eq. 8 with L1 over [D_start, D_start + D_lit], clipped to [0, s_E] (sky s_F)
-    float start = firstLit * metres - cameraShift;
-    float t1 = clamp(start, 0.0, tE);
-    float t2 = clamp(start + litLength * metres, t1, tE);
-    single = max(transmittanceTo(t1) * lookUp(singleTable, t1, first) -
-                     transmittanceTo(t2) * lookUp(singleTable, t2, first),
-                 vec3(0.0));
-  }
-  if (sky) single += TE * lookUp(singleTable, tE, first); // unshadowed beyond the far plane
 #elif CREP_ATMOSPHERE_SHAFTS == 3
   // crep::prefilteredVisibility: Rec. 709 luminance of the shadowed texel over the unshadowed closed form.
   vec3 shadowed = texelFetch(prefiltered, pixel, 0).rgb;
@@ -269,15 +299,37 @@ void main() {
   vec3 unshadowed = constant * crep_transmittanceIntegral(crep_march.extinction.rgb, 0.0, s);
   const vec3 rec709 = vec3(0.2126, 0.7152, 0.0722);
   float den = dot(rec709, unshadowed);
-  float visibility = den > 0.0 ? clamp(dot(rec709, shadowed) / den, 0.0, 1.0) : 1.0;
-  vec3 singleC = lookUp(singleTable, 0.0, first);
-  vec3 singleE = TE * lookUp(singleTable, tE, first);
-  single = visibility * (singleC - singleE);
-  if (sky) single += singleE;
+  visibility = den > 0.0 ? clamp(dot(rec709, shadowed) / den, 0.0, 1.0) : 1.0;
 #endif
-  L = single + H;
-#endif
-  vec3 T = sky ? (hitsGround ? vec3(0.0) : transmittanceTo(rayEnd)) : TE;
+  // The table-based part; near the horizon the blend of a ray just below and one just above it
+  // (crep::horizonBlendWidth), as crep::atmosphereRay.
+  vec3 L;
+  float rC = sqrt(Rg * Rg + rayRR), cz = rayCV / rC;
+  float hC = rayRR / (rC + Rg);
+  float ch = crep_cosHorizon(crep_atmosphere, hC), eps = crep_horizonBlendWidth(crep_atmosphere, hC);
+  vec3 n = normalize(rayC);
+  vec3 across = rayV - cz * n;
+  if (abs(cz - ch) < eps && length(across) > 1e-6) {
+    vec3 u = normalize(across);
+    vec3 v0 = rayV;
+    float cv0 = rayCV, vl0 = rayVL;
+    float w = (cz - ch + eps) / (2.0 * eps);
+    L = vec3(0.0);
+    for (int side = 0; side < 2; ++side) {
+      float c2 = side == 0 ? ch - eps : ch + eps;
+      rayV = c2 * n + sqrt(max(0.0, 1.0 - c2 * c2)) * u;
+      rayCV = rC * c2;
+      rayVL = dot(rayV, rayL);
+      L += (side == 0 ? 1.0 - w : w) * tablePart(sky, tE);
+    }
+    rayV = v0;
+    rayCV = cv0;
+    rayVL = vl0;
+  } else {
+    L = tablePart(sky, tE);
+  }
+  L += single;
+  vec3 T = sky ? (hitsGround ? vec3(0.0) : transmittanceTo(rayEnd)) : segmentTransmittance(tE);
   vec3 inscattering = crep_march.lightIrradiance.rgb * L;
   imageStore(inscatteringOut, pixel, vec4(inscattering, (T.r + T.g + T.b) / 3.0));
   imageStore(transmittanceOut, pixel, vec4(T, 1.0));

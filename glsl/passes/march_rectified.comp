@@ -80,6 +80,7 @@ void crep_walkLitNode(CrepRowRay r, int i, int next, float ta, float tb) {
   litSum += crep_section(litSigma, ta, tb);
 #endif
 }
+#define CREP_MINMAX_WALK_INPUTS 1
 #include "crep/minmax_walk.glsl"
 #endif
 

@@ -404,6 +404,16 @@ double cosHorizon(const AtmosphereParameters& p, double h) {
   return -std::sqrt(hh * (2.0 * p.earthRadius + hh)) / (p.earthRadius + hh);
 }
 
+// Bruneton and Neyret 2008's horizon blend, its width from the table's altitude texels around h.
+double horizonBlendWidth(const AtmosphereParameters& p, const AtmosphereTableSize& size, double h) {
+  const int N = size.height;
+  const double H = p.atmosphereHeight;
+  const double u = std::sqrt(std::clamp(h / H, 0.0, 1.0)) * (N - 1);
+  const int i0 = std::clamp(static_cast<int>(std::floor(u)), 0, N - 2);
+  const double a = double(i0) / (N - 1), b = double(i0 + 1) / (N - 1);
+  return 2.0 * std::abs(cosHorizon(p, H * b * b) - cosHorizon(p, H * a * a)) + 0.004;
+}
+
 // Yusov 2013, Eq. 4-7 with Listing 2's side choice and texel-centre mapping of u_alpha.
 glm::dvec4 atmosphereTableCoords(const AtmosphereParameters& p, const AtmosphereTableSize& size, double h,
                                  double cosViewZenith, double cosSunZenith, double cosSunView,

@@ -16,7 +16,15 @@
 //   far plane F = C + v s_F, s_F = min(s_m, t_X); the ray continues unshadowed to X.
 // - Look-ups of one ray (Yusov 2013, Listing 2): the first 4D look-up (at C) chooses the side of the horizon;
 //   every later look-up of the ray, in any 4D table, gets the first one's coordinates as `previous`.
-//   T(C->P) is atmosphereTransmittance (1 for P = C), T_sun(P) is sunTransmittance.
+//   T(C->P) is atmosphereTransmittance (1 for P = C) inside (a)'s integrand and for the sky's own
+//   transmittance T(C->X); in Eq. 8 (every T(C->E), T(C->F), T(C->P1), T(C->P2) below) and for a surface
+//   pixel's transmittance it is the segment's: exp(-beta_e . densityIntegral(C, P, 16)) (the optical depth
+//   table's difference of two large values steps by several percent near the horizon). T_sun(P) is
+//   sunTransmittance.
+// - Near the horizon (|c_alpha(C) - c_h(C)| < w, w = horizonBlendWidth(h_C)) every term but (a)'s integrated
+//   single scattering is the blend (1 - f) X(v_-) + f X(v_+), f = (c_alpha - c_h + w) / (2 w), of the same
+//   terms for the directions v_-, v_+ in the vertical plane of v with zenith cosines c_h - w and c_h + w
+//   (Bruneton and Neyret 2008's implementation): Eq. 8's two look-ups are large and nearly equal there.
 // - None (Eq. 8 with L_M): surface L = L_M(C) - T(C->E) L_M(E); sky L = L_M(C) (nothing beyond the end).
 // - Shafts (a), (b), (c): single + H, the higher orders unoccluded: surface H = L_H(C) - T(C->E) L_H(E),
 //   sky H = L_H(C).
@@ -82,6 +90,10 @@ void validateRayOptions(const AtmosphereRayOptions& o) {
                           "must be in [1, 2^20]");
 }
 
+/// Trapezoid steps of the transmittance of a segment (RayEvaluator::segmentTransmittance; GLSL twin in
+/// passes/atmosphere.comp).
+constexpr int kSegmentSteps = 16;
+
 /// The look-ups and integrands of one ray from C along v with the sun towards l.
 class RayEvaluator {
 public:
@@ -98,6 +110,15 @@ public:
   glm::dvec3 transmittance(double t) const {
     if (!(t > 0.0)) return glm::dvec3(1.0);
     return atmosphereTransmittance(tables_, C_, at(t));
+  }
+
+  /// T(C -> C + v t) of a segment that Eq. 8 or the output uses: the trapezoid rule with kSegmentSteps steps
+  /// of the densities along it (the optical depth table's difference of two large values has steps of
+  /// several percent near the horizon, where its zenith cosine is coarse); 1 at t <= 0.
+  glm::dvec3 segmentTransmittance(double t) const {
+    if (!(t > 0.0)) return glm::dvec3(1.0);
+    const glm::dvec2 d = densityIntegral(p_, C_, at(t), kSegmentSteps);
+    return glm::exp(-(p_.rayleighScattering * d.x + (p_.mieScattering + p_.mieAbsorption) * d.y));
   }
 
   /// Listing 1 at C + v t; the first look-up of the ray is at C (made first when the first call is
@@ -118,7 +139,7 @@ public:
   /// Eq. 8 between C and C + v t: L(C) - T(C -> C + v t) L(C + v t).
   glm::dvec3 eq8(const AtmosphereTable4D& table, double t) {
     const glm::dvec3 atC = lookUp(table, 0.0);
-    return atC - transmittance(t) * lookUp(table, t);
+    return atC - segmentTransmittance(t) * lookUp(table, t);
   }
 
   /// The single-scattering integrand at C + v t (Listing 3's, with table transmittances).
@@ -196,60 +217,70 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
   const double sEnd = sky ? std::min(sm, tX) : std::min(sm, tTop); // s_F or s_E
 
   RayEvaluator ray(tables, C, v, l);
-  glm::dvec3 radiance(0.0);
-  if (options.shafts == AtmosphereShafts::None) {
-    radiance = sky ? ray.lookUp(tables.multiple, 0.0) : ray.eq8(tables.multiple, sEnd);
-  } else {
+  // The table-based part of the radiance (all but (a)'s integrated single scattering) of the ray of `r`.
+  const auto tablePart = [&](RayEvaluator& r) {
+    if (options.shafts == AtmosphereShafts::None)
+      return sky ? r.lookUp(tables.multiple, 0.0) : r.eq8(tables.multiple, sEnd);
     // Unoccluded higher orders (MS-UnO).
-    const glm::dvec3 higher = sky ? ray.lookUp(tables.higherOrders, 0.0) : ray.eq8(tables.higherOrders, sEnd);
-    glm::dvec3 single(0.0);
-    switch (options.shafts) {
-    case AtmosphereShafts::Integrated: {
-      // SS-Int: the lit sections, then (sky) the unshadowed rest to the end of the ray.
-      for (const glm::dvec2& section : shadowing.litSections) {
-        const double ta = std::clamp(section.x * mpu - enter, 0.0, sEnd);
-        const double tb = std::clamp(section.y * mpu - enter, 0.0, sEnd);
-        if (!(tb > ta)) continue;
-        const double share = std::ceil(options.integrationSteps * (tb - ta) / sm);
-        const int n = static_cast<int>(std::clamp(share, 1.0, static_cast<double>(options.integrationSteps)));
-        single += ray.trapezoid(ta, tb, n);
-      }
-      if (sky && tX > sEnd) single += ray.trapezoid(sEnd, tX, options.skySteps);
-      break;
-    }
-    case AtmosphereShafts::LitLengthTable: {
+    glm::dvec3 part = sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(tables.higherOrders, sEnd);
+    if (options.shafts == AtmosphereShafts::LitLengthTable) {
       // SS-LUT: Eq. 8 with L1 between the first lit point and the end of the lit length.
       const double litLength = std::max(0.0, shadowing.litLength) * mpu;
       if (litLength > 0.0) {
         const double first = shadowing.firstLit * mpu - enter;
         const double a = std::clamp(first, 0.0, sEnd);
         const double b = std::clamp(first + litLength, a, sEnd);
-        const glm::dvec3 l1C = ray.lookUp(tables.single, 0.0); // the first look-up is at C
-        const glm::dvec3 l1a = a > 0.0 ? ray.lookUp(tables.single, a) : l1C;
-        const glm::dvec3 part =
-            ray.transmittance(a) * l1a - ray.transmittance(b) * ray.lookUp(tables.single, b);
-        single = glm::max(part, glm::dvec3(0.0));
+        const glm::dvec3 l1C = r.lookUp(tables.single, 0.0); // the first look-up is at C
+        const glm::dvec3 l1a = a > 0.0 ? r.lookUp(tables.single, a) : l1C;
+        const glm::dvec3 lit =
+            r.segmentTransmittance(a) * l1a - r.segmentTransmittance(b) * r.lookUp(tables.single, b);
+        part += glm::max(lit, glm::dvec3(0.0));
       }
-      if (sky) single += ray.transmittance(sEnd) * ray.lookUp(tables.single, sEnd);
-      break;
+      if (sky) part += r.segmentTransmittance(sEnd) * r.lookUp(tables.single, sEnd);
+    } else if (options.shafts == AtmosphereShafts::PrefilteredVisibility) {
+      const glm::dvec3 l1C = r.lookUp(tables.single, 0.0);
+      const glm::dvec3 beyond = r.segmentTransmittance(sEnd) * r.lookUp(tables.single, sEnd);
+      part += shadowing.visibility * (l1C - beyond);
+      if (sky) part += beyond;
     }
-    case AtmosphereShafts::PrefilteredVisibility: {
-      const glm::dvec3 l1C = ray.lookUp(tables.single, 0.0);
-      const glm::dvec3 beyond = ray.transmittance(sEnd) * ray.lookUp(tables.single, sEnd);
-      single = shadowing.visibility * (l1C - beyond);
-      if (sky) single += beyond;
-      break;
+    return part;
+  };
+  // Near the horizon: the blend of a ray just below and one just above it (horizonBlendWidth).
+  glm::dvec3 radiance(0.0);
+  {
+    const double r = glm::length(C), c = glm::dot(C, v) / r;
+    const double ch = cosHorizon(p, r - R), eps = horizonBlendWidth(p, tables.options.size, r - R);
+    const glm::dvec3 n = C / r, across = v - c * n;
+    if (std::abs(c - ch) < eps && glm::length(across) > 1e-9) {
+      const glm::dvec3 u = glm::normalize(across);
+      const auto tilted = [&](double cz) { return cz * n + std::sqrt(std::max(0.0, 1.0 - cz * cz)) * u; };
+      RayEvaluator below(tables, C, tilted(ch - eps), l), above(tables, C, tilted(ch + eps), l);
+      const double w = (c - ch + eps) / (2.0 * eps);
+      radiance = (1.0 - w) * tablePart(below) + w * tablePart(above);
+    } else {
+      radiance = tablePart(ray);
     }
-    case AtmosphereShafts::None:
-      break;
+  }
+  if (options.shafts == AtmosphereShafts::Integrated) {
+    // SS-Int: the lit sections, then (sky) the unshadowed rest to the end of the ray.
+    glm::dvec3 single(0.0);
+    for (const glm::dvec2& section : shadowing.litSections) {
+      const double ta = std::clamp(section.x * mpu - enter, 0.0, sEnd);
+      const double tb = std::clamp(section.y * mpu - enter, 0.0, sEnd);
+      if (!(tb > ta)) continue;
+      const double share = std::ceil(options.integrationSteps * (tb - ta) / sm);
+      const int steps =
+          static_cast<int>(std::clamp(share, 1.0, static_cast<double>(options.integrationSteps)));
+      single += ray.trapezoid(ta, tb, steps);
     }
-    radiance = single + higher;
+    if (sky && tX > sEnd) single += ray.trapezoid(sEnd, tX, options.skySteps);
+    radiance += single;
   }
   out.inscattering = sun.irradiance() * radiance;
   if (sky)
     out.transmittance = hitsGround ? glm::dvec3(0.0) : ray.transmittance(tX);
   else
-    out.transmittance = ray.transmittance(sEnd);
+    out.transmittance = ray.segmentTransmittance(sEnd);
   return out;
 }
 

@@ -143,6 +143,14 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
 /// cos of the horizon's zenith angle at altitude h: -sqrt(h (2R + h)) / (R + h).
 double cosHorizon(const AtmosphereParameters& p, double h);
 
+/// Half-width, in cos zenith, of the band around the horizon where the segment values of Eq. 8 (the
+/// difference of two look-ups) are blended from one ray just below and one just above the horizon (the fix
+/// of Bruneton and Neyret 2008's implementation, there with a fixed 0.004): near the horizon the two look-ups
+/// are large and nearly equal, and the altitude texels around h have horizons that differ by this spread,
+/// so their difference is noise. The spread of cosHorizon between the two altitude texels around h, plus
+/// 0.004.
+double horizonBlendWidth(const AtmosphereParameters& p, const AtmosphereTableSize& size, double h);
+
 /// World parameters (h, c_alpha, c_phi, c_theta) -> texture coordinates (u_h, u_alpha, u_phi, u_theta) of
 /// the 4D table, each in [0, 1] with texel i's centre at (i + 0.5) / N. `previous` is the previous look-up's
 /// coordinates of the same view ray, or negative for the first (Listing 2: its u_alpha decides the side of
