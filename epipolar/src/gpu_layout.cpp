@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string>
 
 namespace crep {
 
@@ -39,6 +40,17 @@ std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout) {
     out.push_back({glm::vec4(static_cast<float>(s.bMax), static_cast<float>(layout.warp(s.psiMin)),
                              static_cast<float>(layout.warp(s.psiMax)), 0.0f)});
   return out;
+}
+
+// The map-size rule of the passes that read a layout's map (gpu_march.h, resample.h, the atmosphere's).
+void requireMapSize(const RectifiedLayout& layout, int width, int height, const std::string& parameter) {
+  if (width % layout.regionCount() != 0)
+    throw InvalidArgument(parameter, std::to_string(width),
+                          "must be a multiple of the layout's region count " +
+                              std::to_string(layout.regionCount()));
+  if (const auto* e = dynamic_cast<const EpipolarLayout*>(&layout); e && e->sliceCount() != height)
+    throw InvalidArgument(parameter, "height " + std::to_string(height),
+                          "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
 }
 
 } // namespace gpu

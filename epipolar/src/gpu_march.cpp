@@ -100,13 +100,7 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   const GpuLayoutData layoutData = gpu::requireGpuLayout(*f.layout); // serialized once per run
   const gpu::LayoutKind kind = layoutData.kind;
   const int W = info_.mapWidth, H = info_.mapHeight;
-  if (W % f.layout->regionCount() != 0)
-    throw InvalidArgument("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", std::to_string(W),
-                          "must be a multiple of the layout's region count " +
-                              std::to_string(f.layout->regionCount()));
-  if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
-    throw InvalidArgument("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", "height " + std::to_string(H),
-                          "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
+  gpu::requireMapSize(*f.layout, W, H, "RectifiedMarchPass::CreateInfo.mapWidth/mapHeight");
   // The image size is the camera depth texture's own (gl::textureLevel); with a work list, imageWidth x
   // imageHeight when given, and the outputs are the list's.
   const gpu::SampleList* list = f.list;

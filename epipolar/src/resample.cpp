@@ -165,13 +165,7 @@ ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
 void ShadowResamplePass::run(const FrameAttribs& f) {
   if (!f.layout) throw InvalidArgument("ShadowResamplePass::FrameAttribs.layout", "null", "must be set");
   const int W = info_.mapWidth, H = info_.mapHeight;
-  if (W % f.layout->regionCount() != 0)
-    throw InvalidArgument("ShadowResamplePass::CreateInfo.mapWidth/mapHeight", std::to_string(W),
-                          "must be a multiple of the layout's region count " +
-                              std::to_string(f.layout->regionCount()));
-  if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
-    throw InvalidArgument("ShadowResamplePass::CreateInfo.mapWidth/mapHeight", "height " + std::to_string(H),
-                          "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
+  gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
   const gl::TextureLevel shadow =
       gl::requireTexture2D("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
   gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);

@@ -83,13 +83,7 @@ void AtmospherePass::run(const FrameAttribs& f) {
     if (!f.layout)
       throw InvalidArgument("AtmospherePass::FrameAttribs.layout", "null", "must be set (shafts (a), (b))");
     layoutData = gpu::requireGpuLayout(*f.layout, "AtmospherePass::FrameAttribs.layout");
-    if (W % f.layout->regionCount() != 0)
-      throw InvalidArgument("AtmospherePass::CreateInfo.mapWidth/mapHeight", std::to_string(W),
-                            "must be a multiple of the layout's region count " +
-                                std::to_string(f.layout->regionCount()));
-    if (const auto* e = dynamic_cast<const EpipolarLayout*>(f.layout); e && e->sliceCount() != H)
-      throw InvalidArgument("AtmospherePass::CreateInfo.mapWidth/mapHeight", "height " + std::to_string(H),
-                            "must be the EpipolarLayout's slice count " + std::to_string(e->sliceCount()));
+    gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
     gl::requireTexture2D("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
     if (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer))
       throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),

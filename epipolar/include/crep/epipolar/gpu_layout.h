@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -64,5 +65,10 @@ std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout);
 /// Which GLSL layout implements `layout` (its gpuLayoutData().kind); throws InvalidArgument ("layout") for
 /// a RectifiedLayout without GPU mapping.
 LayoutKind layoutKind(const RectifiedLayout& layout);
+
+/// The check every pass that reads a W x H map of `layout` makes: W a multiple of the layout's region count,
+/// and H its slice count for an EpipolarLayout. Throws InvalidArgument naming `parameter` (e.g.
+/// "RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") otherwise.
+void requireMapSize(const RectifiedLayout& layout, int width, int height, const std::string& parameter);
 
 } // namespace crep::gpu
