@@ -267,24 +267,10 @@ gl::Handle compositeAtmosphere(const FrameInputs& frame, std::uint32_t surfaceCo
   static gl::Handle* program = nullptr; // built once per process, lives with the context
   if (!program)
     program = new gl::Handle(buildProgram({{ShaderStage::Compute, "passes/atmosphere_composite.comp", {}}}));
-  gl::Handle out = gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "--size");
   const GLuint p = program->get();
-  glUseProgram(p);
   glProgramUniform2i(p, 0, frame.width, frame.height);
-  glBindTextureUnit(0, surfaceColor);
-  glBindTextureUnit(1, a.inscattering.get());
-  glBindTextureUnit(2, a.transmittance.get());
-  glBindImageTexture(0, out.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((frame.width + 7) / 8), static_cast<GLuint>((frame.height + 7) / 8),
-                    1);
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                  GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  glUseProgram(0);
-  for (GLuint unit = 0; unit < 3; ++unit)
-    glBindTextureUnit(unit, 0);
-  glFinish();
-  gl::checkError("atmosphere composite");
-  return out;
+  return runImageProgram(p, frame.width, frame.height,
+                         {surfaceColor, a.inscattering.get(), a.transmittance.get()}, "atmosphere composite");
 }
 
 } // namespace crep::tool

@@ -77,30 +77,35 @@ Image readRgba(std::uint32_t texture, int width, int height) {
   return gl::readTexture(texture, width, height, gl::TexelData::Rgba);
 }
 
+gl::Handle runImageProgram(std::uint32_t program, int width, int height,
+                           std::initializer_list<std::uint32_t> textures, const char* what) {
+  gl::Handle out = gl::createTexture2D(GL_RGBA32F, width, height, "--size");
+  glUseProgram(program);
+  GLuint unit = 0;
+  for (const std::uint32_t texture : textures)
+    glBindTextureUnit(unit++, texture);
+  glBindImageTexture(0, out.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                  GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  glUseProgram(0);
+  for (GLuint u = 0; u < unit; ++u)
+    glBindTextureUnit(u, 0);
+  glFinish();
+  gl::checkError(what);
+  return out;
+}
+
 gl::Handle compositeImage(const FrameInputs& frame, std::uint32_t surfaceColor, std::uint32_t scattering) {
   static gl::Handle* program = nullptr; // built once per process, lives with the context
   if (!program) program = new gl::Handle(buildProgram({{ShaderStage::Compute, "passes/composite.comp", {}}}));
-  gl::Handle out = gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "--size");
   const GLuint p = program->get();
-  glUseProgram(p);
   setMat4(p, 0, glm::inverse(frame.camera.clipFromWorld()));
   setVec3(p, 1, frame.camera.position());
   setVec3(p, 2, frame.medium.extinction());
   glProgramUniform2i(p, 3, frame.width, frame.height);
-  glBindTextureUnit(0, frame.cameraDepth.get());
-  glBindTextureUnit(1, surfaceColor);
-  glBindTextureUnit(2, scattering);
-  glBindImageTexture(0, out.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((frame.width + 7) / 8), static_cast<GLuint>((frame.height + 7) / 8),
-                    1);
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                  GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  glUseProgram(0);
-  for (GLuint unit = 0; unit < 3; ++unit)
-    glBindTextureUnit(unit, 0);
-  glFinish();
-  gl::checkError("composite");
-  return out;
+  return runImageProgram(p, frame.width, frame.height, {frame.cameraDepth.get(), surfaceColor, scattering},
+                         "composite");
 }
 
 void addScattering(const FrameInputs& frame, std::uint32_t sum, std::uint32_t addend) {

@@ -8,6 +8,7 @@
 #include <crep/core/image.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 
 namespace crep::tool {
@@ -29,6 +30,11 @@ void checkGlErrors(const char* what);
 gl::Handle uploadR32F(const Image& image, const char* parameter);
 /// Reads an RGBA texture back (row 0 = bottom).
 Image readRgba(std::uint32_t texture, int width, int height);
+/// Runs a compositing compute program of the tool (8 x 8 groups, its uniforms already set) over a new
+/// width x height RGBA32F texture at image unit 0, with `textures` bound at units 0, 1, ... (unbound after);
+/// glFinish, then a GL error check naming `what`.
+gl::Handle runImageProgram(std::uint32_t program, int width, int height,
+                           std::initializer_list<std::uint32_t> textures, const char* what);
 /// surface * exp(-sigma_t s) + in-scattering (glsl/passes/composite.comp), a new RGBA32F texture.
 gl::Handle compositeImage(const FrameInputs& frame, std::uint32_t surfaceColor, std::uint32_t scattering);
 
