@@ -3,6 +3,8 @@
 // Eq. 8's two look-ups (at the camera and at the segment's end, on one side of the horizon: Listing 2) must
 // change smoothly while the view direction sweeps through the horizon. The sky itself does jump there (below
 // the horizon the table's rays end on a black ground), which AtmospherePhysicsTest reports.
+#include "atmosphere_test_util.h"
+
 #include <crep/core/light.h>
 #include <crep/postfx/atmosphere.h>
 
@@ -19,20 +21,6 @@ namespace {
 
 using namespace crep;
 
-const AtmosphereTables& horizonTables() {
-  static const AtmosphereTables t = [] {
-    AtmospherePrecomputeOptions o;
-    o.size = {16, 32, 16, 8};
-    o.orders = 2;
-    o.singleSteps = 64;
-    o.orderSteps = 32;
-    o.sphereSamples = 64;
-    o.ambientSize = 16;
-    return precomputeAtmosphere(AtmosphereParameters{}, o);
-  }();
-  return t;
-}
-
 double luminance(const glm::dvec3& c) {
   return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
 }
@@ -40,7 +28,7 @@ double luminance(const glm::dvec3& c) {
 } // namespace
 
 TEST_CASE("Atmosphere horizon: aerial perspective of a fixed segment has no jump through the horizon") {
-  const AtmosphereTables& t = horizonTables();
+  const AtmosphereTables& t = test::smallAtmosphereTables(2);
   const double deg = std::numbers::pi / 180.0;
   for (const double altitude : {50.0, 1000.0}) {
     for (const double sunElevation : {30.0, 5.0}) {

@@ -3,6 +3,8 @@
 // independent brute-force single-scattering integral (densityIntegral for both transmittances, no tables),
 // exact identities of lit sections and lit lengths, prefilteredVisibility's closed form, and atmosphereImage
 // against atmosphereRay per pixel.
+#include "atmosphere_test_util.h"
+
 #include <crep/core/error.h>
 #include <crep/postfx/atmosphere.h>
 #include <crep/scatter/ray.h>
@@ -18,27 +20,9 @@ using namespace crep;
 
 namespace {
 
-/// Small tables shared by every test case: orders 1 and 2, or single scattering only (orders 1).
+/// The small tables of crep::test::smallAtmosphereTables: orders 1 and 2, or single scattering only.
 const AtmosphereTables& tables(int orders = 2) {
-  static const auto make = [](int n) {
-    AtmospherePrecomputeOptions o;
-    o.size = {16, 32, 16, 8};
-    o.orders = n;
-    o.singleSteps = 64;
-    o.orderSteps = 32;
-    o.sphereSamples = 64;
-    o.opticalDepthHeight = 64;
-    o.opticalDepthZenith = 256;
-    o.opticalDepthSteps = 256;
-    o.ambientSize = 16;
-    return precomputeAtmosphere(AtmosphereParameters{}, o);
-  };
-  if (orders == 1) {
-    static const AtmosphereTables single = make(1);
-    return single;
-  }
-  static const AtmosphereTables t = make(2);
-  return t;
+  return test::smallAtmosphereTables(orders);
 }
 
 /// The sun 30 degrees above the horizon, coloured irradiance.
