@@ -1,5 +1,6 @@
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/core/gl_state.h>
 
 #include <epoxy/gl.h>
 
@@ -158,7 +159,7 @@ Image readTexture(std::uint32_t texture, int width, int height, TexelData data, 
   const GLenum format = data == TexelData::Rgba  ? GL_RGBA
                         : data == TexelData::Red ? GL_RED
                                                  : GL_DEPTH_COMPONENT;
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  const PixelStoreScope pixelStore; // tightly packed rows, no pixel pack buffer: whatever the caller left
   glGetTextureSubImage(texture, 0, 0, 0, layer, width, height, 1, format, GL_FLOAT,
                        static_cast<GLsizei>(image.data().size_bytes()), image.data().data());
   checkError("readTexture");
@@ -196,35 +197,6 @@ void checkError(const char* what) {
     errors += (errors.empty() ? "" : ", ") + errorName(error);
   }
   if (!errors.empty()) throw GlError(std::string("crep: GL error in ") + what + ": " + errors);
-}
-
-RasterStateGuard::RasterStateGuard() {
-  GLint framebuffer = 0, depthFunc = GL_LESS;
-  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &framebuffer);
-  glGetIntegerv(GL_VIEWPORT, viewport_);
-  glGetIntegerv(GL_SCISSOR_BOX, scissor_);
-  glGetIntegerv(GL_DEPTH_FUNC, &depthFunc);
-  GLboolean mask = GL_TRUE;
-  glGetBooleanv(GL_DEPTH_WRITEMASK, &mask);
-  framebuffer_ = framebuffer;
-  depthFunc_ = depthFunc;
-  depthMask_ = mask == GL_TRUE;
-  depthTest_ = glIsEnabled(GL_DEPTH_TEST) == GL_TRUE;
-  depthClamp_ = glIsEnabled(GL_DEPTH_CLAMP) == GL_TRUE;
-  cull_ = glIsEnabled(GL_CULL_FACE) == GL_TRUE;
-  scissorTest_ = glIsEnabled(GL_SCISSOR_TEST) == GL_TRUE;
-}
-
-RasterStateGuard::~RasterStateGuard() {
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(framebuffer_));
-  glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
-  glScissor(scissor_[0], scissor_[1], scissor_[2], scissor_[3]);
-  glDepthFunc(static_cast<GLenum>(depthFunc_));
-  glDepthMask(depthMask_ ? GL_TRUE : GL_FALSE);
-  (depthTest_ ? glEnable : glDisable)(GL_DEPTH_TEST);
-  (depthClamp_ ? glEnable : glDisable)(GL_DEPTH_CLAMP);
-  (cull_ ? glEnable : glDisable)(GL_CULL_FACE);
-  (scissorTest_ ? glEnable : glDisable)(GL_SCISSOR_TEST);
 }
 
 GpuTimer::GpuTimer() : query_(createQuery(GL_TIME_ELAPSED)) {}

@@ -1,4 +1,5 @@
 #include <crep/core/error.h>
+#include <crep/core/gl_state.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 
 #include <epoxy/gl.h>
@@ -59,23 +60,16 @@ void RectifiedShadowPass::run(const FrameAttribs& frame) {
             "must have a depth format (GL_DEPTH_COMPONENT32F, 24 or 16)");
   }
   {
-    const gl::RasterStateGuard guard;
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fb);
-    glDisable(GL_SCISSOR_TEST);
-    glDepthMask(GL_TRUE);
+    // Every raster state the map depends on, whatever the caller left (docs/GL_STATE.md); restored after.
+    gl::DepthPassScope scope(fb, W, H);
     const float one = 1.0f;
-    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &one); // once, the whole map
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glEnable(GL_DEPTH_CLAMP);
-    glDisable(GL_CULL_FACE);
-    glEnable(GL_SCISSOR_TEST);
+    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &one); // once, the whole map (the scissor box is the map)
     for (int k = 0; k < r->splitCount(); ++k) {
       const SplitViewport v = r->splitViewport(k, W, H);
-      glViewport(v.x, v.y, v.width, v.height);
-      glScissor(v.x, v.y, v.width, v.height); // a clear in the callback stays inside split k
+      scope.setViewport(v.x, v.y, v.width, v.height); // and the scissor box: a clear stays inside split k
       frame.drawCasters(k, r->splits[static_cast<std::size_t>(k)].rectClipFromWorld);
     }
+    scope.requireUnchanged("RectifiedShadowPass::FrameAttribs.drawCasters");
   }
   glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0);
   gl::checkError("RectifiedShadowPass::run");

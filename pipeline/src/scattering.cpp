@@ -3,6 +3,7 @@
 // (Fig. 8), from the passes of scatter/, epipolar/ and prefilter/.
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/core/gl_state.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
@@ -245,21 +246,15 @@ struct DepthTarget {
     glNamedFramebufferDrawBuffer(framebuffer.get(), GL_NONE);
     glNamedFramebufferReadBuffer(framebuffer.get(), GL_NONE);
   }
-  /// Clears to 1 and calls draw(viewport index) with the raster state of the header set.
+  /// Clears to 1 and calls draw() with the contract's raster state (docs/GL_STATE.md), restored after;
+  /// `callback` names the caller's callback when it leaves that state changed.
   template <class Draw>
-  void render(int viewports, const Draw& draw) {
-    const gl::RasterStateGuard saved;
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer.get());
-    glViewport(0, 0, size, size);
-    glDepthMask(GL_TRUE);
+  void render(const char* callback, const Draw& draw) {
+    gl::DepthPassScope scope(framebuffer.get(), size, size);
     const float one = 1.0f;
     glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &one);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glEnable(GL_DEPTH_CLAMP);
-    glDisable(GL_CULL_FACE);
-    for (int i = 0; i < viewports; ++i)
-      draw(i);
+    draw();
+    scope.requireUnchanged(callback);
   }
 };
 
@@ -427,6 +422,13 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   if (!f.light && !local)
     invalid("Scattering::FrameAttribs.light", "null", "must be set unless local lights are given");
   if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
+  // What the caller's state must not be, since the library cannot set it aside (docs/GL_STATE.md).
+  gl::requireNoActiveTransformFeedback("Scattering::run");
+  if (info.stageTimings) gl::requireNoActiveTimerQuery("Scattering::run (CreateInfo.stageTimings)");
+  // The frame leaves program 0 and units / binding points 0-7 unbound however it ends (docs/GL_STATE.md).
+  struct UnbindOnExit {
+    ~UnbindOnExit() { gl::unbindPassState(8); }
+  } unbindOnExit;
   if (f.output != 0 || !f.froxels) // a froxel volume alone reads no camera depth
     gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
   if (f.output != 0 || !f.froxels)
@@ -513,8 +515,10 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
       // A standard map covering the frustum (casters between the light and it are kept by GL_DEPTH_CLAMP).
       own.lightClipFromWorld = orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners());
       own.bias = info.ownShadowMapBias;
-      stage("shadow pass (standard)",
-            [&] { m.ownShadowMap->render(1, [&](int) { f.drawCasters(own.lightClipFromWorld); }); });
+      stage("shadow pass (standard)", [&] {
+        m.ownShadowMap->render("Scattering::FrameAttribs.drawCasters",
+                               [&] { f.drawCasters(own.lightClipFromWorld); });
+      });
       shadow = &own;
     }
     r.shadowMap = *shadow;
@@ -739,8 +743,10 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         shadow = *given;
       } else {
         if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
-        timed(result, "local light: shadow pass (perspective)",
-              [&] { m.localShadowMap->render(1, [&](int) { f.drawCasters(lightClipFromWorld); }); });
+        timed(result, "local light: shadow pass (perspective)", [&] {
+          m.localShadowMap->render("Scattering::FrameAttribs.drawCasters",
+                                   [&] { f.drawCasters(lightClipFromWorld); });
+        });
         shadow = {m.localShadowMap->texture.get(), lightClipFromWorld, info.ownShadowMapBias};
       }
       timed(result, "local light: world-space march", [&] {

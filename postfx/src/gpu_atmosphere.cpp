@@ -5,6 +5,7 @@
 // atmosphere_sum.comp (L_H and L_M) and atmosphere_ambient.comp (E_sky); look-ups of
 // glsl/crep/atmosphere.glsl.
 #include <crep/core/error.h>
+#include <crep/core/gl_state.h>
 #include <crep/core/shader_library.h>
 #include <crep/postfx/gpu_atmosphere.h>
 
@@ -255,7 +256,8 @@ void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
       tables.ambient.channels() != 3)
     fail("ambient must be ambientSize x 1 with 3 channels");
 
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  const gl::PixelStoreScope
+      pixelStore; // tightly packed floats, no pixel unpack buffer: whatever the caller left
   glTextureSubImage2D(opticalDepth_.get(), 0, 0, 0, o.opticalDepthHeight, o.opticalDepthZenith, GL_RG,
                       GL_FLOAT, tables.opticalDepth.data().data());
   const int depth = o.size.sunZenith * o.size.sunView;
@@ -277,7 +279,8 @@ AtmosphereTables AtmosphereTablesPass::download() const {
   t.parameters = info_.parameters;
   t.options = o;
   t.options.keepOrders = false;
-  glPixelStorei(GL_PACK_ALIGNMENT, 4);
+  const gl::PixelStoreScope
+      pixelStore; // tightly packed floats, no pixel pack buffer: whatever the caller left
   t.opticalDepth = Image(o.opticalDepthHeight, o.opticalDepthZenith, 2);
   glGetTextureImage(opticalDepth_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(t.opticalDepth.byteSize()),
                     t.opticalDepth.data().data());

@@ -3,6 +3,7 @@
 #include "gl_session.h"
 
 #include <crep/core/error.h>
+#include <crep/core/gl_state.h>
 #include <crep/epipolar/resample.h>
 #include <crep/scenes/scene_renderer.h>
 
@@ -26,6 +27,7 @@ LightTextureMap makeLightTextureMap(Image rgb, const glm::dmat4& textureClipFrom
               static_cast<std::size_t>(x)) *
                  4 +
              static_cast<std::size_t>(c)] = rgb.at(x, y, c);
+  const gl::PixelStoreScope pixelStore;
   glTextureSubImage2D(m.texture.get(), 0, 0, 0, rgb.width(), rgb.height(), GL_RGBA, GL_FLOAT, rgba.data());
   m.image = std::move(rgb);
   return m;

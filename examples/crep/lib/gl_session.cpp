@@ -3,6 +3,7 @@
 #include "frame.h"
 
 #include <crep/core/error.h>
+#include <crep/core/gl_state.h>
 #include <crep/core/shader_library.h>
 #include <crep/support/gl_context.h>
 
@@ -67,7 +68,7 @@ gl::Handle uploadR32F(const Image& image, const char* parameter) {
     for (int x = 0; x < image.width(); ++x)
       channel0[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width()) +
                static_cast<std::size_t>(x)] = image.at(x, y, 0);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  const gl::PixelStoreScope pixelStore;
   glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RED, GL_FLOAT, channel0.data());
   gl::checkError("upload");
   return t;

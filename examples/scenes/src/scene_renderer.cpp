@@ -1,4 +1,5 @@
 #include <crep/core/error.h>
+#include <crep/core/gl_state.h>
 #include <crep/core/shader_library.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/scenes/scene_renderer.h>
@@ -85,23 +86,15 @@ void SceneRenderer::renderDepth(const glm::dmat4& clipFromWorld, std::uint32_t d
   if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw GlError("SceneRenderer::renderDepth: depth texture " + std::to_string(depthTexture) +
                   " is not a complete depth attachment (expected GL_DEPTH_COMPONENT32F)");
-  glBindFramebuffer(GL_FRAMEBUFFER, fb);
-  glViewport(x, y, width, height);
-  glEnable(GL_SCISSOR_TEST);
-  glScissor(x, y, width, height);
-  glDepthMask(GL_TRUE);
-  const float one = 1.0f;
-  glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &one);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  if (options.depthClamp) glEnable(GL_DEPTH_CLAMP);
-  if (options.cullBackFaces) glEnable(GL_CULL_FACE);
-  drawDepth(clipFromWorld);
-  glDisable(GL_DEPTH_CLAMP);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_SCISSOR_TEST);
-  glDisable(GL_DEPTH_TEST);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  {
+    // The library's depth-pass contract (docs/GL_STATE.md): every raster state set here, the caller's
+    // restored after.
+    gl::DepthPassScope scope(fb, width, height, {options.depthClamp, options.cullBackFaces});
+    scope.setViewport(x, y, width, height); // and the scissor box: the clear stays inside the viewport
+    const float one = 1.0f;
+    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &one);
+    drawDepth(clipFromWorld);
+  }
   glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0);
   gl::checkError("SceneRenderer::renderDepth");
 }

@@ -113,22 +113,6 @@ void checkTextureSize(const char* parameter, int width, int height);
 /// Throws GlError naming `what` when glGetError() reports an error (drains all pending errors).
 void checkError(const char* what);
 
-/// The raster state a depth pass changes, saved on construction and restored on destruction: the draw
-/// framebuffer binding, viewport, scissor box and test, depth function, mask, test and clamp, face
-/// culling. Used by the shadow passes (RectifiedShadowPass, crep::Scattering's own shadow map), which
-/// leave the caller's state as they found it.
-class RasterStateGuard {
-public:
-  RasterStateGuard();
-  ~RasterStateGuard();
-  RasterStateGuard(const RasterStateGuard&) = delete;
-  RasterStateGuard& operator=(const RasterStateGuard&) = delete;
-
-private:
-  int framebuffer_ = 0, viewport_[4] = {0, 0, 0, 0}, scissor_[4] = {0, 0, 0, 0}, depthFunc_ = 0;
-  bool depthMask_ = true, depthTest_ = false, depthClamp_ = false, cull_ = false, scissorTest_ = false;
-};
-
 /// Measures GPU time between begin() and end() with a GL_TIME_ELAPSED query. Only one
 /// GL_TIME_ELAPSED query can be active at a time, so timers do not nest.
 class GpuTimer {

@@ -8,9 +8,11 @@
 //   - GL_DEPTH_TEST with GL_LESS and depth writes, GL_DEPTH_CLAMP (casters between the light and the view
 //     frustum have a depth below 0 and must be kept at 0, not clipped), no face culling (the rectification
 //     may mirror the winding).
-// The callback draws the casters with gl_Position = clipFromWorld * worldPosition (GL's default clip
-// conventions, [-1, 1] depth) into the bound framebuffer; it must not change the framebuffer binding, the
-// viewport or the scissor. Every raster state the pass sets is restored afterwards (gl::RasterStateGuard).
+// It also sets every other raster state the map depends on (clip control, depth range, polygon mode and
+// offset, rasterizer discard, clip distances, ...) whatever the caller left, and restores the caller's
+// values afterwards: docs/GL_STATE.md lists them (gl::DepthPassScope). The callback draws the casters with
+// gl_Position = clipFromWorld * worldPosition (GL clip conventions, [-1, 1] depth) into the bound
+// framebuffer and must leave that state as it found it (run() names a callback that does not).
 // Requires a current OpenGL 4.5 context; never creates or owns one.
 #pragma once
 
@@ -50,7 +52,8 @@ public:
 
   /// Renders the map (see top). Throws InvalidArgument naming the FrameAttribs field: no rectification, a
   /// rectification that is not projective or uses SplitLayout::Layers, a width that is not a multiple of
-  /// its split count, no callback, a depth texture that is not a 2D texture of the map's size.
+  /// its split count, no callback, a callback that left the pass's raster state changed, a depth texture
+  /// that is not a 2D texture of the map's size; GlError for an active transform feedback.
   void run(const FrameAttribs& frame);
 
   /// The pass's own D32F map (what run() renders into without FrameAttribs::depthTexture; created by the

@@ -78,8 +78,12 @@
 // samples" / "march samples", "interpolate", "unwarp", "correct" and, with downscale > 1, "upscale" and
 // "correct (full)"; FrameResult::sampling counts the samples.
 //
-// GL state: run() restores the draw framebuffer binding, viewport, depth test / function / mask, depth
-// clamp and face culling it changes; the passes' bindings are documented in their headers (they unbind).
+// GL state (docs/GL_STATE.md): the depth passes drawn with drawCasters set every raster state their maps
+// depend on (clip control, depth range, depth state, polygon mode and offset, culling, scissor, discard,
+// clip distances, ...) whatever the caller left, and restore it; run() leaves program 0 and texture /
+// sampler / image units and uniform / storage buffer bindings 0-7 unbound, and every other unit as it was.
+// It throws GlError for states it cannot set aside: an active transform feedback, or with stageTimings an
+// active GL_TIME_ELAPSED query of the caller.
 #pragma once
 
 #include <cstdint>

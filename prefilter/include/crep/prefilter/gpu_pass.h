@@ -10,9 +10,10 @@
 // pointers to CPU objects that must outlive the call. No pass creates, owns or changes the current GL
 // context; each needs one (OpenGL 4.5 core) current on the calling thread for its whole lifetime.
 //
-// GL state: run() binds its own programs, textures, samplers, images and buffers to the units and
-// binding points below and unbinds them (0) before returning; it does not restore the caller's bindings
-// there. It issues glMemoryBarrier so that the results can be sampled / image-loaded afterwards.
+// GL state (docs/GL_STATE.md has the whole contract): run() binds its own programs, textures, samplers,
+// images and buffers to the units and binding points below and unbinds them (0) before returning; it does not
+// restore the caller's bindings there. It issues glMemoryBarrier so that the results can be sampled /
+// image-loaded afterwards.
 //   PrefilterPass::run: texture unit 0 (+ sampler), image unit 0, uniform buffer 0, storage buffer 0.
 //   EvaluatePass::run:  texture units 0 and 1 (+ samplers), image unit 0 (the output, then the froxel
 //                       volume), uniform buffers 0 and 1, storage buffer 1 (near-plane correction), the
