@@ -73,14 +73,7 @@ glm::dmat4 sunWindow(const ScatteringFixture& f) {
 
 /// The off-screen spot of ScatteringLocalGLTest (behind and above the camera, projective).
 SpotLight offScreenSpot(const Camera& c) {
-  const glm::dvec3 position = c.position() - 4.0 * c.forward() + 7.0 * c.up();
-  return SpotLight({.position = position,
-                    .direction = c.position() + 14.0 * c.forward() - position,
-                    .innerConeAngle = 0.35,
-                    .outerConeAngle = 0.55,
-                    .color = {1.0, 0.85, 0.6},
-                    .intensity = 150.0,
-                    .range = 80.0});
+  return spotToward(c, c.position() - 4.0 * c.forward() + 7.0 * c.up());
 }
 
 /// The textured world-space reference: WorldMarchPass (256 steps) with the texture against a shadow map.

@@ -172,6 +172,18 @@ inline Image localReference(ScatteringFixture& f, const LocalLight& light,
   return gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
 }
 
+/// The spot light of the local-light tests at `position`, aimed at the point 14 units in front of the camera
+/// (cone 0.35 / 0.55 rad, warm white, intensity 150, range 80).
+inline SpotLight spotToward(const Camera& c, const glm::dvec3& position) {
+  return SpotLight({.position = position,
+                    .direction = c.position() + 14.0 * c.forward() - position,
+                    .innerConeAngle = 0.35,
+                    .outerConeAngle = 0.55,
+                    .color = {1.0, 0.85, 0.6},
+                    .intensity = 150.0,
+                    .range = 80.0});
+}
+
 /// sum.rgb += add.rgb.
 inline void addInto(Image& sum, const Image& add) {
   for (int y = 0; y < sum.height(); ++y)

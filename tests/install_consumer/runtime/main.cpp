@@ -4,7 +4,10 @@
 // camera and a sun, fills a rectified depth map and a camera depth buffer with ramps, runs
 // crep::PrefilterPass and crep::EvaluatePass and checks the scattering image; then one frame through the
 // frame-level API (crep::Scattering) with the engine's own reversed-Z, [0, 1], infinite-far camera matrices
-// and its own standard shadow map, checked against the same frame through a GL-convention camera.
+// and its own standard shadow map, its casters drawn through drawCasters by its own depth-only program, and
+// its reversed-Z clip control (glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)) set globally, as such engines
+// set it once at start-up; checked against the same frame through a GL-convention camera under GL's default
+// clip control (docs/GL_STATE.md: the library sets the clip control of its own depth passes).
 //
 // Exit status: 0 success, 1 failure, 77 no GL context (the install test treats that as a failure too:
 // llvmpipe is expected wherever the tests run).
@@ -28,6 +31,7 @@
 #include <exception>
 #include <filesystem>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -42,6 +46,51 @@ GLuint depthTexture(int width, int height, const std::vector<float>& values) {
   glTextureSubImage2D(texture, 0, 0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, values.data());
   return texture;
 }
+
+/// The engine's depth-only caster program and mesh: a roof (two triangles at y = 3 over x in [-4, 0],
+/// z in [-2, 6]) that shadows part of the air in front of the wall.
+struct Casters {
+  GLuint program = 0, vao = 0, buffer = 0;
+  int draws = 0;
+  Casters() {
+    const char* vs = "#version 450 core\nlayout(location = 0) in vec3 position;\n"
+                     "layout(location = 0) uniform mat4 clipFromWorld;\n"
+                     "void main() { gl_Position = clipFromWorld * vec4(position, 1.0); }\n";
+    const char* fs = "#version 450 core\nvoid main() {}\n";
+    program = glCreateProgram();
+    for (const auto& [type, source] : {std::pair{GL_VERTEX_SHADER, vs}, std::pair{GL_FRAGMENT_SHADER, fs}}) {
+      const GLuint shader = glCreateShader(type);
+      glShaderSource(shader, 1, &source, nullptr);
+      glCompileShader(shader);
+      glAttachShader(program, shader);
+      glDeleteShader(shader);
+    }
+    glLinkProgram(program);
+    const float roof[] = {-4, 3, -2, 0, 3, -2, 0, 3, 6, -4, 3, -2, 0, 3, 6, -4, 3, 6};
+    glCreateBuffers(1, &buffer);
+    glNamedBufferStorage(buffer, sizeof roof, roof, 0);
+    glCreateVertexArrays(1, &vao);
+    glVertexArrayVertexBuffer(vao, 0, buffer, 0, 3 * sizeof(float));
+    glEnableVertexArrayAttrib(vao, 0);
+    glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 0, 0);
+  }
+  ~Casters() {
+    glDeleteVertexArrays(1, &vao);
+    glDeleteBuffers(1, &buffer);
+    glDeleteProgram(program);
+  }
+  void draw(const glm::dmat4& clipFromWorld) {
+    const glm::mat4 m(clipFromWorld);
+    glUseProgram(program);
+    glProgramUniformMatrix4fv(program, 0, 1, GL_FALSE, &m[0][0]);
+    glBindVertexArray(vao);
+    glDrawArrays(GL_TRIANGLES, 0, 6);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    ++draws;
+  }
+};
 
 int checks() {
   // The installed version header agrees with the package version find_package reported.
@@ -123,9 +172,12 @@ int engineFrame(const crep::Camera& camera, const crep::DirectionalLight& sun, c
       shadow[std::size_t(y) * kShadowSize + x] = x < kShadowSize / 2 ? 0.3f : 1.0f;
 
   crep::Scattering scattering({.width = width, .height = height, .mapSize = 64});
+  Casters casters;
   std::vector<float> images[2];
   for (int pass = 0; pass < 2; ++pass) {
     const bool engine = pass == 1;
+    // The engine's reversed-Z clip control, set once for all its passes; GL's default for the reference.
+    glClipControl(GL_LOWER_LEFT, engine ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
     const GLuint depth = depthTexture(width, height, engine ? reversedDepth : standardDepth);
     const GLuint shadowTexture = depthTexture(kShadowSize, kShadowSize, shadow);
     const GLuint output = outputTexture(width, height);
@@ -138,7 +190,20 @@ int engineFrame(const crep::Camera& camera, const crep::DirectionalLight& sun, c
     f.cameraDepth = depth;
     f.output = output;
     f.shadowMap = &map;
+    f.drawCasters = [&](const glm::dmat4& clipFromWorld) { casters.draw(clipFromWorld); };
+    const int drawsBefore = casters.draws;
     const crep::Scattering::FrameResult r = scattering.run(f);
+    GLint origin = 0, depthMode = 0;
+    glGetIntegerv(GL_CLIP_ORIGIN, &origin);
+    glGetIntegerv(GL_CLIP_DEPTH_MODE, &depthMode);
+    if (casters.draws == drawsBefore || origin != GL_LOWER_LEFT ||
+        depthMode != (engine ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE)) {
+      std::fprintf(stderr,
+                   "consumer: drawCasters not called (%d draws) or the engine's clip control not "
+                   "restored (0x%x, 0x%x)\n",
+                   casters.draws - drawsBefore, origin, depthMode);
+      return 1;
+    }
     std::printf("crep::Scattering, %s camera: %s layout, %zu stages\n", engine ? "reversed-Z" : "GL",
                 r.layout == crep::Scattering::Layout::Projective ? "projective" : "epipolar",
                 r.stages.size());
@@ -158,7 +223,9 @@ int engineFrame(const crep::Camera& camera, const crep::DirectionalLight& sun, c
     if (i % 4 != 3) peak = std::fmax(peak, images[0][i]);
     worst = std::fmax(worst, std::fabs(double(images[1][i]) - images[0][i]));
   }
-  std::printf("crep::Scattering: reversed-Z engine camera vs GL camera: max |difference| %.3g, peak %.4g\n",
+  glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  std::printf("crep::Scattering: reversed-Z engine (GL_ZERO_TO_ONE clip control, casters drawn through "
+              "drawCasters) vs GL camera: max |difference| %.3g, peak %.4g\n",
               worst, peak);
   if (!(peak > 0.0) || !(worst <= 1e-4 * peak)) {
     std::fprintf(stderr, "consumer: the engine camera's frame differs from the GL camera's\n");
