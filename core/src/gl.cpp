@@ -112,6 +112,11 @@ void Handle::reset() noexcept {
   name_ = 0;
 }
 
+void requireNotMovedFrom(const Handle& handle, const char* owner) {
+  if (!handle)
+    throw InvalidArgument(owner, "a moved-from object", "owns no GL objects: assign a constructed one first");
+}
+
 Handle createTexture(std::uint32_t target) {
   GLuint name = 0;
   glCreateTextures(target, 1, &name);
@@ -188,14 +193,22 @@ void checkTextureSize(const char* parameter, int width, int height) {
                   std::to_string(limit) + " of this OpenGL implementation");
 }
 
-void checkError(const char* what) {
+std::string drainErrors() noexcept {
   std::string errors;
-  // A lost context can report GL_CONTEXT_LOST forever: bound the loop.
-  for (int i = 0; i < 32; ++i) {
-    const GLenum error = glGetError();
-    if (error == GL_NO_ERROR) break;
-    errors += (errors.empty() ? "" : ", ") + errorName(error);
+  try {
+    // A lost context can report GL_CONTEXT_LOST forever: bound the loop.
+    for (int i = 0; i < 32; ++i) {
+      const GLenum error = glGetError();
+      if (error == GL_NO_ERROR) break;
+      errors += (errors.empty() ? "" : ", ") + errorName(error);
+    }
+  } catch (...) { // std::bad_alloc of the message: the errors are popped all the same
   }
+  return errors;
+}
+
+void checkError(const char* what) {
+  const std::string errors = drainErrors();
   if (!errors.empty()) throw GlError(std::string("crep: GL error in ") + what + ": " + errors);
 }
 
@@ -211,6 +224,11 @@ void GpuTimer::end() {
   if (state_ != State::Running) throw GlError("crep: GpuTimer::end() called without begin()");
   glEndQuery(GL_TIME_ELAPSED);
   state_ = State::Ended;
+}
+
+void GpuTimer::cancel() noexcept {
+  if (state_ == State::Running) glEndQuery(GL_TIME_ELAPSED);
+  state_ = State::Idle;
 }
 
 double GpuTimer::milliseconds() {
@@ -287,7 +305,11 @@ void requireTexture2D(const char* parameter, std::uint32_t texture, int width, i
                           "size must be > 0");
   if (texture == 0 || !glIsTexture(texture))
     throw InvalidArgument(parameter, std::to_string(texture), "must be the name of an existing texture");
-  GLint w = 0, h = 0, f = 0;
+  GLint target = 0, w = 0, h = 0, f = 0;
+  glGetTextureParameteriv(texture, GL_TEXTURE_TARGET, &target);
+  if (target != GL_TEXTURE_2D) // 3D, array and multisample textures are read as garbage by sampler2D
+    throw InvalidArgument(parameter, "texture " + std::to_string(texture) + " of target " + hex(target),
+                          "must be a GL_TEXTURE_2D");
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_WIDTH, &w);
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_HEIGHT, &h);
   glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &f);
@@ -317,6 +339,47 @@ void passOutputBarrier() {
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT | GL_PIXEL_BUFFER_BARRIER_BIT |
                   GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+} // namespace crep::gl
+
+namespace crep::gl {
+
+namespace {
+GLint levelParameter(std::uint32_t texture, GLenum pname) {
+  GLint v = 0;
+  glGetTextureLevelParameteriv(texture, 0, pname, &v);
+  return v;
+}
+std::string formatText(std::uint32_t texture) {
+  return "texture " + std::to_string(texture) + " of internal format " +
+         hex(static_cast<std::uint32_t>(levelParameter(texture, GL_TEXTURE_INTERNAL_FORMAT)));
+}
+} // namespace
+
+void requireDepthFormat(const char* parameter, std::uint32_t texture) {
+  const GLint format = levelParameter(texture, GL_TEXTURE_INTERNAL_FORMAT);
+  if (format == GL_R32F) return;
+  if (levelParameter(texture, GL_TEXTURE_DEPTH_TYPE) == GL_NONE)
+    throw InvalidArgument(parameter, formatText(texture),
+                          "must have a depth format (GL_DEPTH_COMPONENT32F, GL_DEPTH24_STENCIL8, "
+                          "GL_DEPTH_COMPONENT24, ...) or GL_R32F");
+  GLint mode = GL_DEPTH_COMPONENT;
+  glGetTextureParameteriv(texture, GL_DEPTH_STENCIL_TEXTURE_MODE, &mode);
+  if (mode != GL_DEPTH_COMPONENT)
+    throw InvalidArgument(parameter,
+                          formatText(texture) + " with GL_DEPTH_STENCIL_TEXTURE_MODE = " +
+                              hex(static_cast<std::uint32_t>(mode)),
+                          "must be sampled as depth (GL_DEPTH_STENCIL_TEXTURE_MODE = GL_DEPTH_COMPONENT)");
+}
+
+void requireColorFormat(const char* parameter, std::uint32_t texture) {
+  const GLint red = levelParameter(texture, GL_TEXTURE_RED_TYPE);
+  if (levelParameter(texture, GL_TEXTURE_DEPTH_TYPE) != GL_NONE ||
+      (red != GL_FLOAT && red != GL_UNSIGNED_NORMALIZED && red != GL_SIGNED_NORMALIZED))
+    throw InvalidArgument(parameter, formatText(texture),
+                          "must have a colour format read as float (GL_RGBA8, GL_SRGB8_ALPHA8, GL_RGBA16F, "
+                          "GL_RGBA32F, ...), not depth, stencil or integer");
 }
 
 } // namespace crep::gl

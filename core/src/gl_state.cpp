@@ -1,4 +1,5 @@
 #include <crep/core/error.h>
+#include <crep/core/gl.h>
 #include <crep/core/gl_state.h>
 
 #include <epoxy/gl.h>
@@ -303,6 +304,13 @@ void requireNoActiveTransformFeedback(const char* owner) {
     throw GlError(std::string("crep: ") + owner +
                   ": a transform feedback is active (GL_TRANSFORM_FEEDBACK_ACTIVE) and not paused; it would "
                   "capture the library's draws and rejects its programs: pause or end it before the call");
+}
+
+void requireNoPendingError(const char* owner) {
+  const std::string errors = gl::drainErrors();
+  if (!errors.empty())
+    throw GlError(std::string("crep: ") + owner + ": GL errors were pending before the call (" + errors +
+                  "), raised by earlier GL calls of the caller; check glGetError() after your own passes");
 }
 
 void requireNoActiveTimerQuery(const char* owner) {

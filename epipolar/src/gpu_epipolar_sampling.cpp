@@ -135,12 +135,7 @@ void EpipolarSamplingPass::checkFrame(const FrameAttribs& f) const {
   if (!f.medium) throw InvalidArgument("EpipolarSamplingPass::FrameAttribs.medium", "null", "must be set");
   gl::requireTexture2D("EpipolarSamplingPass::FrameAttribs.cameraDepth", f.cameraDepth, info_.width,
                        info_.height);
-  const GLenum format =
-      gl::textureLevel("EpipolarSamplingPass::FrameAttribs.cameraDepth", f.cameraDepth).internalFormat;
-  if (format != GL_DEPTH_COMPONENT32F && format != GL_DEPTH_COMPONENT24 && format != GL_DEPTH24_STENCIL8 &&
-      format != GL_DEPTH32F_STENCIL8 && format != GL_R32F)
-    throw InvalidArgument("EpipolarSamplingPass::FrameAttribs.cameraDepth",
-                          "format " + std::to_string(format), "must be a depth format or GL_R32F");
+  gl::requireDepthFormat("EpipolarSamplingPass::FrameAttribs.cameraDepth", f.cameraDepth);
   gl::requireTexture2D("EpipolarSamplingPass::FrameAttribs.output", f.output, info_.width, info_.height,
                        GL_RGBA32F);
 }

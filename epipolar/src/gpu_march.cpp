@@ -46,6 +46,7 @@ MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
 
 void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
   gl::requireTexture2D("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth, info_.mapHeight);
+  gl::requireDepthFormat("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth);
   const GLuint p = program_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
@@ -110,6 +111,8 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
           : gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
   const int width = image.width, height = image.height;
   gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
+  gl::requireDepthFormat("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
+  if (!list) gl::requireDepthFormat("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
   // The textures written: the image's, or the list's (its output and coordinates).
   int outWidth = width, outHeight = height;
   if (list) {

@@ -168,6 +168,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
   const gl::TextureLevel shadow =
       gl::requireTexture2D("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
+  gl::requireDepthFormat("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
   gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
 

@@ -55,7 +55,7 @@ layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { Cr
 // Light textures (crep/prefilter/prefilter.h, "Light textures"): the colour map (W x H, rgb) in, the prefix
 // mean colour cbar out (RGBA16F, A = 1); the basis array holds 3 ceil(M / 4) layers, colour c from layer c L.
 layout(binding = 1) uniform sampler2D crep_lightColors;
-layout(binding = 1, rgba16f) uniform writeonly restrict image2D crep_meanColorOut;
+layout(binding = 1, rgba32f) uniform writeonly restrict image2D crep_meanColorOut;
 #endif
 #if CREP_LOCAL_LIGHT
 layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
@@ -167,7 +167,7 @@ void main() {
     vec3 mc = vec3(m);
     for (int c = 0; c < 3; ++c)
       if (cbar[c] > 0.0) mc[c] = clamp(m * (ci[c] / cbar[c]), 0.0, 1.0);
-    if (group == 0) imageStore(crep_meanColorOut, ivec2(x, row), vec4(crep_roundToHalf(vec4(cbar, 1.0)).rgb, 1.0));
+    if (group == 0) imageStore(crep_meanColorOut, ivec2(x, row), vec4(cbar, 1.0));
 #endif
     for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
       int layer = firstLayer + v;

@@ -33,6 +33,7 @@ std::size_t RectifiedShadowPass::memoryBytes() const noexcept {
 }
 
 void RectifiedShadowPass::run(const FrameAttribs& frame) {
+  gl::requireNotMovedFrom(framebuffer_, "RectifiedShadowPass");
   const Rectification* r = frame.rectification;
   if (r == nullptr) invalid("RectifiedShadowPass::FrameAttribs.rectification", "null", "must be set");
   if (!r->projective())
@@ -54,8 +55,11 @@ void RectifiedShadowPass::run(const FrameAttribs& frame) {
   const std::uint32_t target = frame.depthTexture != 0 ? frame.depthTexture : texture_.get();
   const GLuint fb = framebuffer_.get();
   glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, target, 0);
+  struct Detach { // the caller's texture is not kept attached, whatever leaves run()
+    GLuint fb;
+    ~Detach() { glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0); }
+  } detach{fb};
   if (glCheckNamedFramebufferStatus(fb, GL_DRAW_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-    glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0);
     invalid("RectifiedShadowPass::FrameAttribs.depthTexture", std::to_string(target),
             "must have a depth format (GL_DEPTH_COMPONENT32F, 24 or 16)");
   }
@@ -70,8 +74,8 @@ void RectifiedShadowPass::run(const FrameAttribs& frame) {
       frame.drawCasters(k, r->splits[static_cast<std::size_t>(k)].rectClipFromWorld);
     }
     scope.requireUnchanged("RectifiedShadowPass::FrameAttribs.drawCasters");
+    gl::checkError("the rectified map drawn by RectifiedShadowPass::FrameAttribs.drawCasters");
   }
-  glNamedFramebufferTexture(fb, GL_DEPTH_ATTACHMENT, 0, 0);
   gl::checkError("RectifiedShadowPass::run");
 }
 

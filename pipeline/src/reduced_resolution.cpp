@@ -111,7 +111,9 @@ DepthAwareResamplePass::DepthAwareResamplePass(DepthAwareResamplePass&&) noexcep
 DepthAwareResamplePass& DepthAwareResamplePass::operator=(DepthAwareResamplePass&&) noexcept = default;
 
 void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t lowDepth) {
+  gl::requireNotMovedFrom(sampler_, "DepthAwareResamplePass");
   gl::requireTexture2D("DepthAwareResamplePass::downsample.fullDepth", fullDepth, info_.width, info_.height);
+  gl::requireDepthFormat("DepthAwareResamplePass::downsample.fullDepth", fullDepth);
   gl::requireTexture2D("DepthAwareResamplePass::downsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
                        GL_R32F);
   glUseProgram(downsampleProgram_.get());
@@ -141,10 +143,12 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, const glm::vec4& depthMap) {
+  gl::requireNotMovedFrom(sampler_, "DepthAwareResamplePass");
   gl::requireTexture2D("DepthAwareResamplePass::upsample.low", low, lowWidth(), lowHeight(), GL_RGBA32F);
   gl::requireTexture2D("DepthAwareResamplePass::upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
                        GL_R32F);
   gl::requireTexture2D("DepthAwareResamplePass::upsample.fullDepth", fullDepth, info_.width, info_.height);
+  gl::requireDepthFormat("DepthAwareResamplePass::upsample.fullDepth", fullDepth);
   gl::requireTexture2D("DepthAwareResamplePass::upsample.output", output, info_.width, info_.height,
                        GL_RGBA32F);
   const GLuint p = upsampleProgram_.get();

@@ -135,6 +135,7 @@ void requireCovers(const std::string& field, const glm::dmat4& M, const glm::dve
 void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map, const glm::dvec3& position,
                       std::span<const glm::dvec3> directions, const std::string& what) {
   gl::requireTexture2D((field + ".texture").c_str(), map.texture);
+  gl::requireDepthFormat((field + ".texture").c_str(), map.texture);
   if (!std::isfinite(map.bias)) invalid(field + ".bias", detail::formatValue(map.bias), "must be finite");
   try {
     validateLocalLightMatrix(map.lightClipFromWorld, position);
@@ -235,6 +236,25 @@ void validateFroxelTarget(const Scattering::FroxelTarget& t, const Camera& camer
                 std::to_string(t.grid.height) + " x " + std::to_string(t.grid.depth));
 }
 
+/// FrameAttribs::output is written while the inputs are read: it must be none of them.
+void requireOutputNotAnInput(const Scattering::FrameAttribs& f) {
+  const auto check = [&](std::uint32_t input, const std::string& name) {
+    if (input != 0 && input == f.output)
+      invalid("Scattering::FrameAttribs.output", "texture " + std::to_string(f.output) + ", also " + name,
+              "must not be one of the frame's inputs");
+  };
+  check(f.cameraDepth, "FrameAttribs.cameraDepth");
+  if (f.shadowMap) check(f.shadowMap->texture, "FrameAttribs.shadowMap.texture");
+  if (f.lightTexture) check(f.lightTexture->texture, "FrameAttribs.lightTexture.texture");
+  for (std::size_t i = 0; i < f.spotLightTextures.size(); ++i)
+    check(f.spotLightTextures[i].texture,
+          "FrameAttribs.spotLightTextures[" + std::to_string(i) + "].texture");
+  for (std::size_t i = 0; i < f.spotShadowMaps.size(); ++i)
+    check(f.spotShadowMaps[i].texture, "FrameAttribs.spotShadowMaps[" + std::to_string(i) + "].texture");
+  for (std::size_t i = 0; i < f.pointShadowMaps.size(); ++i)
+    check(f.pointShadowMaps[i].texture, "FrameAttribs.pointShadowMaps[" + std::to_string(i) + "].texture");
+}
+
 /// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
 struct DepthTarget {
   gl::Handle texture, framebuffer;
@@ -255,6 +275,7 @@ struct DepthTarget {
     glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &one);
     draw();
     scope.requireUnchanged(callback);
+    gl::checkError((std::string("the shadow map drawn by ") + callback).c_str()); // the callback's own errors
   }
 };
 
@@ -296,6 +317,7 @@ struct Scattering::Impl {
   std::optional<RectifiedMarchPass> march;       ///< ... and the tree march
   std::optional<EpipolarSamplingPass> sampling;  ///< Sampling::Epipolar
   gl::GpuTimer timer;
+  bool running = false; ///< inside run(): a call from drawCasters is refused
   /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
   /// made on the first frame with local lights; their fallback's perspective shadow map.
   gl::Handle localScattering, accumulate;
@@ -370,7 +392,12 @@ struct Scattering::Impl {
     }
     const auto start = std::chrono::steady_clock::now();
     timer.begin();
-    work();
+    try {
+      work();
+    } catch (...) {
+      timer.cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
+      throw;
+    }
     timer.end();
     glFinish();
     const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
@@ -384,10 +411,12 @@ Scattering::Scattering(Scattering&&) noexcept = default;
 Scattering& Scattering::operator=(Scattering&&) noexcept = default;
 
 const Scattering::CreateInfo& Scattering::createInfo() const noexcept {
-  return impl_->info;
+  static const CreateInfo movedFrom{};
+  return impl_ ? impl_->info : movedFrom;
 }
 
 std::size_t Scattering::memoryBytes() const noexcept {
+  if (!impl_) return 0; // moved from
   const Impl& m = *impl_;
   const std::size_t map =
       static_cast<std::size_t>(m.info.mapSize) * static_cast<std::size_t>(m.info.mapSize) * 4;
@@ -415,6 +444,39 @@ std::size_t Scattering::memoryBytes() const noexcept {
 }
 
 Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
+  if (!impl_)
+    invalid("Scattering", "a moved-from object",
+            "owns no GPU resources: assign a constructed Scattering first");
+  Impl& m = *impl_;
+  if (m.running)
+    invalid("Scattering::run",
+            "called while a frame of the same object runs (from FrameAttribs.drawCasters?)",
+            "must not be re-entered");
+  // What the caller's state must not be, since the library cannot set it aside (docs/GL_STATE.md).
+  gl::requireNoPendingError("Scattering::run");
+  gl::requireNoActiveTransformFeedback("Scattering::run");
+  if (m.info.stageTimings) gl::requireNoActiveTimerQuery("Scattering::run (CreateInfo.stageTimings)");
+  // However the frame ends: no query of ours active, program 0 and units / binding points 0-7 unbound
+  // (docs/GL_STATE.md), and the object ready for the next frame. The raster state is restored by the
+  // depth passes' own scopes.
+  m.running = true;
+  struct OnExit {
+    Impl& m;
+    ~OnExit() {
+      m.timer.cancel();
+      gl::unbindPassState(8);
+      m.running = false;
+    }
+  } onExit{m};
+  try {
+    return runFrame(f);
+  } catch (...) {
+    gl::drainErrors(); // raised during this call (by a pass or the caller's callback): not left to the caller
+    throw;
+  }
+}
+
+Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
   Impl& m = *impl_;
   const CreateInfo& info = m.info;
   const bool local = !f.spotLights.empty() || !f.pointLights.empty();
@@ -422,17 +484,12 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   if (!f.light && !local)
     invalid("Scattering::FrameAttribs.light", "null", "must be set unless local lights are given");
   if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
-  // What the caller's state must not be, since the library cannot set it aside (docs/GL_STATE.md).
-  gl::requireNoActiveTransformFeedback("Scattering::run");
-  if (info.stageTimings) gl::requireNoActiveTimerQuery("Scattering::run (CreateInfo.stageTimings)");
-  // The frame leaves program 0 and units / binding points 0-7 unbound however it ends (docs/GL_STATE.md).
-  struct UnbindOnExit {
-    ~UnbindOnExit() { gl::unbindPassState(8); }
-  } unbindOnExit;
-  if (f.output != 0 || !f.froxels) // a froxel volume alone reads no camera depth
+  if (f.output != 0 || !f.froxels) { // a froxel volume alone reads no camera depth
     gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
-  if (f.output != 0 || !f.froxels)
     gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
+    requireOutputNotAnInput(f);
+    gl::requireDepthFormat("Scattering::FrameAttribs.cameraDepth", f.cameraDepth);
+  }
   if (f.froxels) {
     if (!f.light)
       invalid("Scattering::FrameAttribs.froxels", "set without a directional light",
@@ -459,6 +516,7 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   }
   if (f.shadowMap) {
     gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
+    gl::requireDepthFormat("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
     if (!std::isfinite(f.shadowMap->bias))
       invalid("Scattering::FrameAttribs.shadowMap.bias", detail::formatValue(f.shadowMap->bias),
               "must be finite");

@@ -72,6 +72,7 @@ void AtmospherePass::run(const FrameAttribs& f) {
   }
   const gl::TextureLevel image =
       gl::requireTexture2D("AtmospherePass::FrameAttribs.cameraDepth", f.cameraDepth);
+  gl::requireDepthFormat("AtmospherePass::FrameAttribs.cameraDepth", f.cameraDepth);
   const int width = image.width, height = image.height;
   gl::requireTexture2D("AtmospherePass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   if (f.transmittanceOutput != 0)
@@ -85,6 +86,7 @@ void AtmospherePass::run(const FrameAttribs& f) {
     layoutData = gpu::requireGpuLayout(*f.layout, "AtmospherePass::FrameAttribs.layout");
     gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
     gl::requireTexture2D("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
+    gl::requireDepthFormat("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
     if (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer))
       throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
                             "must be the MinMaxTreePass::treeBuffer() of the map (shafts (a), (b))");

@@ -166,6 +166,7 @@ std::size_t EsmPass::memoryBytes() const noexcept {
 
 void EsmPass::run(const FrameAttribs& f) {
   const gl::TextureLevel map = gl::requireTexture2D("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
+  gl::requireDepthFormat("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
   requireMatrix(f.lightClipFromWorld, "EsmPass::FrameAttribs.lightClipFromWorld");
   const double c = esmDepthExponent(info_.options, f.lightClipFromWorld);
   const int factor = info_.options.downsample;
@@ -443,7 +444,12 @@ void FroxelFog::run(const FrameAttribs& f) {
   timings_ = Timings{};
   const auto stage = [&](double& ms, const auto& body) {
     if (info_.timings) timer_.begin();
-    body();
+    try {
+      body();
+    } catch (...) {
+      timer_.cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
+      throw;
+    }
     if (info_.timings) {
       timer_.end();
       ms = timer_.milliseconds();

@@ -31,25 +31,6 @@ RadialBlurParams makeRadialBlurParams(const RadialBlurOptions& o, const RadialLi
 
 } // namespace gpu
 
-namespace {
-
-bool acceptedDepthFormat(std::uint32_t f) {
-  switch (f) {
-  case GL_DEPTH_COMPONENT16:
-  case GL_DEPTH_COMPONENT24:
-  case GL_DEPTH_COMPONENT32:
-  case GL_DEPTH_COMPONENT32F:
-  case GL_DEPTH24_STENCIL8:
-  case GL_DEPTH32F_STENCIL8:
-  case GL_R32F:
-    return true;
-  default:
-    return false;
-  }
-}
-
-} // namespace
-
 RadialBlurPass::RadialBlurPass(const CreateInfo& info) : info_(info) {
   validate(info.options, "RadialBlurPass::CreateInfo.options");
   // 32 x 32 = 1024 invocations: the smallest GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS GL 4.5 guarantees.
@@ -75,11 +56,7 @@ void RadialBlurPass::run(const FrameAttribs& f) {
   if (!f.medium) throw InvalidArgument("RadialBlurPass::FrameAttribs.medium", "null", "must be set");
   const gl::TextureLevel depth =
       gl::requireTexture2D("RadialBlurPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  if (!acceptedDepthFormat(depth.internalFormat))
-    throw InvalidArgument("RadialBlurPass::FrameAttribs.cameraDepth",
-                          "internal format " +
-                              detail::formatValue(static_cast<long long>(depth.internalFormat)),
-                          "must be a depth format or GL_R32F");
+  gl::requireDepthFormat("RadialBlurPass::FrameAttribs.cameraDepth", f.cameraDepth);
   const int width = depth.width, height = depth.height;
   gl::requireTexture2D("RadialBlurPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   const RadialBlurOptions& o = info_.options;

@@ -331,6 +331,7 @@ PrefilterPass::PrefilterPass(PrefilterPass&&) noexcept = default;
 PrefilterPass& PrefilterPass::operator=(PrefilterPass&&) noexcept = default;
 
 void PrefilterPass::run(const FrameAttribs& frame) {
+  gl::requireNotMovedFrom(sampler_, "PrefilterPass");
   if (frame.layout == nullptr)
     invalid("PrefilterPass::FrameAttribs.layout", "null", "must point to the map's layout");
   const gl::TextureLevel depth =
@@ -338,6 +339,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   if (depth.target != GL_TEXTURE_2D)
     invalid("PrefilterPass::FrameAttribs.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
             "must be a GL_TEXTURE_2D");
+  gl::requireDepthFormat("PrefilterPass::FrameAttribs.rectifiedDepth", frame.rectifiedDepth);
   if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
     invalid("PrefilterPass::FrameAttribs.rectifiedDepth", sizeString(depth.width, depth.height),
             "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
@@ -377,7 +379,9 @@ void PrefilterPass::run(const FrameAttribs& frame) {
       glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
       glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      meanColor_ = gl::createTexture2D(GL_RGBA16F, W, H, "PrefilterPass: mean colour (light textures)");
+      // RGBA32F: a light texture's HDR texels (projector images in physical units) are kept whole; half
+      // floats clipped them at 65504. GPU: one fetch per region per pixel, so the extra bytes are cheap.
+      meanColor_ = gl::createTexture2D(GL_RGBA32F, W, H, "PrefilterPass: mean colour (light textures)");
       glTextureParameteri(meanColor_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
       glTextureParameteri(meanColor_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
       gl::checkError("PrefilterPass: light-texture basis array and mean colour");
@@ -431,7 +435,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   if (textured) {
     glBindTextureUnit(1, frame.lightColors);
     glBindSampler(1, sampler_.get());
-    glBindImageTexture(1, meanColor_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+    glBindImageTexture(1, meanColor_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   }
   if (local) {
     glBindBufferBase(GL_UNIFORM_BUFFER, 1, localBuffer_.get());
@@ -597,6 +601,7 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
 }
 
 std::size_t EvaluatePass::memoryBytes() const noexcept {
+  if (!basisSampler_) return 0; // moved from
   const std::size_t coefficients = tableCoefficients_
                                        ? static_cast<std::size_t>(info_.options.visibilityTableSamples) *
                                              static_cast<std::size_t>(layerCount(info_.bases)) * 16
@@ -611,11 +616,12 @@ EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
 
 std::size_t PrefilterPass::memoryBytes() const noexcept {
+  if (!sampler_) return 0; // moved from
   const std::size_t textured =
       texturedTexture_
           ? 3 * filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases,
                                    info_.options.format) +
-                static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight) * 8
+                static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight) * 16
           : 0;
   return textured +
          filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
@@ -624,6 +630,7 @@ std::size_t PrefilterPass::memoryBytes() const noexcept {
 }
 
 void EvaluatePass::run(const FrameAttribs& frame) {
+  gl::requireNotMovedFrom(basisSampler_, "EvaluatePass");
   if (frame.camera == nullptr) invalid("EvaluatePass::FrameAttribs.camera", "null", "must be set");
   const bool local = frame.localLight != nullptr;
   if ((frame.light == nullptr) == !local)
@@ -715,6 +722,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     if (depth.target != GL_TEXTURE_2D)
       invalid("EvaluatePass::FrameAttribs.cameraDepth", "texture " + str(frame.cameraDepth),
               "must be a GL_TEXTURE_2D");
+    gl::requireDepthFormat("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
     out = gl::textureLevel("EvaluatePass::FrameAttribs.output", frame.output);
     if (out.target != GL_TEXTURE_2D || out.internalFormat != outFormat)
       invalid("EvaluatePass::FrameAttribs.output", "texture " + str(frame.output),

@@ -363,7 +363,7 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
             const double ci = colors->at(x, j, c);
             cbar[c] += m * (ci - cbar[c]);
             if (cbar[c] > 0.0) mc = std::clamp(m * (ci / cbar[c]), 0.0, 1.0);
-            b.meanColor[texel / 4 * 3 + static_cast<std::size_t>(c)] = roundToHalf(cbar[c]);
+            b.meanColor[texel / 4 * 3 + static_cast<std::size_t>(c)] = static_cast<float>(cbar[c]);
           }
           std::array<double, kMaxBases>& F = Fc[static_cast<std::size_t>(c)];
           // Listing 2: the normalized weighted prefix, F_i = F_{i-1} + m_i (B_i - F_{i-1}).

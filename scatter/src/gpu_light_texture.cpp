@@ -19,6 +19,7 @@ gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const D
   const std::string f(field);
   const std::string textureField = f + ".texture";
   const gl::TextureLevel level = gl::requireTexture2D(textureField.c_str(), texture.texture);
+  gl::requireColorFormat(textureField.c_str(), texture.texture);
   if (level.width <= 0 || level.height <= 0)
     throw InvalidArgument(textureField, std::to_string(level.width) + " x " + std::to_string(level.height),
                           "must have a level 0");

@@ -109,6 +109,8 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   const gl::TextureLevel depth =
       gl::requireTexture2D("WorldMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
   const gl::TextureLevel shadow = gl::requireTexture2D("WorldMarchPass::FrameAttribs.shadowMap", f.shadowMap);
+  gl::requireDepthFormat("WorldMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
+  gl::requireDepthFormat("WorldMarchPass::FrameAttribs.shadowMap", f.shadowMap);
   const int width = depth.width, height = depth.height;
   gl::requireTexture2D("WorldMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   if (f.stepsOutput != 0)

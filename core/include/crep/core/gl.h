@@ -44,6 +44,10 @@ private:
   std::uint32_t name_ = 0;
 };
 
+/// Throws InvalidArgument naming `owner` when `handle` is empty because its pass was moved from: a moved-from
+/// pass is valid but empty (memoryBytes() 0), and its run() refuses to work.
+void requireNotMovedFrom(const Handle& handle, const char* owner);
+
 /// glCreate* wrappers (DSA). `target` is a GLenum such as GL_TEXTURE_2D or GL_TIME_ELAPSED.
 Handle createTexture(std::uint32_t target);
 Handle createBuffer();
@@ -85,10 +89,20 @@ TextureLevel textureLevel(const char* parameter, std::uint32_t texture);
 /// textureLevel(), and InvalidArgument naming `parameter` unless the target is GL_TEXTURE_2D.
 TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture);
 
-/// Throws InvalidArgument naming `parameter` unless `texture` names an existing texture whose level 0 is
-/// width x height (sizes > 0) and, when `internalFormat` is not 0, of that internal format.
+/// Throws InvalidArgument naming `parameter` unless `texture` names an existing GL_TEXTURE_2D whose level 0
+/// is width x height (sizes > 0) and, when `internalFormat` is not 0, of that internal format.
 void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
                       std::uint32_t internalFormat = 0);
+
+/// Throws InvalidArgument naming `parameter` unless `texture` (an existing texture) can be read as depth:
+/// a depth format (GL_DEPTH_COMPONENT16/24/32/32F, GL_DEPTH24_STENCIL8, GL_DEPTH32F_STENCIL8) sampled as
+/// depth (GL_DEPTH_STENCIL_TEXTURE_MODE = GL_DEPTH_COMPONENT), or GL_R32F. Camera depth, shadow maps and
+/// rectified maps: a colour, half-float, integer or stencil texture would be read as garbage.
+void requireDepthFormat(const char* parameter, std::uint32_t texture);
+/// Throws InvalidArgument naming `parameter` unless `texture` (an existing texture) has a colour format
+/// read as float: floating point, unsigned or signed normalized (GL_RGBA8, GL_SRGB8_ALPHA8, GL_RGBA16F,
+/// GL_RGB32F, ...); not depth, stencil or integer. Light textures.
+void requireColorFormat(const char* parameter, std::uint32_t texture);
 
 /// The state the compute passes of the library leave behind: program 0; texture units, samplers, image
 /// units, uniform and storage buffer bindings 0 .. units - 1 unbound.
@@ -112,6 +126,9 @@ void checkTextureSize(const char* parameter, int width, int height);
 
 /// Throws GlError naming `what` when glGetError() reports an error (drains all pending errors).
 void checkError(const char* what);
+/// Pops every pending GL error (at most 32: a lost context reports one forever) and returns their names,
+/// comma separated ("" when none).
+std::string drainErrors() noexcept;
 
 /// Measures GPU time between begin() and end() with a GL_TIME_ELAPSED query. Only one
 /// GL_TIME_ELAPSED query can be active at a time, so timers do not nest.
@@ -123,6 +140,9 @@ public:
   /// Waits for the result. Milliseconds of GPU time between the last begin() and end(). Throws
   /// GlError when called before a begin()/end() pair has completed.
   double milliseconds();
+  /// Ends a running query without a result (a stage that threw): the context is left without an active
+  /// GL_TIME_ELAPSED query and the timer can begin() again. No-op otherwise.
+  void cancel() noexcept;
 
 private:
   enum class State { Idle, Running, Ended };

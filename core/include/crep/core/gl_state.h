@@ -97,6 +97,11 @@ private:
 /// changing what the engine records.
 void requireNoActiveTransformFeedback(const char* owner);
 
+/// Throws GlError naming `owner` and the errors when GL errors are pending before a call of the library
+/// (the caller's earlier GL calls raised them; glGetError() pops them, so they are reported here rather
+/// than blamed on the library's first check).
+void requireNoPendingError(const char* owner);
+
 /// GL_TIME_ELAPSED queries do not nest: throws GlError naming `owner` when the caller has one active (the
 /// library's stage timers would fail part way through a frame).
 void requireNoActiveTimerQuery(const char* owner);

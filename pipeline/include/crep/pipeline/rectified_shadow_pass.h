@@ -45,6 +45,8 @@ public:
   /// Throws InvalidArgument naming the field for sizes < 1 or beyond GL_MAX_TEXTURE_SIZE.
   explicit RectifiedShadowPass(const CreateInfo& info);
   ~RectifiedShadowPass();
+  /// Moved from: valid but empty (run() throws InvalidArgument naming "RectifiedShadowPass", memoryBytes() is
+  /// 0).
   RectifiedShadowPass(RectifiedShadowPass&&) noexcept;
   RectifiedShadowPass& operator=(RectifiedShadowPass&&) noexcept;
   RectifiedShadowPass(const RectifiedShadowPass&) = delete;

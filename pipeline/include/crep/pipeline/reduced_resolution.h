@@ -48,6 +48,8 @@ public:
   /// Throws InvalidArgument naming the field ("DepthAwareResamplePass::CreateInfo.factor", ...).
   explicit DepthAwareResamplePass(const CreateInfo& info);
   ~DepthAwareResamplePass();
+  /// Moved from: valid but empty (run() throws InvalidArgument naming "DepthAwareResamplePass", memoryBytes()
+  /// is 0).
   DepthAwareResamplePass(DepthAwareResamplePass&&) noexcept;
   DepthAwareResamplePass& operator=(DepthAwareResamplePass&&) noexcept;
   DepthAwareResamplePass(const DepthAwareResamplePass&) = delete;

@@ -325,27 +325,34 @@ public:
   /// frame).
   explicit Scattering(const CreateInfo& info);
   ~Scattering();
+  /// Moved from: valid but empty (run() throws InvalidArgument naming "Scattering", memoryBytes() is 0).
   Scattering(Scattering&&) noexcept;
   Scattering& operator=(Scattering&&) noexcept;
   Scattering(const Scattering&) = delete;
   Scattering& operator=(const Scattering&) = delete;
 
-  /// One frame. Throws InvalidArgument naming the FrameAttribs field (null pointers, textures of the
-  /// wrong size or format, no shadow input, span sizes, bad local maps, e.g.
-  /// "Scattering::FrameAttribs.spotShadowMaps[0].lightClipFromWorld", bad light textures, e.g.
-  /// "Scattering::FrameAttribs.spotLightTextures[0].textureClipFromWorld").
+  /// One frame. Throws InvalidArgument naming the FrameAttribs field (null pointers; textures of the wrong
+  /// target, size or format class, or an output that is also an input; no shadow input; span sizes; bad
+  /// local maps, e.g. "Scattering::FrameAttribs.spotShadowMaps[0].lightClipFromWorld"; bad light textures,
+  /// e.g. "Scattering::FrameAttribs.spotLightTextures[0].textureClipFromWorld"; a moved-from object; a
+  /// call from inside its own drawCasters), GlError for GL errors pending before the call and for the
+  /// states of docs/GL_STATE.md it cannot set aside. Whatever it throws, the context is left as the
+  /// contract says (no query active, raster state restored, units 0-7 unbound, no GL error pending from
+  /// the call) and the next frame of this object or of a new one is right.
   FrameResult run(const FrameAttribs& frame);
 
+  /// A moved-from object: the defaults (it owns nothing).
   const CreateInfo& createInfo() const noexcept;
   /// GPU memory it owns now, bytes: the filtered basis and the region visibility table, the rasterized
   /// (D32F) and resampled (R32F) rectified maps, its own standard shadow map once a fallback frame needed
   /// it, the reduced-resolution depth and scattering (evaluationScale < 1), the local lights' targets once
   /// used (scattering, rasterized and resampled rectified maps, perspective map), the light textures' colour
   /// map once used (and the prefilters' textured bases: PrefilterPass::memoryBytes) and the passes'
-  /// buffers.
+  /// buffers. 0 for a moved-from object.
   std::size_t memoryBytes() const noexcept;
 
 private:
+  FrameResult runFrame(const FrameAttribs& frame);
   void runLocalLights(const FrameAttribs& frame, FrameResult& result);
 
   struct Impl;

@@ -59,7 +59,7 @@ struct FilteredBasisView {
   /// Prefiltered with a light texture's colour map (prefilter.h, "Light textures"): `texture` has 3 ceil(M /
   /// 4) layers (colour c from layer c ceil(M / 4)) and `meanColor` is the prefix mean colour.
   bool textured = false;
-  std::uint32_t meanColor = 0; ///< textured: GL_TEXTURE_2D, width x height, GL_RGBA16F (rgb cbar)
+  std::uint32_t meanColor = 0; ///< textured: GL_TEXTURE_2D, width x height, GL_RGBA32F (rgb cbar)
 
   int regions() const noexcept { return layoutRegions * regionsPerSplit; } ///< R
 };
@@ -127,6 +127,7 @@ public:
   /// workgroup limits), compiles the program and allocates the filtered-basis texture array.
   explicit PrefilterPass(const CreateInfo& info);
   ~PrefilterPass();
+  /// Moved from: valid but empty (run() throws InvalidArgument naming "PrefilterPass", memoryBytes() is 0).
   PrefilterPass(PrefilterPass&&) noexcept;
   PrefilterPass& operator=(PrefilterPass&&) noexcept;
   PrefilterPass(const PrefilterPass&) = delete;
@@ -256,6 +257,7 @@ public:
   /// compiles the program.
   explicit EvaluatePass(const CreateInfo& info);
   ~EvaluatePass();
+  /// Moved from: valid but empty (run() throws InvalidArgument naming "EvaluatePass", memoryBytes() is 0).
   EvaluatePass(EvaluatePass&&) noexcept;
   EvaluatePass& operator=(EvaluatePass&&) noexcept;
   EvaluatePass(const EvaluatePass&) = delete;

@@ -64,14 +64,14 @@
 //   m^c_i = m_i (c_i / cbar_i)   (= w_i c_i / sum_{l<=i} w_l c_l, clamped to [0, 1]; m_i where cbar_i = 0)
 //   F^c_i = F^c_{i-1} + m^c_i (B(z_i) - F^c_{i-1})
 // stored as three bases (3 ceil(M / 4) layers, colour c in layers [c L, (c + 1) L): 3x the storage and the
-// filter work, the tripled storage of Sec. 3.2) and cbar per texel, rounded to binary16 (one RGBA16F
-// texture). A constant texture c gives cbar = c and m^c = m (c / c = 1) exactly, so F^c = F bit for bit.
-// Evaluation per channel: V_c = cbar_c(u_b) clamp(0.5 + a . F^c(u_b), 0, 1) (cbar sampled like F), 0
-// where cbar = 0 (no weighted light); with the near-plane correction the prefix difference weighs each
-// prefix by W cbar: V_c = cseg clamp(0.5 + a . (W_b cbar_b F^c_b - W_a cbar_a F^c_a) / (W_b cbar_b - W_a
-// cbar_a)), cseg = (W_b cbar_b - W_a cbar_a) / (W_b - W_a) (0 where the numerator is <= 0). The region
-// visibility table then holds 3 values per cell (V_c at the region's last texel) and the scattering prefix
-// table multiplies each channel's section integral by its own V_c.
+// filter work, the tripled storage of Sec. 3.2) and cbar per texel as float (one RGBA32F texture: HDR
+// textures beyond binary16's 65504 are not clipped). A constant texture c gives cbar = c and m^c = m (c / c =
+// 1) exactly, so F^c = F bit for bit. Evaluation per channel: V_c = cbar_c(u_b) clamp(0.5 + a . F^c(u_b), 0,
+// 1) (cbar sampled like F), 0 where cbar = 0 (no weighted light); with the near-plane correction the prefix
+// difference weighs each prefix by W cbar: V_c = cseg clamp(0.5 + a . (W_b cbar_b F^c_b - W_a cbar_a F^c_a) /
+// (W_b cbar_b - W_a cbar_a)), cseg = (W_b cbar_b - W_a cbar_a) / (W_b - W_a) (0 where the numerator is <= 0).
+// The region visibility table then holds 3 values per cell (V_c at the region's last texel) and the
+// scattering prefix table multiplies each channel's section integral by its own V_c.
 //
 // ---------------------------------------------------------------------------------------------------
 // Froxel volumes (evaluateFroxels(); EvaluatePass::FrameAttribs::froxels). The in-scattering from the camera
@@ -220,8 +220,8 @@ struct FilteredBasis {
   /// Prefiltered with a light texture's colour map (see "Light textures" at the top): `texels` holds three
   /// bases, colour channel c in layers [c layers, (c + 1) layers), and `meanColor` the prefix mean colours.
   bool textured = false;
-  /// Textured only: cbar_c of every texel, height * width * 3, index (y * width + x) * 3 + c, each rounded
-  /// to binary16 (roundToHalf; the GPU's GL_RGBA16F texture). Empty otherwise.
+  /// Textured only: cbar_c of every texel, height * width * 3, index (y * width + x) * 3 + c, as float (the
+  /// GPU's GL_RGBA32F texture). Empty otherwise.
   std::vector<float> meanColor;
 
   int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
