@@ -14,11 +14,11 @@ const crep::tool::CommandRegistrar kBenchCommand({
     "bench",
     "the benchmark suite of bench/ (as crep_bench): CPU reference vs GPU passes, methods side\n"
     "            by side, bandwidth vs a copy, Table 1/2 rows; ratios measured in one run\n"
-    "            --scene NAME (forest) --size WxH (1920x1080) --map WxH (1024x1024) --bases M (32)\n"
-    "            --repeat N (5) --quick (one size, no tables); the --map width is a multiple of 32\n"
-    "            (16 with --quick); --plot FILE.svg writes the Table 1/2 rows as a chart beside the\n"
-    "            paper's (not with --quick); --section epipolar-sampling | atmosphere runs that section "
-    "alone\n",
+    "            --scene NAME (forest) --size WxH (1920x1080) --map WxH (1024x1024)\n"
+    "            --bases M (32; any even M in [4, 128]) --repeat N (5) --quick (one size, no tables);\n"
+    "            the --map width is a multiple of 32 (16 with --quick); --plot FILE.svg writes the\n"
+    "            Table 1/2 rows as a chart beside the paper's (not with --quick); --section\n"
+    "            epipolar-sampling | atmosphere runs that section alone\n",
     [](const std::vector<std::string>& args) {
       crep::bench::runBenchSuite(crep::bench::parseBenchOptions(args));
       return 0;

@@ -5,6 +5,7 @@
 #include "atmosphere_frame.h"
 #include "gl_session.h"
 #include "methods.h"
+#include "paths.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -154,6 +155,13 @@ EvaluatePass::FrameAttribs evaluateAttribs(const Setup& s, const FilteredBasisVi
   return ev;
 }
 
+/// PrefilterOptions::basesPerInvocation for `requested` bases per invocation at M = `bases`: at most M
+/// rounded up to a multiple of 4 (the library's rule: a multiple of 4 in [4, 128]; the last group of a row
+/// may be partial), so every even M of --bases (6, 10, 30, ...) runs.
+int perInvocationFor(int requested, int bases) {
+  return std::min(requested, (bases + 3) / 4 * 4);
+}
+
 GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
                  int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit,
                  int basesPerInvocation = PrefilterOptions{}.basesPerInvocation, bool limits = false) {
@@ -163,7 +171,7 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
   info.options.bases = bases;
   info.options.format = format;
   info.options.regionsPerSplit = regionsPerSplit;
-  info.options.basesPerInvocation = std::min(basesPerInvocation, bases);
+  info.options.basesPerInvocation = perInvocationFor(basesPerInvocation, bases);
   PrefilterPass prefilter(info);
   EvaluatePass::CreateInfo evalInfo;
   evalInfo.bases = bases;
@@ -206,7 +214,7 @@ GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
     });
     for (const int perInvocation : {4, 8, 16, 32}) {
       PrefilterPass::CreateInfo writer = info;
-      writer.options.basesPerInvocation = std::min(perInvocation, bases);
+      writer.options.basesPerInvocation = perInvocationFor(perInvocation, bases);
       PrefilterPass writeOnly(writer);
       writeOnly.run(frame);
       glFinish();
@@ -677,6 +685,7 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot", "section"}, {"quick"});
   BenchOptions o;
   o.scene = args.string("scene", o.scene);
+  tool::requireSceneName(o.scene); // a usage error before any GL work
   o.quick = args.has("quick");
   const glm::ivec2 size =
       args.size("size", {o.screenWidth, o.screenHeight}, Image::kMaxDimension, Image::kMaxPixels);
@@ -717,6 +726,7 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   if (!o.plot.empty() && o.quick)
     throw tool::UsageError("option --plot: needs the Table 1/2 rows, which --quick omits");
   if (!o.plot.empty() && !o.plot.ends_with(".svg")) throw tool::UsageError("option --plot: must end in .svg");
+  if (!o.plot.empty()) tool::requireOutputFile({"--plot", o.plot}); // the output rule, before any work
   return o;
 }
 
@@ -739,7 +749,7 @@ void constantCost(const BenchOptions& o) {
     info.mapHeight = o.mapHeight;
     info.options = Scattering::CreateInfo{}.prefilter;
     info.options.bases = o.bases;
-    info.options.basesPerInvocation = std::min(info.options.basesPerInvocation, o.bases);
+    info.options.basesPerInvocation = perInvocationFor(info.options.basesPerInvocation, o.bases);
     sc.prefilter = std::make_unique<PrefilterPass>(info);
     EvaluatePass::CreateInfo evalInfo;
     evalInfo.bases = o.bases;

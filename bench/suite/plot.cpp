@@ -2,11 +2,11 @@
 #include "plot.h"
 
 #include <crep/core/error.h>
+#include <crep/support/output_file.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 
 namespace crep::bench {
@@ -87,10 +87,7 @@ void writeBarChartSvg(const std::string& path, const std::string& title,
           << escape(panel.series[s].name) << "</text>\n";
   }
   svg << "</svg>\n";
-  std::ofstream file(path, std::ios::binary);
-  if (!file) throw IoError("crep bench: " + path + ": cannot be written");
-  file << svg.str();
-  if (!file) throw IoError("crep bench: " + path + ": cannot be written");
+  writeTextFile(path, svg.str()); // the output rule of crep/support/output_file.h
 }
 
 } // namespace crep::bench

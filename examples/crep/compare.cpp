@@ -15,12 +15,13 @@
 #include <crep/core/error.h>
 #include <crep/scenes/scene.h>
 #include <crep/support/image_compare.h>
+#include <crep/support/output_file.h>
 #include <crep/support/png.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <unistd.h>
@@ -66,11 +67,25 @@ std::vector<std::string> selectedMethods(const Args& args) {
       if (!m.reference) names.push_back(m.name);
     return names;
   }
-  std::stringstream list(args.string("methods", ""));
-  std::string name;
-  while (std::getline(list, name, ',')) {
+  // Names separated by single commas: an empty list or an empty name ("prefilter,", "a,,b") is an error,
+  // not a silently shorter list.
+  const std::string list = args.string("methods", "");
+  if (list.empty())
+    throw UsageError("option --methods: empty; give methods separated by commas (" + methodNames() + ")");
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = list.find(',', start);
+    const std::string name =
+        list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (name.empty())
+      throw UsageError("option --methods: '" + list +
+                       "' has an empty method name (names separated by single "
+                       "commas: " +
+                       methodNames() + ")");
     const Method& m = findMethod(name, "--methods");
     if (std::find(names.begin(), names.end(), m.name) == names.end()) names.push_back(m.name);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
   }
   return names;
 }
@@ -83,6 +98,7 @@ int compareCommand(const std::vector<std::string>& argv) {
   valued.erase("method");
   const Args args(argv, valued, {"debug-gl"});
   const std::string sceneName = args.string("scene", "colonnade");
+  requireSceneName(sceneName); // before the default --out (crep-compare-<scene>) is derived from it
   const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension, Image::kMaxPixels);
   MethodSettings settings = methodSettings(args);
   if (!args.has("steps")) settings.steps = 512;
@@ -95,6 +111,8 @@ int compareCommand(const std::vector<std::string>& argv) {
   const int tileWidth =
       args.integer("tile-width", std::clamp(size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);
   const std::vector<std::string> names = selectedMethods(args);
+  requireMethodImageSize(settings, names, size,
+                         "--size " + std::to_string(size.x) + "x" + std::to_string(size.y), false);
   const glm::ivec2 sheetBound = sheetSizeBound(tileWidth, size, static_cast<int>(names.size()));
   if (sheetBound.y > Image::kMaxDimension ||
       static_cast<long long>(sheetBound.x) * sheetBound.y > Image::kMaxPixels)
@@ -107,8 +125,10 @@ int compareCommand(const std::vector<std::string>& argv) {
   const std::string out = args.string("out", "crep-compare-" + sceneName);
   requireOutputPrefix({"--out", out});
   const std::string csvPath = out + ".csv", pngPath = out + ".png";
-  requireOutputFile({"--out", pngPath});
-  requireOutputFile({"--out", csvPath});
+  // Both outputs checked now, written at the end, all or nothing (paths.h "The output rule").
+  OutputFiles outputs;
+  outputs.addFile({"--out", pngPath});
+  outputs.addFile({"--out", csvPath});
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep compare");
@@ -166,12 +186,7 @@ int compareCommand(const std::vector<std::string>& argv) {
     }
     csv << "," << fixed(r.timings.total(), 3) << "\n";
   }
-  {
-    std::ofstream file(csvPath, std::ios::binary);
-    file << csv.str();
-    file.close();
-    if (!file) throw IoError("cannot write '" + csvPath + "'");
-  }
+  outputs.write(csvPath, [&](const std::filesystem::path& file) { writeTextFile(file, csv.str()); });
 
   // Contact sheet.
   std::vector<SheetColumn> columns;
@@ -207,7 +222,8 @@ int compareCommand(const std::vector<std::string>& argv) {
                              ", reference = world-space march, " + std::to_string(settings.steps) +
                              " steps; GL renderer: " + glRenderer();
   const Image sheet = composeSheet(header, columns, tileWidth, exposure, amplify);
-  writePng(pngPath, sheet);
+  outputs.write(pngPath, [&](const std::filesystem::path& file) { writePng(file, sheet); });
+  outputs.commit();
 
   std::printf("crep compare: scene %s, %dx%d, map %d^2, reference %d march steps\n", sceneName.c_str(),
               size.x, size.y, settings.mapSize, settings.steps);

@@ -12,6 +12,8 @@
 #include <cstdio>
 #include <map>
 #include <numbers>
+#include <string>
+#include <vector>
 
 namespace crep::tool {
 
@@ -30,7 +32,6 @@ const std::map<std::string, std::string> kOptionOf = {
     {"DirectionalLight.direction", "--light-dir"},
     {"RectifyOptions.splits", "--splits"},
     {"RectifyOptions.blend", "--blend"},
-    {"Camera.orientation", "--camera-target"},
 };
 } // namespace
 
@@ -48,11 +49,20 @@ int rectifyCommand(const std::vector<std::string>& argv) {
   if (!(fovyDeg >= kMinFovyDeg && fovyDeg < 180.0))
     throw UsageError("option --fovy-deg: " + args.string("fovy-deg", "") +
                      " is outside [0.001, 180) degrees");
+  // near >= far: the option the user set is the one to change (both named when both were given).
+  const double near = args.number("near", 0.1), far = args.number("far", 120.0);
+  if (!(near < far)) {
+    const std::string values = "near " + args.string("near", "0.1") + " must be below far " +
+                               args.string("far", "120") + (args.has("far") ? "" : " (the default)");
+    if (args.has("near") && args.has("far")) throw UsageError("options --near/--far: " + values);
+    throw UsageError(std::string("option ") + (args.has("far") ? "--far" : "--near") + ": " + values +
+                     (args.has("near") && !args.has("far") ? "; raise --far too" : ""));
+  }
   try {
-    const Camera camera = Camera::lookAt(
-        args.vec3("camera-pos", scene.camera.position()), args.vec3("camera-target", defaultTarget),
-        args.vec3("camera-up", {0, 1, 0}), fovyDeg * std::numbers::pi / 180.0,
-        args.number("aspect", 16.0 / 9.0), args.number("near", 0.1), args.number("far", 120.0));
+    const Camera camera =
+        Camera::lookAt(args.vec3("camera-pos", scene.camera.position()),
+                       args.vec3("camera-target", defaultTarget), args.vec3("camera-up", {0, 1, 0}),
+                       fovyDeg * std::numbers::pi / 180.0, args.number("aspect", 16.0 / 9.0), near, far);
     const DirectionalLight light(args.vec3("light-dir", scene.sun.direction()));
     RectifyOptions options;
     options.splits = args.integer("splits", options.splits, 1, RectifyOptions::kMaxSplits);
@@ -70,6 +80,20 @@ int rectifyCommand(const std::vector<std::string>& argv) {
     std::printf("%s\n", toJson(r).c_str());
     return 0;
   } catch (const InvalidArgument& e) {
+    // Parameters that depend on several options name the ones the user set (all of them if none was).
+    const std::map<std::string, std::vector<std::string>> kGroups = {
+        {"Camera.target", {"camera-pos", "camera-target"}},
+        {"Camera.orientation", {"camera-pos", "camera-target", "camera-up"}}};
+    if (const auto group = kGroups.find(e.parameter()); group != kGroups.end()) {
+      std::vector<std::string> set;
+      for (const std::string& name : group->second)
+        if (args.has(name)) set.push_back(name);
+      if (set.empty()) set = group->second;
+      std::string names;
+      for (const std::string& name : set)
+        names += (names.empty() ? "--" : "/--") + name;
+      throw UsageError((set.size() == 1 ? "option " : "options ") + names + ": " + e.what());
+    }
     const auto it = kOptionOf.find(e.parameter());
     if (it == kOptionOf.end()) throw;
     throw UsageError("option " + it->second + ": " + e.what());

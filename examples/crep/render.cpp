@@ -22,6 +22,7 @@
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/support/exr.h>
+#include <crep/support/output_file.h>
 #include <crep/support/png.h>
 
 #include <epoxy/gl.h>
@@ -30,10 +31,10 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <string>
 #include <unistd.h>
+#include <utility>
 #include <vector>
 
 namespace crep::tool {
@@ -106,20 +107,23 @@ LocalLightDescription describeLocal(const FrameInputs& f, std::size_t index, Ima
   return d;
 }
 
-void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTimings& timings) {
+/// The --export-frame files into their temporaries of `outputs` (registered by renderCommand: the folder was
+/// created then, and the files are renamed with the command's other outputs).
+void exportFrame(const std::string& directory, const SceneFrame& s, StageTimings& timings,
+                 OutputFiles& outputs) {
   const FrameInputs& f = *s.frame;
+  const std::filesystem::path dir(directory);
+  // Read back first, then write (the temporaries exist only while the files are written).
+  std::vector<std::pair<std::string, Image>> images;
+  const auto exr = [&](const std::string& name, Image image) { images.emplace_back(name, std::move(image)); };
   timings.time("export frame", [&] {
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw IoError("--export-frame: cannot create directory '" + dir.string() + "': " + ec.message());
     const Image depth = scenes::readDepthTexture(f.cameraDepth.get(), f.width, f.height);
-    // Float: half precision would move depth-buffer values by up to 2^-11.
-    writeExr(dir / "depth.exr", depth, ExrPixelType::Float);
+    exr("depth.exr", depth);
     FrameDescription d;
     const std::size_t localCount = f.spotLights.size() + f.pointLights.size();
     std::vector<std::string> files = localLightFiles(*s.scene);
     if (f.lightTexture.present()) {
-      writeExr(dir / kLightTextureFile, f.lightTexture.image, ExrPixelType::Float);
+      exr(kLightTextureFile, f.lightTexture.image);
       d.lightTexture = kLightTextureFile;
       d.lightTextureClipFromWorld = f.lightTexture.textureClipFromWorld;
       files.erase(files.begin());
@@ -130,16 +134,15 @@ void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTim
       if (i == 0 && !f.directional) {
         d.lightType = light.type; // the main light: its map is shadow.exr (--shadow)
         d.localLight = light;
-        writeExr(dir / "shadow.exr", shadow, ExrPixelType::Float);
+        exr("shadow.exr", shadow);
         continue;
       }
       light.shadowFile = files[d.lights.size()];
-      writeExr(dir / light.shadowFile, shadow, ExrPixelType::Float);
+      exr(light.shadowFile, shadow);
       d.lights.push_back(light);
     }
     if (f.directional)
-      writeExr(dir / "shadow.exr", scenes::readDepthTexture(f.shadowMap.get(), f.shadowWidth, f.shadowHeight),
-               ExrPixelType::Float);
+      exr("shadow.exr", scenes::readDepthTexture(f.shadowMap.get(), f.shadowWidth, f.shadowHeight));
     d.viewFromWorld = f.camera.viewFromWorld();
     d.clipFromView = f.camera.clipFromView();
     d.cameraSize = glm::ivec2(f.width, f.height);
@@ -153,11 +156,13 @@ void exportFrame(const std::filesystem::path& dir, const SceneFrame& s, StageTim
     d.hgG = f.medium.hgG();
     d.rayleighScattering = f.medium.rayleighScattering();
     d.absorption = f.medium.absorption();
-    const std::filesystem::path json = dir / "frame.json";
-    std::ofstream out(json, std::ios::binary);
-    out << toJson(d);
-    out.close();
-    if (!out) throw IoError("--export-frame: cannot write '" + json.string() + "'");
+    const std::string json = toJson(d);
+    for (const auto& [name, image] : images)
+      // Float: half precision would move depth-buffer values by up to 2^-11.
+      outputs.write((dir / name).string(),
+                    [&](const std::filesystem::path& file) { writeExr(file, image, ExrPixelType::Float); });
+    outputs.write((dir / "frame.json").string(),
+                  [&](const std::filesystem::path& file) { writeTextFile(file, json); });
   });
 }
 
@@ -214,10 +219,11 @@ int renderAtmosphere(const Args& args, const std::string& sceneName, glm::ivec2 
   requireOutputPrefix({"--out", out});
   if (args.has("export-frame"))
     throw UsageError("option --export-frame: not available with --method atmosphere");
-  const std::vector<PathOption> outputs = {{"--out", out + ".exr"}, {"--out", out + ".png"}};
-  requireDistinctFiles(outputs);
-  requireOutputFile(outputs[0]);
-  requireOutputFile(outputs[1]);
+  const std::vector<PathOption> paths = {{"--out", out + ".exr"}, {"--out", out + ".png"}};
+  requireDistinctFiles(paths);
+  OutputFiles outputs; // checked now, written at the end, all or nothing (paths.h "The output rule")
+  for (const PathOption& p : paths)
+    outputs.addFile(p);
   const scenes::Scene base = scenes::makeScene(sceneName, double(size.x) / size.y);
 
   StageTimings timings;
@@ -250,14 +256,20 @@ int renderAtmosphere(const Args& args, const std::string& sceneName, glm::ivec2 
   requireFinite(compositeImg, "the composited image");
   requireFinite(inscattering, "the atmosphere's in-scattering");
   const std::string exrPath = out + ".exr", pngPath = out + ".png";
+  // The GL work first, then the files (the temporaries exist only while the files are written).
+  Image png;
+  timings.time("tone map", [&] { png = toneMappedPng(toneMap, composite.get(), compositeImg, exposure); });
   timings.time("write exr", [&] {
     const ExrLayer layers[] = {
         {"composite", &compositeImg}, {"scattering", &inscattering}, {"transmittance", &transmittance}};
-    writeExrLayers(exrPath, layers, ExrPixelType::Float); // linear radiance for measurements
+    outputs.write(exrPath, [&](const std::filesystem::path& file) {
+      writeExrLayers(file, layers, ExrPixelType::Float); // linear radiance for measurements
+    });
   });
-  Image png;
-  timings.time("tone map", [&] { png = toneMappedPng(toneMap, composite.get(), compositeImg, exposure); });
-  timings.time("write png", [&] { writePng(pngPath, png, ToneMap{1.0f}); });
+  timings.time("write png", [&] {
+    outputs.write(pngPath, [&](const std::filesystem::path& file) { writePng(file, png, ToneMap{1.0f}); });
+    outputs.commit();
+  });
   const glm::dvec3 sunDir = toSun;
   std::printf("crep render: scene %s, %dx%d, method atmosphere (%s; sun elevation %g deg, azimuth %g deg; "
               "tables %dx%dx%dx%d, %d orders, %s)\n",
@@ -283,15 +295,18 @@ int renderCommand(const std::vector<std::string>& argv) {
   valued.insert(kToneMapValuedOptions.begin(), kToneMapValuedOptions.end());
   const Args args(argv, valued, {"debug-gl", kAutoExposureFlag});
   const std::string sceneName = args.string("scene", "colonnade");
+  requireSceneName(sceneName); // before the default --out (crep-<scene>) is derived from it
   const glm::ivec2 size = args.size("size", {1280, 720}, Image::kMaxDimension, Image::kMaxPixels);
   const double exposure = exposureOption(args);
   const ToneMapSettings toneMap = toneMapSettings(args, exposure);
   const std::string method = args.string("method", "prefilter");
   if (method == "atmosphere") return renderAtmosphere(args, sceneName, size, exposure);
-  if (hasAtmosphereOptions(args))
-    throw UsageError("options --sun-elevation, --shafts, ... need --method atmosphere");
+  for (const std::string& name : kAtmosphereOptions)
+    if (args.has(name)) throw UsageError("option --" + name + " needs --method atmosphere");
   findMethod(method); // usage error before any GL work
   const MethodSettings settings = methodSettings(args);
+  requireMethodImageSize(settings, {method}, size,
+                         "--size " + std::to_string(size.x) + "x" + std::to_string(size.y), true);
   const std::string out = args.string("out", "crep-" + sceneName);
   requireOutputPrefix({"--out", out});
   const std::string exportDir = args.string("export-frame", "");
@@ -306,9 +321,16 @@ int renderCommand(const std::vector<std::string>& argv) {
       outputs.push_back({"--export-frame", (std::filesystem::path(exportDir) / name).string()});
   }
   requireDistinctFiles(outputs);
-  requireOutputFile(outputs[0]);
-  requireOutputFile(outputs[1]);
-  if (args.has("export-frame")) requireOutputDirectory({"--export-frame", exportDir});
+  // Every output checked now (the export folder created), written at the end, all or nothing (paths.h
+  // "The output rule"): a folder or file that cannot be written fails before any GL work.
+  OutputFiles files;
+  files.addFile(outputs[0]);
+  files.addFile(outputs[1]);
+  if (args.has("export-frame")) {
+    files.addDirectory({"--export-frame", exportDir});
+    for (std::size_t i = 2; i < outputs.size(); ++i)
+      files.addFile(outputs[i]);
+  }
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep render");
@@ -331,19 +353,25 @@ int renderCommand(const std::vector<std::string>& argv) {
   requireFinite(scatteringImage, "the scattering image");
 
   const std::string exrPath = out + ".exr", pngPath = out + ".png";
-  timings.time("write exr", [&] {
-    const ExrLayer layers[] = {{"composite", &compositeImg}, {"scattering", &scatteringImage}};
-    writeExrLayers(exrPath, layers, ExrPixelType::Half); // the tool's picture file, as it always was
-  });
+  // The GL work first, then the files (the temporaries exist only while the files are written).
   Image png;
   if (toneMap.enabled)
     timings.time("tone map", [&] { png = toneMappedPng(toneMap, composite.get(), compositeImg, exposure); });
+  timings.time("write exr", [&] {
+    const ExrLayer layers[] = {{"composite", &compositeImg}, {"scattering", &scatteringImage}};
+    files.write(exrPath, [&](const std::filesystem::path& file) {
+      writeExrLayers(file, layers, ExrPixelType::Half); // the tool's picture file, as it always was
+    });
+  });
   // Tone-mapped images are display-referred linear in [0, 1]: writePng's sRGB encoding at exposure 1.
   timings.time("write png", [&] {
-    writePng(pngPath, toneMap.enabled ? png : compositeImg,
-             ToneMap{toneMap.enabled ? 1.0f : static_cast<float>(exposure)});
+    files.write(pngPath, [&](const std::filesystem::path& file) {
+      writePng(file, toneMap.enabled ? png : compositeImg,
+               ToneMap{toneMap.enabled ? 1.0f : static_cast<float>(exposure)});
+    });
   });
-  if (args.has("export-frame")) exportFrame(exportDir, s, timings);
+  if (args.has("export-frame")) exportFrame(exportDir, s, timings, files);
+  files.commit();
 
   std::printf("crep render: scene %s, %dx%d, method %s (%s)\n", s.scene->name.c_str(), size.x, size.y,
               result.used.c_str(), result.detail.c_str());

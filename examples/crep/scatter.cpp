@@ -22,8 +22,10 @@
 
 #include <crep/core/error.h>
 #include <crep/support/exr.h>
+#include <crep/support/output_file.h>
 #include <crep/support/png.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -45,10 +47,26 @@ std::string shortest(T v) {
   return std::string(buf, r.ptr);
 }
 
-/// Reads a depth EXR (channel 0) and checks every value is a depth-buffer value in [0, 1].
+/// The channels a depth EXR is read from (README "crep scatter"): the first present of these, unprefixed.
+constexpr const char* kDepthChannels[] = {"Y", "Z", "depth", "R"};
+
+/// Reads a depth EXR (channel 0 of crep::readExr: Y, Z, depth or R) and checks every value is a depth-buffer
+/// value in [0, 1]. A file without any of those channels (only G, B, A, a lowercase "y", ...) is refused
+/// naming the channels found: readExr would read a lone channel of any name.
 Image readDepthExr(const std::string& option, const std::string& path, const char* what) {
   Image image;
   try {
+    const ExrFileInfo info = readExrInfo(path);
+    bool found = false;
+    std::string list;
+    for (const ExrChannelInfo& c : info.channels) {
+      list += (list.empty() ? "" : ", ") + c.name;
+      for (const char* name : kDepthChannels)
+        found = found || c.name == name;
+    }
+    if (!found)
+      throw FormatError("'" + path + "' has no depth channel (channels: " + (list.empty() ? "none" : list) +
+                        "); a depth EXR holds its values in a channel named Y, Z, depth or R");
     image = readExr(path);
   } catch (const IoError& e) {
     throw IoError(option + " (" + what + "): " + e.what());
@@ -93,6 +111,34 @@ Image pointFace(const Image& stacked, int face) {
   return out;
 }
 
+/// A directional frame whose shadow matrix maps none of the points the camera sees into the map (clip x and
+/// y within [-w, w]) is unshadowed whatever the map holds: most likely the matrix is not the one the map was
+/// rendered with. Warned on stderr (the image is still computed). The points: each pixel's surface from the
+/// depth image, the sky at the integration distance (crep::Camera::surfaceViewDepth), on a grid of at most
+/// about 4M pixels.
+void warnIfShadowMapMissesView(const Camera& camera, const Image& depth, const glm::dmat4& lightClipFromWorld,
+                               const std::string& framePath, const std::string& depthPath) {
+  const int W = depth.width(), H = depth.height();
+  const int step = std::max(1, static_cast<int>(std::ceil(std::sqrt(double(W) * H / 4194304.0))));
+  const glm::dvec3 forward = camera.forward();
+  long long points = 0;
+  for (int y = 0; y < H; y += step)
+    for (int x = 0; x < W; x += step) {
+      const glm::dvec3 dir = camera.rayDirection((x + 0.5) / W * 2.0 - 1.0, (y + 0.5) / H * 2.0 - 1.0);
+      const double viewDepth = camera.surfaceViewDepth(depth.at(x, y, 0));
+      const glm::dvec3 p = camera.position() + dir * (viewDepth / glm::dot(dir, forward));
+      const glm::dvec4 c = lightClipFromWorld * glm::dvec4(p, 1.0);
+      ++points;
+      if (c.w > 0.0 && std::abs(c.x) <= c.w && std::abs(c.y) <= c.w) return;
+    }
+  std::fprintf(
+      stderr,
+      "crep scatter: warning: %s: shadowMap.lightClipFromWorld maps none of the %lld points the camera "
+      "sees (the surfaces of --depth '%s', the sky at %s) inside the shadow map: the image is "
+      "unshadowed; is it the matrix the map was rendered with?\n",
+      framePath.c_str(), points, depthPath.c_str(), shortest(camera.far()).c_str());
+}
+
 } // namespace
 
 int scatterCommand(const std::vector<std::string>& argv) {
@@ -120,16 +166,23 @@ int scatterCommand(const std::vector<std::string>& argv) {
   for (const PathOption& p : outputs)
     requireNonEmpty(p);
   requireDistinctFiles(outputs, inputs); // usage errors above, file system below
+  // Every output checked now, written at the end, all or nothing (paths.h "The output rule").
+  OutputFiles files;
   for (const PathOption& p : outputs)
-    requireOutputFile(p);
+    files.addFile(p);
   for (const PathOption& p : inputs)
-    requireInputFile(p);
+    requireInputFile(p, p.option != "--frame"); // EXRs: regular files; the JSON may come from a pipe
 
   StageTimings timings;
   if (isatty(2)) timings.setProgress("crep scatter");
   // Everything about the inputs is checked before any GL work.
-  const FrameDescription desc =
-      timings.time("read frame json", [&] { return readFrameDescription(framePath); });
+  const FrameDescription desc = timings.time("read frame json", [&] {
+    try {
+      return readFrameDescription(framePath);
+    } catch (const IoError& e) {
+      throw IoError(std::string("--frame: ") + e.what()); // format errors name the file and the field
+    }
+  });
   const Camera camera = cameraOf(desc, framePath);
   const bool directional = desc.lightType == LightType::Directional;
   // A night frame (the main light a spot or point light): no directional light; `light` is unused.
@@ -174,7 +227,7 @@ int scatterCommand(const std::vector<std::string>& argv) {
       std::error_code ec;
       if (!std::filesystem::exists(file, ec))
         throw IoError(framePath + ": " + l.shadowPath + ".file: '" + file.string() + "' does not exist");
-      requireInputFile(lightFiles.back());
+      requireInputFile(lightFiles.back(), true);
     }
   requireDistinctFiles(outputs, lightFiles);
   // Light textures (frame_json.h "Light textures"): the directional light's and the spots', their
@@ -187,6 +240,7 @@ int scatterCommand(const std::vector<std::string>& argv) {
     const std::filesystem::path file = jsonDir / t.file;
     textureFiles.push_back({field, file.string()});
     requireDistinctFiles(outputs, {textureFiles.back()});
+    requireInputFile({framePath + ": " + field, file.string()}, true);
     return timings.time("read light texture", [&] { return readLightTexture(file, field, framePath); });
   };
   std::optional<FrameLightTexture> sunTexture = lightTextureOf(desc, framePath);
@@ -232,6 +286,9 @@ int scatterCommand(const std::vector<std::string>& argv) {
     requireNotEnclosed(image, option + ": '" + path + "' (shadow map of " + l.path + ")");
     localShadows.push_back(std::move(image));
   }
+  requireMethodImageSize(
+      settings, {method}, {depth.width(), depth.height()},
+      "the depth image '" + depthPath + "' (" + sizeText(depth.width(), depth.height()) + ")", true);
   const double imageAspect = double(depth.width()) / double(depth.height());
   const glm::dvec4& tangents = camera.tangents(); // the frustum's own extent (off-centre ones too)
   const double frustumAspect = (tangents.y - tangents.x) / (tangents.w - tangents.z);
@@ -239,6 +296,8 @@ int scatterCommand(const std::vector<std::string>& argv) {
     throw FormatError(framePath + ": camera.clipFromView has aspect ratio " + shortest(frustumAspect) +
                       ", which does not match the depth image '" + depthPath + "' (" +
                       sizeText(depth.width(), depth.height()) + ", aspect " + shortest(imageAspect) + ")");
+
+  if (directional) warnIfShadowMapMissesView(camera, depth, desc.lightClipFromWorld, framePath, depthPath);
 
   ensureGlContext("scatter", args.has("debug-gl"), timings);
   FrameInputs frame(camera, light, medium);
@@ -295,11 +354,17 @@ int scatterCommand(const std::vector<std::string>& argv) {
       timings.time("readback", [&] { return readRgba(result.scattering.get(), frame.width, frame.height); });
   checkGlErrors("scattering");
   requireFinite(scattering, "the scattering image");
-  timings.time("write exr", [&] { writeExr(out, scattering, ExrPixelType::Float); });
+  timings.time("write exr", [&] {
+    files.write(out,
+                [&](const std::filesystem::path& file) { writeExr(file, scattering, ExrPixelType::Float); });
+  });
   if (args.has("png"))
     timings.time("write png", [&] {
-      writePng(args.string("png", ""), scattering, ToneMap{static_cast<float>(exposure)});
+      files.write(args.string("png", ""), [&](const std::filesystem::path& file) {
+        writePng(file, scattering, ToneMap{static_cast<float>(exposure)});
+      });
     });
+  files.commit();
 
   std::printf("crep scatter: %s, %dx%d, method %s (%s)\n", framePath.c_str(), frame.width, frame.height,
               result.used.c_str(), result.detail.c_str());

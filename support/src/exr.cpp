@@ -6,6 +6,7 @@
 // decoded by OpenEXR (Imf::MultiPartInputFile / Imf::InputPart) without chunk table
 // reconstruction; every OpenEXR exception becomes a crep::FormatError naming the file.
 #include <crep/support/exr.h>
+#include <crep/support/output_file.h>
 
 #include <crep/core/error.h>
 
@@ -179,19 +180,17 @@ void writeValidated(const fs::path& path, std::span<const ExrLayer> layers, Imf:
     }
   }
 
-  // Write to a temporary name and rename, so a failure never leaves a truncated file at `path`.
-  fs::path temporary = path;
-  temporary += ".partial";
+  // The output rule (crep/support/output_file.h): a temporary in the target's directory renamed over it,
+  // symbolic links followed, anything but a regular file refused; a failure leaves no file behind.
   try {
-    {
+    writeOutputFile(path, [&](const fs::path& temporary) {
       Imf::OutputFile file(temporary.c_str(), header, 0);
       file.setFrameBuffer(frameBuffer);
       file.writePixels(height);
-    }
-    fs::rename(temporary, path);
+    });
+  } catch (const Error&) {
+    throw;
   } catch (const std::exception& e) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
     throw IoError("crep: cannot write EXR file " + quoted(path) + ": " + e.what());
   }
 }

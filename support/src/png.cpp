@@ -1,5 +1,7 @@
 #include <crep/support/png.h>
 
+#include <crep/support/output_file.h>
+
 #include <crep/core/error.h>
 
 #include <algorithm>
@@ -96,17 +98,17 @@ void writePng(const std::filesystem::path& path, const Image& image, const ToneM
     }
   }
 
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw IoError("crep: cannot write PNG file '" + path.string() + "': cannot open for writing");
-  WriteContext context{&out};
-  const int ok = stbi_write_png_to_func(&writeCallback, &context, width, height, outChannels, pixels.data(),
-                                        width * outChannels);
-  out.close();
-  if (ok == 0 || !out) {
-    std::error_code ignored;
-    std::filesystem::remove(path, ignored);
-    throw IoError("crep: cannot write PNG file '" + path.string() + "': write failed");
-  }
+  // The output rule (crep/support/output_file.h): a temporary in the target's directory renamed over it,
+  // symbolic links followed, anything but a regular file refused; a failure leaves no file behind.
+  writeOutputFile(path, [&](const std::filesystem::path& temporary) {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) throw IoError("crep: cannot write PNG file '" + path.string() + "': cannot open for writing");
+    WriteContext context{&out};
+    const int ok = stbi_write_png_to_func(&writeCallback, &context, width, height, outChannels, pixels.data(),
+                                          width * outChannels);
+    out.close();
+    if (ok == 0 || !out) throw IoError("crep: cannot write PNG file '" + path.string() + "': write failed");
+  });
 }
 
 } // namespace crep

@@ -205,7 +205,8 @@ TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
 
 TEST_CASE("crep bench --plot: the Table 1/2 rows as an SVG chart beside the paper's") {
   CREP_REQUIRE_GL();
-  const std::string svg = std::string(CREP_TEST_OUTPUT_DIR) + "/bench-tables.svg";
+  // testOutputDir() creates the folder: --plot's folder must exist (checked before the suite runs).
+  const std::string svg = (crep::test::testOutputDir() / "bench-tables.svg").string();
   std::remove(svg.c_str());
   const auto r = crep::test::runCrep("bench --size 160x90 --map 128x128 --repeat 1 --plot " + svg);
   INFO(r.output);

@@ -20,12 +20,19 @@ Args::Args(const std::vector<std::string>& argv, const std::set<std::string>& va
       name = name.substr(0, eq);
       hasValue = true;
     }
+    if (name.empty())
+      throw UsageError("unexpected argument '" + a + "' (options are --name VALUE, --name=VALUE or --flag)");
     if (flags.count(name)) {
       if (hasValue) throw UsageError("option --" + name + " takes no value");
       value = "1";
     } else if (valued.count(name)) {
       if (!hasValue) {
         if (i + 1 >= argv.size()) throw UsageError("option --" + name + " needs a value");
+        // "--out --debug-gl" is a forgotten value, not a file named "--debug-gl": a value that starts with
+        // "--" must be attached (--out=--name).
+        if (argv[i + 1].starts_with("--"))
+          throw UsageError("option --" + name + " needs a value, got the option '" + argv[i + 1] +
+                           "' (write --" + name + "=VALUE for a value that starts with --)");
         value = argv[++i];
       }
     } else {

@@ -30,7 +30,8 @@ public:
 class Args {
 public:
   /// `flags` are options that take no value. Throws UsageError for an unknown option (anything not
-  /// in `valued` or `flags`), a missing value or a repeated option.
+  /// in `valued` or `flags`), a missing value or a repeated option. A value given as the next argument
+  /// must not start with "--" ("--out --debug-gl" forgot the value); such a value is written --name=VALUE.
   Args(const std::vector<std::string>& argv, const std::set<std::string>& valued,
        const std::set<std::string>& flags);
 

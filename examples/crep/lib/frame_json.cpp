@@ -502,6 +502,21 @@ void checkLocalLight(const Reader& r, const LocalLightDescription& d, const std:
 
 FrameDescription parseFrameDescription(const std::string& text, const std::string& source) {
   const Reader r(source);
+  // A NUL byte is no JSON text (the parser would stop reading at it and accept what came before).
+  if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < nul; ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    throw FormatError(source + ": not valid JSON at (top level) (line " + std::to_string(line) + ", column " +
+                      std::to_string(column) + ", byte " + std::to_string(nul) +
+                      "): a NUL byte; a frame description is UTF-8 JSON text");
+  }
   Json root;
   PathChecker checker(text, source);
   Json::sax_parse(text, &checker); // throws FormatError with the path; otherwise the text is valid JSON
@@ -720,9 +735,24 @@ Camera cameraOf(const FrameDescription& f, const std::string& source) {
     const bool no = f.clipDepth == ClipDepth::NegativeOneToOne;
     const double a = no ? 0.5 * (1.0 - p[2][2]) : -p[2][2], b = no ? 0.5 * p[3][2] : p[3][2];
     const double near = b < 0.0 ? (a != 0.0 ? -b / a : 0.0) : (a != 1.0 ? b / (1.0 - a) : 0.0);
-    if (near > 0.0 && near < 1e-12 * std::max(1.0, f.maxDistance))
+    // The far plane (depth 1, or 0 reversed; infinite when the depth row says so, as Camera detects it) and
+    // the distance the frame integrates to: maxDistance clamped to a finite far plane (camera.h), else
+    // maxDistance itself.
+    const double denominator = b < 0.0 ? 1.0 - a : -a;
+    const double far =
+        std::abs(denominator) <= 1e-12 ? std::numeric_limits<double>::infinity() : b / denominator;
+    const bool finiteFar = std::isfinite(far) && far > 0.0;
+    const double reach =
+        finiteFar ? (f.maxDistance > 0.0 ? std::min(f.maxDistance, far) : far) : f.maxDistance;
+    if (near > 0.0 && near < 1e-12 * std::max(1.0, reach)) {
+      if (!finiteFar && f.maxDistance > 0.0)
+        r.fail("camera.maxDistance",
+               Reader::format(f.maxDistance) + " is more than 1e12 times the near plane " +
+                   Reader::format(near) +
+                   " (near / maxDistance below 1e-12: the depth buffer cannot resolve it)");
       r.fail("camera.clipFromView", "near / far below 1e-12 (near = " + Reader::format(near) +
                                         "): a near plane too small for the depth buffer");
+    }
   }
   Camera camera = [&] {
     try {
@@ -745,8 +775,9 @@ Camera cameraOf(const FrameDescription& f, const std::string& source) {
                Reader::format(camera.near()) +
                " (|position| must be < 1e12 near): use camera-relative world coordinates");
   if (camera.near() / camera.far() < 1e-12)
-    r.fail("camera.clipFromView", "near / far = " + Reader::format(camera.near() / camera.far()) +
-                                      " below 1e-12: a near plane too small for the depth buffer");
+    r.fail(camera.far() < camera.projectionFar() ? "camera.maxDistance" : "camera.clipFromView",
+           "near / far = " + Reader::format(camera.near() / camera.far()) +
+               " below 1e-12: a near plane too small for the depth buffer");
   return camera;
 }
 
@@ -932,9 +963,18 @@ Image readLightTexture(const std::filesystem::path& file, const std::string& fie
 
 namespace {
 
+/// One term of the radiance bound: a light's share of the in-scattered radiance of a channel.
+struct RadianceTerm {
+  double value = 0.0;
+  int light = -1; ///< -1: the directional light, else the index into localLightsOf()
+};
+
 /// Upper bound of the in-scattered radiance of any pixel (Klehm et al. 2014, Eq. 1 with V = 1 and the
-/// largest phase value): E_c (sigma_mie,c HG_max + sigma_rayleigh,c 3 / (8 pi)) min(s_max, 1 / sigma_t,c).
-double radianceBound(const FrameDescription& f, const Medium& m, const std::vector<FrameLocalLight>& local) {
+/// largest phase value): E_c (sigma_mie,c HG_max + sigma_rayleigh,c 3 / (8 pi)) min(s_max, 1 / sigma_t,c) for
+/// the directional light, plus per local light I_c (the same scattering) pi / nearPlane. Returns the worst
+/// channel's sum and fills `terms` with that channel's per-light shares.
+double radianceBound(const FrameDescription& f, const Medium& m, const std::vector<FrameLocalLight>& local,
+                     std::vector<RadianceTerm>& terms) {
   const double g = std::abs(f.hgG);
   const double hgMax = (1.0 + g) / (4.0 * std::numbers::pi * (1.0 - g) * (1.0 - g));
   const double rayleighMax = 3.0 / (8.0 * std::numbers::pi);
@@ -948,20 +988,37 @@ double radianceBound(const FrameDescription& f, const Medium& m, const std::vect
   double bound = 0.0;
   const bool directional = f.lightType == LightType::Directional;
   for (int c = 0; c < 3; ++c) {
+    std::vector<RadianceTerm> channelTerms;
     const double scattering = f.mieScattering[c] * hgMax + f.rayleighScattering[c] * rayleighMax;
     const double C = directional ? f.lightColor[c] * f.lightIntensity * scattering : 0.0;
     const double length = sigma[c] > 0.0 ? std::min(sMax, 1.0 / sigma[c]) : sMax;
     double channel = C > 0.0 ? C * length : 0.0;
+    if (directional) channelTerms.push_back({channel, -1});
     // Local lights: I exp(-sigma d) / d^2 <= I / d^2, and the integral of 1 / d^2 along a line at distance h
     // >= nearPlane from the light is at most pi / nearPlane.
-    for (const FrameLocalLight& light : local) {
+    for (std::size_t i = 0; i < local.size(); ++i) {
+      const FrameLocalLight& light = local[i];
       const glm::dvec3 I = light.spot ? light.spot->intensity() : light.point->intensity();
       const double near = light.spot ? light.spot->nearPlane() : light.point->nearPlane();
-      channel += I[c] * scattering * std::numbers::pi / near;
+      const double term = I[c] * scattering * std::numbers::pi / near;
+      channel += term;
+      channelTerms.push_back({term, static_cast<int>(i)});
     }
-    bound = std::max(bound, channel);
+    if (!(channel <= bound)) {
+      bound = channel;
+      terms = channelTerms;
+    }
   }
   return bound;
+}
+
+/// The description of local light `index` of localLightsOf() (the main light first when it is local).
+const LocalLightDescription& localDescription(const FrameDescription& f, std::size_t index) {
+  if (f.lightType != LightType::Directional) {
+    if (index == 0) return f.localLight;
+    --index;
+  }
+  return f.lights[index];
 }
 
 } // namespace
@@ -973,14 +1030,39 @@ Medium mediumOf(const FrameDescription& f, const std::string& source) {
               .rayleighScattering = f.rayleighScattering,
               .absorption = f.absorption});
     const std::vector<FrameLocalLight> local = localLightsOf(f, source);
-    const double bound = radianceBound(f, m, local);
-    if (!(bound <= kMaxRadiance))
+    std::vector<RadianceTerm> terms;
+    const double bound = radianceBound(f, m, local, terms);
+    if (!(bound <= kMaxRadiance)) {
+      // Name the light with the largest share, and the field to change: a local light's nearPlane when
+      // raising it to range x 1e-3 (the tool's default for a point light without face matrices) would bring
+      // its share within the bound, else its intensity.
+      RadianceTerm worst = terms.front();
+      for (const RadianceTerm& t : terms)
+        if (t.value > worst.value) worst = t;
+      const std::string what =
+          "with this medium the in-scattered radiance can reach " + Reader::format(bound);
+      if (worst.light < 0)
+        Reader(source).fail("light.intensity",
+                            what + " (irradiance x scattering x phase x path length), beyond " +
+                                Reader::format(kMaxRadiance) +
+                                ": lower light.intensity / light.color or medium.mieScattering / hgG");
+      const FrameLocalLight& light = local[static_cast<std::size_t>(worst.light)];
+      const double near = light.spot ? light.spot->nearPlane() : light.point->nearPlane();
+      const double range = light.spot ? light.spot->range() : light.point->range();
+      const double floor = range * 1e-3;
+      const bool blameNear = near < floor && worst.value * near / floor <= kMaxRadiance;
+      const bool given = localDescription(f, static_cast<std::size_t>(worst.light)).nearPlane.has_value();
+      const std::string nearText = Reader::join(light.path, "nearPlane") + " (" + Reader::format(near) +
+                                   (given ? "" : ", from its shadow matrix") + ")";
       Reader(source).fail(
-          f.lightType != LightType::Directional || f.lights.empty() ? "light.intensity"
-                                                                    : "light.intensity / lights[i].intensity",
-          "with this medium the in-scattered radiance can reach " + Reader::format(bound) +
-              " (irradiance x scattering x phase x path length), beyond " + Reader::format(kMaxRadiance) +
-              ": lower light.intensity / light.color or medium.mieScattering / hgG");
+          Reader::join(light.path, blameNear ? "nearPlane" : "intensity"),
+          what + " (color * intensity x scattering x phase x pi / nearPlane), beyond " +
+              Reader::format(kMaxRadiance) + ": " +
+              (blameNear
+                   ? "raise " + nearText + ", or lower " + Reader::join(light.path, "intensity")
+                   : "lower " + Reader::join(light.path, "intensity") + " / color or raise " + nearText) +
+              " or lower medium.mieScattering / hgG");
+    }
     return m;
   } catch (const InvalidArgument& e) {
     std::string field = "medium (extinction = mieScattering + rayleighScattering + absorption)";

@@ -11,7 +11,8 @@
 //                                                    (glClipControl GL_ZERO_TO_ONE): the matrix's clip depth
 //       "maxDistance": d,                            optional: how far the scattering is integrated (the
 //                                                    sky's distance); required with an infinite far plane,
-//                                                    else at most the far plane (default: the far plane)
+//                                                    else the far plane by default, and a larger value is
+//                                                    clamped to the far plane
 //       "size": [width, height]                      optional: must equal the depth EXR's size
 //     },
 //     "light": {                                     the main light (its shadow map: --shadow)

@@ -416,7 +416,8 @@ MethodOutput runFrontDoor(FrameInputs& frame, const MethodSettings& settings, Sc
   info.rectify = settings.rectify;
   info.prefilter = settings.prefilter;
   info.epipoleBlock.steps = settings.steps;
-  info.evaluationScale = settings.scale;
+  // --scale is the per-pixel evaluation's (compare runs the epipolar methods beside it at full size).
+  info.evaluationScale = sampling == Scattering::Sampling::PerPixel ? settings.scale : 1.0;
   auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });
   const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.lightClipFromWorld, frame.shadowBias};
   Scattering::FrameAttribs a;
@@ -575,19 +576,21 @@ FroxelGrid toolFroxelGrid(const Camera& camera) {
 /// frame: temporal reprojection off (no jitter). The sun only: local lights and light textures are ignored
 /// with a warning on stderr; a frame without a directional light gets no in-scattering (RGB 0, A the
 /// transmittance), also with a warning, so that compare and bench, which run every method, still run.
-MethodOutput runFroxelEsm(FrameInputs& frame, const MethodSettings& settings) {
+/// `name`: the method the user asked for, named in the warnings (froxel-prefilter runs this path without a
+/// sun).
+MethodOutput runFroxelEsmAs(FrameInputs& frame, const MethodSettings& settings, const char* name) {
   if (!frame.directional)
     std::fprintf(stderr,
-                 "crep: froxel-esm: the frame has no directional light; the froxel fog (the sun only) "
-                 "adds no in-scattering\n");
+                 "crep: %s: the frame has no directional light; the froxel fog (the sun only) "
+                 "adds no in-scattering\n",
+                 name);
   if (frame.hasLocalLights())
-    std::fprintf(
-        stderr,
-        "crep: froxel-esm: the froxel fog lights the volume with the sun only; the frame's %zu spot and "
-        "%zu point lights are ignored\n",
-        frame.spotLights.size(), frame.pointLights.size());
+    std::fprintf(stderr,
+                 "crep: %s: the froxel fog lights the volume with the sun only; the frame's %zu spot and "
+                 "%zu point lights are ignored\n",
+                 name, frame.spotLights.size(), frame.pointLights.size());
   if (frame.textured())
-    std::fprintf(stderr, "crep: froxel-esm: light textures are ignored by the froxel fog\n");
+    std::fprintf(stderr, "crep: %s: light textures are ignored by the froxel fog\n", name);
   const DirectionalLight sun =
       frame.directional ? frame.light : DirectionalLight(frame.camera.forward(), glm::dvec3(0.0));
   MethodOutput out;
@@ -625,6 +628,10 @@ MethodOutput runFroxelEsm(FrameInputs& frame, const MethodSettings& settings) {
   return out;
 }
 
+MethodOutput runFroxelEsm(FrameInputs& frame, const MethodSettings& settings) {
+  return runFroxelEsmAs(frame, settings, "froxel-esm");
+}
+
 /// Klehm et al. 2014's prefiltered scattering evaluated at the froxel volume's cells by crep::Scattering
 /// (FrameAttribs::froxels: the same frame's basis, no ESM and no accumulation), then FroxelFog's per-pixel
 /// lookup (Mode::Prefiltered) on the same grid as froxel-esm: the difference between the two froxel methods
@@ -634,7 +641,7 @@ MethodOutput runFroxelPrefilter(FrameInputs& frame, const MethodSettings& settin
   if (!frame.directional) {
     std::fprintf(stderr, "crep: froxel-prefilter: no directional light to prefilter; running froxel-esm's "
                          "unlit volume\n");
-    MethodOutput out = runFroxelEsm(frame, settings);
+    MethodOutput out = runFroxelEsmAs(frame, settings, "froxel-prefilter");
     out.used = "froxel-prefilter (froxel-esm, no sun)";
     return out;
   }

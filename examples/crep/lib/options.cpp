@@ -1,5 +1,8 @@
 #include "options.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace crep::tool {
 
 static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
@@ -53,7 +56,15 @@ MethodSettings methodSettings(const Args& args) {
   try {
     validate(s.sampling, "EpipolarSamplingOptions");
   } catch (const InvalidArgument& e) {
-    throw UsageError(std::string("options --slices/--samples/--initial-step/--downscale: ") + e.what());
+    // The option of the field the library names (EpipolarSamplingOptions.initialStep -> --initial-step).
+    const std::string& p = e.parameter();
+    const std::string option = p.ends_with(".slices")        ? "option --slices"
+                               : p.ends_with(".samples")     ? "option --samples"
+                               : p.ends_with(".initialStep") ? "option --initial-step"
+                               : p.ends_with(".downscale")
+                                   ? "option --downscale"
+                                   : "options --slices/--samples/--initial-step/--downscale";
+    throw UsageError(option + ": " + e.what());
   }
   // Scattering's rule (crep/pipeline/scattering.h): a multiple of the prefilter regions of both layouts.
   Scattering::CreateInfo info;
@@ -66,6 +77,31 @@ MethodSettings methodSettings(const Args& args) {
                      std::to_string(perSplit) + " prefilter regions, and the epipolar fallback's " +
                      std::to_string(info.epipolarRegions * perSplit) + ")");
   return s;
+}
+
+void requireMethodImageSize(const MethodSettings& settings, const std::vector<std::string>& methods,
+                            glm::ivec2 size, const std::string& sizeText, bool explicitMethod) {
+  const auto has = [&](const char* name) {
+    return std::find(methods.begin(), methods.end(), name) != methods.end();
+  };
+  const bool epipolar = has("epipolar-sampling") || has("epipolar-prefilter");
+  const std::string scaleText = settings.scale == 0.5 ? "0.5" : settings.scale == 0.25 ? "0.25" : "1";
+  if (explicitMethod && epipolar && settings.scale != 1.0)
+    throw UsageError("option --scale: " + scaleText +
+                     " applies to the per-pixel prefiltered evaluation; --method " + methods.front() +
+                     " evaluates at its epipolar samples (--downscale reduces its resolution)");
+  const auto multiple = [&](int factor, const std::string& option, const std::string& value,
+                            const char* who) {
+    if (size.x % factor == 0 && size.y % factor == 0) return;
+    throw UsageError("option " + option + ": " + value + " needs an image size that is a multiple of " +
+                     std::to_string(factor) + " per axis (" + who + "); " + sizeText + " is not");
+  };
+  if (has("prefilter") && settings.scale != 1.0)
+    multiple(static_cast<int>(std::lround(1.0 / settings.scale)), "--scale", scaleText,
+             "the prefiltered evaluation at reduced resolution");
+  if (epipolar && settings.sampling.downscale != 1)
+    multiple(settings.sampling.downscale, "--downscale", std::to_string(settings.sampling.downscale),
+             "the epipolar unwarp at reduced resolution");
 }
 
 const std::set<std::string> kToneMapValuedOptions = {"tonemap", "middle-grey", "white-point", "saturation"};

@@ -9,6 +9,7 @@
 
 #include <set>
 #include <string>
+#include <vector>
 
 namespace crep::tool {
 
@@ -17,6 +18,15 @@ extern const std::set<std::string> kMethodOptions;
 
 /// The MethodSettings of those options (UsageError naming the option for bad values).
 MethodSettings methodSettings(const Args& args);
+
+/// The image-size rules of the methods that reduce their resolution, checked before any GL work (UsageError
+/// naming the option): --scale S (the prefiltered per-pixel evaluation, method `prefilter`) needs an image
+/// size that is a multiple of 1 / S per axis, --downscale F (epipolar-sampling, epipolar-prefilter) a
+/// multiple of F. `sizeText` says where the size comes from ("--size 160x90", "the depth image 'd.exr'
+/// (160x90)"). With `explicitMethod` (render and scatter: the one --method given) a --scale other than 1 with
+/// an epipolar method is refused too (they evaluate at their samples; --downscale reduces their resolution).
+void requireMethodImageSize(const MethodSettings& settings, const std::vector<std::string>& methods,
+                            glm::ivec2 size, const std::string& sizeText, bool explicitMethod);
 
 /// "rgba8" | "rgba16f" | "rgba32f" (UsageError naming --format otherwise).
 StorageFormat parseFormat(const std::string& text);

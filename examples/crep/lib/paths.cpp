@@ -5,6 +5,7 @@
 #include <crep/core/error.h>
 
 #include <filesystem>
+#include <stdexcept>
 #include <system_error>
 
 namespace crep::tool {
@@ -34,10 +35,17 @@ void requireNonEmpty(const PathOption& path) {
   if (path.path.empty()) throw UsageError("option " + path.option + ": must not be empty");
 }
 
-void requireInputFile(const PathOption& input) {
+void requireInputFile(const PathOption& input, bool regularOnly) {
   std::error_code ec;
-  if (fs::is_directory(input.path, ec))
+  const fs::file_status status = fs::status(input.path, ec);
+  if (fs::is_directory(status))
     throw IoError(input.option + ": '" + input.path + "' is a directory, not a file");
+  if (regularOnly && fs::exists(status) && !fs::is_regular_file(status))
+    throw IoError(input.option + ": '" + input.path + "' is " +
+                  (fs::is_fifo(status)     ? "a FIFO (named pipe)"
+                   : fs::is_socket(status) ? "a socket"
+                                           : "a device") +
+                  ", not a regular file (an EXR file is read at random positions)");
 }
 
 void requireOutputFile(const PathOption& output) {
@@ -45,11 +53,17 @@ void requireOutputFile(const PathOption& output) {
   const fs::path p(output.path);
   std::error_code ec;
   if (!p.has_filename() || fs::is_directory(p, ec))
-    throw IoError(output.option + ": cannot write '" + output.path + "': it is a directory, not a file");
-  const fs::path parent = p.parent_path();
-  if (!parent.empty() && !fs::is_directory(parent, ec))
-    throw IoError(output.option + ": cannot write '" + output.path + "': directory '" + parent.string() +
-                  "' does not exist");
+    throw IoError(output.option + ": cannot write '" + output.path +
+                  "': it is a directory, not a regular file");
+  // The rule of crep/support/output_file.h: links followed, non-regular files refused, the directory
+  // exists; then a temporary created and removed proves that the directory takes a new file.
+  try {
+    PendingOutput probe(p);
+  } catch (const IoError& e) {
+    std::string what = e.what();
+    if (what.starts_with("crep: ")) what = what.substr(6);
+    throw IoError(output.option + ": " + what);
+  }
 }
 
 void requireOutputDirectory(const PathOption& directory) {
@@ -92,6 +106,92 @@ void requireDistinctFiles(const std::vector<PathOption>& outputs, const std::vec
         throw UsageError("option " + out.option + ": '" + out.path + "' is also written by " +
                          outputs[j].option + " ('" + outputs[j].path + "'); refusing to write it twice");
   }
+}
+
+OutputFiles::~OutputFiles() {
+  if (!committed_) rollback();
+}
+
+void OutputFiles::addFile(const PathOption& output) {
+  requireOutputFile(output);
+  entries_.push_back({output, {}});
+}
+
+void OutputFiles::addDirectory(const PathOption& directory) {
+  requireOutputDirectory(directory);
+  // Create it level by level, remembering what this command created (removed again if it fails).
+  std::vector<fs::path> missing;
+  std::error_code ec;
+  for (fs::path p = fs::path(directory.path); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+    if (!fs::create_directory(*it, ec) && ec)
+      throw IoError(directory.option + ": cannot create directory '" + it->string() + "': " + ec.message());
+    directories_.push_back(*it);
+  }
+  if (!fs::is_directory(directory.path, ec))
+    throw IoError(directory.option + ": '" + directory.path + "' is not a directory");
+}
+
+void OutputFiles::write(const std::string& path, const std::function<void(const fs::path&)>& write) {
+  for (Entry& e : entries_) {
+    if (e.output.path != path) continue;
+    try {
+      e.pending = PendingOutput(e.output.path);
+    } catch (const IoError& error) {
+      std::string what = error.what();
+      if (what.starts_with("crep: ")) what = what.substr(6);
+      throw IoError(e.output.option + ": " + what);
+    }
+    try {
+      write(e.pending.temporary());
+    } catch (const IoError& error) {
+      // Named by the option and the output's own path (the writer saw the temporary's).
+      std::string what = error.what();
+      if (what.starts_with("crep: ")) what = what.substr(6);
+      // The writer named the temporary: name the output instead.
+      const std::string temporary = e.pending.temporary().string();
+      for (std::size_t at = what.find(temporary); !temporary.empty() && at != std::string::npos;
+           at = what.find(temporary, at + e.output.path.size()))
+        what.replace(at, temporary.size(), e.output.path);
+      e.pending.discard();
+      throw IoError(e.output.option + ": " + what);
+    } catch (...) {
+      e.pending.discard();
+      throw;
+    }
+    return;
+  }
+  throw std::logic_error("OutputFiles::write: '" + path + "' was not registered with addFile");
+}
+
+void OutputFiles::commit() {
+  for (const Entry& e : entries_)
+    if (!e.pending.pending())
+      throw std::logic_error("OutputFiles::commit: '" + e.output.path + "' was registered but not written");
+  for (Entry& e : entries_) {
+    try {
+      e.pending.commit();
+    } catch (const IoError& error) {
+      std::string what = error.what();
+      if (what.starts_with("crep: ")) what = what.substr(6);
+      throw IoError(e.output.option + ": " + what);
+    }
+    renamed_.push_back(e.pending.target());
+  }
+  committed_ = true;
+}
+
+void OutputFiles::rollback() noexcept {
+  for (Entry& e : entries_)
+    e.pending.discard();
+  std::error_code ec;
+  for (const fs::path& target : renamed_)
+    fs::remove(target, ec);
+  for (auto it = directories_.rbegin(); it != directories_.rend(); ++it)
+    fs::remove(*it, ec); // only when empty: a folder with files of others stays
 }
 
 } // namespace crep::tool

@@ -1,10 +1,14 @@
 #include "scene_frame.h"
 
+#include "args.h"
+
 #include <crep/core/error.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 
 #include <epoxy/gl.h>
+
+#include <algorithm>
 
 namespace crep::tool {
 
@@ -12,6 +16,24 @@ SceneFrame::SceneFrame() = default;
 SceneFrame::~SceneFrame() = default;
 SceneFrame::SceneFrame(SceneFrame&&) noexcept = default;
 SceneFrame& SceneFrame::operator=(SceneFrame&&) noexcept = default;
+
+std::vector<std::string> builtInSceneNames() {
+  std::vector<std::string> names = scenes::sceneNames();
+  for (const std::string& n : scenes::localLightSceneNames())
+    names.push_back(n);
+  for (const std::string& n : scenes::lightTextureSceneNames())
+    names.push_back(n);
+  return names;
+}
+
+void requireSceneName(const std::string& name, const std::string& option) {
+  const std::vector<std::string> names = builtInSceneNames();
+  if (std::find(names.begin(), names.end(), name) != names.end()) return;
+  std::string list;
+  for (const std::string& n : names)
+    list += (list.empty() ? "" : " | ") + n;
+  throw UsageError("option " + option + ": '" + name + "' is not a built-in scene (" + list + ")");
+}
 
 SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,
                           StageTimings& timings, const SceneOverrides& overrides) {

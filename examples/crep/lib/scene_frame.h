@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace crep::scenes {
 class SceneRenderer;
@@ -43,6 +44,12 @@ struct SceneOverrides {
   /// and the ambient irradiance (SceneRenderer::ShadeInputs' ambient) instead of the sun's and the default.
   std::optional<glm::dvec3> shadeIrradiance, shadeAmbient;
 };
+
+/// Every built-in scene name makeScene accepts: the sunlit, local-light and light-texture scenes.
+std::vector<std::string> builtInSceneNames();
+/// UsageError naming `option` (e.g. "--scene") and listing the scenes when `name` is not a built-in scene:
+/// checked before any output path (the default --out is crep-<scene>) and before any GL work.
+void requireSceneName(const std::string& name, const std::string& option = "--scene");
 
 /// Builds scene `name` for a width x height camera and renders its passes (stages to `timings`).
 SceneFrame makeSceneFrame(const std::string& name, int width, int height, int shadowMapSize,

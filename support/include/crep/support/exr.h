@@ -80,12 +80,15 @@ struct ExrFileInfo {
   std::vector<ExrChannelInfo> channels; ///< every channel of the part, sorted by name
 };
 
-/// Writes a single-layer scanline file. Throws InvalidArgument for an empty image, IoError if the
-/// file cannot be written (the message names the path; no partial file is left behind).
+/// Writes a single-layer scanline file by the output rule of crep/support/output_file.h (a temporary renamed
+/// over the target, symbolic links followed, anything but a regular file refused). Throws InvalidArgument
+/// for an empty image, IoError if the file cannot be written (the message names the path; no partial file
+/// is left behind).
 void writeExr(const std::filesystem::path& path, const Image& image, const ExrWriteOptions& options = {});
 
 /// Writes several layers into one single-part file. Throws InvalidArgument for an empty span, a
-/// null or empty image, layers of different sizes or duplicate names; IoError on write failure.
+/// null or empty image, layers of different sizes or duplicate names; IoError on write failure (the
+/// output rule of writeExr).
 void writeExrLayers(const std::filesystem::path& path, std::span<const ExrLayer> layers,
                     const ExrWriteOptions& options = {});
 

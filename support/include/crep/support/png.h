@@ -24,8 +24,10 @@ struct ToneMap {
   bool keepAlpha = false; ///< 4-channel images: write RGBA instead of RGB
 };
 
-/// Writes `image` as an 8-bit PNG. Throws InvalidArgument for an empty image or a bad exposure,
-/// IoError naming the path if the file cannot be written.
+/// Writes `image` as an 8-bit PNG by the output rule of crep/support/output_file.h (a temporary renamed
+/// over the target, symbolic links followed, anything but a regular file refused). Throws InvalidArgument
+/// for an empty image or a bad exposure, IoError naming the path if the file cannot be written (no partial
+/// file is left behind).
 void writePng(const std::filesystem::path& path, const Image& image, const ToneMap& toneMap = {});
 
 /// sRGB OETF of a linear value clamped to [0, 1] (steps 1, 3 above without exposure), in [0, 1].
