@@ -359,38 +359,87 @@ void methodsSideBySide(const BenchOptions& o) {
   printRows(rows);
 }
 
-/// The sun in view (issue "every frame prefiltered"): the "sunset" scene is the forest's mesh and camera
-/// with the sun in view, so every frame takes the epipolar layout. The prefiltered method (crep::Scattering:
-/// resampling, prefilter, evaluation, epipole block) against the min/max march on that frame, and against
-/// the prefiltered method on the forest's own (projective) frame: the constant-cost claim.
+/// A method's per-frame milliseconds with its shadow input (the stage perFrameStage leaves out: the
+/// rectified shadow pass of a projective frame, the resampling of an epipolar one).
+double withShadowInput(const MethodRow& r) {
+  double ms = r.ms;
+  for (const char* input : {"shadow pass (rectified)", "resample (epipolar)", "resample (projective)"})
+    if (r.stageMs.count(input)) ms += r.stageMs.at(input);
+  return ms;
+}
+
+/// The sun in view (issues "every frame prefiltered" and "sun in view at the cost of any other frame"): the
+/// "sunset" scene is the forest's mesh and camera with the sun in view, so every frame takes the epipolar
+/// layout. At the run's size and at 640x360: the prefiltered method (crep::Scattering: resampling,
+/// prefilter, evaluation, the epipole block tree-marched over the epipolar map) against the same frame with
+/// the world-space block (the reference option), Yusov's epipolar sampling, the hybrid and, at 640x360 and
+/// below, the per-pixel min/max march; and against the prefiltered method on the forest's own (projective)
+/// frame. Ratios with the shadow inputs (resampling / rectified shadow pass), as a frame costs an engine.
 void sunInView(const BenchOptions& o) {
   if (!squareMapOk(o, "sun in view", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
-  double mapMs = 0.0;
-  const std::vector<MethodRow> sun = runMethods(o, "sunset", {"prefilter", "minmax"}, repeat, mapMs);
-  const std::vector<MethodRow> forest = runMethods(o, "forest", {"prefilter"}, repeat, mapMs);
-  std::printf(
-      "\nsun in view (scene sunset: the forest toward the sun, epipolar layout; %dx%d, map %d^2, M = %d;\n"
-      "per-frame ms as above: the shadow inputs, standard shadow pass and resampling, excluded):\n",
-      o.screenWidth, o.screenHeight, o.mapWidth, o.bases);
-  printRows(sun);
-  const double fallbackMs = msOf(sun, "prefilter"), projectiveMs = msOf(forest, "prefilter");
-  std::printf("%-16s %12.2f %14s   %s  [forest: projective]\n", "prefilter", projectiveMs, "",
-              forest.empty() ? "" : forest.front().stages.c_str());
-  const auto stage = [](const std::vector<MethodRow>& rows, const char* method, const char* name) {
-    for (const MethodRow& r : rows)
-      if (r.name == method && r.stageMs.count(name)) return r.stageMs.at(name);
-    return 0.0;
-  };
-  const double resampleMs = stage(sun, "prefilter", "resample (epipolar)"),
-               shadowMs = stage(forest, "prefilter", "shadow pass (rectified)");
-  if (fallbackMs > 0.0 && projectiveMs > 0.0)
+  std::vector<std::pair<int, int>> sizes = {{o.screenWidth, o.screenHeight}};
+  if (o.screenWidth != 640 || o.screenHeight != 360) sizes.push_back({640, 360});
+  for (const auto& [w, h] : sizes) {
+    BenchOptions sized = o;
+    sized.screenWidth = w;
+    sized.screenHeight = h;
+    double mapMs = 0.0;
+    std::vector<std::string> methods = {"prefilter", "epipolar-sampling", "epipolar-prefilter"};
+    if (static_cast<long long>(w) * h <= 640LL * 360) methods.push_back("minmax"); // 20 s a frame at 1080p
+    std::vector<MethodRow> sun = runMethods(sized, "sunset", methods, repeat, mapMs);
+    tool::MethodSettings world;
+    world.epipoleBlock = Scattering::EpipoleBlockMethod::WorldMarch;
+    for (MethodRow r : runMethods(sized, "sunset", {"prefilter"}, repeat, mapMs, world)) {
+      r.name = "prefilter-world";
+      r.used += " (world-space block)";
+      sun.push_back(r);
+    }
+    const std::vector<MethodRow> forest = runMethods(sized, "forest", {"prefilter"}, repeat, mapMs);
     std::printf(
-        "minmax / prefilter on the sun-in-view frame: %.2f\n"
-        "prefilter on the fallback frame / on the projective frame of the same scene (constant cost): %.2f;\n"
-        "with their shadow inputs (resampling %.2f ms / rectified shadow pass %.2f ms): %.2f\n",
-        msOf(sun, "minmax") / fallbackMs, fallbackMs / projectiveMs, resampleMs, shadowMs,
-        (fallbackMs + resampleMs) / (projectiveMs + shadowMs));
+        "\nsun in view (scene sunset: the forest toward the sun, epipolar layout; %dx%d, map %d^2, M = %d;\n"
+        "per-frame ms as above, without the shadow inputs; prefilter-world: the epipole block marched in "
+        "world\n"
+        "space, CreateInfo::epipoleBlockMethod = WorldMarch):\n",
+        w, h, o.mapWidth, o.bases);
+    printRows(sun);
+    const double projective = forest.empty() ? 0.0 : withShadowInput(forest.front());
+    std::printf("%-16s %12.2f %14s   %s  [forest: projective]\n", "prefilter",
+                forest.empty() ? 0.0 : forest.front().ms, "",
+                forest.empty() ? "" : forest.front().stages.c_str());
+    const auto row = [&](const char* name) -> const MethodRow* {
+      for (const MethodRow& r : sun)
+        if (r.name == name) return &r;
+      return nullptr;
+    };
+    const MethodRow *pre = row("prefilter"), *yusov = row("epipolar-sampling"),
+                    *worldRow = row("prefilter-world");
+    if (!pre || !yusov || !worldRow || projective <= 0.0) continue;
+    const double fallback = withShadowInput(*pre), yusovMs = withShadowInput(*yusov);
+    const double correct = yusov->stageMs.count("correct") ? yusov->stageMs.at("correct") : 0.0;
+    const double block =
+        (pre->stageMs.count("min/max trees (epipole block)")
+             ? pre->stageMs.at("min/max trees (epipole block)")
+             : 0.0) +
+        (pre->stageMs.count("epipole block (tree march)") ? pre->stageMs.at("epipole block (tree march)")
+                                                          : 0.0);
+    std::printf("with the shadow inputs (resampling %.2f ms / rectified shadow pass %.2f ms), %dx%d:\n"
+                "  sunset prefilter / forest prefilter (goal <= 1.5): %.2f (%.2f ms / %.2f ms; world-space "
+                "block %.2f)\n"
+                "  sunset prefilter / sunset epipolar-sampling (goal <= 0.5): %.2f\n"
+                "  epipolar-sampling's correction / its frame (goal <= 0.10): %.3f (%.2f ms)\n"
+                "  epipole block (trees + tree march) / sunset prefilter frame: %.3f (%.2f ms; world-space "
+                "block stage %.2f ms)\n",
+                pre->stageMs.count("resample (epipolar)") ? pre->stageMs.at("resample (epipolar)") : 0.0,
+                forest.front().stageMs.count("shadow pass (rectified)")
+                    ? forest.front().stageMs.at("shadow pass (rectified)")
+                    : 0.0,
+                w, h, fallback / projective, fallback, projective, withShadowInput(*worldRow) / projective,
+                fallback / yusovMs, correct / yusovMs, correct, block / fallback, block,
+                worldRow->stageMs.count("epipole block (world march)")
+                    ? worldRow->stageMs.at("epipole block (world march)")
+                    : 0.0);
+  }
 }
 
 /// Post effects (issue "postfx"): Mitchell's radial blur and the froxel fog filled by Wronski's ESM path
@@ -719,8 +768,10 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.repeat = args.integer("repeat", o.repeat, 1, 1000);
   o.plot = args.string("plot", "");
   o.section = args.string("section", "");
-  if (!o.section.empty() && o.section != "epipolar-sampling" && o.section != "atmosphere")
-    throw tool::UsageError("option --section: '" + o.section + "' is not epipolar-sampling or atmosphere");
+  if (!o.section.empty() && o.section != "epipolar-sampling" && o.section != "atmosphere" &&
+      o.section != "sun-in-view")
+    throw tool::UsageError("option --section: '" + o.section +
+                           "' is not epipolar-sampling, sun-in-view or atmosphere");
   if (!o.section.empty() && !o.plot.empty())
     throw tool::UsageError("option --plot: needs the whole suite, not --section");
   if (!o.plot.empty() && o.quick)
@@ -968,6 +1019,11 @@ void runBenchSuite(const BenchOptions& o) {
               o.scene.c_str(), o.screenWidth, o.screenHeight, mapW, mapH, bases, repeat);
   if (o.section == "epipolar-sampling") { // one section alone (its own frames, its own sizes)
     epipolarSamplingBench(o);
+    printHowMeasured(o);
+    return;
+  }
+  if (o.section == "sun-in-view") {
+    sunInView(o);
     printHowMeasured(o);
     return;
   }

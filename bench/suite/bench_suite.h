@@ -19,11 +19,12 @@ struct BenchOptions {
   int repeat = 5;      ///< runs per measurement (median)
   bool quick = false;  ///< one size only: no Table 1/2 rows, one CPU run
   std::string plot;    ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
-  std::string section; ///< empty: the whole suite; "epipolar-sampling" or "atmosphere": that section alone
+  std::string section; ///< empty: the whole suite; "epipolar-sampling", "sun-in-view" or "atmosphere": that
+                       ///< section alone
 };
 
 /// Parses [--scene NAME] [--size WxH] [--map WxH] [--bases M] [--repeat N] [--quick] [--plot FILE.svg]
-/// [--section epipolar-sampling|atmosphere];
+/// [--section epipolar-sampling|sun-in-view|atmosphere];
 /// throws crep::tool::UsageError naming the option.
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv);
 

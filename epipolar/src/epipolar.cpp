@@ -53,6 +53,8 @@ void validate(const EpipolarOptions& o) {
   if (!(o.epipoleBlockRadius >= 0.0) || !std::isfinite(o.epipoleBlockRadius))
     throw InvalidArgument("EpipolarOptions.epipoleBlockRadius", detail::formatValue(o.epipoleBlockRadius),
                           "must be finite and >= 0");
+  if (o.maxBlockPixels < 0)
+    throw InvalidArgument("EpipolarOptions.maxBlockPixels", std::to_string(o.maxBlockPixels), "must be >= 0");
   if (!(o.depthWarp >= 0.0) || !std::isfinite(o.depthWarp))
     throw InvalidArgument("EpipolarOptions.depthWarp", detail::formatValue(o.depthWarp),
                           "must be finite and >= 0");
@@ -143,9 +145,36 @@ std::optional<glm::dvec2> EpipolarLayout::epipolePixel() const {
   return glm::dvec2((ndc.x + 1.0) * 0.5 * width_, (ndc.y + 1.0) * 0.5 * height_);
 }
 
+long long EpipolarLayout::blockPixelCount(double radius) const {
+  const auto e = epipolePixel();
+  if (!e || !(radius >= 0.0) || !std::isfinite(e->x) || !std::isfinite(e->y)) return 0;
+  // Per pixel row, the pixel centres x + 0.5 in [ex - dx, ex + dx], dx = sqrt(r^2 - dy^2), within [0, w).
+  long long n = 0;
+  const int y0 = std::max(0, static_cast<int>(std::floor(e->y - radius - 1.0)));
+  const int y1 = std::min(height_ - 1, static_cast<int>(std::ceil(e->y + radius + 1.0)));
+  for (int y = y0; y <= y1; ++y) {
+    const double dy = y + 0.5 - e->y, h2 = radius * radius - dy * dy;
+    if (h2 < 0.0) continue;
+    const double dx = std::sqrt(h2);
+    const int x0 = std::max(0, static_cast<int>(std::ceil(e->x - dx - 0.5)));
+    const int x1 = std::min(width_ - 1, static_cast<int>(std::floor(e->x + dx - 0.5)));
+    if (x1 >= x0) n += x1 - x0 + 1;
+  }
+  return n;
+}
+
 double EpipolarLayout::epipoleBlockRadiusPixels() const {
-  return options_.epipoleBlockRadius *
-         std::sqrt(static_cast<double>(width_) * width_ + static_cast<double>(height_) * height_);
+  const double r = options_.epipoleBlockRadius *
+                   std::sqrt(static_cast<double>(width_) * width_ + static_cast<double>(height_) * height_);
+  const long long cap = options_.maxBlockPixels;
+  if (cap <= 0 || !(r > 0.0) || blockPixelCount(r) <= cap) return r;
+  // The count grows with the radius: bisect for the largest radius that holds at most `cap` pixels.
+  double lo = 0.0, hi = r;
+  for (int i = 0; i < 40; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (blockPixelCount(mid) <= cap ? lo : hi) = mid;
+  }
+  return lo;
 }
 
 std::vector<int> EpipolarLayout::epipoleBlockPixels() const {

@@ -91,6 +91,27 @@ RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
   gl::checkError("RectifiedMarchPass");
 }
 
+std::uint32_t RectifiedMarchPass::program(gpu::LayoutKind kind, bool textured, bool list) {
+  const int k = static_cast<int>(kind);
+  if (k < 0 || k > 1)
+    throw InvalidArgument("RectifiedMarchPass layout kind", std::to_string(k),
+                          "must be projective or epipolar");
+  gl::Handle& program = programs_[list ? 1 : 0][textured ? 1 : 0][k];
+  if (!program)
+    program = buildProgram({{ShaderStage::Compute,
+                             "passes/march_rectified.comp",
+                             {{"CREP_MARCH_TREE", info_.mode == Mode::MinMaxTree ? "1" : "0"},
+                              {"CREP_LAYOUT", std::to_string(k)},
+                              {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
+                              {"CREP_SAMPLE_LIST", list ? "1" : "0"},
+                              {"CREP_SAMPLE_LIST_BINDING", std::to_string(kListBinding)}}}});
+  return program.get();
+}
+
+void RectifiedMarchPass::prepare(gpu::LayoutKind kind, bool textured, bool list) {
+  program(kind, textured, list);
+}
+
 void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (!f.layout) throw InvalidArgument("RectifiedMarchPass::FrameAttribs.layout", "null", "must be set");
   if (!f.camera || !f.medium)
@@ -142,20 +163,18 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   }
 
   const bool textured = f.lightColors != 0;
-  gl::Handle& program = programs_[list ? 1 : 0][textured ? 1 : 0][static_cast<int>(kind)];
-  if (!program)
-    program = buildProgram({{ShaderStage::Compute,
-                             "passes/march_rectified.comp",
-                             {{"CREP_MARCH_TREE", tree ? "1" : "0"},
-                              {"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
-                              {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
-                              {"CREP_SAMPLE_LIST", list ? "1" : "0"},
-                              {"CREP_SAMPLE_LIST_BINDING", std::to_string(kListBinding)}}}});
+  const GLuint program = this->program(kind, textured, list != nullptr);
 
   gpu::MarchParams params =
       f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
                    : gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
+  if (list && f.blockRadius >= 0.0)
+    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.blockRadius", detail::formatValue(f.blockRadius),
+                          "must be -1 with a work list (the list says which texels to march)");
+  if (!gpu::setMarchRegion(params, width, height, f.blockCenter, list ? -1.0 : f.blockRadius,
+                           "RectifiedMarchPass::FrameAttribs"))
+    return; // the block misses the image
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
   layoutBuffers_.upload(layoutData, H);
 
@@ -163,8 +182,8 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
                                                                  GL_R32F, outWidth, outHeight);
   // A work list reads its coordinates at the camera depth's unit and writes its own output.
-  gpu::bindMarchResources(program.get(), params_.get(), list ? list->coordinates : f.cameraDepth,
-                          f.rectifiedDepth, sampler_.get(), list ? list->output : f.output, steps);
+  gpu::bindMarchResources(program, params_.get(), list ? list->coordinates : f.cameraDepth, f.rectifiedDepth,
+                          sampler_.get(), list ? list->output : f.output, steps);
   layoutBuffers_.bind(1, 1);
   if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
   if (textured) { // Klehm et al. 2014, Sec. 3.2: the light texture's colour per texel
@@ -179,7 +198,7 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
     gl::unbindPassState(2);
     gl::checkError("RectifiedMarchPass::run (list)");
   } else {
-    gpu::dispatchMarch(width, height, "RectifiedMarchPass::run");
+    gpu::dispatchMarch(params.region.z, params.region.w, "RectifiedMarchPass::run");
   }
   if (textured) {
     glBindSampler(2, 0);

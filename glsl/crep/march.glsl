@@ -22,8 +22,8 @@ struct CrepMarchParams {
   ivec4 sizes;             // march: xy camera image, zw map; world march: zw shadow map; resampling: xy shadow map, zw map
   ivec4 info;              // march: x tree levels L, y tree row stride; world march: x steps N, y refinements
   vec4 bias;               // world march: x shadow bias (depth-buffer units); yzw 0
-  vec4 block;              // world march: xy centre (pixels), z radius (pixels, < 0: every pixel), w 0
-  ivec4 region;            // world march: xy first pixel of the dispatch, zw its size
+  vec4 block;              // world and rectified marches: xy centre (pixels), z radius (pixels, < 0: every pixel), w 0
+  ivec4 region;            // world and rectified marches: xy first pixel of the dispatch, zw its size
   mat4 lightClipFromWorld; // world march / resampling: the standard shadow map's matrix
   vec4 cameraCenter;       // xyz the image centre's offset from forward (off-centre projections); w 0
   vec4 cameraDepth;        // x near, y projection far (0 = infinite), z integration far, w 1 = reversed-Z

@@ -7,7 +7,9 @@
 // Resources: params block (binding 0), layout block (crep/epipolar.glsl, binding 1), camera depth
 // (unit 0), rectified map depth (unit 1, texelFetch), min/max nodes (storage buffer 0, tree variant),
 // outputs: RGBA32F scattering (image 0), R32F steps (image 1); CREP_SAMPLE_LIST: the list at storage
-// buffer CREP_SAMPLE_LIST_BINDING (2).
+// buffer CREP_SAMPLE_LIST_BINDING (2). Without a list the dispatch covers the pixel rectangle
+// crep_march.region, and with block.z >= 0 only the pixels within block.z pixels of block.xy are written
+// (crep::Scattering's epipole block on the epipolar map, Klehm et al. 2014, Fig. 8).
 // CREP_LIGHT_TEXTURE 1: a light texture's colour map of the rectified map (crep::lightColorMap,
 // LightColorMapPass; texelFetch at texture unit 2): each lit texel's section times its colour
 // (crep::bruteForceMarch with lightColors); the tree variant walks a lit node texel by texel (the colours
@@ -92,8 +94,12 @@ void main() {
   vec4 coordinates = texelFetch(cameraDepth, pixel, 0);
   vec4 ray = crep_screenRay(crep_march, coordinates.xy, coordinates.z);
 #else
-  ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-  if (any(greaterThanEqual(pixel, crep_march.sizes.xy))) return;
+  // The dispatch covers crep_march.region (the image, or the bounding box of the disc crep_march.block).
+  ivec2 pixel = crep_march.region.xy + ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(ivec2(gl_GlobalInvocationID.xy), crep_march.region.zw)) ||
+      any(greaterThanEqual(pixel, crep_march.sizes.xy)))
+    return;
+  if (crep_march.block.z >= 0.0 && distance(vec2(pixel) + 0.5, crep_march.block.xy) > crep_march.block.z) return;
   vec4 ray = crep_pixelRay(crep_march, pixel, texelFetch(cameraDepth, pixel, 0).r);
 #endif
   vec3 dir = ray.xyz;

@@ -14,6 +14,7 @@
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/fourier.h>
 #include <crep/prefilter/gpu_pass.h>
+#include <crep/rectify/gpu_layout.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -94,6 +95,14 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (!(info.epipoleBlockRadius >= 0.0 && info.epipoleBlockRadius <= 0.5))
     invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
             "must be in [0, 0.5] (a fraction of the screen diagonal)");
+  if (info.epipoleBlockMaxPixels < 0)
+    invalid("Scattering::CreateInfo.epipoleBlockMaxPixels", std::to_string(info.epipoleBlockMaxPixels),
+            "must be >= 0 (0: no bound)");
+  if (info.epipoleBlockMethod != Scattering::EpipoleBlockMethod::TreeMarch &&
+      info.epipoleBlockMethod != Scattering::EpipoleBlockMethod::WorldMarch)
+    invalid("Scattering::CreateInfo.epipoleBlockMethod",
+            std::to_string(static_cast<int>(info.epipoleBlockMethod)),
+            "must be EpipoleBlockMethod::TreeMarch or EpipoleBlockMethod::WorldMarch");
   if (info.method != Scattering::Method::Prefiltered && info.method != Scattering::Method::MinMaxMarch)
     invalid("Scattering::CreateInfo.method", std::to_string(static_cast<int>(info.method)),
             "must be Method::Prefiltered or Method::MinMaxMarch");
@@ -287,11 +296,18 @@ struct Scattering::Impl {
         evaluate({i.prefilter.bases, i.evaluate}), resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}),
         rectified({i.mapSize, i.mapSize}) {
     resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
-    if (i.method == Method::MinMaxMarch) {
+    // The min/max trees and their march: Method::MinMaxMarch's, or the prefiltered method's epipole block.
+    // Made (and the block's program built) with the object, so the first frame with the sun in view
+    // compiles nothing.
+    const bool treeBlock = i.method == Method::Prefiltered &&
+                           i.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch &&
+                           i.epipoleBlockRadius > 0.0;
+    if (i.method == Method::MinMaxMarch || treeBlock) {
       trees.emplace(MinMaxTreePass::CreateInfo{i.mapSize, i.mapSize});
       march.emplace(
           RectifiedMarchPass::CreateInfo{i.mapSize, i.mapSize, RectifiedMarchPass::Mode::MinMaxTree});
     }
+    if (treeBlock) march->prepare(gpu::LayoutKind::Epipolar);
     if (i.sampling == Sampling::Epipolar)
       sampling.emplace(EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling});
     const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
@@ -313,9 +329,10 @@ struct Scattering::Impl {
   std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
   gl::Handle lowDepth, lowOutput;                ///< its camera depth (R32F) and scattering (RGBA32F)
-  std::optional<MinMaxTreePass> trees;           ///< Method::MinMaxMarch: the map's trees ...
-  std::optional<RectifiedMarchPass> march;       ///< ... and the tree march
-  std::optional<EpipolarSamplingPass> sampling;  ///< Sampling::Epipolar
+  /// Method::MinMaxMarch, or the prefiltered method's tree-marched epipole block: the map's trees ...
+  std::optional<MinMaxTreePass> trees;
+  std::optional<RectifiedMarchPass> march;      ///< ... and the tree march
+  std::optional<EpipolarSamplingPass> sampling; ///< Sampling::Epipolar
   gl::GpuTimer timer;
   bool running = false; ///< inside run(): a call from drawCasters is refused
   /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
@@ -564,6 +581,7 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
     options.regions = info.epipolarRegions;
     options.depthWarp = info.epipolarDepthWarp;
     options.epipoleBlockRadius = info.epipoleBlockRadius;
+    options.maxBlockPixels = info.epipoleBlockMaxPixels;
     auto epipolar =
         std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
     layout = epipolar;
@@ -690,23 +708,46 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
     const auto centre = epipolar.epipolePixel();
     const double radius = epipolar.epipoleBlockRadiusPixels();
     if (centre && radius > 0.0) {
-      // Fig. 8: the pixels next to the epipole, where the slices converge, marched in world space.
+      // Fig. 8: the pixels next to the epipole, where the slices converge and the prefilter's weights, exact
+      // for one reference ray per region, fit the rays nearly parallel to the light worst.
       r.epipoleBlockRadius = radius;
-      stage("epipole block", [&] {
-        WorldMarchPass::FrameAttribs b;
-        b.camera = f.camera;
-        b.light = f.light;
-        b.medium = f.medium;
-        b.cameraDepth = f.cameraDepth;
-        b.shadowMap = shadow->texture;
-        b.lightClipFromWorld = shadow->lightClipFromWorld;
-        b.bias = shadow->bias;
-        b.output = f.output;
-        b.blockCenter = *centre;
-        b.blockRadius = radius;
-        if (f.lightTexture) b.lightTexture = *f.lightTexture;
-        m.block.run(b);
-      });
+      if (info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch) {
+        // The min/max tree march over the same epipolar map (Chen et al. 2011; Yusov 2012, Algorithm 2):
+        // exact visibility on the map, and the block's rays cross few of their slice's texels, so the cost
+        // is bounded by the block's pixels times a short walk (not a world-space march per pixel).
+        stage("min/max trees (epipole block)", [&] { m.trees->run(map); });
+        stage("epipole block (tree march)", [&] {
+          RectifiedMarchPass::FrameAttribs a;
+          a.layout = layout.get();
+          a.camera = f.camera;
+          a.light = f.light;
+          a.medium = f.medium;
+          a.cameraDepth = f.cameraDepth;
+          a.rectifiedDepth = map;
+          a.minMaxBuffer = m.trees->treeBuffer();
+          a.output = f.output;
+          a.lightColors = colors;
+          a.blockCenter = *centre;
+          a.blockRadius = radius;
+          m.march->run(a);
+        });
+      } else {
+        stage("epipole block (world march)", [&] {
+          WorldMarchPass::FrameAttribs b;
+          b.camera = f.camera;
+          b.light = f.light;
+          b.medium = f.medium;
+          b.cameraDepth = f.cameraDepth;
+          b.shadowMap = shadow->texture;
+          b.lightClipFromWorld = shadow->lightClipFromWorld;
+          b.bias = shadow->bias;
+          b.output = f.output;
+          b.blockCenter = *centre;
+          b.blockRadius = radius;
+          if (f.lightTexture) b.lightTexture = *f.lightTexture;
+          m.block.run(b);
+        });
+      }
     }
   }
   runLocalLights(f, r);

@@ -43,6 +43,7 @@ MarchParams cameraMediumParams(const Camera& camera, const Medium& medium, int w
   const glm::dvec3 sigma = medium.extinction();
   p.extinction = glm::vec4(glm::vec3(sigma), static_cast<float>(weightExtinction(medium)));
   p.sizes = glm::ivec4(width, height, mapWidth, mapHeight);
+  p.region = glm::ivec4(0, 0, width, height); // the whole image (setMarchRegion narrows it to a block)
   return p;
 }
 
@@ -78,6 +79,27 @@ void bindMarchResources(std::uint32_t program, std::uint32_t params, std::uint32
   glBindSampler(1, sampler);
   glBindImageTexture(0, scattering, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+}
+
+bool setMarchRegion(MarchParams& params, int width, int height, const glm::dvec2& blockCenter,
+                    double blockRadius, const std::string& owner) {
+  if (!std::isfinite(blockRadius) || !std::isfinite(blockCenter.x) || !std::isfinite(blockCenter.y))
+    throw InvalidArgument(owner + ".blockCenter/blockRadius", detail::formatValue(blockRadius),
+                          "must be finite");
+  // The dispatch: the whole image, or the block's bounding box clipped to it.
+  glm::ivec4 region(0, 0, width, height);
+  params.block = glm::vec4(0.0f, 0.0f, -1.0f, 0.0f);
+  if (blockRadius >= 0.0) {
+    const auto lo = glm::max(glm::floor(blockCenter - blockRadius - 1.0), glm::dvec2(0.0));
+    const auto hi = glm::min(glm::ceil(blockCenter + blockRadius + 1.0), glm::dvec2(width, height));
+    region =
+        glm::ivec4(static_cast<int>(lo.x), static_cast<int>(lo.y), std::max(0, static_cast<int>(hi.x - lo.x)),
+                   std::max(0, static_cast<int>(hi.y - lo.y)));
+    params.block = glm::vec4(static_cast<float>(blockCenter.x), static_cast<float>(blockCenter.y),
+                             static_cast<float>(blockRadius), 0.0f);
+  }
+  params.region = region;
+  return region.z > 0 && region.w > 0;
 }
 
 void dispatchMarch(int width, int height, const char* what) {
@@ -141,10 +163,6 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   if (textured)
     textureLevel = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight,
                                                 "WorldMarchPass::FrameAttribs.lightTexture");
-  if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
-    throw InvalidArgument("WorldMarchPass::FrameAttribs.blockCenter/blockRadius",
-                          detail::formatValue(f.blockRadius), "must be finite");
-
   gpu::MarchParams params = f.light ? gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height,
                                                            shadow.width, shadow.height)
                                     : gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height,
@@ -152,19 +170,10 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   params.info = glm::ivec4(info_.options.steps, info_.options.refinements, 0, 0);
   params.bias = glm::vec4(static_cast<float>(f.bias), 0.0f, 0.0f, 0.0f);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
-  // The dispatch: the whole image, or the block's bounding box clipped to it.
-  glm::ivec4 region(0, 0, width, height);
-  if (f.blockRadius >= 0.0) {
-    const auto lo = glm::max(glm::floor(f.blockCenter - f.blockRadius - 1.0), glm::dvec2(0.0));
-    const auto hi = glm::min(glm::ceil(f.blockCenter + f.blockRadius + 1.0), glm::dvec2(width, height));
-    region =
-        glm::ivec4(static_cast<int>(lo.x), static_cast<int>(lo.y), std::max(0, static_cast<int>(hi.x - lo.x)),
-                   std::max(0, static_cast<int>(hi.y - lo.y)));
-    params.block = glm::vec4(static_cast<float>(f.blockCenter.x), static_cast<float>(f.blockCenter.y),
-                             static_cast<float>(f.blockRadius), 0.0f);
-  }
-  params.region = region;
-  if (region.z == 0 || region.w == 0) return; // the block misses the image
+  if (!gpu::setMarchRegion(params, width, height, f.blockCenter, f.blockRadius,
+                           "WorldMarchPass::FrameAttribs"))
+    return; // the block misses the image
+  const glm::ivec4 region = params.region;
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
 
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput

@@ -214,6 +214,44 @@ TEST_CASE("epipolar layout: epipole block pixels lie within the radius of the ep
   CHECK(EpipolarLayout(camera, lightAt(camera, {0.5, 0.25}, true), 160, 90, o).epipoleBlockPixels().empty());
 }
 
+TEST_CASE("epipolar layout: maxBlockPixels bounds the block's pixels on screen at any screen size") {
+  for (const glm::ivec2 size : {glm::ivec2(160, 90), glm::ivec2(640, 360), glm::ivec2(1920, 1080)}) {
+    CAPTURE(size.x);
+    const Camera camera = groundCamera(size.x, size.y);
+    EpipolarOptions o;
+    o.epipoleBlockRadius = 0.06;
+    const DirectionalLight inView = lightAt(camera, {0.5, 0.25}, true);
+    const EpipolarLayout full(camera, inView, size.x, size.y, o);
+    const double r0 = full.epipoleBlockRadiusPixels();
+    // The count is exactly the pixels epipoleBlockPixels() lists (pixel centres within the radius).
+    CHECK(full.blockPixelCount(r0) == static_cast<long long>(full.epipoleBlockPixels().size()));
+    o.maxBlockPixels = 2048;
+    const EpipolarLayout capped(camera, inView, size.x, size.y, o);
+    const double r = capped.epipoleBlockRadiusPixels();
+    const long long n = static_cast<long long>(capped.epipoleBlockPixels().size());
+    MESSAGE(size.x << "x" << size.y << ": 6% radius " << r0 << " px (" << full.blockPixelCount(r0)
+                   << " pixels), capped at 2048 pixels: " << r << " px (" << n << " pixels)");
+    CHECK(n == capped.blockPixelCount(r));
+    CHECK(n <= 2048);
+    if (full.blockPixelCount(r0) <= 2048) {
+      CHECK(r == r0); // small screens keep the whole 6%
+    } else {
+      CHECK(r < r0);
+      CHECK(capped.blockPixelCount(r + 0.01) > 2048); // the largest radius under the bound
+      CHECK(n > 2048 - 8.0 * r);                      // one ring of pixels at most below it
+    }
+    // The light just beyond the right edge: the disc is mostly off screen and keeps its radius.
+    const DirectionalLight outside = lightAt(camera, {1.03, 0.5}, true);
+    const EpipolarLayout edge(camera, outside, size.x, size.y, o);
+    REQUIRE_FALSE(edge.epipoleOnScreen());
+    o.maxBlockPixels = 0;
+    const EpipolarLayout edgeFull(camera, outside, size.x, size.y, o);
+    if (edgeFull.blockPixelCount(edgeFull.epipoleBlockRadiusPixels()) <= 2048)
+      CHECK(edge.epipoleBlockRadiusPixels() == edgeFull.epipoleBlockRadiusPixels());
+    CHECK(edge.blockPixelCount(edge.epipoleBlockRadiusPixels()) <= 2048);
+  }
+}
+
 TEST_CASE("epipolar layout: profiles and reference rays follow the contract of rectified_map.h") {
   const Camera camera = groundCamera(160, 90);
   EpipolarOptions o;
@@ -268,6 +306,9 @@ TEST_CASE("epipolar layout: bad input gets a named InvalidArgument") {
   o = {};
   o.epipoleBlockRadius = -1.0;
   CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.epipoleBlockRadius");
+  o = {};
+  o.maxBlockPixels = -1;
+  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.maxBlockPixels");
   const EpipolarLayout L(camera, light, 16, 9);
   CHECK(parameter([&] { L.toRectified(camera.position()); }) == "EpipolarLayout.toRectified.world");
   CHECK(parameter([&] { L.toRectified(glm::dvec3(std::nan(""))); }) == "EpipolarLayout.toRectified.world");

@@ -8,6 +8,7 @@
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
 
+#include <crep/core/error.h>
 #include <crep/core/gl.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
@@ -17,6 +18,7 @@
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>
 
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -130,6 +132,69 @@ TEST_CASE("epipolar march GL: GPU trees are bit-identical to the CPU trees") {
   const MinMaxTrees oddCpu(depth);
   REQUIRE(oddGpu.size() == oddCpu.data().size());
   CHECK(std::equal(oddGpu.begin(), oddGpu.end(), oddCpu.data().begin()));
+  // Rows of 10 levels (1024 texels, and 1000: not a power of two): the build's first phase then covers
+  // levels 1-4 per invocation (glsl/passes/minmax_build.comp), the rest with a barrier per level.
+  for (const int wide : {1024, 1000}) {
+    CAPTURE(wide);
+    Image row(wide, 3, 1);
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < wide; ++i)
+        row.at(i, j) = static_cast<float>(((i * 7919 + j * 104729) % 1009) / 1008.0);
+    const gl::Handle rowTexture = gl::createTexture2D(GL_R32F, wide, 3);
+    glTextureSubImage2D(rowTexture.get(), 0, 0, 0, wide, 3, GL_RED, GL_FLOAT, row.data().data());
+    MinMaxTreePass rowPass({wide, 3});
+    rowPass.run(rowTexture.get());
+    CHECK(rowPass.levels() == 10);
+    const std::vector<float> rowGpu = rowPass.readNodes();
+    const MinMaxTrees rowCpu(row);
+    REQUIRE(rowGpu.size() == rowCpu.data().size());
+    CHECK(std::equal(rowGpu.begin(), rowGpu.end(), rowCpu.data().begin()));
+  }
+}
+
+TEST_CASE("epipolar march GL: a block marches exactly the pixels of its disc, nothing else") {
+  CREP_REQUIRE_GL();
+  const SceneMaps s = renderScene("forest");
+  MinMaxTreePass trees({kMapWidth, kMapHeight});
+  trees.run(s.mapTexture.get());
+  const GpuMarch whole = gpuMarch(s, RectifiedMarchPass::Mode::MinMaxTree);
+  RectifiedMarchPass pass({kMapWidth, kMapHeight, RectifiedMarchPass::Mode::MinMaxTree});
+  const glm::dvec2 centre(150.3, 20.7); // the disc crosses the right edge
+  const double radius = 17.5;
+  const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
+  const float sentinel[4] = {-7.0f, -7.0f, -7.0f, -7.0f};
+  glClearTexImage(out.get(), 0, GL_RGBA, GL_FLOAT, sentinel);
+  RectifiedMarchPass::FrameAttribs f = marchAttribs(s, trees.treeBuffer());
+  f.cameraDepth = s.cameraTexture.get();
+  f.output = out.get();
+  f.blockCenter = centre;
+  f.blockRadius = radius;
+  pass.run(f);
+  const Image block = gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba);
+  int inside = 0, insideDiffer = 0, outsideWritten = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const bool in = std::hypot(x + 0.5 - centre.x, y + 0.5 - centre.y) <= radius;
+      inside += in;
+      for (int c = 0; c < 4; ++c) {
+        if (in)
+          insideDiffer += block.at(x, y, c) != whole.scattering.at(x, y, c);
+        else
+          outsideWritten += block.at(x, y, c) != -7.0f;
+      }
+    }
+  MESSAGE(inside << " pixels in the disc");
+  CHECK(inside > 500);
+  CHECK(insideDiffer == 0);
+  CHECK(outsideWritten == 0);
+  // A disc off the image writes nothing; a block with a work list, or a non-finite one, is refused.
+  f.blockCenter = glm::dvec2(-100.0, -100.0);
+  pass.run(f);
+  CHECK(gl::readTexture(out.get(), kWidth, kHeight, gl::TexelData::Rgba).at(0, 0, 0) == -7.0f);
+  f.blockRadius = std::nan("");
+  CHECK_THROWS_WITH_AS(pass.run(f),
+                       doctest::Contains("RectifiedMarchPass::FrameAttribs.blockCenter/blockRadius"),
+                       InvalidArgument);
 }
 
 TEST_CASE("epipolar march GL: GPU tree and brute-force marches agree with each other and with the CPU") {

@@ -8,6 +8,7 @@
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/epipolar/march.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -80,7 +81,9 @@ TEST_CASE("Scattering: fallback frames are prefiltered on the epipolar layout, c
       checkStages(r);
       if (std::string(c.name) == "sun in view") {
         CHECK(r.epipoleBlockRadius > 0.0);
-        CHECK(r.stages.back().name == "epipole block");
+        // The block's pixels are tree-marched over the frame's epipolar map (the bounded path).
+        CHECK(r.stages[r.stages.size() - 2].name == "min/max trees (epipole block)");
+        CHECK(r.stages.back().name == "epipole block (tree march)");
       }
       // The reference marches the standard map the frame used: the engine's, or Scattering's own (fitted to
       // the frustum, so its texels differ from the engine's: rays toward the sun fall into one texel each).
@@ -119,6 +122,12 @@ TEST_CASE("Scattering: bad input is named, GL state is restored") {
   bad = smallInfo();
   bad.prefilter.bases = 3;
   CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.prefilter.bases");
+  bad = smallInfo();
+  bad.epipoleBlockMaxPixels = -1;
+  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.epipoleBlockMaxPixels");
+  bad = smallInfo();
+  bad.epipoleBlockMethod = static_cast<Scattering::EpipoleBlockMethod>(7);
+  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.epipoleBlockMethod");
 
   Scattering scattering(smallInfo());
   Scattering::FrameAttribs a = f.attribs(true, false);
@@ -214,13 +223,16 @@ TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
   const auto within = [&](std::size_t bytes, std::size_t textures) {
     return bytes >= textures && bytes <= textures + std::size_t(kMap) * 16 * 16 + coefficients + 4096;
   };
+  // The epipole block's min/max trees (made with the object: MinMaxTreePass::memoryBytes(), rowStride
+  // nodes of 8 bytes per row).
+  const std::size_t trees = std::size_t(MinMaxTrees::rowStrideFor(kMap)) * kMap * 8;
   scattering.run(f.attribs(true, false)); // projective frame
-  CHECK(within(scattering.memoryBytes(), basis + table + 2 * map));
+  CHECK(within(scattering.memoryBytes(), basis + table + 2 * map + trees));
   f.lightToward(1.0, 0.25, 0.2); // a fallback frame with the casters only: its own standard shadow map
   const Scattering::FrameResult r = scattering.run(f.attribs(true, false));
   REQUIRE(r.layout == Scattering::Layout::Epipolar);
   const std::size_t own = std::size_t(info.ownShadowMapSize) * info.ownShadowMapSize * 4;
   const std::size_t epipolarTable = tables(info.epipolarRegions * info.prefilter.regionsPerSplit);
-  CHECK(within(scattering.memoryBytes(), basis + epipolarTable + 2 * map + own));
+  CHECK(within(scattering.memoryBytes(), basis + epipolarTable + 2 * map + own + trees));
   MESSAGE("Scattering at " << kMap << "^2 after a fallback frame: " << scattering.memoryBytes() << " bytes");
 }

@@ -81,6 +81,56 @@ TEST_CASE(
   }
 }
 
+TEST_CASE("sun in view: the epipole block is tree-marched over the map, the world-space option agrees") {
+  CREP_REQUIRE_GL();
+  Scattering tree(accurateInfo());
+  Scattering::CreateInfo worldInfo = accurateInfo();
+  worldInfo.epipoleBlockMethod = Scattering::EpipoleBlockMethod::WorldMarch;
+  Scattering world(worldInfo);
+  Scattering::CreateInfo smallBlockInfo = accurateInfo();
+  smallBlockInfo.epipoleBlockMaxPixels = 100; // the bound at work on this small screen
+  Scattering smallBlock(smallBlockInfo);
+  const auto stageNames = [](const Scattering::FrameResult& r) {
+    std::string names;
+    for (const Scattering::Stage& s : r.stages)
+      names += s.name + "|";
+    return names;
+  };
+  for (const std::string& name : scenes::sceneNames()) {
+    CAPTURE(name);
+    ScatteringFixture f(name);
+    if (name != "sunset") f.lightToward(1.0, 0.25, 0.2);
+    const Scattering::FrameResult rt = tree.run(f.attribs(false, true));
+    const Image treeImage = f.read();
+    const Scattering::FrameResult rw = world.run(f.attribs(false, true));
+    const Image worldImage = f.read();
+    const Scattering::FrameResult rs = smallBlock.run(f.attribs(false, true));
+    const Image smallImage = f.read();
+    REQUIRE(rt.layout == Scattering::Layout::Epipolar);
+    // The bounded path: the block's pixels go through the map's min/max trees, not the world-space march.
+    const std::string treeStages = stageNames(rt), worldStages = stageNames(rw);
+    INFO(treeStages);
+    CHECK(treeStages.find("|min/max trees (epipole block)|epipole block (tree march)|") != std::string::npos);
+    CHECK(treeStages.find("world") == std::string::npos);
+    CHECK(worldStages.find("|epipole block (world march)|") != std::string::npos);
+    CHECK(worldStages.find("tree march") == std::string::npos);
+    CHECK(rt.epipoleBlockRadius == rw.epipoleBlockRadius);
+    const auto* layout = dynamic_cast<const EpipolarLayout*>(rs.rectifiedMap.layout.get());
+    REQUIRE(layout != nullptr);
+    CHECK(rs.epipoleBlockRadius < rt.epipoleBlockRadius);
+    CHECK(layout->blockPixelCount(rs.epipoleBlockRadius) <= 100);
+    const ImageMetrics m = rgbMetrics(treeImage, worldImage);
+    const ImageMetrics ref = rgbMetrics(smallImage, f.reference(rs.shadowMap));
+    MESSAGE(name << ": tree-marched block vs world-space block, relative RMSE " << m.relativeRmse
+                 << " (block radius " << rt.epipoleBlockRadius << " px); a 100-pixel block (radius "
+                 << rs.epipoleBlockRadius << " px) vs the world-space reference " << ref.relativeRmse);
+    CHECK(m.nanCount == 0);
+    CHECK(m.relativeRmse < 0.02);
+    CHECK(ref.nanCount == 0);
+    CHECK(ref.relativeRmse < 0.02);
+  }
+}
+
 TEST_CASE("sun in view: the analytic ground and half-space occluder against the closed form") {
   CREP_REQUIRE_GL();
   const Camera camera = groundCamera(kWidth, kHeight);

@@ -37,6 +37,10 @@ struct MethodSettings {
   double scale = 1.0; ///< prefiltered method: Scattering::CreateInfo::evaluationScale (1, 0.5 or 0.25)
   /// epipolar-sampling, epipolar-prefilter: Scattering::CreateInfo::epipolarSampling
   EpipolarSamplingOptions sampling;
+  /// prefilter, epipolar-prefilter: Scattering::CreateInfo::epipoleBlockMethod and epipoleBlockRadius
+  Scattering::EpipoleBlockMethod epipoleBlock = Scattering::CreateInfo{}.epipoleBlockMethod;
+  double epipoleBlockRadius = Scattering::CreateInfo{}.epipoleBlockRadius;
+  int epipoleBlockMaxPixels = Scattering::CreateInfo{}.epipoleBlockMaxPixels;
 };
 
 /// A rectified depth map on the GPU with its rectification (projective).

@@ -1,8 +1,8 @@
 // The tool's methods, each built from the library: the world-space reference march (WorldMarchPass),
 // Klehm et al. 2014's prefiltered scattering on every frame (crep::Scattering), and the
 // min/max tree and brute-force marches over the rectified rows (MinMaxTreePass, RectifiedMarchPass), with
-// the epipolar resampling fallback (EpipolarLayout + ShadowResamplePass + the epipole block) for frames
-// whose rectification is not projective.
+// the epipolar resampling fallback (EpipolarLayout + ShadowResamplePass) for frames whose rectification is
+// not projective.
 #include "methods.h"
 
 #include "args.h"
@@ -39,9 +39,8 @@ gl::Handle newScatteringTexture(const FrameInputs& frame) {
   return gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "--size");
 }
 
-/// WorldMarchPass on `pixels` of the frame (all, or the block around `blockCenter`).
-void runWorldMarch(const FrameInputs& frame, const MethodSettings& settings, std::uint32_t scattering,
-                   const glm::dvec2& blockCenter = glm::dvec2(0.0), double blockRadius = -1.0) {
+/// WorldMarchPass on every pixel of the frame (the reference).
+void runWorldMarch(const FrameInputs& frame, const MethodSettings& settings, std::uint32_t scattering) {
   WorldMarchPass::CreateInfo info;
   info.options.steps = settings.steps;
   WorldMarchPass pass(info);
@@ -54,8 +53,6 @@ void runWorldMarch(const FrameInputs& frame, const MethodSettings& settings, std
   a.lightClipFromWorld = frame.lightClipFromWorld;
   a.bias = frame.shadowBias;
   a.output = scattering;
-  a.blockCenter = blockCenter;
-  a.blockRadius = blockRadius;
   a.lightTexture = frame.lightTexture.gpu(); // texture 0: untextured
   pass.run(a);
   glFinish();
@@ -183,18 +180,9 @@ EpipolarMap makeEpipolarMap(const FrameInputs& frame, const MethodSettings& sett
 
 namespace {
 
-/// The world-space march of the pixels around the epipole (Klehm et al. 2014, Fig. 8), over `scattering`.
-void marchEpipoleBlock(const FrameInputs& frame, const MethodSettings& settings, const EpipolarLayout& layout,
-                       std::uint32_t scattering, StageTimings& timings) {
-  const auto centre = layout.epipolePixel();
-  if (!centre || layout.epipoleBlockRadiusPixels() <= 0.0) return;
-  timings.time("epipole block march", [&] {
-    runWorldMarch(frame, settings, scattering, *centre, layout.epipoleBlockRadiusPixels());
-  });
-}
-
 /// The min/max tree (tree = true) or brute-force march of every pixel's view ray along its row of the
-/// rectified map (projective), or of the epipolar fallback map (plus the epipole block).
+/// rectified map (projective), or of the epipolar fallback map. No epipole block: both marches take every
+/// texel's visibility exactly, next to the epipole as anywhere (the block is the prefiltered method's).
 void addLocalLightsRectified(FrameInputs& frame, const MethodSettings& settings, bool tree, MethodOutput& out,
                              bool empty);
 
@@ -270,7 +258,6 @@ MethodOutput runRectifiedMarch(FrameInputs& frame, const MethodSettings& setting
     pass->run(a);
     glFinish();
   });
-  if (epipolar) marchEpipoleBlock(frame, settings, *epipolar->layout, out.scattering.get(), out.timings);
   addLocalLightsRectified(frame, settings, tree, out, false);
   return out;
 }
@@ -416,6 +403,9 @@ MethodOutput runFrontDoor(FrameInputs& frame, const MethodSettings& settings, Sc
   info.rectify = settings.rectify;
   info.prefilter = settings.prefilter;
   info.epipoleBlock.steps = settings.steps;
+  info.epipoleBlockMethod = settings.epipoleBlock;
+  info.epipoleBlockRadius = settings.epipoleBlockRadius;
+  info.epipoleBlockMaxPixels = settings.epipoleBlockMaxPixels;
   // --scale is the per-pixel evaluation's (compare runs the epipolar methods beside it at full size).
   info.evaluationScale = sampling == Scattering::Sampling::PerPixel ? settings.scale : 1.0;
   auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });

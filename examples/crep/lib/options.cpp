@@ -7,9 +7,20 @@ namespace crep::tool {
 
 static_assert(static_cast<long long>(kMaxMapSize) * kMaxMapSize <= Image::kMaxPixels);
 
-const std::set<std::string> kMethodOptions = {"method",  "map-size",     "bases",    "format",
-                                              "splits",  "steps",        "scale",    "slices",
-                                              "samples", "initial-step", "downscale"};
+const std::set<std::string> kMethodOptions = {"method",
+                                              "map-size",
+                                              "bases",
+                                              "format",
+                                              "splits",
+                                              "steps",
+                                              "scale",
+                                              "slices",
+                                              "samples",
+                                              "initial-step",
+                                              "downscale",
+                                              "epipole-block",
+                                              "epipole-block-radius",
+                                              "epipole-block-pixels"};
 
 const char* const kMethodOptionsHelp =
     R"(            --map-size N        shadow map and rectified map size (default 1024, at most 16384)
@@ -25,6 +36,13 @@ const char* const kMethodOptionsHelp =
             --initial-step N    every N-th sample evaluated before refinement, a power of two (default 16)
             --downscale F       unwarp at 1 / F of the image per axis, F = 1 (default), 2 or 4, then a
                                 depth-aware upscale (the size a multiple of F)
+            --epipole-block B   prefilter, epipolar-prefilter with the sun in view: the pixels next to
+                                the epipole by the min/max tree march over the frame's epipolar map
+                                (tree, default) or the world-space march of the reference (world)
+            --epipole-block-radius R  that block's radius, a fraction of the screen diagonal in
+                                [0, 0.5] (default 0.06; 0: no block)
+            --epipole-block-pixels N  most pixels of that block on screen, the radius shrinks to
+                                hold at most N (default 2048; 0: no bound)
 )";
 
 StorageFormat parseFormat(const std::string& text) {
@@ -53,6 +71,15 @@ MethodSettings methodSettings(const Args& args) {
   s.sampling.samples = args.integer("samples", s.sampling.samples, 32, 1024);
   s.sampling.initialStep = args.integer("initial-step", s.sampling.initialStep, 1, 1024);
   s.sampling.downscale = args.integer("downscale", s.sampling.downscale, 1, 4);
+  const std::string block = args.string("epipole-block", "tree");
+  if (block == "tree")
+    s.epipoleBlock = Scattering::EpipoleBlockMethod::TreeMarch;
+  else if (block == "world")
+    s.epipoleBlock = Scattering::EpipoleBlockMethod::WorldMarch;
+  else
+    throw UsageError("option --epipole-block: '" + block + "' is not tree or world");
+  s.epipoleBlockRadius = args.number("epipole-block-radius", s.epipoleBlockRadius, 0.0, 0.5);
+  s.epipoleBlockMaxPixels = args.integer("epipole-block-pixels", s.epipoleBlockMaxPixels, 0, 1 << 28);
   try {
     validate(s.sampling, "EpipolarSamplingOptions");
   } catch (const InvalidArgument& e) {

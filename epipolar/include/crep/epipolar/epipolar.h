@@ -52,8 +52,8 @@
 // The map has to be exactly sliceCount() rows high (texel row j = slice j).
 //
 // Epipole block (Fig. 8): next to the epipole view rays and light rays are nearly parallel and a slice
-// holds little information (sin(psi) -> 0): the pixels within epipoleBlockRadius of the epipole (or the
-// anti-epipole) are marched in world space instead (epipoleBlockPixels(), worldSpaceMarchPixels()).
+// holds little information (sin(psi) -> 0): the pixels within epipoleBlockRadiusPixels() of the epipole (or
+// the anti-epipole) are left to a march (epipoleBlockPixels(); crep::Scattering marches them over the map).
 #pragma once
 
 #include <array>
@@ -83,6 +83,11 @@ struct EpipolarOptions {
   /// Radius of the epipole block as a fraction of the screen diagonal (>= 0; 0 = no block); the value
   /// crep::Scattering uses (its CreateInfo says why).
   double epipoleBlockRadius = 0.06;
+  /// Most pixels the block may hold on screen (>= 0; 0 = no bound): when the disc of epipoleBlockRadius
+  /// holds more pixel centres on screen, the radius shrinks to the largest one that holds at most this
+  /// many, so the block costs at most this many pixels at any screen size. A disc mostly off screen (the
+  /// light just outside the view) keeps its full radius.
+  int maxBlockPixels = 0;
   /// Depth warp e (radians, >= 0; 0 = linear depth in psi): depth is linear in
   /// g(psi) = log((psi + e) / (pi - psi + e)), which stretches the rays near the light axis (see top).
   double depthWarp = 0.1;
@@ -136,8 +141,10 @@ public:
   /// Indices y * w + x of the pixels whose centre is within epipoleBlockRadius * diagonal of the epipole or
   /// anti-epipole (empty when it is at infinity or the block misses the screen).
   std::vector<int> epipoleBlockPixels() const;
-  /// The block radius in pixels.
+  /// The block radius in pixels: epipoleBlockRadius * diagonal, shrunk by maxBlockPixels (see there).
   double epipoleBlockRadiusPixels() const;
+  /// Pixel centres on screen within `radius` pixels of the epipole (0 when it is at infinity).
+  long long blockPixelCount(double radius) const;
 
   double perimeter() const noexcept { return 2.0 * (width_ + height_); } ///< P, border pixels
   double arcBegin() const noexcept { return arcBegin_; }                 ///< sigma of row 0

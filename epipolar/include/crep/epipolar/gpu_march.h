@@ -118,6 +118,13 @@ public:
     /// or both 0, else InvalidArgument "RectifiedMarchPass::FrameAttribs.imageWidth/imageHeight". Ignored
     /// without a list (the image is cameraDepth's).
     int imageWidth = 0, imageHeight = 0;
+    /// A disc of the image (without `list`): when blockRadius >= 0, only the pixels whose centre is within
+    /// blockRadius pixels of blockCenter (pixel coordinates, origin at the bottom-left corner) are marched
+    /// and written, the dispatch covering its bounding box (crep::Scattering's epipole block, Klehm et al.
+    /// 2014, Fig. 8, marched over the frame's epipolar map). -1 (default): every pixel. Must be -1 with a
+    /// list (InvalidArgument "RectifiedMarchPass::FrameAttribs.blockRadius").
+    glm::dvec2 blockCenter{0.0};
+    double blockRadius = -1.0;
   };
   /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
   /// MinMaxTreePass.
@@ -125,8 +132,13 @@ public:
   /// Throws InvalidArgument naming the field of FrameAttribs (null pointers, zero names, sizes that do not
   /// match the textures, wrong output formats, a layout with no GPU mapping or too many regions).
   void run(const FrameAttribs& frame);
+  /// Builds now the program run() uses for maps of `kind`, with light colours or not (`textured`) and a
+  /// work list or not (`list`); run() builds it on first use otherwise. For a caller that wants no shader
+  /// compilation inside a frame (crep::Scattering's epipole block: no hitch when the sun enters the view).
+  void prepare(gpu::LayoutKind kind, bool textured = false, bool list = false);
 
 private:
+  std::uint32_t program(gpu::LayoutKind kind, bool textured, bool list);
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
   gl::Handle programs_[2][2][2], params_, sampler_, dummySteps_; ///< [list][textured][layout kind]

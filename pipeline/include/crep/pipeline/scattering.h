@@ -1,7 +1,8 @@
 // The front door: one object per view, one call per frame, every frame prefiltered (Klehm, Seidel,
 // Eisemann 2014). Scattering decides the layout itself: the projective rectification (Sec. 4.2) when
 // rectify() accepts the frame, else the epipolar resampling fallback (Sec. 4.1) with the pixels next to the
-// epipole marched in world space (Fig. 8). It owns every pass and texture it needs; it never creates or
+// epipole (Fig. 8's block) tree-marched over the same epipolar map (Chen et al. 2011; Yusov 2012). It owns
+// every pass and texture it needs; it never creates or
 // owns the GL context (an OpenGL 4.5 core context must be current for its whole lifetime).
 //
 //   crep::Scattering scattering({.width = 1920, .height = 1080});           // once per view
@@ -49,9 +50,12 @@
 // gobo; a perspective projection centred at the spot). A textured light's colour map is made for the
 // layout its frame uses (LightColorMapPass: the projective or the epipolar layout) and prefiltered with it
 // (three bases, PrefilterPass::FrameAttribs::lightColors), the evaluation follows the textured basis; the
-// world-space marches (the epipole block, a spot in or near the view) take the texture itself
+// tree-marched epipole block reads the same colour map (RectifiedMarchPass::FrameAttribs::lightColors), the
+// world-space marches (EpipoleBlockMethod::WorldMarch, a spot in or near the view) take the texture itself
 // (WorldMarchPass::FrameAttribs::lightTexture). A constant white texture gives the untextured result bit
-// for bit. Not with CreateInfo::evaluate.nearPlaneCorrection or the visibility table alone (scatteringPrefix
+// for bit, except inside a tree-marched epipole block, where the textured walk sums each lit texel alone
+// (the untextured one a lit node at once): equal there to float rounding (7e-7 of a 1.5 peak, tested). Not
+// with CreateInfo::evaluate.nearPlaneCorrection or the visibility table alone (scatteringPrefix
 // false with visibilityTableSamples > 0): those have no textured variant (InvalidArgument). Point lights
 // take no texture. Without textures nothing of this runs or is allocated.
 //
@@ -61,7 +65,7 @@
 // through the cell's (u, v) up to its sample view depth, no accumulation pass and no exponential-shadow-map
 // light leaking. `output` (and cameraDepth) may then be 0 (only the volume). Directional light (and its
 // texture) only: local lights are not added to the volume, and on epipolar frames the cells inside the
-// epipole block are evaluated by the prefiltered method too (not marched: WorldMarchPass has no 3D target;
+// epipole block are evaluated by the prefiltered method too (not marched: the marches have no 3D target;
 // measured against the world-space reference at the cells with the sun in view: 1.9% / 3.3% relative RMSE
 // inside the block, 2.8% / 2.7% outside, forest / colonnade, tests/pipeline/ScatteringFroxelGLTest.cpp).
 // The stage "froxels" times the fill (it reuses the per-frame table the per-pixel evaluation built).
@@ -115,6 +119,15 @@ public:
     Prefiltered, ///< Klehm et al. 2014: prefilter the map, evaluate each ray in constant time (default)
     MinMaxMarch, ///< the peer (Chen et al. 2011, Yusov 2012 Algorithm 2): 1D min/max trees, march each ray
   };
+  /// How the epipole block (the pixels next to the epipole on epipolar frames) is evaluated.
+  enum class EpipoleBlockMethod {
+    /// The min/max tree march over the frame's epipolar map (default): exact visibility on the map the
+    /// frame prefiltered, cost bounded by the block's pixels times a short tree walk.
+    TreeMarch,
+    /// The world-space march against the standard shadow map (CreateInfo::epipoleBlock's steps): the
+    /// reference, a world-space march per pixel (about 16x the tree march per pixel, README "Sun in view").
+    WorldMarch,
+  };
   /// Which rays the method evaluates (see "Epipolar sampling" at the top).
   enum class Sampling {
     PerPixel, ///< every pixel's view ray (default)
@@ -159,14 +172,22 @@ public:
     /// (default): 1.17%, 0.245%; 32: 2.5%, 0.32%. Cost of one spot light off screen (crep bench --quick,
     /// colonnade, 320x180, section "local lights"): 7.1x the sun's frame at 128, 4.2x at 64.
     int localLightTableSamples = 64;
-    /// World-space march of the epipole block: sections and refinements (bias comes with the shadow map).
+    /// How the epipole block is evaluated: TreeMarch (default) or the world-space reference.
+    EpipoleBlockMethod epipoleBlockMethod = EpipoleBlockMethod::TreeMarch;
+    /// World-space march of the epipole block with EpipoleBlockMethod::WorldMarch (and of local lights in or
+    /// near the view): sections and refinements (bias comes with the shadow map).
     WorldMarchOptions epipoleBlock;
-    /// Radius of the epipole block as a fraction of the screen diagonal (0 = none), in [0, 0.5]. Default 6%:
-    /// the pixels whose view rays are nearly parallel to the light, where a slice holds least information
-    /// (Fig. 8), including those at the screen edge when the sun is just outside it. Measured with the sun
-    /// 5% of the diagonal beyond the right edge: 2% -> 2.1% relative RMSE, 6% -> 1.9%; it costs a
-    /// world-space march of about 1.1% of the pixels (16:9) when the epipole is on screen.
+    /// Radius of the epipole block as a fraction of the screen diagonal (0 = none), in [0, 0.5], bounded by
+    /// epipoleBlockMaxPixels. Default 6%: the pixels whose view rays are nearly parallel to the light, where
+    /// the prefilter's weights fit worst (Fig. 8), including those at the screen edge when the sun is just
+    /// outside it. Measured with the sun 5% of the diagonal beyond the right edge: 2% -> 2.1% relative RMSE,
+    /// 6% -> 1.9%; with the sun in view the bound (below) sets the radius on large screens.
     double epipoleBlockRadius = 0.06;
+    /// Most pixels of the epipole block on screen (EpipolarOptions::maxBlockPixels; >= 0, 0 = no bound):
+    /// with the sun in view the block's radius shrinks so it holds at most this many pixels, so its cost
+    /// does not grow with the screen (6% of a 1920x1080 diagonal is 55,000 pixels). Default 2048: radius
+    /// 25.5 px (1.2% of the diagonal at 1920x1080, 3.5% at 640x360, the full 6% at 320x180 and below).
+    int epipoleBlockMaxPixels = 2048;
     /// Regions of the epipolar layout (its columns, logarithmic in the distance from the light axis; the
     /// fallback's splits), each cut into P prefilter regions like a split. A slice's view rays range from
     /// nearly parallel to the light (next to the epipole) to the screen border, so their world steps per
@@ -291,11 +312,14 @@ public:
   /// "transmittance".
   struct FrameResult {
     Layout layout = Layout::Projective;
-    Rectification rectification;     ///< the decision (reason, measure, threshold when not projective)
-    double epipoleBlockRadius = 0.0; ///< pixels; 0 without a block (projective, or epipole off screen)
+    Rectification rectification; ///< the decision (reason, measure, threshold when not projective)
+    /// Pixels, after CreateInfo::epipoleBlockMaxPixels; 0 without a block (projective, or epipole at
+    /// infinity).
+    double epipoleBlockRadius = 0.0;
     /// In order: shadow / resample, light colours (with FrameAttribs::lightTexture), prefilter, evaluate
     /// (with an output), froxels (with FrameAttribs::froxels: the volume's fill alone, from the per-frame
-    /// table the evaluation built), epipole block.
+    /// table the evaluation built), and with the epipole on screen "min/max trees (epipole block)" and
+    /// "epipole block (tree march)" (or "epipole block (world march)" with EpipoleBlockMethod::WorldMarch).
     std::vector<Stage> stages;
     /// Epipolar frames: the standard shadow map resampled and marched (the engine's, or the one rendered
     /// with drawCasters, valid until the next run()); texture 0 on projective frames.

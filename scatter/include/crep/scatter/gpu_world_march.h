@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -48,8 +49,10 @@ struct MarchParams {
   glm::ivec4 sizes{0};
   glm::ivec4 info{0};   ///< march: x tree levels L, y tree row stride; world march: x steps N, y refinements
   glm::vec4 bias{0.0f}; ///< world march: x shadow bias (depth-buffer units)
-  glm::vec4 block{0.0f, 0.0f, -1.0f, 0.0f}; ///< world march: xy centre, z radius (pixels; < 0: all pixels)
-  glm::ivec4 region{0};               ///< world march: xy first pixel of the dispatch, zw its size (pixels)
+  glm::vec4 block{0.0f, 0.0f, -1.0f,
+                  0.0f}; ///< world and rectified marches: xy centre, z radius (pixels; < 0: all)
+  glm::ivec4 region{
+      0}; ///< world and rectified marches: first pixel of the dispatch, its size (makeMarchParams: the image)
   glm::mat4 lightClipFromWorld{1.0f}; ///< world march / resampling: the standard shadow map's matrix
   glm::vec4 cameraCenter{0.0f};       ///< xyz: the image centre's offset from forward (off-centre); w: 0
   /// The camera's depth convention: x near, y projection far (0 = infinite), z integration far, w 1 =
@@ -103,6 +106,13 @@ MarchParams makeMarchParams(const Camera& camera, const LocalLight& light, const
 void bindMarchResources(std::uint32_t program, std::uint32_t params, std::uint32_t cameraDepth,
                         std::uint32_t map, std::uint32_t sampler, std::uint32_t scattering,
                         std::uint32_t steps);
+/// The dispatch rectangle of a march over a width x height image: the whole image (blockRadius < 0), or
+/// the bounding box of the disc of blockRadius pixels around blockCenter (pixel coordinates, origin at the
+/// bottom-left corner) clipped to it, with MarchParams::block set so the shader writes only the pixels
+/// whose centre is in the disc. Returns false when the disc misses the image (nothing to dispatch).
+/// Throws InvalidArgument naming `owner` + ".blockCenter/blockRadius" for non-finite values.
+bool setMarchRegion(MarchParams& params, int width, int height, const glm::dvec2& blockCenter,
+                    double blockRadius, const std::string& owner);
 /// Dispatches 8 x 8 workgroups over width x height pixels (local size of the march shaders), then issues
 /// gl::passOutputBarrier(), unbinds (gl::unbindPassState(2)) and checks GL errors under `what`.
 void dispatchMarch(int width, int height, const char* what);
