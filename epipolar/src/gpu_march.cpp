@@ -62,6 +62,28 @@ void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
   gl::checkError("MinMaxTreePass::run");
 }
 
+int MinMaxTreePass::lowLevels(int mapWidth) {
+  return std::max(0, MinMaxTrees::levelCount(mapWidth) - 6);
+}
+
+void MinMaxTreePass::completeUpperLevels() {
+  if (lowLevels(info_.mapWidth) < 1)
+    throw InvalidArgument("MinMaxTreePass::CreateInfo.mapWidth", std::to_string(info_.mapWidth),
+                          "must exceed 64 texels for completeUpperLevels (no low levels to start from)");
+  if (!upperProgram_)
+    upperProgram_ =
+        buildProgram({{ShaderStage::Compute, "passes/minmax_build.comp", {{"CREP_TREE_UPPER_ONLY", "1"}}}});
+  const GLuint p = upperProgram_.get();
+  glUseProgram(p);
+  glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer_.get());
+  if (levels_ > 0) glDispatchCompute(static_cast<GLuint>(info_.mapHeight), 1, 1);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+  glUseProgram(0);
+  gl::checkError("MinMaxTreePass::completeUpperLevels");
+}
+
 std::vector<float> MinMaxTreePass::readNodes() const {
   std::vector<float> out(static_cast<std::size_t>(rowStride_) * static_cast<std::size_t>(info_.mapHeight) *
                          2);

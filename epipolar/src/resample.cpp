@@ -5,6 +5,8 @@
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
+#include <crep/epipolar/gpu_march.h>
+#include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
 
 #include <crep/scatter/gpu_layout_buffers.h>
@@ -172,12 +174,27 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
 
+  const bool trees = f.minMaxBuffer != 0;
+  const int lowLevels = MinMaxTreePass::lowLevels(W);
+  if (trees) {
+    if (lowLevels < 1)
+      throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
+                            "needs a map wider than 64 texels (no low tree levels below the top 6)");
+    GLint64 size = 0;
+    if (glIsBuffer(f.minMaxBuffer)) glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
+    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
+    if (size < needed)
+      throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
+                            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(W) + " x " +
+                                std::to_string(H) + " map (" + std::to_string(needed) + " bytes)");
+  }
   const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
-  gl::Handle& program = programs_[static_cast<int>(kind)];
+  gl::Handle& program = programs_[static_cast<int>(kind)][trees ? 1 : 0];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
                              "passes/epipolar_resample.comp",
-                             {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
+                             {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
+                              {"CREP_RESAMPLE_TREES", trees ? "1" : "0"}}}});
   gpu::MarchParams params;
   params.sizes = glm::ivec4(shadow.width, shadow.height, W, H);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
@@ -193,7 +210,15 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   glBindTextureUnit(0, f.shadowMap);
   glBindSampler(0, sampler_.get());
   glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
+  if (trees) { // one work group of 64 per row, 2^lowLevels texels per invocation
+    glProgramUniform4i(p, 2, MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), lowLevels, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
+    glDispatchCompute(static_cast<GLuint>(H), 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+  } else {
+    glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
+  }
   gl::passOutputBarrier();
   gl::unbindPassState(2);
   gl::checkError("ShadowResamplePass::run");

@@ -13,6 +13,12 @@
 // Resources: rectified map depth (unit 0, texelFetch), nodes (storage buffer 0), sizes (location 0:
 // W, H, L, row stride).
 
+// CREP_TREE_UPPER_ONLY 1: levels 1..C are in the buffer already (written by the epipolar resampling,
+// passes/epipolar_resample.comp with CREP_RESAMPLE_TREES); only levels C + 1..L are built, the map is not read.
+#ifndef CREP_TREE_UPPER_ONLY
+#define CREP_TREE_UPPER_ONLY 0
+#endif
+
 layout(local_size_x = 64) in;
 
 layout(binding = 0) uniform sampler2D rectifiedDepth;
@@ -42,7 +48,9 @@ void main() {
   for (int l = 1; l <= C; ++l) {
     int size = (W + (1 << l) - 1) >> l;
     int first = t << (C - l), last = min((t + 1) << (C - l), size);
+#if !CREP_TREE_UPPER_ONLY
     for (int m = first; m < last; ++m) crep_minMax[base + off + m] = crep_buildNode(l, m, j, base, below, offBelow);
+#endif
     below = size;
     offBelow = off;
     off += size;

@@ -531,6 +531,12 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
     gl::checkError("Scattering::run");
     return r;
   }
+  // The epipole block of an epipolar layout is tree-marched this frame (Fig. 8's block on screen).
+  const auto treeMarchedBlock = [&](const EpipolarLayout& epipolar) {
+    return info.method == Method::Prefiltered && info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch &&
+           epipolar.epipolePixel().has_value() && epipolar.epipoleBlockRadiusPixels() > 0.0;
+  };
+  bool treesFromResample = false; // the resampling wrote the trees' low levels
   if (f.shadowMap) {
     gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
     gl::requireDepthFormat("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
@@ -598,8 +604,13 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
       shadow = &own;
     }
     r.shadowMap = *shadow;
+    // A tree-marched epipole block needs the map's min/max trees: their low levels are written by the
+    // resampling itself (the map read once), the rest after it (the block's stage below).
+    treesFromResample =
+        treeMarchedBlock(*epipolar) && f.output != 0 && MinMaxTreePass::lowLevels(info.mapSize) >= 1;
     stage("resample (epipolar)", [&] {
-      m.resample.run({epipolar.get(), shadow->texture, shadow->lightClipFromWorld, m.resampled.get()});
+      m.resample.run({epipolar.get(), shadow->texture, shadow->lightClipFromWorld, m.resampled.get(),
+                      treesFromResample ? m.trees->treeBuffer() : 0u});
     });
     map = m.resampled.get();
   }
@@ -715,7 +726,12 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
         // The min/max tree march over the same epipolar map (Chen et al. 2011; Yusov 2012, Algorithm 2):
         // exact visibility on the map, and the block's rays cross few of their slice's texels, so the cost
         // is bounded by the block's pixels times a short walk (not a world-space march per pixel).
-        stage("min/max trees (epipole block)", [&] { m.trees->run(map); });
+        stage("min/max trees (epipole block)", [&] {
+          if (treesFromResample)
+            m.trees->completeUpperLevels();
+          else
+            m.trees->run(map);
+        });
         stage("epipole block (tree march)", [&] {
           RectifiedMarchPass::FrameAttribs a;
           a.layout = layout.get();

@@ -221,7 +221,59 @@ TEST_CASE("epipolar GL: the resampling pass matches the CPU resampling (epipolar
                  << " on average");
     CHECK(differ < W * H / 100);
     CHECK(mean < 5e-5);
+    // With a tree buffer the pass also writes the map's min/max tree levels 1..lowLevels (one work group
+    // per row): the same map bit for bit, and after completeUpperLevels() the nodes MinMaxTreePass::run()
+    // builds from the map, bit for bit.
+    MinMaxTreePass fromMap({W, H}), fused({W, H});
+    fromMap.run(map.get());
+    const gl::Handle fusedMap = gl::createTexture2D(GL_R32F, W, H);
+    f.output = fusedMap.get();
+    f.minMaxBuffer = fused.treeBuffer();
+    pass.run(f);
+    fused.completeUpperLevels();
+    const Image fusedImage = gl::readTexture(fusedMap.get(), W, H, gl::TexelData::Red);
+    CHECK(std::equal(fusedImage.data().begin(), fusedImage.data().end(), gpu.data().begin()));
+    const std::vector<float> a = fromMap.readNodes(), b = fused.readNodes();
+    REQUIRE(a.size() == b.size());
+    CHECK(MinMaxTreePass::lowLevels(W) == 2);
+    CHECK(std::equal(a.begin(), a.end(), b.begin()));
   }
+  // Odd widths and the 1024-texel rows of crep::Scattering's default map (4 low levels per invocation).
+  for (const int W : {1024, 200}) {
+    CAPTURE(W);
+    const int H = epipolar->sliceCount();
+    ShadowResamplePass pass({W, H});
+    MinMaxTreePass fromMap({W, H}), fused({W, H});
+    const gl::Handle plain = gl::createTexture2D(GL_R32F, W, H),
+                     withTrees = gl::createTexture2D(GL_R32F, W, H);
+    ShadowResamplePass::FrameAttribs f{epipolar.get(), g.shadow.get(), g.lightMatrix, plain.get()};
+    pass.run(f);
+    fromMap.run(plain.get());
+    f.output = withTrees.get();
+    f.minMaxBuffer = fused.treeBuffer();
+    pass.run(f);
+    fused.completeUpperLevels();
+    const Image p = gl::readTexture(plain.get(), W, H, gl::TexelData::Red),
+                q = gl::readTexture(withTrees.get(), W, H, gl::TexelData::Red);
+    CHECK(std::equal(p.data().begin(), p.data().end(), q.data().begin()));
+    const std::vector<float> a = fromMap.readNodes(), b = fused.readNodes();
+    CHECK(std::equal(a.begin(), a.end(), b.begin()));
+  }
+  // A buffer too small for the map, or a map too narrow for low levels, is named.
+  ShadowResamplePass narrow({64, epipolar->sliceCount()});
+  MinMaxTreePass narrowTrees({64, epipolar->sliceCount()});
+  const gl::Handle narrowMap = gl::createTexture2D(GL_R32F, 64, epipolar->sliceCount());
+  ShadowResamplePass::FrameAttribs bad{epipolar.get(), g.shadow.get(), g.lightMatrix, narrowMap.get(),
+                                       narrowTrees.treeBuffer()};
+  CHECK_THROWS_WITH_AS(narrow.run(bad), doctest::Contains("ShadowResamplePass::FrameAttribs.minMaxBuffer"),
+                       InvalidArgument);
+  CHECK_THROWS_WITH_AS(narrowTrees.completeUpperLevels(),
+                       doctest::Contains("MinMaxTreePass::CreateInfo.mapWidth"), InvalidArgument);
+  ShadowResamplePass wide({256, epipolar->sliceCount()});
+  const gl::Handle wideMap = gl::createTexture2D(GL_R32F, 256, epipolar->sliceCount());
+  bad.output = wideMap.get();
+  CHECK_THROWS_WITH_AS(wide.run(bad), doctest::Contains("must be a MinMaxTreePass::treeBuffer()"),
+                       InvalidArgument);
 }
 
 TEST_CASE("epipolar GL: GPU marches on the epipolar layout agree with the CPU marches") {

@@ -49,6 +49,12 @@ public:
 
   /// Builds the trees of `rectifiedDepth` (the caller's W x H depth texture).
   void run(std::uint32_t rectifiedDepth);
+  /// Levels 1..lowLevels(W) are written by whoever makes the map (ShadowResamplePass::FrameAttribs::
+  /// minMaxBuffer): max(0, levelCount(W) - 6), so the top level of them has at most 64 nodes a row.
+  static int lowLevels(int mapWidth);
+  /// Builds levels lowLevels(W) + 1..L from the low levels already in treeBuffer() (the producer must have
+  /// issued GL_SHADER_STORAGE_BARRIER_BIT); the map itself is not read. Same nodes as run() of that map.
+  void completeUpperLevels();
 
   std::uint32_t treeBuffer() const noexcept { return buffer_.get(); } ///< GL_SHADER_STORAGE_BUFFER
   int levels() const noexcept { return levels_; }
@@ -64,7 +70,7 @@ public:
 private:
   CreateInfo info_;
   int levels_ = 0, rowStride_ = 0;
-  gl::Handle program_, buffer_, sampler_;
+  gl::Handle program_, upperProgram_, buffer_, sampler_;
 };
 
 /// The march of every camera pixel's view ray along its row of a rectified map (march.h "Rectified

@@ -87,6 +87,12 @@ public:
     /// perspective centred at the light for a spot light or point-light face)
     glm::dmat4 lightClipFromWorld{1.0};
     std::uint32_t output = 0; ///< GL_R32F mapWidth x mapHeight texture (written)
+    /// 0, or the MinMaxTreePass::treeBuffer() of a mapWidth x mapHeight map (mapWidth > 64): the pass also
+    /// writes levels 1..MinMaxTreePass::lowLevels(mapWidth) of the output's 1D min/max trees (Yusov 2012,
+    /// Sec. 6.3) from the texels it resamples, one work group per row, and issues the storage barrier;
+    /// MinMaxTreePass::completeUpperLevels() then builds the rest (the nodes of MinMaxTreePass::run()).
+    /// The map is read once instead of twice: for crep::Scattering's tree-marched epipole block.
+    std::uint32_t minMaxBuffer = 0;
   };
   /// Throws InvalidArgument ("ShadowResamplePass::CreateInfo.mapWidth/mapHeight") for sizes <= 0, GlError
   /// beyond GL_MAX_TEXTURE_SIZE.
@@ -97,7 +103,7 @@ public:
 private:
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2], params_, sampler_;
+  gl::Handle programs_[2][2], params_, sampler_; ///< [layout kind][with the trees' low levels]
 };
 
 } // namespace crep

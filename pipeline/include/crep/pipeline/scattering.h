@@ -125,7 +125,7 @@ public:
     /// frame prefiltered, cost bounded by the block's pixels times a short tree walk.
     TreeMarch,
     /// The world-space march against the standard shadow map (CreateInfo::epipoleBlock's steps): the
-    /// reference, a world-space march per pixel (about 16x the tree march per pixel, README "Sun in view").
+    /// reference, a world-space march per pixel (16-23x the tree march per pixel, README "Sun in view").
     WorldMarch,
   };
   /// Which rays the method evaluates (see "Epipolar sampling" at the top).
