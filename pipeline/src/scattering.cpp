@@ -724,8 +724,8 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
       r.epipoleBlockRadius = radius;
       if (info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch) {
         // The min/max tree march over the same epipolar map (Chen et al. 2011; Yusov 2012, Algorithm 2):
-        // exact visibility on the map, and the block's rays cross few of their slice's texels, so the cost
-        // is bounded by the block's pixels times a short walk (not a world-space march per pixel).
+        // exact visibility on the map, the walk skipping lit and shadowed runs of texels whole, so the cost
+        // is the block's pixels (at most epipoleBlockMaxPixels) times a short walk.
         stage("min/max trees (epipole block)", [&] {
           if (treesFromResample)
             m.trees->completeUpperLevels();
