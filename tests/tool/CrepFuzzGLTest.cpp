@@ -49,10 +49,6 @@ constexpr int kCommandLineCases = 160, kJsonCases = 80, kExrCases = 300;
 /// ones.
 constexpr double kDeadlines[3] = {50.0, 72.0, 90.0};
 
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
 /// A file's identity for the before / after comparison: its type, and for regular files size and content
 /// hash, for links the target.
 std::string describe(const fs::path& p) {
@@ -381,17 +377,12 @@ public:
   }
 
   Json localLight() {
-    const crep::SpotLight s = exampleSpot();
-    if (chance(0.5))
-      return Json{
-          {"type", "spot"},
-          {"position", vecJson(s.position())},
-          {"direction", vecJson(s.direction())},
-          {"innerConeDeg", 20},
-          {"outerConeDeg", 30},
-          {"color", Json::array({1.0, 0.9, 0.8})},
-          {"intensity", 30},
-          {"shadowMap", {{"file", "spot.exr"}, {"lightClipFromWorld", matrixJson(s.lightClipFromWorld())}}}};
+    if (chance(0.5)) {
+      Json spot = exampleSpotJson();
+      spot["shadowMap"] = {{"file", "spot.exr"},
+                           {"lightClipFromWorld", matrixJson(exampleSpot().lightClipFromWorld())}};
+      return spot;
+    }
     return Json{{"type", "point"},
                 {"position", Json::array({4.0, 3.0, -2.0})},
                 {"color", Json::array({1.0, 1.0, 1.0})},

@@ -30,17 +30,6 @@ using namespace crep::test::frame_json;
 using crep::test::ArgvResult;
 using crep::test::runCrepArgv;
 
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-std::set<std::string> listing(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    names.insert(e.path().lexically_relative(dir).string());
-  return names;
-}
-
 /// No temporary of the output rule ("<name>.crep-XXXXXX.partial") anywhere in `dir`.
 void checkNoTemporaries(const fs::path& dir) {
   for (const std::string& name : listing(dir)) {

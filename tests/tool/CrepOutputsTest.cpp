@@ -32,18 +32,6 @@ using namespace crep::test::frame_json;
 using crep::test::ArgvResult;
 using crep::test::runCrepArgv;
 
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-/// The names in `dir` (recursively, relative), to see that a failed command left nothing behind.
-std::set<std::string> listing(const fs::path& dir) {
-  std::set<std::string> names;
-  for (const auto& e : fs::recursive_directory_iterator(dir))
-    names.insert(e.path().lexically_relative(dir).string());
-  return names;
-}
-
 std::size_t lineCount(const std::string& text) {
   std::size_t n = 0;
   for (char c : text)
@@ -322,19 +310,13 @@ TEST_CASE("crep scatter: a local light's radiance bound names the field to chang
       }),
       1, {"frame.json: lights[0].intensity: with this medium the in-scattered radiance can reach"});
   // The main light a spot: its own path.
-  expectEarlyFailure(run([](Json& j) {
-                       const crep::SpotLight s = exampleSpot();
-                       j["light"] = {{"type", "spot"},
-                                     {"position", vecJson(s.position())},
-                                     {"direction", vecJson(s.direction())},
-                                     {"innerConeDeg", 20},
-                                     {"outerConeDeg", 30},
-                                     {"color", Json::array({1.0, 0.9, 0.8})},
-                                     {"intensity", 30},
-                                     {"nearPlane", 1e-30}};
-                       j["shadowMap"] = {{"lightClipFromWorld", matrixJson(s.lightClipFromWorld())}};
-                     }),
-                     1, {"frame.json: light.nearPlane: with this medium"});
+  expectEarlyFailure(
+      run([](Json& j) {
+        j["light"] = exampleSpotJson();
+        j["light"]["nearPlane"] = 1e-30;
+        j["shadowMap"] = {{"lightClipFromWorld", matrixJson(exampleSpot().lightClipFromWorld())}};
+      }),
+      1, {"frame.json: light.nearPlane: with this medium"});
   // The directional light's own bound still names light.intensity.
   expectEarlyFailure(run([](Json& j) {
                        j["light"]["intensity"] = 1e28;

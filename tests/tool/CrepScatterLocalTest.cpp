@@ -35,13 +35,7 @@ struct SpotInputs {
     crep::writeExr(dir / "point.exr", crep::Image(32, 192, 1, 1.0f), crep::ExrPixelType::Float);
     frame = Json::parse(readText(kExample));
     const crep::SpotLight s = exampleSpot();
-    frame["light"] = {{"type", "spot"},
-                      {"position", vecJson(s.position())},
-                      {"direction", vecJson(s.direction())},
-                      {"innerConeDeg", 20},
-                      {"outerConeDeg", 30},
-                      {"color", Json::array({1.0, 0.9, 0.8})},
-                      {"intensity", 30}};
+    frame["light"] = exampleSpotJson();
     frame["shadowMap"] = {{"lightClipFromWorld", matrixJson(s.lightClipFromWorld())}, {"bias", 1e-4}};
     frame["lights"] = Json::array({Json{{"type", "point"},
                                         {"position", Json::array({4.0, 3.0, -2.0})},

@@ -25,10 +25,6 @@ namespace {
 
 using namespace crep::test::frame_json;
 
-void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
-}
-
 /// A directory with valid inputs for the example frame: depth.exr (160x90, a constant 0.9),
 /// shadow.exr (256x256, empty: 1) and frame.json (the example).
 struct Inputs {

@@ -60,17 +60,11 @@ struct TextureInputs {
 
 /// A spot entry of "lights" (its map spot.exr) with a texture.
 Json spotEntry() {
-  const crep::SpotLight s = exampleSpot();
-  return Json{
-      {"type", "spot"},
-      {"position", vecJson(s.position())},
-      {"direction", vecJson(s.direction())},
-      {"innerConeDeg", 20},
-      {"outerConeDeg", 30},
-      {"color", Json::array({1.0, 0.9, 0.8})},
-      {"intensity", 30},
-      {"texture", "window.exr"},
-      {"shadowMap", {{"file", "spot.exr"}, {"lightClipFromWorld", matrixJson(s.lightClipFromWorld())}}}};
+  Json e = exampleSpotJson();
+  e["texture"] = "window.exr";
+  e["shadowMap"] = {{"file", "spot.exr"},
+                    {"lightClipFromWorld", matrixJson(exampleSpot().lightClipFromWorld())}};
+  return e;
 }
 
 void expectFailure(const crep::test::ToolResult& r, int status, const std::string& mention) {

@@ -1,5 +1,6 @@
-// Helpers of the crep scatter tests that write frame descriptions (examples/crep/lib/frame_json.h): the
-// example frame, text and JSON conversions, and the spot light of the local-light and texture frames.
+// Helpers of the crep tool tests that write frame descriptions (examples/crep/lib/frame_json.h): the
+// example frame, text files and JSON conversions, the spot light of the local-light and texture frames, and
+// the listing of a folder (what a command left behind).
 #pragma once
 
 #include <crep/core/light.h>
@@ -7,7 +8,9 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -21,6 +24,18 @@ inline std::string readText(const std::string& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+inline void writeText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+/// The names in `dir` (recursively, relative), to see that a failed command left nothing behind.
+inline std::set<std::string> listing(const std::filesystem::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir))
+    names.insert(e.path().lexically_relative(dir).string());
+  return names;
 }
 
 /// 16 numbers, column-major (the schema's matrix convention).
@@ -46,6 +61,19 @@ inline SpotLight exampleSpot() {
                     .intensity = 30.0,
                     .range = 60.0,
                     .nearPlane = 0.1});
+}
+
+/// exampleSpot() as a light entry of the frame (type, position, direction, cones, colour, intensity);
+/// callers add its shadow map, texture or near plane.
+inline Json exampleSpotJson() {
+  const SpotLight s = exampleSpot();
+  return Json{{"type", "spot"},
+              {"position", vecJson(s.position())},
+              {"direction", vecJson(s.direction())},
+              {"innerConeDeg", 20},
+              {"outerConeDeg", 30},
+              {"color", Json::array({1.0, 0.9, 0.8})},
+              {"intensity", 30}};
 }
 
 } // namespace crep::test::frame_json
