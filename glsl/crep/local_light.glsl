@@ -212,19 +212,15 @@ void crep_localConeCuts(inout float cuts[CREP_LOCAL_MAX_CUTS], inout int n, floa
     if (bp + a * roots[i] >= 0.0) crep_localAddCut(cuts, n, roots[i], lo, hi);
 }
 
-// S(ta, tb) per channel for the view ray origin + t dir (dir unit); 0 when tb <= ta. The float
-// counterpart of crep::RayScattering::segment (see the top). GPU: the ray's constants (CrepLocalRay) are recomputed per
-// call (a dot product and a length) rather than held by the caller across its march (few registers).
-vec3 crep_localSegment(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 dir, float ta, float tb) {
-  if (!(tb > ta)) return vec3(0.0);
-  CrepLocalRay r = crep_localRay(l, m, origin, dir);
-  float lo = ta - r.t0, hi = tb - r.t0; // the section in u = t - t0
-  float cuts[CREP_LOCAL_MAX_CUTS];
+// The sorted cuts of the section [lo, hi] (in u = t - t0) into smooth pieces: its ends, the near ball's
+// crossings, the cone angles' (inner, outer) and the sector planes' (crep::RayScattering::breakpoints).
+void crep_localCuts(CrepLocalLight l, CrepLocalRay r, float lo, float hi, out float cuts[CREP_LOCAL_MAX_CUTS],
+                    out int n) {
   for (int i = 0; i < CREP_LOCAL_MAX_CUTS; ++i)
     cuts[i] = hi;
   cuts[0] = lo;
   cuts[1] = hi;
-  int n = 2;
+  n = 2;
   float near2 = l.nearPlane * l.nearPlane, h2 = r.h * r.h;
   // The near ball: |perp + u dir| = near at u = +-sqrt(near^2 - h^2).
   if (h2 < near2) {
@@ -233,7 +229,7 @@ vec3 crep_localSegment(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 di
     crep_localAddCut(cuts, n, e, lo, hi);
   }
   if (l.cone) {
-    float a = dot(dir, l.axis), bp = dot(r.perp, l.axis);
+    float a = dot(r.dir, l.axis), bp = dot(r.perp, l.axis);
     crep_localConeCuts(cuts, n, a, bp, h2, l.cosInner, lo, hi);
     crep_localConeCuts(cuts, n, a, bp, h2, l.cosOuter, lo, hi);
   }
@@ -243,11 +239,103 @@ vec3 crep_localSegment(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 di
       if (j == major) continue;
       for (int k = 0; k < 2; ++k) {
         float sgn = k == 0 ? 1.0 : -1.0;
-        float slope = dir[major] - sgn * dir[j], offset = r.perp[major] - sgn * r.perp[j];
+        float slope = r.dir[major] - sgn * r.dir[j], offset = r.perp[major] - sgn * r.perp[j];
         if (slope != 0.0) crep_localAddCut(cuts, n, -offset / slope, lo, hi);
       }
     }
   }
+}
+
+// The interval of u in [lo, hi] where the angle to the axis is below acos(cosAngle) on the cone's forward
+// nappe (the cone is convex for angles below 90 degrees, so a line meets it in one interval):
+// vec2(first, last), first > last when empty. Straight-line code: the roots of crep_localConeCuts' quadratic,
+// no sorted array. GPU: no dynamically indexed local array (on llvmpipe and many GPUs those live in scratch
+// memory).
+vec2 crep_coneInterval(CrepLocalRay r, vec3 axis, float cosAngle, float lo, float hi) {
+  float a = dot(r.dir, axis), bp = dot(r.perp, axis), h2 = r.h * r.h;
+  float c2 = cosAngle * cosAngle;
+  float qa = a * a - c2, qb = 2.0 * a * bp, qc = bp * bp - c2 * h2;
+  float scale = max(abs(qa), max(abs(qb), abs(qc)));
+  float r0 = hi, r1 = hi;
+  int count = 0;
+  if (scale > 0.0) {
+    float x0 = lo - 1.0, x1 = lo - 1.0; // not roots
+    if (abs(qa) <= 1e-7 * scale) {
+      if (qb != 0.0) x0 = -qc / qb;
+    } else {
+      float disc = qb * qb - 4.0 * qa * qc;
+      if (disc >= 0.0) {
+        float q = -0.5 * (qb + (qb >= 0.0 ? 1.0 : -1.0) * sqrt(disc));
+        x0 = q / qa;
+        if (q != 0.0) x1 = qc / q;
+      }
+    }
+    bool v0 = x0 > lo && x0 < hi && bp + a * x0 >= 0.0, v1 = x1 > lo && x1 < hi && bp + a * x1 >= 0.0;
+    if (v0 && v1) {
+      r0 = min(x0, x1);
+      r1 = max(x0, x1);
+      count = 2;
+    } else if (v0 || v1) {
+      r0 = v0 ? x0 : x1;
+      count = 1;
+    }
+  }
+  // Inside at lo: dot(p, axis) > cosAngle |p| at the point, scaled so that a far lo never overflows.
+  float k = 1.0 / (1.0 + abs(lo));
+  vec3 p = r.perp * k + r.dir * (lo * k);
+  bool inside = dot(p, axis) > cosAngle * length(p);
+  if (inside) return vec2(lo, count >= 1 ? r0 : hi);
+  if (count == 0) return vec2(1.0, 0.0);
+  return vec2(r0, count >= 2 ? r1 : hi);
+}
+
+// The interval of u in [lo, hi] inside point face `face`'s sector (crep::PointLight::faceOf): four half-spaces
+// through the light, s p_major >= |p_j| for the two other axes j, clipped one by one.
+vec2 crep_sectorInterval(CrepLocalRay r, int face, float lo, float hi) {
+  int major = face / 2;
+  float s = face % 2 == 0 ? 1.0 : -1.0;
+  vec2 range = vec2(lo, hi);
+  for (int j = 0; j < 3; ++j) {
+    if (j == major) continue;
+    for (int k = 0; k < 2; ++k) {
+      float sgn = k == 0 ? 1.0 : -1.0;
+      float f0 = s * r.perp[major] - sgn * r.perp[j], f1 = s * r.dir[major] - sgn * r.dir[j]; // f0 + u f1 >= 0
+      if (f1 > 0.0) range.x = max(range.x, -f0 / f1);
+      else if (f1 < 0.0) range.y = min(range.y, -f0 / f1);
+      else if (f0 < 0.0) range = vec2(1.0, 0.0);
+    }
+  }
+  return range.x <= range.y ? range : vec2(1.0, 0.0);
+}
+
+// The part of [lo, hi] (in u = t - t0) the light reaches outside its near ball: the spot's outer cone, the
+// face's sector, or all of it.
+vec2 crep_localReachU(CrepLocalLight l, CrepLocalRay r, float lo, float hi) {
+  if (l.cone) return crep_coneInterval(r, l.axis, l.cosOuter, lo, hi);
+  if (l.face >= 0) return crep_sectorInterval(r, l.face, lo, hi);
+  return vec2(lo, hi);
+}
+
+// The part [first, last] of [ta, tb] (in t) the light reaches: the spot's outer cone, the face's sector;
+// first > last when it reaches none of it, so S(ta, tb) = 0 and a caller can skip the work. A ray through
+// the near ball counts as reached throughout.
+vec2 crep_localReach(CrepLocalLight l, CrepLocalRay r, float ta, float tb) {
+  if (!(tb > ta)) return vec2(1.0, 0.0);
+  if (!(r.h > l.nearPlane)) return vec2(ta, tb);
+  vec2 u = crep_localReachU(l, r, ta - r.t0, tb - r.t0);
+  return u.x <= u.y ? u + r.t0 : vec2(1.0, 0.0);
+}
+
+// S(ta, tb) per channel for the view ray origin + t dir (dir unit); 0 when tb <= ta. The float
+// counterpart of crep::RayScattering::segment (see the top). GPU: the ray's constants (CrepLocalRay) are recomputed per
+// call (a dot product and a length) rather than held by the caller across its march (few registers).
+vec3 crep_localSegment(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 dir, float ta, float tb) {
+  if (!(tb > ta)) return vec3(0.0);
+  CrepLocalRay r = crep_localRay(l, m, origin, dir);
+  float cuts[CREP_LOCAL_MAX_CUTS];
+  int n;
+  crep_localCuts(l, r, ta - r.t0, tb - r.t0, cuts, n);
+  float near2 = l.nearPlane * l.nearPlane, h2 = r.h * r.h;
 
   vec3 total = vec3(0.0);
   for (int i = 0; i + 1 < CREP_LOCAL_MAX_CUTS; ++i) {

@@ -50,7 +50,9 @@
 //                              binding CREP_LOCAL_LIGHT_BINDING, default 3) and integrates every region
 //                              segment with crep_localSegment (crep/local_light.glsl) times its
 //                              visibility; the basis must be prefiltered with the same light. Projective
-//                              frame only, no near-plane correction.
+//                              frame only, no near-plane correction. CREP_AIRLIGHT 1 (default) integrates
+//                              the sections in closed form (crep_airlightSegment, crep/airlight.glsl: the
+//                              airlight table bound at CREP_AIRLIGHT_UNIT, default 4); 0 keeps the quadrature.
 //   CREP_LIGHT_TEXTURE         1: a basis prefiltered with a light texture's colour map (crep/prefilter/
 //                              prefilter.h, "Light textures"; Klehm et al. 2014, Sec. 3.2): the array holds
 //                              three bases (colour c in layers [c L, (c + 1) L), L = ceil(M / 4)) and the
@@ -395,6 +397,12 @@ layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegion
 #error "CREP_LOCAL_LIGHT: local lights are evaluated on the projective frame only"
 #endif
 layout(std140, binding = CREP_LOCAL_LIGHT_BINDING) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
+#ifndef CREP_AIRLIGHT
+#define CREP_AIRLIGHT 1
+#endif
+#if CREP_AIRLIGHT
+#include "airlight.glsl"
+#endif
 
 // The block's light and medium as crep_localSegment takes them.
 CrepLocalLight crep_blockLocalLight() { return crep_localLightOf(crep_localParams); }
@@ -410,7 +418,11 @@ CrepLocalMedium crep_blockLocalMedium() {
 vec3 crep_sectionIntegral(vec3 origin, vec3 dir, vec3 sigma, float ta, float tb) {
 #if CREP_LOCAL_LIGHT
   if (!(tb < 1e30)) return vec3(0.0); // beyond a region boundary the ray never reaches
+#if CREP_AIRLIGHT
+  return crep_airlightSegment(crep_blockLocalLight(), crep_blockLocalMedium(), origin, dir, ta, tb);
+#else
   return crep_localSegment(crep_blockLocalLight(), crep_blockLocalMedium(), origin, dir, ta, tb);
+#endif
 #else
   return crep_transmittanceIntegral(sigma, ta, tb);
 #endif
@@ -599,12 +611,17 @@ vec3 crep_scatteringConstant(vec3 viewDirection) {
 // transmittance integral over that region (Eq. 3, 11). start > 0 needs CREP_NEAR_PLANE_CORRECTION.
 vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface) {
   vec3 sigma = crep_scattering.extinction.rgb;
+  float transmittance = exp(-dot(sigma, vec3(1.0 / 3.0)) * surface);
 #if CREP_LOCAL_LIGHT
   vec3 C = vec3(1.0); // the local light's factors are in each section's integral
+  // A ray the light never reaches (outside the spot's outer cone or the face's sector all along): nothing
+  // to fetch. GPU: neighbouring pixels mostly agree, so whole groups skip the basis.
+  vec2 reach = crep_localReach(crep_blockLocalLight(),
+                               crep_localRay(crep_blockLocalLight(), crep_blockLocalMedium(), origin, dir), start, surface);
+  if (!(reach.x <= reach.y)) return vec4(0.0, 0.0, 0.0, transmittance);
 #else
   vec3 C = crep_scatteringConstant(dir);
 #endif
-  float transmittance = exp(-dot(sigma, vec3(1.0 / 3.0)) * surface);
   CrepEvalRay hit;
   if (!crep_evalMap(origin, dir, surface, hit))
     return vec4(C * crep_sectionIntegral(origin, dir, sigma, start, surface), transmittance);

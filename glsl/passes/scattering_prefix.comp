@@ -59,8 +59,28 @@ void main() {
   vec3 sigma = crep_scattering.extinction.rgb;
   vec3 sum = vec3(0.0), Ea = vec3(1.0);
   float ta = 0.0;
+#if CREP_LOCAL_LIGHT
+  // The sample ray of slopes (y, z) in the scattering block's frame, and the part of it the light reaches
+  // (crep_localReach): regions outside it add nothing, so their basis is not fetched. GPU: the regions a
+  // spot's cone misses are most of a row's.
+  vec3 dir = normalize(crep_scattering.frameAxisX.xyz + ray.data.x * crep_scattering.frameAxisY.xyz +
+                       ray.data.y * crep_scattering.frameAxisZ.xyz);
+  vec2 reach = crep_localReach(crep_blockLocalLight(), crep_localRay(crep_blockLocalLight(), crep_blockLocalMedium(),
+                                                                     crep_scattering.frameOrigin.xyz, dir),
+                               0.0, min(crep_evalBoundary(ray, R), 1e30));
+#endif
   for (int r = 0; r < R; ++r) {
     imageStore(crep_prefixOut, ivec2(r * Z + s, j), vec4(sum, 0.0));
+#if CREP_LOCAL_LIGHT
+    {
+      float tb = max(ta, crep_evalBoundary(ray, r + 1));
+      bool skip = !(tb > reach.x && ta < reach.y);
+      if (skip) {
+        ta = tb;
+        continue;
+      }
+    }
+#endif
 #if CREP_LIGHT_TEXTURE
     vec3 V;
     for (int c = 0; c < 3; ++c) {
@@ -81,9 +101,7 @@ void main() {
     float tb = max(ta, crep_evalBoundary(ray, r + 1));
 #if CREP_LOCAL_LIGHT
     // The local light's in-scattering of the region along the sample ray (crep::scatteringPrefixTable for a
-    // LocalLight): the ray of slopes (y, z) in the scattering block's frame.
-    vec3 dir = normalize(crep_scattering.frameAxisX.xyz + ray.data.x * crep_scattering.frameAxisY.xyz +
-                         ray.data.y * crep_scattering.frameAxisZ.xyz);
+    // LocalLight).
     sum += V * crep_sectionIntegral(crep_scattering.frameOrigin.xyz, dir, sigma, ta, tb);
     ta = tb;
     continue;

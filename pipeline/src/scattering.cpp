@@ -293,8 +293,9 @@ struct DepthTarget {
 struct Scattering::Impl {
   explicit Impl(const CreateInfo& i)
       : info(validated(i)), prefilter({i.mapSize, i.mapSize, i.prefilter}),
-        evaluate({i.prefilter.bases, i.evaluate}), resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}),
-        rectified({i.mapSize, i.mapSize}) {
+        evaluate(
+            {.bases = i.prefilter.bases, .options = i.evaluate, .localClosedForm = i.localLightClosedForm}),
+        resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}), rectified({i.mapSize, i.mapSize}) {
     resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
     // The min/max trees and their march: Method::MinMaxMarch's, or the prefiltered method's epipole block.
     // Made (and the block's program built) with the object, so the first frame with the sun in view
@@ -366,7 +367,8 @@ struct Scattering::Impl {
     if (!localEvaluate) {
       EvaluateOptions options = info.evaluate;
       options.visibilityTableSamples = localTableSamples();
-      localEvaluate.emplace(EvaluatePass::CreateInfo{localBases(), options});
+      localEvaluate.emplace(EvaluatePass::CreateInfo{
+          .bases = localBases(), .options = options, .localClosedForm = info.localLightClosedForm});
     }
     return *localEvaluate;
   }

@@ -7,6 +7,7 @@
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
+#include <crep/scatter/airlight.h>
 #include <crep/scatter/gpu_world_march.h>
 
 #include <epoxy/gl.h>
@@ -41,6 +42,8 @@ constexpr GLuint kPrefixUnit = 7;
 constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 // The local-light block (CREP_LOCAL_LIGHT) of the evaluation and scattering prefix programs.
 constexpr GLuint kLocalLightBinding = 3;
+// The airlight table of the local-light programs (crep/airlight.glsl, crep::makeAirlightTable).
+constexpr GLuint kAirlightUnit = 4;
 // Work lists (EvaluatePass::FrameAttribs::list): the list's storage buffer binding (0 table coefficients,
 // 1 region weights, 2 layout rows).
 constexpr GLuint kSampleListBinding = 3;
@@ -529,6 +532,8 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
   if (local) {
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
+    stages[0].defines.push_back({"CREP_AIRLIGHT", info.localClosedForm ? "1" : "0"});
+    stages[0].defines.push_back({"CREP_AIRLIGHT_UNIT", str(kAirlightUnit)});
   }
   if (textured) {
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
@@ -557,6 +562,8 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
   if (local) {
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
+    stages[0].defines.push_back({"CREP_AIRLIGHT", info.localClosedForm ? "1" : "0"});
+    stages[0].defines.push_back({"CREP_AIRLIGHT_UNIT", str(kAirlightUnit)});
   }
   if (textured) {
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
@@ -607,7 +614,10 @@ std::size_t EvaluatePass::memoryBytes() const noexcept {
                                              static_cast<std::size_t>(layerCount(info_.bases)) * 16
                                        : 0;
   const std::size_t texels = static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_);
-  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + coefficients +
+  const std::size_t airlight =
+      airlightTable_ ? std::size_t(AirlightTable::kDefaultUSamples) * AirlightTable::kDefaultXiSamples * 8
+                     : 0;
+  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + coefficients + airlight +
          sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
 }
 
@@ -760,6 +770,19 @@ void EvaluatePass::run(const FrameAttribs& frame) {
         *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
     glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
     glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, localBuffer_.get());
+    // The airlight table of the medium's g (made on the CPU in double, a few ms, when g changes).
+    if (info_.localClosedForm && (!airlightTable_ || airlightG_ != frame.medium->hgG())) {
+      const AirlightTable t = makeAirlightTable(frame.medium->hgG());
+      airlightTable_ = gl::createTexture2D(GL_RG32F, t.xiSamples, t.uSamples, "EvaluatePass: airlight table");
+      glTextureSubImage2D(airlightTable_.get(), 0, 0, 0, t.xiSamples, t.uSamples, GL_RG, GL_FLOAT,
+                          t.values.data());
+      if (!airlightSampler_) airlightSampler_ = gl::createClampSampler(GL_LINEAR);
+      airlightG_ = frame.medium->hgG();
+    }
+    if (info_.localClosedForm) {
+      glBindTextureUnit(kAirlightUnit, airlightTable_.get());
+      glBindSampler(kAirlightUnit, airlightSampler_.get());
+    }
   }
   gpu::LayoutKind layoutKind{};
   if (!projective) {
@@ -923,7 +946,11 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
-  if (local) glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, 0);
+  if (local) {
+    glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, 0);
+    glBindSampler(kAirlightUnit, 0);
+    glBindTextureUnit(kAirlightUnit, 0);
+  }
   if (!projective) {
     glBindBufferBase(GL_UNIFORM_BUFFER, kLayoutBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLayoutRowsBinding, 0);

@@ -146,10 +146,9 @@ glm::dvec3 RayScattering::gaussLegendre(double a, double b, bool inGamma) const 
   return sum * half;
 }
 
-glm::dvec3 RayScattering::segment(double ta, double tb) const {
-  if (!(tb > ta)) return glm::dvec3(0.0);
-  if (!local_) return constant_ * transmittanceIntegral(sigma_, ta, tb);
-
+std::vector<double> RayScattering::breakpoints(double ta, double tb) const {
+  if (!(tb > ta)) return {};
+  if (!local_) return {ta, tb};
   // Breakpoints: the near ball, the cone angles (spot), the sector planes (point face).
   std::vector<double> cuts{ta, tb};
   const glm::dvec3 p = origin_ - light_.position; // x(t) - L = p + t v
@@ -179,6 +178,16 @@ glm::dvec3 RayScattering::segment(double ta, double tb) const {
     }
   }
   std::sort(cuts.begin(), cuts.end());
+  return cuts;
+}
+
+glm::dvec3 RayScattering::segment(double ta, double tb) const {
+  if (!(tb > ta)) return glm::dvec3(0.0);
+  if (!local_) return constant_ * transmittanceIntegral(sigma_, ta, tb);
+  const std::vector<double> cuts = breakpoints(ta, tb);
+  const glm::dvec3 p = origin_ - light_.position;
+  const glm::dvec3& v = direction_;
+  const double near = light_.nearPlane;
 
   glm::dvec3 total(0.0);
   for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {

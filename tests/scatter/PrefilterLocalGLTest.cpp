@@ -95,14 +95,17 @@ TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation an
     Rectification rect;
     LocalLight light;
   };
-  for (const bool prefixTable : {true, false}) {
+  for (const int variant : {0, 1, 2}) {
+    // Prefix table or per-region loop; the sections by the quadrature or in closed form (airlight table).
+    const bool prefixTable = variant != 1, closedForm = variant == 2;
     EvaluateOptions eo;
     eo.scatteringPrefix = prefixTable;
-    EvaluatePass evaluatePass({.options = eo});
+    EvaluatePass evaluatePass({.options = eo, .localClosedForm = closedForm});
     for (const Case& k : {Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
                           Case{"point light face +X", rectifyPointLight(camera, point, ro)[0],
                                LocalLight::pointFace(point, 0)}}) {
-      const std::string name = std::string(k.name) + (prefixTable ? ", prefix table" : ", per-region table");
+      const std::string name = std::string(k.name) + (prefixTable ? ", prefix table" : ", per-region table") +
+                               (closedForm ? ", closed form" : "");
       CAPTURE(name);
       REQUIRE(k.rect.projective());
       const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);

@@ -172,6 +172,10 @@ public:
     /// (default): 1.17%, 0.245%; 32: 2.5%, 0.32%. Cost of one spot light off screen (crep bench --quick,
     /// colonnade, 320x180, section "local lights"): 7.1x the sun's frame at 128, 4.2x at 64.
     int localLightTableSamples = 64;
+    /// Local lights' sections in closed form (EvaluatePass::CreateInfo::localClosedForm: Sun et al. 2005
+    /// extended, crep/scatter/airlight.h) instead of the quadrature (default false: slower on llvmpipe,
+    /// measured there; see that field).
+    bool localLightClosedForm = false;
     /// How the epipole block is evaluated: TreeMarch (default) or the world-space reference.
     EpipoleBlockMethod epipoleBlockMethod = EpipoleBlockMethod::TreeMarch;
     /// World-space march of the epipole block with EpipoleBlockMethod::WorldMarch (and of local lights in or

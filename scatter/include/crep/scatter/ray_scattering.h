@@ -25,6 +25,8 @@
 // independent adaptive quadrature in t).
 #pragma once
 
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include <crep/core/light.h>
@@ -77,6 +79,10 @@ public:
   glm::dvec3 segment(double ta, double tb) const;
   /// The integrand exp(-sigma t) sigma_s p(theta(t)) E(t) at t (per channel).
   glm::dvec3 density(double t) const;
+  /// The sorted cuts of [ta, tb] into the pieces segment() integrates, ends included: the near ball's,
+  /// the cone angles' (inner, outer) and the sector planes' crossings inside it ({ta, tb} for a
+  /// directional light, empty when tb <= ta).
+  std::vector<double> breakpoints(double ta, double tb) const;
 
 private:
   glm::dvec3 integrandInGamma(double gamma) const; ///< density(t(gamma)) * dt / dgamma
