@@ -769,9 +769,9 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.plot = args.string("plot", "");
   o.section = args.string("section", "");
   if (!o.section.empty() && o.section != "epipolar-sampling" && o.section != "atmosphere" &&
-      o.section != "sun-in-view")
+      o.section != "sun-in-view" && o.section != "local-lights")
     throw tool::UsageError("option --section: '" + o.section +
-                           "' is not epipolar-sampling, sun-in-view or atmosphere");
+                           "' is not epipolar-sampling, sun-in-view, atmosphere or local-lights");
   if (!o.section.empty() && !o.plot.empty())
     throw tool::UsageError("option --plot: needs the whole suite, not --section");
   if (!o.plot.empty() && o.quick)
@@ -950,6 +950,112 @@ void localLightScene(const BenchOptions& o) {
   if (prefilterMs > 0.0) std::printf("minmax / prefilter on the spot scene: %.2f\n", minmaxMs / prefilterMs);
 }
 
+/// Local lights, scaling (issue "local lights", benchmark; `--section local-lights` with localLights and
+/// localLightScene): crep::Scattering on this run's scene with the sun alone and with 1, 2, 4 and 8 spot
+/// lights off screen (behind and above the camera as localLights' spot, each at its own place and aimed at
+/// its own point ahead of the camera: projective, prefiltered), and with one spot in the view (2 units
+/// above the camera and 4 ahead, aimed forward and down: not projective, marched in world space; 2 above
+/// the camera alone is still projective, its apex outside the view). One object and frame;
+/// the variants alternate (sun alone, 1, 2, 4, 8, near, sun alone, ...) after one warm-up round, so load on
+/// the shared machine falls on all alike. Per variant: the frame (median of the frames' summed stage wall
+/// ms) and the spots' LightResult::wallMilliseconds summed per frame (median), per spot and per spot against
+/// the sun's frame; the spots' rectification status is checked and printed, not assumed.
+void localLightScaling(const BenchOptions& o) {
+  if (!squareMapOk(o, "local lights, scaling", Scattering::CreateInfo{}.mapSizeMultiple())) return;
+  tool::StageTimings timings;
+  const ScatteringFrame input(o, timings);
+  scenes::SceneRenderer* renderer = input.scene.frame->renderer;
+  if (!renderer) return;
+  Scattering::FrameAttribs a = input.attribs();
+  a.drawCasters = [&](const glm::dmat4& m) { renderer->drawDepth(m); };
+  const Camera& c = input.scene.frame->camera;
+  // Spot k: 4-5.5 units behind and 7-8 above the camera, alternately left and right and farther out with k,
+  // aimed at a point 10-19 units ahead and half as far to its side (localLights' spot: 4 back, 7 up, 14
+  // ahead), so every spot is distinct and lights its own part of the view.
+  constexpr int kMaxSpots = 8;
+  std::vector<SpotLight> spots;
+  for (int k = 0; k < kMaxSpots; ++k) {
+    const double side = (k % 2 == 0 ? -1.0 : 1.0) * 1.5 * (1 + k / 2);
+    const glm::dvec3 position = c.position() - (4.0 + 0.5 * (k / 2)) * c.forward() +
+                                (7.0 + 0.5 * (k % 3)) * c.up() + side * c.right();
+    const glm::dvec3 target = c.position() + (10.0 + 3.0 * (k / 2)) * c.forward() + 0.5 * side * c.right();
+    spots.emplace_back(SpotLightParams{.position = position,
+                                       .direction = target - position,
+                                       .innerConeAngle = 0.35,
+                                       .outerConeAngle = 0.55,
+                                       .intensity = 150.0,
+                                       .range = 200.0});
+  }
+  const SpotLight nearSpot({.position = c.position() + 4.0 * c.forward() + 2.0 * c.up(),
+                            .direction = c.forward() - 0.5 * c.up(),
+                            .innerConeAngle = 0.35,
+                            .outerConeAngle = 0.55,
+                            .intensity = 150.0,
+                            .range = 200.0});
+  struct Variant {
+    std::span<const SpotLight> spots;
+    std::vector<double> frameMs, spotsMs;
+    std::vector<RectifyStatus> status; ///< of the last measured frame, one per spot
+  };
+  std::vector<Variant> variants;
+  for (const int n : {0, 1, 2, 4, kMaxSpots})
+    variants.push_back({std::span<const SpotLight>(spots.data(), static_cast<std::size_t>(n)), {}, {}, {}});
+  variants.push_back({std::span<const SpotLight>(&nearSpot, 1), {}, {}, {}});
+  Scattering scattering(ScatteringFrame::createInfo(o));
+  const int repeat = std::max(1, std::min(o.repeat, 3));
+  for (int i = 0; i < repeat + 1; ++i) // round 0: warm-up (shader builds, the local lights' textures)
+    for (Variant& v : variants) {
+      Scattering::FrameAttribs f = a;
+      f.spotLights = v.spots;
+      const Scattering::FrameResult r = scattering.run(f);
+      if (i == 0) continue;
+      double frame = 0.0, local = 0.0;
+      for (const Scattering::Stage& st : r.stages)
+        frame += st.wallMilliseconds;
+      v.status.clear();
+      for (const Scattering::LightResult& l : r.localLights) {
+        local += l.wallMilliseconds;
+        v.status.push_back(l.status);
+      }
+      v.frameMs.push_back(frame);
+      v.spotsMs.push_back(local);
+    }
+  const double sunMs = median(variants.front().frameMs);
+  std::printf(
+      "\nlocal lights, scaling (%s, %dx%d, map %d^2, M = %d; crep::Scattering, one object and frame, the\n"
+      "variants alternating, wall-clock medians of %d frames after a warm-up round; N spots off screen,\n"
+      "behind and above the camera, each aimed at its own point ahead; spots ms: their LightResult ms "
+      "summed):\n",
+      o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.bases, repeat);
+  std::printf("  %5s %10s %10s %12s %15s   %s\n", "N", "frame ms", "spots ms", "per spot ms",
+              "per spot / sun", "status");
+  std::printf("  %5d %10.2f %10s %12s %15s   sun alone\n", 0, sunMs, "-", "-", "-");
+  for (std::size_t i = 1; i + 1 < variants.size(); ++i) {
+    const Variant& v = variants[i];
+    const int n = static_cast<int>(v.spots.size());
+    const int prefiltered =
+        static_cast<int>(std::count(v.status.begin(), v.status.end(), RectifyStatus::Projective));
+    const double spotsMs = median(v.spotsMs), perSpot = spotsMs / n;
+    std::printf("  %5d %10.2f %10.2f %12.2f %15.3f   prefiltered %d of %d\n", n, median(v.frameMs), spotsMs,
+                perSpot, perSpot / sunMs, prefiltered, n);
+  }
+  std::string statuses;
+  for (const RectifyStatus s : variants[variants.size() - 2].status)
+    statuses += std::string(statuses.empty() ? "" : " ") + statusToken(s);
+  std::printf("  the %d spots' rectification: %s\n", kMaxSpots, statuses.c_str());
+  const Variant& nearRun = variants.back();
+  const RectifyStatus nearStatus = nearRun.status.empty() ? RectifyStatus::Empty : nearRun.status.front();
+  const double nearMs = median(nearRun.spotsMs);
+  std::printf(
+      "  a spot in the view (2 units above the camera, 4 ahead, aimed forward and down): %s (%s) | frame "
+      "%.2f ms | the spot %.2f ms | spot / sun frame %.3f\n",
+      statusToken(nearStatus),
+      nearStatus == RectifyStatus::Projective ? "prefiltered"
+      : nearStatus == RectifyStatus::Fallback ? "world-space march"
+                                              : "outside the view, nothing done",
+      median(nearRun.frameMs), nearMs, nearMs / sunMs);
+}
+
 /// Light textures (README "Light textures"; Klehm et al. 2014, Sec. 3.2): the stained-glass scene's
 /// prefiltered frame (crep::Scattering, the tool's `prefilter` method) with the sun's stained-glass texture
 /// and without it, on the same SceneFrame, measured side by side in one run: the two variants alternate
@@ -1029,6 +1135,13 @@ void runBenchSuite(const BenchOptions& o) {
   }
   if (o.section == "atmosphere") {
     atmosphereBench(o);
+    printHowMeasured(o);
+    return;
+  }
+  if (o.section == "local-lights") {
+    localLights(o);
+    localLightScene(o);
+    localLightScaling(o);
     printHowMeasured(o);
     return;
   }
@@ -1112,6 +1225,7 @@ void runBenchSuite(const BenchOptions& o) {
   memoryTable(o);
   localLights(o);
   localLightScene(o);
+  localLightScaling(o);
   lightTextures(o);
   constantCost(o);
   reducedResolution(o);

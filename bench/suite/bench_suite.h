@@ -16,15 +16,16 @@ struct BenchOptions {
   int screenWidth = 1920, screenHeight = 1080;
   int mapWidth = 1024, mapHeight = 1024;
   int bases = 32;
-  int repeat = 5;      ///< runs per measurement (median)
-  bool quick = false;  ///< one size only: no Table 1/2 rows, one CPU run
-  std::string plot;    ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
-  std::string section; ///< empty: the whole suite; "epipolar-sampling", "sun-in-view" or "atmosphere": that
-                       ///< section alone
+  int repeat = 5;     ///< runs per measurement (median)
+  bool quick = false; ///< one size only: no Table 1/2 rows, one CPU run
+  std::string plot;   ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
+  /// Empty: the whole suite; "epipolar-sampling", "sun-in-view", "atmosphere" or "local-lights" (the
+  /// local-light sections and the spot scaling): that section alone.
+  std::string section;
 };
 
 /// Parses [--scene NAME] [--size WxH] [--map WxH] [--bases M] [--repeat N] [--quick] [--plot FILE.svg]
-/// [--section epipolar-sampling|sun-in-view|atmosphere];
+/// [--section epipolar-sampling|sun-in-view|atmosphere|local-lights];
 /// throws crep::tool::UsageError naming the option.
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv);
 

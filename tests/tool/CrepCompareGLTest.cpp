@@ -13,6 +13,8 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -197,10 +199,49 @@ TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
                            "reference", "vs prefilter", "how measured"})
     CHECK(r.output.find(text) != std::string::npos);
   CHECK(r.output.find("Table 1") == std::string::npos); // --quick: no tables
-  for (const char* text : {"limits", "fetch-only", "write-only", "evaluation profile", "GPU memory",
-                           "reduced resolution", "sun in view", "constant cost", "epipolar sampling",
-                           "epipolar sampling scaling", "minmax / epipolar-sampling"})
+  for (const char* text :
+       {"limits", "fetch-only", "write-only", "evaluation profile", "GPU memory", "reduced resolution",
+        "sun in view", "constant cost", "epipolar sampling", "local lights, scaling",
+        "epipolar sampling scaling", "minmax / epipolar-sampling"})
     CHECK(r.output.find(text) != std::string::npos);
+}
+
+TEST_CASE("crep bench --section local-lights: the local-light sections alone and the spot scaling rows") {
+  CREP_REQUIRE_GL();
+  const auto r = crep::test::runCrep("bench --section local-lights --quick --size 64x36 --map 256x256 "
+                                     "--repeat 1");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  for (const char* text : {"local lights (", "local lights, spot scene", "local lights, scaling", "sun alone",
+                           "a spot in the view", "how measured"})
+    CHECK(r.output.find(text) != std::string::npos);
+  CHECK(r.output.find("bandwidth over") == std::string::npos); // the section alone
+  // The scaling rows: N, frame ms, spots ms, per spot ms, per spot / sun, "prefiltered k of N"; every spot
+  // is placed off screen, so every one is prefiltered (projective).
+  const std::regex row(R"(^\s*(\d+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+prefiltered (\d+) of (\d+)\s*$)");
+  std::set<int> counts;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (!std::regex_match(line, m, row)) continue;
+    INFO(line);
+    const int n = std::stoi(m[1].str());
+    counts.insert(n);
+    CHECK(std::stoi(m[7].str()) == n);
+    CHECK(std::stoi(m[6].str()) == n);
+    for (int i = 2; i <= 5; ++i) {
+      const double value = std::strtod(m[i].str().c_str(), nullptr);
+      CHECK(std::isfinite(value));
+      CHECK(value > 0.0);
+    }
+  }
+  CHECK(counts == std::set<int>{1, 2, 4, 8});
+  // The option's error and the help name the section.
+  const auto bad = crep::test::runCrep("bench --section bogus");
+  CHECK(bad.status == 2);
+  CHECK(bad.output.find("local-lights") != std::string::npos);
+  const auto help = crep::test::runCrep("bench --help");
+  CHECK(help.output.find("--section local-lights") != std::string::npos);
 }
 
 TEST_CASE("crep bench --plot: the Table 1/2 rows as an SVG chart beside the paper's") {
