@@ -326,6 +326,29 @@ vec2 crep_localReach(CrepLocalLight l, CrepLocalRay r, float ta, float tb) {
   return u.x <= u.y ? u + r.t0 : vec2(1.0, 0.0);
 }
 
+// The share of S(ta, tEnd) that [ta, tb] holds (ta <= tb <= tEnd), per channel, by the trapezoid rule in
+// gamma on the part the light reaches (crep::RayScattering::partialShare): the evaluation's last region
+// takes its section from the table of its sample rays times this share of its own ray (one integrand at
+// each of three points instead of a quadrature of the region). Exact for an integrand constant in gamma
+// (the 1 / d^2 peak is the substitution's); 1 when the light reaches the region's ray only before tb.
+vec3 crep_localPartialShare(CrepLocalLight l, CrepLocalMedium m, vec3 origin, vec3 dir, float ta, float tb,
+                            float tEnd) {
+  CrepLocalRay r = crep_localRay(l, m, origin, dir);
+  vec2 lit = r.h > l.nearPlane ? crep_localReachU(l, r, ta - r.t0, tEnd - r.t0) : vec2(ta, tEnd) - r.t0;
+  if (!(lit.x < lit.y)) return vec3(0.0);
+  // Inside the part the light reaches a point face's sector holds by construction: its ends lie on the
+  // sector's planes, where a sector test in float could fall on either side.
+  if (r.h > l.nearPlane) l.face = -1;
+  float ub = clamp(tb - r.t0, lit.x, lit.y);
+  float ga = atan(lit.x / r.hq), gb = atan(ub / r.hq), ge = atan(lit.y / r.hq);
+  vec3 fa = crep_localIntegrand(l, m, r, ga, true), fb = crep_localIntegrand(l, m, r, gb, true),
+       fe = crep_localIntegrand(l, m, r, ge, true);
+  vec3 fab = crep_localIntegrand(l, m, r, 0.5 * (ga + gb), true), fbe = crep_localIntegrand(l, m, r, 0.5 * (gb + ge), true);
+  vec3 part = (gb - ga) * (fa + 4.0 * fab + fb), rest = (ge - gb) * (fb + 4.0 * fbe + fe);
+  vec3 whole = part + rest;
+  return mix(vec3((gb - ga) / max(ge - ga, 1e-30)), part / max(whole, vec3(1e-37)), greaterThan(whole, vec3(0.0)));
+}
+
 // S(ta, tb) per channel for the view ray origin + t dir (dir unit); 0 when tb <= ta. The float
 // counterpart of crep::RayScattering::segment (see the top). GPU: the ray's constants (CrepLocalRay) are recomputed per
 // call (a dot product and a length) rather than held by the caller across its march (few registers).

@@ -45,6 +45,9 @@
 //                              scatteringPrefix; built by EvaluatePass, or glsl/passes/scattering_prefix.comp)
 //                              bound as an RGBA32F sampler2D with GL_LINEAR at CREP_SCATTERING_PREFIX_UNIT
 //                              (default 7): one fetch per pixel, whatever the number of regions crossed.
+//   CREP_LOCAL_SECTIONS        1 (with CREP_LOCAL_LIGHT and CREP_SCATTERING_PREFIX): the last region's
+//                              section from the local section table (RGBA32F, the prefix table's layout,
+//                              at CREP_LOCAL_SECTION_UNIT, default 5) times crep_localPartialShare.
 //   CREP_LOCAL_LIGHT           1: a local light (spot, or one point-light face) instead of the directional
 //                              light of the block: declares CrepLocalLightBlock (gpu::LocalLightParams,
 //                              binding CREP_LOCAL_LIGHT_BINDING, default 3) and integrates every region
@@ -85,6 +88,12 @@
 #ifndef CREP_LOCAL_LIGHT_BINDING
 #define CREP_LOCAL_LIGHT_BINDING 3
 #endif
+#ifndef CREP_LOCAL_SECTIONS
+#define CREP_LOCAL_SECTIONS 0
+#endif
+// A local section's far end when its end boundary is beyond reach (the ray never gets there): far enough
+// that nothing is left of the light beyond it, small enough for float arithmetic on it.
+#define CREP_LOCAL_SECTION_END 1e29
 #ifndef CREP_RINGING_LANCZOS
 #define CREP_RINGING_LANCZOS 0
 #endif
@@ -369,6 +378,12 @@ layout(binding = CREP_VISIBILITY_TABLE_UNIT) uniform sampler2D crep_visibilityTa
 #define CREP_SCATTERING_PREFIX_UNIT 7
 #endif
 layout(binding = CREP_SCATTERING_PREFIX_UNIT) uniform sampler2D crep_scatteringPrefix;
+#if CREP_LOCAL_LIGHT && CREP_LOCAL_SECTIONS
+#ifndef CREP_LOCAL_SECTION_UNIT
+#define CREP_LOCAL_SECTION_UNIT 5
+#endif
+layout(binding = CREP_LOCAL_SECTION_UNIT) uniform sampler2D crep_localSections;
+#endif
 #endif
 #endif
 #if CREP_NEAR_PLANE_CORRECTION
@@ -593,6 +608,14 @@ vec3 crep_scatteringPrefixAt(int r, vec2 coord) {
   int Z = CREP_VISIBILITY_TABLE_SAMPLES, RZ = crep_scattering.mapSize.z * Z;
   return textureLod(crep_scatteringPrefix, vec2((float(r * Z) + coord.x) / float(RZ), coord.y), 0.0).rgb;
 }
+#if CREP_LOCAL_LIGHT && CREP_LOCAL_SECTIONS
+// The local light's section table (built with the prefix table): region r's unshadowed in-scattering along
+// the sample rays, up to its end boundary or CREP_LOCAL_SECTION_END (same layout and filtering).
+vec3 crep_localSectionAt(int r, vec2 coord) {
+  int Z = CREP_VISIBILITY_TABLE_SAMPLES, RZ = crep_scattering.mapSize.z * Z;
+  return textureLod(crep_localSections, vec2((float(r * Z) + coord.x) / float(RZ), coord.y), 0.0).rgb;
+}
+#endif
 #endif
 #endif
 
@@ -686,12 +709,22 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
       ta = tb;
     }
 #endif
+#if CREP_SCATTERING_PREFIX && CREP_LOCAL_LIGHT && CREP_LOCAL_SECTIONS
+    // The last region's section: its sample rays' section from the table times the share of it that this
+    // ray's [ta, surface] holds (crep_localPartialShare), instead of a quadrature per pixel.
+    float tEnd = min(max(crep_evalBoundary(hit, lastRegion + 1), surface), CREP_LOCAL_SECTION_END);
+    vec3 lastSection = crep_localSectionAt(lastRegion, coord) *
+                       crep_localPartialShare(crep_blockLocalLight(), crep_blockLocalMedium(), origin, dir, ta,
+                                              surface, tEnd);
+#else
+    vec3 lastSection = crep_sectionIntegral(origin, dir, sigma, ta, surface);
+#endif
 #if CREP_LIGHT_TEXTURE
-    L += crep_texturedVisibility(a, lastRegion, lastU, hit.row) * crep_sectionIntegral(origin, dir, sigma, ta, surface);
+    L += crep_texturedVisibility(a, lastRegion, lastU, hit.row) * lastSection;
 #else
     float dotF = 0.0;
     for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(lastRegion, lastU, hit.row, l));
-    L += clamp(0.5 + dotF, 0.0, 1.0) * crep_sectionIntegral(origin, dir, sigma, ta, surface);
+    L += clamp(0.5 + dotF, 0.0, 1.0) * lastSection;
 #endif
     return vec4(C * L, transmittance);
   }

@@ -43,6 +43,10 @@
 
 layout(local_size_x = 64) in;
 layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_prefixOut; // width R Z, height H
+#if CREP_LOCAL_LIGHT && CREP_LOCAL_SECTIONS
+// The local section table: region r's unshadowed in-scattering along the sample ray (same layout).
+layout(binding = 1, rgba32f) uniform writeonly restrict image2D crep_sectionOut;
+#endif
 // a(z_s) of sample s, layer l at index s * layers + l (Eq. 8 order, zero beyond M).
 layout(std430, binding = CREP_TABLE_COEFFICIENTS_BINDING) readonly restrict buffer CrepTableCoefficients {
   vec4 crep_tableA[];
@@ -75,6 +79,9 @@ void main() {
     {
       float tb = max(ta, crep_evalBoundary(ray, r + 1));
       bool skip = !(tb > reach.x && ta < reach.y);
+#if CREP_LOCAL_SECTIONS
+      if (skip) imageStore(crep_sectionOut, ivec2(r * Z + s, j), vec4(0.0));
+#endif
       if (skip) {
         ta = tb;
         continue;
@@ -102,7 +109,13 @@ void main() {
 #if CREP_LOCAL_LIGHT
     // The local light's in-scattering of the region along the sample ray (crep::scatteringPrefixTable for a
     // LocalLight).
+#if CREP_LOCAL_SECTIONS
+    vec3 section = crep_sectionIntegral(crep_scattering.frameOrigin.xyz, dir, sigma, ta, min(tb, CREP_LOCAL_SECTION_END));
+    imageStore(crep_sectionOut, ivec2(r * Z + s, j), vec4(section, 0.0));
+    sum += V * (tb < 1e30 ? section : vec3(0.0));
+#else
     sum += V * crep_sectionIntegral(crep_scattering.frameOrigin.xyz, dir, sigma, ta, tb);
+#endif
     ta = tb;
     continue;
 #endif

@@ -44,6 +44,9 @@ constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
 constexpr GLuint kLocalLightBinding = 3;
 // The airlight table of the local-light programs (crep/airlight.glsl, crep::makeAirlightTable).
 constexpr GLuint kAirlightUnit = 4;
+// The local section table (EvaluateOptions::localSectionTable): image 1 of the prefix pass, unit 5 of the
+// evaluation.
+constexpr GLuint kLocalSectionUnit = 5, kLocalSectionImage = 1;
 // Work lists (EvaluatePass::FrameAttribs::list): the list's storage buffer binding (0 table coefficients,
 // 1 region weights, 2 layout rows).
 constexpr GLuint kSampleListBinding = 3;
@@ -534,6 +537,8 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
     stages[0].defines.push_back({"CREP_AIRLIGHT", info.localClosedForm ? "1" : "0"});
     stages[0].defines.push_back({"CREP_AIRLIGHT_UNIT", str(kAirlightUnit)});
+    stages[0].defines.push_back({"CREP_LOCAL_SECTIONS", usesLocalSectionTable(info.options) ? "1" : "0"});
+    stages[0].defines.push_back({"CREP_LOCAL_SECTION_UNIT", str(kLocalSectionUnit)});
   }
   if (textured) {
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
@@ -564,6 +569,8 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
     stages[0].defines.push_back({"CREP_AIRLIGHT", info.localClosedForm ? "1" : "0"});
     stages[0].defines.push_back({"CREP_AIRLIGHT_UNIT", str(kAirlightUnit)});
+    stages[0].defines.push_back({"CREP_LOCAL_SECTIONS", usesLocalSectionTable(info.options) ? "1" : "0"});
+    stages[0].defines.push_back({"CREP_LOCAL_SECTION_UNIT", str(kLocalSectionUnit)});
   }
   if (textured) {
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
@@ -617,7 +624,8 @@ std::size_t EvaluatePass::memoryBytes() const noexcept {
   const std::size_t airlight =
       airlightTable_ ? std::size_t(AirlightTable::kDefaultUSamples) * AirlightTable::kDefaultXiSamples * 8
                      : 0;
-  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + coefficients + airlight +
+  const std::size_t sections = sectionTexture_ ? texels * 16 : 0;
+  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + coefficients + airlight + sections +
          sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
 }
 
@@ -831,6 +839,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     // scattering prefix table (RGBA32F, the default) or the region visibility table (R32F), rebuilt every
     // run; both R Z x H texels.
     const int Z = info_.options.visibilityTableSamples, R = basis.regions();
+    const bool sections = local && usesLocalSectionTable(info_.options);
+    if (sections && (!sectionTexture_ || tableWidth_ != R * Z || tableHeight_ != basis.height))
+      sectionTexture_ = gl::createTexture2D(GL_RGBA32F, R * Z, basis.height,
+                                            "EvaluatePass: local section table (regions x samples, rows)");
     if (tableWidth_ != R * Z || tableHeight_ != basis.height) {
       tableTexture_ =
           gl::createTexture2D(prefix ? GL_RGBA32F : GL_R32F, R * Z, basis.height,
@@ -874,7 +886,11 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
       glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
       glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      if (sections)
+        glBindImageTexture(kLocalSectionImage, sectionTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                           GL_RGBA32F);
       glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height), 1);
+      if (sections) glBindImageTexture(kLocalSectionImage, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     } else {
       glUseProgram(tableProgram_.get());
       glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
@@ -892,6 +908,10 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     const GLuint unit = prefix ? kPrefixUnit : kTableUnit;
     glBindTextureUnit(unit, tableTexture_.get());
     glBindSampler(unit, tableSampler_.get());
+    if (local && usesLocalSectionTable(info_.options)) {
+      glBindTextureUnit(kLocalSectionUnit, sectionTexture_.get());
+      glBindSampler(kLocalSectionUnit, tableSampler_.get());
+    }
   }
   glUseProgram(program);
   if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
@@ -950,6 +970,8 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, 0);
     glBindSampler(kAirlightUnit, 0);
     glBindTextureUnit(kAirlightUnit, 0);
+    glBindSampler(kLocalSectionUnit, 0);
+    glBindTextureUnit(kLocalSectionUnit, 0);
   }
   if (!projective) {
     glBindBufferBase(GL_UNIFORM_BUFFER, kLayoutBinding, 0);

@@ -489,6 +489,38 @@ std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std:
   });
 }
 
+std::vector<double> localSectionTable(const FilteredBasis& basis, int samples, const LocalLight& light,
+                                      const Medium& medium) {
+  validateBasis(basis);
+  if (samples < 2 || samples > kMaxVisibilityTableSamples)
+    throw InvalidArgument("localSectionTable.samples", std::to_string(samples),
+                          "must be in [2, " + std::to_string(kMaxVisibilityTableSamples) + "]");
+  const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
+  const RectifiedLayout& layout = *basis.layout;
+  std::vector<double> table(static_cast<std::size_t>(H) * static_cast<std::size_t>(R) *
+                            static_cast<std::size_t>(Z) * static_cast<std::size_t>(C));
+  parallelRows(H, 0, [&](int j) {
+    const double row = (j + 0.5) / H;
+    for (int s = 0; s < Z; ++s) {
+      const double depth = static_cast<double>(s) / (Z - 1);
+      const RayScattering ray(light, medium, layout.origin(), layout.viewRayDirection(row, depth));
+      double ta = 0.0;
+      for (int r = 0; r < R; ++r) {
+        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
+        const glm::dvec3 S = ray.segment(std::min(ta, kLocalSectionEnd), std::min(tb, kLocalSectionEnd));
+        const std::size_t cell =
+            (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
+                static_cast<std::size_t>(Z) +
+            static_cast<std::size_t>(s);
+        for (int c = 0; c < C; ++c)
+          table[cell * C + static_cast<std::size_t>(c)] = S[c];
+        ta = tb;
+      }
+    }
+  });
+  return table;
+}
+
 namespace {
 
 /// The in-scattering of a region segment of one view ray for a directional light: C V TI (Eq. 1, 3, 11).
@@ -511,10 +543,11 @@ struct LocalSegments {
 /// `prefixTable(visibility)` the scattering prefix table.
 /// `rayAt(x, y)` gives the PixelRay of output pixel (x, y) of a w x h image (the camera image's pixel rays,
 /// or the froxel volume's sample rays).
-template <class RayAt, class SegmentsFor, class PrefixTable>
+/// `sectionTable()` gives a local light's section table (EvaluateOptions::localSectionTable) or nothing.
+template <class RayAt, class SegmentsFor, class PrefixTable, class SectionTable>
 Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt, const Camera& camera,
                    const Medium& medium, const EvaluateOptions& options, const SegmentsFor& segmentsFor,
-                   const PrefixTable& prefixTable) {
+                   const PrefixTable& prefixTable, const SectionTable& sectionTable) {
   validateBasis(basis);
   validate(options);
   const RectifiedLayout& layout = *basis.layout;
@@ -528,6 +561,7 @@ Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt,
   const std::vector<double> tableValues =
       table ? visibilityTable(basis, Z, options.ringing) : std::vector<double>();
   const std::vector<double> prefixValues = prefix ? prefixTable(tableValues) : std::vector<double>();
+  const std::vector<double> sectionValues = prefix ? sectionTable() : std::vector<double>();
   // GL_LINEAR of a table texture (width R Z, height H, `channels` values per texel) at depth d and
   // normalized row: x = d (Z - 1) inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for
   // the basis.
@@ -625,6 +659,20 @@ Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt,
             dot /= wbc - wac;
             V[c] = (wbc - wac) / (wb - wa) * std::clamp(0.5 + dot, 0.0, 1.0);
           }
+          if constexpr (requires { segment.ray.partialShare(ta, tb, tb); }) {
+            if (!sectionValues.empty() && r == m.last.region) {
+              // The last region of a local light from the section table (EvaluateOptions::localSectionTable):
+              // its sample rays' section times this ray's share of it up to the surface.
+              const double tEnd =
+                  std::min(std::max(layout.rayDistance(m.row, m.depth, static_cast<double>(r + 1) / R), tb),
+                           kLocalSectionEnd);
+              glm::dvec3 S;
+              for (int c = 0; c < kScatteringPrefixChannels; ++c)
+                S[c] = lerpTable(sectionValues, kScatteringPrefixChannels, c, r, m.depth, m.row);
+              L += (C == 1 ? glm::dvec3(V[0]) : V) * S * segment.ray.partialShare(ta, tb, tEnd);
+              return;
+            }
+          }
           L += segment.weighted(C == 1 ? glm::dvec3(V[0]) : V, ta, tb);
         });
       }
@@ -653,7 +701,8 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
       },
       [&](const std::vector<double>& visibility) {
         return scatteringPrefixTable(basis, visibility, Z, sigma);
-      });
+      },
+      [] { return std::vector<double>(); });
 }
 
 // The froxel fill (prefilter.h, "Froxel volumes"): Klehm et al. 2014's per-ray evaluation (Sec. 3.3,
@@ -703,7 +752,8 @@ Image evaluateFroxels(const FilteredBasis& basis, const FroxelGrid& grid, const 
       },
       [&](const std::vector<double>& visibility) {
         return scatteringPrefixTable(basis, visibility, Z, sigma);
-      });
+      },
+      [] { return std::vector<double>(); });
 }
 
 Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camera& camera,
@@ -722,6 +772,10 @@ Image evaluate(const FilteredBasis& basis, const Image& cameraDepth, const Camer
       [&](const glm::dvec3& v) { return LocalSegments{RayScattering(light, medium, camera.position(), v)}; },
       [&](const std::vector<double>& visibility) {
         return scatteringPrefixTable(basis, visibility, Z, light, medium);
+      },
+      [&] {
+        return usesLocalSectionTable(options) ? localSectionTable(basis, Z, light, medium)
+                                              : std::vector<double>();
       });
 }
 

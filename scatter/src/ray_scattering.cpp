@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -179,6 +180,42 @@ std::vector<double> RayScattering::breakpoints(double ta, double tb) const {
   }
   std::sort(cuts.begin(), cuts.end());
   return cuts;
+}
+
+glm::dvec3 RayScattering::partialShare(double ta, double tb, double tEnd) const {
+  if (!local_) return glm::dvec3(1.0);
+  // The part the light reaches: the pieces inside the outer cone / the sector (one interval: both are
+  // convex), or everything when the ray passes through the near ball.
+  double lo = ta, hi = tEnd;
+  if (h_ > light_.nearPlane && (light_.cone || light_.face >= 0)) {
+    lo = std::numeric_limits<double>::infinity();
+    hi = -lo;
+    const std::vector<double> cuts = breakpoints(ta, tEnd);
+    for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+      if (!(cuts[i + 1] > cuts[i])) continue;
+      const glm::dvec3 p = origin_ + 0.5 * (cuts[i] + cuts[i + 1]) * direction_ - light_.position;
+      const glm::dvec3 w = glm::normalize(p);
+      if (light_.face >= 0 && PointLight::faceOf(w) != light_.face) continue;
+      if (light_.cone && !(glm::dot(w, light_.axis) > light_.cosOuter)) continue;
+      lo = std::min(lo, cuts[i]);
+      hi = std::max(hi, cuts[i + 1]);
+    }
+  }
+  if (!(lo < hi)) return glm::dvec3(0.0);
+  // Inside that part a point face's sector holds by construction: its ends lie on the sector's planes,
+  // where faceOf could fall on either side (crep_localPartialShare does the same).
+  RayScattering inside = *this;
+  if (h_ > light_.nearPlane) inside.light_.face = -1;
+  const auto integrandInGamma = [&](double g) { return inside.integrandInGamma(g); };
+  const double b = std::clamp(tb, lo, hi);
+  const double ga = gammaOf(lo), gb = gammaOf(b), ge = gammaOf(hi);
+  const glm::dvec3 fa = integrandInGamma(ga), fb = integrandInGamma(gb), fe = integrandInGamma(ge);
+  const glm::dvec3 part = (gb - ga) * (fa + 4.0 * integrandInGamma(0.5 * (ga + gb)) + fb);
+  const glm::dvec3 whole = part + (ge - gb) * (fb + 4.0 * integrandInGamma(0.5 * (gb + ge)) + fe);
+  glm::dvec3 share;
+  for (int c = 0; c < 3; ++c)
+    share[c] = whole[c] > 0.0 ? part[c] / whole[c] : (gb - ga) / std::max(ge - ga, 1e-300);
+  return share;
 }
 
 glm::dvec3 RayScattering::segment(double ta, double tb) const {

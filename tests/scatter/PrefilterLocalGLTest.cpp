@@ -126,6 +126,17 @@ TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation an
       const Image gpu = readRgbaTexture(out.get(), w, h);
       const Image cpu = evaluate(prefilter(map, medium, k.light, o), depth, camera, k.light, medium, eo);
       const ImageMetrics vsCpu = rgbMetrics(gpu, cpu);
+      if (prefixTable) {
+        // The last region from the local section table times the ray's share (EvaluateOptions::
+        // localSectionTable, the default) against its own quadrature, on the CPU.
+        EvaluateOptions quadrature = eo;
+        quadrature.localSectionTable = false;
+        const Image exact =
+            evaluate(prefilter(map, medium, k.light, o), depth, camera, k.light, medium, quadrature);
+        const ImageMetrics rule = rgbMetrics(cpu, exact);
+        report(name + ": CPU, section table and share vs the last region's quadrature", rule);
+        CHECK(rule.relativeRmse < 2e-4);
+      }
       const ImageMetrics vsTruth = rgbMetrics(gpu, closedFormLocal(depth, camera, {k.light}, medium, true));
       report(name + ": GPU vs CPU evaluation", vsCpu);
       report(name + ": GPU vs closed form", vsTruth);

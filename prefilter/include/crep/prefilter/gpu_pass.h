@@ -291,6 +291,8 @@ private:
   gl::Handle localProgram_, localPrefixProgram_, localBuffer_;
   /// Local lights: the airlight table (crep/scatter/airlight.h, RG32F) of the medium's g, and its sampler.
   gl::Handle airlightTable_, airlightSampler_;
+  /// Local lights: the local section table (EvaluateOptions::localSectionTable), the prefix table's size.
+  gl::Handle sectionTexture_;
   double airlightG_ = 0.0;
   gl::Handle layoutPrograms_[2]; ///< per gpu::LayoutKind, built on first use (non-projective layouts)
   /// The region visibility table (EvaluateOptions::visibilityTableSamples): its pass, R32F texture

@@ -295,6 +295,12 @@ struct EvaluateOptions {
   /// Sec. 3.1 run across regions, not in the paper). Default true; false = the per-region loop over the
   /// visibility table (the figures of bench/README.md, "Profile", compare them).
   bool scatteringPrefix = true;
+  /// Local lights with the scattering prefix table: also tabulate each region's unshadowed in-scattering
+  /// along the sample rays (the local section table, built with the prefix table); a pixel's last region
+  /// [t_last, surface] then takes the section of its (row, depth) from it, times the share of it its own
+  /// ray holds up to the surface (RayScattering::partialShare: the trapezoid rule in the substitution's
+  /// angle, three integrand values), instead of a quadrature per pixel. Not in the paper. Default true.
+  bool localSectionTable = true;
   /// CPU worker threads: 0 = hardware concurrency. Never changes the result.
   int threads = 0;
 };
@@ -307,6 +313,10 @@ inline bool usesVisibilityTable(const EvaluateOptions& options) {
 /// Whether evaluation with `options` uses the scattering prefix table (see scatteringPrefix).
 inline bool usesScatteringPrefix(const EvaluateOptions& options) {
   return usesVisibilityTable(options) && options.scatteringPrefix;
+}
+/// Whether a local light's evaluation with `options` uses the local section table (see localSectionTable).
+inline bool usesLocalSectionTable(const EvaluateOptions& options) {
+  return usesScatteringPrefix(options) && options.localSectionTable;
 }
 inline constexpr int kMaxVisibilityTableSamples = 4096;
 
@@ -371,5 +381,13 @@ Image evaluateFroxels(const FilteredBasis& basis, const FroxelGrid& grid, const 
 /// from layout.origin() in the direction layout.viewRayDirection(row, depth)).
 std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
                                           int samples, const LocalLight& light, const Medium& medium);
+/// A local section's far end when its end boundary is beyond reach (glsl CREP_LOCAL_SECTION_END).
+inline constexpr double kLocalSectionEnd = 1e29;
+/// The local section table (EvaluateOptions::localSectionTable): for texel row j, depth sample s and region
+/// r, the unshadowed in-scattering RayScattering::segment(t_r, min(t_r+1, kLocalSectionEnd)) along the sample
+/// ray of scatteringPrefixTable; the same layout (3 channels). What EvaluatePass's prefix pass writes beside
+/// the prefix table on the GPU.
+std::vector<double> localSectionTable(const FilteredBasis& basis, int samples, const LocalLight& light,
+                                      const Medium& medium);
 
 } // namespace crep

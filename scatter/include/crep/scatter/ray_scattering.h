@@ -83,6 +83,12 @@ public:
   /// the cone angles' (inner, outer) and the sector planes' crossings inside it ({ta, tb} for a
   /// directional light, empty when tb <= ta).
   std::vector<double> breakpoints(double ta, double tb) const;
+  /// The share of S(ta, tEnd) that [ta, tb] holds (ta <= tb <= tEnd), per channel, by Simpson's rule in
+  /// gamma on each side of tb over the part of [ta, tEnd] the light reaches (its outer cone or sector; all
+  /// of it for a ray through the near ball): 5 integrand values. Exact where the integrand in gamma is a
+  /// cubic; 1 when the light reaches the part only before tb. Local lights only (1 for a directional light).
+  /// The rule of the GPU evaluation's last region with a section table (crep_localPartialShare).
+  glm::dvec3 partialShare(double ta, double tb, double tEnd) const;
 
 private:
   glm::dvec3 integrandInGamma(double gamma) const; ///< density(t(gamma)) * dt / dgamma
