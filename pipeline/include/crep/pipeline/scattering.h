@@ -40,7 +40,9 @@
 //     engine's cube-map face matrices. A projective light's rectified map is then point-resampled from it
 //     (ShadowResamplePass, Sec. 4.1's rule on the light's layout), a fallback light marches it directly.
 // A projective light is prefiltered with its light-side factor in the weights and evaluated with every
-// ray's exact in-scattering; a fallback light is marched in world space against its perspective map
+// ray's own in-scattering (the regions it crosses whole from the scattering prefix table, its last region
+// from the local section table times its share, EvaluateOptions::localSectionTable; pixels the light never
+// reaches, outside the spot's cone or the face's sector, return at once); a fallback light is marched in world space against its perspective map
 // (WorldMarchPass, epipoleBlock's steps: the reference's cost, not the prefiltered one); one that does not
 // reach the camera frustum costs nothing. Local lights are evaluated at full resolution.
 //
