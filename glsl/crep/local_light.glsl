@@ -340,7 +340,11 @@ vec3 crep_localPartialShare(CrepLocalLight l, CrepLocalMedium m, vec3 origin, ve
   // sector's planes, where a sector test in float could fall on either side.
   if (r.h > l.nearPlane) l.face = -1;
   float ub = clamp(tb - r.t0, lit.x, lit.y);
-  float ga = atan(lit.x / r.hq), gb = atan(ub / r.hq), ge = atan(lit.y / r.hq);
+  // GPU: gamma kept 1e-6 inside +-pi / 2: float(pi / 2) exceeds pi / 2, and its cosine's sign flips t(gamma)
+  // to the far other end of the line (a section ending at CREP_LOCAL_SECTION_END reaches it).
+  const float gmax = float(CREP_PI / 2.0) - 1e-6;
+  float ga = clamp(atan(lit.x / r.hq), -gmax, gmax), gb = clamp(atan(ub / r.hq), -gmax, gmax),
+        ge = clamp(atan(lit.y / r.hq), -gmax, gmax);
   vec3 fa = crep_localIntegrand(l, m, r, ga, true), fb = crep_localIntegrand(l, m, r, gb, true),
        fe = crep_localIntegrand(l, m, r, ge, true);
   vec3 fab = crep_localIntegrand(l, m, r, 0.5 * (ga + gb), true), fbe = crep_localIntegrand(l, m, r, 0.5 * (gb + ge), true);

@@ -24,6 +24,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -60,6 +61,8 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   validate(info.evaluate, "Scattering::CreateInfo.evaluate");
   if (info.localLightBases != 0)
     validateBases(info.localLightBases, "Scattering::CreateInfo.localLightBases");
+  if (info.spotLightBases != 0 && info.spotLightBases != -1)
+    validateBases(info.spotLightBases, "Scattering::CreateInfo.spotLightBases");
   if (info.localLightTableSamples != 0 &&
       (info.localLightTableSamples < 2 || info.localLightTableSamples > kMaxVisibilityTableSamples))
     invalid("Scattering::CreateInfo.localLightTableSamples", std::to_string(info.localLightTableSamples),
@@ -342,35 +345,46 @@ struct Scattering::Impl {
   std::optional<DepthTarget> localShadowMap;
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
   gl::Handle localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
-  /// CreateInfo::localLightBases / localLightTableSamples when they differ from the directional light's:
-  /// the local lights' own passes.
-  std::optional<PrefilterPass> localPrefilter;
-  std::optional<EvaluatePass> localEvaluate;
+  /// The local lights' own passes for an M (CreateInfo::spotLightBases, localLightBases) or table samples
+  /// (localLightTableSamples) that differ from the directional light's, made on first use.
+  std::map<int, PrefilterPass> localPrefilters;
+  std::map<int, EvaluatePass> localEvaluates;
   int localBases() const { return info.localLightBases == 0 ? info.prefilter.bases : info.localLightBases; }
+  int spotBases() const {
+    return info.spotLightBases == -1  ? localBases()
+           : info.spotLightBases == 0 ? info.prefilter.bases
+                                      : info.spotLightBases;
+  }
   int localTableSamples() const {
     const int Z = info.evaluate.visibilityTableSamples;
     return Z == 0 || info.localLightTableSamples == 0 ? Z : info.localLightTableSamples;
   }
-  /// The prefilter and evaluation of local lights (their own passes, or the directional light's).
-  PrefilterPass& localLightPrefilter() {
-    if (localBases() == info.prefilter.bases) return prefilter;
-    if (!localPrefilter) {
+  /// The prefilter and evaluation of local lights with M bases (their own passes, or the directional
+  /// light's).
+  PrefilterPass& localLightPrefilter(int M) {
+    if (M == info.prefilter.bases) return prefilter;
+    auto it = localPrefilters.find(M);
+    if (it == localPrefilters.end()) {
       PrefilterOptions options = info.prefilter;
-      options.bases = localBases();
-      localPrefilter.emplace(PrefilterPass::CreateInfo{info.mapSize, info.mapSize, options});
+      options.bases = M;
+      it = localPrefilters.emplace(M, PrefilterPass::CreateInfo{info.mapSize, info.mapSize, options}).first;
     }
-    return *localPrefilter;
+    return it->second;
   }
-  EvaluatePass& localLightEvaluate() {
-    if (localBases() == info.prefilter.bases && localTableSamples() == info.evaluate.visibilityTableSamples)
+  EvaluatePass& localLightEvaluate(int M) {
+    if (M == info.prefilter.bases && localTableSamples() == info.evaluate.visibilityTableSamples)
       return evaluate;
-    if (!localEvaluate) {
+    auto it = localEvaluates.find(M);
+    if (it == localEvaluates.end()) {
       EvaluateOptions options = info.evaluate;
       options.visibilityTableSamples = localTableSamples();
-      localEvaluate.emplace(EvaluatePass::CreateInfo{
-          .bases = localBases(), .options = options, .localClosedForm = info.localLightClosedForm});
+      it = localEvaluates
+               .emplace(M, EvaluatePass::CreateInfo{.bases = M,
+                                                    .options = options,
+                                                    .localClosedForm = info.localLightClosedForm})
+               .first;
     }
-    return *localEvaluate;
+    return it->second;
   }
   /// Light textures: the colour map of a rectified map (mapSize^2), made on the first textured frame.
   std::optional<LightColorMapPass> colorMap;
@@ -447,8 +461,10 @@ std::size_t Scattering::memoryBytes() const noexcept {
   if (m.trees) bytes += m.trees->memoryBytes();
   if (m.sampling) bytes += m.sampling->memoryBytes();
   if (m.localRectified) bytes += m.localRectified->memoryBytes();
-  if (m.localPrefilter) bytes += m.localPrefilter->memoryBytes();
-  if (m.localEvaluate) bytes += m.localEvaluate->memoryBytes();
+  for (const auto& [M, pass] : m.localPrefilters)
+    bytes += pass.memoryBytes();
+  for (const auto& [M, pass] : m.localEvaluates)
+    bytes += pass.memoryBytes();
   if (m.localResampled) bytes += map;
   if (m.colorMap) bytes += m.colorMap->memoryBytes();
   if (m.localScattering)
@@ -833,12 +849,13 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       if (texture)
         timed(result, "local light: light colours",
               [&] { colors = m.lightColors(*layout, *texture, nullptr, &light); });
+      const int M = light.cone ? m.spotBases() : m.localBases();
       timed(result, "local light: prefilter", [&] {
-        m.localLightPrefilter().run({.rectifiedDepth = map,
-                                     .layout = layout.get(),
-                                     .medium = f.medium,
-                                     .localLight = &light,
-                                     .lightColors = colors});
+        m.localLightPrefilter(M).run({.rectifiedDepth = map,
+                                      .layout = layout.get(),
+                                      .medium = f.medium,
+                                      .localLight = &light,
+                                      .lightColors = colors});
       });
       timed(result, "local light: evaluate", [&] {
         EvaluatePass::FrameAttribs e;
@@ -847,9 +864,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         e.camera = f.camera;
         e.medium = f.medium;
         e.layout = layout.get();
-        e.basis = m.localLightPrefilter().filteredBasis();
+        e.basis = m.localLightPrefilter(M).filteredBasis();
         e.localLight = &light;
-        m.localLightEvaluate().run(e);
+        m.localLightEvaluate(M).run(e);
         addToOutput();
       });
     } else {

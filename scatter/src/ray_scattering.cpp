@@ -208,7 +208,10 @@ glm::dvec3 RayScattering::partialShare(double ta, double tb, double tEnd) const 
   if (h_ > light_.nearPlane) inside.light_.face = -1;
   const auto integrandInGamma = [&](double g) { return inside.integrandInGamma(g); };
   const double b = std::clamp(tb, lo, hi);
-  const double ga = gammaOf(lo), gb = gammaOf(b), ge = gammaOf(hi);
+  // gamma kept 1e-6 inside +-pi / 2, as the GPU must (crep_localPartialShare).
+  constexpr double kMax = 0.5 * 3.14159265358979323846 - 1e-6;
+  const double ga = std::clamp(gammaOf(lo), -kMax, kMax), gb = std::clamp(gammaOf(b), -kMax, kMax),
+               ge = std::clamp(gammaOf(hi), -kMax, kMax);
   const glm::dvec3 fa = integrandInGamma(ga), fb = integrandInGamma(gb), fe = integrandInGamma(ge);
   const glm::dvec3 part = (gb - ga) * (fa + 4.0 * integrandInGamma(0.5 * (ga + gb)) + fb);
   const glm::dvec3 whole = part + (ge - gb) * (fb + 4.0 * integrandInGamma(0.5 * (gb + ge)) + fe);

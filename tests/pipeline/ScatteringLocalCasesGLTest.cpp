@@ -140,8 +140,8 @@ TEST_CASE("Scattering, point light at the camera's position: finite and equal to
   CHECK(m.relativeRmse < 0.02);
 }
 
-TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad values of it and of "
-          "localLightTableSamples named") {
+TEST_CASE("Scattering::CreateInfo.spotLightBases and localLightBases: 0 is prefilter.bases, -1 follows "
+          "localLightBases, bad values of them and of localLightTableSamples named") {
   CREP_REQUIRE_GL();
   ScatteringFixture f("colonnade");
   f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0)));
@@ -152,8 +152,9 @@ TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad val
                         .outerConeAngle = 0.5,
                         .intensity = 100.0,
                         .range = 80.0});
-  const auto image = [&](int localBases) {
+  const auto image = [&](int spotBases, int localBases = 64) {
     Scattering::CreateInfo info = caseInfo();
+    info.spotLightBases = spotBases;
     info.localLightBases = localBases;
     Scattering scattering(info);
     Scattering::FrameAttribs a = f.attribs(true, false);
@@ -167,13 +168,17 @@ TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad val
   const auto [same, sameBytes] = image(0);
   const auto [explicitSame, explicitBytes] = image(M);
   const auto [own, ownBytes] = image(2 * M);
+  // -1: the spot takes localLightBases (the rule before spotLightBases).
+  const auto [followed, followedBytes] = image(-1, 2 * M);
+  CHECK(rgbMetrics(followed, own).maxAbsError == 0.0);
+  CHECK(followedBytes == ownBytes);
   // 0 and prefilter.bases share the directional light's passes: the same image, the same memory.
   CHECK(rgbMetrics(same, explicitSame).maxAbsError == 0.0);
   CHECK(sameBytes == explicitBytes);
   // Another M runs its own passes (more memory) on the same map: a different image of the same light.
   CHECK(ownBytes > sameBytes);
   const ImageMetrics m = rgbMetrics(own, same);
-  report("localLightBases 2M vs M", m);
+  report("spotLightBases 2M vs M", m);
   CHECK(m.maxAbsError > 0.0);
   CHECK(m.relativeRmse < 0.02);
   for (const int bad : {-1, 1, 5000}) {
@@ -186,6 +191,10 @@ TEST_CASE("Scattering::CreateInfo.localLightBases: 0 is prefilter.bases, bad val
     Scattering::CreateInfo info = caseInfo();
     info.localLightBases = bad;
     CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.localLightBases"),
+                         crep::InvalidArgument);
+    info = caseInfo();
+    info.spotLightBases = bad;
+    CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.spotLightBases"),
                          crep::InvalidArgument);
   }
 }

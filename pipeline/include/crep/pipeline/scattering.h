@@ -42,9 +42,10 @@
 // A projective light is prefiltered with its light-side factor in the weights and evaluated with every
 // ray's own in-scattering (the regions it crosses whole from the scattering prefix table, its last region
 // from the local section table times its share, EvaluateOptions::localSectionTable; pixels the light never
-// reaches, outside the spot's cone or the face's sector, return at once); a fallback light is marched in world space against its perspective map
-// (WorldMarchPass, epipoleBlock's steps: the reference's cost, not the prefiltered one); one that does not
-// reach the camera frustum costs nothing. Local lights are evaluated at full resolution.
+// reaches, outside the spot's cone or the face's sector, return at once); a fallback light is marched in
+// world space against its perspective map (WorldMarchPass, epipoleBlock's steps: the reference's cost, not
+// the prefiltered one); one that does not reach the camera frustum costs nothing. Local lights are evaluated
+// at full resolution.
 //
 // Light textures (README "Light textures"; Klehm et al. 2014, Sec. 3.2: a coloured light texture is a
 // light-side factor stored per colour channel): FrameAttribs::lightTexture (the directional light's, e.g. a
@@ -157,15 +158,21 @@ public:
     /// M (32), storage (RGBA8), weights (exact), regions per split (default 2, see rectify), ...
     PrefilterOptions prefilter{.regionsPerSplit = 2};
     EvaluateOptions evaluate; ///< sampling (bilinear), near-plane correction, ringing filter
-    /// M of the local lights' prefilter and evaluation (spot lights, point-light faces; even, in [4, 128];
-    /// 0 = prefilter.bases). A point light's faces see the whole depth range of the view from close by,
-    /// and M = 32 smooths their visibility steps over too much of it. Measured on the colonnade
-    /// (tests/pipeline/ScatteringLocalGLTest.cpp, map 512, relative RMSE against the world-space
+    /// M of the point-light faces' prefilter and evaluation (and of spot lights with spotLightBases = -1;
+    /// even, in [4, 128]; 0 = prefilter.bases). A point light's faces see the whole depth range of the view
+    /// from close by, and M = 32 smooths their visibility steps over too much of it. Measured on the
+    /// colonnade (tests/pipeline/ScatteringLocalGLTest.cpp, map 512, relative RMSE against the world-space
     /// reference): point light M = 32 2.67%, 48 1.57%, 64 (default) 1.08%; spot light off screen 0.45%,
     /// 0.30%, 0.31%. Cost when it differs from prefilter.bases: a second PrefilterPass and EvaluatePass
     /// (made on the first frame with a projective local light), M / 4 RGBA layers per texel of the local
     /// map (2x at 64) and M / 4 basis fetches per pixel in its evaluation.
     int localLightBases = 64;
+    /// M of the spot lights' prefilter and evaluation: 0 = prefilter.bases (default: the directional
+    /// light's passes serve them, no second basis), -1 = localLightBases (the rule before this field), or
+    /// even in [4, 128]. A spot lights a cone, seen from outside the view: M = 32 keeps it within 0.45% of
+    /// the world-space reference on the colonnade (0.31% at 64, table above) for half the prefilter and the
+    /// basis fetches of 64.
+    int spotLightBases = 0;
     /// Depth samples of the local lights' scattering prefix table (EvaluateOptions::visibilityTableSamples
     /// of their evaluation; 0 = evaluate.visibilityTableSamples; no table when that is 0). The table holds
     /// each region's in-scattering along R x Z x H sample rays, a quadrature per entry for a local light:
