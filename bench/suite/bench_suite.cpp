@@ -642,6 +642,14 @@ struct ScatteringFrame {
     a.shadowMap = &shadow;
     return a;
   }
+  /// attribs() with drawCasters drawing the scene's casters (null: the scene has no renderer).
+  scenes::SceneRenderer* renderer() const { return scene.frame->renderer; }
+  Scattering::FrameAttribs attribsWithCasters() const {
+    Scattering::FrameAttribs a = attribs();
+    scenes::SceneRenderer* r = renderer();
+    a.drawCasters = [r](const glm::dmat4& m) { r->drawDepth(m); };
+    return a;
+  }
 };
 
 /// GPU memory per configuration (issue "performance", item 6): what crep::Scattering and the peers own,
@@ -853,10 +861,9 @@ void localLights(const BenchOptions& o) {
   }
   tool::StageTimings timings;
   const ScatteringFrame input(o, timings);
-  scenes::SceneRenderer* renderer = input.scene.frame->renderer;
+  scenes::SceneRenderer* renderer = input.renderer();
   if (!renderer) return;
-  Scattering::FrameAttribs a = input.attribs();
-  a.drawCasters = [&](const glm::dmat4& m) { renderer->drawDepth(m); };
+  const Scattering::FrameAttribs a = input.attribsWithCasters();
   const Camera& c = input.scene.frame->camera;
   const glm::dvec3 position = c.position() - 4.0 * c.forward() + 7.0 * c.up();
   const SpotLight spot({.position = position,
@@ -965,10 +972,9 @@ void localLightScaling(const BenchOptions& o) {
   if (!squareMapOk(o, "local lights, scaling", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   tool::StageTimings timings;
   const ScatteringFrame input(o, timings);
-  scenes::SceneRenderer* renderer = input.scene.frame->renderer;
+  scenes::SceneRenderer* renderer = input.renderer();
   if (!renderer) return;
-  Scattering::FrameAttribs a = input.attribs();
-  a.drawCasters = [&](const glm::dmat4& m) { renderer->drawDepth(m); };
+  const Scattering::FrameAttribs a = input.attribsWithCasters();
   const Camera& c = input.scene.frame->camera;
   // Spot k: 4-5.5 units behind and 7-8 above the camera, alternately left and right and farther out with k,
   // aimed at a point 10-19 units ahead and half as far to its side (localLights' spot: 4 back, 7 up, 14

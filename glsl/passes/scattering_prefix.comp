@@ -75,17 +75,14 @@ void main() {
 #endif
   for (int r = 0; r < R; ++r) {
     imageStore(crep_prefixOut, ivec2(r * Z + s, j), vec4(sum, 0.0));
+    float tb = max(ta, crep_evalBoundary(ray, r + 1));
 #if CREP_LOCAL_LIGHT
-    {
-      float tb = max(ta, crep_evalBoundary(ray, r + 1));
-      bool skip = !(tb > reach.x && ta < reach.y);
+    if (!(tb > reach.x && ta < reach.y)) {
 #if CREP_LOCAL_SECTIONS
-      if (skip) imageStore(crep_sectionOut, ivec2(r * Z + s, j), vec4(0.0));
+      imageStore(crep_sectionOut, ivec2(r * Z + s, j), vec4(0.0));
 #endif
-      if (skip) {
-        ta = tb;
-        continue;
-      }
+      ta = tb;
+      continue;
     }
 #endif
 #if CREP_LIGHT_TEXTURE
@@ -105,7 +102,6 @@ void main() {
 #if CREP_MEMORY_LIMIT
     sum += vec3(dotF > 1e30 ? 0.0 : 1.0); // counts the regions (memory-limit test), keeps the reads
 #else
-    float tb = max(ta, crep_evalBoundary(ray, r + 1));
 #if CREP_LOCAL_LIGHT
     // The local light's in-scattering of the region along the sample ray (crep::scatteringPrefixTable for a
     // LocalLight).

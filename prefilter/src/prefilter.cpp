@@ -429,6 +429,33 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
 
 namespace {
 
+/// The tables' sample rays (scatteringPrefixTable, localSectionTable): for texel row j and depth sample s,
+/// `rayFor(row, depth)` makes the sample ray's state, then `region(state, cell, ta, tb)` runs for r = 0 .. R
+/// - 1 in order with the region's boundary distances (tb = +infinity where the ray never gets there) and its
+/// cell (j R + r) Z + s.
+template <class RayFor, class Region>
+void forEachTableRegion(const FilteredBasis& basis, int samples, const RayFor& rayFor, const Region& region) {
+  const int H = basis.height, R = basis.regions, Z = samples;
+  const RectifiedLayout& layout = *basis.layout;
+  parallelRows(H, 0, [&](int j) {
+    const double row = (j + 0.5) / H;
+    for (int s = 0; s < Z; ++s) {
+      const double depth = static_cast<double>(s) / (Z - 1);
+      auto ray = rayFor(row, depth);
+      double ta = 0.0;
+      for (int r = 0; r < R; ++r) {
+        const std::size_t cell =
+            (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
+                static_cast<std::size_t>(Z) +
+            static_cast<std::size_t>(s);
+        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
+        region(ray, cell, ta, tb);
+        ta = tb;
+      }
+    }
+  });
+}
+
 /// The scattering prefix table (prefilter.h) with `sectionsFor(row, depth)` giving the sample ray's
 /// section rule section(ta, tb) (per channel; region boundaries at +infinity contribute nothing).
 template <class SectionsFor>
@@ -443,31 +470,19 @@ std::vector<double> prefixTable(const FilteredBasis& basis, const std::vector<do
     throw InvalidArgument("scatteringPrefixTable.visibility", "size " + std::to_string(visibility.size()),
                           "must be visibilityTable(basis, samples) with samples in [2, " +
                               std::to_string(kMaxVisibilityTableSamples) + "]");
-  const RectifiedLayout& layout = *basis.layout;
   std::vector<double> table(cells * static_cast<std::size_t>(C));
-  parallelRows(H, 0, [&](int j) {
-    const double row = (j + 0.5) / H;
-    for (int s = 0; s < Z; ++s) {
-      const double depth = static_cast<double>(s) / (Z - 1);
-      const auto section = sectionsFor(row, depth);
-      glm::dvec3 sum(0.0);
-      double ta = 0.0;
-      for (int r = 0; r < R; ++r) {
-        const std::size_t cell =
-            (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
-                static_cast<std::size_t>(Z) +
-            static_cast<std::size_t>(s);
+  forEachTableRegion(
+      basis, samples,
+      [&](double row, double depth) { return std::make_pair(sectionsFor(row, depth), glm::dvec3(0.0)); },
+      [&](auto& ray, std::size_t cell, double ta, double tb) {
+        auto& [section, sum] = ray;
         for (int c = 0; c < C; ++c)
           table[cell * C + static_cast<std::size_t>(c)] = sum[c];
-        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
         const glm::dvec3 V = perCell == 1 ? glm::dvec3(visibility[cell])
                                           : glm::dvec3(visibility[cell * 3], visibility[cell * 3 + 1],
                                                        visibility[cell * 3 + 2]);
         if (std::isfinite(tb)) sum += V * section(ta, tb);
-        ta = tb;
-      }
-    }
-  });
+      });
   return table;
 }
 
@@ -495,29 +510,20 @@ std::vector<double> localSectionTable(const FilteredBasis& basis, int samples, c
   if (samples < 2 || samples > kMaxVisibilityTableSamples)
     throw InvalidArgument("localSectionTable.samples", std::to_string(samples),
                           "must be in [2, " + std::to_string(kMaxVisibilityTableSamples) + "]");
-  const int H = basis.height, R = basis.regions, Z = samples, C = kScatteringPrefixChannels;
+  const int C = kScatteringPrefixChannels;
   const RectifiedLayout& layout = *basis.layout;
-  std::vector<double> table(static_cast<std::size_t>(H) * static_cast<std::size_t>(R) *
-                            static_cast<std::size_t>(Z) * static_cast<std::size_t>(C));
-  parallelRows(H, 0, [&](int j) {
-    const double row = (j + 0.5) / H;
-    for (int s = 0; s < Z; ++s) {
-      const double depth = static_cast<double>(s) / (Z - 1);
-      const RayScattering ray(light, medium, layout.origin(), layout.viewRayDirection(row, depth));
-      double ta = 0.0;
-      for (int r = 0; r < R; ++r) {
-        const double tb = std::max(ta, layout.rayDistance(row, depth, static_cast<double>(r + 1) / R));
+  std::vector<double> table(static_cast<std::size_t>(basis.height) * static_cast<std::size_t>(basis.regions) *
+                            static_cast<std::size_t>(samples) * static_cast<std::size_t>(C));
+  forEachTableRegion(
+      basis, samples,
+      [&](double row, double depth) {
+        return RayScattering(light, medium, layout.origin(), layout.viewRayDirection(row, depth));
+      },
+      [&](const RayScattering& ray, std::size_t cell, double ta, double tb) {
         const glm::dvec3 S = ray.segment(std::min(ta, kLocalSectionEnd), std::min(tb, kLocalSectionEnd));
-        const std::size_t cell =
-            (static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
-                static_cast<std::size_t>(Z) +
-            static_cast<std::size_t>(s);
         for (int c = 0; c < C; ++c)
           table[cell * C + static_cast<std::size_t>(c)] = S[c];
-        ta = tb;
-      }
-    }
-  });
+      });
   return table;
 }
 
