@@ -66,6 +66,31 @@ EpipolarLayout::EpipolarLayout(const Camera& camera, const DirectionalLight& lig
                                int screenHeight, const EpipolarOptions& options)
     : camera_(camera), l_(light.direction()), m_(-light.direction()), width_(screenWidth),
       height_(screenHeight), options_(options) {
+  init();
+}
+
+// Sec. 3.2 "Local Lights" on the Sec. 4.1 layout: the axis through the camera and the light.
+EpipolarLayout::EpipolarLayout(const Camera& camera, const glm::dvec3& lightPosition, int screenWidth,
+                               int screenHeight, const EpipolarOptions& options)
+    : camera_(camera), width_(screenWidth), height_(screenHeight), options_(options) {
+  const glm::dvec3 toLight = lightPosition - camera.position();
+  const double D = glm::length(toLight);
+  if (!std::isfinite(D) || !(D > 1e-9))
+    throw InvalidArgument("EpipolarLayout.lightPosition", vecString(lightPosition),
+                          "must be finite and differ from the camera position");
+  if (options.regions < 2)
+    throw InvalidArgument("EpipolarOptions.regions", detail::formatValue(options.regions),
+                          "must be >= 2 for a local light (no region may span more than pi / 2)");
+  lightDistance_ = D;
+  m_ = toLight / D;
+  l_ = -m_;
+  init();
+}
+
+void EpipolarLayout::init() {
+  const int screenWidth = width_, screenHeight = height_;
+  const Camera& camera = camera_;
+  const EpipolarOptions& options = options_;
   if (screenWidth <= 0 || screenHeight <= 0 || screenWidth > Image::kMaxDimension ||
       screenHeight > Image::kMaxDimension)
     throw InvalidArgument("EpipolarLayout.screenSize",
@@ -122,6 +147,11 @@ EpipolarLayout::EpipolarLayout(const Camera& camera, const DirectionalLight& lig
     fractions_[static_cast<std::size_t>(k)] = options.regionScheme == SplitScheme::Uniform
                                                   ? static_cast<double>(k) / K
                                                   : std::pow(ratio, 1.0 - static_cast<double>(k) / K);
+  // A local light's regions span at most half of [0, thetaMax] <= pi / 2 (tan of the half width <= 1).
+  if (localLight())
+    for (int k = K - 1; k >= 1; --k)
+      fractions_[static_cast<std::size_t>(k)] = std::max(fractions_[static_cast<std::size_t>(k)],
+                                                         fractions_[static_cast<std::size_t>(k) + 1] - 0.5);
 }
 
 glm::dvec3 EpipolarLayout::image(const glm::dvec3& w) const {
@@ -329,19 +359,33 @@ void EpipolarLayout::buildSlices() {
     s.psiMax = -kInf;
   }
   // Includes the view ray of angle psi in the half-plane n into slice j's bounds.
+  // The far-plane point of the view ray of angle psi in the half-plane n: b (directional) or theta (local).
+  const auto includeFar = [&](Slice& s, const glm::dvec3& n, double psiValue) {
+    const glm::dvec3 w = std::cos(psiValue) * m_ + std::sin(psiValue) * n;
+    const double cosF = glm::dot(w, F);
+    if (!(cosF > 0.0)) return;
+    const double t = far / cosF;
+    if (localLight())
+      s.thetaMax = std::max(s.thetaMax, thetaOf(t * w));
+    else
+      s.bMax = std::max(s.bMax, t * std::sin(psiValue));
+  };
   const auto include = [&](int j, const glm::dvec3& n, double psiValue) {
     Slice& s = slices_[static_cast<std::size_t>(j)];
     s.psiMin = std::min(s.psiMin, psiValue);
     s.psiMax = std::max(s.psiMax, psiValue);
-    const glm::dvec3 w = std::cos(psiValue) * m_ + std::sin(psiValue) * n;
-    const double cosF = glm::dot(w, F);
-    if (cosF > 0.0) s.bMax = std::max(s.bMax, far / cosF * std::sin(psiValue));
+    includeFar(s, n, psiValue);
   };
   const auto includeSlice = [&](int j, double row) {
     const glm::dvec3 n = sliceDirection(row);
     if (const auto view = viewOfHalfPlane(n)) {
       include(j, n, view->psiLo);
       include(j, n, view->psiHi);
+      // theta is not convex on the far plane: its largest value on the sector can lie inside an edge.
+      if (localLight())
+        for (int i = 1; i < 16; ++i)
+          includeFar(slices_[static_cast<std::size_t>(j)], n,
+                     view->psiLo + (view->psiHi - view->psiLo) * i / 16.0);
     }
   };
   for (int j = 0; j < H; ++j) {
@@ -376,7 +420,44 @@ void EpipolarLayout::buildSlices() {
       s.psiMax = std::min(kPi, s.psiMin + 2.0 * minRange);
     }
     s.bMax = s.bMax > 0.0 ? s.bMax * (1.0 + 1e-12) : far * 1e-9;
+    // Local light: a margin for the sector between the sampled rays, at most pi (the axis beyond L).
+    if (localLight()) s.thetaMax = s.thetaMax > 0.0 ? std::min(kPi, s.thetaMax * 1.01) : 1e-6;
   }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Local lights (see the header, "Local lights")
+
+double EpipolarLayout::thetaOf(const glm::dvec3& q) const {
+  const double a = glm::dot(q, m_);
+  return std::atan2(glm::length(q - a * m_), lightDistance_ - a);
+}
+
+glm::dvec2 EpipolarLayout::regionAngles(int slice, int region) const {
+  const double thetaMax = slices_[static_cast<std::size_t>(std::clamp(slice, 0, sliceCount() - 1))].thetaMax;
+  const double t0 = fractions_[static_cast<std::size_t>(region)] * thetaMax,
+               t1 = fractions_[static_cast<std::size_t>(region) + 1] * thetaMax;
+  return {0.5 * (t0 + t1), std::tan(0.5 * (t1 - t0))};
+}
+
+double EpipolarLayout::columnTheta(int slice, double column) const {
+  const int K = regionCount();
+  const int k = std::clamp(static_cast<int>(std::floor(column * K)), 0, K - 1);
+  const glm::dvec2 angles = regionAngles(slice, k);
+  return angles.x + std::atan((2.0 * (column * K - k) - 1.0) * angles.y);
+}
+
+double EpipolarLayout::thetaColumn(int slice, double theta, int& region, double& u) const {
+  const double thetaMax = slices_[static_cast<std::size_t>(std::clamp(slice, 0, sliceCount() - 1))].thetaMax;
+  const double fraction = theta / thetaMax;
+  const int K = regionCount();
+  int k = 0;
+  while (k < K - 1 && fraction >= fractions_[static_cast<std::size_t>(k) + 1])
+    ++k;
+  const glm::dvec2 angles = regionAngles(slice, k);
+  region = k;
+  u = 0.5 * (std::tan(theta - angles.x) / angles.y + 1.0);
+  return (k + u) / K;
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -404,6 +485,10 @@ RectPoint EpipolarLayout::toRectified(const glm::dvec3& world) const {
   const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(p.row))];
   const double fraction = b / s.bMax;
   p.depth = depthOfPsi(sliceIndex(p.row), std::atan2(b, a));
+  if (localLight()) {
+    p.column = thetaColumn(sliceIndex(p.row), std::atan2(b, lightDistance_ - a), p.split, p.splitColumn);
+    return p;
+  }
   const int K = regionCount();
   int k = 0;
   while (k < K - 1 && fraction >= fractions_[static_cast<std::size_t>(k) + 1])
@@ -421,6 +506,10 @@ LightRay EpipolarLayout::lightRay(double column, double row) const {
                           "column " + detail::formatValue(column) + ", row " + detail::formatValue(row),
                           "must be finite");
   const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(row))];
+  if (localLight()) {
+    const double theta = columnTheta(sliceIndex(row), column);
+    return {lightPosition(), -std::cos(theta) * m_ + std::sin(theta) * sliceDirection(row)};
+  }
   return {camera_.position() + columnFraction(column) * s.bMax * sliceDirection(row), l_};
 }
 
@@ -431,6 +520,11 @@ glm::dvec3 EpipolarLayout::viewRayDirection(double row, double depth) const {
 
 double EpipolarLayout::rayDistance(double row, double depth, double column) const {
   const int j = sliceIndex(row);
+  if (localLight()) {
+    // The law of sines in the triangle (camera, light, point).
+    const double theta = columnTheta(j, column), s = std::sin(psi(j, depth) + theta);
+    return s > 0.0 ? lightDistance_ * std::sin(theta) / s : kInf;
+  }
   // A ray along the light axis (sin(psi) = 0) never leaves column 0: the same huge finite step as
   // rayProfile() keeps the two consistent.
   const double sinPsi = std::max(std::sin(psi(j, depth)), kMinSinPsi);
@@ -472,6 +566,13 @@ DistanceProfile EpipolarLayout::rayProfile(double row, double depth, int region)
                           "row " + detail::formatValue(row) + ", depth " + detail::formatValue(depth),
                           "must be finite");
   const int j = sliceIndex(row);
+  if (localLight()) {
+    // t = D (sin mu + cos mu tau) / (sin(psi + mu) + cos(psi + mu) tau), tau = (2 u - 1) tan h.
+    const glm::dvec2 angles = regionAngles(j, region);
+    const double mu = angles.x, T = angles.y, D = lightDistance_, pm = psi(j, depth) + mu;
+    return {D * (std::sin(mu) - T * std::cos(mu)), 2.0 * D * T * std::cos(mu),
+            std::sin(pm) - T * std::cos(pm), 2.0 * T * std::cos(pm)};
+  }
   const double sinPsi = std::max(std::sin(psi(j, depth)), kMinSinPsi);
   const double scale = slices_[static_cast<std::size_t>(j)].bMax / sinPsi;
   const double f0 = fractions_[static_cast<std::size_t>(region)],
@@ -480,7 +581,20 @@ DistanceProfile EpipolarLayout::rayProfile(double row, double depth, int region)
 }
 
 DistanceProfile EpipolarLayout::referenceProfile(double row, int region) const {
-  return rayProfile(row, referenceDepth(row), region);
+  return rayProfile(row, regionReferenceDepth(row, region), region);
+}
+
+double EpipolarLayout::regionReferenceDepth(double row, int region) const {
+  const double reference = referenceDepth(row);
+  if (!localLight()) return reference;
+  const int j = sliceIndex(row);
+  const Slice& s = slices_[static_cast<std::size_t>(j)];
+  const double end = fractions_[static_cast<std::size_t>(std::clamp(region, 0, regionCount() - 1)) + 1] *
+                     s.thetaMax,
+               psiRef = psi(j, reference);
+  if (psiRef <= 0.75 * (kPi - end)) return reference;
+  const double chosen = std::clamp(0.5 * (kPi - end), std::max(s.psiMin, std::min(1e-3, s.psiMax)), s.psiMax);
+  return depthOfPsi(j, chosen);
 }
 
 } // namespace crep

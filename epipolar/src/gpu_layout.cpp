@@ -15,7 +15,7 @@ EpipolarLayoutParams makeEpipolarLayoutParams(const EpipolarLayout& layout) {
   const Camera& c = layout.camera();
   const double tanY = std::tan(0.5 * c.fovY()), tanX = tanY * c.aspect();
   EpipolarLayoutParams p;
-  p.origin = glm::vec4(glm::vec3(c.position()), 0.0f);
+  p.origin = glm::vec4(glm::vec3(c.position()), static_cast<float>(layout.lightDistance()));
   p.towardLight = glm::vec4(glm::vec3(-layout.lightDirection()), 0.0f);
   p.imageX = glm::vec4(glm::vec3(c.right() / tanX), 0.0f);
   p.imageY = glm::vec4(glm::vec3(c.up() / tanY), 0.0f);
@@ -37,7 +37,8 @@ std::vector<EpipolarSlice> makeEpipolarSlices(const EpipolarLayout& layout) {
   std::vector<EpipolarSlice> out;
   out.reserve(layout.slices().size());
   for (const auto& s : layout.slices())
-    out.push_back({glm::vec4(static_cast<float>(s.bMax), static_cast<float>(layout.warp(s.psiMin)),
+    out.push_back({glm::vec4(static_cast<float>(layout.localLight() ? s.thetaMax : s.bMax),
+                             static_cast<float>(layout.warp(s.psiMin)),
                              static_cast<float>(layout.warp(s.psiMax)), 0.0f)});
   return out;
 }

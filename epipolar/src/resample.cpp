@@ -72,10 +72,7 @@ void validateLocalLightMatrix(const glm::dmat4& M, const glm::dvec3& lightPositi
 }
 
 std::optional<glm::dvec3> localLightPosition(const RectifiedLayout& layout) {
-  if (const auto* p = dynamic_cast<const ProjectiveLayout*>(&layout);
-      p && p->rectification().frame.inverseLightDistance > 0.0)
-    return p->rectification().frame.lightPosition;
-  return std::nullopt;
+  return layout.localLightPosition();
 }
 
 void validateLayoutLightMatrix(const RectifiedLayout& layout, const glm::dmat4& lightClipFromWorld) {
@@ -90,9 +87,8 @@ namespace {
 /// How far along a layout's light ray the projected point lies (rule in resample.h): 0 for a directional
 /// light (the ray origin), the light-camera distance 1 / rho for a local one.
 double projectedPointDistance(const RectifiedLayout& layout) {
-  if (const auto* p = dynamic_cast<const ProjectiveLayout*>(&layout);
-      p && p->rectification().frame.inverseLightDistance > 0.0)
-    return 1.0 / p->rectification().frame.inverseLightDistance;
+  if (const std::optional<glm::dvec3> position = layout.localLightPosition())
+    return glm::length(*position - layout.origin());
   return 0.0;
 }
 

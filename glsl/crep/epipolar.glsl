@@ -21,6 +21,7 @@
 //   CrepRowRay crep_rowRayAt(float row, float depth, ivec2 mapSize)
 //         the row ray of a normalized row and depth (its `last` left 0)
 //   CrepLightRay crep_layoutLightRay(float column, float row)
+//   vec3  crep_layoutViewDirection(float row, float depth)   unit direction of the view ray there
 #ifndef CREP_EPIPOLAR_GLSL
 #define CREP_EPIPOLAR_GLSL
 
@@ -138,6 +139,13 @@ CrepRowRay crep_rowRayAt(float row, float depth, ivec2 mapSize) {
   return r;
 }
 
+// The unit direction of the view ray of a normalized row and depth.
+vec3 crep_layoutViewDirection(float row, float depth) {
+  vec4 s = crep_projective.slopes;
+  float y = s.x + row * (s.y - s.x), z = s.z + clamp(depth, 0.0, 1.0) * (s.w - s.z);
+  return normalize(crep_projective.axisX.xyz + y * crep_projective.axisY.xyz + z * crep_projective.axisZ.xyz);
+}
+
 bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r, out vec4 p) {
   r = CrepRowRay(0.0, 0.0, 0, 0, vec4(0.0));
   if (!crep_layoutToRectified(crep_projective.origin.xyz + surface * dir, p)) return false;
@@ -168,10 +176,14 @@ float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
 // by the border position sigma (pixels, Yusov's order) of its exit point; row = (sigma - arcBegin) /
 // arcLength; column = b / bMax_j, depth = (psi - psiMin_j) / (psiMax_j - psiMin_j) with the bounds of
 // texel row j = floor(row H).
+// A local light at L (origin.w = D = |L - camera| > 0; crep/epipolar/epipolar.h "Local lights"): m = (L -
+// camera) / D, the light rays leave L at angle theta = atan(b, D - a) from the direction toward the camera;
+// column = region k of theta / thetaMax_j (bounds.x), inside it theta = mu + atan((2 u - 1) tan h) (mu the
+// region's mid angle, h its half width), distances t = D sin(theta) / sin(psi + theta).
 
 // gpu::EpipolarLayoutParams (std140).
 struct CrepEpipolarLayoutParams {
-  vec4 origin;      // xyz camera position
+  vec4 origin;      // xyz camera position, w D (local light) or 0
   vec4 towardLight; // xyz m
   vec4 imageX;      // xyz right / tanX
   vec4 imageY;      // xyz up / tanY
@@ -185,7 +197,7 @@ struct CrepEpipolarLayoutParams {
 
 // gpu::EpipolarSlice (std430).
 struct CrepEpipolarSlice {
-  vec4 bounds; // x bMax, y g(psiMin), z g(psiMax) (g: the depth warp)
+  vec4 bounds; // x bMax (local light: thetaMax), y g(psiMin), z g(psiMax) (g: the depth warp)
 };
 
 layout(std140, binding = CREP_LAYOUT_BINDING) uniform CrepEpipolarLayoutBlock {
@@ -290,6 +302,23 @@ float crep_epipolarUnwarp(float g) {
   return clamp((r * (3.14159265 + e) - e) / (1.0 + r), 0.0, 3.14159265);
 }
 
+// Local light: the mid angle and tan of the half width of region k of a slice with thetaMax.
+vec2 crep_epipolarRegionAngles(int k, float thetaMax) {
+  float t0 = crep_epipolarFraction(k) * thetaMax, t1 = crep_epipolarFraction(k + 1) * thetaMax;
+  return vec2(0.5 * (t0 + t1), tan(0.5 * (t1 - t0)));
+}
+
+// Local light: theta at column u of region k, and region k and u of theta.
+float crep_epipolarRegionTheta(int k, float u, float thetaMax) {
+  vec2 angles = crep_epipolarRegionAngles(k, thetaMax);
+  return angles.x + atan((2.0 * u - 1.0) * angles.y);
+}
+void crep_epipolarThetaRegion(float theta, float thetaMax, out int k, out float u) {
+  crep_epipolarFractionRegion(theta / thetaMax, k, u);
+  vec2 angles = crep_epipolarRegionAngles(k, thetaMax);
+  u = 0.5 * (tan(theta - angles.x) / angles.y + 1.0);
+}
+
 int crep_epipolarSliceIndex(float row) {
   int H = crep_epipolar.counts.x;
   return clamp(int(floor(row * float(H))), 0, H - 1);
@@ -321,13 +350,25 @@ bool crep_layoutToRectified(vec3 world, out vec4 p) {
   vec4 s = crep_slices[crep_epipolarSliceIndex(row)].bounds;
   int k;
   float u;
-  crep_epipolarFractionRegion(b / s.x, k, u);
+  float D = crep_epipolar.origin.w;
+  if (D > 0.0)
+    crep_epipolarThetaRegion(atan(b, D - a), s.x, k, u);
+  else
+    crep_epipolarFractionRegion(b / s.x, k, u);
   p = vec4(row, (float(k) + u) / float(crep_epipolar.counts.y), (crep_epipolarWarp(atan(b, a)) - s.y) / (s.z - s.y), float(k));
   return true;
 }
 
 CrepLightRay crep_layoutLightRay(float column, float row) {
   vec4 s = crep_slices[crep_epipolarSliceIndex(row)].bounds;
+  float D = crep_epipolar.origin.w;
+  vec3 m = crep_epipolar.towardLight.xyz;
+  if (D > 0.0) { // local light: from L at theta to the direction toward the camera
+    int K = crep_epipolar.counts.y;
+    int k = clamp(int(floor(column * float(K))), 0, K - 1);
+    float theta = crep_epipolarRegionTheta(k, column * float(K) - float(k), s.x);
+    return CrepLightRay(crep_epipolar.origin.xyz + D * m, -cos(theta) * m + sin(theta) * crep_epipolarSliceDirection(row));
+  }
   return CrepLightRay(crep_epipolar.origin.xyz + crep_epipolarColumnFraction(column) * s.x *
                                                      crep_epipolarSliceDirection(row),
                       -crep_epipolar.towardLight.xyz);
@@ -335,11 +376,23 @@ CrepLightRay crep_layoutLightRay(float column, float row) {
 
 // The row ray of a normalized row and depth (every point of a ray from the camera shares them) in texel row
 // `texelRow` with slice bounds `s`: depth clamped to [0, 1] and the distance data of crep_rowRayDistance,
-// T = (b / bMax) bMax / sin(psi) with psi at that depth. `last` is left 0.
+// T = (b / bMax) bMax / sin(psi) with psi at that depth (a local light: sin(psi), cos(psi), thetaMax). `last`
+// is left 0.
 CrepRowRay crep_epipolarRowRay(float row, float depth, int texelRow, vec4 s) {
   CrepRowRay r = CrepRowRay(row, clamp(depth, 0.0, 1.0), texelRow, 0, vec4(0.0));
-  r.dist = vec4(s.x / max(sin(crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y))), 1e-30), 0.0, 0.0, 0.0);
+  float psi = crep_epipolarUnwarp(s.y + r.depth * (s.z - s.y));
+  if (crep_epipolar.origin.w > 0.0)
+    r.dist = vec4(sin(psi), cos(psi), s.x, 0.0);
+  else
+    r.dist = vec4(s.x / max(sin(psi), 1e-30), 0.0, 0.0, 0.0);
   return r;
+}
+
+// The unit direction of the view ray of a normalized row and depth.
+vec3 crep_layoutViewDirection(float row, float depth) {
+  vec4 s = crep_slices[crep_epipolarSliceIndex(row)].bounds;
+  float psi = crep_epipolarUnwarp(s.y + clamp(depth, 0.0, 1.0) * (s.z - s.y));
+  return cos(psi) * crep_epipolar.towardLight.xyz + sin(psi) * crep_epipolarSliceDirection(row);
 }
 
 CrepRowRay crep_rowRayAt(float row, float depth, ivec2 mapSize) {
@@ -368,7 +421,11 @@ bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay 
   int K = crep_epipolar.counts.y, n = mapSize.x / K;
   int k;
   float u;
-  crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
+  float D = crep_epipolar.origin.w;
+  if (D > 0.0)
+    crep_epipolarThetaRegion(atan(surface * sinPsi, D - surface * a), s.x, k, u);
+  else
+    crep_epipolarFractionRegion(surface * sinPsi / s.x, k, u);
   r.last = crep_lastTexel(k, u, K, n);
   p = vec4(row, (float(k) + u) / float(K), depth, float(k));
   return true;
@@ -377,6 +434,12 @@ bool crep_mapRowRayPoint(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay 
 float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
   int K = crep_epipolar.counts.y, n = mapSize.x / K;
   int k = i / n, q = i - k * n;
+  float D = crep_epipolar.origin.w;
+  if (D > 0.0) { // local light: the law of sines in the triangle (camera, light, point)
+    float theta = k >= K ? r.dist.z : crep_epipolarRegionTheta(k, float(q) / float(n), r.dist.z);
+    float den = r.dist.x * cos(theta) + r.dist.y * sin(theta);
+    return den > 0.0 ? D * sin(theta) / den : CREP_NEVER;
+  }
   if (k >= K) return r.dist.x;
   float f0 = crep_epipolarFraction(k), f1 = crep_epipolarFraction(k + 1);
   return (f0 + (f1 - f0) * float(q) / float(n)) * r.dist.x;

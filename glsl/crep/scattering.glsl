@@ -52,8 +52,9 @@
 //                              light of the block: declares CrepLocalLightBlock (gpu::LocalLightParams,
 //                              binding CREP_LOCAL_LIGHT_BINDING, default 3) and integrates every region
 //                              segment with crep_localSegment (crep/local_light.glsl) times its
-//                              visibility; the basis must be prefiltered with the same light. Projective
-//                              frame only, no near-plane correction. CREP_AIRLIGHT 1 (default) integrates
+//                              visibility; the basis must be prefiltered with the same light. The
+//                              projective frame or CREP_EVAL_LAYOUT (an EpipolarLayout built for the
+//                              light's position), no near-plane correction. CREP_AIRLIGHT 1 (default) integrates
 //                              the sections in closed form (crep_airlightSegment, crep/airlight.glsl: the
 //                              airlight table bound at CREP_AIRLIGHT_UNIT, default 4); 0 keeps the quadrature.
 //   CREP_LIGHT_TEXTURE         1: a basis prefiltered with a light texture's colour map (crep/prefilter/
@@ -408,9 +409,6 @@ layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegion
 #endif
 
 #if CREP_LOCAL_LIGHT
-#ifdef CREP_EVAL_LAYOUT
-#error "CREP_LOCAL_LIGHT: local lights are evaluated on the projective frame only"
-#endif
 layout(std140, binding = CREP_LOCAL_LIGHT_BINDING) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
 #ifndef CREP_AIRLIGHT
 #define CREP_AIRLIGHT 1
@@ -542,6 +540,16 @@ CrepEvalRay crep_evalRayAt(float row, float depth) {
   float y = crep_scattering.slopes.x + row / crep_scattering.slopes.y;
   float z = crep_scattering.slopes.z + depth / crep_scattering.slopes.w;
   return CrepEvalRay(row, depth, 0, 0.0, vec4(y, z, 0.0, 0.0));
+#endif
+}
+
+// The unit direction of a ray of crep_evalRayAt.
+vec3 crep_evalRayDirection(CrepEvalRay e) {
+#ifdef CREP_EVAL_LAYOUT
+  return crep_layoutViewDirection(e.row, e.depth);
+#else
+  return normalize(crep_scattering.frameAxisX.xyz + e.data.x * crep_scattering.frameAxisY.xyz +
+                   e.data.y * crep_scattering.frameAxisZ.xyz);
 #endif
 }
 

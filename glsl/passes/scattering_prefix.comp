@@ -64,11 +64,9 @@ void main() {
   vec3 sum = vec3(0.0), Ea = vec3(1.0);
   float ta = 0.0;
 #if CREP_LOCAL_LIGHT
-  // The sample ray of slopes (y, z) in the scattering block's frame, and the part of it the light reaches
-  // (crep_localReach): regions outside it add nothing, so their basis is not fetched. GPU: the regions a
-  // spot's cone misses are most of a row's.
-  vec3 dir = normalize(crep_scattering.frameAxisX.xyz + ray.data.x * crep_scattering.frameAxisY.xyz +
-                       ray.data.y * crep_scattering.frameAxisZ.xyz);
+  // The sample ray, and the part of it the light reaches (crep_localReach): regions outside it add nothing,
+  // so their basis is not fetched. GPU: the regions a spot's cone misses are most of a row's.
+  vec3 dir = crep_evalRayDirection(ray);
   vec2 reach = crep_localReach(crep_blockLocalLight(), crep_localRay(crep_blockLocalLight(), crep_blockLocalMedium(),
                                                                      crep_scattering.frameOrigin.xyz, dir),
                                0.0, min(crep_evalBoundary(ray, R), 1e30));

@@ -81,6 +81,9 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.mapSize", std::to_string(info.mapSize),
             "must be a multiple of epipolarRegions * prefilter.regionsPerSplit = " +
                 std::to_string(epipolarRegions));
+  if (!(info.localLightDepthWarp >= 0.0 && std::isfinite(info.localLightDepthWarp)))
+    invalid("Scattering::CreateInfo.localLightDepthWarp", detail::formatValue(info.localLightDepthWarp),
+            "must be finite and >= 0");
   if (!(info.epipolarDepthWarp >= 0.0 && std::isfinite(info.epipolarDepthWarp)))
     invalid("Scattering::CreateInfo.epipolarDepthWarp", detail::formatValue(info.epipolarDepthWarp),
             "must be finite and >= 0 (radians; 0 = linear depth)");
@@ -790,7 +793,8 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
 }
 
 // Klehm et al. 2014, Sec. 3.2 "Local Lights": every spot light and point-light face rectified for the camera,
-// prefiltered with its light-side factor when projective, marched in world space otherwise, and added.
+// prefiltered with its light-side factor on its projective layout, or in or near the view on its epipolar
+// layout (or marched in world space, CreateInfo::localLightFallback), and added.
 void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
   Impl& m = *impl_;
   const CreateInfo& info = m.info;
@@ -824,35 +828,35 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       r.localLights.push_back(result);
       return;
     }
-    if (rect.projective()) {
-      const auto layout = std::make_shared<const ProjectiveLayout>(rect);
-      std::uint32_t map = 0;
-      if (given) {
-        // Sec. 4.1's point resampling on the light's layout: the engine's perspective map, no casters drawn.
-        if (!m.localResampled)
-          m.localResampled =
-              gl::createTexture2D(GL_R32F, info.mapSize, info.mapSize, "Scattering: local map");
-        timed(result, "local light: resample (projective)", [&] {
-          m.resample.run({layout.get(), given->texture, given->lightClipFromWorld, m.localResampled.get()});
-        });
-        map = m.localResampled.get();
-      } else {
-        if (!m.localRectified)
-          m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
-        timed(result, "local light: shadow pass (rectified)", [&] {
-          m.localRectified->run(
-              {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
-        });
-        map = m.localRectified->depthTexture();
-      }
+    // The light's perspective map (the given one, else its own matrix's rendered with drawCasters).
+    const auto perspectiveMap = [&] {
+      if (given) return *given;
+      if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
+      timed(result, "local light: shadow pass (perspective)", [&] {
+        m.localShadowMap->render("Scattering::FrameAttribs.drawCasters",
+                                 [&] { f.drawCasters(lightClipFromWorld); });
+      });
+      return ShadowMap{m.localShadowMap->texture.get(), lightClipFromWorld, info.ownShadowMapBias};
+    };
+    // Sec. 4.1's point resampling of a perspective map into `layout` (no casters drawn).
+    const auto resampled = [&](const RectifiedLayout& layout, const ShadowMap& shadow, const char* name) {
+      if (!m.localResampled)
+        m.localResampled = gl::createTexture2D(GL_R32F, info.mapSize, info.mapSize, "Scattering: local map");
+      timed(result, name, [&] {
+        m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, m.localResampled.get()});
+      });
+      return m.localResampled.get();
+    };
+    // The light's map on `layout` prefiltered with its light-side factor and evaluated into the output.
+    const auto prefiltered = [&](const RectifiedLayout& layout, std::uint32_t map) {
       std::uint32_t colors = 0;
       if (texture)
         timed(result, "local light: light colours",
-              [&] { colors = m.lightColors(*layout, *texture, nullptr, &light); });
+              [&] { colors = m.lightColors(layout, *texture, nullptr, &light); });
       const int M = light.cone ? m.spotBases() : m.localBases();
       timed(result, "local light: prefilter", [&] {
         m.localLightPrefilter(M).run({.rectifiedDepth = map,
-                                      .layout = layout.get(),
+                                      .layout = &layout,
                                       .medium = f.medium,
                                       .localLight = &light,
                                       .lightColors = colors});
@@ -863,26 +867,43 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         e.output = m.localScattering.get();
         e.camera = f.camera;
         e.medium = f.medium;
-        e.layout = layout.get();
+        e.layout = &layout;
         e.basis = m.localLightPrefilter(M).filteredBasis();
         e.localLight = &light;
         m.localLightEvaluate(M).run(e);
         addToOutput();
       });
-    } else {
-      // In or near the view: the world-space march against the light's perspective shadow map (the given
-      // one, else its own matrix's rendered with drawCasters).
-      ShadowMap shadow;
+    };
+    if (rect.projective()) {
+      const ProjectiveLayout layout(rect);
+      std::uint32_t map = 0;
       if (given) {
-        shadow = *given;
+        map = resampled(layout, *given, "local light: resample (projective)");
       } else {
-        if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
-        timed(result, "local light: shadow pass (perspective)", [&] {
-          m.localShadowMap->render("Scattering::FrameAttribs.drawCasters",
-                                   [&] { f.drawCasters(lightClipFromWorld); });
+        if (!m.localRectified)
+          m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
+        timed(result, "local light: shadow pass (rectified)", [&] {
+          m.localRectified->run(
+              {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
         });
-        shadow = {m.localShadowMap->texture.get(), lightClipFromWorld, info.ownShadowMapBias};
+        map = m.localRectified->depthTexture();
       }
+      prefiltered(layout, map);
+    } else if (info.localLightFallback == LocalLightFallback::Epipolar && info.epipolarRegions >= 2) {
+      // In or near the view: Sec. 4.1's epipolar layout around the camera-light axis (the light's image is
+      // the epipole), mapSize slices, the light's perspective map resampled into it.
+      EpipolarOptions options;
+      options.slices = info.mapSize;
+      options.referenceRay = info.rectify.referenceRay;
+      options.regions = info.epipolarRegions;
+      options.depthWarp = info.localLightDepthWarp;
+      options.epipoleBlockRadius = 0.0;
+      const EpipolarLayout layout(*f.camera, light.position, info.width, info.height, options);
+      result.epipolar = true;
+      prefiltered(layout, resampled(layout, perspectiveMap(), "local light: resample (epipolar)"));
+    } else {
+      // The world-space march against the light's perspective map (the reference).
+      const ShadowMap shadow = perspectiveMap();
       timed(result, "local light: world-space march", [&] {
         WorldMarchPass::FrameAttribs b;
         b.camera = f.camera;

@@ -759,20 +759,22 @@ void EvaluatePass::run(const FrameAttribs& frame) {
         "EvaluatePass::FrameAttribs.basis.localLight", basis.localLight ? "true" : "false",
         local ? "the basis must be prefiltered with the local light (PrefilterPass::FrameAttribs::localLight)"
               : "a basis prefiltered for a local light needs FrameAttribs::localLight");
-  if (local && !projective)
-    invalid("EvaluatePass::FrameAttribs.layout", "not projective", "local lights need a ProjectiveLayout");
   if (local && info_.options.nearPlaneCorrection)
     invalid("EvaluatePass::CreateInfo.options.nearPlaneCorrection", "true", "not supported for local lights");
   std::optional<GpuLayoutData> layoutData;
   if (!projective) layoutData = gpu::requireGpuLayout(*frame.layout);
+  // The program variants' slot: the projective frame (0) or the layout block of a kind (1 + kind).
+  const int layoutSlot = projective ? 0 : 1 + static_cast<int>(layoutData->kind);
   // A local light has no constant C: the block's directional light is unused (zero irradiance).
   const DirectionalLight unusedLight(glm::dvec3(0.0, 0.0, -1.0), glm::dvec3(0.0));
   const gpu::ScatteringParams scattering =
       scatteringParamsOf(basis, *frame.layout, local ? unusedLight : *frame.light, *frame.medium);
   GLuint program = program_.get();
   if (local) {
-    if (!localProgram_ && !textured) localProgram_ = buildProgram(evaluateStages(info_, -1, true));
-    program = localProgram_.get();
+    gl::Handle& localProgram = localPrograms_[layoutSlot];
+    if (!localProgram && !textured)
+      localProgram = buildProgram(evaluateStages(info_, projective ? -1 : layoutSlot - 1, true));
+    program = localProgram.get();
     if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
     const gpu::LocalLightParams lp = localLightParams(
         *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
@@ -797,14 +799,14 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     const gpu::LayoutKind kind =
         layoutBuffers_.upload(*layoutData, basis.height, "EvaluatePass::FrameAttribs.layout");
     layoutKind = kind;
-    if (!textured && pixels) {
+    if (!textured && pixels && !local) {
       gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
       if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
       program = variant.get();
     }
   }
   // Light textures: the CREP_LIGHT_TEXTURE variants (projective frame, layouts, local light), on first use.
-  const int variantIndex = local ? 3 : projective ? 0 : 1 + static_cast<int>(layoutKind);
+  const int variantIndex = (local ? 3 : 0) + layoutSlot;
   if (textured && pixels) {
     gl::Handle& variant = texturedPrograms_[variantIndex];
     if (!variant)
@@ -830,7 +832,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   const bool prefix = usesScatteringPrefix(info_.options);
   const bool reuse = table && frame.reuseTable;
   if (reuse &&
-      (tableBasis_ != basis.texture || tableVariant_ != variantIndex + 4 * int(textured) ||
+      (tableBasis_ != basis.texture || tableVariant_ != variantIndex + 6 * int(textured) ||
        tableWidth_ != basis.regions() * info_.options.visibilityTableSamples || tableHeight_ != basis.height))
     invalid("EvaluatePass::FrameAttribs.reuseTable", "true",
             "the previous run() built no table for this basis (texture, size, regions, layout kind)");
@@ -877,7 +879,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
       // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
       gl::Handle& prefixProgram = textured ? texturedPrefixPrograms_[variantIndex]
                                   : local
-                                      ? localPrefixProgram_
+                                      ? localPrefixPrograms_[layoutSlot]
                                       : prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
       if (!prefixProgram)
         prefixProgram = buildProgram(
@@ -902,7 +904,7 @@ void EvaluatePass::run(const FrameAttribs& frame) {
     glBindSampler(kTableBasisUnit, 0);
     glBindTextureUnit(kTableBasisUnit, 0);
     tableBasis_ = basis.texture;
-    tableVariant_ = variantIndex + 4 * int(textured);
+    tableVariant_ = variantIndex + 6 * int(textured);
   }
   if (table) {
     const GLuint unit = prefix ? kPrefixUnit : kTableUnit;

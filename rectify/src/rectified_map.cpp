@@ -117,6 +117,11 @@ DistanceProfile ProjectiveLayout::referenceProfile(double row, int region) const
   return rayProfile(row, referenceDepth(row), region);
 }
 
+std::optional<glm::dvec3> ProjectiveLayout::localLightPosition() const {
+  if (rect_.frame.inverseLightDistance > 0.0) return rect_.frame.lightPosition;
+  return std::nullopt;
+}
+
 double ProjectiveLayout::regionReferenceDepth(double row, int region) const {
   const RowReference ref = rect_.rowReference(row);
   if (rect_.frame.inverseLightDistance == 0.0)

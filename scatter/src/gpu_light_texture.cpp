@@ -67,10 +67,10 @@ void LightColorMapPass::run(const FrameAttribs& f) {
   if ((f.light != nullptr) == (f.localLight != nullptr))
     throw InvalidArgument("LightColorMapPass::FrameAttribs.light/localLight",
                           f.light ? "both set" : "both null", "exactly one must be set");
-  const bool projective = dynamic_cast<const ProjectiveLayout*>(f.layout) != nullptr;
-  if (f.localLight && !projective)
-    throw InvalidArgument("LightColorMapPass::FrameAttribs.layout", "not projective",
-                          "a local light's map has a ProjectiveLayout");
+  if (f.localLight && !f.layout->localLightPosition())
+    throw InvalidArgument(
+        "LightColorMapPass::FrameAttribs.layout", "a directional light's",
+        "a local light's map has its layout (ProjectiveLayout or EpipolarLayout of the light)");
   const gl::TextureLevel level = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight,
                                                               "LightColorMapPass::FrameAttribs.lightTexture");
   const gpu::LayoutKind kind =

@@ -1,8 +1,8 @@
 // crep::Scattering with local lights (FrameAttribs::spotLights / pointLights; Klehm et al. 2014, Sec. 3.2
 // "Local Lights"): on a built-in scene, a spot light off screen (projective: prefiltered), a spot light in
-// view (not projective: marched in world space) and a point light (six faces), each against the world-space
-// reference march of the same light (WorldMarchPass with the light's own perspective shadow maps, 1024^2,
-// 256 steps). The directional light has zero irradiance, so the output is the local lights' alone.
+// view (not projective: prefiltered on its epipolar layout) and a point light (six faces), each against the
+// world-space reference march of the same light (WorldMarchPass with the light's own perspective shadow maps,
+// 1024^2, 256 steps). The directional light has zero irradiance, so the output is the local lights' alone.
 #include "pipeline/scattering_frame.h"
 #include "prefilter/prefilter_gpu_util.h"
 #include "support/gl_fixture.h"
@@ -55,6 +55,7 @@ TEST_CASE(
     REQUIRE(r.localLights.size() == 1);
     MESSAGE(std::string(k.name) << ": " << r.localLights[0].message);
     CHECK(r.localLights[0].status == k.expected);
+    CHECK(r.localLights[0].epipolar == (k.expected == RectifyStatus::Fallback));
     CHECK(r.localLights[0].wallMilliseconds > 0.0);
     const Image ours = f.read();
     const Image ref = localReference(f, LocalLight::spot(spot), spot.lightClipFromWorld());
@@ -62,7 +63,25 @@ TEST_CASE(
     report(std::string("spot light ") + k.name + ": Scattering vs world-space reference", m);
     CHECK(m.nanCount == 0);
     CHECK(m.peak > 0.0);
+    // The issue's goal for both: within 2% of the world-space reference. Measured 0.46% off screen, 1.35% in
+    // view (on its epipolar layout, depth warp 0.03; 3.2% with the sun's 0.1).
     CHECK(m.relativeRmse < 0.02);
+    if (k.expected != RectifyStatus::Fallback) continue;
+    // The world-space march kept as an option (CreateInfo::localLightFallback): the reference's method.
+    Scattering::CreateInfo marchInfo = localInfo();
+    marchInfo.localLightFallback = Scattering::LocalLightFallback::WorldMarch;
+    Scattering march(marchInfo);
+    const Scattering::FrameResult rm = march.run(a);
+    REQUIRE(rm.localLights.size() == 1);
+    CHECK(rm.localLights[0].status == RectifyStatus::Fallback);
+    CHECK(!rm.localLights[0].epipolar);
+    bool marched = false;
+    for (const Scattering::Stage& stage : rm.stages)
+      marched = marched || stage.name == "local light: world-space march";
+    CHECK(marched);
+    const ImageMetrics mm = rgbMetrics(f.read(), ref);
+    report("spot light in view, localLightFallback = WorldMarch: Scattering vs world-space reference", mm);
+    CHECK(mm.relativeRmse < 0.01);
   }
 }
 
@@ -83,7 +102,7 @@ TEST_CASE("Scattering with local lights: a point light's six faces and a spot ad
   a.pointLights = std::span<const PointLight>(&point, 1);
   const Scattering::FrameResult r = scattering.run(a);
   REQUIRE(r.localLights.size() == 6);
-  Image expected(kWidth, kHeight, 4); // the point light's faces, each marched in world space
+  Image expected(kWidth, kHeight, 4); // the point light's faces, each's world-space reference
   int projective = 0;
   for (const Scattering::LightResult& face : r.localLights) {
     MESSAGE("face " << face.face << ": " << face.message);

@@ -135,7 +135,7 @@ TEST_CASE("Scattering local lights from the engine's perspective maps: spot ligh
     CHECK(names.find("shadow pass") == std::string::npos); // nothing drawn
     CHECK(names.find(k.expected == RectifyStatus::Projective
                          ? "local light: resample (projective)"
-                         : "local light: world-space march") != std::string::npos);
+                         : "local light: resample (epipolar)") != std::string::npos);
     CHECK(rb.rectifiedMap.texture == 0);
     const Image fromMaps = f.read();
 

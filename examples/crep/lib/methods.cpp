@@ -452,11 +452,16 @@ MethodOutput runFrontDoor(FrameInputs& frame, const MethodSettings& settings, Sc
           : "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
   std::string local;
   if (!r.localLights.empty()) {
-    int counts[3] = {0, 0, 0}; // prefiltered, marched, outside the view
+    // prefiltered (projective layout), prefiltered on the epipolar layout (in or near the view), marched,
+    // outside the view
+    int counts[4] = {0, 0, 0, 0};
     for (const Scattering::LightResult& l : r.localLights)
-      ++counts[l.status == RectifyStatus::Projective ? 0 : l.status == RectifyStatus::Fallback ? 1 : 2];
-    local = "; local lights: " + std::to_string(counts[0]) + " prefiltered, " + std::to_string(counts[1]) +
-            " marched in world space, " + std::to_string(counts[2]) + " outside the view";
+      ++counts[l.status == RectifyStatus::Projective ? 0
+               : l.status == RectifyStatus::Fallback ? (l.epipolar ? 1 : 2)
+                                                     : 3];
+    local = "; local lights: " + std::to_string(counts[0] + counts[1]) + " prefiltered (" +
+            std::to_string(counts[1]) + " on the epipolar layout), " + std::to_string(counts[2]) +
+            " marched in world space, " + std::to_string(counts[3]) + " outside the view";
   }
   if (!frame.directional) {
     out.detail =

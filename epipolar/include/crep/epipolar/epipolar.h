@@ -51,6 +51,20 @@
 //   sin(psi_ref) = sqrt(k_min k_max) and falls back to the bisectrix when k_min = 0).
 // The map has to be exactly sliceCount() rows high (texel row j = slice j).
 //
+// Local lights (a spot light or a point-light face at L, in or near the view, where the projective
+// rectification falls back; Klehm et al. 2014, Sec. 3.2 "Local Lights" on the Sec. 4.1 layout): the same
+// slices, rows and depth around the axis through the camera and the light, m = (L - c) / D, D = |L - c|
+// (the epipole is the light's image). Light rays are half-lines from L; in a slice, the one at angle theta
+// from the direction L -> c holds the points with theta = atan2(b, D - a), theta in [0, pi], and along it psi
+// grows from 0 (at L) in the direction of travel, so the stored depth (psi) keeps its meaning. Columns:
+//   theta in [0, thetaMax_j] (thetaMax_j = the largest theta of the far-plane points of the slice row's
+//   sector, sampled along its limiting rays, clamped to pi), regions at theta_k = f_k thetaMax_j, and inside
+//   region k (mid angle mu, half width h <= pi / 4: the fractions are raised so no region spans more than
+//   half of [0, thetaMax_j]) theta = mu + atan((2 u - 1) tan h), the light rays through evenly spaced points
+//   of the chord: the law of sines in the triangle (c, L, p) gives the distance along the view ray of
+//   angle psi, t = D sin(theta) / sin(psi + theta), a projective function of u inside each region (exact
+//   DistanceProfile), +infinity where psi + theta >= pi (the ray never reaches that light ray).
+//
 // Epipole block (Fig. 8): next to the epipole view rays and light rays are nearly parallel and a slice
 // holds little information (sin(psi) -> 0): the pixels within epipoleBlockRadiusPixels() of the epipole (or
 // the anti-epipole) are left to a march (epipoleBlockPixels(); crep::Scattering marches them over the map).
@@ -115,6 +129,7 @@ public:
     double psiMax = 0.0; ///< radians: depth 1
     glm::dvec3 direction{
         0.0}; ///< unit direction of the slice's half-plane orthogonal to the light (at the row centre)
+    double thetaMax = 0.0; ///< local light: radians in (0, pi], the angle at the light of column 1 (see top)
   };
 
   /// Throws InvalidArgument for screen sizes <= 0 or > Image::kMaxDimension ("EpipolarLayout.screenSize"),
@@ -122,11 +137,25 @@ public:
   EpipolarLayout(const Camera& camera, const DirectionalLight& light, int screenWidth, int screenHeight,
                  const EpipolarOptions& options = {});
 
+  /// The layout of a local light at `lightPosition` (see top, "Local lights"). Throws InvalidArgument as
+  /// above, for a non-finite light position or one within 1e-9 far of the camera
+  /// ("EpipolarLayout.lightPosition"), and for options.regions < 2 ("EpipolarOptions.regions").
+  EpipolarLayout(const Camera& camera, const glm::dvec3& lightPosition, int screenWidth, int screenHeight,
+                 const EpipolarOptions& options = {});
+
+  /// True for the layout of a local light (light rays from lightPosition()).
+  bool localLight() const noexcept { return lightDistance_ > 0.0; }
+  /// Local light: its position (the camera position plus D m); directional: the camera position.
+  glm::dvec3 lightPosition() const noexcept { return camera_.position() + lightDistance_ * m_; }
+  /// D = |L - c| (world units) for a local light, 0 for a directional one.
+  double lightDistance() const noexcept { return lightDistance_; }
+
   int sliceCount() const noexcept { return static_cast<int>(slices_.size()); } ///< the map height H
   int screenWidth() const noexcept { return width_; }
   int screenHeight() const noexcept { return height_; }
   const EpipolarOptions& options() const noexcept { return options_; }
   const Camera& camera() const noexcept { return camera_; }
+  /// The direction light travels at the camera (a local light's: (c - L) / D).
   const glm::dvec3& lightDirection() const noexcept { return l_; }
   const std::vector<Slice>& slices() const noexcept { return slices_; }
 
@@ -185,7 +214,15 @@ public:
   double referenceDepth(double row) const override;
   DistanceProfile rayProfile(double row, double depth, int region) const override;
   DistanceProfile referenceProfile(double row, int region) const override;
+  /// Local light: the row's reference ray when it reaches the region's far end with a margin (psi <= 3/4
+  /// (pi - theta_(k+1))), else the ray of angle 1/2 (pi - theta_(k+1)) (clamped to the row's rays and >=
+  /// 1e-3): the row's rays closest to the light reach furthest, and the exact weights of a ray that meets
+  /// the region's far light rays near its horizon vanish there. Directional: referenceDepth(row).
+  double regionReferenceDepth(double row, int region) const override;
   std::optional<GpuLayoutData> gpuLayoutData() const override;
+  std::optional<glm::dvec3> localLightPosition() const override {
+    return localLight() ? std::optional<glm::dvec3>(lightPosition()) : std::nullopt;
+  }
 
   /// The visible psi interval of the half-plane with unit in-plane direction n (orthogonal to the light)
   /// and the border sigma of its exit point; nullopt when no part of it is on screen.
@@ -199,10 +236,18 @@ private:
   image(const glm::dvec3& w) const; ///< homogeneous image point (x tX, y tY, forward) of a direction
   glm::dvec3 borderDirection(double sigma) const;
   double rowOfSigma(double sigma) const;
+  void init();
   void buildSlices();
+  /// Local light: theta of a point q - c (see top), and the column <-> theta mapping of slice j.
+  double thetaOf(const glm::dvec3& q) const;
+  double columnTheta(int slice, double column) const;
+  double thetaColumn(int slice, double theta, int& region, double& u) const;
+  /// Local light: mid angle and tan of the half width of region k in slice j.
+  glm::dvec2 regionAngles(int slice, int region) const;
 
   Camera camera_;
   glm::dvec3 l_, m_;
+  double lightDistance_ = 0.0; ///< D, 0 for a directional light
   int width_, height_;
   EpipolarOptions options_;
   double tanX_ = 0.0, tanY_ = 0.0;

@@ -33,7 +33,8 @@ namespace crep::gpu {
 /// std140 block CrepEpipolarLayoutBlock { CrepEpipolarLayoutParams crep_epipolar; } (CREP_LAYOUT 1): the
 /// geometry of crep::EpipolarLayout (epipolar.h); the per-slice bounds are in the storage buffer below.
 struct EpipolarLayoutParams {
-  glm::vec4 origin{0.0f};                        ///< xyz: camera position (world); w: 0
+  glm::vec4 origin{
+      0.0f}; ///< xyz: camera position (world); w: D = |light - camera| (local light), 0 (directional)
   glm::vec4 towardLight{0.0f, 1.0f, 0.0f, 0.0f}; ///< xyz: m = -light direction (unit); w: 0
   glm::vec4 imageX{
       1.0f, 0.0f, 0.0f,
@@ -54,7 +55,8 @@ static_assert(sizeof(EpipolarLayoutParams) == 16 * (9 + kMaxLayoutRegions / 4 + 
 
 /// std430 element of CrepEpipolarSlicesBlock { CrepEpipolarSlice crep_slices[]; }: one slice (texel row).
 struct EpipolarSlice {
-  glm::vec4 bounds{0.0f}; ///< x: bMax (world units), y: psiMin, z: psiMax (radians), w: 0
+  /// x: bMax (world units; local light: thetaMax, radians), y: g(psiMin), z: g(psiMax) (the depth warp), w: 0
+  glm::vec4 bounds{0.0f};
 };
 static_assert(sizeof(EpipolarSlice) == 16, "std430 CrepEpipolarSlice");
 

@@ -16,8 +16,9 @@
 //   (on the ray: the inverse maps NDC (x, y) to the ray through the centre of projection),
 //   stored depth = clamp(layout.toRectified(p).depth, 0, 1).
 // A layout's light is local when it is a ProjectiveLayout of rectify(camera, SpotLight) or a face of
-// rectifyPointLight (RectifiedFrame::inverseLightDistance > 0, its lightPosition the light's); the
-// EpipolarLayout and rectify(camera, DirectionalLight) are directional.
+// rectifyPointLight (RectifiedFrame::inverseLightDistance > 0, its lightPosition the light's), or an
+// EpipolarLayout built for a light position (EpipolarLayout::localLight(), 1 / rho = lightDistance()); the
+// other EpipolarLayouts and rectify(camera, DirectionalLight) are directional.
 // Blocker clamping (Sec. 4.1): an occluder between the light and the camera frustum has a depth < 0 in the
 // slice's bounds and is clamped to 0, so it still shadows every view ray of the texel (like GL_DEPTH_CLAMP
 // for the projective matrices); one behind the frustum clamps to 1 (lit).
@@ -54,8 +55,8 @@ void validateLightMatrix(const glm::dmat4& lightClipFromWorld, const glm::dvec3&
 /// (SpotLight::lightClipFromWorld, PointLight::faceClipFromWorld, an engine's cube-map face matrices).
 void validateLocalLightMatrix(const glm::dmat4& lightClipFromWorld, const glm::dvec3& lightPosition);
 
-/// The light position of a layout whose light is local (ProjectiveLayout with inverseLightDistance > 0),
-/// else nullopt (directional: EpipolarLayout, ProjectiveLayout of a directional light, any other layout).
+/// The light position of a layout whose light is local (ProjectiveLayout with inverseLightDistance > 0, a
+/// local EpipolarLayout), else nullopt (directional layouts, any other layout).
 std::optional<glm::dvec3> localLightPosition(const RectifiedLayout& layout);
 
 /// The check resampleShadowMap and ShadowResamplePass apply to a matrix for `layout`'s light:

@@ -42,10 +42,11 @@
 // A projective light is prefiltered with its light-side factor in the weights and evaluated with every
 // ray's own in-scattering (the regions it crosses whole from the scattering prefix table, its last region
 // from the local section table times its share, EvaluateOptions::localSectionTable; pixels the light never
-// reaches, outside the spot's cone or the face's sector, return at once); a fallback light is marched in
-// world space against its perspective map (WorldMarchPass, epipoleBlock's steps: the reference's cost, not
-// the prefiltered one); one that does not reach the camera frustum costs nothing. Local lights are evaluated
-// at full resolution.
+// reaches, outside the spot's cone or the face's sector, return at once); a fallback light (in or near the
+// view) is prefiltered the same way on its epipolar layout (the light's image is the epipole; its
+// perspective map resampled into it, CreateInfo::localLightFallback), or marched in world space against
+// that map (WorldMarchPass, the reference); one that does not reach the camera frustum costs nothing. Local
+// lights are evaluated at full resolution.
 //
 // Light textures (README "Light textures"; Klehm et al. 2014, Sec. 3.2: a coloured light texture is a
 // light-side factor stored per colour channel): FrameAttribs::lightTexture (the directional light's, e.g. a
@@ -122,6 +123,14 @@ public:
     Prefiltered, ///< Klehm et al. 2014: prefilter the map, evaluate each ray in constant time (default)
     MinMaxMarch, ///< the peer (Chen et al. 2011, Yusov 2012 Algorithm 2): 1D min/max trees, march each ray
   };
+  /// How a local light whose rectification is not projective (in or near the view) is evaluated.
+  enum class LocalLightFallback {
+    /// Prefiltered on the light's epipolar layout (EpipolarLayout for its position: the light's image is the
+    /// epipole), its perspective map resampled into it (default): the projective light's passes.
+    Epipolar,
+    /// The world-space march against its perspective map (CreateInfo::epipoleBlock's steps): the reference.
+    WorldMarch,
+  };
   /// How the epipole block (the pixels next to the epipole on epipolar frames) is evaluated.
   enum class EpipoleBlockMethod {
     /// The min/max tree march over the frame's epipolar map (default): exact visibility on the map the
@@ -185,6 +194,9 @@ public:
     /// extended, crep/scatter/airlight.h) instead of the quadrature (default false: slower on llvmpipe,
     /// measured there; see that field).
     bool localLightClosedForm = false;
+    /// Local lights in or near the view: prefiltered on their epipolar layout (default; needs
+    /// epipolarRegions >= 2, else they are marched) or marched in world space.
+    LocalLightFallback localLightFallback = LocalLightFallback::Epipolar;
     /// How the epipole block is evaluated: TreeMarch (default) or the world-space reference.
     EpipoleBlockMethod epipoleBlockMethod = EpipoleBlockMethod::TreeMarch;
     /// World-space march of the epipole block with EpipoleBlockMethod::WorldMarch (and of local lights in or
@@ -213,6 +225,10 @@ public:
     /// lowers the light bleeding around the epipole block. Measured (README "Sun in view"): 0 -> 3.0%
     /// relative RMSE with the sun just outside the screen, 0.1 -> 2.1%, 0.3 -> 2.4%, 1 -> 2.8%.
     double epipolarDepthWarp = 0.1;
+    /// The same for a local light's epipolar layout (localLightFallback Epipolar; radians, >= 0): its glow
+    /// lies on the view rays next to the light, at small psi, so a smaller warp than the sun's serves it
+    /// (figures in docs/measurements.md, "Local lights in view").
+    double localLightDepthWarp = 0.03;
     /// Reduced-resolution evaluation (crep/pipeline/reduced_resolution.h; not in the paper): 1 (full), 0.5
     /// or 0.25. Below 1 the evaluation runs on a camera image 2x or 4x smaller per axis (checkerboard
     /// min/max depth) and a depth-aware upsample brings it back; the epipole block is still marched at full
@@ -302,8 +318,12 @@ public:
     enum class Kind { Spot, PointFace } kind = Kind::Spot;
     int index = 0; ///< into FrameAttribs::spotLights or pointLights
     int face = -1; ///< point light face 0-5 (+X, -X, +Y, -Y, +Z, -Z), -1 for a spot
-    /// Projective: prefiltered; Fallback: marched in world space; Empty: outside the view, nothing done.
+    /// The rectification's status: Projective (prefiltered on the projective layout), Fallback (in or near
+    /// the view: `epipolar` or marched in world space), Empty (outside the view, nothing done).
     RectifyStatus status = RectifyStatus::Empty;
+    /// A Fallback light prefiltered on its epipolar layout (CreateInfo::localLightFallback Epipolar); false:
+    /// marched in world space.
+    bool epipolar = false;
     /// Its shadow input: the given perspective map (FrameAttribs::spotShadowMaps / pointShadowMaps,
     /// resampled when projective) rather than drawCasters.
     bool preRenderedMap = false;

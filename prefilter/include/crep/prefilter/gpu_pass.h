@@ -228,8 +228,9 @@ public:
     /// Instead of `light`: a local light (a spot, or one point-light face) whose rectification the basis
     /// was prefiltered from with PrefilterPass::FrameAttribs::localLight. Every region segment of a pixel
     /// ray contributes its visibility times the ray's own in-scattering (crep_localSegment of
-    /// crep/local_light.glsl; crep::evaluate(..., LocalLight) on the CPU). Projective layouts only, no
-    /// near-plane correction (InvalidArgument naming the field).
+    /// crep/local_light.glsl; crep::evaluate(..., LocalLight) on the CPU). A ProjectiveLayout, or an
+    /// EpipolarLayout built for the light's position (in or near the view); no near-plane correction
+    /// (InvalidArgument naming the field).
     const LocalLight* localLight = nullptr;
     /// Froxel volumes (prefilter.h, "Froxel volumes"): one more dispatch over width x height x depth cells
     /// (workgroups of CreateInfo::workgroupWidth x workgroupHeight x 1 cells: neighbouring cells of one
@@ -274,7 +275,7 @@ public:
 
   /// Writes the scattering image into frame.output and / or the froxel volume (at least one). Throws
   /// InvalidArgument naming the FrameAttribs field (null pointers, texture 0, wrong target / format / size,
-  /// bases mismatch, layout not projective, froxels.grid / froxels.jitter / froxels.volume, reuseTable
+  /// bases mismatch, froxels.grid / froxels.jitter / froxels.volume, reuseTable
   /// without a matching table).
   void run(const FrameAttribs& frame);
 
@@ -287,8 +288,8 @@ private:
   CreateInfo info_;
   gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
   /// The local-light variants (CREP_LOCAL_LIGHT): evaluation and scattering prefix programs on the
-  /// projective frame, built on first use, and their light block.
-  gl::Handle localProgram_, localPrefixProgram_, localBuffer_;
+  /// projective frame, then per gpu::LayoutKind, built on first use, and their light block.
+  gl::Handle localPrograms_[3], localPrefixPrograms_[3], localBuffer_;
   /// Local lights: the airlight table (crep/scatter/airlight.h, RG32F) of the medium's g, and its sampler.
   gl::Handle airlightTable_, airlightSampler_;
   /// Local lights: the local section table (EvaluateOptions::localSectionTable), the prefix table's size.
@@ -302,14 +303,14 @@ private:
   gl::Handle tableProgram_, tableTexture_, tableSampler_;
   gl::Handle prefixPrograms_[3];
   /// Light textures (CREP_LIGHT_TEXTURE): evaluation and scattering prefix programs, index 0 projective
-  /// frame, 1 + gpu::LayoutKind for layouts, 3 local light; built on first use.
-  gl::Handle texturedPrograms_[4], texturedPrefixPrograms_[4];
+  /// frame, 1 + gpu::LayoutKind for layouts, 3 + the same for a local light; built on first use.
+  gl::Handle texturedPrograms_[6], texturedPrefixPrograms_[6];
   /// Froxel volumes (CREP_FROXELS): index [textured][0 projective frame, 1 + gpu::LayoutKind], built on
   /// first use.
   gl::Handle froxelPrograms_[2][3];
-  /// Work lists (CREP_SAMPLE_LIST): index [textured][0 projective frame, 1 + gpu::LayoutKind, 3 local
-  /// light], built on first use.
-  gl::Handle listPrograms_[2][4];
+  /// Work lists (CREP_SAMPLE_LIST): index [textured][0 projective frame, 1 + gpu::LayoutKind, 3 + the same
+  /// for a local light], built on first use.
+  gl::Handle listPrograms_[2][6];
   /// What the table was last built for (FrameAttribs::reuseTable): basis texture, program variant.
   std::uint32_t tableBasis_ = 0;
   int tableVariant_ = -1;

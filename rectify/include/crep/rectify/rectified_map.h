@@ -90,6 +90,9 @@ public:
   /// The layout serialized for the GPU (crep/rectify/gpu_layout.h), or nullopt when the GLSL has no
   /// mapping for it. Throws InvalidArgument when the layout exceeds what the GPU blocks hold.
   virtual std::optional<GpuLayoutData> gpuLayoutData() const { return std::nullopt; }
+  /// The position of the layout's light when it is local (a spot light or point-light face: light rays
+  /// leave it), nullopt for a directional light.
+  virtual std::optional<glm::dvec3> localLightPosition() const { return std::nullopt; }
 };
 
 /// The projective rectification (Sec. 4.2) as a RectifiedLayout: regions = splits.
@@ -121,6 +124,7 @@ public:
   /// wherever any ray of the row crosses the region. Directional lights (rho = 0): referenceDepth(row).
   double regionReferenceDepth(double row, int region) const override;
   std::optional<GpuLayoutData> gpuLayoutData() const override;
+  std::optional<glm::dvec3> localLightPosition() const override;
 
 private:
   Rectification rect_;
