@@ -1003,6 +1003,7 @@ void localLightScaling(const BenchOptions& o) {
     std::span<const SpotLight> spots;
     std::vector<double> frameMs, spotsMs;
     std::vector<RectifyStatus> status; ///< of the last measured frame, one per spot
+    bool epipolar = false;             ///< the last frame's first spot prefiltered on its epipolar layout
   };
   std::vector<Variant> variants;
   for (const int n : {0, 1, 2, 4, kMaxSpots})
@@ -1020,6 +1021,7 @@ void localLightScaling(const BenchOptions& o) {
       for (const Scattering::Stage& st : r.stages)
         frame += st.wallMilliseconds;
       v.status.clear();
+      v.epipolar = !r.localLights.empty() && r.localLights.front().epipolar;
       for (const Scattering::LightResult& l : r.localLights) {
         local += l.wallMilliseconds;
         v.status.push_back(l.status);
@@ -1058,8 +1060,9 @@ void localLightScaling(const BenchOptions& o) {
       "%.2f ms | the spot %.2f ms | spot / sun frame %.3f\n",
       statusToken(nearStatus),
       nearStatus == RectifyStatus::Projective ? "prefiltered"
-      : nearStatus == RectifyStatus::Fallback ? "world-space march"
-                                              : "outside the view, nothing done",
+      : nearStatus == RectifyStatus::Fallback
+          ? (nearRun.epipolar ? "prefiltered on its epipolar layout" : "world-space march")
+          : "outside the view, nothing done",
       median(nearRun.frameMs), nearMs, nearMs / sunMs);
 }
 

@@ -227,7 +227,7 @@ public:
     double epipolarDepthWarp = 0.1;
     /// The same for a local light's epipolar layout (localLightFallback Epipolar; radians, >= 0): its glow
     /// lies on the view rays next to the light, at small psi, so a smaller warp than the sun's serves it
-    /// (figures in docs/measurements.md, "Local lights in view").
+    /// (figures in README "Local lights").
     double localLightDepthWarp = 0.03;
     /// Reduced-resolution evaluation (crep/pipeline/reduced_resolution.h; not in the paper): 1 (full), 0.5
     /// or 0.25. Below 1 the evaluation runs on a camera image 2x or 4x smaller per axis (checkerboard
