@@ -2,6 +2,8 @@
 // on the Sec. 4.1 layout): the RectifiedLayout contract checked on random cameras and light positions in,
 // near and behind the view, against the geometry itself (points on view rays and light rays), not against
 // the layout's own formulas.
+#include "epipolar/epipolar_test_util.h"
+
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
 
@@ -15,19 +17,12 @@
 #include <random>
 
 using namespace crep;
+using namespace crep::test;
 
 namespace {
 
 double uniform(std::mt19937_64& rng, double a, double b) {
   return std::uniform_real_distribution<double>(a, b)(rng);
-}
-
-Camera randomCamera(std::mt19937_64& rng) {
-  std::normal_distribution<double> n;
-  const glm::dquat q(n(rng), n(rng), n(rng), n(rng));
-  return Camera({uniform(rng, -10, 10), uniform(rng, -10, 10), uniform(rng, -10, 10)}, q,
-                glm::radians(uniform(rng, 30.0, 100.0)), uniform(rng, 0.6, 2.5), uniform(rng, 0.05, 1.0),
-                uniform(rng, 20.0, 200.0));
 }
 
 /// Distance from p to the half-line of `ray`.
@@ -46,7 +41,7 @@ TEST_CASE("epipolar layout of a local light: view rays keep row and depth, light
          worstLightRay = 0.0, worstOutside = 0.0, worstOrigin = 0.0;
   int depthOrder = 0;
   for (int trial = 0; trial < 200; ++trial) {
-    const Camera camera = randomCamera(rng);
+    const Camera camera = randomEpipolarCamera(rng);
     // The light in the view (2 / 3 of the trials) or anywhere around the camera.
     const glm::dvec3 direction =
         trial % 3 != 0

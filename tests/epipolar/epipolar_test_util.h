@@ -16,6 +16,8 @@
 
 #include <doctest/doctest.h>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -25,6 +27,18 @@
 #include <string>
 
 namespace crep::test {
+
+/// A random camera: position in [-10, 10]^3, any orientation, fovY 30-100 degrees, aspect 0.6-2.5, near
+/// 0.05-1, far 20-500.
+inline Camera randomEpipolarCamera(std::mt19937_64& rng) {
+  const auto uniform = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  std::normal_distribution<double> n;
+  const glm::dquat q(n(rng), n(rng), n(rng), n(rng));
+  const glm::dvec3 position(uniform(-10, 10), uniform(-10, 10), uniform(-10, 10));
+  const double fovY = glm::radians(uniform(30.0, 100.0)), aspect = uniform(0.6, 2.5),
+               near = uniform(0.05, 1.0);
+  return Camera(position, q, fovY, aspect, near, uniform(20.0, 500.0));
+}
 
 /// The shadow map of the half-space occluder for an orthographic or perspective light matrix: each texel
 /// stores the depth-buffer value of the plane along the light ray through its centre (clamped like

@@ -18,7 +18,7 @@
 // A layout's light is local when it is a ProjectiveLayout of rectify(camera, SpotLight) or a face of
 // rectifyPointLight (RectifiedFrame::inverseLightDistance > 0, its lightPosition the light's), or an
 // EpipolarLayout built for a light position (EpipolarLayout::localLight(), 1 / rho = lightDistance()); the
-// other EpipolarLayouts and rectify(camera, DirectionalLight) are directional.
+// other epipolar layouts and rectify(camera, DirectionalLight) are directional.
 // Blocker clamping (Sec. 4.1): an occluder between the light and the camera frustum has a depth < 0 in the
 // slice's bounds and is clamped to 0, so it still shadows every view ray of the texel (like GL_DEPTH_CLAMP
 // for the projective matrices); one behind the frustum clamps to 1 (lit).
