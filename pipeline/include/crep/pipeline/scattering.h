@@ -187,8 +187,7 @@ public:
     /// each region's in-scattering along R x Z x H sample rays, a quadrature per entry for a local light:
     /// it dominates a local light's cost, and halving Z halves it. Measured on the colonnade (relative
     /// RMSE against the world-space reference, map 512): Z = 128: point light 1.08%, spot 0.235%; 64
-    /// (default): 1.17%, 0.245%; 32: 2.5%, 0.32%. Cost of one spot light off screen (crep bench --quick,
-    /// colonnade, 320x180, section "local lights"): 7.1x the sun's frame at 128, 4.2x at 64.
+    /// (default): 1.17%, 0.245%; 32: 2.5%, 0.32%. Cost: see README "Local lights".
     int localLightTableSamples = 64;
     /// Local lights' sections in closed form (EvaluatePass::CreateInfo::localClosedForm: Sun et al. 2005
     /// extended, crep/scatter/airlight.h) instead of the quadrature (default false: slower on llvmpipe,

@@ -185,10 +185,9 @@ public:
     /// crep/scatter/airlight.h; GLSL crep_airlightSegment: a table end per channel where the intensity is
     /// constant, the quadrature on a spot's falloff band) instead of the quadrature throughout
     /// (crep_localSegment, default). Same result within 2.3e-3 of a ray's sum (the table's interpolation).
-    /// Measured on llvmpipe (colonnade-night lamp, 1920x1080, map 1024^2, M = 64): the closed form is slower
-    /// there, spot 2.1 s vs 1.4 s per evaluation, point face 1.8 s vs 1.5 s: a software rasterizer samples a
-    /// texture at the cost of several quadrature points. On GPUs (texture units beside the ALUs) the fetches
-    /// are the cheap side; unmeasured here.
+    /// Slower on llvmpipe (README "Local lights"): a software rasterizer samples a texture at the cost of
+    /// several quadrature points. On GPUs (texture units beside the ALUs) the fetches are the cheap side;
+    /// unmeasured here.
     bool localClosedForm = false;
     /// Benchmarks only (the output is meaningless): the pass stripped to its memory traffic, the same
     /// camera-depth fetch, the same filtered-basis fetches per pixel (count, format, filtering; the
