@@ -68,6 +68,11 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.localLightTableSamples", std::to_string(info.localLightTableSamples),
             "must be 0 (evaluate.visibilityTableSamples) or in [2, " +
                 std::to_string(kMaxVisibilityTableSamples) + "]");
+  if (info.spotLightTableSamples != 0 &&
+      (info.spotLightTableSamples < 2 || info.spotLightTableSamples > kMaxVisibilityTableSamples))
+    invalid("Scattering::CreateInfo.spotLightTableSamples", std::to_string(info.spotLightTableSamples),
+            "must be 0 (localLightTableSamples) or in [2, " + std::to_string(kMaxVisibilityTableSamples) +
+                "]");
   validate(info.epipoleBlock);
   const int regions = info.rectify.splits * info.prefilter.regionsPerSplit;
   if (info.mapSize % regions != 0)
@@ -349,9 +354,10 @@ struct Scattering::Impl {
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
   gl::Handle localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
   /// The local lights' own passes for an M (CreateInfo::spotLightBases, localLightBases) or table samples
-  /// (localLightTableSamples) that differ from the directional light's, made on first use.
+  /// (spotLightTableSamples, localLightTableSamples) that differ from the directional light's, made on
+  /// first use; the evaluations keyed by (M, Z).
   std::map<int, PrefilterPass> localPrefilters;
-  std::map<int, EvaluatePass> localEvaluates;
+  std::map<std::pair<int, int>, EvaluatePass> localEvaluates;
   int localBases() const { return info.localLightBases == 0 ? info.prefilter.bases : info.localLightBases; }
   int spotBases() const {
     return info.spotLightBases == -1  ? localBases()
@@ -361,6 +367,11 @@ struct Scattering::Impl {
   int localTableSamples() const {
     const int Z = info.evaluate.visibilityTableSamples;
     return Z == 0 || info.localLightTableSamples == 0 ? Z : info.localLightTableSamples;
+  }
+  int spotTableSamples() const {
+    return info.evaluate.visibilityTableSamples == 0 || info.spotLightTableSamples == 0
+               ? localTableSamples()
+               : info.spotLightTableSamples;
   }
   /// The prefilter and evaluation of local lights with M bases (their own passes, or the directional
   /// light's).
@@ -374,17 +385,16 @@ struct Scattering::Impl {
     }
     return it->second;
   }
-  EvaluatePass& localLightEvaluate(int M) {
-    if (M == info.prefilter.bases && localTableSamples() == info.evaluate.visibilityTableSamples)
-      return evaluate;
-    auto it = localEvaluates.find(M);
+  EvaluatePass& localLightEvaluate(int M, int Z) {
+    if (M == info.prefilter.bases && Z == info.evaluate.visibilityTableSamples) return evaluate;
+    auto it = localEvaluates.find({M, Z});
     if (it == localEvaluates.end()) {
       EvaluateOptions options = info.evaluate;
-      options.visibilityTableSamples = localTableSamples();
+      options.visibilityTableSamples = Z;
       it = localEvaluates
-               .emplace(M, EvaluatePass::CreateInfo{.bases = M,
-                                                    .options = options,
-                                                    .localClosedForm = info.localLightClosedForm})
+               .emplace(std::pair(M, Z),
+                        EvaluatePass::CreateInfo{
+                            .bases = M, .options = options, .localClosedForm = info.localLightClosedForm})
                .first;
     }
     return it->second;
@@ -854,6 +864,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         timed(result, "local light: light colours",
               [&] { colors = m.lightColors(layout, *texture, nullptr, &light); });
       const int M = light.cone ? m.spotBases() : m.localBases();
+      const int Z = light.cone && dynamic_cast<const ProjectiveLayout*>(&layout) != nullptr
+                        ? m.spotTableSamples()
+                        : m.localTableSamples();
       timed(result, "local light: prefilter", [&] {
         m.localLightPrefilter(M).run({.rectifiedDepth = map,
                                       .layout = &layout,
@@ -870,7 +883,7 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         e.layout = &layout;
         e.basis = m.localLightPrefilter(M).filteredBasis();
         e.localLight = &light;
-        m.localLightEvaluate(M).run(e);
+        m.localLightEvaluate(M, Z).run(e);
         addToOutput();
       });
     };

@@ -79,9 +79,18 @@ int ceilDiv(int a, int b) {
   return (a + b - 1) / b;
 }
 
+/// Bases per invocation of the program: options.basesPerInvocation, or for a local light (the light-side
+/// weights of a texel computed by every invocation of its row and region) all of M up to 32 in one.
+/// GPU: 32 bases keep 8 vec4 accumulators live, and 1024 rows x 16 regions still fill a GPU; on llvmpipe one
+/// invocation computing a texel's three light factors once is 23% faster (63 -> 49 ms at 1024^2, M = 32).
+int basesPerInvocation(const PrefilterPass::CreateInfo& info, bool local) {
+  const int b = info.options.basesPerInvocation;
+  return local ? std::max(b, std::min(32, 4 * layerCount(info.options.bases))) : b;
+}
+
 /// Invocations per row and region: groups of basesPerInvocation / 4 layers (the last may be partial).
-int baseGroups(const PrefilterPass::CreateInfo& info) {
-  return ceilDiv(layerCount(info.options.bases), info.options.basesPerInvocation / 4);
+int baseGroups(const PrefilterPass::CreateInfo& info, bool local = false) {
+  return ceilDiv(layerCount(info.options.bases), basesPerInvocation(info, local) / 4);
 }
 
 void requireAtLeast(const char* parameter, int value, int minimum) {
@@ -254,7 +263,7 @@ std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& 
   const PrefilterOptions& o = info.options;
   return {{ShaderStage::Compute,
            "passes/prefilter.comp",
-           {{"CREP_BASES_PER_INVOCATION", str(o.basesPerInvocation)},
+           {{"CREP_BASES_PER_INVOCATION", str(basesPerInvocation(info, local))},
             {"CREP_BASIS_FORMAT", imageFormatQualifier(o.format)},
             {"CREP_BASIS_UNORM8", o.format == StorageFormat::RGBA8 ? "1" : "0"},
             {"CREP_BASIS_HALF", o.format == StorageFormat::RGBA16F ? "1" : "0"},
@@ -429,7 +438,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
 
   gpu::PrefilterParams params;
   params.mapSize = glm::ivec4(W, H, R, n);
-  params.basisInfo = glm::ivec4(info_.options.bases, info_.options.basesPerInvocation,
+  params.basisInfo = glm::ivec4(info_.options.bases, basesPerInvocation(info_, local),
                                 static_cast<int>(info_.options.weights), 0);
   params.weights =
       glm::vec4(static_cast<float>(s), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
@@ -454,7 +463,7 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, paramsBuffer_.get());
   glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes));
   glDispatchCompute(static_cast<GLuint>(ceilDiv(H, info_.workgroupRows)),
-                    static_cast<GLuint>(ceilDiv(baseGroups(info_), info_.workgroupBaseGroups)),
+                    static_cast<GLuint>(ceilDiv(baseGroups(info_, local), info_.workgroupBaseGroups)),
                     static_cast<GLuint>(ceilDiv(R, info_.workgroupRegions)));
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT);

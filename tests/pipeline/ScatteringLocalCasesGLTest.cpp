@@ -141,7 +141,7 @@ TEST_CASE("Scattering, point light at the camera's position: finite and equal to
 }
 
 TEST_CASE("Scattering::CreateInfo.spotLightBases and localLightBases: 0 is prefilter.bases, -1 follows "
-          "localLightBases, bad values of them and of localLightTableSamples named") {
+          "localLightBases, spotLightTableSamples 0 follows localLightTableSamples, bad values named") {
   CREP_REQUIRE_GL();
   ScatteringFixture f("colonnade");
   f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0)));
@@ -152,10 +152,11 @@ TEST_CASE("Scattering::CreateInfo.spotLightBases and localLightBases: 0 is prefi
                         .outerConeAngle = 0.5,
                         .intensity = 100.0,
                         .range = 80.0});
-  const auto image = [&](int spotBases, int localBases = 64) {
+  const auto image = [&](int spotBases, int localBases = 64, int spotTable = 32) {
     Scattering::CreateInfo info = caseInfo();
     info.spotLightBases = spotBases;
     info.localLightBases = localBases;
+    info.spotLightTableSamples = spotTable;
     Scattering scattering(info);
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.spotLights = std::span<const SpotLight>(&spot, 1);
@@ -181,10 +182,24 @@ TEST_CASE("Scattering::CreateInfo.spotLightBases and localLightBases: 0 is prefi
   report("spotLightBases 2M vs M", m);
   CHECK(m.maxAbsError > 0.0);
   CHECK(m.relativeRmse < 0.02);
+  // spotLightTableSamples: 0 takes localLightTableSamples (the same table as naming it), another Z its own.
+  const int Z = caseInfo().localLightTableSamples;
+  const auto [followTable, followTableBytes] = image(0, 64, 0);
+  const auto [explicitTable, explicitTableBytes] = image(0, 64, Z);
+  CHECK(rgbMetrics(followTable, explicitTable).maxAbsError == 0.0);
+  CHECK(followTableBytes == explicitTableBytes);
+  const ImageMetrics mz = rgbMetrics(same, explicitTable);
+  report("spotLightTableSamples 32 vs localLightTableSamples", mz);
+  CHECK(mz.maxAbsError > 0.0);
+  CHECK(mz.relativeRmse < 0.02);
   for (const int bad : {-1, 1, 5000}) {
     Scattering::CreateInfo info = caseInfo();
     info.localLightTableSamples = bad;
     CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.localLightTableSamples"),
+                         crep::InvalidArgument);
+    info = caseInfo();
+    info.spotLightTableSamples = bad;
+    CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.spotLightTableSamples"),
                          crep::InvalidArgument);
   }
   for (const int bad : {-2, 3, 130}) {
