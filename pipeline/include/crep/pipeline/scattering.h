@@ -55,9 +55,9 @@
 // layout its frame uses (LightColorMapPass: the projective or the epipolar layout) and prefiltered with it
 // (three bases, PrefilterPass::FrameAttribs::lightColors), the evaluation follows the textured basis; the
 // tree-marched epipole block reads the same colour map (RectifiedMarchPass::FrameAttribs::lightColors), the
-// world-space marches (EpipoleBlockMethod::WorldMarch, a spot in or near the view) take the texture itself
-// (WorldMarchPass::FrameAttribs::lightTexture). A constant white texture gives the untextured result bit
-// for bit, except inside a tree-marched epipole block, where the textured walk sums each lit texel alone
+// world-space marches (EpipoleBlockMethod::WorldMarch, LocalLightFallback::WorldMarch) take the texture
+// itself (WorldMarchPass::FrameAttribs::lightTexture). A constant white texture gives the untextured result
+// bit for bit, except inside a tree-marched epipole block, where the textured walk sums each lit texel alone
 // (the untextured one a lit node at once): equal there to float rounding (7e-7 of a 1.5 peak, tested). Not
 // with CreateInfo::evaluate.nearPlaneCorrection or the visibility table alone (scatteringPrefix
 // false with visibilityTableSamples > 0): those have no textured variant (InvalidArgument). Point lights
@@ -200,7 +200,8 @@ public:
     /// measured there; see that field).
     bool localLightClosedForm = false;
     /// Local lights in or near the view: prefiltered on their epipolar layout (default; needs
-    /// epipolarRegions >= 2, else they are marched) or marched in world space.
+    /// epipolarRegions >= 2, and a light within the camera's near distance of it has no camera-light axis:
+    /// both are marched) or marched in world space.
     LocalLightFallback localLightFallback = LocalLightFallback::Epipolar;
     /// How the epipole block is evaluated: TreeMarch (default) or the world-space reference.
     EpipoleBlockMethod epipoleBlockMethod = EpipoleBlockMethod::TreeMarch;
