@@ -106,6 +106,9 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (!(info.epipoleBlockRadius >= 0.0 && info.epipoleBlockRadius <= 0.5))
     invalid("Scattering::CreateInfo.epipoleBlockRadius", detail::formatValue(info.epipoleBlockRadius),
             "must be in [0, 0.5] (a fraction of the screen diagonal)");
+  if (!(info.localLightBlockRadius >= 0.0 && info.localLightBlockRadius <= 0.5))
+    invalid("Scattering::CreateInfo.localLightBlockRadius", detail::formatValue(info.localLightBlockRadius),
+            "must be in [0, 0.5] (a fraction of the screen diagonal)");
   if (info.epipoleBlockMaxPixels < 0)
     invalid("Scattering::CreateInfo.epipoleBlockMaxPixels", std::to_string(info.epipoleBlockMaxPixels),
             "must be >= 0 (0: no bound)");
@@ -884,7 +887,25 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         e.basis = m.localLightPrefilter(M).filteredBasis();
         e.localLight = &light;
         m.localLightEvaluate(M, Z).run(e);
-        addToOutput();
+      });
+    };
+    // The world-space march of the light against a perspective map, into the light's image: every pixel, or
+    // those within `radius` pixels of `centre` (radius >= 0).
+    const auto worldMarch = [&](const ShadowMap& shadow, glm::dvec2 centre, double radius, const char* name) {
+      timed(result, name, [&] {
+        WorldMarchPass::FrameAttribs b;
+        b.camera = f.camera;
+        b.localLight = &light;
+        b.medium = f.medium;
+        b.cameraDepth = f.cameraDepth;
+        b.shadowMap = shadow.texture;
+        b.lightClipFromWorld = shadow.lightClipFromWorld;
+        b.bias = shadow.bias;
+        b.output = m.localScattering.get();
+        b.blockCenter = centre;
+        b.blockRadius = radius;
+        if (texture) b.lightTexture = *texture;
+        m.block.run(b);
       });
     };
     if (rect.projective()) {
@@ -902,8 +923,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
         map = m.localRectified->depthTexture();
       }
       prefiltered(layout, map);
+      addToOutput();
     } else if (info.localLightFallback == LocalLightFallback::Epipolar && info.epipolarRegions >= 2 &&
-               glm::length(light.position - f.camera->position()) > f.camera->near()) {
+               !texture && glm::length(light.position - f.camera->position()) > f.camera->near()) {
       // In or near the view: Sec. 4.1's epipolar layout around the camera-light axis (the light's image is
       // the epipole), mapSize slices, the light's perspective map resampled into it.
       EpipolarOptions options;
@@ -911,27 +933,23 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       options.referenceRay = info.rectify.referenceRay;
       options.regions = info.epipolarRegions;
       options.depthWarp = info.localLightDepthWarp;
-      options.epipoleBlockRadius = 0.0;
+      options.epipoleBlockRadius = info.localLightBlockRadius;
+      options.maxBlockPixels = info.epipoleBlockMaxPixels;
       const EpipolarLayout layout(*f.camera, light.position, info.width, info.height, options);
       result.epipolar = true;
-      prefiltered(layout, resampled(layout, perspectiveMap(), "local light: resample (epipolar)"));
+      const ShadowMap shadow = perspectiveMap();
+      prefiltered(layout, resampled(layout, shadow, "local light: resample (epipolar)"));
+      // Fig. 8's epipole block around the light's image: there every slice meets and a pixel's rays cross
+      // every light ray within a short distance of the light.
+      const std::optional<glm::dvec2> centre = layout.epipolePixel();
+      const double radius = layout.epipoleBlockRadiusPixels();
+      if (centre && radius > 0.0)
+        worldMarch(shadow, *centre, radius, "local light: epipole block (world march)");
+      addToOutput();
     } else {
       // The world-space march against the light's perspective map (the reference).
-      const ShadowMap shadow = perspectiveMap();
-      timed(result, "local light: world-space march", [&] {
-        WorldMarchPass::FrameAttribs b;
-        b.camera = f.camera;
-        b.localLight = &light;
-        b.medium = f.medium;
-        b.cameraDepth = f.cameraDepth;
-        b.shadowMap = shadow.texture;
-        b.lightClipFromWorld = shadow.lightClipFromWorld;
-        b.bias = shadow.bias;
-        b.output = m.localScattering.get();
-        if (texture) b.lightTexture = *texture;
-        m.block.run(b);
-        addToOutput();
-      });
+      worldMarch(perspectiveMap(), glm::dvec2(0.0), -1.0, "local light: world-space march");
+      addToOutput();
     }
     r.localLights.push_back(result);
   };

@@ -202,6 +202,18 @@ TEST_CASE("Scattering::CreateInfo.spotLightBases and localLightBases: 0 is prefi
     CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.spotLightTableSamples"),
                          crep::InvalidArgument);
   }
+  for (const double bad : {-0.1, 0.6, std::nan("")}) {
+    Scattering::CreateInfo info = caseInfo();
+    info.localLightBlockRadius = bad;
+    CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.localLightBlockRadius"),
+                         crep::InvalidArgument);
+  }
+  for (const double bad : {-1.0, std::nan(""), HUGE_VAL}) {
+    Scattering::CreateInfo info = caseInfo();
+    info.localLightDepthWarp = bad;
+    CHECK_THROWS_WITH_AS(Scattering{info}, doctest::Contains("Scattering::CreateInfo.localLightDepthWarp"),
+                         crep::InvalidArgument);
+  }
   for (const int bad : {-2, 3, 130}) {
     Scattering::CreateInfo info = caseInfo();
     info.localLightBases = bad;

@@ -63,8 +63,13 @@ TEST_CASE(
     report(std::string("spot light ") + k.name + ": Scattering vs world-space reference", m);
     CHECK(m.nanCount == 0);
     CHECK(m.peak > 0.0);
-    // The goal for both: within 2% of the world-space reference. Measured 0.46% off screen, 1.35% in
-    // view (on its epipolar layout, depth warp 0.03; 3.2% with the sun's 0.1).
+    // The goal for both: within 2% of the world-space reference. Measured 0.52% off screen, 0.76% in
+    // view (on its epipolar layout, depth warp 0.03, the epipole block of 1% of the diagonal; 1.35% without
+    // the block, 3.2% with the sun's depth warp 0.1).
+    bool block = false;
+    for (const Scattering::Stage& stage : r.stages)
+      block = block || stage.name == "local light: epipole block (world march)";
+    CHECK(block == (k.expected == RectifyStatus::Fallback));
     CHECK(m.relativeRmse < 0.02);
     if (k.expected != RectifyStatus::Fallback) continue;
     // The world-space march kept as an option (CreateInfo::localLightFallback): the reference's method.

@@ -199,9 +199,10 @@ public:
     /// extended, crep/scatter/airlight.h) instead of the quadrature (default false: slower on llvmpipe,
     /// measured there; see that field).
     bool localLightClosedForm = false;
-    /// Local lights in or near the view: prefiltered on their epipolar layout (default; needs
-    /// epipolarRegions >= 2, and a light within the camera's near distance of it has no camera-light axis:
-    /// both are marched) or marched in world space.
+    /// Local lights in or near the view: prefiltered on their epipolar layout (default) or marched in world
+    /// space. Marched in any case: a light within the camera's near distance (no camera-light axis), a spot
+    /// with a light texture (its colours on the epipolar layout are off next to the light: README "Local
+    /// lights"), and all of them when epipolarRegions < 2.
     LocalLightFallback localLightFallback = LocalLightFallback::Epipolar;
     /// How the epipole block is evaluated: TreeMarch (default) or the world-space reference.
     EpipoleBlockMethod epipoleBlockMethod = EpipoleBlockMethod::TreeMarch;
@@ -235,6 +236,12 @@ public:
     /// lies on the view rays next to the light, at small psi, so a smaller warp than the sun's serves it
     /// (figures in README "Local lights").
     double localLightDepthWarp = 0.03;
+    /// Radius of a local light's epipole block on its epipolar layout (fraction of the screen diagonal, in
+    /// [0, 0.5], 0 = none; bounded by epipoleBlockMaxPixels): the pixels around the light's image, where
+    /// every slice meets and a ray crosses every light ray next to the light, are marched in world space
+    /// against its perspective map. A light texture's colours need it most there (figures in README "Local
+    /// lights").
+    double localLightBlockRadius = 0.01;
     /// Reduced-resolution evaluation (crep/pipeline/reduced_resolution.h; not in the paper): 1 (full), 0.5
     /// or 0.25. Below 1 the evaluation runs on a camera image 2x or 4x smaller per axis (checkerboard
     /// min/max depth) and a depth-aware upsample brings it back; the epipole block is still marched at full
