@@ -925,7 +925,7 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       prefiltered(layout, map);
       addToOutput();
     } else if (info.localLightFallback == LocalLightFallback::Epipolar && info.epipolarRegions >= 2 &&
-               !texture && glm::length(light.position - f.camera->position()) > f.camera->near()) {
+               glm::length(light.position - f.camera->position()) > f.camera->near()) {
       // In or near the view: Sec. 4.1's epipolar layout around the camera-light axis (the light's image is
       // the epipole), mapSize slices, the light's perspective map resampled into it.
       EpipolarOptions options;

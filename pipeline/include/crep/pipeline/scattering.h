@@ -200,9 +200,8 @@ public:
     /// measured there; see that field).
     bool localLightClosedForm = false;
     /// Local lights in or near the view: prefiltered on their epipolar layout (default) or marched in world
-    /// space. Marched in any case: a light within the camera's near distance (no camera-light axis), a spot
-    /// with a light texture (its colours on the epipolar layout are off next to the light: README "Local
-    /// lights"), and all of them when epipolarRegions < 2.
+    /// space. Marched in any case: a light within the camera's near distance (no camera-light axis), and all
+    /// of them when epipolarRegions < 2.
     LocalLightFallback localLightFallback = LocalLightFallback::Epipolar;
     /// How the epipole block is evaluated: TreeMarch (default) or the world-space reference.
     EpipoleBlockMethod epipoleBlockMethod = EpipoleBlockMethod::TreeMarch;
