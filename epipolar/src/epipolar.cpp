@@ -482,13 +482,12 @@ RectPoint EpipolarLayout::toRectified(const glm::dvec3& world) const {
                           "its epipolar half-plane is not on screen (no slice)");
   RectPoint p;
   p.row = rowOfSigma(view->exitSigma);
-  const Slice& s = slices_[static_cast<std::size_t>(sliceIndex(p.row))];
-  const double fraction = b / s.bMax;
   p.depth = depthOfPsi(sliceIndex(p.row), std::atan2(b, a));
   if (localLight()) {
     p.column = thetaColumn(sliceIndex(p.row), std::atan2(b, lightDistance_ - a), p.split, p.splitColumn);
     return p;
   }
+  const double fraction = b / slices_[static_cast<std::size_t>(sliceIndex(p.row))].bMax;
   const int K = regionCount();
   int k = 0;
   while (k < K - 1 && fraction >= fractions_[static_cast<std::size_t>(k) + 1])

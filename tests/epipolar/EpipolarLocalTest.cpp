@@ -151,13 +151,7 @@ TEST_CASE(
   const Camera camera = groundCamera(w, h);
   const Image depth = groundDepth(camera, w, h);
   const Medium medium = colouredMedium();
-  const SpotLight spot({.position = {-1.0, 4.0, -8.0},
-                        .direction = {4.0, -4.0, -4.0},
-                        .innerConeAngle = 0.45,
-                        .outerConeAngle = 0.7,
-                        .color = {1.0, 0.85, 0.7},
-                        .intensity = 30.0,
-                        .range = 60.0});
+  const SpotLight spot = analyticViewSpot();
   const LocalLight light = LocalLight::spot(spot);
   // A red / blue slide: its edge runs through the spot's axis.
   Image slide(64, 64, 3);

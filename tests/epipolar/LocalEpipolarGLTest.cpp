@@ -28,27 +28,6 @@
 using namespace crep;
 using namespace crep::test;
 
-namespace {
-
-/// A spot in the ground camera's view, left of the wall, aimed down across it.
-SpotLight viewSpot() {
-  return SpotLight({.position = {-1.0, 4.0, -8.0},
-                    .direction = {4.0, -4.0, -4.0},
-                    .innerConeAngle = 0.45,
-                    .outerConeAngle = 0.7,
-                    .color = {1.0, 0.85, 0.7},
-                    .intensity = 30.0,
-                    .range = 60.0});
-}
-
-/// A point light in the view, left of the wall.
-PointLight viewPoint() {
-  return PointLight(
-      {.position = {-1.0, 3.0, -6.0}, .color = {1.0, 0.9, 0.8}, .intensity = 20.0, .range = 60.0});
-}
-
-} // namespace
-
 TEST_CASE(
     "evaluate GL, a local light in view on its epipolar layout: GPU equals CPU, CPU near the closed form") {
   CREP_REQUIRE_GL();
@@ -61,8 +40,8 @@ TEST_CASE(
   PrefilterPass prefilterPass({.mapWidth = W, .mapHeight = H, .options = o});
   EvaluatePass evaluatePass({});
   const gl::Handle depthTexture = uploadR32F(depth);
-  const SpotLight spot = viewSpot();
-  const PointLight point = viewPoint();
+  const SpotLight spot = analyticViewSpot();
+  const PointLight point = analyticViewPoint();
   struct Case {
     const char* name;
     LocalLight light;
@@ -152,7 +131,7 @@ TEST_CASE(
   CREP_REQUIRE_GL();
   constexpr int w = 160, h = 90, kMap = 256;
   const Camera camera = groundCamera(w, h);
-  const SpotLight spot = viewSpot();
+  const SpotLight spot = analyticViewSpot();
   const LocalLight light = LocalLight::spot(spot);
   EpipolarOptions eo;
   eo.slices = kMap;

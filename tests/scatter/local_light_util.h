@@ -42,6 +42,24 @@ inline PointLight analyticPoint() {
       {.position = {-8.0, 3.0, -2.0}, .color = {1.0, 0.9, 0.8}, .intensity = 20.0, .range = 60.0});
 }
 
+/// A spot in the ground camera's view, left of the wall, aimed down across it (its rectification falls
+/// back: the epipolar layout of the light).
+inline SpotLight analyticViewSpot() {
+  return SpotLight({.position = {-1.0, 4.0, -8.0},
+                    .direction = {4.0, -4.0, -4.0},
+                    .innerConeAngle = 0.45,
+                    .outerConeAngle = 0.7,
+                    .color = {1.0, 0.85, 0.7},
+                    .intensity = 30.0,
+                    .range = 60.0});
+}
+
+/// A point light in the ground camera's view, left of the wall.
+inline PointLight analyticViewPoint() {
+  return PointLight(
+      {.position = {-1.0, 3.0, -6.0}, .color = {1.0, 0.9, 0.8}, .intensity = 20.0, .range = 60.0});
+}
+
 /// The first hit of a light ray from a local light with the wall's plane, in front of the light only.
 inline std::optional<glm::dvec3> wallHitFromLight(const LightRay& ray) {
   const HalfSpace plane = wall();
