@@ -109,8 +109,9 @@ vec4 crep_atmosphereTableCoords(CrepAtmosphereParams a, float h, float cosViewZe
 }
 
 // Listing 1 (Yusov 2013): the packed 4D table at `coords`, GL trilinear in the packed dimensions (the
-// phi coordinate clamped to its slice's texel centres) and linear between the two theta slices.
-vec3 crep_sampleAtmosphereTable(sampler3D table, CrepAtmosphereParams a, vec4 coords) {
+// phi coordinate clamped to its slice's texel centres) and linear between the two theta slices; RGBA
+// (crep::sampleAtmosphereTableRgba).
+vec4 crep_sampleAtmosphereTableRgba(sampler3D table, CrepAtmosphereParams a, vec4 coords) {
   float nPhi = float(a.tableSize.z);
   float nTheta = float(a.tableSize.w);
   float q = coords.w * nTheta - 0.5;
@@ -120,9 +121,38 @@ vec3 crep_sampleAtmosphereTable(sampler3D table, CrepAtmosphereParams a, vec4 co
   float z0 = clamp((q0 + coords.z) / nTheta, q0 / nTheta + 0.5 / (nPhi * nTheta),
                    (q0 + 1.0) / nTheta - 0.5 / (nPhi * nTheta));
   float z1 = z0 + (q1 - q0) / nTheta;
-  vec3 s0 = textureLod(table, vec3(coords.xy, z0), 0.0).rgb;
-  vec3 s1 = textureLod(table, vec3(coords.xy, z1), 0.0).rgb;
+  vec4 s0 = textureLod(table, vec3(coords.xy, z0), 0.0);
+  vec4 s1 = textureLod(table, vec3(coords.xy, z1), 0.0);
   return mix(s0, s1, weight);
+}
+vec3 crep_sampleAtmosphereTable(sampler3D table, CrepAtmosphereParams a, vec4 coords) {
+  return crep_sampleAtmosphereTableRgba(table, a, coords).rgb;
+}
+
+// Single scattering is stored without its phase functions (crep/postfx/atmosphere.h): the single table
+// holds S_R in RGB and S_M's red in A, the single Mie table S_M in RGB. With
+// CREP_ATMOSPHERE_COMBINED_MIE 1 (AtmospherePrecomputeOptions::combinedMie) there is no single Mie table
+// and S_M is rebuilt from the single table's texel by Bruneton's 2017 rule (crep::combinedMieScattering).
+#ifndef CREP_ATMOSPHERE_COMBINED_MIE
+#define CREP_ATMOSPHERE_COMBINED_MIE 0
+#endif
+vec3 crep_combinedMieScattering(CrepAtmosphereParams a, vec4 single) {
+  if (!(single.r > 0.0) || !(a.mieScattering.r > 0.0)) return vec3(0.0);
+  return single.rgb * (single.a / single.r) * (a.rayleighScattering.r / a.mieScattering.r) *
+         (a.mieScattering.rgb / a.rayleighScattering.rgb);
+}
+// L1 at `coords` for the scattering cosine c = v . l (crep::sampleSingleScattering): S_R p_R(c) + S_M p_HG(c).
+// `singleMie` is not read with CREP_ATMOSPHERE_COMBINED_MIE 1 (bind any 3D texture there).
+vec3 crep_sampleSingleScattering(sampler3D single, sampler3D singleMie, CrepAtmosphereParams a, vec4 coords,
+                                 float cosSunView) {
+  vec4 s = crep_sampleAtmosphereTableRgba(single, a, coords);
+#if CREP_ATMOSPHERE_COMBINED_MIE
+  vec3 mie = crep_combinedMieScattering(a, s);
+#else
+  vec3 mie = crep_sampleAtmosphereTable(singleMie, a, coords);
+#endif
+  float c = clamp(cosSunView, -1.0, 1.0);
+  return s.rgb * crep_rayleighPhase(c) + mie * crep_henyeyGreenstein(a.mieExtinction.w, c);
 }
 
 // Listing 1 end to end (crep::lookUpAtmosphere): the table's value at `position` (metres, planet centre at

@@ -25,7 +25,8 @@
 // tree levels, info.y tree row stride, info.z integrationSteps, info.w skySteps), layout block
 // (crep/epipolar.glsl, uniform binding 1, and the epipolar row table at storage binding 1; (a), (b)),
 // atmosphere block (uniform binding 2), camera depth (unit 0), rectified depth (unit 1, (a), (b)),
-// optical depth table (unit 2), L1 (unit 3), L_H (unit 4), L_M (unit 5), prefiltered radiance (unit 6,
+// optical depth table (unit 2), single S_R + S_M.r (unit 3), L_H (unit 4), single S_M (unit 5; not read with
+// CREP_ATMOSPHERE_COMBINED_MIE 1), prefiltered radiance (unit 6,
 // (c)), min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance
 // (image 0), RGBA32F transmittance (image 1).
 #ifndef CREP_ATMOSPHERE_SHAFTS
@@ -50,7 +51,7 @@ layout(binding = 0) uniform sampler2D cameraDepth;
 layout(binding = 2) uniform sampler2D opticalDepthTable;
 layout(binding = 3) uniform sampler3D singleTable;
 layout(binding = 4) uniform sampler3D higherOrdersTable;
-layout(binding = 5) uniform sampler3D multipleTable;
+layout(binding = 5) uniform sampler3D singleMieTable; // not read with CREP_ATMOSPHERE_COMBINED_MIE 1
 #if CREP_SHAFTS_WALK
 layout(binding = 1) uniform sampler2D rectifiedDepth;
 layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
@@ -130,6 +131,18 @@ vec3 lookUp(sampler3D table, float t, vec4 first) {
   return lookUpAt(table, t, coords);
 }
 
+// L1 at C + v t: the phase-free single tables with the current ray's phase functions (rayVL;
+// crep_sampleSingleScattering). `coords`: as crep_lookUpAtmosphere's.
+vec3 singleAt(float t, inout vec4 coords) {
+  RayPoint p = rayPoint(t);
+  coords = crep_atmosphereTableCoords(crep_atmosphere, p.h, p.cosView, p.cosSun, rayVL, coords);
+  return crep_sampleSingleScattering(singleTable, singleMieTable, crep_atmosphere, coords, rayVL);
+}
+vec3 singleLookUp(float t, vec4 first) {
+  vec4 coords = first;
+  return singleAt(t, coords);
+}
+
 #if CREP_ATMOSPHERE_SHAFTS == 1
 // Single scattering integrand at C + v t (metres): (beta_R d_R p_R + beta_M d_M p_HG) T(C->P) T_sun(P).
 vec3 singleIntegrand(float t) {
@@ -195,8 +208,11 @@ vec3 tablePart(bool sky, float tE) {
   vec4 first = vec4(-1.0);
   vec3 TE = segmentTransmittance(tE);
 #if CREP_ATMOSPHERE_SHAFTS == 0
-  vec3 multipleC = lookUpAt(multipleTable, 0.0, first);
-  return sky ? multipleC : multipleC - TE * lookUp(multipleTable, tE, first); // Eq. 8
+  // L_M = L1 + L_H (the same coordinates).
+  vec3 multipleC = singleAt(0.0, first) + lookUp(higherOrdersTable, 0.0, first);
+  if (sky) return multipleC;
+  vec3 multipleE = singleLookUp(tE, first) + lookUp(higherOrdersTable, tE, first);
+  return multipleC - TE * multipleE; // Eq. 8
 #else
   vec3 higherC = lookUpAt(higherOrdersTable, 0.0, first);
   vec3 part = sky ? higherC : higherC - TE * lookUp(higherOrdersTable, tE, first); // unoccluded, Eq. 8
@@ -205,14 +221,13 @@ vec3 tablePart(bool sky, float tE) {
     float start = firstLit * metres - cameraShift;
     float t1 = clamp(start, 0.0, tE);
     float t2 = clamp(start + litLength * metres, t1, tE);
-    part += max(segmentTransmittance(t1) * lookUp(singleTable, t1, first) -
-                    segmentTransmittance(t2) * lookUp(singleTable, t2, first),
+    part += max(segmentTransmittance(t1) * singleLookUp(t1, first) - segmentTransmittance(t2) * singleLookUp(t2, first),
                 vec3(0.0));
   }
-  if (sky) part += TE * lookUp(singleTable, tE, first); // unshadowed beyond the far plane
+  if (sky) part += TE * singleLookUp(tE, first); // unshadowed beyond the far plane
 #elif CREP_ATMOSPHERE_SHAFTS == 3
-  vec3 singleC = lookUp(singleTable, 0.0, first);
-  vec3 singleE = TE * lookUp(singleTable, tE, first);
+  vec3 singleC = singleLookUp(0.0, first);
+  vec3 singleE = TE * singleLookUp(tE, first);
   part += visibility * (singleC - singleE);
   if (sky) part += singleE;
 #endif

@@ -1,8 +1,9 @@
 #version 450 core
 // AtmosphereTablesPass, ambient sky light stage (Yusov 2013, Eq. 3 and Listing 6): texel i of N holds
 // E_sky at c_phi = -1 + 2 i / (N - 1) for a point 20 m above the ground: the sum over the
-// CREP_ATMOSPHERE_SAMPLES Fibonacci directions (lower ones mirrored to the upper hemisphere) of
-// L_M(C, w, l) (w . zenith), times 2 pi / samples.
+// CREP_ATMOSPHERE_SAMPLES (kAmbientSampleFactor * sphereSamples) Fibonacci directions (lower ones mirrored) of
+// L_M(C, w, l) (w . zenith), times 2 pi / samples; L_M = L1 (the phase-free single tables with their phase
+// functions at w . l) + L_H.
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_SAMPLES
@@ -12,7 +13,9 @@
 layout(local_size_x = 64) in;
 
 layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler3D crep_multiple;
+layout(binding = 0) uniform sampler3D crep_single;
+layout(binding = 1) uniform sampler3D crep_singleMie;
+layout(binding = 2) uniform sampler3D crep_higherOrders;
 layout(binding = 0, rgba32f) uniform restrict writeonly image2D crep_ambient;
 
 void main() {
@@ -26,8 +29,11 @@ void main() {
   for (int k = 0; k < CREP_ATMOSPHERE_SAMPLES; ++k) {
     vec3 w = crep_fibonacciSphereDirection(k, CREP_ATMOSPHERE_SAMPLES);
     w.y = abs(w.y);
-    vec4 coords = crep_atmosphereTableCoords(crep_atmosphere, h, w.y, c, dot(w, sun), vec4(-1.0));
-    sum += crep_sampleAtmosphereTable(crep_multiple, crep_atmosphere, coords) * w.y;
+    float wl = dot(w, sun);
+    vec4 coords = crep_atmosphereTableCoords(crep_atmosphere, h, w.y, c, wl, vec4(-1.0));
+    vec3 multiple = crep_sampleSingleScattering(crep_single, crep_singleMie, crep_atmosphere, coords, wl) +
+                    crep_sampleAtmosphereTable(crep_higherOrders, crep_atmosphere, coords);
+    sum += multiple * w.y;
   }
   imageStore(crep_ambient, ivec2(i, 0), vec4(sum * float(CREP_TWO_PI / float(CREP_ATMOSPHERE_SAMPLES)), 0.0));
 }

@@ -2,7 +2,8 @@
 // AtmosphereTablesPass, J_n stage (Yusov 2013, Eq. 1, n >= 2): each texel of the 4D table sums over the
 // CREP_ATMOSPHERE_SAMPLES directions w of the Fibonacci sphere (beta_R d_R(h) p_R(w . v) + beta_M d_M(h)
 // p_HG(w . v)) L_(n-1)(C, w, l) times 4 pi / samples, L_(n-1) looked up (Listing 1) at the texel's point with
-// fresh coordinates.
+// fresh coordinates. CREP_ATMOSPHERE_FIRST_ORDER 1 (n = 2): L1 from the phase-free single tables with its
+// phase functions at w . l (crep_sampleSingleScattering).
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_SAMPLES
@@ -12,7 +13,13 @@
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
 layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler3D crep_previousOrder;
+#ifndef CREP_ATMOSPHERE_FIRST_ORDER
+#define CREP_ATMOSPHERE_FIRST_ORDER 0
+#endif
+layout(binding = 0) uniform sampler3D crep_previousOrder; // n = 2: the single table
+#if CREP_ATMOSPHERE_FIRST_ORDER
+layout(binding = 1) uniform sampler3D crep_singleMie;
+#endif
 layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
 
 void main() {
@@ -24,8 +31,13 @@ void main() {
   vec3 sum = vec3(0.0);
   for (int i = 0; i < CREP_ATMOSPHERE_SAMPLES; ++i) {
     vec3 w = crep_fibonacciSphereDirection(i, CREP_ATMOSPHERE_SAMPLES);
-    vec4 coords = crep_atmosphereTableCoords(crep_atmosphere, ray.h, w.y, ray.sun.y, dot(w, ray.sun), vec4(-1.0));
+    float wl = dot(w, ray.sun);
+    vec4 coords = crep_atmosphereTableCoords(crep_atmosphere, ray.h, w.y, ray.sun.y, wl, vec4(-1.0));
+#if CREP_ATMOSPHERE_FIRST_ORDER
+    vec3 radiance = crep_sampleSingleScattering(crep_previousOrder, crep_singleMie, crep_atmosphere, coords, wl);
+#else
     vec3 radiance = crep_sampleAtmosphereTable(crep_previousOrder, crep_atmosphere, coords);
+#endif
     sum += crep_atmosphereScattering(crep_atmosphere, dens, dot(w, ray.view)) * radiance;
   }
   imageStore(crep_output, p, vec4(sum * float(CREP_FOUR_PI / float(CREP_ATMOSPHERE_SAMPLES)), 0.0));

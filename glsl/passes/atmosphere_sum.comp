@@ -1,6 +1,5 @@
 #version 450 core
-// AtmosphereTablesPass, table sums: accumulator += addend, texel by texel (L_H = L2 + ... + LN and
-// L_M = L1 + L_H).
+// AtmosphereTablesPass, table sums: accumulator += addend, texel by texel (L_H = L2 + ... + LN).
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
 layout(binding = 0, rgba32f) uniform restrict image3D crep_accumulator;

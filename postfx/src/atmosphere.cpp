@@ -149,23 +149,23 @@ Lerp1 glLerp(double s, int n) {
   return {std::clamp(i, 0, n - 1), std::clamp(i + 1, 0, n - 1), f};
 }
 
-glm::dvec3 texel3(const AtmosphereTable4D& t, int ih, int ia, int slice) {
+glm::dvec4 texel4(const AtmosphereTable4D& t, int ih, int ia, int slice) {
   const std::size_t idx = ((static_cast<std::size_t>(slice) * static_cast<std::size_t>(t.size.viewZenith) +
                             static_cast<std::size_t>(ia)) *
                                static_cast<std::size_t>(t.size.height) +
                            static_cast<std::size_t>(ih)) *
                           4;
-  return {t.rgba[idx], t.rgba[idx + 1], t.rgba[idx + 2]};
+  return {t.rgba[idx], t.rgba[idx + 1], t.rgba[idx + 2], t.rgba[idx + 3]};
 }
 
 /// One GL trilinear fetch of the packed 3D texture (clamp to edge).
-glm::dvec3 fetchTrilinear(const AtmosphereTable4D& t, double s, double tc, double r) {
+glm::dvec4 fetchTrilinear(const AtmosphereTable4D& t, double s, double tc, double r) {
   const int depth = t.size.sunZenith * t.size.sunView;
   const Lerp1 x = glLerp(s, t.size.height);
   const Lerp1 y = glLerp(tc, t.size.viewZenith);
   const Lerp1 z = glLerp(r, depth);
   const auto row = [&](int iy, int iz) {
-    return glm::mix(texel3(t, x.i0, iy, iz), texel3(t, x.i1, iy, iz), x.f);
+    return glm::mix(texel4(t, x.i0, iy, iz), texel4(t, x.i1, iy, iz), x.f);
   };
   const auto plane = [&](int iz) { return glm::mix(row(y.i0, iz), row(y.i1, iz), y.f); };
   return glm::mix(plane(z.i0), plane(z.i1), z.f);
@@ -219,29 +219,39 @@ void forEachTexel(const AtmosphereTableSize& size, int threads, const Body& body
   });
 }
 
-/// Yusov 2013, Listing 3: single scattering of one texel by the trapezoid rule, T_sun from the table.
-glm::dvec3 singleScattering(const AtmosphereTables& tables, const TexelRay& r, int steps) {
+/// Single scattering without the phase functions: S_R and S_M of the top of the header.
+struct SingleParts {
+  glm::dvec3 rayleigh{0.0}, mie{0.0};
+};
+
+/// Yusov 2013, Listing 3 without the phase functions (Bruneton and Neyret 2008, Sec. 4): S_R and S_M of
+/// one texel by the trapezoid rule, T_sun from the table.
+SingleParts singleScattering(const AtmosphereTables& tables, const TexelRay& r, int steps) {
   const AtmosphereParameters& p = tables.parameters;
-  const double ct = glm::dot(r.v, r.l);
-  const double phaseR = rayleighPhase(ct);
-  const double phaseM = henyeyGreenstein(p.mieG, ct);
   const double ds = r.length / steps;
   glm::dvec2 camDensity(0.0);
   glm::dvec2 prevD(0.0);
-  glm::dvec3 prevF(0.0), sum(0.0);
+  SingleParts prevF, sum;
   for (int k = 0; k <= steps; ++k) {
     const glm::dvec3 pk = r.c + r.v * (r.length * k / steps);
     const glm::dvec2 d = densities(p, glm::length(pk));
     if (k > 0) camDensity += (prevD + d) * (0.5 * ds);
-    const glm::dvec3 tCam = transmittanceOf(p, camDensity);
-    const glm::dvec3 tSun = sunTransmittance(tables, pk, r.l);
-    const glm::dvec3 f =
-        (p.rayleighScattering * (d.x * phaseR) + p.mieScattering * (d.y * phaseM)) * tCam * tSun;
-    if (k > 0) sum += (prevF + f) * (0.5 * ds);
+    const glm::dvec3 tt = transmittanceOf(p, camDensity) * sunTransmittance(tables, pk, r.l);
+    const SingleParts f{p.rayleighScattering * d.x * tt, p.mieScattering * d.y * tt};
+    if (k > 0) {
+      sum.rayleigh += (prevF.rayleigh + f.rayleigh) * (0.5 * ds);
+      sum.mie += (prevF.mie + f.mie) * (0.5 * ds);
+    }
     prevD = d;
     prevF = f;
   }
   return sum;
+}
+
+/// S_R p_R(c) + S_M p_HG(c): L1 of phase-free parts.
+glm::dvec3 withPhase(const AtmosphereParameters& p, const glm::dvec3& rayleigh, const glm::dvec3& mie,
+                     double c) {
+  return rayleigh * rayleighPhase(c) + mie * henyeyGreenstein(p.mieG, c);
 }
 
 /// The Fibonacci directions of Eq. 1 and 3 and, per table altitude, their u_alpha coordinates for a
@@ -270,11 +280,12 @@ SphereSamples sphereSamples(const AtmosphereParameters& p, const AtmosphereTable
 }
 
 /// Yusov 2013, Eq. 1 / Listing 4: J_n of one texel from L_(n-1) over the Fibonacci sphere (each a fresh
-/// Listing 1 look-up at C; u_h, u_alpha and u_phi do not depend on the texel's view).
-glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTable4D& prev, const TexelRay& r,
+/// Listing 1 look-up at C; u_h, u_alpha and u_phi do not depend on the texel's view). `prev` null: L1 of
+/// `tables` (n = 2), its phase functions at w . l.
+glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTable4D* prev, const TexelRay& r,
                              int ih, const SphereSamples& sphere) {
   const AtmosphereParameters& p = tables.parameters;
-  const AtmosphereTableSize& size = prev.size;
+  const AtmosphereTableSize& size = tables.options.size;
   const glm::dvec2 d = densities(p, glm::length(r.c));
   const glm::dvec3 betaR = p.rayleighScattering * d.x;
   const glm::dvec3 betaM = p.mieScattering * d.y;
@@ -284,9 +295,11 @@ glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTab
   glm::dvec3 sum(0.0);
   for (int i = 0; i < samples; ++i) {
     const glm::dvec3& w = sphere.dirs[static_cast<std::size_t>(i)];
-    const double uTheta = texCoord(thetaParam(std::clamp(glm::dot(w, r.l), -1.0, 1.0)), size.sunView);
-    const glm::dvec3 l = sampleAtmosphereTable(
-        prev, glm::dvec4(sphere.height[static_cast<std::size_t>(ih)], alpha[i], uPhi, uTheta));
+    const double wl = std::clamp(glm::dot(w, r.l), -1.0, 1.0);
+    const glm::dvec4 coords(sphere.height[static_cast<std::size_t>(ih)], alpha[i], uPhi,
+                            texCoord(thetaParam(wl), size.sunView));
+    const glm::dvec3 l =
+        prev ? sampleAtmosphereTable(*prev, coords) : sampleSingleScattering(tables, coords, wl);
     const double c = glm::dot(w, r.v);
     sum += (betaR * rayleighPhase(c) + betaM * henyeyGreenstein(p.mieG, c)) * l;
   }
@@ -358,6 +371,16 @@ void validate(const AtmospherePrecomputeOptions& o) {
   requireRange("opticalDepthZenith", o.opticalDepthZenith, 2, kMaxSize);
   requireRange("opticalDepthSteps", o.opticalDepthSteps, 1, kMaxSteps);
   requireRange("ambientSize", o.ambientSize, 2, kMaxSize);
+}
+
+void validate(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o) {
+  validate(p);
+  validate(o);
+  const glm::dvec3& r = p.rayleighScattering;
+  if (o.combinedMie && !(r.x > 0.0 && r.y > 0.0 && r.z > 0.0 && p.mieScattering.x > 0.0))
+    throw InvalidArgument("AtmospherePrecomputeOptions.combinedMie", "true",
+                          "needs AtmosphereParameters.rayleighScattering > 0 in every channel and "
+                          "mieScattering.r > 0 (the combined form divides by them)");
 }
 
 void validate(const AtmospherePlacement& placement, const AtmosphereParameters& p) {
@@ -461,8 +484,12 @@ void atmosphereDirections(double cosViewZenith, double cosSunZenith, double cosS
   sun = glm::normalize(glm::dvec3(lx, ly, lz));
 }
 
-// Yusov 2013, Listing 1: trilinear in the packed 3D texture, linear between the two theta slices.
 glm::dvec3 sampleAtmosphereTable(const AtmosphereTable4D& table, const glm::dvec4& coords) {
+  return glm::dvec3(sampleAtmosphereTableRgba(table, coords));
+}
+
+// Yusov 2013, Listing 1: trilinear in the packed 3D texture, linear between the two theta slices.
+glm::dvec4 sampleAtmosphereTableRgba(const AtmosphereTable4D& table, const glm::dvec4& coords) {
   const int nTheta = table.size.sunView;
   const int depth = table.size.sunZenith * nTheta;
   const double q = coords.w * nTheta - 0.5;
@@ -473,9 +500,37 @@ glm::dvec3 sampleAtmosphereTable(const AtmosphereTable4D& table, const glm::dvec
   const double zMax = (q0 + 1.0) / nTheta - 0.5 / depth;
   const double z0 = std::clamp((q0 + coords.z) / nTheta, zMin, zMax);
   const double z1 = z0 + (q1 - q0) / nTheta;
-  const glm::dvec3 a = fetchTrilinear(table, coords.x, coords.y, z0);
-  const glm::dvec3 b = fetchTrilinear(table, coords.x, coords.y, z1);
+  const glm::dvec4 a = fetchTrilinear(table, coords.x, coords.y, z0);
+  const glm::dvec4 b = fetchTrilinear(table, coords.x, coords.y, z1);
   return glm::mix(a, b, weight);
+}
+
+// Bruneton's 2017 implementation, GetExtrapolatedSingleMieScattering.
+glm::dvec3 combinedMieScattering(const AtmosphereParameters& p, const glm::dvec4& single) {
+  if (!(single.x > 0.0) || !(p.mieScattering.x > 0.0)) return glm::dvec3(0.0);
+  const glm::dvec3 ratio = p.mieScattering / p.rayleighScattering; // > 0 by validate(p, o)
+  return glm::dvec3(single) * (single.w / single.x) * (p.rayleighScattering.x / p.mieScattering.x) * ratio;
+}
+
+// L1 = S_R p_R + S_M p_HG (the top of the header).
+glm::dvec3 sampleSingleScattering(const AtmosphereTables& tables, const glm::dvec4& coords,
+                                  double cosSunView) {
+  const glm::dvec4 s = sampleAtmosphereTableRgba(tables.single, coords);
+  const glm::dvec3 mie = tables.options.combinedMie ? combinedMieScattering(tables.parameters, s)
+                                                    : sampleAtmosphereTable(tables.singleMie, coords);
+  return withPhase(tables.parameters, glm::dvec3(s), mie, std::clamp(cosSunView, -1.0, 1.0));
+}
+
+glm::dvec3 lookUpSingleScattering(const AtmosphereTables& tables, const glm::dvec3& position,
+                                  const glm::dvec3& view, const glm::dvec3& toSun, glm::dvec4& coords) {
+  lookUpAtmosphere(tables, tables.single, position, view, toSun, coords);
+  return sampleSingleScattering(tables, coords, glm::dot(view, toSun));
+}
+
+glm::dvec3 lookUpMultipleScattering(const AtmosphereTables& tables, const glm::dvec3& position,
+                                    const glm::dvec3& view, const glm::dvec3& toSun, glm::dvec4& coords) {
+  const glm::dvec3 single = lookUpSingleScattering(tables, position, view, toSun, coords);
+  return single + sampleAtmosphereTable(tables.higherOrders, coords);
 }
 
 // Yusov 2013, Listing 1 end to end.
@@ -575,8 +630,7 @@ glm::dvec3 atmospherePosition(const AtmospherePlacement& placement, const Atmosp
 // Yusov 2013, "Multiple Scattering" steps 1-3 and Eq. 3.
 AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
                                       int threads) {
-  validate(p);
-  validate(o);
+  validate(p, o);
   AtmosphereTables t;
   t.parameters = p;
   t.options = o;
@@ -608,25 +662,30 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
 
   const AtmosphereTableSize& size = o.size;
   const std::size_t n = emptyTable(size).texels();
-  std::vector<glm::dvec3> single(n), higher(n, glm::dvec3(0.0));
+  std::vector<glm::dvec3> higher(n, glm::dvec3(0.0));
 
-  // Step 1: single scattering.
-  AtmosphereTable4D previous = emptyTable(size);
+  // Step 1: single scattering without its phase functions (S_R, S_M).
+  t.single = emptyTable(size);
+  if (!o.combinedMie) t.singleMie = emptyTable(size);
+  AtmosphereTable4D first; // L1 with its phase functions at each texel's c_theta (keepOrders)
+  if (o.keepOrders) first = emptyTable(size);
   forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
     const TexelRay r = texelRay(p, size, ih, ia, ip, it);
-    const glm::dvec3 v = singleScattering(t, r, o.singleSteps);
-    single[packedIndex(size, ih, ia, ip, it)] = v;
-    store(previous, ih, ia, ip, it, v);
+    const SingleParts v = singleScattering(t, r, o.singleSteps);
+    t.single.at(ih, ia, ip, it) = glm::vec4(glm::vec3(v.rayleigh), static_cast<float>(v.mie.x));
+    if (!o.combinedMie) store(t.singleMie, ih, ia, ip, it, v.mie);
+    if (o.keepOrders) store(first, ih, ia, ip, it, withPhase(p, v.rayleigh, v.mie, glm::dot(r.v, r.l)));
   });
-  if (o.keepOrders) t.orders.push_back(previous);
+  if (o.keepOrders) t.orders.push_back(std::move(first));
 
-  // Step 2: J_n from L_(n-1), then L_n from J_n; L_H accumulates.
+  // Step 2: J_n from L_(n-1) (n = 2: L1 with its phase functions), then L_n from J_n; L_H accumulates.
   const SphereSamples sphere = sphereSamples(p, size, o.sphereSamples);
+  AtmosphereTable4D previous;
   for (int order = 2; order <= o.orders; ++order) {
     AtmosphereTable4D j = emptyTable(size);
     forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
       const TexelRay r = texelRay(p, size, ih, ia, ip, it);
-      store(j, ih, ia, ip, it, scatteredRadiance(t, previous, r, ih, sphere));
+      store(j, ih, ia, ip, it, scatteredRadiance(t, order == 2 ? nullptr : &previous, r, ih, sphere));
     });
     AtmosphereTable4D ln = emptyTable(size);
     forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
@@ -639,17 +698,11 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
     if (o.keepOrders) t.orders.push_back(previous);
   }
 
-  // Step 3: L_1, L_H and L_M = L_1 + L_H.
-  t.single = emptyTable(size);
+  // Step 3: L_H.
   t.higherOrders = emptyTable(size);
-  t.multiple = emptyTable(size);
   for (std::size_t i = 0; i < n; ++i) {
-    const glm::vec4 a(glm::vec3(single[i]), 0.0f);
     const glm::vec4 b(glm::vec3(higher[i]), 0.0f);
-    const glm::vec4 m(glm::vec3(single[i] + higher[i]), 0.0f);
-    std::copy(&a.x, &a.x + 4, t.single.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
     std::copy(&b.x, &b.x + 4, t.higherOrders.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
-    std::copy(&m.x, &m.x + 4, t.multiple.rgba.begin() + static_cast<std::ptrdiff_t>(4 * i));
   }
 
   // Eq. 3 / Listing 6: ambient sky light at 20 m from L_M.
@@ -661,13 +714,14 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
       const double cp = -1.0 + 2.0 * i / (na - 1);
       const glm::dvec3 l(std::sqrt(std::max(0.0, 1.0 - cp * cp)), cp, 0.0);
       glm::dvec3 sum(0.0);
-      for (int k = 0; k < o.sphereSamples; ++k) {
-        glm::dvec3 w = sphere.dirs[static_cast<std::size_t>(k)];
+      const int samples = kAmbientSampleFactor * o.sphereSamples;
+      for (int k = 0; k < samples; ++k) {
+        glm::dvec3 w = fibonacciSphereDirection(k, samples);
         w.y = std::abs(w.y);
         glm::dvec4 coords(-1.0);
-        sum += lookUpAtmosphere(t, t.multiple, c, w, l, coords) * w.y;
+        sum += lookUpMultipleScattering(t, c, w, l, coords) * w.y;
       }
-      sum *= 2.0 * kPi / o.sphereSamples;
+      sum *= 2.0 * kPi / samples;
       for (int ch = 0; ch < 3; ++ch)
         t.ambient.at(i, 0, ch) = static_cast<float>(sum[ch]);
     });

@@ -2,31 +2,32 @@
 //
 // ---------------------------------------------------------------------------------------------------
 // Cache key (atmosphereCacheKey): FNV-1a 64 (Fowler, Noll and Vo) over, in this order, the ASCII tag
-// "crep-atmosphere-key-1", then the little-endian IEEE-754 bytes of the 14 doubles of AtmosphereParameters
+// "crep-atmosphere-key-2", then the little-endian IEEE-754 bytes of the 14 doubles of AtmosphereParameters
 //   earthRadius, atmosphereHeight, rayleighScattering.x, .y, .z, rayleighScaleHeight,
 //   mieScattering.x, .y, .z, mieAbsorption.x, .y, .z, mieScaleHeight, mieG
-// and the little-endian int32 bytes of the 12 ints of AtmospherePrecomputeOptions
+// and the little-endian int32 bytes of the 13 ints of AtmospherePrecomputeOptions
 //   size.height, size.viewZenith, size.sunZenith, size.sunView, orders, singleSteps, orderSteps,
-//   sphereSamples, opticalDepthHeight, opticalDepthZenith, opticalDepthSteps, ambientSize
+//   sphereSamples, opticalDepthHeight, opticalDepthZenith, opticalDepthSteps, ambientSize, combinedMie (0, 1)
 // (keepOrders and the thread count do not change the tables and are left out). The key is the 64-bit
 // digest as 16 lower-case hex digits. Exact bytes: 0.0 and -0.0 give different keys.
 //
-// File format (version 1), every number little-endian, no padding:
+// File format (version 2; version 1 stored L1 with its phase functions and L_M), every number
+// little-endian, no padding:
 //   offset  size  field
 //        0     8  magic "CREPATM1" (ASCII)
-//        8     4  uint32 version = 1
+//        8     4  uint32 version = 2
 //       12    16  the cache key of the stored parameters and options (16 ASCII hex digits)
 //       28   112  14 float64: the AtmosphereParameters fields in the key's order
-//      140    48  12 int32: the AtmospherePrecomputeOptions ints in the key's order
-//      188     4  uint32 keepOrders (0 or 1)
-//      192     4  uint32 K, the number of per-order tables that follow (0, or `orders` when keepOrders)
-//      196    12  int32 width, height, channels of the optical depth image
+//      140    52  13 int32: the AtmospherePrecomputeOptions ints in the key's order
+//      192     4  uint32 keepOrders (0 or 1)
+//      196     4  uint32 K, the number of per-order tables that follow (0, or `orders` when keepOrders)
+//      200    12  int32 width, height, channels of the optical depth image
 //                 (must be opticalDepthHeight, opticalDepthZenith, 2)
-//      208    12  int32 width, height, channels of the ambient image (must be ambientSize, 1, 3)
-//      220    16  int32 N_h, N_alpha, N_phi, N_theta of every 4D table (must equal options.size)
-//      236        float32 data, each block in its in-memory order:
+//      212    12  int32 width, height, channels of the ambient image (must be ambientSize, 1, 3)
+//      224    16  int32 N_h, N_alpha, N_phi, N_theta of every 4D table (must equal options.size)
+//      240        float32 data, each block in its in-memory order:
 //                   optical depth (W * H * 2), ambient (ambientSize * 3),
-//                   single, higherOrders, multiple, then the K order tables L1..LK
+//                   single, singleMie (not with combinedMie), higherOrders, then the K order tables L1..LK
 //                   (each N_h * N_alpha * N_phi * N_theta * 4, the packed order of AtmosphereTable4D)
 //      end-8   8  uint64 checksum: FNV-1a 64 of every preceding byte of the file
 // A reader checks the magic, the version, every size against the limits of validate(options) before it
@@ -55,9 +56,10 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr char kMagic[8] = {'C', 'R', 'E', 'P', 'A', 'T', 'M', '1'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
 constexpr std::size_t kKeyDigits = 16;
-constexpr std::size_t kHeaderBytes = 236;
+constexpr std::size_t kHeaderBytes = 240;
+constexpr std::size_t kOptionFields = 13;
 constexpr std::size_t kChecksumBytes = 8;
 
 constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -132,14 +134,23 @@ AtmosphereParameters parametersFromFields(const std::array<double, 14>& f) {
   return p;
 }
 
-// The 12 ints of the options in the key's (and the file's) order.
-std::array<int, 12> optionFields(const AtmospherePrecomputeOptions& o) {
-  return {
-      o.size.height,       o.size.viewZenith, o.size.sunZenith, o.size.sunView,       o.orders,
-      o.singleSteps,       o.orderSteps,      o.sphereSamples,  o.opticalDepthHeight, o.opticalDepthZenith,
-      o.opticalDepthSteps, o.ambientSize};
+// The 13 ints of the options in the key's (and the file's) order.
+std::array<int, kOptionFields> optionFields(const AtmospherePrecomputeOptions& o) {
+  return {o.size.height,
+          o.size.viewZenith,
+          o.size.sunZenith,
+          o.size.sunView,
+          o.orders,
+          o.singleSteps,
+          o.orderSteps,
+          o.sphereSamples,
+          o.opticalDepthHeight,
+          o.opticalDepthZenith,
+          o.opticalDepthSteps,
+          o.ambientSize,
+          o.combinedMie ? 1 : 0};
 }
-AtmospherePrecomputeOptions optionsFromFields(const std::array<int, 12>& f, bool keepOrders) {
+AtmospherePrecomputeOptions optionsFromFields(const std::array<int, kOptionFields>& f, bool keepOrders) {
   AtmospherePrecomputeOptions o;
   o.size = {f[0], f[1], f[2], f[3]};
   o.orders = f[4];
@@ -150,6 +161,7 @@ AtmospherePrecomputeOptions optionsFromFields(const std::array<int, 12>& f, bool
   o.opticalDepthZenith = f[9];
   o.opticalDepthSteps = f[10];
   o.ambientSize = f[11];
+  o.combinedMie = f[12] != 0;
   o.keepOrders = keepOrders;
   return o;
 }
@@ -180,13 +192,13 @@ std::size_t tableFloats(const AtmosphereTableSize& s) {
 
 // The limits of validate(AtmospherePrecomputeOptions) (atmosphere.h), checked on a file's sizes before
 // anything is allocated from them. Returns the reason, or empty when they hold.
-std::string sizeProblem(const std::array<int, 12>& f) {
-  static const char* const names[12] = {
+std::string sizeProblem(const std::array<int, kOptionFields>& f) {
+  static const char* const names[kOptionFields] = {
       "size.height",       "size.viewZenith", "size.sunZenith", "size.sunView",       "orders",
       "singleSteps",       "orderSteps",      "sphereSamples",  "opticalDepthHeight", "opticalDepthZenith",
-      "opticalDepthSteps", "ambientSize"};
-  for (int i = 0; i < 12; ++i) {
-    const int v = f[static_cast<std::size_t>(i)];
+      "opticalDepthSteps", "ambientSize",     "combinedMie"};
+  for (std::size_t i = 0; i < kOptionFields; ++i) {
+    const int v = f[i];
     int lo = 2, hi = 2048;
     if (i == 4) {
       lo = 1;
@@ -197,6 +209,9 @@ std::string sizeProblem(const std::array<int, 12>& f) {
     } else if (i == 10) {
       lo = 1;
       hi = 4096;
+    } else if (i == 12) {
+      lo = 0;
+      hi = 1;
     }
     if (v < lo || v > hi)
       return std::string("stored ") + names[i] + " = " + std::to_string(v) + " outside [" +
@@ -278,7 +293,7 @@ std::string uniqueSuffix() {
 } // namespace
 
 std::string atmosphereCacheKey(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o) {
-  std::string bytes = "crep-atmosphere-key-1";
+  std::string bytes = "crep-atmosphere-key-2";
   for (double v : parameterFields(p))
     putF64(bytes, v);
   for (int v : optionFields(o))
@@ -290,7 +305,7 @@ std::string atmosphereCacheKey(const AtmosphereParameters& p, const AtmospherePr
 
 void saveAtmosphereTables(const AtmosphereTables& tables, const fs::path& path) {
   const AtmospherePrecomputeOptions& o = tables.options;
-  const std::array<int, 12> sizes = optionFields(o);
+  const std::array<int, kOptionFields> sizes = optionFields(o);
   if (const std::string problem = sizeProblem(sizes); !problem.empty()) throwWrite(path, problem);
   const std::size_t floats4D = tableFloats(o.size);
   const bool withOrders = o.keepOrders && !tables.orders.empty();
@@ -306,8 +321,8 @@ void saveAtmosphereTables(const AtmosphereTables& tables, const fs::path& path) 
                            ")");
   };
   checkTable(tables.single, "single");
+  if (!o.combinedMie) checkTable(tables.singleMie, "singleMie");
   checkTable(tables.higherOrders, "higherOrders");
-  checkTable(tables.multiple, "multiple");
   if (withOrders)
     for (std::size_t i = 0; i < tables.orders.size(); ++i)
       checkTable(tables.orders[i], "orders[" + std::to_string(i) + "]");
@@ -367,8 +382,8 @@ void saveAtmosphereTables(const AtmosphereTables& tables, const fs::path& path) 
     emitFloats(tables.opticalDepth.data().data(), tables.opticalDepth.sampleCount());
     emitFloats(tables.ambient.data().data(), tables.ambient.sampleCount());
     emitFloats(tables.single.rgba.data(), floats4D);
+    if (!o.combinedMie) emitFloats(tables.singleMie.rgba.data(), floats4D);
     emitFloats(tables.higherOrders.rgba.data(), floats4D);
-    emitFloats(tables.multiple.rgba.data(), floats4D);
     if (withOrders)
       for (const AtmosphereTable4D& t : tables.orders)
         emitFloats(t.rgba.data(), floats4D);
@@ -410,14 +425,14 @@ AtmosphereTables loadAtmosphereTables(const fs::path& path) {
   std::array<double, 14> pf{};
   for (std::size_t i = 0; i < pf.size(); ++i)
     pf[i] = getF64(h.data() + 28 + 8 * i);
-  std::array<int, 12> of{};
+  std::array<int, kOptionFields> of{};
   for (std::size_t i = 0; i < of.size(); ++i)
     of[i] = getI32(h.data() + 140 + 4 * i);
-  const std::uint32_t keepOrders = getU32(h.data() + 188);
-  const std::uint32_t orderCount = getU32(h.data() + 192);
+  const std::uint32_t keepOrders = getU32(h.data() + 192);
+  const std::uint32_t orderCount = getU32(h.data() + 196);
   std::array<int, 10> dims{};
   for (std::size_t i = 0; i < dims.size(); ++i)
-    dims[i] = getI32(h.data() + 196 + 4 * i);
+    dims[i] = getI32(h.data() + 200 + 4 * i);
 
   if (const std::string problem = sizeProblem(of); !problem.empty()) throwRead(path, "bad sizes: " + problem);
   if (keepOrders > 1) throwRead(path, "bad sizes: keepOrders = " + std::to_string(keepOrders));
@@ -439,7 +454,7 @@ AtmosphereTables loadAtmosphereTables(const fs::path& path) {
   const std::size_t ambientFloats = static_cast<std::size_t>(o.ambientSize) * 3u;
   const std::uintmax_t expected =
       kHeaderBytes + kChecksumBytes +
-      (depthFloats + ambientFloats + floats4D * (3u + orderCount)) * sizeof(float);
+      (depthFloats + ambientFloats + floats4D * ((o.combinedMie ? 2u : 3u) + orderCount)) * sizeof(float);
   if (fileBytes != expected)
     throwRead(path, (fileBytes < expected ? "truncated: " : "wrong length: ") + std::to_string(fileBytes) +
                         " bytes, the sizes imply " + std::to_string(expected));
@@ -458,8 +473,8 @@ AtmosphereTables loadAtmosphereTables(const fs::path& path) {
     reader.readFloats(table.rgba.data(), floats4D, what);
   };
   readTable(t.single, "the single scattering table");
+  if (!o.combinedMie) readTable(t.singleMie, "the single Mie scattering table");
   readTable(t.higherOrders, "the higher orders table");
-  readTable(t.multiple, "the multiple scattering table");
   t.orders.resize(orderCount);
   for (AtmosphereTable4D& table : t.orders)
     readTable(table, "an order table");

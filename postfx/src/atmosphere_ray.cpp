@@ -32,6 +32,8 @@
 //       with max(1, ceil(integrationSteps (tb - ta) / s_m)) steps of
 //       (beta_R d_R(h) p_R(c) + beta_M d_M(h) p_HG(c)) T(C->P) T_sun(P), c = v . l, d = exp(-h / H) with
 //       h = max(0, |P| - R); sky: plus [s_F, t_X] unshadowed with skySteps steps.
+//   L1 of a look-up is the single table's phase-free parts with the ray's own phase functions (c = v . l;
+//   sampleSingleScattering), L_M = L1 + L_H at the same coordinates.
 //   (b) P1 = C + v D_start, P2 = C + v min(D_start + D_lit, end) with D_start clamped to [0, end] (end = s_E,
 //       sky s_F); single = max(0, T(C->P1) L1(P1) - T(C->P2) L1(P2)) per channel (Eq. 8 on the lit part),
 //       0 without lit length; sky: plus T(C->F) L1(F) (unshadowed beyond the far plane).
@@ -99,9 +101,9 @@ class RayEvaluator {
 public:
   RayEvaluator(const AtmosphereTables& tables, const glm::dvec3& C, const glm::dvec3& v, const glm::dvec3& l)
       : tables_(tables), p_(tables.parameters), C_(C), v_(v), l_(l) {
-    const double c = glm::dot(v, l);
-    phaseR_ = rayleighPhase(c);
-    phaseM_ = henyeyGreenstein(p_.mieG, c);
+    cosSunView_ = glm::dot(v, l);
+    phaseR_ = rayleighPhase(cosSunView_);
+    phaseM_ = henyeyGreenstein(p_.mieG, cosSunView_);
   }
 
   glm::dvec3 at(double t) const { return C_ + v_ * t; }
@@ -126,20 +128,18 @@ public:
   /// table reads 0.
   glm::dvec3 lookUp(const AtmosphereTable4D& table, double t) {
     if (table.rgba.empty()) return glm::dvec3(0.0);
-    if (!haveFirst_ && t != 0.0) lookUp(table, 0.0);
-    glm::dvec4 coords = haveFirst_ ? first_ : glm::dvec4(-1.0);
-    const glm::dvec3 value = lookUpAtmosphere(tables_, table, at(t), v_, l_, coords);
-    if (!haveFirst_) {
-      first_ = coords;
-      haveFirst_ = true;
-    }
-    return value;
+    return sampleAtmosphereTable(table, coords(t));
   }
+  /// L1 at C + v t: the phase-free parts with this ray's phase functions (sampleSingleScattering).
+  glm::dvec3 single(double t) { return sampleSingleScattering(tables_, coords(t), cosSunView_); }
+  /// L_M = L1 + L_H at C + v t.
+  glm::dvec3 multiple(double t) { return single(t) + lookUp(tables_.higherOrders, t); }
 
-  /// Eq. 8 between C and C + v t: L(C) - T(C -> C + v t) L(C + v t).
-  glm::dvec3 eq8(const AtmosphereTable4D& table, double t) {
-    const glm::dvec3 atC = lookUp(table, 0.0);
-    return atC - segmentTransmittance(t) * lookUp(table, t);
+  /// Eq. 8 between C and C + v t of a quantity `of(t)`: L(C) - T(C -> C + v t) L(C + v t).
+  template <class Of>
+  glm::dvec3 eq8(const Of& of, double t) {
+    const glm::dvec3 atC = of(0.0);
+    return atC - segmentTransmittance(t) * of(t);
   }
 
   /// The single-scattering integrand at C + v t (Listing 3's, with table transmittances).
@@ -162,10 +162,27 @@ public:
   }
 
 private:
+  /// The table coordinates of C + v t; the first look-up of the ray is at C (made first when the first
+  /// call is elsewhere) and chooses the side of the horizon that every later one keeps (Listing 2).
+  glm::dvec4 coords(double t) {
+    if (!haveFirst_ && t != 0.0) coords(0.0);
+    glm::dvec4 c = haveFirst_ ? first_ : glm::dvec4(-1.0);
+    const glm::dvec3 P = at(t);
+    const double r = glm::length(P);
+    const glm::dvec3 up = P / r;
+    c = atmosphereTableCoords(p_, tables_.options.size, r - p_.earthRadius, glm::dot(up, v_),
+                              glm::dot(up, l_), cosSunView_, c);
+    if (!haveFirst_) {
+      first_ = c;
+      haveFirst_ = true;
+    }
+    return c;
+  }
+
   const AtmosphereTables& tables_;
   const AtmosphereParameters& p_;
   glm::dvec3 C_, v_, l_;
-  double phaseR_ = 0.0, phaseM_ = 0.0;
+  double cosSunView_ = 0.0, phaseR_ = 0.0, phaseM_ = 0.0;
   glm::dvec4 first_{-1.0};
   bool haveFirst_ = false;
 };
@@ -219,10 +236,11 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
   RayEvaluator ray(tables, C, v, l);
   // The table-based part of the radiance (all but (a)'s integrated single scattering) of the ray of `r`.
   const auto tablePart = [&](RayEvaluator& r) {
-    if (options.shafts == AtmosphereShafts::None)
-      return sky ? r.lookUp(tables.multiple, 0.0) : r.eq8(tables.multiple, sEnd);
+    const auto multiple = [&](double t) { return r.multiple(t); };
+    const auto higher = [&](double t) { return r.lookUp(tables.higherOrders, t); };
+    if (options.shafts == AtmosphereShafts::None) return sky ? r.multiple(0.0) : r.eq8(multiple, sEnd);
     // Unoccluded higher orders (MS-UnO).
-    glm::dvec3 part = sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(tables.higherOrders, sEnd);
+    glm::dvec3 part = sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd);
     if (options.shafts == AtmosphereShafts::LitLengthTable) {
       // SS-LUT: Eq. 8 with L1 between the first lit point and the end of the lit length.
       const double litLength = std::max(0.0, shadowing.litLength) * mpu;
@@ -230,16 +248,15 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
         const double first = shadowing.firstLit * mpu - enter;
         const double a = std::clamp(first, 0.0, sEnd);
         const double b = std::clamp(first + litLength, a, sEnd);
-        const glm::dvec3 l1C = r.lookUp(tables.single, 0.0); // the first look-up is at C
-        const glm::dvec3 l1a = a > 0.0 ? r.lookUp(tables.single, a) : l1C;
-        const glm::dvec3 lit =
-            r.segmentTransmittance(a) * l1a - r.segmentTransmittance(b) * r.lookUp(tables.single, b);
+        const glm::dvec3 l1C = r.single(0.0); // the first look-up is at C
+        const glm::dvec3 l1a = a > 0.0 ? r.single(a) : l1C;
+        const glm::dvec3 lit = r.segmentTransmittance(a) * l1a - r.segmentTransmittance(b) * r.single(b);
         part += glm::max(lit, glm::dvec3(0.0));
       }
-      if (sky) part += r.segmentTransmittance(sEnd) * r.lookUp(tables.single, sEnd);
+      if (sky) part += r.segmentTransmittance(sEnd) * r.single(sEnd);
     } else if (options.shafts == AtmosphereShafts::PrefilteredVisibility) {
-      const glm::dvec3 l1C = r.lookUp(tables.single, 0.0);
-      const glm::dvec3 beyond = r.segmentTransmittance(sEnd) * r.lookUp(tables.single, sEnd);
+      const glm::dvec3 l1C = r.single(0.0);
+      const glm::dvec3 beyond = r.segmentTransmittance(sEnd) * r.single(sEnd);
       part += shadowing.visibility * (l1C - beyond);
       if (sky) part += beyond;
     }

@@ -2,7 +2,7 @@
 // AtmosphereTablesPass; the CPU reference and the algorithm are crep/postfx/atmosphere.h's). Stages, one
 // compute shader each (one texel per invocation): passes/atmosphere_optical_depth.comp,
 // atmosphere_single.comp (L1), atmosphere_scattered.comp (J_n), atmosphere_order.comp (L_n),
-// atmosphere_sum.comp (L_H and L_M) and atmosphere_ambient.comp (E_sky); look-ups of
+// atmosphere_sum.comp (L_H) and atmosphere_ambient.comp (E_sky); look-ups of
 // glsl/crep/atmosphere.glsl.
 #include <crep/core/error.h>
 #include <crep/core/gl_state.h>
@@ -84,8 +84,7 @@ GLuint groups(int n, int local) {
 } // namespace
 
 AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info) {
-  validate(info.parameters);
-  validate(info.options);
+  validate(info.parameters, info.options);
   const AtmospherePrecomputeOptions& o = info.options;
   const std::string size = std::string(kOptions) + ".size.";
   const int max3D = max3DTextureSize();
@@ -101,8 +100,8 @@ AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info)
   gl::checkError("AtmosphereTablesPass (before allocation)");
   opticalDepth_ = createLinearTexture2D(GL_RG32F, o.opticalDepthHeight, o.opticalDepthZenith);
   single_ = createTable3D(o.size);
+  if (!o.combinedMie) singleMie_ = createTable3D(o.size);
   higher_ = createTable3D(o.size);
-  multiple_ = createTable3D(o.size);
   ambient_ = createLinearTexture2D(GL_RGBA32F, o.ambientSize, 1);
   gl::checkError("AtmosphereTablesPass: allocating the tables");
 }
@@ -120,16 +119,26 @@ void AtmosphereTablesPass::compute() {
   const auto steps = [](int n) {
     return std::vector<ShaderDefine>{{"CREP_ATMOSPHERE_STEPS", std::to_string(n)}};
   };
-  const std::vector<ShaderDefine> samples{{"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)}};
+  const ShaderDefine combined{"CREP_ATMOSPHERE_COMBINED_MIE", o.combinedMie ? "1" : "0"};
+  const std::vector<ShaderDefine> samples{{"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)},
+                                          combined};
+  std::vector<ShaderDefine> singleDefines = steps(o.singleSteps);
+  singleDefines.push_back(combined);
+  std::vector<ShaderDefine> firstOrder = samples;
+  firstOrder.push_back({"CREP_ATMOSPHERE_FIRST_ORDER", "1"});
   gl::Handle opticalProgram = buildProgram(
       {{ShaderStage::Compute, "passes/atmosphere_optical_depth.comp", steps(o.opticalDepthSteps)}});
   gl::Handle singleProgram =
-      buildProgram({{ShaderStage::Compute, "passes/atmosphere_single.comp", steps(o.singleSteps)}});
+      buildProgram({{ShaderStage::Compute, "passes/atmosphere_single.comp", singleDefines}});
   gl::Handle sumProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere_sum.comp", {}}});
+  const std::vector<ShaderDefine> ambientSamples{
+      {"CREP_ATMOSPHERE_SAMPLES", std::to_string(kAmbientSampleFactor * o.sphereSamples)}, combined};
   gl::Handle ambientProgram =
-      buildProgram({{ShaderStage::Compute, "passes/atmosphere_ambient.comp", samples}});
-  gl::Handle scatteredProgram, orderProgram;
+      buildProgram({{ShaderStage::Compute, "passes/atmosphere_ambient.comp", ambientSamples}});
+  gl::Handle scatteredProgram, firstScatteredProgram, orderProgram;
   if (o.orders > 1) {
+    firstScatteredProgram =
+        buildProgram({{ShaderStage::Compute, "passes/atmosphere_scattered.comp", firstOrder}});
     scatteredProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere_scattered.comp", samples}});
     orderProgram =
         buildProgram({{ShaderStage::Compute, "passes/atmosphere_order.comp", steps(o.orderSteps)}});
@@ -174,18 +183,20 @@ void AtmosphereTablesPass::compute() {
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   endStage("optical depth");
 
-  // L1.
+  // L1 without its phase functions (S_R, S_M).
   glUseProgram(singleProgram.get());
   glBindTextureUnit(0, opticalDepth_.get());
   glBindImageTexture(0, single_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  if (!o.combinedMie) glBindImageTexture(1, singleMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   dispatchTable();
   if (o.orders == 1) {
-    // L_H = 0, L_M = L1 (timed with single scattering).
+    // L_H = 0 (timed with single scattering).
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearTexImage(higher_.get(), 0, GL_RGBA, GL_FLOAT, zero);
-    copy(single_.get(), multiple_.get());
   }
   endStage("single scattering");
+  // The single Mie unit of the passes that read L1 (the single table itself with combinedMie: not read).
+  const GLuint mieTable = o.combinedMie ? single_.get() : singleMie_.get();
 
   if (o.orders > 1) {
     // J_n and L_n ping-pong through two scratch tables: J_n reads L_(n-1) (L1 or the previous L_n), L_n reads
@@ -195,8 +206,9 @@ void AtmosphereTablesPass::compute() {
     gl::checkError("AtmosphereTablesPass::compute: allocating the scratch tables");
     for (int n = 2; n <= o.orders; ++n) {
       const std::string name = "order " + std::to_string(n) + ": ";
-      glUseProgram(scatteredProgram.get());
+      glUseProgram(n == 2 ? firstScatteredProgram.get() : scatteredProgram.get());
       glBindTextureUnit(0, n == 2 ? single_.get() : order.get());
+      if (n == 2) glBindTextureUnit(1, mieTable);
       glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
       dispatchTable();
       endStage(name + "J");
@@ -204,28 +216,26 @@ void AtmosphereTablesPass::compute() {
       glBindTextureUnit(0, scattered.get());
       glBindImageTexture(0, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
       dispatchTable();
-      // L_H += L_n; after the last order L_M = L1 + L_H (both timed with this L stage).
+      // L_H += L_n (timed with this L stage).
       if (n == 2)
         copy(order.get(), higher_.get());
       else
         sum(higher_.get(), order.get());
-      if (n == o.orders) {
-        copy(single_.get(), multiple_.get());
-        sum(multiple_.get(), higher_.get());
-      }
       endStage(name + "L");
     }
   }
 
   // E_sky.
   glUseProgram(ambientProgram.get());
-  glBindTextureUnit(0, multiple_.get());
+  glBindTextureUnit(0, single_.get());
+  glBindTextureUnit(1, mieTable);
+  glBindTextureUnit(2, higher_.get());
   glBindImageTexture(0, ambient_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glDispatchCompute(groups(o.ambientSize, 64), 1, 1);
   gl::passOutputBarrier();
   endStage("ambient");
 
-  gl::unbindPassState(2);
+  gl::unbindPassState(3);
   gl::checkError("AtmosphereTablesPass::compute");
 }
 
@@ -245,8 +255,10 @@ void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
   };
   if (atmosphereCacheKey(tables.parameters, tables.options) != atmosphereCacheKey(info_.parameters, o))
     fail("must have the parameters and options of the pass's CreateInfo");
-  const AtmosphereTable4D* tables4D[] = {&tables.single, &tables.higherOrders, &tables.multiple};
-  for (const AtmosphereTable4D* t : tables4D)
+  std::vector<std::pair<GLuint, const AtmosphereTable4D*>> targets = {{single_.get(), &tables.single},
+                                                                      {higher_.get(), &tables.higherOrders}};
+  if (!o.combinedMie) targets.emplace_back(singleMie_.get(), &tables.singleMie);
+  for (const auto& [texture, t] : targets)
     if (!sameSize(t->size, o.size) || t->rgba.size() != t->texels() * 4)
       fail("4D tables must be of the CreateInfo's size");
   if (tables.opticalDepth.width() != o.opticalDepthHeight ||
@@ -261,9 +273,6 @@ void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
   glTextureSubImage2D(opticalDepth_.get(), 0, 0, 0, o.opticalDepthHeight, o.opticalDepthZenith, GL_RG,
                       GL_FLOAT, tables.opticalDepth.data().data());
   const int depth = o.size.sunZenith * o.size.sunView;
-  const std::pair<GLuint, const AtmosphereTable4D*> targets[] = {{single_.get(), &tables.single},
-                                                                 {higher_.get(), &tables.higherOrders},
-                                                                 {multiple_.get(), &tables.multiple}};
   for (const auto& [texture, table] : targets)
     glTextureSubImage3D(texture, 0, 0, 0, 0, o.size.height, o.size.viewZenith, depth, GL_RGBA, GL_FLOAT,
                         table->rgba.data());
@@ -284,8 +293,9 @@ AtmosphereTables AtmosphereTablesPass::download() const {
   t.opticalDepth = Image(o.opticalDepthHeight, o.opticalDepthZenith, 2);
   glGetTextureImage(opticalDepth_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(t.opticalDepth.byteSize()),
                     t.opticalDepth.data().data());
-  const std::pair<GLuint, AtmosphereTable4D*> sources[] = {
-      {single_.get(), &t.single}, {higher_.get(), &t.higherOrders}, {multiple_.get(), &t.multiple}};
+  std::vector<std::pair<GLuint, AtmosphereTable4D*>> sources = {{single_.get(), &t.single},
+                                                                {higher_.get(), &t.higherOrders}};
+  if (!o.combinedMie) sources.emplace_back(singleMie_.get(), &t.singleMie);
   for (const auto& [texture, table] : sources) {
     table->size = o.size;
     table->rgba.assign(table->texels() * 4, 0.0f);

@@ -19,7 +19,7 @@ namespace {
 
 /// Texture units, uniform and storage bindings of passes/atmosphere.comp (its header comment).
 constexpr GLuint kUnitCameraDepth = 0, kUnitRectifiedDepth = 1, kUnitOpticalDepth = 2, kUnitSingle = 3,
-                 kUnitHigherOrders = 4, kUnitMultiple = 5, kUnitPrefiltered = 6;
+                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6;
 constexpr int kUnits = 7; ///< units and bindings unbound afterwards (gl::unbindPassState)
 
 bool walksTrees(AtmosphereShafts shafts) {
@@ -51,9 +51,9 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
   atmosphereParams_ = gl::createDynamicBuffer(sizeof(gpu::AtmosphereParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);
   if (!walksTrees(info.shafts)) // the one program of None and (c): compile errors surface here
-    programs_[0] = buildProgram({{ShaderStage::Compute,
-                                  "passes/atmosphere.comp",
-                                  {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(mode)}}}});
+    programs_[0][0] = buildProgram({{ShaderStage::Compute,
+                                     "passes/atmosphere.comp",
+                                     {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(mode)}}}});
   gl::checkError("AtmospherePass");
 }
 
@@ -105,12 +105,14 @@ void AtmospherePass::run(const FrameAttribs& f) {
       throw InvalidArgument("AtmospherePass::FrameAttribs.proxyMedium", "null", "must be set (shafts (c))");
   }
 
-  gl::Handle& program = programs_[walk ? static_cast<int>(layoutData.kind) : 0];
+  const bool combined = tables.options.combinedMie;
+  gl::Handle& program = programs_[combined ? 1 : 0][walk ? static_cast<int>(layoutData.kind) : 0];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
                              "passes/atmosphere.comp",
                              {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(shafts))},
-                              {"CREP_LAYOUT", std::to_string(static_cast<int>(layoutData.kind))}}}});
+                              {"CREP_LAYOUT", std::to_string(static_cast<int>(layoutData.kind))},
+                              {"CREP_ATMOSPHERE_COMBINED_MIE", combined ? "1" : "0"}}}});
 
   // The march block carries the camera and the sun (and (c)'s proxy medium: the closed form of
   // prefilteredVisibility); a placeholder medium otherwise (its members are not read).
@@ -138,7 +140,8 @@ void AtmospherePass::run(const FrameAttribs& f) {
   glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
   glBindTextureUnit(kUnitSingle, f.tables->singleTexture());
   glBindTextureUnit(kUnitHigherOrders, f.tables->higherOrdersTexture());
-  glBindTextureUnit(kUnitMultiple, f.tables->multipleTexture());
+  // With combinedMie there is no single Mie table (the shader does not read the unit).
+  glBindTextureUnit(kUnitSingleMie, combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
   if (walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees
     layoutBuffers_.upload(layoutData, H);
     layoutBuffers_.bind(1, 1);

@@ -103,7 +103,7 @@ AtmosphereTables patternTables(const AtmosphereParameters& p, const AtmospherePr
   t.ambient = patternImage(o.ambientSize, 1, 3, seed * 7u + 2u);
   t.single = patternTable(o.size, seed * 7u + 3u);
   t.higherOrders = patternTable(o.size, seed * 7u + 4u);
-  t.multiple = patternTable(o.size, seed * 7u + 5u);
+  if (!o.combinedMie) t.singleMie = patternTable(o.size, seed * 7u + 5u);
   if (o.keepOrders)
     for (int n = 0; n < o.orders; ++n)
       t.orders.push_back(patternTable(o.size, seed * 7u + 6u + 1000u * static_cast<std::uint32_t>(n)));
@@ -144,7 +144,7 @@ bool sameTables(const AtmosphereTables& a, const AtmosphereTables& b) {
     if (!sameBits(a.orders[i], b.orders[i])) return false;
   return sameBits(a.opticalDepth, b.opticalDepth) && sameBits(a.ambient, b.ambient) &&
          sameBits(a.single, b.single) && sameBits(a.higherOrders, b.higherOrders) &&
-         sameBits(a.multiple, b.multiple);
+         sameBits(a.singleMie, b.singleMie) && a.singleMie.rgba.size() == b.singleMie.rgba.size();
 }
 
 std::vector<char> readBytes(const fs::path& path) {
@@ -204,6 +204,25 @@ TEST_CASE("AtmosphereCache: save and load are bit-identical with equal parameter
   CHECK(sameTables(loadAtmosphereTables(file), other));
 }
 
+TEST_CASE("AtmosphereCache: combinedMie stores no single Mie table and round-trips") {
+  TempDir dir;
+  AtmospherePrecomputeOptions o = smallOptions();
+  o.combinedMie = true;
+  const AtmosphereTables tables = patternTables(someParameters(), o, 21u);
+  const fs::path combined = dir.path / "combined.bin", separate = dir.path / "separate.bin";
+  saveAtmosphereTables(tables, combined);
+  const AtmosphereTables loaded = loadAtmosphereTables(combined);
+  CHECK(loaded.options.combinedMie);
+  CHECK(loaded.singleMie.rgba.empty());
+  CHECK(sameTables(loaded, tables));
+  // One 4D table (N_h N_alpha N_phi N_theta RGBA floats) less than the separate form.
+  o.combinedMie = false;
+  saveAtmosphereTables(patternTables(someParameters(), o, 21u), separate);
+  const auto table4D = static_cast<std::uintmax_t>(o.size.height) * o.size.viewZenith * o.size.sunZenith *
+                       o.size.sunView * 4u * sizeof(float);
+  CHECK(fs::file_size(separate) - fs::file_size(combined) == table4D);
+}
+
 TEST_CASE("AtmosphereCache: the key changes with every field that changes the tables, not keepOrders") {
   const AtmosphereParameters p0 = someParameters();
   const AtmospherePrecomputeOptions o0 = smallOptions();
@@ -246,6 +265,7 @@ TEST_CASE("AtmosphereCache: the key changes with every field that changes the ta
       [](AtmospherePrecomputeOptions& o) { o.opticalDepthZenith += 1; },
       [](AtmospherePrecomputeOptions& o) { o.opticalDepthSteps += 1; },
       [](AtmospherePrecomputeOptions& o) { o.ambientSize += 1; },
+      [](AtmospherePrecomputeOptions& o) { o.combinedMie = true; },
   };
   std::set<std::string> keys{key0};
   for (std::size_t i = 0; i < parameterChanges.size(); ++i) {
@@ -264,7 +284,7 @@ TEST_CASE("AtmosphereCache: the key changes with every field that changes the ta
     CHECK(key != key0);
     keys.insert(key);
   }
-  // 14 parameter fields and 12 option fields: 27 distinct keys with the original.
+  // 14 parameter fields and 13 option fields: 28 distinct keys with the original.
   CHECK(keys.size() == 1u + parameterChanges.size() + optionChanges.size());
 }
 
@@ -277,7 +297,7 @@ TEST_CASE("AtmosphereCache: truncated, flipped, wrong magic and missing files ar
   saveAtmosphereTables(tables, good);
   const std::vector<char> bytes = readBytes(good);
   MESSAGE("small cache file: " << bytes.size() << " bytes");
-  REQUIRE(bytes.size() > 236u);
+  REQUIRE(bytes.size() > 240u);
   const fs::path bad = dir.path / "bad.bin";
 
   // Cut lengths: every one within the header and the first table, then every 7th, and the last 16.
@@ -348,7 +368,7 @@ TEST_CASE("AtmosphereCache: truncated, flipped, wrong magic and missing files ar
   }
   {
     std::vector<char> wrongVersion = bytes;
-    wrongVersion[8] = 2;
+    wrongVersion[8] = 1; // version 1 held L1 with its phase functions and L_M
     writeBytes(bad, wrongVersion, wrongVersion.size());
     const std::string message = loadError(bad);
     CHECK(message.find(bad.string()) != std::string::npos);

@@ -113,7 +113,8 @@ TEST_CASE("AtmospherePhysics: thin homogeneous Rayleigh layer, single scattering
               sphere += std::exp(-beta * t) * std::exp(-beta * sunPath);
             }
             sphere *= beta * rayleighPhaseHere(c) * sEnd / n;
-            const double got = texel[ch];
+            // The table holds S_R without its phase function (Mie off: S_M's red in A is 0).
+            const double got = texel[ch] * rayleighPhaseHere(c);
             worstPlane = std::max(worstPlane, std::abs(got - plane) / plane);
             worstSphere = std::max(worstSphere, std::abs(got - sphere) / sphere);
             worstCurvature = std::max(worstCurvature, std::abs(sphere - plane) / plane);
@@ -159,18 +160,38 @@ TEST_CASE("AtmospherePhysics: each scattering order carries less energy and the 
   CHECK(convergedAt >= 2);
   CHECK(convergedAt <= 6);
 
-  // L_M = L1 + L_H and L_H = L2 + ... + L6 (float sums of double values: a few float ulps).
+  // L_H = L2 + ... + L6 (float sums of double values: a few float ulps), and the kept L1 is the single
+  // tables' parts with each texel's phase functions.
   double worst = 0.0;
-  for (std::size_t i = 0; i < t.multiple.rgba.size(); ++i) {
+  for (std::size_t i = 0; i < t.higherOrders.rgba.size(); ++i) {
     double higher = 0.0;
     for (std::size_t n = 1; n < t.orders.size(); ++n)
       higher += t.orders[n].rgba[i];
-    const double scale = std::max(1e-12, static_cast<double>(std::abs(t.multiple.rgba[i])));
+    const double scale = std::max(1e-12, static_cast<double>(std::abs(t.higherOrders.rgba[i])));
     worst = std::max(worst, std::abs(t.higherOrders.rgba[i] - higher) / scale);
-    worst = std::max(worst, std::abs(t.multiple.rgba[i] - (t.orders[0].rgba[i] + higher)) / scale);
   }
-  MESSAGE("L_M vs L1 + sum L_n, L_H vs sum L_n: max relative difference " << worst);
+  MESSAGE("L_H vs sum L_n: max relative difference " << worst);
   CHECK(worst < 1e-5);
+  const AtmosphereTableSize& s = t.options.size;
+  double worstL1 = 0.0;
+  for (int ih = 0; ih < s.height; ++ih)
+    for (int ia = 0; ia < s.viewZenith; ++ia)
+      for (int ip = 0; ip < s.sunZenith; ++ip)
+        for (int it = 0; it < s.sunView; ++it) {
+          glm::dvec3 v, l;
+          const glm::dvec4 w = atmosphereTexelParams(t.parameters, s, ih, ia, ip, it);
+          atmosphereDirections(w.y, w.z, w.w, v, l);
+          const double c = glm::dot(v, l);
+          const glm::dvec4 parts(t.single.at(ih, ia, ip, it));
+          const glm::dvec3 mie(t.singleMie.at(ih, ia, ip, it));
+          CHECK(parts.w == doctest::Approx(mie.x).epsilon(1e-6)); // A: S_M's red
+          const glm::dvec3 expected =
+              glm::dvec3(parts) * rayleighPhaseHere(c) + mie * henyeyGreenstein(t.parameters.mieG, c);
+          const glm::dvec3 kept(t.orders[0].at(ih, ia, ip, it));
+          worstL1 = std::max(worstL1, glm::length(kept - expected) / (glm::length(expected) + 1e-30));
+        }
+  MESSAGE("kept L1 vs S_R p_R + S_M p_HG at the texel: max relative difference " << worstL1);
+  CHECK(worstL1 < 1e-5);
 }
 
 // Sun zenith texel 0 (the sun ~11.4 degrees below the horizon) is left to the next test case: its c_phi,
@@ -179,7 +200,7 @@ TEST_CASE("AtmospherePhysics: look-ups at texel centres reproduce the table") {
   const AtmosphereTables& t = earthTables();
   const AtmosphereParameters& p = t.parameters;
   const AtmosphereTableSize& s = t.options.size;
-  const AtmosphereTable4D& table = t.multiple;
+  const AtmosphereTable4D& table = t.higherOrders; // any 4D table
   double maxValue = 0.0;
   for (float v : table.rgba)
     maxValue = std::max(maxValue, static_cast<double>(std::abs(v)));
@@ -261,17 +282,17 @@ TEST_CASE("AtmospherePhysics: sun zenith texel 0 look-ups are off by the Eq. 6 c
   CHECK(offsetTexels == doctest::Approx(clampU * (s.sunZenith - 1)).epsilon(1e-6));
   CHECK(offsetTexels < 0.01);
   double worstRelative = 0.0, worstOfMax = 0.0, maxValue = 0.0;
-  for (float v : t.multiple.rgba)
+  for (float v : t.higherOrders.rgba)
     maxValue = std::max(maxValue, static_cast<double>(std::abs(v)));
   for (int ih = 0; ih < s.height; ++ih)
     for (int ia = 0; ia < s.viewZenith; ++ia)
       for (int it = 0; it < s.sunView; ++it) {
         const glm::dvec4 w = atmosphereTexelParams(p, s, ih, ia, 0, it);
-        const glm::dvec3 expected(t.multiple.at(ih, ia, 0, it));
-        const glm::dvec3 next(t.multiple.at(ih, ia, 1, it));
+        const glm::dvec3 expected(t.higherOrders.at(ih, ia, 0, it));
+        const glm::dvec3 next(t.higherOrders.at(ih, ia, 1, it));
         const glm::dvec4 side(0.0, ia < s.viewZenith / 2 ? 0.25 : 0.75, 0.0, 0.0);
         const glm::dvec3 a =
-            sampleAtmosphereTable(t.multiple, atmosphereTableCoords(p, s, w.x, w.y, w.z, w.w, side));
+            sampleAtmosphereTable(t.higherOrders, atmosphereTableCoords(p, s, w.x, w.y, w.z, w.w, side));
         worstRelative = std::max(worstRelative, glm::length(a - expected) / (glm::length(expected) + 1e-30));
         worstOfMax = std::max(worstOfMax, glm::length(a - expected) / maxValue);
         // The look-up is the blend of texels 0 and 1 at the offset: it stays between them.
@@ -312,7 +333,7 @@ TEST_CASE("AtmospherePhysics: the sky has no jump on either side of the horizon"
           const glm::dvec3 v(side * std::sqrt(1.0 - ca * ca), ca, 0.0);
           glm::dvec4 coords(-1.0);
           const auto k = static_cast<std::size_t>(i);
-          y[k] = luminance(lookUpAtmosphere(t, t.multiple, C, v, toSun, coords));
+          y[k] = luminance(lookUpMultipleScattering(t, C, v, toSun, coords));
           above[k] = coords.y >= 0.5; // the side the look-up chose
           finite = finite && std::isfinite(y[k]);
         }
@@ -372,8 +393,7 @@ TEST_CASE("AtmospherePhysics: blue zenith at noon, red horizon by a low sun, dar
   {
     glm::dvec4 coords(-1.0);
     const glm::dvec3 toSun(std::sin(degrees(30.0)), std::cos(degrees(30.0)), 0.0);
-    const glm::dvec3 zenith =
-        lookUpAtmosphere(t, t.multiple, ground, glm::dvec3(0.0, 1.0, 0.0), toSun, coords);
+    const glm::dvec3 zenith = lookUpMultipleScattering(t, ground, glm::dvec3(0.0, 1.0, 0.0), toSun, coords);
     MESSAGE("noon zenith sky RGB " << zenith.r << " " << zenith.g << " " << zenith.b);
     CHECK(zenith.b > zenith.g);
     CHECK(zenith.g > zenith.r);
@@ -384,7 +404,7 @@ TEST_CASE("AtmospherePhysics: blue zenith at noon, red horizon by a low sun, dar
     glm::dvec4 coords(-1.0);
     const glm::dvec3 toSun(std::cos(degrees(2.0)), std::sin(degrees(2.0)), 0.0);
     const glm::dvec3 view(std::cos(degrees(0.5)), std::sin(degrees(0.5)), 0.0);
-    const glm::dvec3 horizon = lookUpAtmosphere(t, t.multiple, ground, view, toSun, coords);
+    const glm::dvec3 horizon = lookUpMultipleScattering(t, ground, view, toSun, coords);
     MESSAGE("sun 2 deg up, horizon next to the sun RGB " << horizon.r << " " << horizon.g << " "
                                                          << horizon.b);
     CHECK(horizon.r > horizon.b);
@@ -394,9 +414,9 @@ TEST_CASE("AtmospherePhysics: blue zenith at noon, red horizon by a low sun, dar
   {
     const glm::dvec3 toSun(std::cos(degrees(-2.0)), std::sin(degrees(-2.0)), 0.0);
     glm::dvec4 c1(-1.0), c2(-1.0);
-    const glm::dvec3 zenith = lookUpAtmosphere(t, t.multiple, ground, glm::dvec3(0.0, 1.0, 0.0), toSun, c1);
-    const glm::dvec3 horizon = lookUpAtmosphere(
-        t, t.multiple, ground, glm::dvec3(std::cos(degrees(0.5)), std::sin(degrees(0.5)), 0.0), toSun, c2);
+    const glm::dvec3 zenith = lookUpMultipleScattering(t, ground, glm::dvec3(0.0, 1.0, 0.0), toSun, c1);
+    const glm::dvec3 horizon = lookUpMultipleScattering(
+        t, ground, glm::dvec3(std::cos(degrees(0.5)), std::sin(degrees(0.5)), 0.0), toSun, c2);
     MESSAGE("twilight (sun -2 deg): zenith luminance " << luminance(zenith) << ", horizon below the sun "
                                                        << luminance(horizon));
     CHECK(luminance(zenith) < luminance(horizon));

@@ -148,6 +148,13 @@ struct LookUps {
     if (first.x < 0.0) first = coords;
     return value;
   }
+  /// L1 (the phase-free single tables with the ray's phase functions).
+  glm::dvec3 single(double t) {
+    glm::dvec4 coords = first;
+    const glm::dvec3 value = lookUpSingleScattering(tables(), C + v * t, v, l, coords);
+    if (first.x < 0.0) first = coords;
+    return value;
+  }
   /// The segment's transmittance of Eq. 8 (atmosphere_ray.cpp's rule: 16 trapezoid steps of the densities).
   glm::dvec3 T(double t) const {
     return t > 0.0 ? extinctionOf(tables().parameters, densityIntegral(tables().parameters, C, C + v * t, 16))
@@ -160,7 +167,7 @@ LookUps lookUpsOf(const TestRay& r) {
   u.C = atmospherePosition(placement(), tables().parameters, r.origin);
   u.v = r.direction;
   u.l = -sun().direction();
-  u.at(tables().single, 0.0); // the first look-up at C
+  u.single(0.0); // the first look-up at C
   return u;
 }
 
@@ -250,9 +257,8 @@ TEST_CASE("Atmosphere ray: shadowed halves add up, (b) gives Eq. 8 of the lit pa
         r.sky ? u.at(tables().higherOrders, 0.0)
               : u.at(tables().higherOrders, 0.0) - u.T(end) * u.at(tables().higherOrders, end);
     glm::dvec3 single =
-        glm::max(u.T(half * m) * u.at(tables().single, half * m) - u.T(end) * u.at(tables().single, end),
-                 glm::dvec3(0.0));
-    if (r.sky) single += u.T(end) * u.at(tables().single, end);
+        glm::max(u.T(half * m) * u.single(half * m) - u.T(end) * u.single(end), glm::dvec3(0.0));
+    if (r.sky) single += u.T(end) * u.single(end);
     const double eq8 = maxRelative(b, sun().irradiance() * (single + higher));
     MESSAGE(r.name << ": (b) lit half vs Eq. 8 from the look-ups, relative " << eq8);
     CHECK(eq8 < 1e-12);
@@ -283,7 +289,7 @@ TEST_CASE("Atmosphere ray: zero lit length gives zero single scattering and keep
     glm::dvec3 expected = sun().irradiance() * higher;
     if (r.sky) {
       // The sky keeps its unshadowed single scattering beyond the far plane.
-      const glm::dvec3 beyond = sun().irradiance() * u.T(end) * u.at(tables().single, end);
+      const glm::dvec3 beyond = sun().irradiance() * u.T(end) * u.single(end);
       CHECK(maxRelative(b, expected + beyond) < 1e-12);
       CHECK(maxRelative(c, expected + beyond) < 1e-12);
       continue;

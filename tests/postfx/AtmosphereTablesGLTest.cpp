@@ -164,24 +164,66 @@ TEST_CASE("AtmosphereTablesPass: every GPU table equals precomputeAtmosphere's")
   CHECK(occluded > 0);
   CHECK(mismatched == 0);
   const double odError = odWorst / odScale;
-  const double singleError = tableError(gpu.single.rgba, cpu.single.rgba, 4, 3);
+  // The single table's four channels (RGB S_R, A S_M's red), the single Mie table's RGB.
+  const double singleError = tableError(gpu.single.rgba, cpu.single.rgba, 4, 4);
+  const double mieError = tableError(gpu.singleMie.rgba, cpu.singleMie.rgba, 4, 3);
   const double higherError = tableError(gpu.higherOrders.rgba, cpu.higherOrders.rgba, 4, 3);
-  const double multipleError = tableError(gpu.multiple.rgba, cpu.multiple.rgba, 4, 3);
   const double ambientError = tableError(toVector(gpu.ambient), toVector(cpu.ambient), 3, 3);
-  MESSAGE("relative errors GPU vs CPU: optical depth " << odError << ", L1 " << singleError << ", L_H "
-                                                       << higherError << ", L_M " << multipleError
+  MESSAGE("relative errors GPU vs CPU: optical depth " << odError << ", S_R and S_M.r " << singleError
+                                                       << ", S_M " << mieError << ", L_H " << higherError
                                                        << ", ambient " << ambientError);
   CHECK(odError < kOpticalDepthTolerance);
   CHECK(singleError < kTableTolerance);
+  CHECK(mieError < kTableTolerance);
   CHECK(higherError < kTableTolerance);
-  CHECK(multipleError < kTableTolerance);
   CHECK(ambientError < kAmbientTolerance);
-  // The A channels are 0 and L_M = L1 + L_H to float rounding.
-  for (std::size_t i = 3; i < gpu.multiple.rgba.size(); i += 4)
-    REQUIRE(gpu.multiple.rgba[i] == 0.0f);
+  // The single table's A is the single Mie table's R; the other A channels are 0.
+  for (std::size_t i = 3; i < gpu.singleMie.rgba.size(); i += 4) {
+    REQUIRE(gpu.singleMie.rgba[i] == 0.0f);
+    REQUIRE(gpu.higherOrders.rgba[i] == 0.0f);
+    REQUIRE(gpu.single.rgba[i] == gpu.singleMie.rgba[i - 3]);
+  }
 }
 
-TEST_CASE("AtmosphereTablesPass: orders = 1 gives L_H = 0 and L_M = L1") {
+TEST_CASE("AtmosphereTablesPass: combinedMie keeps no single Mie table, its look-ups agree with the CPU") {
+  CREP_REQUIRE_GL();
+  AtmospherePrecomputeOptions o = smallOptions();
+  o.combinedMie = true;
+  AtmosphereTablesPass pass({AtmosphereParameters{}, o});
+  CHECK(pass.singleMieTexture() == 0u);
+  pass.compute();
+  const AtmosphereTables gpu = pass.download();
+  CHECK(gpu.singleMie.rgba.empty());
+  // Against the CPU reference of the same option, as the separate form's tables.
+  const AtmosphereTables cpu = precomputeAtmosphere(AtmosphereParameters{}, o);
+  CHECK(cpu.singleMie.rgba.empty());
+  const double singleError = tableError(gpu.single.rgba, cpu.single.rgba, 4, 4);
+  const double higherError = tableError(gpu.higherOrders.rgba, cpu.higherOrders.rgba, 4, 3);
+  const double ambientError = tableError(toVector(gpu.ambient), toVector(cpu.ambient), 3, 3);
+  // What the combined form costs: its L_H (J_2 reads the rebuilt Mie) and E_sky against the separate form's.
+  const double higherVsSeparate = tableError(cpu.higherOrders.rgba, cpuTables().higherOrders.rgba, 4, 3);
+  const double ambientVsSeparate = tableError(toVector(cpu.ambient), toVector(cpuTables().ambient), 3, 3);
+  MESSAGE("combinedMie, GPU vs CPU: single " << singleError << ", L_H " << higherError << ", ambient "
+                                             << ambientError << "; CPU combined vs separate: L_H "
+                                             << higherVsSeparate << ", ambient " << ambientVsSeparate
+                                             << " of each table's peak");
+  CHECK(gpu.single.rgba == pass.download().single.rgba);
+  CHECK(singleError < kTableTolerance);
+  CHECK(higherError < kTableTolerance);
+  CHECK(ambientError < kAmbientTolerance);
+  CHECK(tableError(gpu.single.rgba, cpuTables().single.rgba, 4, 4) < kTableTolerance); // the same S_R
+  // Parameters whose combined form cannot be formed are refused, naming the option.
+  AtmosphereParameters noRed;
+  noRed.rayleighScattering.x = 0.0;
+  try {
+    AtmosphereTablesPass bad({noRed, o});
+    FAIL("no exception");
+  } catch (const InvalidArgument& e) {
+    CHECK(e.parameter() == "AtmospherePrecomputeOptions.combinedMie");
+  }
+}
+
+TEST_CASE("AtmosphereTablesPass: orders = 1 gives L_H = 0") {
   CREP_REQUIRE_GL();
   AtmospherePrecomputeOptions o = smallOptions();
   o.orders = 1;
@@ -191,9 +233,9 @@ TEST_CASE("AtmosphereTablesPass: orders = 1 gives L_H = 0 and L_M = L1") {
   CHECK(pass.stageTimes().size() == 3);
   CHECK(std::all_of(gpu.higherOrders.rgba.begin(), gpu.higherOrders.rgba.end(),
                     [](float v) { return v == 0.0f; }));
-  CHECK(gpu.multiple.rgba == gpu.single.rgba);
   // The same L1 as with three orders (identical programs and inputs).
-  CHECK(tableError(gpu.single.rgba, cpuTables().single.rgba, 4, 3) < kTableTolerance);
+  CHECK(tableError(gpu.single.rgba, cpuTables().single.rgba, 4, 4) < kTableTolerance);
+  CHECK(tableError(gpu.singleMie.rgba, cpuTables().singleMie.rgba, 4, 3) < kTableTolerance);
 }
 
 TEST_CASE("AtmosphereTablesPass: upload then download is bit-identical") {
@@ -208,7 +250,7 @@ TEST_CASE("AtmosphereTablesPass: upload then download is bit-identical") {
   CHECK(bits(toVector(back.opticalDepth), toVector(cpu.opticalDepth)));
   CHECK(bits(back.single.rgba, cpu.single.rgba));
   CHECK(bits(back.higherOrders.rgba, cpu.higherOrders.rgba));
-  CHECK(bits(back.multiple.rgba, cpu.multiple.rgba));
+  CHECK(bits(back.singleMie.rgba, cpu.singleMie.rgba));
   CHECK(bits(toVector(back.ambient), toVector(cpu.ambient)));
   CHECK(back.orders.empty());
 
@@ -235,9 +277,9 @@ struct LookUpCase {
   glm::vec4 end;      ///< xyz a second point on the view ray (transmittance)
 };
 struct LookUpResult {
-  glm::vec4 multiple; ///< crep_lookUpAtmosphere on L_M, rgb
+  glm::vec4 multiple; ///< L_M: crep_lookUpAtmosphere on L_H plus crep_sampleSingleScattering there, rgb
   glm::vec4 coords;   ///< its coordinates
-  glm::vec4 single;   ///< a second look-up on L1 with those coordinates as previous, rgb
+  glm::vec4 single;   ///< a second look-up, L1 with those coordinates as previous, rgb
   glm::vec4 density;  ///< xy crep_densityToTop(h, cos view zenith)
   glm::vec4 sunT;     ///< crep_sunTransmittance
   glm::vec4 segment;  ///< crep_atmosphereTransmittance(position, end)
@@ -252,19 +294,23 @@ struct Case { vec4 position; vec4 view; vec4 sun; vec4 end; };
 struct Result { vec4 multiple; vec4 coords; vec4 single; vec4 density; vec4 sunT; vec4 segment; vec4 ambient; };
 layout(std430, binding = 0) readonly buffer Cases { Case cases[]; };
 layout(std430, binding = 1) writeonly buffer Results { Result results[]; };
-layout(binding = 0) uniform sampler3D multipleTable;
+layout(binding = 0) uniform sampler3D higherTable;
 layout(binding = 1) uniform sampler3D singleTable;
 layout(binding = 2) uniform sampler2D opticalDepth;
 layout(binding = 3) uniform sampler2D ambient;
+layout(binding = 4) uniform sampler3D singleMieTable;
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= uint(cases.length())) return;
   Case c = cases[i];
   Result r;
   vec4 coords = vec4(-1.0);
-  r.multiple = vec4(crep_lookUpAtmosphere(multipleTable, crep_atmosphere, c.position.xyz, c.view.xyz, c.sun.xyz, coords), 0.0);
+  float cosSunView = dot(c.view.xyz, c.sun.xyz);
+  vec3 higher = crep_lookUpAtmosphere(higherTable, crep_atmosphere, c.position.xyz, c.view.xyz, c.sun.xyz, coords);
+  r.multiple = vec4(higher + crep_sampleSingleScattering(singleTable, singleMieTable, crep_atmosphere, coords, cosSunView), 0.0);
   r.coords = coords;
-  r.single = vec4(crep_lookUpAtmosphere(singleTable, crep_atmosphere, c.end.xyz, c.view.xyz, c.sun.xyz, coords), 0.0);
+  crep_lookUpAtmosphere(singleTable, crep_atmosphere, c.end.xyz, c.view.xyz, c.sun.xyz, coords);
+  r.single = vec4(crep_sampleSingleScattering(singleTable, singleMieTable, crep_atmosphere, coords, cosSunView), 0.0);
   float rr = length(c.position.xyz);
   r.density = vec4(crep_densityToTop(opticalDepth, crep_atmosphere, rr - crep_atmosphere.radii.x,
                                      dot(c.position.xyz / rr, c.view.xyz)), 0.0, 0.0);
@@ -324,26 +370,39 @@ TEST_CASE("atmosphere.glsl: the GLSL look-ups equal the CPU look-ups on the same
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, block.get());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, in.get());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out.get());
-  glBindTextureUnit(0, pass.multipleTexture());
+  glBindTextureUnit(0, pass.higherOrdersTexture());
   glBindTextureUnit(1, pass.singleTexture());
   glBindTextureUnit(2, pass.opticalDepthTexture());
   glBindTextureUnit(3, pass.ambientTexture());
+  glBindTextureUnit(4, pass.singleMieTexture());
   glDispatchCompute((count + 63) / 64, 1, 1);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   std::vector<LookUpResult> results(count);
   glGetNamedBufferSubData(out.get(), 0, static_cast<GLsizeiptr>(results.size() * sizeof(LookUpResult)),
                           results.data());
-  gl::unbindPassState(4);
+  gl::unbindPassState(5);
 
-  // Scales: the largest value of each table (relative errors as in the tables' test).
+  // Scales: the largest value of each quantity (relative errors as in the tables' test).
   const auto tableMax = [](const std::vector<float>& v) {
     double m = 0.0;
     for (float x : v)
       m = std::max(m, std::abs(double(x)));
     return m;
   };
-  const double multipleMax = tableMax(cpu.multiple.rgba), singleMax = tableMax(cpu.single.rgba);
   const double ambientMax = tableMax(toVector(cpu.ambient));
+  std::vector<glm::dvec3> cpuMultiple(count), cpuSingle(count);
+  double multipleMax = 0.0, singleMax = 0.0;
+  for (int i = 0; i < count; ++i) {
+    const LookUpCase& c = cases[i];
+    glm::dvec4 coords(-1.0);
+    const glm::dvec3 view(c.view), sun(c.sun);
+    cpuMultiple[i] = lookUpMultipleScattering(cpu, glm::dvec3(c.position), view, sun, coords);
+    cpuSingle[i] = lookUpSingleScattering(cpu, glm::dvec3(c.end), view, sun, coords);
+    for (int k = 0; k < 3; ++k) {
+      multipleMax = std::max(multipleMax, std::abs(cpuMultiple[i][k]));
+      singleMax = std::max(singleMax, std::abs(cpuSingle[i][k]));
+    }
+  }
   // [0]: points on the axis, [1]: anywhere.
   double multipleErr[2] = {}, singleErr[2] = {}, coordsErr[2] = {}, densityErr[2] = {}, sunErr[2] = {};
   double segmentErr[2] = {};
@@ -354,11 +413,9 @@ TEST_CASE("atmosphere.glsl: the GLSL look-ups equal the CPU look-ups on the same
     const LookUpCase& c = cases[i];
     const LookUpResult& r = results[i];
     const glm::dvec3 position(c.position), view(c.view), sun(c.sun), end(c.end);
-    glm::dvec4 coords(-1.0);
-    const glm::dvec3 m = lookUpAtmosphere(cpu, cpu.multiple, position, view, sun, coords);
-    const glm::dvec3 s = lookUpAtmosphere(cpu, cpu.single, end, view, sun, coords);
+    const glm::dvec3 m = cpuMultiple[i], s = cpuSingle[i];
     glm::dvec4 firstCoords(-1.0);
-    lookUpAtmosphere(cpu, cpu.multiple, position, view, sun, firstCoords);
+    lookUpAtmosphere(cpu, cpu.higherOrders, position, view, sun, firstCoords);
     const double rr = glm::length(position);
     const glm::dvec2 d = lookUpDensityToTop(cpu, rr - p.earthRadius, glm::dot(position / rr, view));
     const glm::dvec3 t = sunTransmittance(cpu, position, sun);

@@ -516,12 +516,12 @@ TEST_CASE("Atmosphere precomputation is deterministic, consistent and fast") {
   CHECK(seconds < 10.0); // well under a second on an idle machine; generous for a shared one
   const AtmosphereTables b = precomputeAtmosphere(p, o, 1);
   CHECK(a.single.rgba == b.single.rgba);
-  CHECK(a.multiple.rgba == b.multiple.rgba);
+  CHECK(a.singleMie.rgba == b.singleMie.rgba);
+  CHECK(a.higherOrders.rgba == b.higherOrders.rgba);
   CHECK(a.ambient.data().size() == b.ambient.data().size());
   CHECK(std::equal(a.ambient.data().begin(), a.ambient.data().end(), b.ambient.data().begin()));
 
   REQUIRE(a.orders.size() == 4u);
-  CHECK(a.orders[0].rgba == a.single.rgba);
   double worstSum = 0.0, l1 = 0.0, l2 = 0.0, l3 = 0.0;
   bool finite = true, nonNegative = true;
   for (std::size_t i = 0; i < a.single.texels(); ++i)
@@ -529,10 +529,10 @@ TEST_CASE("Atmosphere precomputation is deterministic, consistent and fast") {
       const std::size_t k = 4 * i + static_cast<std::size_t>(ch);
       const double hsum = double(a.orders[1].rgba[k]) + a.orders[2].rgba[k] + a.orders[3].rgba[k];
       worstSum = std::max(worstSum, std::abs(hsum - a.higherOrders.rgba[k]) / std::max(1e-12, hsum));
-      const double m = double(a.single.rgba[k]) + a.higherOrders.rgba[k];
-      CHECK(a.multiple.rgba[k] == doctest::Approx(m).epsilon(1e-6));
-      finite = finite && std::isfinite(a.multiple.rgba[k]);
-      nonNegative = nonNegative && a.multiple.rgba[k] >= 0.0f && a.higherOrders.rgba[k] >= 0.0f;
+      for (const AtmosphereTable4D* table : {&a.single, &a.singleMie, &a.higherOrders}) {
+        finite = finite && std::isfinite(table->rgba[k]);
+        nonNegative = nonNegative && table->rgba[k] >= 0.0f;
+      }
       l1 += a.orders[0].rgba[k];
       l2 += a.orders[1].rgba[k];
       l3 += a.orders[2].rgba[k];
@@ -547,8 +547,11 @@ TEST_CASE("Atmosphere precomputation is deterministic, consistent and fast") {
   CHECK(l2 < l1);
   CHECK(l3 < l2);
   CHECK(l2 > 0.0);
-  // The A channel is 0.
-  CHECK(a.multiple.at(3, 9, 4, 2).w == 0.0f);
+  // The A channel is 0 but in the single table, where it is S_M's red.
+  CHECK(a.higherOrders.at(3, 9, 4, 2).w == 0.0f);
+  CHECK(a.singleMie.at(3, 9, 4, 2).w == 0.0f);
+  CHECK(a.single.at(3, 9, 4, 2).w == a.singleMie.at(3, 9, 4, 2).x);
+  CHECK(a.single.at(3, 9, 4, 2).w > 0.0f);
   // Ambient sky light: positive by day, larger with a higher sun; the look-up reads the texels.
   const glm::dvec3 noon = lookUpAmbientSkyLight(a, 1.0), low = lookUpAmbientSkyLight(a, 0.1);
   CHECK(noon.z > low.z);
@@ -556,12 +559,12 @@ TEST_CASE("Atmosphere precomputation is deterministic, consistent and fast") {
   CHECK(noon.x == doctest::Approx(a.ambient.at(o.ambientSize - 1, 0, 0)));
   CHECK(lookUpAmbientSkyLight(a, -1.0).x == doctest::Approx(a.ambient.at(0, 0, 0)));
 
-  // Single scattering only: L_H = 0 and L_M = L1.
+  // Single scattering only: L_H = 0 and the same L1.
   AtmospherePrecomputeOptions one = smallOptions();
   one.orders = 1;
   const AtmosphereTables s = precomputeAtmosphere(p, one);
   CHECK(s.single.rgba == a.single.rgba);
-  CHECK(s.multiple.rgba == s.single.rgba);
+  CHECK(s.singleMie.rgba == a.singleMie.rgba);
   CHECK(
       std::all_of(s.higherOrders.rgba.begin(), s.higherOrders.rgba.end(), [](float x) { return x == 0.0f; }));
   CHECK(s.orders.empty());
@@ -585,9 +588,8 @@ TEST_CASE("Atmosphere single scattering matches an independent integral with exa
     const double len = ia < s.viewZenith / 2
                            ? -r0 * w.y - std::sqrt(std::max(0.0, r0 * r0 * (w.y * w.y - 1.0) + R * R))
                            : -r0 * w.y + std::sqrt(r0 * r0 * (w.y * w.y - 1.0) + top * top);
-    const double ct = glm::dot(v, l);
     const int n = 2000;
-    glm::dvec3 sum(0.0);
+    glm::dvec3 sumR(0.0), sumM(0.0);
     for (int k = 0; k < n; ++k) {
       const glm::dvec3 pk = c + v * (len * (k + 0.5) / n);
       const double rk = glm::length(pk);
@@ -602,30 +604,46 @@ TEST_CASE("Atmosphere single scattering matches an independent integral with exa
         tSun = glm::exp(-(p.rayleighScattering * ds.x + betaMe * ds.y));
       }
       const glm::dvec3 tCam = glm::exp(-(p.rayleighScattering * dc.x + betaMe * dc.y));
-      sum += (p.rayleighScattering * std::exp(-hk / p.rayleighScaleHeight) * rayleighPhase(ct) +
-              p.mieScattering * std::exp(-hk / p.mieScaleHeight) * henyeyGreenstein(p.mieG, ct)) *
-             tCam * tSun * (len / n);
+      sumR += p.rayleighScattering * std::exp(-hk / p.rayleighScaleHeight) * tCam * tSun * (len / n);
+      sumM += p.mieScattering * std::exp(-hk / p.mieScaleHeight) * tCam * tSun * (len / n);
     }
-    return sum;
+    return std::pair(sumR, sumM);
   };
   struct Texel {
     int ih, ia, ip, it;
   };
   // Daylight texels away from the terminator (the sun's transmittance is smooth there).
   const Texel texels[] = {{0, 12, 6, 1}, {2, 10, 7, 0}, {3, 14, 5, 2}, {1, 4, 6, 1}, {5, 9, 7, 3}};
-  double worst = 0.0;
+  double worst = 0.0, worstR = 0.0, worstM = 0.0;
   for (const Texel& x : texels) {
-    const glm::dvec3 ref = reference(x.ih, x.ia, x.ip, x.it);
-    const glm::vec4 got = t.single.at(x.ih, x.ia, x.ip, x.it);
+    // L1 at the texel's own c_theta (S_R p_R + S_M p_HG, the quantity the table's look-ups give), and the
+    // phase-free parts S_R (RGB), S_M (the single Mie table, its red in the single table's A) on their own.
+    const auto [refR, refM] = reference(x.ih, x.ia, x.ip, x.it);
+    const glm::vec4 gotR = t.single.at(x.ih, x.ia, x.ip, x.it);
+    const glm::vec4 gotM = t.singleMie.at(x.ih, x.ia, x.ip, x.it);
+    const glm::dvec4 w = atmosphereTexelParams(p, s, x.ih, x.ia, x.ip, x.it);
+    glm::dvec3 v, l;
+    atmosphereDirections(w.y, w.z, w.w, v, l);
+    const double ct = glm::dot(v, l);
+    const glm::dvec3 ref = refR * rayleighPhase(ct) + refM * henyeyGreenstein(p.mieG, ct);
+    const glm::dvec3 got =
+        glm::dvec3(gotR) * rayleighPhase(ct) + glm::dvec3(gotM) * henyeyGreenstein(p.mieG, ct);
     for (int ch = 0; ch < 3; ++ch) {
       const double e = relErr(got[ch], ref[ch]);
       worst = std::max(worst, e);
       CHECK(e < 0.03);
+      worstR = std::max(worstR, relErr(gotR[ch], refR[ch]));
+      worstM = std::max(worstM, relErr(gotM[ch], refM[ch]));
     }
+    CHECK(gotR.w == gotM.x);
   }
   MESSAGE("L1 texels vs an independent single-scattering integral (exact transmittances): largest relative "
           "error "
-          << worst << " (tolerance 3%)");
+          << worst << " (tolerance 3%); its parts: S_R " << worstR << ", S_M " << worstM);
+  // The Mie part alone carries the trapezoid rule's error of 100 steps over rays whose Mie density falls
+  // within the first 1.2 km (measured 3.2%); Rayleigh dominates L1 at these texels.
+  CHECK(worstR < 0.03);
+  CHECK(worstM < 0.05);
 }
 
 TEST_CASE("Atmosphere validation names the bad field") {

@@ -27,7 +27,15 @@
 // texels are the limits from below and above, and a look-up that stays on one side is continuous).
 // Packing (Listing 1): a 3D texture of width N_h, height N_alpha and depth N_phi * N_theta; slice
 // z = q * N_phi + k holds u_theta texel q and u_phi texel k. Each texel is RGBA float, RGB the quantity
-// (A unused, 0).
+// (A unused, 0, except in the single scattering table).
+//
+// Single scattering is stored without its phase functions (Bruneton and Neyret 2008, Sec. 4; Bruneton's
+// 2017 implementation): `single` holds the Rayleigh part S_R = integral of beta_R d_R T(C->P) T(P->sun) in
+// RGB and the red channel of the Mie part S_M (the same with beta_M d_M) in A; `singleMie` holds S_M in RGB
+// (empty with AtmospherePrecomputeOptions::combinedMie, which rebuilds S_M from `single` alone by Bruneton
+// 2017's rule, combinedMieScattering). L1 of a look-up is S_R p_R(c) + S_M p_HG(c), c = v . l, the phase
+// functions evaluated per look-up: 16 sun-view texels cannot hold the Mie peak (g = 0.76), a phase-free
+// integrand varies slowly with c.
 //
 // Look-ups (Listing 1 and 2): texture coordinates in [0, 1] (texel i's centre at (i + 0.5) / N); GL linear
 // filtering with clamp to edge in the three packed dimensions, clamped to the phi slice's texel centres,
@@ -39,13 +47,17 @@
 //     and c = cos(zenith angle) in [-1, 1], the integrals of e^(-h/H_R) and e^(-h/H_M) along the ray to the
 //     top (metres), or kOccludedDensity when the ray hits the ground;
 //   L1 (single scattering, Listing 3): trapezoid rule with `singleSteps` steps from the point to the ground
-//     or the top, of (beta_R(h) p_R + beta_M(h) p_M) e^(-T(C->P)) e^(-T(P->sun));
+//     or the top, of beta_R(h) e^(-T(C->P)) e^(-T(P->sun)) (S_R) and beta_M(h) e^(-T(C->P)) e^(-T(P->sun))
+//     (S_M), without the phase functions (above);
 //   for n = 2..N: J_n (Eq. 1, `sphereSamples` directions of a Fibonacci sphere, each a look-up into
-//     L_(n-1)), then L_n (Eq. 2, Listing 5, trapezoid rule with `orderSteps` steps, look-ups into J_n);
-//   higher orders L_H = sum of L_n (n = 2..N), multiple scattering L_M = L1 + L_H;
+//     L_(n-1), for n = 2 L1 with its phase functions at w . l), then L_n (Eq. 2, Listing 5, trapezoid rule
+//     with `orderSteps` steps, look-ups into J_n);
+//   higher orders L_H = sum of L_n (n = 2..N); multiple scattering L_M = L1 + L_H is formed per look-up
+//     (lookUpMultipleScattering), not stored;
 //   ambient sky light E_sky(c_phi) (Eq. 3, Listing 6) at 20 m above the ground: the upper hemisphere of
-//     the same Fibonacci directions (lower ones mirrored) times cos, from L_M; 1D, texel i at
-//     c_phi = 2 i / (N - 1) - 1.
+//     kAmbientSampleFactor * sphereSamples Fibonacci directions (lower ones mirrored) times cos, from L_M
+//     (L1's Mie lobe, ~14 degrees wide for g = 0.76, needs more directions than J_n's smooth orders; 64
+//     texels make them cheap); 1D, texel i at c_phi = 2 i / (N - 1) - 1.
 #pragma once
 
 #include <cstdint>
@@ -98,15 +110,25 @@ struct AtmospherePrecomputeOptions {
   int opticalDepthSteps = 256;  ///< trapezoid steps of each optical depth integral
   int ambientSize = 64;         ///< E_sky texels over c_phi in [-1, 1]
   bool keepOrders = false;      ///< keep each L_n in AtmosphereTables::orders (tests, analysis)
+  /// Store single Mie scattering only as the red channel in `single`'s alpha and rebuild its RGB per
+  /// look-up (Bruneton 2017's combined form, combinedMieScattering): one 4D table less, at the error the
+  /// README's atmosphere section states. Needs rayleighScattering > 0 in every channel, mieScattering.r > 0.
+  bool combinedMie = false;
 };
 /// Throws InvalidArgument naming the field ("AtmospherePrecomputeOptions.size.viewZenith", ...): sizes >= 2
 /// (viewZenith even and >= 4), orders in [1, 16], steps and samples in [1, 4096], a packed depth
 /// sunZenith * sunView <= 2048 and every size <= 2048 (GL_MAX_3D_TEXTURE_SIZE's guaranteed minimum).
 void validate(const AtmospherePrecomputeOptions& o);
+/// Both of the above, and what combinedMie needs of the parameters (InvalidArgument
+/// "AtmospherePrecomputeOptions.combinedMie").
+void validate(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o);
 
 /// The value a texel of the optical depth table holds for a ray that hits the ground (metres of sea-level
 /// density): large enough that every channel's transmittance is 0 in float.
 inline constexpr double kOccludedDensity = 1.0e9;
+
+/// E_sky's directions per sphereSamples (the top of this header).
+inline constexpr int kAmbientSampleFactor = 16;
 
 /// A 4D table packed as described at the top: texels() = N_h * N_alpha * N_phi * N_theta RGBA floats,
 /// texel (ih, ia, ip, it) at index ((it * N_phi + ip) * N_alpha + ia) * N_h + ih (the 3D texture's order).
@@ -125,11 +147,13 @@ struct AtmosphereTables {
   AtmospherePrecomputeOptions options;
   /// opticalDepthHeight x opticalDepthZenith, 2 channels: Rayleigh and Mie density integrals, metres.
   Image opticalDepth;
-  AtmosphereTable4D single;              ///< L1
-  AtmosphereTable4D higherOrders;        ///< L_H = L2 + ... + LN
-  AtmosphereTable4D multiple;            ///< L_M = L1 + L_H
-  Image ambient;                         ///< ambientSize x 1, 3 channels: E_sky per unit sun irradiance
-  std::vector<AtmosphereTable4D> orders; ///< L1, L2, ..., LN when options.keepOrders, else empty
+  AtmosphereTable4D single;       ///< L1 without phase: RGB S_R, A the red channel of S_M (see the top)
+  AtmosphereTable4D singleMie;    ///< RGB S_M (A 0); empty (no texels) with options.combinedMie
+  AtmosphereTable4D higherOrders; ///< L_H = L2 + ... + LN (phase functions inside)
+  Image ambient;                  ///< ambientSize x 1, 3 channels: E_sky per unit sun irradiance
+  /// L1, L2, ..., LN when options.keepOrders, else empty; L1 there with its phase functions at each
+  /// texel's own c_theta (for analysis: the sum of the orders at a texel).
+  std::vector<AtmosphereTable4D> orders;
 };
 
 /// Yusov 2013, "Multiple Scattering" steps 1-3 and Eq. 3 on the CPU, in double (stored as float), rows in
@@ -174,12 +198,32 @@ void atmosphereDirections(double cosViewZenith, double cosSunZenith, double cosS
 /// packed dimensions (GL rules, clamp to edge) and linear between theta slices.
 glm::dvec3 sampleAtmosphereTable(const AtmosphereTable4D& table, const glm::dvec4& coords);
 
+/// sampleAtmosphereTable with the alpha channel (`single`'s Mie red).
+glm::dvec4 sampleAtmosphereTableRgba(const AtmosphereTable4D& table, const glm::dvec4& coords);
+
 /// Listing 1 end to end: the table's value for the point `position` (metres, planet centre at the origin)
 /// looking along unit `view` with the sun towards unit `toSun`. `coords` carries the previous look-up's
 /// coordinates of the same ray in (negative for the first) and this look-up's out.
 glm::dvec3 lookUpAtmosphere(const AtmosphereTables& tables, const AtmosphereTable4D& table,
                             const glm::dvec3& position, const glm::dvec3& view, const glm::dvec3& toSun,
                             glm::dvec4& coords);
+
+/// Bruneton's 2017 combined form: S_M's RGB from a texel (or look-up) of `single` (RGB S_R, A S_M's red):
+/// S_R (A / S_R.r) (beta_R.r / beta_M.r) (beta_M / beta_R), exact where S_M / S_R is the ratio of the
+/// coefficients times one factor for all channels; 0 where S_R.r <= 0.
+glm::dvec3 combinedMieScattering(const AtmosphereParameters& p, const glm::dvec4& single);
+
+/// L1 at table coordinates `coords` with the phase functions of c = cos(view, sun) applied: S_R p_R(c) +
+/// S_M p_HG(g, c), S_M from `singleMie` or, with options.combinedMie, combinedMieScattering.
+glm::dvec3 sampleSingleScattering(const AtmosphereTables& tables, const glm::dvec4& coords,
+                                  double cosSunView);
+
+/// lookUpAtmosphere for L1 (sampleSingleScattering) and for L_M = L1 + L_H (the same coordinates for both
+/// tables).
+glm::dvec3 lookUpSingleScattering(const AtmosphereTables& tables, const glm::dvec3& position,
+                                  const glm::dvec3& view, const glm::dvec3& toSun, glm::dvec4& coords);
+glm::dvec3 lookUpMultipleScattering(const AtmosphereTables& tables, const glm::dvec3& position,
+                                    const glm::dvec3& view, const glm::dvec3& toSun, glm::dvec4& coords);
 
 /// The optical depth table, bilinear (GL rules): (Rayleigh, Mie) density integrals from altitude h along
 /// a ray with cos zenith c to the top of the atmosphere.

@@ -45,11 +45,13 @@ AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const Atmospher
 
 /// The tables on the GPU: textures owned by the pass, sized by CreateInfo.
 ///   opticalDepthTexture(): GL_TEXTURE_2D GL_RG32F, opticalDepthHeight x opticalDepthZenith;
-///   single/higherOrders/multipleTexture(): GL_TEXTURE_3D GL_RGBA32F, N_h x N_alpha x (N_phi N_theta)
-///     (the packing of atmosphere.h), linear filtering, clamp to edge;
+///   single/singleMie/higherOrdersTexture(): GL_TEXTURE_3D GL_RGBA32F, N_h x N_alpha x (N_phi N_theta)
+///     (the packing of atmosphere.h: single scattering without its phase functions, `single` RGB Rayleigh
+///     and A Mie's red, `singleMie` RGB Mie; singleMieTexture() is 0 with options.combinedMie), linear
+///     filtering, clamp to edge;
 ///   ambientTexture(): GL_TEXTURE_2D GL_RGBA32F, ambientSize x 1.
-/// 4D tables take 16 bytes per texel: 64 mebibytes each at the default size (three, plus two of the same size
-/// while computing).
+/// 4D tables take 16 bytes per texel: 64 mebibytes each at the default size (three, two with combinedMie,
+/// plus two of the same size while computing more than one order).
 class AtmosphereTablesPass {
 public:
   struct CreateInfo {
@@ -73,14 +75,14 @@ public:
   const CreateInfo& info() const noexcept { return info_; }
   std::uint32_t opticalDepthTexture() const noexcept { return opticalDepth_.get(); }
   std::uint32_t singleTexture() const noexcept { return single_.get(); }
+  std::uint32_t singleMieTexture() const noexcept { return singleMie_.get(); }
   std::uint32_t higherOrdersTexture() const noexcept { return higher_.get(); }
-  std::uint32_t multipleTexture() const noexcept { return multiple_.get(); }
   std::uint32_t ambientTexture() const noexcept { return ambient_.get(); }
   const std::vector<std::pair<std::string, double>>& stageTimes() const noexcept { return times_; }
 
 private:
   CreateInfo info_;
-  gl::Handle opticalDepth_, single_, higher_, multiple_, ambient_;
+  gl::Handle opticalDepth_, single_, singleMie_, higher_, ambient_;
   std::vector<std::pair<std::string, double>> times_;
 };
 

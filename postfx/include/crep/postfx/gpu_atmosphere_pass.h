@@ -84,7 +84,8 @@ public:
 private:
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2]; ///< [layout kind] ((a), (b)); [0] for None and (c)
+  /// [combinedMie][layout kind] ((a), (b)); [.][0] for None and (c)
+  gl::Handle programs_[2][2];
   gl::Handle marchParams_, atmosphereParams_, nearest_, dummyTransmittance_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
