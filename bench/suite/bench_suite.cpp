@@ -532,27 +532,42 @@ void epipolarSamplingBench(const BenchOptions& o) {
   }
 }
 
-/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per table
-/// and scattering order at the default size (16x64x32x8 with --quick), then the per-frame cost of the sky,
+/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per stage
+/// at the default size (16x64x32x8 with --quick), Hillaire 2020's multiple scattering table (the default)
+/// and the orders' reference side by side, then the per-frame cost of the sky,
 /// aerial perspective and shafts with each shaft method on the terrain at the run's size, side by side in
 /// one run (median of the per-frame sums of `repeat` runs after a warm-up; "setup" stages excluded).
 void atmosphereBench(const BenchOptions& o) {
   tool::AtmosphereSettings s;
   s.cacheDirectory.clear(); // always compute: the precomputation's cost is the point
   if (o.quick) s.tables.size = {16, 64, 32, 8};
-  tool::StageTimings tableTimings;
-  const tool::AtmosphereTableSet tables = tool::atmosphereTables(s, tableTimings);
   const AtmosphereTableSize& n = s.tables.size;
-  std::printf("\natmosphere tables (%dx%dx%dx%d, %d orders, %d sphere samples; optical depth %dx%d; ms, one "
-              "run, glFinish + wall clock per stage):\n",
-              n.height, n.viewZenith, n.sunZenith, n.sunView, s.tables.orders, s.tables.sphereSamples,
-              s.tables.opticalDepthHeight, s.tables.opticalDepthZenith);
-  double total = 0.0;
-  for (const auto& [stage, ms] : tables.pass->stageTimes()) {
-    std::printf("  %-28s %10.1f\n", stage.c_str(), ms);
-    total += ms;
+  double totals[2] = {0.0, 0.0};
+  std::optional<tool::AtmosphereTableSet> kept;
+  for (const AtmosphereMultipleScattering method :
+       {AtmosphereMultipleScattering::Orders, AtmosphereMultipleScattering::Lut}) {
+    tool::AtmosphereSettings m = s;
+    m.tables.multipleScattering = method;
+    tool::StageTimings tableTimings;
+    tool::AtmosphereTableSet tables = tool::atmosphereTables(m, tableTimings);
+    const bool lut = method == AtmosphereMultipleScattering::Lut;
+    std::printf(
+        "\natmosphere tables from scratch, %s (%dx%dx%dx%d, %d sphere samples; optical depth %dx%d; ms, "
+        "one run, glFinish + wall clock per stage):\n",
+        lut ? "multiple scattering LUT (Hillaire 2020, the option)"
+            : (std::to_string(m.tables.orders) + " orders (default)").c_str(),
+        n.height, n.viewZenith, n.sunZenith, n.sunView, m.tables.sphereSamples, m.tables.opticalDepthHeight,
+        m.tables.opticalDepthZenith);
+    double& total = totals[lut ? 1 : 0];
+    for (const auto& [stage, ms] : tables.pass->stageTimes()) {
+      std::printf("  %-28s %10.1f\n", stage.c_str(), ms);
+      total += ms;
+    }
+    std::printf("  %-28s %10.1f\n", "total", total);
+    if (!lut) kept.emplace(std::move(tables));
   }
-  std::printf("  %-28s %10.1f\n", "total", total);
+  std::printf("  LUT / orders: %.3f\n", totals[1] / totals[0]);
+  const tool::AtmosphereTableSet& tables = *kept;
 
   // Per frame: the terrain at 20 degrees of sun elevation, the scene's sun azimuth.
   const std::string scene = "terrain";

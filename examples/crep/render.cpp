@@ -272,11 +272,15 @@ int renderAtmosphere(const Args& args, const std::string& sceneName, glm::ivec2 
   });
   const glm::dvec3 sunDir = toSun;
   std::printf("crep render: scene %s, %dx%d, method atmosphere (%s; sun elevation %g deg, azimuth %g deg; "
-              "tables %dx%dx%dx%d, %d orders, %s)\n",
+              "tables %dx%dx%dx%d, %s, %s)\n",
               s.scene->name.c_str(), size.x, size.y, result.detail.c_str(), atmosphere.sunElevation,
               std::atan2(sunDir.x, -sunDir.z) * 180.0 / std::numbers::pi, atmosphere.tables.size.height,
               atmosphere.tables.size.viewZenith, atmosphere.tables.size.sunZenith,
-              atmosphere.tables.size.sunView, atmosphere.tables.orders,
+              atmosphere.tables.size.sunView,
+              atmosphere.tables.orders == 1 ? "single scattering only"
+              : usesMultipleScatteringLut(atmosphere.tables)
+                  ? "multiple scattering LUT"
+                  : (std::to_string(atmosphere.tables.orders) + " orders").c_str(),
               tables.loaded ? "loaded from the cache" : "computed");
   timings.print(stdout);
   std::printf("wrote %s (layers composite.RGBA, scattering.RGBA, transmittance.RGBA) and %s\n",

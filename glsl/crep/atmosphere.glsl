@@ -29,6 +29,7 @@ struct CrepAtmosphereParams {
   ivec4 tableSize;         // N_h, N_alpha, N_phi, N_theta
   ivec4 auxSizes;          // optical depth width (altitude), height (zenith); ambient size; orders
   vec4 placement;          // x: metersPerUnit; y: originAltitude; zw: 0
+  vec4 multipleScattering; // x: ground albedo; y: Psi_ms texels per side; z: Psi_ms steps; w: 0
 };
 
 // (Rayleigh, Mie) densities at altitude h (clamped to >= 0): exp(-h / H) (Bruneton and Neyret 2008, Sec. 2).
@@ -230,6 +231,15 @@ vec3 crep_atmosphereTransmittance(sampler2D opticalDepth, CrepAtmosphereParams a
     D = crep_densityToTop(opticalDepth, a, hb, -cb) - crep_densityToTop(opticalDepth, a, ha, -ca);
   }
   return exp(-crep_atmosphereExtinction(a, max(D, vec2(0.0))));
+}
+
+// Psi_ms at altitude h and sun zenith cosine c (Hillaire 2020, Sec. 5.5; bilinear, texel (i, j) at
+// u = sqrt(h / H_Atm) = i / (n - 1), c = 2 j / (n - 1) - 1; crep::lookUpMultipleScatteringLut).
+vec3 crep_multipleScatteringLut(sampler2D lut, CrepAtmosphereParams a, float h, float cosSunZenith) {
+  int n = int(a.multipleScattering.y);
+  vec2 uv = vec2(crep_atmosphereTexCoord(sqrt(clamp(h / a.radii.z, 0.0, 1.0)), n),
+                 crep_atmosphereTexCoord((clamp(cosSunZenith, -1.0, 1.0) + 1.0) * 0.5, n));
+  return textureLod(lut, uv, 0.0).rgb;
 }
 
 // E_sky at the cos of the sun's zenith angle (linear in the 1D table; crep::lookUpAmbientSkyLight).

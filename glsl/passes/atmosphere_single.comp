@@ -3,7 +3,8 @@
 // crep/postfx/atmosphere.h's contract): each texel of the 4D table (packed 3D: x h, y alpha, z theta * N_phi
 // + phi) integrates S_R = beta_R d_R T(C -> P) T(P -> sun) and S_M = beta_M d_M T(C -> P) T(P -> sun) (the
 // single table: RGB S_R, A S_M's red; the single Mie table, unless CREP_ATMOSPHERE_COMBINED_MIE: RGB S_M)
-// by the trapezoid rule with CREP_ATMOSPHERE_STEPS
+// (with CREP_ATMOSPHERE_MS_LUT 1 also L_H = T(C -> P) sigma_s(P) Psi_ms(P), Hillaire 2020, Sec. 5.5, into the
+// higher orders table) by the trapezoid rule with CREP_ATMOSPHERE_STEPS
 // steps from its point C to the ground (lower alpha half) or the top of the atmosphere (upper half); the
 // camera's density integral is accumulated by the trapezoid rule over the steps so far (Listing 5's way),
 // the sun's transmittance comes from the optical depth table.
@@ -21,6 +22,13 @@ layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
 #if !CREP_ATMOSPHERE_COMBINED_MIE
 layout(binding = 1, rgba32f) uniform restrict writeonly image3D crep_outputMie;
 #endif
+#ifndef CREP_ATMOSPHERE_MS_LUT
+#define CREP_ATMOSPHERE_MS_LUT 0
+#endif
+#if CREP_ATMOSPHERE_MS_LUT
+layout(binding = 1) uniform sampler2D crep_msLut; // Psi_ms
+layout(binding = 2, rgba32f) uniform restrict writeonly image3D crep_outputHigher;
+#endif
 
 void main() {
   ivec3 p = ivec3(gl_GlobalInvocationID);
@@ -30,7 +38,7 @@ void main() {
   float dt = ray.end / float(CREP_ATMOSPHERE_STEPS);
   vec2 camera = vec2(0.0);
   vec2 previousDensity = vec2(0.0);
-  vec3 sumR = vec3(0.0), sumM = vec3(0.0);
+  vec3 sumR = vec3(0.0), sumM = vec3(0.0), sumH = vec3(0.0);
   for (int k = 0; k <= CREP_ATMOSPHERE_STEPS; ++k) {
     CrepAtmosphereRayPoint q = crep_atmosphereRayPoint(crep_atmosphere, ray, dt * float(k));
     vec2 dens = crep_atmosphereDensity(crep_atmosphere, q.h);
@@ -43,9 +51,17 @@ void main() {
     float weight = (k == 0 || k == CREP_ATMOSPHERE_STEPS) ? 0.5 : 1.0;
     sumR += weight * (crep_atmosphere.rayleighScattering.rgb * dens.x) * tt;
     sumM += weight * (crep_atmosphere.mieScattering.rgb * dens.y) * tt;
+#if CREP_ATMOSPHERE_MS_LUT
+    vec3 sigmaS = crep_atmosphere.rayleighScattering.rgb * dens.x + crep_atmosphere.mieScattering.rgb * dens.y;
+    sumH += weight * cameraT * sigmaS *
+            crep_multipleScatteringLut(crep_msLut, crep_atmosphere, q.h, q.cosSunZenith);
+#endif
   }
   imageStore(crep_output, p, vec4(sumR * dt, sumM.r * dt));
 #if !CREP_ATMOSPHERE_COMBINED_MIE
   imageStore(crep_outputMie, p, vec4(sumM * dt, 0.0));
+#endif
+#if CREP_ATMOSPHERE_MS_LUT
+  imageStore(crep_outputHigher, p, vec4(sumH * dt, 0.0));
 #endif
 }

@@ -219,14 +219,16 @@ void forEachTexel(const AtmosphereTableSize& size, int threads, const Body& body
   });
 }
 
-/// Single scattering without the phase functions: S_R and S_M of the top of the header.
+/// Single scattering without the phase functions: S_R and S_M of the top of the header; with the Lut
+/// method's table also L_H.
 struct SingleParts {
-  glm::dvec3 rayleigh{0.0}, mie{0.0};
+  glm::dvec3 rayleigh{0.0}, mie{0.0}, higher{0.0};
 };
 
 /// Yusov 2013, Listing 3 without the phase functions (Bruneton and Neyret 2008, Sec. 4): S_R and S_M of
-/// one texel by the trapezoid rule, T_sun from the table.
-SingleParts singleScattering(const AtmosphereTables& tables, const TexelRay& r, int steps) {
+/// one texel by the trapezoid rule, T_sun from the table; `lut`: also L_H = the integral of T(C->P)
+/// sigma_s(P) Psi_ms(P) (Hillaire 2020, Sec. 5.5).
+SingleParts singleScattering(const AtmosphereTables& tables, const TexelRay& r, int steps, bool lut) {
   const AtmosphereParameters& p = tables.parameters;
   const double ds = r.length / steps;
   glm::dvec2 camDensity(0.0);
@@ -234,18 +236,78 @@ SingleParts singleScattering(const AtmosphereTables& tables, const TexelRay& r, 
   SingleParts prevF, sum;
   for (int k = 0; k <= steps; ++k) {
     const glm::dvec3 pk = r.c + r.v * (r.length * k / steps);
-    const glm::dvec2 d = densities(p, glm::length(pk));
+    const double rk = glm::length(pk);
+    const glm::dvec2 d = densities(p, rk);
     if (k > 0) camDensity += (prevD + d) * (0.5 * ds);
-    const glm::dvec3 tt = transmittanceOf(p, camDensity) * sunTransmittance(tables, pk, r.l);
-    const SingleParts f{p.rayleighScattering * d.x * tt, p.mieScattering * d.y * tt};
+    const glm::dvec3 tCam = transmittanceOf(p, camDensity);
+    const glm::dvec3 tt = tCam * sunTransmittance(tables, pk, r.l);
+    SingleParts f{p.rayleighScattering * d.x * tt, p.mieScattering * d.y * tt, glm::dvec3(0.0)};
+    if (lut) {
+      const glm::dvec3 sigmaS = p.rayleighScattering * d.x + p.mieScattering * d.y;
+      f.higher =
+          tCam * sigmaS * lookUpMultipleScatteringLut(tables, rk - p.earthRadius, glm::dot(pk / rk, r.l));
+    }
     if (k > 0) {
       sum.rayleigh += (prevF.rayleigh + f.rayleigh) * (0.5 * ds);
       sum.mie += (prevF.mie + f.mie) * (0.5 * ds);
+      sum.higher += (prevF.higher + f.higher) * (0.5 * ds);
     }
     prevD = d;
     prevF = f;
   }
   return sum;
+}
+
+/// Hillaire 2020, Sec. 5.5: Psi_ms at altitude h for sun zenith cosine mu. From the point x, `samples`
+/// Fibonacci directions w, each marched to the ground or the top with `steps` midpoint steps: the second
+/// order L2 = mean over w of L'(w) = the integral of T(x, y) (beta_R d_R p_R + beta_M d_M p_HG)(w . l)
+/// T_sun(y) (the first scattering with its true phase functions; Hillaire takes the isotropic 1 / (4 pi),
+/// measured 5% darker in red on the Earth's table) plus, where w ends on the ground, T(x, ground)
+/// T_sun(ground) max(0, n . l) albedo / pi; and the transfer f_ms = mean
+/// over w of the integral of T(x, y) sigma_s(y) (the isotropic phase at x makes both means over the
+/// sphere). Psi_ms = L2 / (1 - f_ms): every order >= 2, a geometric series.
+glm::dvec3 multipleScatteringAt(const AtmosphereTables& tables, double h, double mu, int samples, int steps) {
+  const AtmosphereParameters& p = tables.parameters;
+  const double R = p.earthRadius, top = R + p.atmosphereHeight;
+  const glm::dvec3 x(0.0, R + h, 0.0);
+  const glm::dvec3 l(std::sqrt(std::max(0.0, 1.0 - mu * mu)), mu, 0.0);
+  const double r0 = R + h;
+  glm::dvec3 second(0.0), transfer(0.0);
+  for (int i = 0; i < samples; ++i) {
+    const glm::dvec3 w = fibonacciSphereDirection(i, samples);
+    const double c = w.y;
+    const bool ground = c < 0.0 && r0 * r0 * (c * c - 1.0) + R * R >= 0.0;
+    const double length = ground ? groundRoot(r0, c, R) : farRoot(r0, c, top);
+    const double dt = length / steps;
+    const double wl = glm::dot(w, l);
+    const double phaseR = rayleighPhase(wl), phaseM = henyeyGreenstein(p.mieG, wl);
+    glm::dvec2 optical(0.0);
+    glm::dvec3 lum(0.0), fms(0.0);
+    for (int k = 0; k < steps; ++k) {
+      const glm::dvec3 y = x + w * ((k + 0.5) * dt);
+      const double ry = glm::length(y);
+      const glm::dvec2 d = densities(p, ry);
+      // The transmittance to the step's middle: the half step's densities added first (midpoint rule).
+      const glm::dvec3 t = transmittanceOf(p, optical + d * (0.5 * dt));
+      optical += d * dt;
+      const glm::dvec3 sigmaS = p.rayleighScattering * d.x + p.mieScattering * d.y;
+      const glm::dvec3 phased = p.rayleighScattering * (d.x * phaseR) + p.mieScattering * (d.y * phaseM);
+      lum += t * phased * sunTransmittance(tables, y, l) * dt;
+      fms += t * sigmaS * dt;
+    }
+    if (ground) {
+      const glm::dvec3 g = x + w * length;
+      const double cosSun = glm::dot(g / glm::length(g), l);
+      if (cosSun > 0.0)
+        lum += transmittanceOf(p, optical) * sunTransmittance(tables, g, l) * (cosSun * p.groundAlbedo / kPi);
+    }
+    second += lum;
+    transfer += fms;
+  }
+  // Isotropic phase 1 / (4 pi) at x times the sphere's 4 pi / samples: the means.
+  second /= samples;
+  transfer /= samples;
+  return second / (glm::dvec3(1.0) - transfer);
 }
 
 /// S_R p_R(c) + S_M p_HG(c): L1 of phase-free parts.
@@ -347,6 +409,9 @@ void validate(const AtmosphereParameters& p) {
                           "some Rayleigh or Mie scattering is needed (mieScattering is 0 too)");
   if (!(std::isfinite(p.mieG) && std::abs(p.mieG) < 1.0))
     throw InvalidArgument("AtmosphereParameters.mieG", detail::formatValue(p.mieG), "must satisfy |g| < 1");
+  if (!(p.groundAlbedo >= 0.0 && p.groundAlbedo <= 1.0))
+    throw InvalidArgument("AtmosphereParameters.groundAlbedo", detail::formatValue(p.groundAlbedo),
+                          "must be in [0, 1]");
 }
 
 void validate(const AtmospherePrecomputeOptions& o) {
@@ -363,6 +428,13 @@ void validate(const AtmospherePrecomputeOptions& o) {
     throw InvalidArgument("AtmospherePrecomputeOptions.size.sunView",
                           detail::formatValue(o.size.sunZenith * o.size.sunView),
                           "the packed depth sunZenith * sunView must be <= 2048");
+  if (o.multipleScattering != AtmosphereMultipleScattering::Lut &&
+      o.multipleScattering != AtmosphereMultipleScattering::Orders)
+    throw InvalidArgument("AtmospherePrecomputeOptions.multipleScattering",
+                          detail::formatValue(static_cast<int>(o.multipleScattering)),
+                          "must be one of AtmosphereMultipleScattering");
+  requireRange("multipleScatteringSize", o.multipleScatteringSize, 2, kMaxSize);
+  requireRange("multipleScatteringSteps", o.multipleScatteringSteps, 1, kMaxSteps);
   requireRange("orders", o.orders, 1, 16);
   requireRange("singleSteps", o.singleSteps, 1, kMaxSteps);
   requireRange("orderSteps", o.orderSteps, 1, kMaxSteps);
@@ -587,6 +659,21 @@ glm::dvec3 atmosphereTransmittance(const AtmosphereTables& tables, const glm::dv
   return transmittanceOf(tables.parameters, glm::max(d, glm::dvec2(0.0)));
 }
 
+// Hillaire 2020, Sec. 5.5: Psi_ms bilinear (texel (i, j) at u = sqrt(h / H_Atm) = i / (n - 1), c = 2 j / (n -
+// 1) - 1).
+glm::dvec3 lookUpMultipleScatteringLut(const AtmosphereTables& tables, double h, double cosSunZenith) {
+  const Image& img = tables.multipleScatteringLut;
+  if (img.width() < 2 || img.height() < 2) return glm::dvec3(0.0);
+  const int n = img.width(), m = img.height();
+  const double uh = std::sqrt(std::clamp(h / tables.parameters.atmosphereHeight, 0.0, 1.0));
+  const double uc = (std::clamp(cosSunZenith, -1.0, 1.0) + 1.0) * 0.5;
+  const Lerp1 x = glLerp(texCoord(uh, n), n);
+  const Lerp1 y = glLerp(texCoord(uc, m), m);
+  const auto at = [&](int i, int j) { return glm::dvec3(img.at(i, j, 0), img.at(i, j, 1), img.at(i, j, 2)); };
+  return glm::mix(glm::mix(at(x.i0, y.i0), at(x.i1, y.i0), x.f),
+                  glm::mix(at(x.i0, y.i1), at(x.i1, y.i1), x.f), y.f);
+}
+
 // Yusov 2013, "Terrain shaders": E_sky linear in the 1D table (texel i at c = 2 i / (N - 1) - 1).
 glm::dvec3 lookUpAmbientSkyLight(const AtmosphereTables& tables, double cosSunZenith) {
   const Image& img = tables.ambient;
@@ -660,28 +747,48 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
     });
   }
 
+  // Hillaire 2020's multiple scattering table (the Lut method; L_H from it below).
+  const bool lut = usesMultipleScatteringLut(o);
+  if (lut) {
+    const int m = o.multipleScatteringSize;
+    t.multipleScatteringLut = Image(m, m, 3);
+    parallelRows(m, threads, [&](int j) {
+      const double mu = -1.0 + 2.0 * j / (m - 1);
+      for (int i = 0; i < m; ++i) {
+        const double u = static_cast<double>(i) / (m - 1);
+        const glm::dvec3 psi = multipleScatteringAt(t, p.atmosphereHeight * u * u, mu, o.sphereSamples,
+                                                    o.multipleScatteringSteps);
+        for (int ch = 0; ch < 3; ++ch)
+          t.multipleScatteringLut.at(i, j, ch) = static_cast<float>(psi[ch]);
+      }
+    });
+  }
+
   const AtmosphereTableSize& size = o.size;
   const std::size_t n = emptyTable(size).texels();
   std::vector<glm::dvec3> higher(n, glm::dvec3(0.0));
 
-  // Step 1: single scattering without its phase functions (S_R, S_M).
+  // Step 1: single scattering without its phase functions (S_R, S_M); Lut: L_H in the same march.
   t.single = emptyTable(size);
   if (!o.combinedMie) t.singleMie = emptyTable(size);
+  const bool orders = o.multipleScattering == AtmosphereMultipleScattering::Orders;
+  const bool keep = o.keepOrders && orders;
   AtmosphereTable4D first; // L1 with its phase functions at each texel's c_theta (keepOrders)
-  if (o.keepOrders) first = emptyTable(size);
+  if (keep) first = emptyTable(size);
   forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
     const TexelRay r = texelRay(p, size, ih, ia, ip, it);
-    const SingleParts v = singleScattering(t, r, o.singleSteps);
+    const SingleParts v = singleScattering(t, r, o.singleSteps, lut);
+    if (lut) higher[packedIndex(size, ih, ia, ip, it)] = v.higher;
     t.single.at(ih, ia, ip, it) = glm::vec4(glm::vec3(v.rayleigh), static_cast<float>(v.mie.x));
     if (!o.combinedMie) store(t.singleMie, ih, ia, ip, it, v.mie);
-    if (o.keepOrders) store(first, ih, ia, ip, it, withPhase(p, v.rayleigh, v.mie, glm::dot(r.v, r.l)));
+    if (keep) store(first, ih, ia, ip, it, withPhase(p, v.rayleigh, v.mie, glm::dot(r.v, r.l)));
   });
-  if (o.keepOrders) t.orders.push_back(std::move(first));
+  if (keep) t.orders.push_back(std::move(first));
 
   // Step 2: J_n from L_(n-1) (n = 2: L1 with its phase functions), then L_n from J_n; L_H accumulates.
   const SphereSamples sphere = sphereSamples(p, size, o.sphereSamples);
   AtmosphereTable4D previous;
-  for (int order = 2; order <= o.orders; ++order) {
+  for (int order = 2; orders && order <= o.orders; ++order) {
     AtmosphereTable4D j = emptyTable(size);
     forEachTexel(size, threads, [&](int ih, int ia, int ip, int it) {
       const TexelRay r = texelRay(p, size, ih, ia, ip, it);
@@ -695,7 +802,7 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
       store(ln, ih, ia, ip, it, v);
     });
     previous = std::move(ln);
-    if (o.keepOrders) t.orders.push_back(previous);
+    if (keep) t.orders.push_back(previous);
   }
 
   // Step 3: L_H.

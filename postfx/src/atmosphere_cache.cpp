@@ -2,12 +2,13 @@
 //
 // ---------------------------------------------------------------------------------------------------
 // Cache key (atmosphereCacheKey): FNV-1a 64 (Fowler, Noll and Vo) over, in this order, the ASCII tag
-// "crep-atmosphere-key-2", then the little-endian IEEE-754 bytes of the 14 doubles of AtmosphereParameters
+// "crep-atmosphere-key-3", then the little-endian IEEE-754 bytes of the 15 doubles of AtmosphereParameters
 //   earthRadius, atmosphereHeight, rayleighScattering.x, .y, .z, rayleighScaleHeight,
-//   mieScattering.x, .y, .z, mieAbsorption.x, .y, .z, mieScaleHeight, mieG
-// and the little-endian int32 bytes of the 13 ints of AtmospherePrecomputeOptions
+//   mieScattering.x, .y, .z, mieAbsorption.x, .y, .z, mieScaleHeight, mieG, groundAlbedo
+// and the little-endian int32 bytes of the 16 ints of AtmospherePrecomputeOptions
 //   size.height, size.viewZenith, size.sunZenith, size.sunView, orders, singleSteps, orderSteps,
-//   sphereSamples, opticalDepthHeight, opticalDepthZenith, opticalDepthSteps, ambientSize, combinedMie (0, 1)
+//   sphereSamples, opticalDepthHeight, opticalDepthZenith, opticalDepthSteps, ambientSize, combinedMie (0,
+//   1), multipleScattering (0 Lut, 1 Orders), multipleScatteringSize, multipleScatteringSteps
 // (keepOrders and the thread count do not change the tables and are left out). The key is the 64-bit
 // digest as 16 lower-case hex digits. Exact bytes: 0.0 and -0.0 give different keys.
 //
@@ -17,16 +18,17 @@
 //        0     8  magic "CREPATM1" (ASCII)
 //        8     4  uint32 version = 2
 //       12    16  the cache key of the stored parameters and options (16 ASCII hex digits)
-//       28   112  14 float64: the AtmosphereParameters fields in the key's order
-//      140    52  13 int32: the AtmospherePrecomputeOptions ints in the key's order
-//      192     4  uint32 keepOrders (0 or 1)
-//      196     4  uint32 K, the number of per-order tables that follow (0, or `orders` when keepOrders)
-//      200    12  int32 width, height, channels of the optical depth image
+//       28   120  15 float64: the AtmosphereParameters fields in the key's order
+//      148    64  16 int32: the AtmospherePrecomputeOptions ints in the key's order
+//      212     4  uint32 keepOrders (0 or 1)
+//      216     4  uint32 K, the number of per-order tables that follow (0, or `orders` when keepOrders)
+//      220    12  int32 width, height, channels of the optical depth image
 //                 (must be opticalDepthHeight, opticalDepthZenith, 2)
-//      212    12  int32 width, height, channels of the ambient image (must be ambientSize, 1, 3)
-//      224    16  int32 N_h, N_alpha, N_phi, N_theta of every 4D table (must equal options.size)
-//      240        float32 data, each block in its in-memory order:
+//      232    12  int32 width, height, channels of the ambient image (must be ambientSize, 1, 3)
+//      244    16  int32 N_h, N_alpha, N_phi, N_theta of every 4D table (must equal options.size)
+//      260        float32 data, each block in its in-memory order:
 //                   optical depth (W * H * 2), ambient (ambientSize * 3),
+//                   Psi_ms (multipleScatteringSize^2 * 3; only when usesMultipleScatteringLut),
 //                   single, singleMie (not with combinedMie), higherOrders, then the K order tables L1..LK
 //                   (each N_h * N_alpha * N_phi * N_theta * 4, the packed order of AtmosphereTable4D)
 //      end-8   8  uint64 checksum: FNV-1a 64 of every preceding byte of the file
@@ -58,8 +60,9 @@ namespace fs = std::filesystem;
 constexpr char kMagic[8] = {'C', 'R', 'E', 'P', 'A', 'T', 'M', '1'};
 constexpr std::uint32_t kVersion = 2;
 constexpr std::size_t kKeyDigits = 16;
-constexpr std::size_t kHeaderBytes = 240;
-constexpr std::size_t kOptionFields = 13;
+constexpr std::size_t kHeaderBytes = 260;
+constexpr std::size_t kParameterFields = 15;
+constexpr std::size_t kOptionFields = 16;
 constexpr std::size_t kChecksumBytes = 8;
 
 constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
@@ -111,17 +114,18 @@ double getF64(const unsigned char* b) {
   return std::bit_cast<double>(getU64(b));
 }
 
-// The 14 doubles of the parameters in the key's (and the file's) order.
-std::array<double, 14> parameterFields(const AtmosphereParameters& p) {
+// The 15 doubles of the parameters in the key's (and the file's) order.
+std::array<double, kParameterFields> parameterFields(const AtmosphereParameters& p) {
   return {p.earthRadius,          p.atmosphereHeight,
           p.rayleighScattering.x, p.rayleighScattering.y,
           p.rayleighScattering.z, p.rayleighScaleHeight,
           p.mieScattering.x,      p.mieScattering.y,
           p.mieScattering.z,      p.mieAbsorption.x,
           p.mieAbsorption.y,      p.mieAbsorption.z,
-          p.mieScaleHeight,       p.mieG};
+          p.mieScaleHeight,       p.mieG,
+          p.groundAlbedo};
 }
-AtmosphereParameters parametersFromFields(const std::array<double, 14>& f) {
+AtmosphereParameters parametersFromFields(const std::array<double, kParameterFields>& f) {
   AtmosphereParameters p;
   p.earthRadius = f[0];
   p.atmosphereHeight = f[1];
@@ -131,6 +135,7 @@ AtmosphereParameters parametersFromFields(const std::array<double, 14>& f) {
   p.mieAbsorption = glm::dvec3(f[9], f[10], f[11]);
   p.mieScaleHeight = f[12];
   p.mieG = f[13];
+  p.groundAlbedo = f[14];
   return p;
 }
 
@@ -148,7 +153,10 @@ std::array<int, kOptionFields> optionFields(const AtmospherePrecomputeOptions& o
           o.opticalDepthZenith,
           o.opticalDepthSteps,
           o.ambientSize,
-          o.combinedMie ? 1 : 0};
+          o.combinedMie ? 1 : 0,
+          static_cast<int>(o.multipleScattering),
+          o.multipleScatteringSize,
+          o.multipleScatteringSteps};
 }
 AtmospherePrecomputeOptions optionsFromFields(const std::array<int, kOptionFields>& f, bool keepOrders) {
   AtmospherePrecomputeOptions o;
@@ -162,6 +170,9 @@ AtmospherePrecomputeOptions optionsFromFields(const std::array<int, kOptionField
   o.opticalDepthSteps = f[10];
   o.ambientSize = f[11];
   o.combinedMie = f[12] != 0;
+  o.multipleScattering = static_cast<AtmosphereMultipleScattering>(f[13]);
+  o.multipleScatteringSize = f[14];
+  o.multipleScatteringSteps = f[15];
   o.keepOrders = keepOrders;
   return o;
 }
@@ -193,10 +204,22 @@ std::size_t tableFloats(const AtmosphereTableSize& s) {
 // The limits of validate(AtmospherePrecomputeOptions) (atmosphere.h), checked on a file's sizes before
 // anything is allocated from them. Returns the reason, or empty when they hold.
 std::string sizeProblem(const std::array<int, kOptionFields>& f) {
-  static const char* const names[kOptionFields] = {
-      "size.height",       "size.viewZenith", "size.sunZenith", "size.sunView",       "orders",
-      "singleSteps",       "orderSteps",      "sphereSamples",  "opticalDepthHeight", "opticalDepthZenith",
-      "opticalDepthSteps", "ambientSize",     "combinedMie"};
+  static const char* const names[kOptionFields] = {"size.height",
+                                                   "size.viewZenith",
+                                                   "size.sunZenith",
+                                                   "size.sunView",
+                                                   "orders",
+                                                   "singleSteps",
+                                                   "orderSteps",
+                                                   "sphereSamples",
+                                                   "opticalDepthHeight",
+                                                   "opticalDepthZenith",
+                                                   "opticalDepthSteps",
+                                                   "ambientSize",
+                                                   "combinedMie",
+                                                   "multipleScattering",
+                                                   "multipleScatteringSize",
+                                                   "multipleScatteringSteps"};
   for (std::size_t i = 0; i < kOptionFields; ++i) {
     const int v = f[i];
     int lo = 2, hi = 2048;
@@ -209,9 +232,12 @@ std::string sizeProblem(const std::array<int, kOptionFields>& f) {
     } else if (i == 10) {
       lo = 1;
       hi = 4096;
-    } else if (i == 12) {
+    } else if (i == 12 || i == 13) {
       lo = 0;
       hi = 1;
+    } else if (i == 15) {
+      lo = 1;
+      hi = 4096;
     }
     if (v < lo || v > hi)
       return std::string("stored ") + names[i] + " = " + std::to_string(v) + " outside [" +
@@ -293,7 +319,7 @@ std::string uniqueSuffix() {
 } // namespace
 
 std::string atmosphereCacheKey(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o) {
-  std::string bytes = "crep-atmosphere-key-2";
+  std::string bytes = "crep-atmosphere-key-3";
   for (double v : parameterFields(p))
     putF64(bytes, v);
   for (int v : optionFields(o))
@@ -332,6 +358,10 @@ void saveAtmosphereTables(const AtmosphereTables& tables, const fs::path& path) 
   if (tables.ambient.width() != o.ambientSize || tables.ambient.height() != 1 ||
       tables.ambient.channels() != 3)
     throwWrite(path, "the ambient image is not ambientSize x 1 x 3");
+  if (usesMultipleScatteringLut(o) && (tables.multipleScatteringLut.width() != o.multipleScatteringSize ||
+                                       tables.multipleScatteringLut.height() != o.multipleScatteringSize ||
+                                       tables.multipleScatteringLut.channels() != 3))
+    throwWrite(path, "the multiple scattering table is not multipleScatteringSize^2 x 3");
 
   std::string header;
   header.append(kMagic, sizeof kMagic);
@@ -381,6 +411,8 @@ void saveAtmosphereTables(const AtmosphereTables& tables, const fs::path& path) 
     };
     emitFloats(tables.opticalDepth.data().data(), tables.opticalDepth.sampleCount());
     emitFloats(tables.ambient.data().data(), tables.ambient.sampleCount());
+    if (usesMultipleScatteringLut(o))
+      emitFloats(tables.multipleScatteringLut.data().data(), tables.multipleScatteringLut.sampleCount());
     emitFloats(tables.single.rgba.data(), floats4D);
     if (!o.combinedMie) emitFloats(tables.singleMie.rgba.data(), floats4D);
     emitFloats(tables.higherOrders.rgba.data(), floats4D);
@@ -422,17 +454,17 @@ AtmosphereTables loadAtmosphereTables(const fs::path& path) {
     throwRead(path, "unsupported version " + std::to_string(version) + " (expected " +
                         std::to_string(kVersion) + ")");
   const std::string storedKey(reinterpret_cast<const char*>(h.data() + 12), kKeyDigits);
-  std::array<double, 14> pf{};
+  std::array<double, kParameterFields> pf{};
   for (std::size_t i = 0; i < pf.size(); ++i)
     pf[i] = getF64(h.data() + 28 + 8 * i);
   std::array<int, kOptionFields> of{};
   for (std::size_t i = 0; i < of.size(); ++i)
-    of[i] = getI32(h.data() + 140 + 4 * i);
-  const std::uint32_t keepOrders = getU32(h.data() + 192);
-  const std::uint32_t orderCount = getU32(h.data() + 196);
+    of[i] = getI32(h.data() + 148 + 4 * i);
+  const std::uint32_t keepOrders = getU32(h.data() + 212);
+  const std::uint32_t orderCount = getU32(h.data() + 216);
   std::array<int, 10> dims{};
   for (std::size_t i = 0; i < dims.size(); ++i)
-    dims[i] = getI32(h.data() + 200 + 4 * i);
+    dims[i] = getI32(h.data() + 220 + 4 * i);
 
   if (const std::string problem = sizeProblem(of); !problem.empty()) throwRead(path, "bad sizes: " + problem);
   if (keepOrders > 1) throwRead(path, "bad sizes: keepOrders = " + std::to_string(keepOrders));
@@ -452,9 +484,14 @@ AtmosphereTables loadAtmosphereTables(const fs::path& path) {
   const std::size_t floats4D = tableFloats(o.size);
   const std::size_t depthFloats = static_cast<std::size_t>(o.opticalDepthHeight) * o.opticalDepthZenith * 2u;
   const std::size_t ambientFloats = static_cast<std::size_t>(o.ambientSize) * 3u;
+  const std::size_t lutFloats = usesMultipleScatteringLut(o)
+                                    ? static_cast<std::size_t>(o.multipleScatteringSize) *
+                                          static_cast<std::size_t>(o.multipleScatteringSize) * 3u
+                                    : 0u;
   const std::uintmax_t expected =
       kHeaderBytes + kChecksumBytes +
-      (depthFloats + ambientFloats + floats4D * ((o.combinedMie ? 2u : 3u) + orderCount)) * sizeof(float);
+      (depthFloats + ambientFloats + lutFloats + floats4D * ((o.combinedMie ? 2u : 3u) + orderCount)) *
+          sizeof(float);
   if (fileBytes != expected)
     throwRead(path, (fileBytes < expected ? "truncated: " : "wrong length: ") + std::to_string(fileBytes) +
                         " bytes, the sizes imply " + std::to_string(expected));
@@ -467,6 +504,10 @@ AtmosphereTables loadAtmosphereTables(const fs::path& path) {
   t.ambient = Image(o.ambientSize, 1, 3);
   reader.readFloats(t.opticalDepth.data().data(), depthFloats, "the optical depth table");
   reader.readFloats(t.ambient.data().data(), ambientFloats, "the ambient table");
+  if (lutFloats > 0) {
+    t.multipleScatteringLut = Image(o.multipleScatteringSize, o.multipleScatteringSize, 3);
+    reader.readFloats(t.multipleScatteringLut.data().data(), lutFloats, "the multiple scattering table");
+  }
   auto readTable = [&](AtmosphereTable4D& table, const char* what) {
     table.size = o.size;
     table.rgba.resize(floats4D);

@@ -33,6 +33,9 @@ AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const Atmospher
   a.auxSizes = glm::ivec4(o.opticalDepthHeight, o.opticalDepthZenith, o.ambientSize, o.orders);
   a.placement = glm::vec4(static_cast<float>(placement.metersPerUnit),
                           static_cast<float>(placement.originAltitude), 0.0f, 0.0f);
+  a.multipleScattering =
+      glm::vec4(static_cast<float>(p.groundAlbedo), static_cast<float>(o.multipleScatteringSize),
+                static_cast<float>(o.multipleScatteringSteps), 0.0f);
   return a;
 }
 
@@ -103,6 +106,11 @@ AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info)
   if (!o.combinedMie) singleMie_ = createTable3D(o.size);
   higher_ = createTable3D(o.size);
   ambient_ = createLinearTexture2D(GL_RGBA32F, o.ambientSize, 1);
+  if (usesMultipleScatteringLut(o)) {
+    requireAtMost(std::string(kOptions) + ".multipleScatteringSize", o.multipleScatteringSize, max2D,
+                  "GL_MAX_TEXTURE_SIZE");
+    msLut_ = createLinearTexture2D(GL_RGBA32F, o.multipleScatteringSize, o.multipleScatteringSize);
+  }
   gl::checkError("AtmosphereTablesPass: allocating the tables");
 }
 
@@ -122,8 +130,11 @@ void AtmosphereTablesPass::compute() {
   const ShaderDefine combined{"CREP_ATMOSPHERE_COMBINED_MIE", o.combinedMie ? "1" : "0"};
   const std::vector<ShaderDefine> samples{{"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)},
                                           combined};
+  const bool lut = usesMultipleScatteringLut(o);
+  const bool orders = o.orders > 1 && !lut;
   std::vector<ShaderDefine> singleDefines = steps(o.singleSteps);
   singleDefines.push_back(combined);
+  singleDefines.push_back({"CREP_ATMOSPHERE_MS_LUT", lut ? "1" : "0"});
   std::vector<ShaderDefine> firstOrder = samples;
   firstOrder.push_back({"CREP_ATMOSPHERE_FIRST_ORDER", "1"});
   gl::Handle opticalProgram = buildProgram(
@@ -135,8 +146,13 @@ void AtmosphereTablesPass::compute() {
       {"CREP_ATMOSPHERE_SAMPLES", std::to_string(kAmbientSampleFactor * o.sphereSamples)}, combined};
   gl::Handle ambientProgram =
       buildProgram({{ShaderStage::Compute, "passes/atmosphere_ambient.comp", ambientSamples}});
-  gl::Handle scatteredProgram, firstScatteredProgram, orderProgram;
-  if (o.orders > 1) {
+  gl::Handle scatteredProgram, firstScatteredProgram, orderProgram, msProgram;
+  if (lut) {
+    std::vector<ShaderDefine> msDefines = steps(o.multipleScatteringSteps);
+    msDefines.push_back({"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)});
+    msProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere_ms.comp", msDefines}});
+  }
+  if (orders) {
     firstScatteredProgram =
         buildProgram({{ShaderStage::Compute, "passes/atmosphere_scattered.comp", firstOrder}});
     scatteredProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere_scattered.comp", samples}});
@@ -183,22 +199,36 @@ void AtmosphereTablesPass::compute() {
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   endStage("optical depth");
 
-  // L1 without its phase functions (S_R, S_M).
+  // Psi_ms (Hillaire 2020, the Lut method).
+  if (lut) {
+    glUseProgram(msProgram.get());
+    glBindTextureUnit(0, opticalDepth_.get());
+    glBindImageTexture(0, msLut_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(groups(o.multipleScatteringSize, 8), groups(o.multipleScatteringSize, 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    endStage("multiple scattering LUT");
+  }
+
+  // L1 without its phase functions (S_R, S_M); Lut: L_H in the same march.
   glUseProgram(singleProgram.get());
   glBindTextureUnit(0, opticalDepth_.get());
   glBindImageTexture(0, single_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   if (!o.combinedMie) glBindImageTexture(1, singleMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  if (lut) {
+    glBindTextureUnit(1, msLut_.get());
+    glBindImageTexture(2, higher_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  }
   dispatchTable();
   if (o.orders == 1) {
     // L_H = 0 (timed with single scattering).
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glClearTexImage(higher_.get(), 0, GL_RGBA, GL_FLOAT, zero);
   }
-  endStage("single scattering");
+  endStage(lut ? "single scattering and L_H" : "single scattering");
   // The single Mie unit of the passes that read L1 (the single table itself with combinedMie: not read).
   const GLuint mieTable = o.combinedMie ? single_.get() : singleMie_.get();
 
-  if (o.orders > 1) {
+  if (orders) {
     // J_n and L_n ping-pong through two scratch tables: J_n reads L_(n-1) (L1 or the previous L_n), L_n reads
     // J_n and overwrites the previous L_n, already added to L_H.
     gl::Handle scattered = createTable3D(s);
@@ -267,6 +297,11 @@ void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
   if (tables.ambient.width() != o.ambientSize || tables.ambient.height() != 1 ||
       tables.ambient.channels() != 3)
     fail("ambient must be ambientSize x 1 with 3 channels");
+  const bool lut = usesMultipleScatteringLut(o);
+  if (lut && (tables.multipleScatteringLut.width() != o.multipleScatteringSize ||
+              tables.multipleScatteringLut.height() != o.multipleScatteringSize ||
+              tables.multipleScatteringLut.channels() != 3))
+    fail("multipleScatteringLut must be multipleScatteringSize^2 with 3 channels");
 
   const gl::PixelStoreScope
       pixelStore; // tightly packed floats, no pixel unpack buffer: whatever the caller left
@@ -278,6 +313,9 @@ void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
                         table->rgba.data());
   glTextureSubImage2D(ambient_.get(), 0, 0, 0, o.ambientSize, 1, GL_RGB, GL_FLOAT,
                       tables.ambient.data().data());
+  if (lut)
+    glTextureSubImage2D(msLut_.get(), 0, 0, 0, o.multipleScatteringSize, o.multipleScatteringSize, GL_RGB,
+                        GL_FLOAT, tables.multipleScatteringLut.data().data());
   gl::passOutputBarrier();
   gl::checkError("AtmosphereTablesPass::upload");
 }
@@ -305,6 +343,12 @@ AtmosphereTables AtmosphereTablesPass::download() const {
   t.ambient = Image(o.ambientSize, 1, 3);
   glGetTextureImage(ambient_.get(), 0, GL_RGB, GL_FLOAT, static_cast<GLsizei>(t.ambient.byteSize()),
                     t.ambient.data().data());
+  if (usesMultipleScatteringLut(o)) {
+    t.multipleScatteringLut = Image(o.multipleScatteringSize, o.multipleScatteringSize, 3);
+    glGetTextureImage(msLut_.get(), 0, GL_RGB, GL_FLOAT,
+                      static_cast<GLsizei>(t.multipleScatteringLut.byteSize()),
+                      t.multipleScatteringLut.data().data());
+  }
   gl::checkError("AtmosphereTablesPass::download");
   return t;
 }

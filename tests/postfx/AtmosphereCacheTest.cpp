@@ -104,6 +104,9 @@ AtmosphereTables patternTables(const AtmosphereParameters& p, const AtmospherePr
   t.single = patternTable(o.size, seed * 7u + 3u);
   t.higherOrders = patternTable(o.size, seed * 7u + 4u);
   if (!o.combinedMie) t.singleMie = patternTable(o.size, seed * 7u + 5u);
+  if (usesMultipleScatteringLut(o))
+    t.multipleScatteringLut =
+        patternImage(o.multipleScatteringSize, o.multipleScatteringSize, 3, seed * 7u + 9u);
   if (o.keepOrders)
     for (int n = 0; n < o.orders; ++n)
       t.orders.push_back(patternTable(o.size, seed * 7u + 6u + 1000u * static_cast<std::uint32_t>(n)));
@@ -125,7 +128,7 @@ bool sameParameters(const AtmosphereParameters& a, const AtmosphereParameters& b
   return a.earthRadius == b.earthRadius && a.atmosphereHeight == b.atmosphereHeight &&
          a.rayleighScattering == b.rayleighScattering && a.rayleighScaleHeight == b.rayleighScaleHeight &&
          a.mieScattering == b.mieScattering && a.mieAbsorption == b.mieAbsorption &&
-         a.mieScaleHeight == b.mieScaleHeight && a.mieG == b.mieG;
+         a.mieScaleHeight == b.mieScaleHeight && a.mieG == b.mieG && a.groundAlbedo == b.groundAlbedo;
 }
 
 bool sameOptions(const AtmospherePrecomputeOptions& a, const AtmospherePrecomputeOptions& b) {
@@ -134,7 +137,10 @@ bool sameOptions(const AtmospherePrecomputeOptions& a, const AtmospherePrecomput
          a.singleSteps == b.singleSteps && a.orderSteps == b.orderSteps &&
          a.sphereSamples == b.sphereSamples && a.opticalDepthHeight == b.opticalDepthHeight &&
          a.opticalDepthZenith == b.opticalDepthZenith && a.opticalDepthSteps == b.opticalDepthSteps &&
-         a.ambientSize == b.ambientSize && a.keepOrders == b.keepOrders;
+         a.ambientSize == b.ambientSize && a.keepOrders == b.keepOrders && a.combinedMie == b.combinedMie &&
+         a.multipleScattering == b.multipleScattering &&
+         a.multipleScatteringSize == b.multipleScatteringSize &&
+         a.multipleScatteringSteps == b.multipleScatteringSteps;
 }
 
 /// Every table bit-identical (and the orders too).
@@ -144,7 +150,8 @@ bool sameTables(const AtmosphereTables& a, const AtmosphereTables& b) {
     if (!sameBits(a.orders[i], b.orders[i])) return false;
   return sameBits(a.opticalDepth, b.opticalDepth) && sameBits(a.ambient, b.ambient) &&
          sameBits(a.single, b.single) && sameBits(a.higherOrders, b.higherOrders) &&
-         sameBits(a.singleMie, b.singleMie) && a.singleMie.rgba.size() == b.singleMie.rgba.size();
+         sameBits(a.singleMie, b.singleMie) && a.singleMie.rgba.size() == b.singleMie.rgba.size() &&
+         sameBits(a.multipleScatteringLut, b.multipleScatteringLut);
 }
 
 std::vector<char> readBytes(const fs::path& path) {
@@ -223,6 +230,27 @@ TEST_CASE("AtmosphereCache: combinedMie stores no single Mie table and round-tri
   CHECK(fs::file_size(separate) - fs::file_size(combined) == table4D);
 }
 
+TEST_CASE("AtmosphereCache: the multiple scattering LUT is stored and round-trips") {
+  TempDir dir;
+  AtmospherePrecomputeOptions o = smallOptions();
+  o.multipleScattering = AtmosphereMultipleScattering::Lut;
+  o.multipleScatteringSize = 6;
+  REQUIRE(usesMultipleScatteringLut(o));
+  const AtmosphereTables tables = patternTables(someParameters(), o, 31u);
+  const fs::path file = dir.path / "lut.bin";
+  saveAtmosphereTables(tables, file);
+  const AtmosphereTables loaded = loadAtmosphereTables(file);
+  CHECK(loaded.options.multipleScattering == AtmosphereMultipleScattering::Lut);
+  CHECK(loaded.options.multipleScatteringSize == 6);
+  CHECK(loaded.parameters.groundAlbedo == tables.parameters.groundAlbedo);
+  CHECK(loaded.multipleScatteringLut.width() == 6);
+  CHECK(sameTables(loaded, tables));
+  // A LUT of the wrong size is refused on save, naming the file.
+  AtmosphereTables bad = tables;
+  bad.multipleScatteringLut = Image(5, 6, 3);
+  CHECK_THROWS_AS(saveAtmosphereTables(bad, dir.path / "bad.bin"), IoError);
+}
+
 TEST_CASE("AtmosphereCache: the key changes with every field that changes the tables, not keepOrders") {
   const AtmosphereParameters p0 = someParameters();
   const AtmospherePrecomputeOptions o0 = smallOptions();
@@ -251,6 +279,7 @@ TEST_CASE("AtmosphereCache: the key changes with every field that changes the ta
       [](AtmosphereParameters& p) { p.mieAbsorption.z *= 1.01; },
       [](AtmosphereParameters& p) { p.mieScaleHeight += 1.0; },
       [](AtmosphereParameters& p) { p.mieG = 0.81; },
+      [](AtmosphereParameters& p) { p.groundAlbedo = 0.2; },
   };
   std::vector<std::function<void(AtmospherePrecomputeOptions&)>> optionChanges = {
       [](AtmospherePrecomputeOptions& o) { o.size.height += 1; },
@@ -266,6 +295,9 @@ TEST_CASE("AtmosphereCache: the key changes with every field that changes the ta
       [](AtmospherePrecomputeOptions& o) { o.opticalDepthSteps += 1; },
       [](AtmospherePrecomputeOptions& o) { o.ambientSize += 1; },
       [](AtmospherePrecomputeOptions& o) { o.combinedMie = true; },
+      [](AtmospherePrecomputeOptions& o) { o.multipleScattering = AtmosphereMultipleScattering::Lut; },
+      [](AtmospherePrecomputeOptions& o) { o.multipleScatteringSize += 1; },
+      [](AtmospherePrecomputeOptions& o) { o.multipleScatteringSteps += 1; },
   };
   std::set<std::string> keys{key0};
   for (std::size_t i = 0; i < parameterChanges.size(); ++i) {
@@ -284,7 +316,7 @@ TEST_CASE("AtmosphereCache: the key changes with every field that changes the ta
     CHECK(key != key0);
     keys.insert(key);
   }
-  // 14 parameter fields and 13 option fields: 28 distinct keys with the original.
+  // 15 parameter fields and 16 option fields: 32 distinct keys with the original.
   CHECK(keys.size() == 1u + parameterChanges.size() + optionChanges.size());
 }
 
@@ -377,8 +409,8 @@ TEST_CASE("AtmosphereCache: truncated, flipped, wrong magic and missing files ar
   {
     // A size beyond the options' limits (size.height = 2^31 - 1) is refused before any allocation.
     std::vector<char> huge = bytes;
-    huge[140] = huge[141] = huge[142] = static_cast<char>(0xff);
-    huge[143] = 0x7f;
+    huge[148] = huge[149] = huge[150] = static_cast<char>(0xff); // the options' first int (offset 148)
+    huge[151] = 0x7f;
     writeBytes(bad, huge, huge.size());
     const std::string message = loadError(bad);
     MESSAGE("huge size: " << message);

@@ -506,3 +506,36 @@ TEST_CASE("AtmosphereTablesPass: a bad create-info names the field") {
   const std::string packed = parameterOf(info);
   CHECK(packed == "AtmospherePrecomputeOptions.size.sunView");
 }
+
+TEST_CASE("AtmosphereTablesPass: the multiple scattering LUT (Hillaire 2020) and its L_H equal the CPU's") {
+  CREP_REQUIRE_GL();
+  AtmosphereParameters p;
+  p.groundAlbedo = 0.3;
+  AtmospherePrecomputeOptions o = smallOptions();
+  o.multipleScattering = AtmosphereMultipleScattering::Lut;
+  o.multipleScatteringSize = 16;
+  AtmosphereTablesPass pass({p, o});
+  REQUIRE(pass.multipleScatteringLutTexture() != 0u);
+  pass.compute();
+  const AtmosphereTables gpu = pass.download();
+  const AtmosphereTables cpu = precomputeAtmosphere(p, o);
+  const double lutError =
+      tableError(toVector(gpu.multipleScatteringLut), toVector(cpu.multipleScatteringLut), 3, 3);
+  const double singleError = tableError(gpu.single.rgba, cpu.single.rgba, 4, 4);
+  const double higherError = tableError(gpu.higherOrders.rgba, cpu.higherOrders.rgba, 4, 3);
+  const double ambientError = tableError(toVector(gpu.ambient), toVector(cpu.ambient), 3, 3);
+  MESSAGE("LUT method, GPU vs CPU: Psi_ms " << lutError << ", single " << singleError << ", L_H "
+                                            << higherError << ", ambient " << ambientError
+                                            << " of each table's peak");
+  CHECK(pass.stageTimes().size() == 4); // optical depth, LUT, single scattering and L_H, ambient
+  CHECK(lutError < kTableTolerance);
+  CHECK(singleError < kTableTolerance);
+  CHECK(higherError < kTableTolerance);
+  CHECK(ambientError < kAmbientTolerance);
+  // Upload then download: the LUT too, bit for bit.
+  AtmosphereTablesPass other({p, o});
+  other.upload(cpu);
+  const AtmosphereTables back = other.download();
+  CHECK(std::memcmp(back.multipleScatteringLut.data().data(), cpu.multipleScatteringLut.data().data(),
+                    cpu.multipleScatteringLut.byteSize()) == 0);
+}

@@ -669,6 +669,9 @@ TEST_CASE("Atmosphere validation names the bad field") {
             "AtmosphereParameters.mieAbsorption");
   badParams([](AtmosphereParameters& p) { p.mieG = 1.0; }, "AtmosphereParameters.mieG");
   badParams([](AtmosphereParameters& p) { p.mieG = -1.5; }, "AtmosphereParameters.mieG");
+  badParams([](AtmosphereParameters& p) { p.groundAlbedo = -0.1; }, "AtmosphereParameters.groundAlbedo");
+  badParams([](AtmosphereParameters& p) { p.groundAlbedo = 1.5; }, "AtmosphereParameters.groundAlbedo");
+  badParams([&](AtmosphereParameters& p) { p.groundAlbedo = nan; }, "AtmosphereParameters.groundAlbedo");
   badParams(
       [](AtmosphereParameters& p) {
         p.rayleighScattering = glm::dvec3(0.0);
@@ -718,6 +721,15 @@ TEST_CASE("Atmosphere validation names the bad field") {
              "AtmospherePrecomputeOptions.opticalDepthSteps");
   badOptions([](AtmospherePrecomputeOptions& o) { o.ambientSize = 0; },
              "AtmospherePrecomputeOptions.ambientSize");
+  badOptions([](AtmospherePrecomputeOptions& o) { o.multipleScatteringSize = 1; },
+             "AtmospherePrecomputeOptions.multipleScatteringSize");
+  badOptions([](AtmospherePrecomputeOptions& o) { o.multipleScatteringSteps = 0; },
+             "AtmospherePrecomputeOptions.multipleScatteringSteps");
+  badOptions(
+      [](AtmospherePrecomputeOptions& o) {
+        o.multipleScattering = static_cast<AtmosphereMultipleScattering>(7);
+      },
+      "AtmospherePrecomputeOptions.multipleScattering");
   // precomputeAtmosphere validates the parameters too.
   AtmosphereParameters bad = good;
   bad.mieG = 2.0;
@@ -748,4 +760,74 @@ TEST_CASE("Atmosphere placement puts world points around the planet centre") {
   // The planet centre in world units maps to the origin.
   const glm::dvec3 c = atmospherePosition(place, p, glm::dvec3(0.0, -(p.earthRadius + 300.0) / 2.5, 0.0));
   CHECK(glm::length(c) < 1e-6);
+}
+
+// Hillaire 2020, Sec. 5.5: Psi_ms and the L_H it gives, against the orders' reference on the same small
+// table.
+TEST_CASE("Atmosphere multiple scattering LUT: Psi_ms, the ground's bounce and L_H against the orders") {
+  AtmosphereParameters p;
+  p.groundAlbedo = 0.0;
+  AtmospherePrecomputeOptions o = smallOptions();
+  o.orders = 8; // the orders' sum within 0.1% of its limit (AtmospherePhysicsTest)
+  const AtmosphereTables orders = precomputeAtmosphere(p, o);
+  o.multipleScattering = AtmosphereMultipleScattering::Lut;
+  const AtmosphereTables lut = precomputeAtmosphere(p, o);
+  REQUIRE(usesMultipleScatteringLut(o));
+  REQUIRE(lut.multipleScatteringLut.width() == o.multipleScatteringSize);
+  REQUIRE(lut.multipleScatteringLut.height() == o.multipleScatteringSize);
+  CHECK(orders.multipleScatteringLut.data().empty());
+  for (float v : lut.multipleScatteringLut.data()) {
+    REQUIRE(std::isfinite(v));
+    REQUIRE(v >= 0.0f);
+  }
+  // The same single scattering: L_H is the only table the method changes.
+  CHECK(lut.single.rgba == orders.single.rgba);
+  // By day Psi_ms grows with the sun's height at the ground; a sun far below the horizon leaves ~nothing.
+  const glm::dvec3 low = lookUpMultipleScatteringLut(lut, 0.0, 0.1),
+                   high = lookUpMultipleScatteringLut(lut, 0.0, 1.0);
+  const glm::dvec3 night = lookUpMultipleScatteringLut(lut, 0.0, -0.8);
+  MESSAGE("Psi_ms at the ground: sun 6 degrees up " << low.b << ", at the zenith " << high.b
+                                                    << ", 53 degrees below " << night.b << " (blue)");
+  CHECK(high.b > low.b);
+  CHECK(night.b < 1e-3 * high.b);
+
+  // L_H against the orders' (no ground in either): per channel, the sums over the table and the relative
+  // RMS difference of the texels. The isotropic scattering at the table's point misses the Mie lobe's
+  // forward peak of the second scattering (the red channel, Mie's share of the scattering largest, the
+  // furthest off). Bounds: 10% around the measured values (see the MESSAGE).
+  double sumLut[3] = {0.0, 0.0, 0.0}, sumOrders[3] = {0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < lut.higherOrders.rgba.size(); i += 4)
+    for (int c = 0; c < 3; ++c) {
+      sumLut[c] += lut.higherOrders.rgba[i + static_cast<std::size_t>(c)];
+      sumOrders[c] += orders.higherOrders.rgba[i + static_cast<std::size_t>(c)];
+    }
+  const glm::dvec3 ratio(sumLut[0] / sumOrders[0], sumLut[1] / sumOrders[1], sumLut[2] / sumOrders[2]);
+  MESSAGE("L_H of the LUT over the 8 orders', summed over the table: RGB " << ratio.r << " " << ratio.g << " "
+                                                                           << ratio.b);
+  CHECK(ratio.r > 0.5);
+  CHECK(ratio.b > 0.8);
+  CHECK(ratio.r < ratio.g);
+  CHECK(ratio.g < ratio.b);
+  CHECK(ratio.b < 1.0);
+
+  // The ground's bounce: a white ground adds light where the sun is up; with the sun 53 degrees below the
+  // horizon no ground point within reach is lit, so the albedo changes nothing there.
+  AtmosphereParameters white = p;
+  white.groundAlbedo = 1.0;
+  const AtmosphereTables bright = precomputeAtmosphere(white, o);
+  const glm::dvec3 dayWhite = lookUpMultipleScatteringLut(bright, 0.0, 1.0);
+  MESSAGE("Psi_ms at the ground, sun at the zenith: albedo 0 " << high.g << ", albedo 1 " << dayWhite.g);
+  CHECK(dayWhite.g > 1.2 * high.g);
+  const int m = o.multipleScatteringSize;
+  const int below = static_cast<int>(std::floor(0.1 * (m - 1))); // c_phi = -0.8 and lower
+  for (int j = 0; j <= below; ++j)
+    for (int c = 0; c < 3; ++c)
+      CHECK(bright.multipleScatteringLut.at(0, j, c) == lut.multipleScatteringLut.at(0, j, c));
+
+  // One order only: no LUT and no L_H.
+  o.orders = 1;
+  const AtmosphereTables single = precomputeAtmosphere(p, o);
+  CHECK(single.multipleScatteringLut.data().empty());
+  CHECK(std::all_of(single.higherOrders.rgba.begin(), single.higherOrders.rgba.end(),
+                    [](float x) { return x == 0.0f; }));
 }

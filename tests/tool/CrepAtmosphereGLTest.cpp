@@ -206,8 +206,35 @@ TEST_CASE("crep render --method atmosphere: usage errors name the option") {
   const auto table = runCrep(kCommon + "--atmosphere-table 16x31x16x8" + out);
   CHECK(table.status == 2);
   CHECK(table.output.find("--atmosphere-table") != std::string::npos);
+  const auto multiple = runCrep(kCommon + "--multiple-scattering many" + out);
+  CHECK(multiple.status == 2);
+  CHECK(multiple.output.find("--multiple-scattering") != std::string::npos);
+  const auto albedo = runCrep(kCommon + "--ground-albedo 1.5" + out);
+  CHECK(albedo.status == 2);
+  CHECK(albedo.output.find("--ground-albedo") != std::string::npos);
   const auto without = runCrep("render --scene terrain --size 64x36 --sun-elevation 10" + out);
   CHECK(without.status == 2);
   CHECK(without.output.find("--method atmosphere") != std::string::npos);
   CHECK_FALSE(std::filesystem::exists(dir.path() / "bad.png"));
+}
+
+TEST_CASE("crep render --method atmosphere: the multiple scattering LUT and the ground's albedo") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir;
+  const std::string options = "--sun-elevation 20 --shafts none --multiple-scattering lut ";
+  const Run dark = render(dir, "dark", options + "--ground-albedo 0");
+  const Run bright = render(dir, "bright", options + "--ground-albedo 1");
+  const Run orders = render(dir, "orders", "--sun-elevation 20 --shafts none");
+  CHECK(dark.output.find("multiple scattering LUT") != std::string::npos);
+  CHECK(orders.output.find("3 orders") != std::string::npos);
+  CHECK(allFinite(dark.scattering));
+  // A white ground's bounce brightens the air; the LUT and the orders differ by their multiple scattering
+  // only (the same single scattering), printed.
+  const glm::dvec3 d = block(dark.scattering, 0, 0, 64, 36), b = block(bright.scattering, 0, 0, 64, 36);
+  MESSAGE("mean in-scattering: albedo 0 " << text(d) << ", albedo 1 " << text(b)
+                                          << "; LUT (albedo 0) vs 3 orders "
+                                          << relativeRmse(dark.scattering, orders.scattering));
+  CHECK(b.g > 1.02 * d.g);
+  CHECK(relativeRmse(dark.scattering, orders.scattering) > 1e-4);
+  CHECK(relativeRmse(dark.scattering, orders.scattering) < 0.2);
 }

@@ -20,8 +20,9 @@
 namespace crep::tool {
 
 const std::set<std::string> kAtmosphereOptions = {
-    "sun-elevation",   "sun-azimuth",      "camera-elevation", "shafts",           "meters-per-unit",
-    "origin-altitude", "atmosphere-table", "orders",           "atmosphere-cache", "sun-irradiance"};
+    "sun-elevation",    "sun-azimuth",     "camera-elevation",    "shafts",
+    "meters-per-unit",  "origin-altitude", "atmosphere-table",    "orders",
+    "atmosphere-cache", "sun-irradiance",  "multiple-scattering", "ground-albedo"};
 
 const char* const kAtmosphereOptionsHelp =
     R"(          atmosphere (--method atmosphere; Bruneton and Neyret 2008 tables, Yusov 2013):
@@ -36,7 +37,12 @@ const char* const kAtmosphereOptionsHelp =
             --meters-per-unit X  metres per world unit (default 50)
             --origin-altitude M  metres above sea level of world y = 0 (default 0)
             --atmosphere-table HxAxPxT  4D table size (default 32x128x64x16)
-            --orders N           scattering orders 1..N (default 4)
+            --multiple-scattering M  orders (default: orders 2..N by sphere and ray integrals) | lut
+                                 (Hillaire 2020's table of every order >= 2: seconds, not minutes, and
+                                 darker; README, Atmosphere)
+            --orders N           orders: scattering orders 1..N (default 4); 1: single scattering only
+            --ground-albedo A    the ground's albedo in lut's multiple scattering, in [0, 1]
+                                 (default 0.1)
             --atmosphere-cache DIR  table cache (default $XDG_CACHE_HOME/crepuscular or
                                  ~/.cache/crepuscular; `none`: always compute)
             --sun-irradiance E   extraterrestrial sun irradiance, white (default 10)
@@ -125,6 +131,14 @@ AtmosphereSettings atmosphereSettings(const Args& args) {
       args.number("origin-altitude", s.placement.originAltitude, 0.0, s.parameters.atmosphereHeight * 0.5);
   if (args.has("atmosphere-table")) s.tables.size = parseTableSize(args.string("atmosphere-table", ""));
   s.tables.orders = args.integer("orders", s.tables.orders, 1, 16);
+  const std::string multiple = args.string("multiple-scattering", "orders");
+  if (multiple == "lut")
+    s.tables.multipleScattering = AtmosphereMultipleScattering::Lut;
+  else if (multiple == "orders")
+    s.tables.multipleScattering = AtmosphereMultipleScattering::Orders;
+  else
+    throw UsageError("option --multiple-scattering: '" + multiple + "' is not lut or orders");
+  s.parameters.groundAlbedo = args.number("ground-albedo", s.parameters.groundAlbedo, 0.0, 1.0);
   s.sunIrradiance = args.number("sun-irradiance", s.sunIrradiance, 1e-6, 1e6);
   try {
     validate(s.tables);

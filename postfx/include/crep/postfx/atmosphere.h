@@ -49,7 +49,9 @@
 //   L1 (single scattering, Listing 3): trapezoid rule with `singleSteps` steps from the point to the ground
 //     or the top, of beta_R(h) e^(-T(C->P)) e^(-T(P->sun)) (S_R) and beta_M(h) e^(-T(C->P)) e^(-T(P->sun))
 //     (S_M), without the phase functions (above);
-//   for n = 2..N: J_n (Eq. 1, `sphereSamples` directions of a Fibonacci sphere, each a look-up into
+//   AtmosphereMultipleScattering::Lut instead of the orders below: Psi_ms (Hillaire 2020, Sec. 5.5; see the
+//     enum) and L_H of each texel integrated from it in the single scattering march;
+//   Orders, for n = 2..N: J_n (Eq. 1, `sphereSamples` directions of a Fibonacci sphere, each a look-up into
 //     L_(n-1), for n = 2 L1 with its phase functions at w . l), then L_n (Eq. 2, Listing 5, trapezoid rule
 //     with `orderSteps` steps, look-ups into J_n);
 //   higher orders L_H = sum of L_n (n = 2..N); multiple scattering L_M = L1 + L_H is formed per look-up
@@ -85,10 +87,13 @@ struct AtmosphereParameters {
   glm::dvec3 mieAbsorption{2.0e-5 / 9.0}; ///< Mie extinction = scattering / 0.9 (Bruneton and Neyret 2008)
   double mieScaleHeight = 1200.0;         ///< H_M, metres
   double mieG = 0.76;                     ///< Henyey-Greenstein g of the aerosols, |g| < 1
+  /// Lambertian albedo of the ground in [0, 1]: the sunlit ground's bounce into multiple scattering
+  /// (AtmosphereMultipleScattering::Lut; the Orders reference has no ground). 0.1: Hillaire 2020's Earth.
+  double groundAlbedo = 0.1;
 };
 /// Throws InvalidArgument naming the field ("AtmosphereParameters.earthRadius", ...): radii and scale
 /// heights must be finite and > 0, coefficients finite and >= 0 with some Rayleigh or Mie scattering,
-/// |mieG| < 1.
+/// |mieG| < 1, groundAlbedo in [0, 1].
 void validate(const AtmosphereParameters& p);
 
 /// The 4D table's size (Yusov 2013: 32 x 128 x 64 x 16).
@@ -99,9 +104,26 @@ struct AtmosphereTableSize {
   int sunView = 16;     ///< N_theta
 };
 
+/// How the tables hold the scattering orders n >= 2 (L_H).
+enum class AtmosphereMultipleScattering {
+  /// Hillaire 2020, Sec. 5.5: a 2D table Psi_ms(h, c_phi) of every order >= 2 at a point, as an isotropic
+  /// source (the second order from sphereSamples rays of multipleScatteringSteps steps each, with the
+  /// ground's bounce, times the geometric series 1 / (1 - f_ms) of its transfer f_ms); L_H of a texel is
+  /// the integral of T(C->P) sigma_s(P) Psi_ms(P) along its ray, in the single scattering pass. Tables in
+  /// seconds instead of minutes, but the isotropic second scattering leaves the image darker than Orders
+  /// (the README's atmosphere section has the figures): an option, not the default.
+  Lut,
+  /// Bruneton and Neyret 2008, Yusov 2013 (default): orders 2..`orders` by the sphere integral J_n and the
+  /// ray integral L_n (no ground).
+  Orders,
+};
+
 struct AtmospherePrecomputeOptions {
   AtmosphereTableSize size;
-  int orders = 4;               ///< N: orders 1..N (1: single scattering only, L_H = 0)
+  AtmosphereMultipleScattering multipleScattering = AtmosphereMultipleScattering::Orders;
+  int multipleScatteringSize = 32;  ///< Lut: Psi_ms texels per side (u = sqrt(h / H_Atm), c_phi linear)
+  int multipleScatteringSteps = 20; ///< Lut: midpoint steps of each of Psi_ms's rays
+  int orders = 4; ///< Orders: N, orders 1..N (1: single scattering only, L_H = 0); Lut: 1 drops L_H too
   int singleSteps = 100;        ///< trapezoid steps of L1 (Listing 3)
   int orderSteps = 64;          ///< trapezoid steps of each L_n (Listing 5)
   int sphereSamples = 128;      ///< directions of J_n and E_sky (Eq. 1, 3)
@@ -115,6 +137,10 @@ struct AtmospherePrecomputeOptions {
   /// README's atmosphere section states. Needs rayleighScattering > 0 in every channel, mieScattering.r > 0.
   bool combinedMie = false;
 };
+/// Whether tables of `o` hold Psi_ms (AtmosphereTables::multipleScatteringLut): Lut with orders > 1.
+inline bool usesMultipleScatteringLut(const AtmospherePrecomputeOptions& o) {
+  return o.multipleScattering == AtmosphereMultipleScattering::Lut && o.orders > 1;
+}
 /// Throws InvalidArgument naming the field ("AtmospherePrecomputeOptions.size.viewZenith", ...): sizes >= 2
 /// (viewZenith even and >= 4), orders in [1, 16], steps and samples in [1, 4096], a packed depth
 /// sunZenith * sunView <= 2048 and every size <= 2048 (GL_MAX_3D_TEXTURE_SIZE's guaranteed minimum).
@@ -151,6 +177,9 @@ struct AtmosphereTables {
   AtmosphereTable4D singleMie;    ///< RGB S_M (A 0); empty (no texels) with options.combinedMie
   AtmosphereTable4D higherOrders; ///< L_H = L2 + ... + LN (phase functions inside)
   Image ambient;                  ///< ambientSize x 1, 3 channels: E_sky per unit sun irradiance
+  /// Lut: multipleScatteringSize^2, 3 channels: Psi_ms per unit sun irradiance, texel (i, j) at
+  /// h = H_Atm (i / (n - 1))^2, c_phi = 2 j / (n - 1) - 1; empty with Orders.
+  Image multipleScatteringLut;
   /// L1, L2, ..., LN when options.keepOrders, else empty; L1 there with its phase functions at each
   /// texel's own c_theta (for analysis: the sum of the orders at a texel).
   std::vector<AtmosphereTable4D> orders;
@@ -238,6 +267,9 @@ glm::dvec3 sunTransmittance(const AtmosphereTables& tables, const glm::dvec3& po
 /// does not hit the ground, exp(-beta_e . (D(a, v) - D(b, v))); when it does (it descends all the way from a
 /// to b), exp(-beta_e . (D(b, -v) - D(a, -v))), v = normalize(b - a). Differences are clamped to >= 0.
 glm::dvec3 atmosphereTransmittance(const AtmosphereTables& tables, const glm::dvec3& a, const glm::dvec3& b);
+
+/// Psi_ms at altitude h and sun zenith cosine c (bilinear in the Lut method's table; 0 without it).
+glm::dvec3 lookUpMultipleScatteringLut(const AtmosphereTables& tables, double h, double cosSunZenith);
 
 /// E_sky at the cosine of the sun's zenith angle (linear in the 1D table).
 glm::dvec3 lookUpAmbientSkyLight(const AtmosphereTables& tables, double cosSunZenith);

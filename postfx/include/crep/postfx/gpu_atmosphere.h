@@ -34,8 +34,10 @@ struct AtmosphereParams {
   glm::ivec4 tableSize{0};            ///< N_h, N_alpha, N_phi, N_theta
   glm::ivec4 auxSizes{0}; ///< optical depth width (altitude), height (zenith); ambient size; orders
   glm::vec4 placement{1.0f, 0.0f, 0.0f, 0.0f}; ///< x: metersPerUnit; y: originAltitude; zw: 0
+  /// x: ground albedo; y: Psi_ms texels per side; z: Psi_ms steps per ray (sizes exact in float); w: 0
+  glm::vec4 multipleScattering{0.0f};
 };
-static_assert(sizeof(AtmosphereParams) == 112, "std140 CrepAtmosphereParams");
+static_assert(sizeof(AtmosphereParams) == 128, "std140 CrepAtmosphereParams");
 
 /// The block of (p, o, placement).
 AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
@@ -49,7 +51,9 @@ AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const Atmospher
 ///     (the packing of atmosphere.h: single scattering without its phase functions, `single` RGB Rayleigh
 ///     and A Mie's red, `singleMie` RGB Mie; singleMieTexture() is 0 with options.combinedMie), linear
 ///     filtering, clamp to edge;
-///   ambientTexture(): GL_TEXTURE_2D GL_RGBA32F, ambientSize x 1.
+///   ambientTexture(): GL_TEXTURE_2D GL_RGBA32F, ambientSize x 1;
+///   multipleScatteringLutTexture(): GL_TEXTURE_2D GL_RGBA32F, multipleScatteringSize^2, linear, clamp to
+///     edge (Psi_ms; 0 unless usesMultipleScatteringLut).
 /// 4D tables take 16 bytes per texel: 64 mebibytes each at the default size (three, two with combinedMie,
 /// plus two of the same size while computing more than one order).
 class AtmosphereTablesPass {
@@ -78,11 +82,12 @@ public:
   std::uint32_t singleMieTexture() const noexcept { return singleMie_.get(); }
   std::uint32_t higherOrdersTexture() const noexcept { return higher_.get(); }
   std::uint32_t ambientTexture() const noexcept { return ambient_.get(); }
+  std::uint32_t multipleScatteringLutTexture() const noexcept { return msLut_.get(); }
   const std::vector<std::pair<std::string, double>>& stageTimes() const noexcept { return times_; }
 
 private:
   CreateInfo info_;
-  gl::Handle opticalDepth_, single_, singleMie_, higher_, ambient_;
+  gl::Handle opticalDepth_, single_, singleMie_, higher_, ambient_, msLut_;
   std::vector<std::pair<std::string, double>> times_;
 };
 
