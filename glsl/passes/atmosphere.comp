@@ -27,7 +27,7 @@
 // atmosphere block (uniform binding 2), camera depth (unit 0), rectified depth (unit 1, (a), (b)),
 // optical depth table (unit 2), single S_R + S_M.r (unit 3), L_H (unit 4), single S_M (unit 5; not read with
 // CREP_ATMOSPHERE_COMBINED_MIE 1), prefiltered radiance (unit 6,
-// (c)), min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance
+// (c)), ambient sky light (unit 7), min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance
 // (image 0), RGBA32F transmittance (image 1).
 #ifndef CREP_ATMOSPHERE_SHAFTS
 #define CREP_ATMOSPHERE_SHAFTS 0
@@ -52,6 +52,7 @@ layout(binding = 2) uniform sampler2D opticalDepthTable;
 layout(binding = 3) uniform sampler3D singleTable;
 layout(binding = 4) uniform sampler3D higherOrdersTable;
 layout(binding = 5) uniform sampler3D singleMieTable; // not read with CREP_ATMOSPHERE_COMBINED_MIE 1
+layout(binding = 7) uniform sampler2D ambientTable;   // E_sky: the ground beyond the scene
 #if CREP_SHAFTS_WALK
 layout(binding = 1) uniform sampler2D rectifiedDepth;
 layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
@@ -144,20 +145,32 @@ vec3 singleLookUp(float t, vec4 first) {
 }
 
 #if CREP_ATMOSPHERE_SHAFTS == 1
-// Single scattering integrand at C + v t (metres): (beta_R d_R p_R + beta_M d_M p_HG) T(C->P) T_sun(P).
-vec3 singleIntegrand(float t) {
-  RayPoint p = rayPoint(t);
-  vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
-  vec2 D = crep_densityToTop(opticalDepthTable, crep_atmosphere, p.h, p.cosSun); // crep_sunTransmittance
-  return (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) * transmittanceTo(t) *
-         exp(-crep_atmosphereExtinction(crep_atmosphere, D));
-}
-
-// The trapezoid rule with n steps over [ta, tb] metres.
+// The trapezoid rule with n steps over [ta, tb] metres of the single scattering integrand (beta_R d_R p_R +
+// beta_M d_M p_HG) T(C->P) T_sun(P): T(C->P) from the densities along the ray (CREP_SEGMENT_STEPS to ta,
+// then the section's own steps), not the optical depth table's difference (crep::atmosphereRay's rule).
 vec3 trapezoid(float ta, float tb, int n) {
   float h = (tb - ta) / float(n);
-  vec3 sum = 0.5 * (singleIntegrand(ta) + singleIntegrand(tb));
-  for (int k = 1; k < n; ++k) sum += singleIntegrand(ta + float(k) * h);
+  vec2 optical = vec2(0.0);
+  if (ta > 0.0) {
+    float dt = ta / float(CREP_SEGMENT_STEPS);
+    optical = 0.5 * (crep_atmosphereDensity(crep_atmosphere, rayPoint(0.0).h) +
+                     crep_atmosphereDensity(crep_atmosphere, rayPoint(ta).h));
+    for (int k = 1; k < CREP_SEGMENT_STEPS; ++k)
+      optical += crep_atmosphereDensity(crep_atmosphere, rayPoint(float(k) * dt).h);
+    optical *= dt;
+  }
+  vec2 previous = vec2(0.0);
+  vec3 sum = vec3(0.0);
+  for (int k = 0; k <= n; ++k) {
+    RayPoint p = rayPoint(ta + float(k) * h);
+    vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
+    if (k > 0) optical += 0.5 * (previous + d) * h;
+    previous = d;
+    vec2 D = crep_densityToTop(opticalDepthTable, crep_atmosphere, p.h, p.cosSun); // crep_sunTransmittance
+    vec3 f = (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) * exp(-crep_atmosphereExtinction(crep_atmosphere, optical)) *
+             exp(-crep_atmosphereExtinction(crep_atmosphere, D));
+    sum += (k == 0 || k == n) ? 0.5 * f : f;
+  }
   return sum * h;
 }
 
@@ -344,6 +357,18 @@ void main() {
     L = tablePart(sky, tE);
   }
   L += single;
+  // A sky pixel whose ray ends on the ground beyond the scene: the ground's Lambertian reflection of the sun
+  // and the sky light seen through the air (crep::atmosphereRay's rule).
+  float albedo = crep_atmosphere.multipleScattering.x;
+  if (sky && hitsGround && albedo > 0.0) {
+    RayPoint X = rayPoint(rayEnd);
+    vec3 direct = X.cosSun > 0.0
+                      ? exp(-crep_atmosphereExtinction(crep_atmosphere, crep_densityToTop(opticalDepthTable, crep_atmosphere,
+                                                                                          X.h, X.cosSun))) * X.cosSun
+                      : vec3(0.0);
+    L += segmentTransmittance(rayEnd) * (albedo * float(CREP_INV_PI)) *
+         (direct + crep_ambientSkyLight(ambientTable, crep_atmosphere, X.cosSun));
+  }
   vec3 T = sky ? (hitsGround ? vec3(0.0) : transmittanceTo(rayEnd)) : segmentTransmittance(tE);
   vec3 inscattering = crep_march.lightIrradiance.rgb * L;
   imageStore(inscatteringOut, pixel, vec4(inscattering, (T.r + T.g + T.b) / 3.0));

@@ -31,7 +31,9 @@
 //   (a) single = sum over the lit sections [ta, tb] (clipped to [0, s_E], sky [0, s_F]) of the trapezoid rule
 //       with max(1, ceil(integrationSteps (tb - ta) / s_m)) steps of
 //       (beta_R d_R(h) p_R(c) + beta_M d_M(h) p_HG(c)) T(C->P) T_sun(P), c = v . l, d = exp(-h / H) with
-//       h = max(0, |P| - R); sky: plus [s_F, t_X] unshadowed with skySteps steps.
+//       h = max(0, |P| - R); sky: plus [s_F, t_X] unshadowed with skySteps steps. T(C->P) there is
+//       exp(-beta_e . D) with D the densities integrated along the ray: densityIntegral(C, C + v ta, 16) to
+//       the section's start, then the trapezoid rule on the section's own steps.
 //   L1 of a look-up is the single table's phase-free parts with the ray's own phase functions (c = v . l;
 //   sampleSingleScattering), L_M = L1 + L_H at the same coordinates.
 //   (b) P1 = C + v D_start, P2 = C + v min(D_start + D_lit, end) with D_start clamped to [0, end] (end = s_E,
@@ -39,8 +41,11 @@
 //       0 without lit length; sky: plus T(C->F) L1(F) (unshadowed beyond the far plane).
 //   (c) surface single = visibility (L1(C) - T(C->E) L1(E)); sky single = visibility (L1(C) - T(C->F) L1(F))
 //       + T(C->F) L1(F).
-// - In-scattering = sun.irradiance() (single + H), None: sun.irradiance() L. Transmittance: surface
-//   T(C->E); sky 0 when the ray hits the ground, else T(C->X).
+// - A sky pixel whose ray hits the ground (beyond the scene's geometry: nothing else draws there) adds the
+//   ground's Lambertian reflection seen through the air: T(C->X) (the segment's, below) (groundAlbedo / pi) (T_sun(X) max(0, n . l)
+//   + E_sky(n . l)), n the ground's normal at X (no shadows; nothing with groundAlbedo = 0).
+// - In-scattering = sun.irradiance() (single + H + ground), None: sun.irradiance() (L + ground).
+//   Transmittance: surface T(C->E); sky 0 when the ray hits the ground (opaque), else T(C->X).
 // atmosphereImage: pixelRay(camera, depth, x, y) per pixel (no near-plane correction), sky iff the depth
 // value >= 1, origin camera.position(); RGBA = (in-scattering, mean of the RGB transmittance).
 #include <crep/core/error.h>
@@ -50,6 +55,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
@@ -142,22 +148,30 @@ public:
     return atC - segmentTransmittance(t) * of(t);
   }
 
-  /// The single-scattering integrand at C + v t (Listing 3's, with table transmittances).
-  glm::dvec3 integrand(double t) const {
-    const glm::dvec3 P = at(t);
-    const double h = std::max(0.0, glm::length(P) - p_.earthRadius);
-    const double dR = std::exp(-h / p_.rayleighScaleHeight), dM = std::exp(-h / p_.mieScaleHeight);
-    const glm::dvec3 scattering = p_.rayleighScattering * (dR * phaseR_) + p_.mieScattering * (dM * phaseM_);
-    return scattering * transmittance(t) * sunTransmittance(tables_, P, l_);
-  }
-
-  /// Trapezoid rule with n steps of the integrand over [ta, tb].
+  /// Trapezoid rule with n steps over [ta, tb] of the single-scattering integrand (beta_R d_R p_R + beta_M
+  /// d_M p_HG) T(C->P) T_sun(P) (Listing 3's): T(C->P) from the densities marched along the ray (the
+  /// segment's to ta, then the trapezoid rule of the same steps), never the optical depth table's
+  /// difference, whose two large values cancel on rays that graze the ground.
   glm::dvec3 trapezoid(double ta, double tb, int n) const {
     if (!(tb > ta)) return glm::dvec3(0.0);
     const double dt = (tb - ta) / n;
-    glm::dvec3 sum = 0.5 * (integrand(ta) + integrand(tb));
-    for (int k = 1; k < n; ++k)
-      sum += integrand(ta + dt * k);
+    glm::dvec2 optical =
+        ta > 0.0 ? densityIntegral(p_, C_, at(ta), kSegmentSteps) : glm::dvec2(0.0); // C -> the section
+    glm::dvec2 previous(0.0);
+    glm::dvec3 sum(0.0);
+    for (int k = 0; k <= n; ++k) {
+      const double t = ta + dt * k;
+      const glm::dvec3 P = at(t);
+      const double h = std::max(0.0, glm::length(P) - p_.earthRadius);
+      const glm::dvec2 d(std::exp(-h / p_.rayleighScaleHeight), std::exp(-h / p_.mieScaleHeight));
+      if (k > 0) optical += 0.5 * (previous + d) * dt;
+      previous = d;
+      const glm::dvec3 scattering =
+          p_.rayleighScattering * (d.x * phaseR_) + p_.mieScattering * (d.y * phaseM_);
+      const glm::dvec3 T =
+          glm::exp(-(p_.rayleighScattering * optical.x + (p_.mieScattering + p_.mieAbsorption) * optical.y));
+      sum += (k == 0 || k == n ? 0.5 : 1.0) * scattering * T * sunTransmittance(tables_, P, l_);
+    }
     return sum * dt;
   }
 
@@ -292,6 +306,14 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
     }
     if (sky && tX > sEnd) single += ray.trapezoid(sEnd, tX, options.skySteps);
     radiance += single;
+  }
+  // A sky pixel whose ray ends on the ground beyond the scene: the ground's reflected light.
+  if (sky && hitsGround && p.groundAlbedo > 0.0) {
+    const glm::dvec3 X = ray.at(tX);
+    const double cosSun = glm::dot(X / glm::length(X), l);
+    const glm::dvec3 direct = cosSun > 0.0 ? sunTransmittance(tables, X, l) * cosSun : glm::dvec3(0.0);
+    radiance += ray.segmentTransmittance(tX) * (p.groundAlbedo / std::numbers::pi) *
+                (direct + lookUpAmbientSkyLight(tables, cosSun));
   }
   out.inscattering = sun.irradiance() * radiance;
   if (sky)

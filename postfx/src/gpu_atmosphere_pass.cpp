@@ -19,8 +19,8 @@ namespace {
 
 /// Texture units, uniform and storage bindings of passes/atmosphere.comp (its header comment).
 constexpr GLuint kUnitCameraDepth = 0, kUnitRectifiedDepth = 1, kUnitOpticalDepth = 2, kUnitSingle = 3,
-                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6;
-constexpr int kUnits = 7; ///< units and bindings unbound afterwards (gl::unbindPassState)
+                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6, kUnitAmbient = 7;
+constexpr int kUnits = 8; ///< units and bindings unbound afterwards (gl::unbindPassState)
 
 bool walksTrees(AtmosphereShafts shafts) {
   return shafts == AtmosphereShafts::Integrated || shafts == AtmosphereShafts::LitLengthTable;
@@ -140,6 +140,7 @@ void AtmospherePass::run(const FrameAttribs& f) {
   glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
   glBindTextureUnit(kUnitSingle, f.tables->singleTexture());
   glBindTextureUnit(kUnitHigherOrders, f.tables->higherOrdersTexture());
+  glBindTextureUnit(kUnitAmbient, f.tables->ambientTexture());
   // With combinedMie there is no single Mie table (the shader does not read the unit).
   glBindTextureUnit(kUnitSingleMie, combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
   if (walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees

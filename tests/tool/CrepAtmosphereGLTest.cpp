@@ -238,3 +238,48 @@ TEST_CASE("crep render --method atmosphere: the multiple scattering LUT and the 
   CHECK(relativeRmse(dark.scattering, orders.scattering) > 1e-4);
   CHECK(relativeRmse(dark.scattering, orders.scattering) < 0.2);
 }
+
+// The horizon seam: at golden hour the row of the last ray that hits the ground showed a one-pixel spike
+// ((a) integrated its single scattering with the optical depth table's difference of two large values,
+// which cancels to a transmittance of 1 on a ray grazing the ground: 48.6% above both neighbours at
+// 640x360 with the default tables), and the ground beyond the scene was black. Measured on the
+// composite in every column where ground-hit rays lie below the horizon: the largest single-row
+// overshoot, luminance over the brighter neighbour, across the band of the horizon's three rows.
+TEST_CASE("crep render --method atmosphere: no seam at the horizon, the ground beyond the scene is lit") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir;
+  const std::string prefix = (dir.path() / "horizon").string();
+  const auto r = runCrep("render --scene terrain --method atmosphere --size 320x180 --map-size 256 "
+                         "--atmosphere-table 16x64x16x8 --orders 2 --sun-elevation 4 --camera-elevation 2 "
+                         "--atmosphere-cache none --out '" +
+                         prefix + "'");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const crep::Image composite = crep::readExr(prefix + ".exr", {.layer = "composite"});
+  const crep::Image transmittance = crep::readExr(prefix + ".exr", {.layer = "transmittance"});
+  const auto lum = [&](int x, int y) { return luminance(rgb(composite, x, y)); };
+  const int w = composite.width(), h = composite.height();
+  double worst = 0.0, groundBand = 0.0;
+  int columns = 0;
+  for (int x = 0; x < w; ++x) {
+    // EXR rows count from the bottom: the first ray above a ground-hit one that leaves the atmosphere (a
+    // sky ray grazing the horizon keeps little blue; a surface of the scene keeps most of it).
+    int horizon = -1;
+    for (int y = 1; y < h; ++y)
+      if (transmittance.at(x, y, 2) > 0.0f && transmittance.at(x, y, 2) < 0.5f &&
+          transmittance.at(x, y - 1, 2) == 0.0f) {
+        horizon = y;
+        break;
+      }
+    if (horizon < 3 || horizon > h - 4 || transmittance.at(x, horizon - 2, 2) != 0.0f) continue;
+    ++columns;
+    for (int y = horizon - 1; y <= horizon + 1; ++y)
+      worst = std::max(worst, (lum(x, y) - std::max(lum(x, y - 1), lum(x, y + 1))) / lum(x, y));
+    groundBand = std::max(groundBand, lum(x, horizon - 2)); // a ray ending on the ground beyond the scene
+  }
+  MESSAGE(columns << " columns with ground below the horizon: largest single-row overshoot " << worst
+                  << ", brightest ground-hit pixel next to it " << groundBand);
+  CHECK(columns > 100);
+  CHECK(worst < 0.05);
+  CHECK(groundBand > 0.0);
+}
