@@ -42,8 +42,9 @@
 //   (c) surface single = visibility (L1(C) - T(C->E) L1(E)); sky single = visibility (L1(C) - T(C->F) L1(F))
 //       + T(C->F) L1(F).
 // - A sky pixel whose ray hits the ground (beyond the scene's geometry: nothing else draws there) adds the
-//   ground's Lambertian reflection seen through the air: T(C->X) (the segment's, below) (groundAlbedo / pi) (T_sun(X) max(0, n . l)
-//   + E_sky(n . l)), n the ground's normal at X (no shadows; nothing with groundAlbedo = 0).
+//   ground's Lambertian reflection seen through the air: T(C->X) (the segment's, below) (groundAlbedo / pi)
+//   (T_sun(X) max(0, n . l) + E_sky(n . l)), n the ground's normal at X (no shadows; nothing with
+//   groundAlbedo = 0).
 // - In-scattering = sun.irradiance() (single + H + ground), None: sun.irradiance() (L + ground).
 //   Transmittance: surface T(C->E); sky 0 when the ray hits the ground (opaque), else T(C->X).
 // atmosphereImage: pixelRay(camera, depth, x, y) per pixel (no near-plane correction), sky iff the depth
