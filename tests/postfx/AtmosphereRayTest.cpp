@@ -112,7 +112,8 @@ std::vector<TestRay> testRays() {
 }
 
 AtmosphereRay run(const TestRay& r, AtmosphereShafts shafts, const AtmosphereShadowing& shadowing,
-                  int steps = 64, int skySteps = 16, int orders = 2, const AtmosphereTables* other = nullptr) {
+                  int steps = 64, int skySteps = 16, int orders = 2,
+                  const AtmosphereTables* other = nullptr) {
   AtmosphereRayOptions o;
   o.shafts = shafts;
   o.integrationSteps = steps;
@@ -218,12 +219,12 @@ TEST_CASE("Atmosphere ray: (a) against a brute-force single-scattering integral 
       {"sky to the ground", {0.0, 20.0, 0.0}, glm::normalize(glm::dvec3(0.0, -0.2, -1.0)), 500.0, true});
   for (const TestRay& r : rays) {
     CAPTURE(r.name);
-    const glm::dvec3 a = run(r, AtmosphereShafts::Integrated, sections({{0.0, r.surface}}), 256, 256, 1,
-                             &blackGroundTables())
-                             .inscattering;
-    const glm::dvec3 b = run(r, AtmosphereShafts::LitLengthTable, litLength(0.0, r.surface), 64, 16, 1,
-                             &blackGroundTables())
-                             .inscattering;
+    const glm::dvec3 a =
+        run(r, AtmosphereShafts::Integrated, sections({{0.0, r.surface}}), 256, 256, 1, &blackGroundTables())
+            .inscattering;
+    const glm::dvec3 b =
+        run(r, AtmosphereShafts::LitLengthTable, litLength(0.0, r.surface), 64, 16, 1, &blackGroundTables())
+            .inscattering;
     const glm::dvec3 C = atmospherePosition(placement(), p, r.origin);
     double length = r.surface * placement().metersPerUnit;
     if (r.sky) length = distanceToTop(p, C, r.direction);
@@ -477,8 +478,8 @@ TEST_CASE("Atmosphere ray: a sky ray that hits the ground adds the ground's refl
   // The ground term of atmosphereRay's rule, from the public look-ups: T(C->X) (the segment's 16 steps)
   // (albedo / pi) (T_sun(X) max(0, n . l) + E_sky(n . l)), times the sun's irradiance; the same ray with a
   // black ground lacks exactly it, and a ray above the horizon has none.
-  const TestRay down{"sky to the ground", {0.0, 20.0, 0.0}, glm::normalize(glm::dvec3(0.0, -0.2, -1.0)), 500.0,
-                     true};
+  const TestRay down{
+      "sky to the ground", {0.0, 20.0, 0.0}, glm::normalize(glm::dvec3(0.0, -0.2, -1.0)), 500.0, true};
   const AtmosphereTables& t = tables(1);
   REQUIRE(t.parameters.groundAlbedo > 0.0);
   for (AtmosphereShafts mode : {AtmosphereShafts::None, AtmosphereShafts::Integrated}) {
@@ -487,7 +488,8 @@ TEST_CASE("Atmosphere ray: a sky ray that hits the ground adds the ground's refl
     const glm::dvec3 without = run(down, mode, lit, 64, 16, 1, &blackGroundTables()).inscattering;
     const glm::dvec3 C = atmospherePosition(placement(), t.parameters, down.origin);
     const double cv = glm::dot(C, down.direction), rc = glm::length(C);
-    const double tX = -cv - std::sqrt(cv * cv - (rc - t.parameters.earthRadius) * (rc + t.parameters.earthRadius));
+    const double tX =
+        -cv - std::sqrt(cv * cv - (rc - t.parameters.earthRadius) * (rc + t.parameters.earthRadius));
     const glm::dvec3 X = C + down.direction * tX, l = -sun().direction();
     const double cosSun = glm::dot(X / glm::length(X), l);
     REQUIRE(cosSun > 0.0);
