@@ -113,11 +113,14 @@ AtmosphereTables patternTables(const AtmosphereParameters& p, const AtmospherePr
   return t;
 }
 
+// Empty blocks (a table the options leave out) compare equal without memcmp, whose pointers may be null.
 bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
 }
 bool sameBits(const Image& a, const Image& b) {
-  return a.sameShape(b) && std::memcmp(a.data().data(), b.data().data(), a.byteSize()) == 0;
+  return a.sameShape(b) &&
+         (a.byteSize() == 0 || std::memcmp(a.data().data(), b.data().data(), a.byteSize()) == 0);
 }
 bool sameBits(const AtmosphereTable4D& a, const AtmosphereTable4D& b) {
   return a.size.height == b.size.height && a.size.viewZenith == b.size.viewZenith &&
