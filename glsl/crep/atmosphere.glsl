@@ -168,10 +168,16 @@ vec3 crep_lookUpAtmosphere(sampler3D table, CrepAtmosphereParams a, vec3 positio
   return crep_sampleAtmosphereTable(table, a, coords);
 }
 
+// Texture coordinates at altitude h and cos zenith c of a 2D table of size.x altitudes (u = sqrt(h / H_Atm))
+// by size.y cosines (linear in [-1, 1]): the optical depth table's and Psi_ms's rule (atmosphere.h).
+vec2 crep_heightCosineCoords(CrepAtmosphereParams a, float h, float cosZenith, ivec2 size) {
+  return vec2(crep_atmosphereTexCoord(sqrt(clamp(h / a.radii.z, 0.0, 1.0)), size.x),
+              crep_atmosphereTexCoord((clamp(cosZenith, -1.0, 1.0) + 1.0) * 0.5, size.y));
+}
+
 // Texture coordinates of the optical depth table at altitude h and cos zenith c (atmosphere.h's rule).
 vec2 crep_opticalDepthCoords(CrepAtmosphereParams a, float h, float cosZenith) {
-  return vec2(crep_atmosphereTexCoord(sqrt(clamp(h / a.radii.z, 0.0, 1.0)), a.auxSizes.x),
-              crep_atmosphereTexCoord((clamp(cosZenith, -1.0, 1.0) + 1.0) * 0.5, a.auxSizes.y));
+  return crep_heightCosineCoords(a, h, cosZenith, a.auxSizes.xy);
 }
 
 // (Rayleigh, Mie) density integrals from altitude h along cos zenith c to the top of the atmosphere
@@ -180,11 +186,26 @@ vec2 crep_densityToTop(sampler2D opticalDepth, CrepAtmosphereParams a, float h, 
   return textureLod(opticalDepth, crep_opticalDepthCoords(a, h, cosZenith), 0.0).rg;
 }
 
+// Transmittance to the sun from altitude h with the sun at zenith cosine c.
+vec3 crep_sunTransmittanceAt(sampler2D opticalDepth, CrepAtmosphereParams a, float h, float cosSunZenith) {
+  return exp(-crep_atmosphereExtinction(a, crep_densityToTop(opticalDepth, a, h, cosSunZenith)));
+}
+
 // Transmittance from `position` (metres) to the sun along unit `toSun` (crep::sunTransmittance).
 vec3 crep_sunTransmittance(sampler2D opticalDepth, CrepAtmosphereParams a, vec3 position, vec3 toSun) {
   float r = length(position);
-  vec2 D = crep_densityToTop(opticalDepth, a, r - a.radii.x, dot(position / r, toSun));
-  return exp(-crep_atmosphereExtinction(a, D));
+  return crep_sunTransmittanceAt(opticalDepth, a, r - a.radii.x, dot(position / r, toSun));
+}
+
+// Distances along a ray from altitude h (hh = h (2R + h) = |x|^2 - R^2, b = |x| times the ray's cos zenith,
+// disc = b^2 - hh) to the ground (the near root of |x + t v| = R, written without cancellation; the tangent
+// point at disc = 0) and to the top of the atmosphere (the far root of |x + t v| = R + H_Atm).
+float crep_atmosphereGroundDistance(float hh, float b, float disc) { return hh / (-b + sqrt(max(disc, 0.0))); }
+float crep_atmosphereTopDistance(CrepAtmosphereParams a, float h, float b) {
+  float R = a.radii.x, H = a.radii.z;
+  float cc = (H - h) * (2.0 * R + H + h); // (R + H)^2 - |x|^2
+  float d = sqrt(b * b + cc);
+  return b >= 0.0 ? cc / (b + d) : d - b;
 }
 
 // Ray-sphere intersection (sphere of `radius` at the origin, unit `dir`): the (near, far) distances along
@@ -237,9 +258,7 @@ vec3 crep_atmosphereTransmittance(sampler2D opticalDepth, CrepAtmosphereParams a
 // u = sqrt(h / H_Atm) = i / (n - 1), c = 2 j / (n - 1) - 1; crep::lookUpMultipleScatteringLut).
 vec3 crep_multipleScatteringLut(sampler2D lut, CrepAtmosphereParams a, float h, float cosSunZenith) {
   int n = int(a.multipleScattering.y);
-  vec2 uv = vec2(crep_atmosphereTexCoord(sqrt(clamp(h / a.radii.z, 0.0, 1.0)), n),
-                 crep_atmosphereTexCoord((clamp(cosSunZenith, -1.0, 1.0) + 1.0) * 0.5, n));
-  return textureLod(lut, uv, 0.0).rgb;
+  return textureLod(lut, crep_heightCosineCoords(a, h, cosSunZenith, ivec2(n)), 0.0).rgb;
 }
 
 // E_sky at the cos of the sun's zenith angle (linear in the 1D table; crep::lookUpAmbientSkyLight).
@@ -336,15 +355,7 @@ CrepAtmosphereTexelRay crep_atmosphereTexelRay(CrepAtmosphereParams a, ivec4 tex
   crep_atmosphereDirections(c, cPhi, cTheta, ray.view, ray.sun);
   ray.cosSunView = dot(ray.view, ray.sun); // the texel's c_theta unless l was renormalized
   float b = r0 * c;
-  if (ray.below) {
-    // Near root of |C + t v| = R: t = -b - sqrt(disc) = hh / (-b + sqrt(disc)) (tangent point at disc = 0).
-    ray.end = hh / (-b + sqrt(max(ray.disc, 0.0)));
-  } else {
-    // Far root of |C + t v| = R + H: disc' = b^2 + (H - h)(2R + H + h).
-    float cc = (H - h) * (2.0 * R + H + h);
-    float d = sqrt(b * b + cc);
-    ray.end = b >= 0.0 ? cc / (b + d) : d - b;
-  }
+  ray.end = ray.below ? crep_atmosphereGroundDistance(hh, b, ray.disc) : crep_atmosphereTopDistance(a, h, b);
   ray.end = max(ray.end, 0.0);
   ray.coords = (vec4(texel) + 0.5) / vec4(n);
   return ray;

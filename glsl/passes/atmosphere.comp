@@ -25,10 +25,10 @@
 // tree levels, info.y tree row stride, info.z integrationSteps, info.w skySteps), layout block
 // (crep/epipolar.glsl, uniform binding 1, and the epipolar row table at storage binding 1; (a), (b)),
 // atmosphere block (uniform binding 2), camera depth (unit 0), rectified depth (unit 1, (a), (b)),
-// optical depth table (unit 2), single S_R + S_M.r (unit 3), L_H (unit 4), single S_M (unit 5; not read with
-// CREP_ATMOSPHERE_COMBINED_MIE 1), prefiltered radiance (unit 6,
-// (c)), ambient sky light (unit 7), min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance
-// (image 0), RGBA32F transmittance (image 1).
+// optical depth table (unit 2), single S_R + S_M.r (unit 3), L_H (unit 4), single S_M (unit 5; not read
+// with CREP_ATMOSPHERE_COMBINED_MIE 1), prefiltered radiance (unit 6, (c)), ambient sky light (unit 7),
+// min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance (image 0),
+// RGBA32F transmittance (image 1).
 #ifndef CREP_ATMOSPHERE_SHAFTS
 #define CREP_ATMOSPHERE_SHAFTS 0
 #endif
@@ -116,14 +116,19 @@ vec3 transmittanceTo(float t) {
 // trapezoid rule with CREP_SEGMENT_STEPS steps of the densities along the segment (the optical depth
 // table's difference of two large values steps by several percent near the horizon); 1 at t = 0.
 #define CREP_SEGMENT_STEPS 16
-vec3 segmentTransmittance(float t) {
-  if (!(t > 0.0)) return vec3(1.0);
+// The (Rayleigh, Mie) density integrals of that segment (0 at t <= 0).
+vec2 segmentDensity(float t) {
+  if (!(t > 0.0)) return vec2(0.0);
   float dt = t / float(CREP_SEGMENT_STEPS);
   vec2 sum = 0.5 * (crep_atmosphereDensity(crep_atmosphere, rayPoint(0.0).h) +
                     crep_atmosphereDensity(crep_atmosphere, rayPoint(t).h));
   for (int k = 1; k < CREP_SEGMENT_STEPS; ++k)
     sum += crep_atmosphereDensity(crep_atmosphere, rayPoint(float(k) * dt).h);
-  return exp(-crep_atmosphereExtinction(crep_atmosphere, sum * dt));
+  return sum * dt;
+}
+vec3 segmentTransmittance(float t) {
+  if (!(t > 0.0)) return vec3(1.0);
+  return exp(-crep_atmosphereExtinction(crep_atmosphere, segmentDensity(t)));
 }
 
 // A table at C + v t, with the ray's look-up coordinates (Listing 2: every look-up on the first's side).
@@ -150,15 +155,7 @@ vec3 singleLookUp(float t, vec4 first) {
 // then the section's own steps), not the optical depth table's difference (crep::atmosphereRay's rule).
 vec3 trapezoid(float ta, float tb, int n) {
   float h = (tb - ta) / float(n);
-  vec2 optical = vec2(0.0);
-  if (ta > 0.0) {
-    float dt = ta / float(CREP_SEGMENT_STEPS);
-    optical = 0.5 * (crep_atmosphereDensity(crep_atmosphere, rayPoint(0.0).h) +
-                     crep_atmosphereDensity(crep_atmosphere, rayPoint(ta).h));
-    for (int k = 1; k < CREP_SEGMENT_STEPS; ++k)
-      optical += crep_atmosphereDensity(crep_atmosphere, rayPoint(float(k) * dt).h);
-    optical *= dt;
-  }
+  vec2 optical = segmentDensity(ta); // C -> the section
   vec2 previous = vec2(0.0);
   vec3 sum = vec3(0.0);
   for (int k = 0; k <= n; ++k) {
@@ -166,9 +163,9 @@ vec3 trapezoid(float ta, float tb, int n) {
     vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
     if (k > 0) optical += 0.5 * (previous + d) * h;
     previous = d;
-    vec2 D = crep_densityToTop(opticalDepthTable, crep_atmosphere, p.h, p.cosSun); // crep_sunTransmittance
-    vec3 f = (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) * exp(-crep_atmosphereExtinction(crep_atmosphere, optical)) *
-             exp(-crep_atmosphereExtinction(crep_atmosphere, D));
+    vec3 f = (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) *
+             exp(-crep_atmosphereExtinction(crep_atmosphere, optical)) *
+             crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, p.h, p.cosSun);
     sum += (k == 0 || k == n) ? 0.5 * f : f;
   }
   return sum * h;
@@ -234,7 +231,8 @@ vec3 tablePart(bool sky, float tE) {
     float start = firstLit * metres - cameraShift;
     float t1 = clamp(start, 0.0, tE);
     float t2 = clamp(start + litLength * metres, t1, tE);
-    part += max(segmentTransmittance(t1) * singleLookUp(t1, first) - segmentTransmittance(t2) * singleLookUp(t2, first),
+    part += max(segmentTransmittance(t1) * singleLookUp(t1, first) -
+                    segmentTransmittance(t2) * singleLookUp(t2, first),
                 vec3(0.0));
   }
   if (sky) part += TE * singleLookUp(tE, first); // unshadowed beyond the far plane
@@ -363,8 +361,7 @@ void main() {
   if (sky && hitsGround && albedo > 0.0) {
     RayPoint X = rayPoint(rayEnd);
     vec3 direct = X.cosSun > 0.0
-                      ? exp(-crep_atmosphereExtinction(crep_atmosphere, crep_densityToTop(opticalDepthTable, crep_atmosphere,
-                                                                                          X.h, X.cosSun))) * X.cosSun
+                      ? crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, X.h, X.cosSun) * X.cosSun
                       : vec3(0.0);
     L += segmentTransmittance(rayEnd) * (albedo * float(CREP_INV_PI)) *
          (direct + crep_ambientSkyLight(ambientTable, crep_atmosphere, X.cosSun));

@@ -6,8 +6,7 @@
 // top of the atmosphere with CREP_ATMOSPHERE_STEPS midpoint steps, give the second order L2 (the mean of
 // the integral of T(x, y) (beta_R d_R p_R + beta_M d_M p_HG)(w . l) T_sun(y), the first scattering with its
 // true phase functions where Hillaire takes the isotropic one, plus the sunlit ground's albedo / pi
-// bounce) and the
-// transfer f_ms (the mean of the integral of T(x, y) sigma_s(y)); Psi_ms = L2 / (1 - f_ms).
+// bounce) and the transfer f_ms (the mean of the integral of T(x, y) sigma_s(y)); Psi_ms = L2 / (1 - f_ms).
 // Positions are offsets from x (altitudes from |x|^2 - R^2 without cancellation, as the 4D passes').
 #include "crep/atmosphere.glsl"
 
@@ -42,14 +41,8 @@ void main() {
     float c = w.y, b = r0 * c, wl = dot(w, l);
     float disc = b * b - hh;
     bool ground = c < 0.0 && disc >= 0.0;
-    float len;
-    if (ground) {
-      len = hh / (-b + sqrt(disc)); // near root of |x + t w| = R
-    } else {
-      float cc = (H - h) * (2.0 * R + H + h);
-      float d = sqrt(b * b + cc);
-      len = b >= 0.0 ? cc / (b + d) : d - b; // far root of |x + t w| = R + H
-    }
+    float len = ground ? crep_atmosphereGroundDistance(hh, b, disc)
+                       : crep_atmosphereTopDistance(crep_atmosphere, h, b);
     float dt = len / float(CREP_ATMOSPHERE_STEPS);
     float phaseR = crep_rayleighPhase(wl), phaseM = crep_henyeyGreenstein(crep_atmosphere.mieExtinction.w, wl);
     vec2 optical = vec2(0.0);
@@ -63,18 +56,18 @@ void main() {
       vec3 T = exp(-crep_atmosphereExtinction(crep_atmosphere, optical + d * (0.5 * dt)));
       optical += d * dt;
       vec3 sigmaS = crep_atmosphere.rayleighScattering.rgb * d.x + crep_atmosphere.mieScattering.rgb * d.y;
-      vec2 toSun = crep_densityToTop(crep_opticalDepth, crep_atmosphere, hy, (r0 * mu + t * wl) / r);
-      vec3 phased = crep_atmosphere.rayleighScattering.rgb * (d.x * phaseR) + crep_atmosphere.mieScattering.rgb * (d.y * phaseM);
-      lum += T * phased * exp(-crep_atmosphereExtinction(crep_atmosphere, toSun)) * dt;
+      vec3 phased = crep_atmosphere.rayleighScattering.rgb * (d.x * phaseR) +
+                    crep_atmosphere.mieScattering.rgb * (d.y * phaseM);
+      vec3 sunT = crep_sunTransmittanceAt(crep_opticalDepth, crep_atmosphere, hy, (r0 * mu + t * wl) / r);
+      lum += T * phased * sunT * dt;
       fms += T * sigmaS * dt;
     }
     if (ground) {
       float cosSun = (r0 * mu + len * wl) / R;
-      if (cosSun > 0.0) {
-        vec2 toSun = crep_densityToTop(crep_opticalDepth, crep_atmosphere, 0.0, cosSun);
+      if (cosSun > 0.0)
         lum += exp(-crep_atmosphereExtinction(crep_atmosphere, optical)) *
-               exp(-crep_atmosphereExtinction(crep_atmosphere, toSun)) * (cosSun * albedo * float(CREP_INV_PI));
-      }
+               crep_sunTransmittanceAt(crep_opticalDepth, crep_atmosphere, 0.0, cosSun) *
+               (cosSun * albedo * float(CREP_INV_PI));
     }
     second += lum;
     transfer += fms;

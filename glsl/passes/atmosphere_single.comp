@@ -45,8 +45,7 @@ void main() {
     if (k > 0) camera += 0.5 * (previousDensity + dens) * dt;
     previousDensity = dens;
     vec3 cameraT = exp(-crep_atmosphereExtinction(crep_atmosphere, camera));
-    vec2 toSun = crep_densityToTop(crep_opticalDepth, crep_atmosphere, q.h, q.cosSunZenith);
-    vec3 sunT = exp(-crep_atmosphereExtinction(crep_atmosphere, toSun));
+    vec3 sunT = crep_sunTransmittanceAt(crep_opticalDepth, crep_atmosphere, q.h, q.cosSunZenith);
     vec3 tt = cameraT * sunT;
     float weight = (k == 0 || k == CREP_ATMOSPHERE_STEPS) ? 0.5 : 1.0;
     sumR += weight * (crep_atmosphere.rayleighScattering.rgb * dens.x) * tt;

@@ -171,6 +171,24 @@ glm::dvec4 fetchTrilinear(const AtmosphereTable4D& t, double s, double tc, doubl
   return glm::mix(plane(z.i0), plane(z.i1), z.f);
 }
 
+/// GL bilinear filtering (clamp to edge) of a 2D table of altitudes (u = sqrt(h / H_Atm), across) by cosines
+/// (linear in [-1, 1], down): the optical depth table's and Psi_ms's rule. Its first min(3, channels).
+glm::dvec3 sampleHeightCosine(const Image& img, double atmosphereHeight, double h, double cosZenith) {
+  const int w = img.width(), hgt = img.height(), channels = std::min(3, img.channels());
+  const double uh = std::sqrt(std::clamp(h / atmosphereHeight, 0.0, 1.0));
+  const double uc = (std::clamp(cosZenith, -1.0, 1.0) + 1.0) * 0.5;
+  const Lerp1 x = glLerp(texCoord(uh, w), w);
+  const Lerp1 y = glLerp(texCoord(uc, hgt), hgt);
+  const auto at = [&](int i, int j) {
+    glm::dvec3 v(0.0);
+    for (int c = 0; c < channels; ++c)
+      v[c] = img.at(i, j, c);
+    return v;
+  };
+  return glm::mix(glm::mix(at(x.i0, y.i0), at(x.i1, y.i0), x.f),
+                  glm::mix(at(x.i0, y.i1), at(x.i1, y.i1), x.f), y.f);
+}
+
 void store(AtmosphereTable4D& t, int ih, int ia, int ip, int it, const glm::dvec3& v) {
   t.at(ih, ia, ip, it) = glm::vec4(glm::vec3(v), 0.0f);
 }
@@ -595,7 +613,7 @@ glm::dvec3 sampleSingleScattering(const AtmosphereTables& tables, const glm::dve
 
 glm::dvec3 lookUpSingleScattering(const AtmosphereTables& tables, const glm::dvec3& position,
                                   const glm::dvec3& view, const glm::dvec3& toSun, glm::dvec4& coords) {
-  lookUpAtmosphere(tables, tables.single, position, view, toSun, coords);
+  coords = atmosphereLookUpCoords(tables.parameters, tables.single.size, position, view, toSun, coords);
   return sampleSingleScattering(tables, coords, glm::dot(view, toSun));
 }
 
@@ -609,25 +627,24 @@ glm::dvec3 lookUpMultipleScattering(const AtmosphereTables& tables, const glm::d
 glm::dvec3 lookUpAtmosphere(const AtmosphereTables& tables, const AtmosphereTable4D& table,
                             const glm::dvec3& position, const glm::dvec3& view, const glm::dvec3& toSun,
                             glm::dvec4& coords) {
+  coords = atmosphereLookUpCoords(tables.parameters, table.size, position, view, toSun, coords);
+  return sampleAtmosphereTable(table, coords);
+}
+
+// Listing 1's coordinates of a world point and its directions.
+glm::dvec4 atmosphereLookUpCoords(const AtmosphereParameters& p, const AtmosphereTableSize& size,
+                                  const glm::dvec3& position, const glm::dvec3& view, const glm::dvec3& toSun,
+                                  const glm::dvec4& previous) {
   const double r = glm::length(position);
   const glm::dvec3 up = position / r;
-  coords = atmosphereTableCoords(tables.parameters, table.size, r - tables.parameters.earthRadius,
-                                 glm::dot(up, view), glm::dot(up, toSun), glm::dot(view, toSun), coords);
-  return sampleAtmosphereTable(table, coords);
+  return atmosphereTableCoords(p, size, r - p.earthRadius, glm::dot(up, view), glm::dot(up, toSun),
+                               glm::dot(view, toSun), previous);
 }
 
 // Yusov 2013, the net density table look-up (bilinear, clamp to edge).
 glm::dvec2 lookUpDensityToTop(const AtmosphereTables& tables, double h, double cosZenith) {
-  const Image& img = tables.opticalDepth;
-  const int w = img.width();
-  const int hgt = img.height();
-  const double uh = std::sqrt(std::clamp(h / tables.parameters.atmosphereHeight, 0.0, 1.0));
-  const double uc = (std::clamp(cosZenith, -1.0, 1.0) + 1.0) * 0.5;
-  const Lerp1 x = glLerp(texCoord(uh, w), w);
-  const Lerp1 y = glLerp(texCoord(uc, hgt), hgt);
-  const auto at = [&](int i, int j) { return glm::dvec2(img.at(i, j, 0), img.at(i, j, 1)); };
-  return glm::mix(glm::mix(at(x.i0, y.i0), at(x.i1, y.i0), x.f),
-                  glm::mix(at(x.i0, y.i1), at(x.i1, y.i1), x.f), y.f);
+  return glm::dvec2(
+      sampleHeightCosine(tables.opticalDepth, tables.parameters.atmosphereHeight, h, cosZenith));
 }
 
 // Yusov 2013, "Terrain shaders": the sun's extinction from the net density to the top.
@@ -664,14 +681,7 @@ glm::dvec3 atmosphereTransmittance(const AtmosphereTables& tables, const glm::dv
 glm::dvec3 lookUpMultipleScatteringLut(const AtmosphereTables& tables, double h, double cosSunZenith) {
   const Image& img = tables.multipleScatteringLut;
   if (img.width() < 2 || img.height() < 2) return glm::dvec3(0.0);
-  const int n = img.width(), m = img.height();
-  const double uh = std::sqrt(std::clamp(h / tables.parameters.atmosphereHeight, 0.0, 1.0));
-  const double uc = (std::clamp(cosSunZenith, -1.0, 1.0) + 1.0) * 0.5;
-  const Lerp1 x = glLerp(texCoord(uh, n), n);
-  const Lerp1 y = glLerp(texCoord(uc, m), m);
-  const auto at = [&](int i, int j) { return glm::dvec3(img.at(i, j, 0), img.at(i, j, 1), img.at(i, j, 2)); };
-  return glm::mix(glm::mix(at(x.i0, y.i0), at(x.i1, y.i0), x.f),
-                  glm::mix(at(x.i0, y.i1), at(x.i1, y.i1), x.f), y.f);
+  return sampleHeightCosine(img, tables.parameters.atmosphereHeight, h, cosSunZenith);
 }
 
 // Yusov 2013, "Terrain shaders": E_sky linear in the 1D table (texel i at c = 2 i / (N - 1) - 1).

@@ -124,11 +124,7 @@ public:
   /// T(C -> C + v t) of a segment that Eq. 8 or the output uses: the trapezoid rule with kSegmentSteps steps
   /// of the densities along it (the optical depth table's difference of two large values has steps of
   /// several percent near the horizon, where its zenith cosine is coarse); 1 at t <= 0.
-  glm::dvec3 segmentTransmittance(double t) const {
-    if (!(t > 0.0)) return glm::dvec3(1.0);
-    const glm::dvec2 d = densityIntegral(p_, C_, at(t), kSegmentSteps);
-    return glm::exp(-(p_.rayleighScattering * d.x + (p_.mieScattering + p_.mieAbsorption) * d.y));
-  }
+  glm::dvec3 segmentTransmittance(double t) const { return extinguished(segmentDensity(t)); }
 
   /// Listing 1 at C + v t; the first look-up of the ray is at C (made first when the first call is
   /// elsewhere) and chooses the side of the horizon that every later look-up keeps (Listing 2). An empty
@@ -156,8 +152,7 @@ public:
   glm::dvec3 trapezoid(double ta, double tb, int n) const {
     if (!(tb > ta)) return glm::dvec3(0.0);
     const double dt = (tb - ta) / n;
-    glm::dvec2 optical =
-        ta > 0.0 ? densityIntegral(p_, C_, at(ta), kSegmentSteps) : glm::dvec2(0.0); // C -> the section
+    glm::dvec2 optical = segmentDensity(ta); // C -> the section
     glm::dvec2 previous(0.0);
     glm::dvec3 sum(0.0);
     for (int k = 0; k <= n; ++k) {
@@ -169,24 +164,29 @@ public:
       previous = d;
       const glm::dvec3 scattering =
           p_.rayleighScattering * (d.x * phaseR_) + p_.mieScattering * (d.y * phaseM_);
-      const glm::dvec3 T =
-          glm::exp(-(p_.rayleighScattering * optical.x + (p_.mieScattering + p_.mieAbsorption) * optical.y));
-      sum += (k == 0 || k == n ? 0.5 : 1.0) * scattering * T * sunTransmittance(tables_, P, l_);
+      sum += (k == 0 || k == n ? 0.5 : 1.0) * scattering * extinguished(optical) *
+             sunTransmittance(tables_, P, l_);
     }
     return sum * dt;
   }
 
 private:
+  /// The (Rayleigh, Mie) density integrals of the segment to C + v t (kSegmentSteps trapezoid steps; 0 at
+  /// t <= 0).
+  glm::dvec2 segmentDensity(double t) const {
+    return t > 0.0 ? densityIntegral(p_, C_, at(t), kSegmentSteps) : glm::dvec2(0.0);
+  }
+  /// exp(-beta_e . D) of density integrals D.
+  glm::dvec3 extinguished(const glm::dvec2& d) const {
+    return glm::exp(-(p_.rayleighScattering * d.x + (p_.mieScattering + p_.mieAbsorption) * d.y));
+  }
+
   /// The table coordinates of C + v t; the first look-up of the ray is at C (made first when the first
   /// call is elsewhere) and chooses the side of the horizon that every later one keeps (Listing 2).
   glm::dvec4 coords(double t) {
     if (!haveFirst_ && t != 0.0) coords(0.0);
-    glm::dvec4 c = haveFirst_ ? first_ : glm::dvec4(-1.0);
-    const glm::dvec3 P = at(t);
-    const double r = glm::length(P);
-    const glm::dvec3 up = P / r;
-    c = atmosphereTableCoords(p_, tables_.options.size, r - p_.earthRadius, glm::dot(up, v_),
-                              glm::dot(up, l_), cosSunView_, c);
+    const glm::dvec4 c = atmosphereLookUpCoords(p_, tables_.options.size, at(t), v_, l_,
+                                                haveFirst_ ? first_ : glm::dvec4(-1.0));
     if (!haveFirst_) {
       first_ = c;
       haveFirst_ = true;

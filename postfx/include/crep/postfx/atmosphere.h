@@ -227,6 +227,12 @@ void atmosphereDirections(double cosViewZenith, double cosSunZenith, double cosS
 /// packed dimensions (GL rules, clamp to edge) and linear between theta slices.
 glm::dvec3 sampleAtmosphereTable(const AtmosphereTable4D& table, const glm::dvec4& coords);
 
+/// Listing 1's coordinates for the point `position` (metres, planet centre at the origin) looking along unit
+/// `view` with the sun towards unit `toSun`: atmosphereTableCoords of its altitude and three cosines.
+glm::dvec4 atmosphereLookUpCoords(const AtmosphereParameters& p, const AtmosphereTableSize& size,
+                                  const glm::dvec3& position, const glm::dvec3& view, const glm::dvec3& toSun,
+                                  const glm::dvec4& previous = glm::dvec4(-1.0));
+
 /// sampleAtmosphereTable with the alpha channel (`single`'s Mie red).
 glm::dvec4 sampleAtmosphereTableRgba(const AtmosphereTable4D& table, const glm::dvec4& coords);
 
