@@ -150,6 +150,34 @@ vec3 singleLookUp(float t, vec4 first) {
 }
 
 #if CREP_ATMOSPHERE_SHAFTS == 1
+// (a)'s unshadowed rest of a sky ray, [ta, tb] (crep::atmosphereRay's rule, kSkyStepPower): the trapezoid
+// rule with n steps in u of t = ta + (tb - ta) u^3, steps short where the ray starts low in dense air and
+// long towards the top (a grazing ray runs ~1000 km, most of its Mie light within the first ~30 km); the
+// integrand and T(C->P) of trapezoid() below.
+#define CREP_SKY_POWER 3
+vec3 skyQuadrature(float ta, float tb, int n) {
+  float len = tb - ta;
+  vec2 optical = segmentDensity(ta);
+  vec2 previous = vec2(0.0);
+  float tPrev = ta;
+  vec3 sum = vec3(0.0);
+  for (int k = 0; k <= n; ++k) {
+    float u = float(k) / float(n);
+    float t = ta + len * pow(u, float(CREP_SKY_POWER));
+    RayPoint p = rayPoint(t);
+    vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
+    if (k > 0) optical += 0.5 * (previous + d) * (t - tPrev);
+    previous = d;
+    tPrev = t;
+    float dtdu = len * float(CREP_SKY_POWER) * pow(u, float(CREP_SKY_POWER - 1));
+    vec3 f = (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) *
+             exp(-crep_atmosphereExtinction(crep_atmosphere, optical)) *
+             crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, p.h, p.cosSun) * dtdu;
+    sum += (k == 0 || k == n) ? 0.5 * f : f;
+  }
+  return sum / float(n);
+}
+
 // The trapezoid rule with n steps over [ta, tb] metres of the single scattering integrand (beta_R d_R p_R +
 // beta_M d_M p_HG) T(C->P) T_sun(P): T(C->P) from the densities along the ray (CREP_SEGMENT_STEPS to ta,
 // then the section's own steps), not the optical depth table's difference (crep::atmosphereRay's rule).
@@ -304,7 +332,7 @@ void main() {
     if (pendingB > pendingA) integrateSection(pendingA, pendingB);
   }
   single = singleSum;
-  if (sky && rayEnd > tE) single += trapezoid(tE, rayEnd, max(crep_march.info.w, 1)); // unshadowed
+  if (sky && rayEnd > tE) single += skyQuadrature(tE, rayEnd, max(crep_march.info.w, 1)); // unshadowed
 #elif CREP_ATMOSPHERE_SHAFTS == 2
   if (!mapped) {
     if (s > 0.0) {

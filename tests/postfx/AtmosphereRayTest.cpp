@@ -248,6 +248,31 @@ TEST_CASE("Atmosphere ray: (a) against a brute-force single-scattering integral 
   }
 }
 
+TEST_CASE("Atmosphere ray: (a)'s sky beyond the far plane at its default steps against brute force") {
+  // Sky rays 20, 5 and 1 degrees up from 500 m, the far plane at 5 km: (a)'s default skySteps (16) over the
+  // rest of the ray (80 to ~1000 km) in the substitution t = s_F + (t_X - s_F) u^3. Measured 0.16%, 0.40%,
+  // 0.47% (16 uniform steps, before the substitution: 3.4%, 8.2%, 29%).
+  const AtmosphereParameters& p = tables(1).parameters;
+  const AtmosphereRayOptions defaults;
+  for (double degrees : {20.0, 5.0, 1.0}) {
+    CAPTURE(degrees);
+    const double e = glm::radians(degrees);
+    const TestRay r{
+        "sky", {0.0, 50.0, 0.0}, {std::cos(e) * 0.6, std::sin(e), -std::cos(e) * 0.8}, 500.0, true};
+    const glm::dvec3 a = run(r, AtmosphereShafts::Integrated, sections({{0.0, r.surface}}),
+                             defaults.integrationSteps, defaults.skySteps, 1, &blackGroundTables())
+                             .inscattering;
+    const glm::dvec3 C = atmospherePosition(placement(), p, r.origin);
+    const double length = distanceToTop(p, C, r.direction);
+    REQUIRE(length > 0.0);
+    const glm::dvec3 reference =
+        sun().irradiance() * bruteSingle(p, C, r.direction, -sun().direction(), length, 8192);
+    const double rel = maxRelative(a, reference);
+    MESSAGE(degrees << " degrees up: (a) at default steps vs brute force, max relative error " << rel);
+    CHECK(rel < 0.01);
+  }
+}
+
 TEST_CASE("Atmosphere ray: shadowed halves add up, (b) gives Eq. 8 of the lit part") {
   for (const TestRay& r : testRays()) {
     CAPTURE(r.name);

@@ -20,9 +20,10 @@
 namespace crep::tool {
 
 const std::set<std::string> kAtmosphereOptions = {
-    "sun-elevation",    "sun-azimuth",     "camera-elevation",    "shafts",
-    "meters-per-unit",  "origin-altitude", "atmosphere-table",    "orders",
-    "atmosphere-cache", "sun-irradiance",  "multiple-scattering", "ground-albedo"};
+    "sun-elevation",     "sun-azimuth",     "camera-elevation",    "shafts",
+    "meters-per-unit",   "origin-altitude", "atmosphere-table",    "orders",
+    "atmosphere-cache",  "sun-irradiance",  "multiple-scattering", "ground-albedo",
+    "integration-steps", "sky-steps"};
 
 const char* const kAtmosphereOptionsHelp =
     R"(          atmosphere (--method atmosphere; Bruneton and Neyret 2008 tables, Yusov 2013):
@@ -43,6 +44,9 @@ const char* const kAtmosphereOptionsHelp =
             --orders N           orders: scattering orders 1..N (default 4); 1: single scattering only
             --ground-albedo A    the ground's albedo in lut's multiple scattering, in [0, 1]
                                  (default 0.1)
+            --integration-steps N  (a): trapezoid steps over the scene's part of a ray, in [1, 4096]
+                                 (default 64)
+            --sky-steps N        (a): steps of a sky ray beyond the far plane, in [1, 4096] (default 16)
             --atmosphere-cache DIR  table cache (default $XDG_CACHE_HOME/crepuscular or
                                  ~/.cache/crepuscular; `none`: always compute)
             --sun-irradiance E   extraterrestrial sun irradiance, white (default 10)
@@ -140,6 +144,8 @@ AtmosphereSettings atmosphereSettings(const Args& args) {
     throw UsageError("option --multiple-scattering: '" + multiple + "' is not lut or orders");
   s.parameters.groundAlbedo = args.number("ground-albedo", s.parameters.groundAlbedo, 0.0, 1.0);
   s.sunIrradiance = args.number("sun-irradiance", s.sunIrradiance, 1e-6, 1e6);
+  s.ray.integrationSteps = args.integer("integration-steps", s.ray.integrationSteps, 1, 4096);
+  s.ray.skySteps = args.integer("sky-steps", s.ray.skySteps, 1, 4096);
   try {
     validate(s.tables);
   } catch (const InvalidArgument& e) {
@@ -262,6 +268,7 @@ AtmosphereOutput runAtmosphere(FrameInputs& frame, const MethodSettings& setting
   }
   AtmospherePass::CreateInfo info;
   info.shafts = s.shafts;
+  info.options = s.ray;
   info.mapWidth = mapWidth;
   info.mapHeight = mapHeight;
   auto pass = timings.time("atmosphere setup", [&] { return std::make_unique<AtmospherePass>(info); });

@@ -26,7 +26,8 @@
 namespace crep::tool {
 
 /// --sun-elevation --sun-azimuth --camera-elevation --shafts --meters-per-unit --origin-altitude
-/// --atmosphere-table --orders --atmosphere-cache --sun-irradiance
+/// --atmosphere-table --orders --atmosphere-cache --sun-irradiance --multiple-scattering --ground-albedo
+/// --integration-steps --sky-steps
 extern const std::set<std::string> kAtmosphereOptions;
 extern const char* const kAtmosphereOptionsHelp;
 
@@ -38,6 +39,7 @@ struct AtmosphereSettings {
   AtmospherePlacement placement{50.0, 0.0};
   AtmosphereParameters parameters;
   AtmospherePrecomputeOptions tables;
+  AtmosphereRayOptions ray;    ///< (a)'s steps (shafts: the `shafts` field above)
   std::string cacheDirectory;  ///< empty: no cache
   double sunIrradiance = 10.0; ///< extraterrestrial sun irradiance (white)
 };

@@ -336,7 +336,7 @@ struct AtmosphereShadowing {
 struct AtmosphereRayOptions {
   AtmosphereShafts shafts = AtmosphereShafts::None;
   int integrationSteps = 64; ///< (a): trapezoid steps over [0, surface] (lit sections get their share)
-  int skySteps = 16;         ///< (a): steps of single scattering beyond the far plane, to the top
+  int skySteps = 16; ///< (a): steps beyond the far plane to the end of a sky ray (t = s_F + (t_X - s_F) u^3)
 };
 
 /// One view ray of a camera: from world point `origin` along unit world `direction` to world distance
