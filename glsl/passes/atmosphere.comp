@@ -15,6 +15,9 @@
 //     then Eq. 8 with L1 over [D_start, D_start + D_lit]; higher orders as (a);
 //   3 (c) PrefilteredVisibility: the prefiltered texel's visible fraction (crep::prefilteredVisibility)
 //     times Eq. 8 with L1; higher orders as (a).
+// With CREP_ATMOSPHERE_VOLUME 1 (the default), None, (b) and (c) take L1 from the view tables instead of
+// Eq. 8 (the rule at the top of postfx/src/atmosphere_ray.cpp): the same shadows, no difference of two large
+// look-ups.
 // Points along the ray are never formed as float positions (0.5 m resolution at the planet's surface):
 // rayPoint() gives the altitude and zenith cosines of C + v t from |C|^2 - R^2 and C.v, C.l, and the
 // look-ups, transmittances and sun transmittances (the formulas of crep_lookUpAtmosphere,
@@ -27,10 +30,24 @@
 // atmosphere block (uniform binding 2), camera depth (unit 0), rectified depth (unit 1, (a), (b)),
 // optical depth table (unit 2), single S_R + S_M.r (unit 3), L_H (unit 4), single S_M (unit 5; not read
 // with CREP_ATMOSPHERE_COMBINED_MIE 1), prefiltered radiance (unit 6, (c)), ambient sky light (unit 7),
+// the view tables (units 8-11, CREP_ATMOSPHERE_VOLUME),
 // min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance (image 0),
 // RGBA32F transmittance (image 1).
 #ifndef CREP_ATMOSPHERE_SHAFTS
 #define CREP_ATMOSPHERE_SHAFTS 0
+#endif
+// CREP_ATMOSPHERE_VOLUME 1 (None, (b), (c)): L1 from the camera's view tables (crep::AtmosphereViewTables,
+// Hillaire 2020, Sec. 5.2-5.3): the aerial perspective volume (units 8 Rayleigh, 9 Mie; march block region =
+// (W, H, D, steps)) in front of the far plane, the sky-view table (units 10, 11; block = (W, H, steps, 0))
+// beyond it; the 4D table's Eq. 8 when the camera is above the atmosphere (cameraShift > 0).
+// CREP_ATMOSPHERE_VOLUME_PASS 1: this program computes the volume instead (one invocation per froxel
+// column, images 0 and 1: 3D RGBA32F, RGB the integrals, A 0); CREP_ATMOSPHERE_VOLUME_PASS 2 the sky-view
+// table (one invocation per texel, images 0 and 1: 2D RGBA32F).
+#ifndef CREP_ATMOSPHERE_VOLUME
+#define CREP_ATMOSPHERE_VOLUME 0
+#endif
+#ifndef CREP_ATMOSPHERE_VOLUME_PASS
+#define CREP_ATMOSPHERE_VOLUME_PASS 0
 #endif
 #define CREP_SHAFTS_WALK (CREP_ATMOSPHERE_SHAFTS == 1 || CREP_ATMOSPHERE_SHAFTS == 2)
 
@@ -60,8 +77,22 @@ layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]
 #if CREP_ATMOSPHERE_SHAFTS == 3
 layout(binding = 6) uniform sampler2D prefiltered;
 #endif
+#if CREP_ATMOSPHERE_VOLUME_PASS == 1
+layout(binding = 0, rgba32f) uniform writeonly image3D volumeRayleighOut;
+layout(binding = 1, rgba32f) uniform writeonly image3D volumeMieOut;
+#elif CREP_ATMOSPHERE_VOLUME_PASS == 2
+layout(binding = 0, rgba32f) uniform writeonly image2D skyRayleighOut;
+layout(binding = 1, rgba32f) uniform writeonly image2D skyMieOut;
+#else
 layout(binding = 0, rgba32f) uniform writeonly image2D inscatteringOut;
 layout(binding = 1, rgba32f) uniform writeonly image2D transmittanceOut;
+#endif
+#if CREP_ATMOSPHERE_VOLUME
+layout(binding = 8) uniform sampler3D volumeRayleigh;
+layout(binding = 9) uniform sampler3D volumeMie;
+layout(binding = 10) uniform sampler2D skyRayleigh;
+layout(binding = 11) uniform sampler2D skyMie;
+#endif
 
 // The ray of this invocation, in metres around the planet centre (atmosphere.h's table frame).
 vec3 rayC = vec3(0.0);    // the (restrained) camera position C
@@ -242,9 +273,16 @@ float visibility = 1.0; // (c): the prefiltered visible fraction of the ray
 // Everything but (a)'s integrated single scattering, for the current ray (rayV, rayCV, rayVL): Eq. 8 with
 // L_M (None), or the unoccluded higher orders (Eq. 8 with L_H) plus (b)'s or (c)'s single scattering. The
 // first look-up (at C) fixes the side of the horizon of every later one (Listing 2).
+bool useVolume = false; // CREP_ATMOSPHERE_VOLUME with the camera in the atmosphere
 vec3 tablePart(bool sky, float tE) {
   vec4 first = vec4(-1.0);
   vec3 TE = segmentTransmittance(tE);
+#if CREP_ATMOSPHERE_VOLUME
+  if (useVolume) { // L_H only: the view tables have L1
+    vec3 higherC = lookUpAt(higherOrdersTable, 0.0, first);
+    return sky ? higherC : higherC - TE * lookUp(higherOrdersTable, tE, first);
+  }
+#endif
 #if CREP_ATMOSPHERE_SHAFTS == 0
   // L_M = L1 + L_H (the same coordinates).
   vec3 multipleC = singleAt(0.0, first) + lookUp(higherOrdersTable, 0.0, first);
@@ -274,6 +312,169 @@ vec3 tablePart(bool sky, float tE) {
 #endif
 }
 
+// The ray state above for the camera's ray along unit world direction v (C not yet restrained).
+void beginRay(vec3 v) {
+  rayV = v;
+  rayL = -crep_march.lightDirection.xyz;
+  metres = crep_atmosphere.placement.x;
+  vec3 C0 = crep_atmospherePosition(crep_atmosphere, crep_march.cameraPosition.xyz);
+  rayC = C0;
+  vec3 w = crep_march.cameraPosition.xyz * metres;
+  float yAlt = w.y + crep_atmosphere.placement.y; // the camera's altitude
+  rayRR = w.x * w.x + w.z * w.z + yAlt * (yAlt + 2.0 * crep_atmosphere.radii.x);
+  rayCV = dot(C0, rayV);
+  rayCL = dot(C0, rayL);
+  rayVL = dot(rayV, rayL);
+}
+
+// crep::AtmosphereViewTables' sky-view frame at the camera: the zenith, the sun's horizontal direction, the
+// third axis, the horizon's elevation e_h.
+struct SkyFrame {
+  vec3 zenith, sunAzimuth, side;
+  float horizon;
+};
+SkyFrame skyFrame() {
+  SkyFrame f;
+  f.zenith = normalize(rayC);
+  vec3 across = rayL - dot(rayL, f.zenith) * f.zenith;
+  vec3 other = abs(f.zenith.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 0.0, 1.0);
+  f.sunAzimuth = length(across) > 1e-6 ? normalize(across) : normalize(cross(f.zenith, other));
+  f.side = cross(f.zenith, f.sunAzimuth);
+  float R = crep_atmosphere.radii.x, r = sqrt(R * R + rayRR);
+  f.horizon = asin(clamp(crep_cosHorizon(crep_atmosphere, max(rayRR / (r + R), 0.0)), -1.0, 1.0));
+  return f;
+}
+
+#if CREP_ATMOSPHERE_VOLUME_PASS
+// crep's ViewMarch (postfx/src/atmosphere_ray.cpp): the trapezoid rule of the phase-free integrands
+// (beta_R d_R, beta_M d_M) T(C->P) T_sun(P) along the current ray, T(C->P) from the densities marched
+// from C. viewStep(t, wPrevious, w): to t, adding (wPrevious f(t_prev) + w f(t)) / 2.
+vec3 vmRayleigh = vec3(0.0), vmMie = vec3(0.0), vmFR = vec3(0.0), vmFM = vec3(0.0);
+vec2 vmDensity = vec2(0.0), vmOptical = vec2(0.0);
+float vmT = 0.0;
+void viewIntegrand(RayPoint p, vec2 d) {
+  vec3 w = exp(-crep_atmosphereExtinction(crep_atmosphere, vmOptical)) *
+           crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, p.h, p.cosSun);
+  vmFR = crep_atmosphere.rayleighScattering.rgb * d.x * w;
+  vmFM = crep_atmosphere.mieScattering.rgb * d.y * w;
+}
+void viewBegin() {
+  RayPoint p = rayPoint(0.0);
+  vmDensity = crep_atmosphereDensity(crep_atmosphere, p.h);
+  viewIntegrand(p, vmDensity);
+}
+void viewStep(float t, float wPrevious, float w) {
+  RayPoint p = rayPoint(t);
+  vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
+  vmOptical += 0.5 * (vmDensity + d) * (t - vmT);
+  vec3 fR = vmFR, fM = vmFM;
+  viewIntegrand(p, d);
+  vmRayleigh += 0.5 * (wPrevious * fR + w * vmFR);
+  vmMie += 0.5 * (wPrevious * fM + w * vmFM);
+  vmT = t;
+  vmDensity = d;
+}
+#endif
+
+#if CREP_ATMOSPHERE_VOLUME_PASS == 1
+// The aerial perspective volume: column (i, j) from the camera to the far plane, slice k at view depth
+// far (k / (D - 1))^2, `steps` trapezoid steps per slice.
+void main() {
+  ivec3 size = crep_march.region.xyz;
+  int steps = crep_march.region.w;
+  ivec2 column = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(column, size.xy))) return;
+  vec2 position = (vec2(column) + 0.5) / vec2(size.xy) * vec2(crep_march.sizes.xy);
+  beginRay(crep_screenRay(crep_march, position, 0.5).xyz);
+  float end = crep_march.cameraDepth.z / dot(rayV, crep_march.cameraForward.xyz) * metres;
+  viewBegin();
+  imageStore(volumeRayleighOut, ivec3(column, 0), vec4(0.0));
+  imageStore(volumeMieOut, ivec3(column, 0), vec4(0.0));
+  float t = 0.0;
+  for (int k = 1; k < size.z; ++k) {
+    float u = float(k) / float(size.z - 1);
+    float tb = end * u * u, dt = (tb - t) / float(steps);
+    for (int i = 1; i <= steps; ++i)
+      viewStep(t + dt * float(i), dt, dt);
+    t = tb;
+    imageStore(volumeRayleighOut, ivec3(column, k), vec4(vmRayleigh, 0.0));
+    imageStore(volumeMieOut, ivec3(column, k), vec4(vmMie, 0.0));
+  }
+}
+#elif CREP_ATMOSPHERE_VOLUME_PASS == 2
+// The sky-view table: texel (i, j)'s whole ray, t = t_end u^3; the lower half ends on the ground (from
+// |C|^2 - R^2 and C.v, as main()), the upper half at the top, decided by the half.
+void main() {
+  ivec2 size = ivec2(crep_march.block.xy);
+  int n = int(crep_march.block.z);
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (any(greaterThanEqual(texel, size))) return;
+  beginRay(vec3(0.0, 1.0, 0.0));
+  SkyFrame f = skyFrame();
+  int halfRows = size.y / 2;
+  bool above = texel.y >= halfRows;
+  float s = float(above ? texel.y - halfRows : texel.y) / float(halfRows - 1);
+  float pi = float(CREP_PI);
+  float e = above ? f.horizon + s * s * (0.5 * pi - f.horizon) : f.horizon - s * s * (f.horizon + 0.5 * pi);
+  float phi = pi * float(texel.x) / float(size.x - 1);
+  beginRay(cos(e) * (cos(phi) * f.sunAzimuth + sin(phi) * f.side) + sin(e) * f.zenith);
+  // C.v and, below the horizon, the ground's near root from the elevations (a float C.v leaves b^2 - c
+  // metres^2 off near the tangent): b = r sin e, b^2 - c = (R - r cos e)(R + r cos e) with
+  // R - r cos e = r (cos e_h - cos e) = -2 r sin((e_h + e) / 2) sin((e_h - e) / 2).
+  float R = crep_atmosphere.radii.x, r = sqrt(R * R + rayRR);
+  rayCV = r * sin(e);
+  float end = 0.0;
+  if (!above) {
+    float disc = max(-2.0 * r * sin(0.5 * (f.horizon + e)) * sin(0.5 * (f.horizon - e)) * (R + r * cos(e)), 0.0);
+    end = rayRR / (sqrt(disc) - rayCV);
+  } else {
+    end = max(crep_raySphere(rayC, rayV, crep_atmosphere.radii.y).y, 0.0);
+  }
+  viewBegin();
+  float du = 1.0 / float(n), w = du * 3.0 * end; // du dt/du = w u^2
+  for (int k = 1; k <= n; ++k) {
+    float u = float(k) * du, u0 = u - du;
+    viewStep(end * u * u * u, w * u0 * u0, w * u * u);
+  }
+  imageStore(skyRayleighOut, texel, vec4(vmRayleigh, 0.0));
+  imageStore(skyMieOut, texel, vec4(vmMie, 0.0));
+}
+#else
+#if CREP_ATMOSPHERE_VOLUME
+// L1 of this pixel's ray from C to C + v t (metres): crep::sampleAerialPerspective (hardware trilinear).
+vec2 pixelScreen = vec2(0.0);
+vec3 volumeSingle(float t) {
+  if (!(t > 0.0)) return vec3(0.0);
+  float z = t / metres * dot(rayV, crep_march.cameraForward.xyz);
+  float D = float(crep_march.region.z);
+  float slice = sqrt(clamp(z / crep_march.cameraDepth.z, 0.0, 1.0)) * (D - 1.0);
+  float c = rayVL;
+  vec3 coords = vec3(pixelScreen, (slice + 0.5) / D);
+  return texture(volumeRayleigh, coords).rgb * crep_rayleighPhase(c) +
+         texture(volumeMie, coords).rgb * crep_henyeyGreenstein(crep_atmosphere.mieExtinction.w, c);
+}
+// L1 of this pixel's whole ray: crep::sampleSkyView (hardware bilinear within the ray's half).
+vec3 skyViewSingle() {
+  SkyFrame f = skyFrame();
+  vec2 size = crep_march.block.xy;
+  float halfRows = 0.5 * size.y, pi = float(CREP_PI);
+  // atan2, not asin / acos: well conditioned at every angle (acos of a cosine near 1 loses half the digits).
+  float cz = dot(rayV, f.zenith);
+  vec3 level = rayV - cz * f.zenith;
+  float e = atan(cz, length(level));
+  float across = dot(level, f.side), along = dot(level, f.sunAzimuth);
+  float phi = across != 0.0 || along != 0.0 ? abs(atan(across, along)) : 0.0;
+  float x = clamp(phi / pi, 0.0, 1.0) * (size.x - 1.0);
+  float y = e >= f.horizon
+                ? halfRows + sqrt(clamp((e - f.horizon) / (0.5 * pi - f.horizon), 0.0, 1.0)) * (halfRows - 1.0)
+                : sqrt(clamp((f.horizon - e) / (f.horizon + 0.5 * pi), 0.0, 1.0)) * (halfRows - 1.0);
+  vec2 coords = (vec2(x, y) + 0.5) / size;
+  float c = rayVL;
+  return texture(skyRayleigh, coords).rgb * crep_rayleighPhase(c) +
+         texture(skyMie, coords).rgb * crep_henyeyGreenstein(crep_atmosphere.mieExtinction.w, c);
+}
+#endif
+
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
   if (any(greaterThanEqual(pixel, crep_march.sizes.xy))) return;
@@ -281,18 +482,9 @@ void main() {
   bool sky = !(depth < 1.0); // the sky test of crep::atmosphereImage (NaN: the sky)
   vec4 ray = crep_pixelRay(crep_march, pixel, depth);
   float s = ray.w;
-  rayV = ray.xyz;
-  rayL = -crep_march.lightDirection.xyz;
-  metres = crep_atmosphere.placement.x;
+  beginRay(ray.xyz);
   float Rg = crep_atmosphere.radii.x, Rt = crep_atmosphere.radii.y;
-  vec3 C0 = crep_atmospherePosition(crep_atmosphere, crep_march.cameraPosition.xyz);
-  rayC = C0;
-  vec3 w = crep_march.cameraPosition.xyz * metres;
-  float yAlt = w.y + crep_atmosphere.placement.y; // the camera's altitude
-  rayRR = w.x * w.x + w.z * w.z + yAlt * (yAlt + 2.0 * Rg);
-  rayCV = dot(C0, rayV);
-  rayCL = dot(C0, rayL);
-  rayVL = dot(rayV, rayL);
+  vec3 C0 = rayC;
   if (length(C0) > Rt) { // above the top: start where the ray enters the atmosphere
     vec2 top = crep_raySphere(C0, rayV, Rt);
     if (!(top.y > 0.0)) { // misses the atmosphere: nothing in-scattered, everything transmitted
@@ -306,11 +498,19 @@ void main() {
     rayCV += cameraShift;
     rayCL += cameraShift * rayVL;
   }
+#if CREP_ATMOSPHERE_VOLUME
+  useVolume = cameraShift == 0.0;
+  pixelScreen = (vec2(pixel) + 0.5) / vec2(crep_march.sizes.xy);
+#endif
   surfaceM = max(s * metres - cameraShift, 0.0);
   float exitTop = max(crep_raySphere(rayC, rayV, Rt).y, 0.0);
-  vec2 ground = crep_raySphere(rayC, rayV, Rg);
-  bool hitsGround = ground.x > 0.0;
-  float rayEnd = hitsGround ? min(ground.x, exitTop) : exitTop;   // t_X: the ray's end X
+  // The ground's near root from |C|^2 - R^2 and C.v (rayRR, rayCV): a float ray-sphere test with |C|^2 ~ 4e13
+  // m^2 moves it by metres, and a look-up at a point metres above the ground reads a fraction of the next
+  // altitude texel. t0 = -b - sqrt(b^2 - c) = c / (-b + sqrt(b^2 - c)) for b = C.v < 0, c = |C|^2 - R^2 > 0.
+  float discGround = rayCV * rayCV - rayRR;
+  bool hitsGround = rayCV < 0.0 && rayRR > 0.0 && discGround >= 0.0;
+  float groundT = hitsGround ? rayRR / (sqrt(discGround) - rayCV) : 0.0;
+  float rayEnd = hitsGround ? min(groundT, exitTop) : exitTop;   // t_X: the ray's end X
   float tE = sky ? min(surfaceM, rayEnd) : min(surfaceM, exitTop); // s_F (sky: the far plane) or s_E
 
   float cosTheta = dot(rayV, rayL);
@@ -382,6 +582,23 @@ void main() {
   } else {
     L = tablePart(sky, tE);
   }
+#if CREP_ATMOSPHERE_VOLUME
+  if (useVolume) { // L1: the volume in front of the far plane, the sky-view table's whole ray beyond it
+    vec3 toEnd = volumeSingle(tE);
+#if CREP_ATMOSPHERE_SHAFTS == 0
+    L += toEnd;
+#elif CREP_ATMOSPHERE_SHAFTS == 2
+    if (litLength > 0.0) {
+      float t1 = clamp(firstLit * metres, 0.0, tE);
+      float t2 = clamp(firstLit * metres + litLength * metres, t1, tE);
+      L += max(volumeSingle(t2) - volumeSingle(t1), vec3(0.0));
+    }
+#elif CREP_ATMOSPHERE_SHAFTS == 3
+    L += visibility * toEnd;
+#endif
+    if (sky) L += max(skyViewSingle() - toEnd, vec3(0.0));
+  }
+#endif
   L += single;
   // A sky pixel whose ray ends on the ground beyond the scene: the ground's Lambertian reflection of the sun
   // and the sky light seen through the air (crep::atmosphereRay's rule).
@@ -399,3 +616,4 @@ void main() {
   imageStore(inscatteringOut, pixel, vec4(inscattering, (T.r + T.g + T.b) / 3.0));
   imageStore(transmittanceOut, pixel, vec4(T, 1.0));
 }
+#endif // CREP_ATMOSPHERE_VOLUME_PASS

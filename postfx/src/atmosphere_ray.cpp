@@ -43,6 +43,12 @@
 //       0 without lit length; sky: plus T(C->F) L1(F) (unshadowed beyond the far plane).
 //   (c) surface single = visibility (L1(C) - T(C->E) L1(E)); sky single = visibility (L1(C) - T(C->F) L1(F))
 //       + T(C->F) L1(F).
+// - With `view` (AtmosphereViewTables of the camera at `origin`, options.single ViewTables), a camera in the
+//   atmosphere and shafts None, (b) or (c), L1 comes from the view tables instead of the 4D table, and the
+//   table part (blended at the horizon as above) is L_H alone: V(t) = sampleAerialPerspective at distance t,
+//   S = sampleSkyView of the whole ray; None single = V(s_E); (b) single = max(0, V(b) - V(a)) with a, b the
+//   clamped D_start and D_start + D_lit (0 without lit length); (c) single = visibility V(s_E); a sky pixel
+//   adds max(0, S - V(s_F)) (unshadowed beyond the far plane). No difference of two large look-ups remains.
 // - A sky pixel whose ray hits the ground (beyond the scene's geometry: nothing else draws there) adds the
 //   ground's Lambertian reflection seen through the air: T(C->X) (the segment's, below) (groundAlbedo / pi)
 //   (T_sun(X) max(0, n . l) + E_sky(n . l)), n the ground's normal at X (no shadows; nothing with
@@ -59,6 +65,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -99,6 +106,37 @@ void validateRayOptions(const AtmosphereRayOptions& o) {
   if (o.skySteps < 1 || o.skySteps > 1 << 20)
     throw InvalidArgument("AtmosphereRayOptions.skySteps", detail::formatValue(o.skySteps),
                           "must be in [1, 2^20]");
+  if (o.single != AtmosphereSingleScattering::ViewTables && o.single != AtmosphereSingleScattering::Table4D)
+    throw InvalidArgument("AtmosphereRayOptions.single", detail::formatValue(static_cast<int>(o.single)),
+                          "must be one of AtmosphereSingleScattering");
+  const char* axes[] = {"AtmosphereRayOptions.volumeSize.x", "AtmosphereRayOptions.volumeSize.y",
+                        "AtmosphereRayOptions.volumeSize.z"};
+  for (int i = 0; i < 3; ++i)
+    if (o.volumeSize[i] < 2 || o.volumeSize[i] > 1024)
+      throw InvalidArgument(axes[i], detail::formatValue(o.volumeSize[i]), "must be in [2, 1024]");
+  if (o.volumeSteps < 1 || o.volumeSteps > 64)
+    throw InvalidArgument("AtmosphereRayOptions.volumeSteps", detail::formatValue(o.volumeSteps),
+                          "must be in [1, 64]");
+  if (o.skyViewSize.x < 2 || o.skyViewSize.x > 4096)
+    throw InvalidArgument("AtmosphereRayOptions.skyViewSize.x", detail::formatValue(o.skyViewSize.x),
+                          "must be in [2, 4096]");
+  if (o.skyViewSize.y < 4 || o.skyViewSize.y > 4096 || o.skyViewSize.y % 2 != 0)
+    throw InvalidArgument("AtmosphereRayOptions.skyViewSize.y", detail::formatValue(o.skyViewSize.y),
+                          "must be even and in [4, 4096]");
+  if (o.skyViewSteps < 1 || o.skyViewSteps > 4096)
+    throw InvalidArgument("AtmosphereRayOptions.skyViewSteps", detail::formatValue(o.skyViewSteps),
+                          "must be in [1, 4096]");
+}
+
+/// (d_R, d_M) at P (metres around the planet centre): exp(-h / H) with h = max(0, |P| - R).
+glm::dvec2 densityAt(const AtmosphereParameters& p, const glm::dvec3& P) {
+  const double h = std::max(0.0, glm::length(P) - p.earthRadius);
+  return {std::exp(-h / p.rayleighScaleHeight), std::exp(-h / p.mieScaleHeight)};
+}
+
+/// exp(-beta_e . D) of density integrals D.
+glm::dvec3 extinguishedBy(const AtmosphereParameters& p, const glm::dvec2& d) {
+  return glm::exp(-(p.rayleighScattering * d.x + (p.mieScattering + p.mieAbsorption) * d.y));
 }
 
 /// Trapezoid steps of the transmittance of a segment (RayEvaluator::segmentTransmittance; GLSL twin in
@@ -194,11 +232,7 @@ public:
   }
 
 private:
-  /// (d_R, d_M) at P: exp(-h / H) with h = max(0, |P| - R).
-  glm::dvec2 density(const glm::dvec3& P) const {
-    const double h = std::max(0.0, glm::length(P) - p_.earthRadius);
-    return {std::exp(-h / p_.rayleighScaleHeight), std::exp(-h / p_.mieScaleHeight)};
-  }
+  glm::dvec2 density(const glm::dvec3& P) const { return densityAt(p_, P); }
   /// (beta_R d_R p_R + beta_M d_M p_HG) T_sun(P), without T(C->P).
   glm::dvec3 integrand(const glm::dvec3& P, const glm::dvec2& d) const {
     return (p_.rayleighScattering * (d.x * phaseR_) + p_.mieScattering * (d.y * phaseM_)) *
@@ -210,10 +244,7 @@ private:
   glm::dvec2 segmentDensity(double t) const {
     return t > 0.0 ? densityIntegral(p_, C_, at(t), kSegmentSteps) : glm::dvec2(0.0);
   }
-  /// exp(-beta_e . D) of density integrals D.
-  glm::dvec3 extinguished(const glm::dvec2& d) const {
-    return glm::exp(-(p_.rayleighScattering * d.x + (p_.mieScattering + p_.mieAbsorption) * d.y));
-  }
+  glm::dvec3 extinguished(const glm::dvec2& d) const { return extinguishedBy(p_, d); }
 
   /// The table coordinates of C + v t; the first look-up of the ray is at C (made first when the first
   /// call is elsewhere) and chooses the side of the horizon that every later one keeps (Listing 2).
@@ -246,7 +277,8 @@ double luminance(const glm::dvec3& c) {
 AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlacement& placement,
                             const DirectionalLight& sun, const glm::dvec3& origin,
                             const glm::dvec3& direction, double surface, bool sky,
-                            const AtmosphereShadowing& shadowing, const AtmosphereRayOptions& options) {
+                            const AtmosphereShadowing& shadowing, const AtmosphereRayOptions& options,
+                            const AtmosphereViewTables* view) {
   validate(placement, tables.parameters);
   validateRayOptions(options);
   requireFiniteVector("origin", origin);
@@ -283,10 +315,14 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
   const double sEnd = sky ? std::min(sm, tX) : std::min(sm, tTop); // s_F or s_E
 
   RayEvaluator ray(tables, C, v, l);
-  // The table-based part of the radiance (all but (a)'s integrated single scattering) of the ray of `r`.
+  // The view tables: None, (b), (c) with a camera in the atmosphere.
+  const bool fromView = view && options.shafts != AtmosphereShafts::Integrated && enter == 0.0;
+  // The table-based part of the radiance (all but (a)'s integrated single scattering and the view tables'
+  // part) of the ray of `r`.
   const auto tablePart = [&](RayEvaluator& r) {
     const auto multiple = [&](double t) { return r.multiple(t); };
     const auto higher = [&](double t) { return r.lookUp(tables.higherOrders, t); };
+    if (fromView) return sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd); // L_H only
     if (options.shafts == AtmosphereShafts::None) return sky ? r.multiple(0.0) : r.eq8(multiple, sEnd);
     // Unoccluded higher orders (MS-UnO).
     glm::dvec3 part = sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd);
@@ -326,6 +362,26 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
     } else {
       radiance = tablePart(ray);
     }
+  }
+  if (fromView) { // L1: the volume in front of the far plane, the sky-view table's whole ray beyond it
+    const double cosSunView = glm::dot(v, l);
+    const auto L1 = [&](double t) {
+      return t > 0.0 ? sampleAerialPerspective(*view, p, v, t / mpu, cosSunView) : glm::dvec3(0.0);
+    };
+    const glm::dvec3 toEnd = L1(sEnd);
+    if (options.shafts == AtmosphereShafts::None) {
+      radiance += toEnd;
+    } else if (options.shafts == AtmosphereShafts::LitLengthTable) {
+      const double litLength = std::max(0.0, shadowing.litLength) * mpu;
+      if (litLength > 0.0) {
+        const double a = std::clamp(shadowing.firstLit * mpu, 0.0, sEnd);
+        const double b = std::clamp(shadowing.firstLit * mpu + litLength, a, sEnd);
+        radiance += glm::max(L1(b) - L1(a), glm::dvec3(0.0));
+      }
+    } else {
+      radiance += shadowing.visibility * toEnd;
+    }
+    if (sky) radiance += glm::max(sampleSkyView(*view, p, v, cosSunView) - toEnd, glm::dvec3(0.0));
   }
   if (options.shafts == AtmosphereShafts::Integrated) {
     // SS-Int: the lit sections, then (sky) the unshadowed rest to the end of the ray.
@@ -380,6 +436,219 @@ double prefilteredVisibility(const glm::dvec3& shadowed, const DirectionalLight&
   return std::clamp(visibility, 0.0, 1.0);
 }
 
+namespace {
+
+/// The trapezoid rule of the phase-free integrands (beta_R d_R, beta_M d_M) T(C->P) T_sun(P) along C + v t,
+/// T(C->P) from the densities marched from C: add(t) moves to t, adding to `rayleigh` and `mie` (the
+/// aerial perspective volume's slices and the sky-view table's rays; GLSL twin ViewMarch in
+/// passes/atmosphere.comp).
+class ViewMarch {
+public:
+  ViewMarch(const AtmosphereTables& tables, const glm::dvec3& C, const glm::dvec3& v, const glm::dvec3& l)
+      : tables_(tables), p_(tables.parameters), C_(C), v_(v), l_(l) {
+    d_ = densityAt(p_, C);
+    integrand(C, d_, fR_, fM_);
+  }
+  /// One trapezoid step to t: rayleigh += (wPrevious f(t_prev) + w f(t)) / 2, the weights dt (uniform
+  /// steps) or du dt/du at each end (a substitution t(u)); the optical depth takes the step's dt.
+  void step(double t, double wPrevious, double w) {
+    const glm::dvec3 P = C_ + v_ * t;
+    const glm::dvec2 d = densityAt(p_, P);
+    optical_ += 0.5 * (d_ + d) * (t - t_);
+    glm::dvec3 gR, gM;
+    integrand(P, d, gR, gM);
+    rayleigh += 0.5 * (wPrevious * fR_ + w * gR);
+    mie += 0.5 * (wPrevious * fM_ + w * gM);
+    t_ = t;
+    d_ = d;
+    fR_ = gR;
+    fM_ = gM;
+  }
+  glm::dvec3 rayleigh{0.0}, mie{0.0};
+
+private:
+  void integrand(const glm::dvec3& P, const glm::dvec2& d, glm::dvec3& fR, glm::dvec3& fM) const {
+    const glm::dvec3 w = extinguishedBy(p_, optical_) * sunTransmittance(tables_, P, l_);
+    fR = p_.rayleighScattering * d.x * w;
+    fM = p_.mieScattering * d.y * w;
+  }
+  const AtmosphereTables& tables_;
+  const AtmosphereParameters& p_;
+  glm::dvec3 C_, v_, l_;
+  glm::dvec2 d_{0.0}, optical_{0.0};
+  glm::dvec3 fR_{0.0}, fM_{0.0};
+  double t_ = 0.0;
+};
+
+/// The direction of sky-view texel (i, j) (atmosphere.h's rule); its elevation in `elevation`.
+glm::dvec3 skyViewDirection(const AtmosphereViewTables& view, int i, int j, double* elevation) {
+  const int W = view.skyViewSize.x, half = view.skyViewSize.y / 2;
+  const double eh = view.horizonElevation, pi = std::numbers::pi;
+  const double phi = pi * i / (W - 1);
+  const bool above = j >= half;
+  const double s = static_cast<double>(above ? j - half : j) / (half - 1);
+  const double e = above ? eh + s * s * (0.5 * pi - eh) : eh - s * s * (eh + 0.5 * pi);
+  *elevation = e;
+  const glm::dvec3 side = glm::cross(view.zenith, view.sunAzimuth);
+  return std::cos(e) * (std::cos(phi) * view.sunAzimuth + std::sin(phi) * side) + std::sin(e) * view.zenith;
+}
+
+} // namespace
+
+// Hillaire 2020, Sec. 5.2-5.3: the sky-view table and the aerial perspective volume (atmosphere.h's rule).
+AtmosphereViewTables atmosphereViewTables(const AtmosphereTables& tables,
+                                          const AtmospherePlacement& placement, const Camera& camera,
+                                          const DirectionalLight& sun, const AtmosphereRayOptions& options,
+                                          int threads) {
+  validate(placement, tables.parameters);
+  validateRayOptions(options);
+  if (threads < 0) throw InvalidArgument("threads", detail::formatValue(threads), "must be >= 0");
+  const AtmosphereParameters& p = tables.parameters;
+  AtmosphereViewTables view;
+  view.volumeSize = options.volumeSize;
+  view.skyViewSize = options.skyViewSize;
+  view.origin = camera.position();
+  view.forward = camera.forward();
+  view.right = camera.right();
+  view.up = camera.up();
+  view.tangents = camera.tangents();
+  view.far = camera.far();
+  const glm::dvec3 C = atmospherePosition(placement, p, camera.position()), l = -sun.direction();
+  const double mpu = placement.metersPerUnit, R = p.earthRadius;
+  view.zenith = glm::normalize(C);
+  const glm::dvec3 across = l - glm::dot(l, view.zenith) * view.zenith;
+  view.sunAzimuth = glm::length(across) > 1e-9
+                        ? glm::normalize(across)
+                        : glm::normalize(glm::cross(view.zenith, std::abs(view.zenith.x) < 0.9
+                                                                     ? glm::dvec3(1.0, 0.0, 0.0)
+                                                                     : glm::dvec3(0.0, 0.0, 1.0)));
+  const double hC = std::max(0.0, glm::length(C) - R);
+  view.horizonElevation = std::asin(std::clamp(cosHorizon(p, hC), -1.0, 1.0));
+
+  // The aerial perspective volume: one column per froxel, slice k at view depth far (k / (D - 1))^2.
+  const int W = view.volumeSize.x, H = view.volumeSize.y, D = view.volumeSize.z, steps = options.volumeSteps;
+  const std::size_t count = static_cast<std::size_t>(W) * static_cast<std::size_t>(H) * D;
+  view.volumeRayleigh.assign(count, glm::vec3(0.0f));
+  view.volumeMie.assign(count, glm::vec3(0.0f));
+  parallelRows(H, threads, [&](int j) {
+    for (int i = 0; i < W; ++i) {
+      const glm::dvec3 v = camera.rayDirection(2.0 * (i + 0.5) / W - 1.0, 2.0 * (j + 0.5) / H - 1.0);
+      const double end = view.far / glm::dot(v, view.forward) * mpu; // metres to the far plane
+      ViewMarch march(tables, C, v, l);
+      double t = 0.0;
+      for (int k = 1; k < D; ++k) {
+        const double u = static_cast<double>(k) / (D - 1);
+        const double tb = end * u * u, dt = (tb - t) / steps;
+        for (int s = 1; s <= steps; ++s)
+          march.step(t + dt * s, dt, dt);
+        t = tb;
+        const std::size_t index = (static_cast<std::size_t>(k) * H + j) * W + i;
+        view.volumeRayleigh[index] = glm::vec3(march.rayleigh);
+        view.volumeMie[index] = glm::vec3(march.mie);
+      }
+    }
+  });
+
+  // The sky-view table: each texel's whole ray, t = t_end u^3; a ray of the lower half ends on the ground
+  // (the tangent point at the horizon row), of the upper half at the top, decided by the half.
+  const int SW = view.skyViewSize.x, SH = view.skyViewSize.y, n = options.skyViewSteps;
+  view.skyRayleigh.assign(static_cast<std::size_t>(SW) * SH, glm::vec3(0.0f));
+  view.skyMie.assign(static_cast<std::size_t>(SW) * SH, glm::vec3(0.0f));
+  const double rr = hC * (2.0 * R + hC), top = R + p.atmosphereHeight, rc = glm::length(C);
+  parallelRows(SH, threads, [&](int j) {
+    for (int i = 0; i < SW; ++i) {
+      double e = 0.0;
+      const glm::dvec3 v = skyViewDirection(view, i, j, &e);
+      const double b = glm::dot(C, v);
+      double end = 0.0;
+      if (j < SH / 2) { // b^2 - c = (R - r cos e)(R + r cos e), R - r cos e = r (cos e_h - cos e)
+        const double eh = view.horizonElevation;
+        const double disc = std::max(0.0, -2.0 * rc * std::sin(0.5 * (eh + e)) * std::sin(0.5 * (eh - e)) *
+                                              (R + rc * std::cos(e)));
+        end = rr / (std::sqrt(disc) - b);
+      } else {
+        end = -b + std::sqrt(std::max(0.0, b * b - (rc - top) * (rc + top)));
+      }
+      ViewMarch march(tables, C, v, l);
+      const double du = 1.0 / n;
+      const auto weight = [&](double u) { return du * 3.0 * end * u * u; }; // du dt/du
+      for (int k = 1; k <= n; ++k) {                                        // trapezoid in u
+        const double u = static_cast<double>(k) / n;
+        march.step(end * u * u * u, weight(u - du), weight(u));
+      }
+      const std::size_t index = static_cast<std::size_t>(j) * SW + i;
+      view.skyRayleigh[index] = glm::vec3(march.rayleigh);
+      view.skyMie[index] = glm::vec3(march.mie);
+    }
+  });
+  return view;
+}
+
+// The volume's trilinear look-up at a ray's screen position and depth (GL rules; atmosphere.h).
+glm::dvec3 sampleAerialPerspective(const AtmosphereViewTables& view, const AtmosphereParameters& p,
+                                   const glm::dvec3& direction, double distance, double cosSunView) {
+  const glm::dvec4& tg = view.tangents;
+  const double f = glm::dot(direction, view.forward);
+  if (!(f > 0.0) || view.volumeRayleigh.empty()) return glm::dvec3(0.0);
+  const double a = glm::dot(direction, view.right) / f, b = glm::dot(direction, view.up) / f;
+  const double ndcX = (a - 0.5 * (tg.x + tg.y)) / (0.5 * (tg.y - tg.x));
+  const double ndcY = (b - 0.5 * (tg.z + tg.w)) / (0.5 * (tg.w - tg.z));
+  const int W = view.volumeSize.x, H = view.volumeSize.y, D = view.volumeSize.z;
+  // Texel-space coordinates (texel i's centre at i); the depth slice at sqrt(z / far) (D - 1).
+  const double x = std::clamp(0.5 * (ndcX + 1.0) * W - 0.5, 0.0, W - 1.0);
+  const double y = std::clamp(0.5 * (ndcY + 1.0) * H - 0.5, 0.0, H - 1.0);
+  const double z = std::sqrt(std::clamp(distance * f / view.far, 0.0, 1.0)) * (D - 1);
+  const int x0 = std::min(static_cast<int>(x), W - 2), y0 = std::min(static_cast<int>(y), H - 2),
+            z0 = std::min(static_cast<int>(z), D - 2);
+  const double fx = x - x0, fy = y - y0, fz = z - z0;
+  glm::dvec3 rayleigh(0.0), mie(0.0);
+  for (int c = 0; c < 8; ++c) {
+    const int dx = c & 1, dy = (c >> 1) & 1, dz = c >> 2;
+    const double weight = (dx ? fx : 1.0 - fx) * (dy ? fy : 1.0 - fy) * (dz ? fz : 1.0 - fz);
+    const std::size_t index = (static_cast<std::size_t>(z0 + dz) * H + (y0 + dy)) * W + (x0 + dx);
+    rayleigh += weight * glm::dvec3(view.volumeRayleigh[index]);
+    mie += weight * glm::dvec3(view.volumeMie[index]);
+  }
+  return rayleigh * rayleighPhase(cosSunView) + mie * henyeyGreenstein(p.mieG, cosSunView);
+}
+
+// The sky-view table's bilinear look-up within the direction's half (atmosphere.h's rule).
+glm::dvec3 sampleSkyView(const AtmosphereViewTables& view, const AtmosphereParameters& p,
+                         const glm::dvec3& direction, double cosSunView) {
+  if (view.skyRayleigh.empty()) return glm::dvec3(0.0);
+  const int W = view.skyViewSize.x, H = view.skyViewSize.y, half = H / 2;
+  const double pi = std::numbers::pi, eh = view.horizonElevation;
+  // atan2 for both angles (the GLSL twin's float needs it; atmosphere.comp).
+  const glm::dvec3 v = glm::normalize(direction);
+  const double cz = glm::dot(v, view.zenith);
+  const glm::dvec3 level = v - cz * view.zenith;
+  const double e = std::atan2(cz, glm::length(level));
+  const double across = glm::dot(level, glm::cross(view.zenith, view.sunAzimuth)),
+               along = glm::dot(level, view.sunAzimuth);
+  const double phi = across != 0.0 || along != 0.0 ? std::abs(std::atan2(across, along)) : 0.0;
+  const double x = std::clamp(phi / pi, 0.0, 1.0) * (W - 1);
+  double y = 0.0;
+  int y0 = 0;
+  if (e >= eh) {
+    y = half + std::sqrt(std::clamp((e - eh) / (0.5 * pi - eh), 0.0, 1.0)) * (half - 1);
+    y0 = std::min(static_cast<int>(y), H - 2);
+  } else {
+    y = std::sqrt(std::clamp((eh - e) / (eh + 0.5 * pi), 0.0, 1.0)) * (half - 1);
+    y0 = std::min(static_cast<int>(y), half - 2);
+  }
+  const int x0 = std::min(static_cast<int>(x), W - 2);
+  const double fx = x - x0, fy = y - y0;
+  glm::dvec3 rayleigh(0.0), mie(0.0);
+  for (int c = 0; c < 4; ++c) {
+    const int dx = c & 1, dy = c >> 1;
+    const double weight = (dx ? fx : 1.0 - fx) * (dy ? fy : 1.0 - fy);
+    const std::size_t index = static_cast<std::size_t>(y0 + dy) * W + (x0 + dx);
+    rayleigh += weight * glm::dvec3(view.skyRayleigh[index]);
+    mie += weight * glm::dvec3(view.skyMie[index]);
+  }
+  return rayleigh * rayleighPhase(cosSunView) + mie * henyeyGreenstein(p.mieG, cosSunView);
+}
+
 // atmosphereRay per pixel (rays of crep/scatter/ray.h), rows in parallel.
 AtmosphereImage atmosphereImage(const AtmosphereTables& tables, const AtmospherePlacement& placement,
                                 const Camera& camera, const DirectionalLight& sun, const Image& cameraDepth,
@@ -402,14 +671,19 @@ AtmosphereImage atmosphereImage(const AtmosphereTables& tables, const Atmosphere
   AtmosphereImage out{Image(w, h, 4), Image(w, h, 3)};
   const AtmosphereShadowing unshadowed;
   const glm::dvec3 origin = camera.position();
+  std::optional<AtmosphereViewTables> view;
+  if (options.single == AtmosphereSingleScattering::ViewTables &&
+      options.shafts != AtmosphereShafts::Integrated)
+    view = atmosphereViewTables(tables, placement, camera, sun, options, threads);
   parallelRows(h, threads, [&](int y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t index =
           static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
       const PixelRay pr = pixelRay(camera, cameraDepth, x, y);
       const bool sky = cameraDepth.at(x, y) >= 1.0f;
-      const AtmosphereRay r = atmosphereRay(tables, placement, sun, origin, pr.direction, pr.surface, sky,
-                                            shadowing.empty() ? unshadowed : shadowing[index], options);
+      const AtmosphereRay r =
+          atmosphereRay(tables, placement, sun, origin, pr.direction, pr.surface, sky,
+                        shadowing.empty() ? unshadowed : shadowing[index], options, view ? &*view : nullptr);
       for (int c = 0; c < 3; ++c) {
         out.inscattering.at(x, y, c) = static_cast<float>(r.inscattering[c]);
         out.transmittance.at(x, y, c) = static_cast<float>(r.transmittance[c]);

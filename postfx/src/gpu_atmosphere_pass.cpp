@@ -19,16 +19,33 @@ namespace {
 
 /// Texture units, uniform and storage bindings of passes/atmosphere.comp (its header comment).
 constexpr GLuint kUnitCameraDepth = 0, kUnitRectifiedDepth = 1, kUnitOpticalDepth = 2, kUnitSingle = 3,
-                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6, kUnitAmbient = 7;
-constexpr int kUnits = 8; ///< units and bindings unbound afterwards (gl::unbindPassState)
+                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6, kUnitAmbient = 7,
+                 kUnitVolumeRayleigh = 8, kUnitVolumeMie = 9, kUnitSkyRayleigh = 10, kUnitSkyMie = 11;
+constexpr int kUnits = 12; ///< units and bindings unbound afterwards (gl::unbindPassState)
 
 bool walksTrees(AtmosphereShafts shafts) {
   return shafts == AtmosphereShafts::Integrated || shafts == AtmosphereShafts::LitLengthTable;
 }
 
-void checkSteps(const char* parameter, int steps) {
-  if (steps < 1 || steps > 4096)
-    throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, 4096]");
+void checkSteps(const char* parameter, int steps, int most = 4096) {
+  if (steps < 1 || steps > most)
+    throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, " + std::to_string(most) + "]");
+}
+
+/// A GL_TEXTURE_3D (the aerial perspective volume) or GL_TEXTURE_2D (the sky-view table, size.z 0) RGBA32F:
+/// linear filtering, clamp to edge.
+gl::Handle createViewTable(const glm::ivec3& size) {
+  gl::Handle t = gl::createTexture(size.z > 0 ? GL_TEXTURE_3D : GL_TEXTURE_2D);
+  if (size.z > 0)
+    glTextureStorage3D(t.get(), 1, GL_RGBA32F, size.x, size.y, size.z);
+  else
+    glTextureStorage2D(t.get(), 1, GL_RGBA32F, size.x, size.y);
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  return t;
 }
 
 } // namespace
@@ -47,13 +64,47 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
       throw GlError("crep: AtmospherePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
                     " needs more than 16 tree levels");
   }
+  const AtmosphereSingleScattering single = info.options.single;
+  if (single != AtmosphereSingleScattering::ViewTables && single != AtmosphereSingleScattering::Table4D)
+    throw InvalidArgument("AtmospherePass::CreateInfo.options.single",
+                          std::to_string(static_cast<int>(single)),
+                          "must be one of AtmosphereSingleScattering");
+  view_ = single == AtmosphereSingleScattering::ViewTables && info.shafts != AtmosphereShafts::Integrated;
+  if (view_) {
+    const AtmosphereRayOptions& o = info.options;
+    checkSteps("AtmospherePass::CreateInfo.options.volumeSteps", o.volumeSteps, 64);
+    checkSteps("AtmospherePass::CreateInfo.options.skyViewSteps", o.skyViewSteps);
+    const char* axes[] = {"AtmospherePass::CreateInfo.options.volumeSize.x",
+                          "AtmospherePass::CreateInfo.options.volumeSize.y",
+                          "AtmospherePass::CreateInfo.options.volumeSize.z"};
+    for (int i = 0; i < 3; ++i) {
+      const int n = o.volumeSize[i];
+      if (n < 2 || n > 1024) throw InvalidArgument(axes[i], std::to_string(n), "must be in [2, 1024]");
+    }
+    if (o.skyViewSize.x < 2 || o.skyViewSize.x > 4096)
+      throw InvalidArgument("AtmospherePass::CreateInfo.options.skyViewSize.x",
+                            std::to_string(o.skyViewSize.x), "must be in [2, 4096]");
+    if (o.skyViewSize.y < 4 || o.skyViewSize.y > 4096 || o.skyViewSize.y % 2 != 0)
+      throw InvalidArgument("AtmospherePass::CreateInfo.options.skyViewSize.y",
+                            std::to_string(o.skyViewSize.y), "must be even and in [4, 4096]");
+    gl::checkTextureSize("AtmospherePass::CreateInfo.options.skyViewSize", o.skyViewSize.x, o.skyViewSize.y);
+    volumeRayleigh_ = createViewTable(o.volumeSize);
+    volumeMie_ = createViewTable(o.volumeSize);
+    skyRayleigh_ = createViewTable(glm::ivec3(o.skyViewSize, 0));
+    skyMie_ = createViewTable(glm::ivec3(o.skyViewSize, 0));
+    volumeProgram_ = buildProgram(
+        {{ShaderStage::Compute, "passes/atmosphere.comp", {{"CREP_ATMOSPHERE_VOLUME_PASS", "1"}}}});
+    skyViewProgram_ = buildProgram(
+        {{ShaderStage::Compute, "passes/atmosphere.comp", {{"CREP_ATMOSPHERE_VOLUME_PASS", "2"}}}});
+  }
   marchParams_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   atmosphereParams_ = gl::createDynamicBuffer(sizeof(gpu::AtmosphereParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);
   if (!walksTrees(info.shafts)) // the one program of None and (c): compile errors surface here
     programs_[0][0] = buildProgram({{ShaderStage::Compute,
                                      "passes/atmosphere.comp",
-                                     {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(mode)}}}});
+                                     {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(mode)},
+                                      {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
   gl::checkError("AtmospherePass");
 }
 
@@ -112,7 +163,8 @@ void AtmospherePass::run(const FrameAttribs& f) {
                              "passes/atmosphere.comp",
                              {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(shafts))},
                               {"CREP_LAYOUT", std::to_string(static_cast<int>(layoutData.kind))},
-                              {"CREP_ATMOSPHERE_COMBINED_MIE", combined ? "1" : "0"}}}});
+                              {"CREP_ATMOSPHERE_COMBINED_MIE", combined ? "1" : "0"},
+                              {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
 
   // The march block carries the camera and the sun (and (c)'s proxy medium: the closed form of
   // prefilteredVisibility); a placeholder medium otherwise (its members are not read).
@@ -122,10 +174,30 @@ void AtmospherePass::run(const FrameAttribs& f) {
                            walk ? W : 0, walk ? H : 0);
   params.info = glm::ivec4(walk ? MinMaxTrees::levelCount(W) : 0, walk ? MinMaxTrees::rowStrideFor(W) : 0,
                            info_.options.integrationSteps, info_.options.skySteps);
+  const glm::ivec3 vs = info_.options.volumeSize;
+  const glm::ivec2 ss = info_.options.skyViewSize;
+  if (view_) {
+    params.region = glm::ivec4(vs, info_.options.volumeSteps);
+    params.block = glm::vec4(glm::vec2(ss), static_cast<float>(info_.options.skyViewSteps), 0.0f);
+  }
   glNamedBufferSubData(marchParams_.get(), 0, sizeof(params), &params);
   const gpu::AtmosphereParams atmosphere =
       gpu::atmosphereParams(tables.parameters, tables.options, *f.placement);
   glNamedBufferSubData(atmosphereParams_.get(), 0, sizeof(atmosphere), &atmosphere);
+  if (view_) { // Hillaire 2020, Sec. 5.2-5.3: the camera's view tables, one ray per invocation
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
+    glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
+    glUseProgram(volumeProgram_.get());
+    glBindImageTexture(0, volumeRayleigh_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>((vs.x + 7) / 8), static_cast<GLuint>((vs.y + 7) / 8), 1);
+    glUseProgram(skyViewProgram_.get());
+    glBindImageTexture(0, skyRayleigh_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>((ss.x + 7) / 8), static_cast<GLuint>((ss.y + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+  }
 
   const GLuint transmittance =
       f.transmittanceOutput != 0
@@ -153,6 +225,12 @@ void AtmospherePass::run(const FrameAttribs& f) {
   if (prefilteredMode) {
     glBindTextureUnit(kUnitPrefiltered, f.prefiltered);
     glBindSampler(kUnitPrefiltered, nearest_.get());
+  }
+  if (view_) { // the view tables keep their own sampling state (linear, clamp to edge)
+    glBindTextureUnit(kUnitVolumeRayleigh, volumeRayleigh_.get());
+    glBindTextureUnit(kUnitVolumeMie, volumeMie_.get());
+    glBindTextureUnit(kUnitSkyRayleigh, skyRayleigh_.get());
+    glBindTextureUnit(kUnitSkyMie, skyMie_.get());
   }
   glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(1, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);

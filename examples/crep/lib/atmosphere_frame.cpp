@@ -23,7 +23,7 @@ const std::set<std::string> kAtmosphereOptions = {
     "sun-elevation",     "sun-azimuth",     "camera-elevation",    "shafts",
     "meters-per-unit",   "origin-altitude", "atmosphere-table",    "orders",
     "atmosphere-cache",  "sun-irradiance",  "multiple-scattering", "ground-albedo",
-    "integration-steps", "sky-steps"};
+    "integration-steps", "sky-steps",       "single-scattering"};
 
 const char* const kAtmosphereOptionsHelp =
     R"(          atmosphere (--method atmosphere; Bruneton and Neyret 2008 tables, Yusov 2013):
@@ -44,6 +44,9 @@ const char* const kAtmosphereOptionsHelp =
             --orders N           orders: scattering orders 1..N (default 4); 1: single scattering only
             --ground-albedo A    the ground's albedo in lut's multiple scattering, in [0, 1]
                                  (default 0.1)
+            --single-scattering S  none, lut, prefiltered: view-tables (default; Hillaire 2020's
+                                 per-frame aerial perspective volume and sky-view table) | table (Eq. 8
+                                 on the 4D table, the reference of earlier versions)
             --integration-steps N  (a): trapezoid steps over the scene's part of a ray, in [1, 4096]
                                  (default 64)
             --sky-steps N        (a): steps of a sky ray beyond the far plane, in [1, 4096] (default 16)
@@ -144,6 +147,13 @@ AtmosphereSettings atmosphereSettings(const Args& args) {
     throw UsageError("option --multiple-scattering: '" + multiple + "' is not lut or orders");
   s.parameters.groundAlbedo = args.number("ground-albedo", s.parameters.groundAlbedo, 0.0, 1.0);
   s.sunIrradiance = args.number("sun-irradiance", s.sunIrradiance, 1e-6, 1e6);
+  const std::string single = args.string("single-scattering", "view-tables");
+  if (single == "view-tables")
+    s.ray.single = AtmosphereSingleScattering::ViewTables;
+  else if (single == "table")
+    s.ray.single = AtmosphereSingleScattering::Table4D;
+  else
+    throw UsageError("option --single-scattering: '" + single + "' is not view-tables or table");
   s.ray.integrationSteps = args.integer("integration-steps", s.ray.integrationSteps, 1, 4096);
   s.ray.skySteps = args.integer("sky-steps", s.ray.skySteps, 1, 4096);
   try {

@@ -333,19 +333,82 @@ struct AtmosphereShadowing {
   double visibility = 1.0;             ///< (c): the visible fraction
 };
 
+/// Where None, (b) and (c) take single scattering from.
+enum class AtmosphereSingleScattering {
+  /// Hillaire 2020, Sec. 5.2-5.3 (default): the camera's AtmosphereViewTables, integrated from the camera
+  /// once per frame: the aerial perspective volume in front of the far plane, the sky-view table beyond it.
+  ViewTables,
+  /// Yusov 2013, Eq. 8 on the 4D table: L1(C) - T(C->P) L1(P); 8-16% off on short segments, where the two
+  /// look-ups are large and nearly equal, and several percent in the horizon's blend band.
+  Table4D,
+};
+
 struct AtmosphereRayOptions {
   AtmosphereShafts shafts = AtmosphereShafts::None;
   int integrationSteps = 64; ///< (a): trapezoid steps over [0, surface] (lit sections get their share)
   int skySteps = 16; ///< (a): steps beyond the far plane to the end of a sky ray (t = s_F + (t_X - s_F) u^3)
+  /// None, (b), (c); (a) integrates its own. atmosphereRay takes the view tables as an argument.
+  AtmosphereSingleScattering single = AtmosphereSingleScattering::ViewTables;
+  glm::ivec3 volumeSize{64, 64, 32}; ///< ViewTables: volume froxels across, up, depth slices; [2, 1024]
+  int volumeSteps = 4;               ///< ViewTables: trapezoid steps per depth slice, in [1, 64]
+  glm::ivec2 skyViewSize{192, 108};  ///< ViewTables: sky-view azimuths, elevations (even); [2, 4096]
+  int skyViewSteps = 32;             ///< ViewTables: steps of a sky-view ray, in [1, 4096]
 };
+
+/// The per-frame tables of one camera (Hillaire 2020, Sec. 5.2-5.3), without phase functions. Both hold
+/// integrals from the camera C along a ray of beta_R d_R T(C->P) T_sun(P) (`...Rayleigh`) and
+/// beta_M d_M T(C->P) T_sun(P) (`...Mie`), per unit sun irradiance, RGB: (a)'s integrand without its phase
+/// functions, T(C->P) from the densities marched from C. L1 of a ray is p_R(c) Rayleigh + p_HG(c) Mie read
+/// there, c = v . l of the ray itself.
+/// - The aerial perspective volume: froxel (i, j, k) of W x H x D (volumeSize) is the ray of
+///   screenRay(camera, W, H, i + 0.5, j + 0.5, .) to view depth z_k = far (k / (D - 1))^2 (far =
+///   camera.far()), volumeSteps trapezoid steps per slice; index (k H + j) W + i. Read by
+///   sampleAerialPerspective.
+/// - The sky-view table: texel (i, j) of W x H (skyViewSize) is the whole ray to the ground or the top of the
+///   atmosphere along the direction of azimuth phi_i = pi i / (W - 1) from the sun's vertical plane (the
+///   atmosphere is mirror-symmetric about it) and elevation e_j: rows [0, H/2) below the horizon's
+///   elevation e_h (row 0 at it, from below; H/2 - 1 straight down), rows [H/2, H) above (H/2 at it, from
+///   above; H - 1 the zenith), e = e_h -/+ s^2 (e_h + pi/2 or pi/2 - e_h), s = k / (H/2 - 1) within each
+///   half (texels crowd at the horizon, and a look-up never mixes the two sides); skyViewSteps trapezoid
+///   steps in u of t = t_end u^3 (as (a)'s sky). Index j W + i. Read by sampleSkyView.
+/// Not used when the camera is above the atmosphere (Table4D then).
+struct AtmosphereViewTables {
+  glm::ivec3 volumeSize{0};
+  glm::ivec2 skyViewSize{0};
+  glm::dvec3 origin{0.0};                       ///< the camera's world position
+  glm::dvec3 forward{0.0}, right{0.0}, up{0.0}; ///< the camera's unit axes
+  glm::dvec4 tangents{0.0};                     ///< Camera::tangents()
+  double far = 0.0;                             ///< world units: camera.far()
+  glm::dvec3 zenith{0.0}, sunAzimuth{0.0};      ///< unit: the camera's zenith, the sun's horizontal direction
+  double horizonElevation = 0.0;                ///< e_h, radians (<= 0)
+  std::vector<glm::vec3> volumeRayleigh, volumeMie, skyRayleigh, skyMie;
+};
+/// Computes both tables of `camera` (validates placement and the ViewTables fields of `options`; rows in
+/// parallel on `threads` workers, 0 = hardware concurrency).
+AtmosphereViewTables atmosphereViewTables(const AtmosphereTables& tables,
+                                          const AtmospherePlacement& placement, const Camera& camera,
+                                          const DirectionalLight& sun, const AtmosphereRayOptions& options,
+                                          int threads = 0);
+/// L1 per unit sun irradiance of the camera ray along unit world `direction` to world distance `distance`:
+/// the volume trilinear (GL rules: texel centres, clamp to edge) at the direction's screen position and
+/// sqrt(z / far) (D - 1) of its depth z = distance (direction . forward), phases of `cosSunView`.
+glm::dvec3 sampleAerialPerspective(const AtmosphereViewTables& view, const AtmosphereParameters& p,
+                                   const glm::dvec3& direction, double distance, double cosSunView);
+/// L1 per unit sun irradiance of the whole camera ray along unit world `direction`: the sky-view table
+/// bilinear (GL rules within the direction's half), phases of `cosSunView`.
+glm::dvec3 sampleSkyView(const AtmosphereViewTables& view, const AtmosphereParameters& p,
+                         const glm::dvec3& direction, double cosSunView);
 
 /// One view ray of a camera: from world point `origin` along unit world `direction` to world distance
 /// `surface` (the far plane for sky pixels: `sky` true, then the ray continues unshadowed to the ground or
 /// the top of the atmosphere and its transmittance is 0 where it hits the ground, else the sky's own).
+/// `view`: the AtmosphereViewTables of the camera at `origin` that None, (b) and (c) read (null: Table4D,
+/// whatever options.single says).
 AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlacement& placement,
                             const DirectionalLight& sun, const glm::dvec3& origin,
                             const glm::dvec3& direction, double surface, bool sky,
-                            const AtmosphereShadowing& shadowing, const AtmosphereRayOptions& options);
+                            const AtmosphereShadowing& shadowing, const AtmosphereRayOptions& options,
+                            const AtmosphereViewTables* view = nullptr);
 
 /// The shadowing of (b) from the lit sections of (a): D_lit = the sum of their lengths, D_start = the first
 /// section's start (0 and 0 without sections). Keeps the sections.
@@ -367,7 +430,8 @@ struct AtmosphereImage {
 
 /// atmosphereRay for every pixel of `camera` (pixel rays and sky test of crep/scatter/ray.h: depth-buffer
 /// value 1 is the sky) with `shadowing` per pixel in row-major order (width * height entries; may be empty
-/// for AtmosphereShafts::None). Rows in parallel on `threads` workers (0 = hardware concurrency).
+/// for AtmosphereShafts::None). Rows in parallel on `threads` workers (0 = hardware concurrency). With
+/// options.single ViewTables (and shafts other than (a)) the camera's AtmosphereViewTables first.
 AtmosphereImage atmosphereImage(const AtmosphereTables& tables, const AtmospherePlacement& placement,
                                 const Camera& camera, const DirectionalLight& sun, const Image& cameraDepth,
                                 const std::vector<AtmosphereShadowing>& shadowing,

@@ -9,7 +9,7 @@
 // The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
 // buffers and samplers (RAII); the textures and buffers of FrameAttribs are the caller's (non-owning GL
 // names). Depth textures hold depth-buffer values in [0, 1] (read with texelFetch through the pass's own
-// nearest sampler); a camera depth value >= 1 (or NaN) is the sky. It leaves program 0, texture units 0-6
+// nearest sampler); a camera depth value >= 1 (or NaN) is the sky. It leaves program 0, texture units 0-11
 // with no texture and no sampler, image units 0-1, uniform buffer bindings 0-2 and storage buffer bindings
 // 0-1 unbound (gl::unbindPassState) and issues gl::passOutputBarrier().
 #pragma once
@@ -36,6 +36,9 @@ public:
     AtmosphereShafts shafts = AtmosphereShafts::None;
     /// The steps of (a): integrationSteps and skySteps, each in [1, 4096] (InvalidArgument
     /// "AtmospherePass::CreateInfo.options.integrationSteps" / ".skySteps"); uniforms, not compiled in.
+    /// None, (b), (c): `single` (default ViewTables: crep::atmosphereViewTables computed on the GPU each
+    /// run, two volumeSize 3D and two skyViewSize 2D RGBA32F textures: 2.6 MiB at the defaults), volumeSize,
+    /// volumeSteps, skyViewSize, skyViewSteps (InvalidArgument naming the field).
     AtmosphereRayOptions options;
     /// (a), (b): the rectified map's size W x H in texels (> 0, <= GL_MAX_TEXTURE_SIZE, at most 16 tree
     /// levels); ignored (may be 0) for None and (c).
@@ -80,9 +83,18 @@ public:
   void run(const FrameAttribs& frame);
 
   const CreateInfo& info() const noexcept { return info_; }
+  /// The view tables of the last run, RGB crep::AtmosphereViewTables' volumeRayleigh / volumeMie
+  /// (GL_TEXTURE_3D RGBA32F) and skyRayleigh / skyMie (GL_TEXTURE_2D RGBA32F), A 0; 0 without them (shafts
+  /// (a), or options.single Table4D).
+  std::uint32_t volumeRayleighTexture() const noexcept { return volumeRayleigh_.get(); }
+  std::uint32_t volumeMieTexture() const noexcept { return volumeMie_.get(); }
+  std::uint32_t skyRayleighTexture() const noexcept { return skyRayleigh_.get(); }
+  std::uint32_t skyMieTexture() const noexcept { return skyMie_.get(); }
 
 private:
   CreateInfo info_;
+  bool view_ = false;
+  gl::Handle volumeProgram_, skyViewProgram_, volumeRayleigh_, volumeMie_, skyRayleigh_, skyMie_;
   gpu::LayoutBuffers layoutBuffers_;
   /// [combinedMie][layout kind] ((a), (b)); [.][0] for None and (c)
   gl::Handle programs_[2][2];
