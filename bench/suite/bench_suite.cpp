@@ -532,41 +532,56 @@ void epipolarSamplingBench(const BenchOptions& o) {
   }
 }
 
-/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per stage
-/// at the default size (16x64x32x8 with --quick), Hillaire 2020's multiple scattering table (the default)
-/// and the orders' reference side by side, then the per-frame cost of the sky,
-/// aerial perspective and shafts with each shaft method on the terrain at the run's size, side by side in
-/// one run (median of the per-frame sums of `repeat` runs after a warm-up; "setup" stages excluded).
+/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per stage,
+/// side by side in one run: the default (4 orders on the 32x32x32x8 table of the higher orders; 16x64x32x8
+/// with --quick), Hillaire 2020's multiple scattering table at the same size (the option) and the 4 orders
+/// on Yusov's 32x128x64x16 table (the reference; not with --quick); then the per-frame cost of the sky,
+/// aerial perspective and shafts with each shaft method on the terrain at the run's size (median of the
+/// per-frame sums of `repeat` runs after a warm-up; "setup" stages excluded), and None through Eq. 8 on the
+/// reference table for comparison.
 void atmosphereBench(const BenchOptions& o) {
   tool::AtmosphereSettings s;
   s.cacheDirectory.clear(); // always compute: the precomputation's cost is the point
   if (o.quick) s.tables.size = {16, 64, 32, 8};
-  const AtmosphereTableSize& n = s.tables.size;
-  double totals[2] = {0.0, 0.0};
-  std::optional<tool::AtmosphereTableSet> kept;
-  for (const AtmosphereMultipleScattering method :
-       {AtmosphereMultipleScattering::Orders, AtmosphereMultipleScattering::Lut}) {
+  struct TableRun {
+    const char* name;
+    AtmosphereMultipleScattering method;
+    AtmosphereTableSize size;
+  };
+  std::vector<TableRun> runs = {{"4 orders (default)", AtmosphereMultipleScattering::Orders, s.tables.size},
+                                {"multiple scattering LUT (Hillaire 2020, the option)",
+                                 AtmosphereMultipleScattering::Lut, s.tables.size}};
+  if (!o.quick)
+    runs.push_back({"4 orders on Yusov's table (the reference)", AtmosphereMultipleScattering::Orders,
+                    AtmosphereTableSize{32, 128, 64, 16}});
+  std::vector<double> totals;
+  std::optional<tool::AtmosphereTableSet> kept, reference;
+  for (const TableRun& run : runs) {
     tool::AtmosphereSettings m = s;
-    m.tables.multipleScattering = method;
+    m.tables.multipleScattering = run.method;
+    m.tables.size = run.size;
     tool::StageTimings tableTimings;
     tool::AtmosphereTableSet tables = tool::atmosphereTables(m, tableTimings);
-    const bool lut = method == AtmosphereMultipleScattering::Lut;
-    std::printf(
-        "\natmosphere tables from scratch, %s (%dx%dx%dx%d, %d sphere samples; optical depth %dx%d; ms, "
-        "one run, glFinish + wall clock per stage):\n",
-        lut ? "multiple scattering LUT (Hillaire 2020, the option)"
-            : (std::to_string(m.tables.orders) + " orders (default)").c_str(),
-        n.height, n.viewZenith, n.sunZenith, n.sunView, m.tables.sphereSamples, m.tables.opticalDepthHeight,
-        m.tables.opticalDepthZenith);
-    double& total = totals[lut ? 1 : 0];
+    const AtmosphereTableSize& n = run.size;
+    const double megabytes =
+        3.0 * 16.0 * n.height * n.viewZenith * n.sunZenith * n.sunView / (1024.0 * 1024.0);
+    std::printf("\natmosphere tables from scratch, %s (%dx%dx%dx%d, %d sphere samples; optical depth %dx%d; "
+                "three 4D RGBA32F tables, %.1f MiB; ms, one run, glFinish + wall clock per stage):\n",
+                run.name, n.height, n.viewZenith, n.sunZenith, n.sunView, m.tables.sphereSamples,
+                m.tables.opticalDepthHeight, m.tables.opticalDepthZenith, megabytes);
+    double total = 0.0;
     for (const auto& [stage, ms] : tables.pass->stageTimes()) {
       std::printf("  %-28s %10.1f\n", stage.c_str(), ms);
       total += ms;
     }
     std::printf("  %-28s %10.1f\n", "total", total);
-    if (!lut) kept.emplace(std::move(tables));
+    totals.push_back(total);
+    if (&run == &runs.front()) kept.emplace(std::move(tables));
+    if (&run == &runs.back() && runs.size() > 2) reference.emplace(std::move(tables));
   }
-  std::printf("  LUT / orders: %.3f\n", totals[1] / totals[0]);
+  std::printf("  to the default: LUT %.3f", totals[1] / totals[0]);
+  if (totals.size() > 2) std::printf(", reference %.3f", totals[2] / totals[0]);
+  std::printf("\n");
   const tool::AtmosphereTableSet& tables = *kept;
 
   // Per frame: the terrain at 20 degrees of sun elevation, the scene's sun azimuth.
@@ -620,6 +635,21 @@ void atmosphereBench(const BenchOptions& o) {
     perFrame[shafts] = median(sums);
     std::printf("  %-12s %10.1f   %s\n", tool::atmosphereShaftsName(shafts), perFrame[shafts],
                 breakdown.c_str());
+  }
+  if (reference) { // None through Eq. 8 on the reference table (the single scattering of earlier versions)
+    s.shafts = AtmosphereShafts::None;
+    s.ray.single = AtmosphereSingleScattering::Table4D;
+    std::vector<double> sums;
+    for (int run = 0; run <= repeat; ++run) {
+      tool::StageTimings t;
+      (void)tool::runAtmosphere(*frame.frame, settings, s, *reference->pass, t);
+      double sum = 0.0;
+      for (const auto& row : t.rows())
+        if (row.stage.find("setup") == std::string::npos) sum += row.ms;
+      if (run > 0) sums.push_back(sum);
+    }
+    std::sort(sums.begin(), sums.end());
+    std::printf("  %-12s %10.1f   (Eq. 8 on the reference table)\n", "none (4D)", sums[sums.size() / 2]);
   }
   const double a = perFrame[AtmosphereShafts::Integrated];
   if (a > 0.0)

@@ -62,9 +62,9 @@ void requireAtMost(const std::string& parameter, int value, int limit, const cha
 // that is short of memory could store RGBA16F (Yusov 2013 does: 32 MB at the default size) at ~1e-3
 // relative precision. Filtering is the hardware's (float weights on llvmpipe; 8-bit fractions on many
 // GPUs, which blur the comparison with the CPU reference, not the image).
-gl::Handle createTable3D(const AtmosphereTableSize& s) {
+gl::Handle createTable3D(const AtmosphereTableSize& s, GLenum format = GL_RGBA32F) {
   gl::Handle t = gl::createTexture(GL_TEXTURE_3D);
-  glTextureStorage3D(t.get(), 1, GL_RGBA32F, s.height, s.viewZenith, s.sunZenith * s.sunView);
+  glTextureStorage3D(t.get(), 1, format, s.height, s.viewZenith, s.sunZenith * s.sunView);
   glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -102,9 +102,10 @@ AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info)
   requireAtMost(std::string(kOptions) + ".ambientSize", o.ambientSize, max2D, "GL_MAX_TEXTURE_SIZE");
   gl::checkError("AtmosphereTablesPass (before allocation)");
   opticalDepth_ = createLinearTexture2D(GL_RG32F, o.opticalDepthHeight, o.opticalDepthZenith);
-  single_ = createTable3D(o.size);
-  if (!o.combinedMie) singleMie_ = createTable3D(o.size);
-  higher_ = createTable3D(o.size);
+  const GLenum format = info.halfFloatTables ? GL_RGBA16F : GL_RGBA32F;
+  single_ = createTable3D(o.size, format);
+  if (!o.combinedMie) singleMie_ = createTable3D(o.size, format);
+  higher_ = createTable3D(o.size, format);
   ambient_ = createLinearTexture2D(GL_RGBA32F, o.ambientSize, 1);
   if (usesMultipleScatteringLut(o)) {
     requireAtMost(std::string(kOptions) + ".multipleScatteringSize", o.multipleScatteringSize, max2D,
@@ -119,6 +120,15 @@ void AtmosphereTablesPass::compute() {
   const AtmosphereTableSize& s = o.size;
   const int depth = s.sunZenith * s.sunView;
   times_.clear();
+  // halfFloatTables: compute into RGBA32F tables, then round them once into the RGBA16F ones (the stages
+  // store to rgba32f images and the orders read the tables they wrote).
+  std::vector<gl::Handle> halves;
+  if (info_.halfFloatTables) {
+    for (gl::Handle* table : {&single_, &singleMie_, &higher_}) {
+      halves.push_back(std::move(*table));
+      if (halves.back()) *table = createTable3D(s);
+    }
+  }
 
   const gpu::AtmosphereParams params = gpu::atmosphereParams(info_.parameters, o);
   gl::Handle block = gl::createDynamicBuffer(sizeof params);
@@ -266,6 +276,19 @@ void AtmosphereTablesPass::compute() {
   endStage("ambient");
 
   gl::unbindPassState(3);
+  if (info_.halfFloatTables) { // round to RGBA16F through the host (GL converts float to half on upload)
+    std::vector<float> texels(static_cast<std::size_t>(s.height) * s.viewZenith * depth * 4);
+    const GLsizei bytes = static_cast<GLsizei>(texels.size() * sizeof(float));
+    gl::Handle* tables[] = {&single_, &singleMie_, &higher_};
+    for (int i = 0; i < 3; ++i) {
+      if (!halves[static_cast<std::size_t>(i)]) continue;
+      glGetTextureImage(tables[i]->get(), 0, GL_RGBA, GL_FLOAT, bytes, texels.data());
+      glTextureSubImage3D(halves[static_cast<std::size_t>(i)].get(), 0, 0, 0, 0, s.height, s.viewZenith,
+                          depth, GL_RGBA, GL_FLOAT, texels.data());
+      *tables[i] = std::move(halves[static_cast<std::size_t>(i)]);
+    }
+    endStage("RGBA16F rounding");
+  }
   gl::checkError("AtmosphereTablesPass::compute");
 }
 

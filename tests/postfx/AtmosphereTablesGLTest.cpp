@@ -238,6 +238,50 @@ TEST_CASE("AtmosphereTablesPass: orders = 1 gives L_H = 0") {
   CHECK(tableError(gpu.singleMie.rgba, cpuTables().singleMie.rgba, 4, 3) < kTableTolerance);
 }
 
+TEST_CASE("AtmosphereTablesPass: halfFloatTables holds the RGBA32F tables rounded to half precision") {
+  CREP_REQUIRE_GL();
+  const AtmospherePrecomputeOptions o = smallOptions();
+  AtmosphereTablesPass full({AtmosphereParameters{}, o});
+  full.compute();
+  const AtmosphereTables reference = full.download();
+  AtmosphereTablesPass::CreateInfo info{AtmosphereParameters{}, o};
+  info.halfFloatTables = true;
+  AtmosphereTablesPass half(info);
+  GLint format = 0;
+  glGetTextureLevelParameteriv(half.singleTexture(), 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+  CHECK(format == GL_RGBA16F);
+  // Half precision keeps 11 significant bits: |h - f| <= 2^-10 |f| whatever the rounding mode of the
+  // conversion, plus 2^-24 for values below half's normal range.
+  const auto rounded = [](const std::vector<float>& h, const std::vector<float>& f) {
+    REQUIRE(h.size() == f.size());
+    double worst = 0.0;
+    int outside = 0;
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const double error = std::abs(double(h[i]) - double(f[i]));
+      if (error > std::ldexp(std::abs(double(f[i])), -10) + std::ldexp(1.0, -24)) ++outside;
+      if (std::abs(f[i]) > 1e-4f) worst = std::max(worst, error / std::abs(double(f[i])));
+    }
+    CHECK(outside == 0);
+    return worst;
+  };
+  half.compute();
+  CHECK(half.stageTimes().back().first == "RGBA16F rounding");
+  const AtmosphereTables computed = half.download();
+  const double single = rounded(computed.single.rgba, reference.single.rgba);
+  const double mie = rounded(computed.singleMie.rgba, reference.singleMie.rgba);
+  const double higher = rounded(computed.higherOrders.rgba, reference.higherOrders.rgba);
+  MESSAGE("RGBA16F tables vs RGBA32F, largest relative difference: S_R + S_M.r " << single << ", S_M " << mie
+                                                                                 << ", L_H " << higher);
+  // The rest is computed as before.
+  CHECK(toVector(computed.ambient) == toVector(reference.ambient));
+  // Upload rounds the same way.
+  AtmosphereTablesPass uploaded(info);
+  uploaded.upload(reference);
+  const AtmosphereTables back = uploaded.download();
+  CHECK(back.single.rgba == computed.single.rgba);
+  CHECK(back.higherOrders.rgba == computed.higherOrders.rgba);
+}
+
 TEST_CASE("AtmosphereTablesPass: upload then download is bit-identical") {
   CREP_REQUIRE_GL();
   const AtmosphereTables& cpu = cpuTables();

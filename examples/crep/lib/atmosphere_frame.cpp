@@ -23,7 +23,7 @@ const std::set<std::string> kAtmosphereOptions = {
     "sun-elevation",     "sun-azimuth",     "camera-elevation",    "shafts",
     "meters-per-unit",   "origin-altitude", "atmosphere-table",    "orders",
     "atmosphere-cache",  "sun-irradiance",  "multiple-scattering", "ground-albedo",
-    "integration-steps", "sky-steps",       "single-scattering"};
+    "integration-steps", "sky-steps",       "single-scattering",   "half-float-tables"};
 
 const char* const kAtmosphereOptionsHelp =
     R"(          atmosphere (--method atmosphere; Bruneton and Neyret 2008 tables, Yusov 2013):
@@ -37,7 +37,8 @@ const char* const kAtmosphereOptionsHelp =
                                  the prefiltered visibility times the table) | none (no shadows)
             --meters-per-unit X  metres per world unit (default 50)
             --origin-altitude M  metres above sea level of world y = 0 (default 0)
-            --atmosphere-table HxAxPxT  4D table size (default 32x128x64x16)
+            --atmosphere-table HxAxPxT  4D table size (default 32x32x32x8; 32x128x64x16: the
+                                 reference)
             --multiple-scattering M  orders (default: orders 2..N by sphere and ray integrals) | lut
                                  (Hillaire 2020's table of every order >= 2: seconds, not minutes, and
                                  darker; README, Atmosphere)
@@ -50,6 +51,7 @@ const char* const kAtmosphereOptionsHelp =
             --integration-steps N  (a): trapezoid steps over the scene's part of a ray, in [1, 4096]
                                  (default 64)
             --sky-steps N        (a): steps of a sky ray beyond the far plane, in [1, 4096] (default 16)
+            --half-float-tables on|off  the 4D tables as RGBA16F on the GPU (default off)
             --atmosphere-cache DIR  table cache (default $XDG_CACHE_HOME/crepuscular or
                                  ~/.cache/crepuscular; `none`: always compute)
             --sun-irradiance E   extraterrestrial sun irradiance, white (default 10)
@@ -147,6 +149,10 @@ AtmosphereSettings atmosphereSettings(const Args& args) {
     throw UsageError("option --multiple-scattering: '" + multiple + "' is not lut or orders");
   s.parameters.groundAlbedo = args.number("ground-albedo", s.parameters.groundAlbedo, 0.0, 1.0);
   s.sunIrradiance = args.number("sun-irradiance", s.sunIrradiance, 1e-6, 1e6);
+  const std::string half = args.string("half-float-tables", "off");
+  if (half != "on" && half != "off")
+    throw UsageError("option --half-float-tables: '" + half + "' is not on or off");
+  s.halfFloatTables = half == "on";
   const std::string single = args.string("single-scattering", "view-tables");
   if (single == "view-tables")
     s.ray.single = AtmosphereSingleScattering::ViewTables;
@@ -193,16 +199,23 @@ Camera atmosphereCamera(const AtmosphereSettings& s, const Camera& c) {
 AtmosphereTableSet atmosphereTables(const AtmosphereSettings& s, StageTimings& timings) {
   AtmosphereTableSet set;
   set.pass = timings.time("atmosphere tables setup", [&] {
-    return std::make_unique<AtmosphereTablesPass>(AtmosphereTablesPass::CreateInfo{s.parameters, s.tables});
+    return std::make_unique<AtmosphereTablesPass>(
+        AtmosphereTablesPass::CreateInfo{s.parameters, s.tables, s.halfFloatTables});
   });
   AtmosphereTablesPass& pass = *set.pass;
   bool computed = false;
   const auto compute = [&] {
     computed = true;
-    pass.compute();
-    for (const auto& [name, ms] : pass.stageTimes())
+    // RGBA16F: compute in an RGBA32F pass so that the cache keeps the unrounded tables, then upload.
+    std::optional<AtmosphereTablesPass> full;
+    if (s.halfFloatTables) full.emplace(AtmosphereTablesPass::CreateInfo{s.parameters, s.tables});
+    AtmosphereTablesPass& target = full ? *full : pass;
+    target.compute();
+    for (const auto& [name, ms] : target.stageTimes())
       timings.add("atmosphere: " + name, ms);
-    return timings.time("atmosphere tables download", [&] { return pass.download(); });
+    AtmosphereTables tables = timings.time("atmosphere tables download", [&] { return target.download(); });
+    if (full) timings.time("atmosphere tables upload (RGBA16F)", [&] { pass.upload(tables); });
+    return tables;
   };
   if (s.cacheDirectory.empty()) {
     set.cpu = compute();

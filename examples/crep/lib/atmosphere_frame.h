@@ -27,7 +27,7 @@ namespace crep::tool {
 
 /// --sun-elevation --sun-azimuth --camera-elevation --shafts --meters-per-unit --origin-altitude
 /// --atmosphere-table --orders --atmosphere-cache --sun-irradiance --multiple-scattering --ground-albedo
-/// --integration-steps --sky-steps --single-scattering
+/// --integration-steps --sky-steps --single-scattering --half-float-tables
 extern const std::set<std::string> kAtmosphereOptions;
 extern const char* const kAtmosphereOptionsHelp;
 
@@ -39,9 +39,10 @@ struct AtmosphereSettings {
   AtmospherePlacement placement{50.0, 0.0};
   AtmosphereParameters parameters;
   AtmospherePrecomputeOptions tables;
-  AtmosphereRayOptions ray;    ///< (a)'s steps, None/(b)/(c)'s single scattering (shafts: `shafts` above)
-  std::string cacheDirectory;  ///< empty: no cache
-  double sunIrradiance = 10.0; ///< extraterrestrial sun irradiance (white)
+  AtmosphereRayOptions ray;     ///< (a)'s steps, None/(b)/(c)'s single scattering (shafts: `shafts` above)
+  bool halfFloatTables = false; ///< AtmosphereTablesPass::CreateInfo::halfFloatTables
+  std::string cacheDirectory;   ///< empty: no cache
+  double sunIrradiance = 10.0;  ///< extraterrestrial sun irradiance (white)
 };
 
 /// The settings of those options (UsageError naming the option for bad values). The cache directory

@@ -96,12 +96,15 @@ struct AtmosphereParameters {
 /// |mieG| < 1, groundAlbedo in [0, 1].
 void validate(const AtmosphereParameters& p);
 
-/// The 4D table's size (Yusov 2013: 32 x 128 x 64 x 16).
+/// The 4D table's size. The default 32 x 32 x 32 x 8 holds the higher orders L_H, which vary slowly, for
+/// the per-frame view tables' single scattering (AtmosphereSingleScattering::ViewTables); Yusov 2013's
+/// 32 x 128 x 64 x 16 (16x the texels and the time) is the reference, and what AtmosphereSingleScattering::
+/// Table4D's look-ups of L1 need (the README's atmosphere section has both images' difference).
 struct AtmosphereTableSize {
-  int height = 32;      ///< N_h
-  int viewZenith = 128; ///< N_alpha, even (two halves)
-  int sunZenith = 64;   ///< N_phi
-  int sunView = 16;     ///< N_theta
+  int height = 32;     ///< N_h
+  int viewZenith = 32; ///< N_alpha, even (two halves)
+  int sunZenith = 32;  ///< N_phi
+  int sunView = 8;     ///< N_theta
 };
 
 /// How the tables hold the scattering orders n >= 2 (L_H).

@@ -47,20 +47,25 @@ AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const Atmospher
 
 /// The tables on the GPU: textures owned by the pass, sized by CreateInfo.
 ///   opticalDepthTexture(): GL_TEXTURE_2D GL_RG32F, opticalDepthHeight x opticalDepthZenith;
-///   single/singleMie/higherOrdersTexture(): GL_TEXTURE_3D GL_RGBA32F, N_h x N_alpha x (N_phi N_theta)
+///   single/singleMie/higherOrdersTexture(): GL_TEXTURE_3D GL_RGBA32F (GL_RGBA16F with halfFloatTables),
+///     N_h x N_alpha x (N_phi N_theta)
 ///     (the packing of atmosphere.h: single scattering without its phase functions, `single` RGB Rayleigh
 ///     and A Mie's red, `singleMie` RGB Mie; singleMieTexture() is 0 with options.combinedMie), linear
 ///     filtering, clamp to edge;
 ///   ambientTexture(): GL_TEXTURE_2D GL_RGBA32F, ambientSize x 1;
 ///   multipleScatteringLutTexture(): GL_TEXTURE_2D GL_RGBA32F, multipleScatteringSize^2, linear, clamp to
 ///     edge (Psi_ms; 0 unless usesMultipleScatteringLut).
-/// 4D tables take 16 bytes per texel: 64 mebibytes each at the default size (three, two with combinedMie,
-/// plus two of the same size while computing more than one order).
+/// 4D tables take 16 bytes per texel (8 with halfFloatTables): 4 mebibytes each at the default size, 64 at
+/// Yusov's 32 x 128 x 64 x 16 (three, two with combinedMie, plus two of the same size while computing more
+/// than one order, and three more with halfFloatTables).
 class AtmosphereTablesPass {
 public:
   struct CreateInfo {
     AtmosphereParameters parameters;
     AtmospherePrecomputeOptions options; ///< keepOrders is ignored
+    /// The three 4D tables as GL_RGBA16F: half the memory, each value rounded once to half precision
+    /// (relative 2^-11) after compute() in RGBA32F or in upload(); download() returns the rounded values.
+    bool halfFloatTables = false;
   };
   /// Validates both (InvalidArgument naming the field; sizes beyond the GL limits name the size field) and
   /// allocates the textures. Throws GlError when allocation fails.
