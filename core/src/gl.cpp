@@ -245,6 +245,7 @@ Handle createClampSampler(std::uint32_t filter) {
   glSamplerParameteri(s.get(), GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
   glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
   glSamplerParameteri(s.get(), GL_TEXTURE_COMPARE_MODE, GL_NONE);
   return s;
 }

@@ -12,6 +12,7 @@
 #include <epoxy/gl.h>
 
 #include <string>
+#include <utility>
 
 namespace crep {
 
@@ -32,19 +33,14 @@ void checkSteps(const char* parameter, int steps, int most = 4096) {
     throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, " + std::to_string(most) + "]");
 }
 
-/// A GL_TEXTURE_3D (the aerial perspective volume) or GL_TEXTURE_2D (the sky-view table, size.z 0) RGBA32F:
-/// linear filtering, clamp to edge.
+/// A GL_TEXTURE_3D (the aerial perspective volume) or GL_TEXTURE_2D (the sky-view table, size.z 0) RGBA32F;
+/// read through the pass's linear clamp-to-edge sampler.
 gl::Handle createViewTable(const glm::ivec3& size) {
   gl::Handle t = gl::createTexture(size.z > 0 ? GL_TEXTURE_3D : GL_TEXTURE_2D);
   if (size.z > 0)
     glTextureStorage3D(t.get(), 1, GL_RGBA32F, size.x, size.y, size.z);
   else
     glTextureStorage2D(t.get(), 1, GL_RGBA32F, size.x, size.y);
-  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
   return t;
 }
 
@@ -100,6 +96,7 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
   marchParams_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   atmosphereParams_ = gl::createDynamicBuffer(sizeof(gpu::AtmosphereParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);
+  linear_ = gl::createClampSampler(GL_LINEAR);
   if (!walksTrees(info.shafts)) // the one program of None and (c): compile errors surface here
     programs_[0][0] = buildProgram({{ShaderStage::Compute,
                                      "passes/atmosphere.comp",
@@ -226,11 +223,15 @@ void AtmospherePass::run(const FrameAttribs& f) {
     glBindTextureUnit(kUnitPrefiltered, f.prefiltered);
     glBindSampler(kUnitPrefiltered, nearest_.get());
   }
-  if (view_) { // the view tables keep their own sampling state (linear, clamp to edge)
-    glBindTextureUnit(kUnitVolumeRayleigh, volumeRayleigh_.get());
-    glBindTextureUnit(kUnitVolumeMie, volumeMie_.get());
-    glBindTextureUnit(kUnitSkyRayleigh, skyRayleigh_.get());
-    glBindTextureUnit(kUnitSkyMie, skyMie_.get());
+  if (view_) {
+    const std::pair<GLuint, GLuint> views[] = {{kUnitVolumeRayleigh, volumeRayleigh_.get()},
+                                               {kUnitVolumeMie, volumeMie_.get()},
+                                               {kUnitSkyRayleigh, skyRayleigh_.get()},
+                                               {kUnitSkyMie, skyMie_.get()}};
+    for (const auto& [unit, texture] : views) {
+      glBindTextureUnit(unit, texture);
+      glBindSampler(unit, linear_.get());
+    }
   }
   glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(1, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);

@@ -62,8 +62,8 @@ Handle createSampler();
 Handle createTexture2D(std::uint32_t internalFormat, int width, int height,
                        const char* parameter = "texture size");
 
-/// A sampler with `filter` (GL_NEAREST or GL_LINEAR) for minification and magnification, clamp to edge,
-/// no depth comparison: texelFetch / texture read the raw values whatever the texture's compare mode.
+/// A sampler with `filter` (GL_NEAREST or GL_LINEAR) for minification and magnification, clamp to edge in
+/// s, t and r, no depth comparison: texelFetch / texture read the raw values whatever the texture's compare mode.
 Handle createClampSampler(std::uint32_t filter);
 /// A buffer of `bytes` bytes with GL_DYNAMIC_STORAGE_BIT (filled with glNamedBufferSubData).
 Handle createDynamicBuffer(std::size_t bytes);

@@ -98,7 +98,7 @@ private:
   gpu::LayoutBuffers layoutBuffers_;
   /// [combinedMie][layout kind] ((a), (b)); [.][0] for None and (c)
   gl::Handle programs_[2][2];
-  gl::Handle marchParams_, atmosphereParams_, nearest_, dummyTransmittance_;
+  gl::Handle marchParams_, atmosphereParams_, nearest_, linear_, dummyTransmittance_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 
