@@ -37,8 +37,8 @@ public:
     /// The steps of (a): integrationSteps and skySteps, each in [1, 4096] (InvalidArgument
     /// "AtmospherePass::CreateInfo.options.integrationSteps" / ".skySteps"); uniforms, not compiled in.
     /// None, (b), (c): `single` (default ViewTables: crep::atmosphereViewTables computed on the GPU each
-    /// run, two volumeSize 3D and two skyViewSize 2D RGBA32F textures: 2.6 MiB at the defaults), volumeSize,
-    /// volumeSteps, skyViewSize, skyViewSteps (InvalidArgument naming the field).
+    /// run, two volumeSize 3D and two skyViewSize 2D RGBA32F textures: 2.6 mebibytes at the defaults),
+    /// volumeSize, volumeSteps, skyViewSize, skyViewSteps (InvalidArgument naming the field).
     AtmosphereRayOptions options;
     /// (a), (b): the rectified map's size W x H in texels (> 0, <= GL_MAX_TEXTURE_SIZE, at most 16 tree
     /// levels); ignored (may be 0) for None and (c).
