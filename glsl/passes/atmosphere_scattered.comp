@@ -3,7 +3,8 @@
 // CREP_ATMOSPHERE_SAMPLES directions w of the Fibonacci sphere (beta_R d_R(h) p_R(w . v) + beta_M d_M(h)
 // p_HG(w . v)) L_(n-1)(C, w, l) times 4 pi / samples, L_(n-1) looked up (Listing 1) at the texel's point with
 // fresh coordinates. CREP_ATMOSPHERE_FIRST_ORDER 1 (n = 2): L1 from the phase-free single tables with its
-// phase functions at w . l (crep_sampleSingleScattering).
+// phase functions at w . l (crep_sampleSingleScattering), plus the ground's first bounce of the sunlight for
+// the directions that hit the ground (crep::precomputeAtmosphere's groundBounce; optical depth at unit 2).
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_SAMPLES
@@ -19,6 +20,25 @@ layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams c
 layout(binding = 0) uniform sampler3D crep_previousOrder; // n = 2: the single table
 #if CREP_ATMOSPHERE_FIRST_ORDER
 layout(binding = 1) uniform sampler3D crep_singleMie;
+layout(binding = 2) uniform sampler2D crep_opticalDepth;
+
+// T(C->g) (albedo / pi) T_sun(g) max(0, n_g . l) for a direction w from altitude h that hits the ground at g.
+vec3 groundBounce(float h, vec3 w, vec3 sun, float wl) {
+  float albedo = crep_atmosphere.multipleScattering.x;
+  if (!(albedo > 0.0) || !(w.y < 0.0)) return vec3(0.0);
+  float R = crep_atmosphere.radii.x, r0 = R + h, hh = h * (2.0 * R + h), b = r0 * w.y;
+  float disc = b * b - hh;
+  if (disc < 0.0) return vec3(0.0);
+  float t = crep_atmosphereGroundDistance(hh, b, disc);
+  float mu = (b + t) / R, cosSun = (r0 * sun.y + t * wl) / R;
+  if (!(cosSun > 0.0)) return vec3(0.0);
+  vec2 D = max(crep_densityToTop(crep_opticalDepth, crep_atmosphere, 0.0, -mu) -
+                   crep_densityToTop(crep_opticalDepth, crep_atmosphere, h, -w.y),
+               vec2(0.0));
+  return exp(-crep_atmosphereExtinction(crep_atmosphere, D)) *
+         crep_sunTransmittanceAt(crep_opticalDepth, crep_atmosphere, 0.0, cosSun) *
+         (cosSun * albedo * float(CREP_INV_PI));
+}
 #endif
 layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
 
@@ -34,7 +54,8 @@ void main() {
     float wl = dot(w, ray.sun);
     vec4 coords = crep_atmosphereTableCoords(crep_atmosphere, ray.h, w.y, ray.sun.y, wl, vec4(-1.0));
 #if CREP_ATMOSPHERE_FIRST_ORDER
-    vec3 radiance = crep_sampleSingleScattering(crep_previousOrder, crep_singleMie, crep_atmosphere, coords, wl);
+    vec3 radiance = crep_sampleSingleScattering(crep_previousOrder, crep_singleMie, crep_atmosphere, coords, wl) +
+                    groundBounce(ray.h, w, ray.sun, wl);
 #else
     vec3 radiance = crep_sampleAtmosphereTable(crep_previousOrder, crep_atmosphere, coords);
 #endif

@@ -359,9 +359,28 @@ SphereSamples sphereSamples(const AtmosphereParameters& p, const AtmosphereTable
   return s;
 }
 
+/// The ground's first bounce seen from the texel's point along w (Bruneton 2017's ground term of the
+/// orders, the direct sunlight only): a direction that hits the ground at g brings T(C->g) (groundAlbedo /
+/// pi) T_sun(g) max(0, n_g . l), T(C->g) from the optical depth table (atmosphereTransmittance's rule for a
+/// ray that hits the ground); 0 for the other directions. GLSL twin in passes/atmosphere_scattered.comp.
+glm::dvec3 groundBounce(const AtmosphereTables& tables, const TexelRay& r, const glm::dvec3& w) {
+  const AtmosphereParameters& p = tables.parameters;
+  if (!(p.groundAlbedo > 0.0) || !(w.y < 0.0)) return glm::dvec3(0.0);
+  const double R = p.earthRadius, r0 = R + r.h, hh = r.h * (2.0 * R + r.h), b = r0 * w.y;
+  const double disc = b * b - hh;
+  if (disc < 0.0) return glm::dvec3(0.0);
+  const double t = hh / (std::sqrt(disc) - b); // the near root, without cancellation
+  const double mu = (b + t) / R, cosSun = (r0 * r.l.y + t * glm::dot(w, r.l)) / R;
+  if (!(cosSun > 0.0)) return glm::dvec3(0.0);
+  const glm::dvec2 D =
+      glm::max(lookUpDensityToTop(tables, 0.0, -mu) - lookUpDensityToTop(tables, r.h, -w.y), glm::dvec2(0.0));
+  return transmittanceOf(p, D) * transmittanceOf(p, lookUpDensityToTop(tables, 0.0, cosSun)) *
+         (cosSun * p.groundAlbedo / kPi);
+}
+
 /// Yusov 2013, Eq. 1 / Listing 4: J_n of one texel from L_(n-1) over the Fibonacci sphere (each a fresh
 /// Listing 1 look-up at C; u_h, u_alpha and u_phi do not depend on the texel's view). `prev` null: L1 of
-/// `tables` (n = 2), its phase functions at w . l.
+/// `tables` (n = 2), its phase functions at w . l, plus the ground's first bounce (groundBounce).
 glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTable4D* prev, const TexelRay& r,
                              int ih, const SphereSamples& sphere) {
   const AtmosphereParameters& p = tables.parameters;
@@ -378,8 +397,8 @@ glm::dvec3 scatteredRadiance(const AtmosphereTables& tables, const AtmosphereTab
     const double wl = std::clamp(glm::dot(w, r.l), -1.0, 1.0);
     const glm::dvec4 coords(sphere.height[static_cast<std::size_t>(ih)], alpha[i], uPhi,
                             texCoord(thetaParam(wl), size.sunView));
-    const glm::dvec3 l =
-        prev ? sampleAtmosphereTable(*prev, coords) : sampleSingleScattering(tables, coords, wl);
+    glm::dvec3 l = prev ? sampleAtmosphereTable(*prev, coords) : sampleSingleScattering(tables, coords, wl);
+    if (!prev) l += groundBounce(tables, r, w);
     const double c = glm::dot(w, r.v);
     sum += (betaR * rayleighPhase(c) + betaM * henyeyGreenstein(p.mieG, c)) * l;
   }

@@ -2,7 +2,7 @@
 //
 // ---------------------------------------------------------------------------------------------------
 // Cache key (atmosphereCacheKey): FNV-1a 64 (Fowler, Noll and Vo) over, in this order, the ASCII tag
-// "crep-atmosphere-key-3", then the little-endian IEEE-754 bytes of the 15 doubles of AtmosphereParameters
+// "crep-atmosphere-key-4", then the little-endian IEEE-754 bytes of the 15 doubles of AtmosphereParameters
 //   earthRadius, atmosphereHeight, rayleighScattering.x, .y, .z, rayleighScaleHeight,
 //   mieScattering.x, .y, .z, mieAbsorption.x, .y, .z, mieScaleHeight, mieG, groundAlbedo
 // and the little-endian int32 bytes of the 16 ints of AtmospherePrecomputeOptions
@@ -319,7 +319,7 @@ std::string uniqueSuffix() {
 } // namespace
 
 std::string atmosphereCacheKey(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o) {
-  std::string bytes = "crep-atmosphere-key-3";
+  std::string bytes = "crep-atmosphere-key-4";
   for (double v : parameterFields(p))
     putF64(bytes, v);
   for (int v : optionFields(o))

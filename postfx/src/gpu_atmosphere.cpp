@@ -248,7 +248,10 @@ void AtmosphereTablesPass::compute() {
       const std::string name = "order " + std::to_string(n) + ": ";
       glUseProgram(n == 2 ? firstScatteredProgram.get() : scatteredProgram.get());
       glBindTextureUnit(0, n == 2 ? single_.get() : order.get());
-      if (n == 2) glBindTextureUnit(1, mieTable);
+      if (n == 2) { // L1's Mie part and, for the ground's bounce, the optical depth table
+        glBindTextureUnit(1, mieTable);
+        glBindTextureUnit(2, opticalDepth_.get());
+      }
       glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
       dispatchTable();
       endStage(name + "J");

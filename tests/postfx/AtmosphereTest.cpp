@@ -762,6 +762,50 @@ TEST_CASE("Atmosphere placement puts world points around the planet centre") {
   CHECK(glm::length(c) < 1e-6);
 }
 
+// The orders' ground term (Bruneton 2017: the ground's first bounce of the sunlight in J_2).
+TEST_CASE("Atmosphere orders: the ground's bounce is linear in the albedo and follows the sunlit ground") {
+  // With two orders L_H = L_2 is a linear function of J_2, and only J_2's ground term depends on the albedo:
+  // L_H(a) = L_H(0) + a (L_H(1) - L_H(0)) texel by texel (float storage: relative 1e-6 of the texel).
+  AtmosphereParameters p;
+  AtmospherePrecomputeOptions o = smallOptions();
+  o.orders = 2;
+  const auto withAlbedo = [&](double a) {
+    AtmosphereParameters q = p;
+    q.groundAlbedo = a;
+    return precomputeAtmosphere(q, o);
+  };
+  const AtmosphereTables black = withAlbedo(0.0), white = withAlbedo(1.0), grey = withAlbedo(0.3),
+                         earth = withAlbedo(0.1);
+  CHECK(black.single.rgba == white.single.rgba); // single scattering has no ground
+  double worst = 0.0, added = 0.0, total = 0.0;
+  for (std::size_t i = 0; i < black.higherOrders.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const double b = black.higherOrders.rgba[i], w = white.higherOrders.rgba[i],
+                 g = grey.higherOrders.rgba[i];
+    worst = std::max(worst, std::abs(g - (b + 0.3 * (w - b))) / std::max(std::abs(g), 1e-12));
+    CHECK(w >= b);
+    added += earth.higherOrders.rgba[i] - b;
+    total += b;
+  }
+  MESSAGE("L_H linear in the albedo: largest relative deviation "
+          << worst << "; albedo 0.1 adds " << added / total << " of L_H summed over the table");
+  CHECK(worst < 1e-5);
+  CHECK(added > 0.0);
+  // The bounce follows the sunlit ground: a white ground adds more to L_H with the sun at the zenith than
+  // with the sun at Eq. 6's clamp, 11 degrees below the horizon (summed over the other coordinates).
+  const auto gain = [&](int ip) {
+    double sum = 0.0;
+    for (int ih = 0; ih < o.size.height; ++ih)
+      for (int ia = 0; ia < o.size.viewZenith; ++ia)
+        for (int it = 0; it < o.size.sunView; ++it)
+          sum += white.higherOrders.at(ih, ia, ip, it).g - black.higherOrders.at(ih, ia, ip, it).g;
+    return sum;
+  };
+  MESSAGE("white ground's gain in L_H (green): sun at the zenith " << gain(o.size.sunZenith - 1)
+                                                                   << ", 11 degrees below " << gain(0));
+  CHECK(gain(o.size.sunZenith - 1) > 10.0 * gain(0));
+}
+
 // Hillaire 2020, Sec. 5.5: Psi_ms and the L_H it gives, against the orders' reference on the same small
 // table.
 TEST_CASE("Atmosphere multiple scattering LUT: Psi_ms, the ground's bounce and L_H against the orders") {

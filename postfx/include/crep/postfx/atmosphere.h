@@ -52,7 +52,9 @@
 //   AtmosphereMultipleScattering::Lut instead of the orders below: Psi_ms (Hillaire 2020, Sec. 5.5; see the
 //     enum) and L_H of each texel integrated from it in the single scattering march;
 //   Orders, for n = 2..N: J_n (Eq. 1, `sphereSamples` directions of a Fibonacci sphere, each a look-up into
-//     L_(n-1), for n = 2 L1 with its phase functions at w . l), then L_n (Eq. 2, Listing 5, trapezoid rule
+//     L_(n-1), for n = 2 L1 with its phase functions at w . l plus, for a direction that hits the ground at
+//     g, the ground's first bounce T(C->g) (groundAlbedo / pi) T_sun(g) max(0, n_g . l), Bruneton 2017's
+//     ground term for the direct sunlight), then L_n (Eq. 2, Listing 5, trapezoid rule
 //     with `orderSteps` steps, look-ups into J_n);
 //   higher orders L_H = sum of L_n (n = 2..N); multiple scattering L_M = L1 + L_H is formed per look-up
 //     (lookUpMultipleScattering), not stored;
@@ -87,8 +89,9 @@ struct AtmosphereParameters {
   glm::dvec3 mieAbsorption{2.0e-5 / 9.0}; ///< Mie extinction = scattering / 0.9 (Bruneton and Neyret 2008)
   double mieScaleHeight = 1200.0;         ///< H_M, metres
   double mieG = 0.76;                     ///< Henyey-Greenstein g of the aerosols, |g| < 1
-  /// Lambertian albedo of the ground in [0, 1]: the sunlit ground's bounce into multiple scattering
-  /// (AtmosphereMultipleScattering::Lut; the Orders reference has no ground). 0.1: Hillaire 2020's Earth.
+  /// Lambertian albedo of the ground in [0, 1]: the sunlit ground's bounce into multiple scattering (Orders:
+  /// its first bounce, in J_2; Lut: in Psi_ms) and what sky rays that end on the ground see. 0.1: Hillaire
+  /// 2020's Earth.
   double groundAlbedo = 0.1;
 };
 /// Throws InvalidArgument naming the field ("AtmosphereParameters.earthRadius", ...): radii and scale
@@ -98,7 +101,7 @@ void validate(const AtmosphereParameters& p);
 
 /// The 4D table's size. The default 32 x 32 x 32 x 8 holds the higher orders L_H, which vary slowly, for
 /// the per-frame view tables' single scattering (AtmosphereSingleScattering::ViewTables); Yusov 2013's
-/// 32 x 128 x 64 x 16 (16x the texels and the time) is the reference, and what AtmosphereSingleScattering::
+/// 32 x 128 x 64 x 16 (16x the texels) is the reference, and what AtmosphereSingleScattering::
 /// Table4D's look-ups of L1 need (the README's atmosphere section has both images' difference).
 struct AtmosphereTableSize {
   int height = 32;     ///< N_h
@@ -117,7 +120,7 @@ enum class AtmosphereMultipleScattering {
   /// (the README's atmosphere section has the figures): an option, not the default.
   Lut,
   /// Bruneton and Neyret 2008, Yusov 2013 (default): orders 2..`orders` by the sphere integral J_n and the
-  /// ray integral L_n (no ground).
+  /// ray integral L_n; J_2 with the ground's first bounce of the sunlight (groundAlbedo).
   Orders,
 };
 
