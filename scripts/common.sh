@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Shared set-up for the two README commands: installs the Debian 12 packages that are missing,
-# then configures and builds crepuscular in ./build (Release, warnings as errors).
+# then configures and builds crepuscular in ./build (Release, warnings as errors): everything, or one
+# target (CREP_BUILD_TARGET).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -25,9 +26,11 @@ crep_install_packages() {
   fi
 }
 
+# crep_build DIR [cmake configure arguments...]; CREP_BUILD_TARGET=NAME builds that target only (the render
+# command builds the `crep` tool, not the test suite).
 crep_build() {
   local dir=${1:-build}
   shift || true
   cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@"
-  cmake --build "$dir" -j "$(nproc)"
+  cmake --build "$dir" -j "$(nproc)" ${CREP_BUILD_TARGET:+--target "$CREP_BUILD_TARGET"}
 }
