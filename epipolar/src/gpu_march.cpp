@@ -1,7 +1,7 @@
 // GPU passes of the marches (crep/epipolar/gpu_march.h) and the shared blocks (gpu_layout.h): min/max
-// trees (Yusov 2012 Sec. 6.3), tree / brute-force march along rectified rows (Algorithm 2), world-space
-// reference march (Klehm et al. 2014, Eq. 1, 3). Shaders: passes/minmax_build.comp,
-// passes/march_rectified.comp, passes/march_reference.comp, crep/epipolar.glsl.
+// trees (Yusov 2012 Sec. 6.3) and the tree / brute-force march along rectified rows (Algorithm 2). The
+// world-space reference march is WorldMarchPass in scatter/ (crep/scatter/gpu_world_march.h). Shaders:
+// passes/minmax_build.comp, passes/march_rectified.comp, crep/epipolar.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>

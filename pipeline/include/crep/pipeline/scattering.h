@@ -369,9 +369,6 @@ public:
     /// Epipolar frames: the standard shadow map resampled and marched (the engine's, or the one rendered
     /// with drawCasters, valid until the next run()); texture 0 on projective frames.
     ShadowMap shadowMap;
-    /// The rectified map the frame was prefiltered from (rasterized or resampled; depth-buffer values or
-    /// R32F, mapSize x mapSize) and its layout, valid until the next run(): for debug views, and for
-    /// running the peers of the prefiltered method (RectifiedMarchPass, MinMaxTreePass) on the same data.
     /// The local lights, in order (spots, then the faces of each point light).
     std::vector<LightResult> localLights;
     /// Sampling::Epipolar with stageTimings: the frame's sample and correction counts (read back from the
@@ -382,6 +379,9 @@ public:
       int correctedPixels = 0;     ///< evaluated directly after the unwarp (no valid sample near them)
       int correctedFullPixels = 0; ///< the same after the upscale (downscale > 1)
     } sampling;
+    /// The rectified map the frame was prefiltered from (rasterized or resampled; depth-buffer values or
+    /// R32F, mapSize x mapSize) and its layout, valid until the next run(): for debug views, and for
+    /// running the peers of the prefiltered method (RectifiedMarchPass, MinMaxTreePass) on the same data.
     struct RectifiedMapView {
       std::shared_ptr<const RectifiedLayout> layout;
       std::uint32_t texture = 0;
