@@ -1,6 +1,7 @@
 // `crep compare` and `crep bench` end to end at test sizes.
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
+#include "support/png_read.h"
 #include "support/tool_runner.h"
 
 #include <doctest/doctest.h>
@@ -124,6 +125,45 @@ TEST_CASE("crep compare: --methods selects methods and always adds the reference
   CHECK(rows[0].at("method") == "reference");
   CHECK(rows[1].at("method") == "prefilter");
   CHECK(pngSize(prefix + ".png").first == 8 + 2 * (80 + 8));
+}
+
+TEST_CASE("crep compare: every title and text line stays within its tile") {
+  // Three methods and the reference in 80-pixel tiles on the sunset, where the marches fall back to the
+  // epipolar layout: their titles ("minmax (ran minmax (epipolar))") and the error legend are wider than
+  // a tile at their font sizes. Between two tiles runs an 8-pixel gap of background: no text may be drawn
+  // there from the first row of images down (the header above spans the sheet).
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir("crep-compare");
+  const std::string prefix = (dir / "labels").string();
+  const auto r =
+      crep::test::runCrep("compare --scene sunset --size 160x90 --map-size 128 --steps 32 --methods "
+                          "prefilter,minmax,brute --tile-width 80 --out '" +
+                          prefix + "'");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  REQUIRE(r.output.find("(epipolar)") != std::string::npos); // the long titles
+  const crep::test::Png sheet = crep::test::readPng(prefix + ".png");
+  const int columns = 4, tile = 80, margin = 8;
+  REQUIRE(sheet.width == margin + columns * (tile + margin));
+  const unsigned char* background = sheet.at(0, sheet.height - 1);
+  const auto isBackground = [&](int x, int y) {
+    const unsigned char* p = sheet.at(x, y);
+    return p[0] == background[0] && p[1] == background[1] && p[2] == background[2];
+  };
+  // The first row of images: the first run of 20 rows that are not background at the first tile's centre
+  // (a line of text is at most 10 rows tall).
+  int imagesTop = -1;
+  for (int y = 0, run = 0; y < sheet.height && imagesTop < 0; ++y) {
+    run = isBackground(margin + tile / 2, y) ? 0 : run + 1;
+    if (run == 20) imagesTop = y - 19;
+  }
+  REQUIRE(imagesTop > 0);
+  int drawn = 0;
+  for (int y = imagesTop; y < sheet.height; ++y)
+    for (int c = 0; c + 1 < columns; ++c)
+      for (int x = margin + c * (tile + margin) + tile; x < margin + (c + 1) * (tile + margin); ++x)
+        drawn += isBackground(x, y) ? 0 : 1;
+  CHECK(drawn == 0);
 }
 
 TEST_CASE("crep compare: images 1 pixel wide (--size 1x1, 1x2, 1x90) make a sheet of 16-pixel tiles") {

@@ -2,6 +2,7 @@
 // of every operator, usage errors for unknown names (listing them) and for knobs without --tonemap.
 #include "support/gl_fixture.h"
 #include "support/image_check.h"
+#include "support/png_read.h"
 #include "support/tool_runner.h"
 
 #include <crep/postfx/tone_mapping.h>
@@ -15,43 +16,11 @@
 #include <string>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#define STB_IMAGE_STATIC
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#define STBI_NO_STDIO
-#include <stb/stb_image.h>
-#pragma GCC diagnostic pop
-
 namespace {
 
+using crep::test::Png;
+using crep::test::readPng;
 using crep::test::runCrep;
-
-/// A decoded 8-bit RGB PNG.
-struct Png {
-  int width = 0, height = 0;
-  std::vector<unsigned char> rgb;
-};
-
-Png readPng(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
-                                         std::istreambuf_iterator<char>());
-  Png png;
-  int channels = 0;
-  unsigned char* data = stbi_load_from_memory(bytes.data(), static_cast<int>(bytes.size()), &png.width,
-                                              &png.height, &channels, 3);
-  if (data) {
-    png.rgb.assign(data, data + static_cast<std::size_t>(png.width) * png.height * 3);
-    stbi_image_free(data);
-  }
-  return png;
-}
 
 /// Mean absolute difference of two same-size PNGs in 8-bit codes.
 double meanDifference(const Png& a, const Png& b) {

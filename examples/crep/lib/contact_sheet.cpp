@@ -157,6 +157,14 @@ std::vector<std::string> wrap(const std::string& text, int width) {
       line = candidate;
     }
     word.clear();
+    // A word wider than the line on its own: cut it where it fills the line.
+    while (textWidth(line, 1) > width && line.size() > 1) {
+      std::size_t fits = 1;
+      while (fits + 1 < line.size() && textWidth(line.substr(0, fits + 1), 1) <= width)
+        ++fits;
+      lines.push_back(line.substr(0, fits));
+      line = line.substr(fits);
+    }
   };
   for (char c : text) {
     if (c == ' ')
@@ -179,6 +187,23 @@ std::string shortNumber(double v) {
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
 }
+
+/// A tile's title: one line at scale 2 when it fits the tile, else wrapped to the tile at scale 1.
+struct Label {
+  std::vector<std::string> lines;
+  int scale = 2;
+  int height() const { return static_cast<int>(lines.size()) * 10 * scale; }
+};
+Label fitLabel(const std::string& title, int width) {
+  if (textWidth(title, 2) <= width) return {{title}, 2};
+  return {wrap(title, width), 1};
+}
+void drawLabel(Image& sheet, int x, int y, const Label& label, const glm::vec3& rgb) {
+  for (const std::string& line : label.lines) {
+    drawText(sheet, x, y, line, label.scale, rgb);
+    y += 10 * label.scale;
+  }
+}
 } // namespace
 
 int sheetTileHeight(int tileWidth, glm::ivec2 imageSize) {
@@ -197,12 +222,24 @@ Image composeSheet(const std::string& header, const std::vector<SheetColumn>& co
   if (columns.empty()) throw InvalidArgument("composeSheet.columns", "none", "must not be empty");
   if (tileWidth < 1)
     throw InvalidArgument("composeSheet.tileWidth", std::to_string(tileWidth), "must be >= 1");
-  const int margin = kMargin, lineHeight = 10, titleHeight = 20;
+  const int margin = kMargin, lineHeight = 10;
   const Image& first = columns.front().image;
   const int tileHeight = sheetTileHeight(tileWidth, {first.width(), first.height()});
+  // Every title and text line fits its tile: titles shrink and wrap, lines wrap.
+  std::vector<Label> titles;
+  std::vector<std::vector<std::string>> texts;
+  int titleHeight = 20;
   std::size_t maxLines = 0;
-  for (const SheetColumn& c : columns)
-    maxLines = std::max(maxLines, c.lines.size());
+  for (const SheetColumn& c : columns) {
+    titles.push_back(fitLabel(c.title, tileWidth));
+    titleHeight = std::max(titleHeight, titles.back().height());
+    std::vector<std::string> lines;
+    for (const std::string& line : c.lines)
+      for (std::string& part : wrap(line, tileWidth))
+        lines.push_back(std::move(part));
+    maxLines = std::max(maxLines, lines.size());
+    texts.push_back(std::move(lines));
+  }
   const int columnsCount = static_cast<int>(columns.size());
   const int width = margin + columnsCount * (tileWidth + margin);
   const std::vector<std::string> headerLines = wrap(header, width - 2 * margin);
@@ -243,15 +280,36 @@ Image composeSheet(const std::string& header, const std::vector<SheetColumn>& co
         for (int dy = 0; dy < 16; ++dy)
           setTopDown(sheet, x0 + x, barTop + dy, v);
       }
-      drawText(sheet, x0, barTop - 14, "error scale (reference: no error)", 1, white);
+      // Its caption above the bar and its ends below, each within the tile (narrow tiles: shorter
+      // caption, the right end on a line of its own).
+      std::vector<std::string> caption = wrap("error scale (reference: no error)", tileWidth);
+      const int captionLines = std::max(1, (barTop - 4 - y) / lineHeight);
+      if (static_cast<int>(caption.size()) > captionLines) caption = wrap("error scale", tileWidth);
+      if (static_cast<int>(caption.size()) > captionLines)
+        caption.resize(static_cast<std::size_t>(captionLines));
+      int captionY = barTop - 4 - static_cast<int>(caption.size()) * lineHeight;
+      for (const std::string& line : caption) {
+        drawText(sheet, x0, captionY, line, 1, white);
+        captionY += lineHeight;
+      }
       drawText(sheet, x0, barTop + 20, "0", 1, white);
-      const std::string right = ">= peak / " + shortNumber(amplification);
-      drawText(sheet, x0 + tileWidth - textWidth(right, 1), barTop + 20, right, 1, white);
+      std::string right = ">= peak / " + shortNumber(amplification);
+      if (textWidth("0 ", 1) + textWidth(right, 1) > tileWidth)
+        right = ">=peak/" + shortNumber(amplification);
+      if (textWidth("0 ", 1) + textWidth(right, 1) <= tileWidth) {
+        drawText(sheet, x0 + tileWidth - textWidth(right, 1), barTop + 20, right, 1, white);
+      } else {
+        int rightY = barTop + 20 + lineHeight;
+        for (const std::string& line : wrap(right, tileWidth)) {
+          drawText(sheet, x0, rightY, line, 1, white);
+          rightY += lineHeight;
+        }
+      }
     }
     y += tileHeight + margin / 2;
-    drawText(sheet, x0, y + 2, col.title, 2, white);
+    drawLabel(sheet, x0, y + 2, titles[static_cast<std::size_t>(i)], white);
     y += titleHeight;
-    for (const std::string& line : col.lines) {
+    for (const std::string& line : texts[static_cast<std::size_t>(i)]) {
       drawText(sheet, x0, y, line, 1, grey);
       y += lineHeight;
     }
@@ -265,7 +323,7 @@ Image composeGridSheet(const std::string& header, const std::vector<SheetTile>& 
   if (tileWidth < 1)
     throw InvalidArgument("composeGridSheet.tileWidth", std::to_string(tileWidth), "must be >= 1");
   if (columns < 1) throw InvalidArgument("composeGridSheet.columns", std::to_string(columns), "must be >= 1");
-  const int margin = kMargin, lineHeight = 10, titleHeight = 20;
+  const int margin = kMargin, lineHeight = 10;
   const Image& first = tiles.front().image;
   const int tileHeight = sheetTileHeight(tileWidth, {first.width(), first.height()});
   const int count = static_cast<int>(tiles.size());
@@ -274,6 +332,12 @@ Image composeGridSheet(const std::string& header, const std::vector<SheetTile>& 
   const int width = margin + columns * (tileWidth + margin);
   const std::vector<std::string> headerLines = wrap(header, width - 2 * margin);
   const int headerHeight = 2 * margin + static_cast<int>(headerLines.size()) * lineHeight;
+  std::vector<Label> titles;
+  int titleHeight = 20;
+  for (const SheetTile& tile : tiles) {
+    titles.push_back(fitLabel(tile.title, tileWidth));
+    titleHeight = std::max(titleHeight, titles.back().height());
+  }
   const int cellHeight = tileHeight + margin / 2 + titleHeight + margin;
   Image sheet(width, headerHeight + rows * cellHeight, 3, srgbToLinear(0.12f));
   int y = margin;
@@ -286,7 +350,8 @@ Image composeGridSheet(const std::string& header, const std::vector<SheetTile>& 
     const int x0 = margin + (i % columns) * (tileWidth + margin),
               y0 = headerHeight + (i / columns) * cellHeight;
     blit(sheet, resizeImage(tile.image, tileWidth, tileHeight), x0, y0, 1.0);
-    drawText(sheet, x0, y0 + tileHeight + margin / 2 + 2, tile.title, 2, glm::vec3(1.0f));
+    drawLabel(sheet, x0, y0 + tileHeight + margin / 2 + 2, titles[static_cast<std::size_t>(i)],
+              glm::vec3(1.0f));
   }
   return sheet;
 }
