@@ -180,33 +180,57 @@ vec3 singleLookUp(float t, vec4 first) {
   return singleAt(t, coords);
 }
 
-#if CREP_ATMOSPHERE_SHAFTS == 1
-// (a)'s unshadowed rest of a sky ray, [ta, tb] (crep::atmosphereRay's rule, kSkyStepPower): the trapezoid
-// rule with n steps in u of t = ta + (tb - ta) u^3, steps short where the ray starts low in dense air and
-// long towards the top (a grazing ray runs ~1000 km, most of its Mie light within the first ~30 km); the
-// integrand and T(C->P) of trapezoid() below.
-#define CREP_SKY_POWER 3
-vec3 skyQuadrature(float ta, float tb, int n) {
-  float len = tb - ta;
-  vec2 optical = segmentDensity(ta);
-  vec2 previous = vec2(0.0);
-  float tPrev = ta;
-  vec3 sum = vec3(0.0);
-  for (int k = 0; k <= n; ++k) {
-    float u = float(k) / float(n);
-    float t = ta + len * pow(u, float(CREP_SKY_POWER));
-    RayPoint p = rayPoint(t);
-    vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
-    if (k > 0) optical += 0.5 * (previous + d) * (t - tPrev);
-    previous = d;
-    tPrev = t;
-    float dtdu = len * float(CREP_SKY_POWER) * pow(u, float(CREP_SKY_POWER - 1));
-    vec3 f = (rayleighPhaseBeta * d.x + miePhaseBeta * d.y) *
-             exp(-crep_atmosphereExtinction(crep_atmosphere, optical)) *
-             crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, p.h, p.cosSun) * dtdu;
-    sum += (k == 0 || k == n) ? 0.5 * f : f;
+#if CREP_ATMOSPHERE_VOLUME_PASS || CREP_ATMOSPHERE_SHAFTS == 1
+// crep's ViewMarch (postfx/src/atmosphere_ray.cpp): the trapezoid rule of the phase-free integrands
+// (beta_R d_R, beta_M d_M) T(C->P) T_sun(P) along the current ray from t0, T(C->P) the densities marched
+// from C (`optical0` those of [0, t0]). viewStep(t, wPrevious, w): to t, adding (wPrevious f(t_prev) +
+// w f(t)) / 2; viewCubic(tb, n): n steps in u to tb in t = ta + (tb - ta) u^3.
+vec3 vmRayleigh = vec3(0.0), vmMie = vec3(0.0), vmFR = vec3(0.0), vmFM = vec3(0.0);
+vec2 vmDensity = vec2(0.0), vmOptical = vec2(0.0);
+float vmT = 0.0;
+void viewIntegrand(RayPoint p, vec2 d) {
+  vec3 w = exp(-crep_atmosphereExtinction(crep_atmosphere, vmOptical)) *
+           crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, p.h, p.cosSun);
+  vmFR = crep_atmosphere.rayleighScattering.rgb * d.x * w;
+  vmFM = crep_atmosphere.mieScattering.rgb * d.y * w;
+}
+void viewBegin(float t0, vec2 optical0) {
+  RayPoint p = rayPoint(t0);
+  vmRayleigh = vec3(0.0);
+  vmMie = vec3(0.0);
+  vmOptical = optical0;
+  vmT = t0;
+  vmDensity = crep_atmosphereDensity(crep_atmosphere, p.h);
+  viewIntegrand(p, vmDensity);
+}
+void viewStep(float t, float wPrevious, float w) {
+  RayPoint p = rayPoint(t);
+  vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
+  vmOptical += 0.5 * (vmDensity + d) * (t - vmT);
+  vec3 fR = vmFR, fM = vmFM;
+  viewIntegrand(p, d);
+  vmRayleigh += 0.5 * (wPrevious * fR + w * vmFR);
+  vmMie += 0.5 * (wPrevious * fM + w * vmFM);
+  vmT = t;
+  vmDensity = d;
+}
+void viewCubic(float tb, int n) {
+  float ta = vmT, len = tb - ta, du = 1.0 / float(n), w = du * 3.0 * len; // du dt/du = w u^2
+  for (int k = 1; k <= n; ++k) {
+    float u = float(k) * du, u0 = u - du;
+    viewStep(ta + len * u * u * u, w * u0 * u0, w * u * u);
   }
-  return sum / float(n);
+}
+#endif
+
+#if CREP_ATMOSPHERE_SHAFTS == 1
+// (a)'s unshadowed rest of a sky ray, [ta, tb] (crep::atmosphereRay's rule): viewCubic's n steps of the
+// integrand of trapezoid() below, T(C->P) the segment's densities to ta, then marched.
+vec3 skyQuadrature(float ta, float tb, int n) {
+  if (!(tb > ta)) return vec3(0.0);
+  viewBegin(ta, segmentDensity(ta));
+  viewCubic(tb, n);
+  return vmRayleigh * crep_rayleighPhase(rayVL) + vmMie * crep_henyeyGreenstein(crep_atmosphere.mieExtinction.w, rayVL);
 }
 
 // The trapezoid rule with n steps over [ta, tb] metres of the single scattering integrand (beta_R d_R p_R +
@@ -345,36 +369,6 @@ SkyFrame skyFrame() {
   return f;
 }
 
-#if CREP_ATMOSPHERE_VOLUME_PASS
-// crep's ViewMarch (postfx/src/atmosphere_ray.cpp): the trapezoid rule of the phase-free integrands
-// (beta_R d_R, beta_M d_M) T(C->P) T_sun(P) along the current ray, T(C->P) from the densities marched
-// from C. viewStep(t, wPrevious, w): to t, adding (wPrevious f(t_prev) + w f(t)) / 2.
-vec3 vmRayleigh = vec3(0.0), vmMie = vec3(0.0), vmFR = vec3(0.0), vmFM = vec3(0.0);
-vec2 vmDensity = vec2(0.0), vmOptical = vec2(0.0);
-float vmT = 0.0;
-void viewIntegrand(RayPoint p, vec2 d) {
-  vec3 w = exp(-crep_atmosphereExtinction(crep_atmosphere, vmOptical)) *
-           crep_sunTransmittanceAt(opticalDepthTable, crep_atmosphere, p.h, p.cosSun);
-  vmFR = crep_atmosphere.rayleighScattering.rgb * d.x * w;
-  vmFM = crep_atmosphere.mieScattering.rgb * d.y * w;
-}
-void viewBegin() {
-  RayPoint p = rayPoint(0.0);
-  vmDensity = crep_atmosphereDensity(crep_atmosphere, p.h);
-  viewIntegrand(p, vmDensity);
-}
-void viewStep(float t, float wPrevious, float w) {
-  RayPoint p = rayPoint(t);
-  vec2 d = crep_atmosphereDensity(crep_atmosphere, p.h);
-  vmOptical += 0.5 * (vmDensity + d) * (t - vmT);
-  vec3 fR = vmFR, fM = vmFM;
-  viewIntegrand(p, d);
-  vmRayleigh += 0.5 * (wPrevious * fR + w * vmFR);
-  vmMie += 0.5 * (wPrevious * fM + w * vmFM);
-  vmT = t;
-  vmDensity = d;
-}
-#endif
 
 #if CREP_ATMOSPHERE_VOLUME_PASS == 1
 // The aerial perspective volume: column (i, j) from the camera to the far plane, slice k at view depth
@@ -387,7 +381,7 @@ void main() {
   vec2 position = (vec2(column) + 0.5) / vec2(size.xy) * vec2(crep_march.sizes.xy);
   beginRay(crep_screenRay(crep_march, position, 0.5).xyz);
   float end = crep_march.cameraDepth.z / dot(rayV, crep_march.cameraForward.xyz) * metres;
-  viewBegin();
+  viewBegin(0.0, vec2(0.0));
   imageStore(volumeRayleighOut, ivec3(column, 0), vec4(0.0));
   imageStore(volumeMieOut, ivec3(column, 0), vec4(0.0));
   float t = 0.0;
@@ -430,12 +424,8 @@ void main() {
   } else {
     end = max(crep_raySphere(rayC, rayV, crep_atmosphere.radii.y).y, 0.0);
   }
-  viewBegin();
-  float du = 1.0 / float(n), w = du * 3.0 * end; // du dt/du = w u^2
-  for (int k = 1; k <= n; ++k) {
-    float u = float(k) * du, u0 = u - du;
-    viewStep(end * u * u * u, w * u0 * u0, w * u * u);
-  }
+  viewBegin(0.0, vec2(0.0));
+  viewCubic(end, n);
   imageStore(skyRayleighOut, texel, vec4(vmRayleigh, 0.0));
   imageStore(skyMieOut, texel, vec4(vmMie, 0.0));
 }

@@ -142,8 +142,60 @@ glm::dvec3 extinguishedBy(const AtmosphereParameters& p, const glm::dvec2& d) {
 /// Trapezoid steps of the transmittance of a segment (RayEvaluator::segmentTransmittance; GLSL twin in
 /// passes/atmosphere.comp).
 constexpr int kSegmentSteps = 16;
-/// The power of (a)'s sky substitution t = s_F + (t_X - s_F) u^p (CREP_SKY_POWER in passes/atmosphere.comp).
-constexpr int kSkyStepPower = 3;
+
+/// The trapezoid rule of the phase-free integrands (beta_R d_R, beta_M d_M) T(C->P) T_sun(P) along C + v t
+/// from t0, T(C->P) the densities marched from C (`optical0` those of [0, t0]): step(t, ...) moves to t,
+/// adding to `rayleigh` and `mie`. The aerial perspective volume's slices, the sky-view table's rays and
+/// (a)'s sky (RayEvaluator::skyQuadrature); GLSL twin viewStep in passes/atmosphere.comp.
+class ViewMarch {
+public:
+  ViewMarch(const AtmosphereTables& tables, const glm::dvec3& C, const glm::dvec3& v, const glm::dvec3& l,
+            double t0 = 0.0, const glm::dvec2& optical0 = glm::dvec2(0.0))
+      : tables_(tables), p_(tables.parameters), C_(C), v_(v), l_(l), optical_(optical0), t_(t0) {
+    const glm::dvec3 P = C + v * t0;
+    d_ = densityAt(p_, P);
+    integrand(P, d_, fR_, fM_);
+  }
+  /// One trapezoid step to t: rayleigh += (wPrevious f(t_prev) + w f(t)) / 2, the weights dt (uniform
+  /// steps) or du dt/du at each end (a substitution t(u)); the optical depth takes the step's dt.
+  void step(double t, double wPrevious, double w) {
+    const glm::dvec3 P = C_ + v_ * t;
+    const glm::dvec2 d = densityAt(p_, P);
+    optical_ += 0.5 * (d_ + d) * (t - t_);
+    glm::dvec3 gR, gM;
+    integrand(P, d, gR, gM);
+    rayleigh += 0.5 * (wPrevious * fR_ + w * gR);
+    mie += 0.5 * (wPrevious * fM_ + w * gM);
+    t_ = t;
+    d_ = d;
+    fR_ = gR;
+    fM_ = gM;
+  }
+  /// `n` trapezoid steps in u from the current t to tb in the substitution t = ta + (tb - ta) u^3 (short
+  /// steps in the dense air where a ray starts, long ones towards the top of the atmosphere).
+  void cubic(double tb, int n) {
+    const double ta = t_, len = tb - ta, du = 1.0 / n;
+    const auto weight = [&](double u) { return du * 3.0 * len * u * u; }; // du dt/du
+    for (int k = 1; k <= n; ++k) {
+      const double u = static_cast<double>(k) / n;
+      step(ta + len * u * u * u, weight(u - du), weight(u));
+    }
+  }
+  glm::dvec3 rayleigh{0.0}, mie{0.0};
+
+private:
+  void integrand(const glm::dvec3& P, const glm::dvec2& d, glm::dvec3& fR, glm::dvec3& fM) const {
+    const glm::dvec3 w = extinguishedBy(p_, optical_) * sunTransmittance(tables_, P, l_);
+    fR = p_.rayleighScattering * d.x * w;
+    fM = p_.mieScattering * d.y * w;
+  }
+  const AtmosphereTables& tables_;
+  const AtmosphereParameters& p_;
+  glm::dvec3 C_, v_, l_;
+  glm::dvec2 d_{0.0}, optical_{0.0};
+  glm::dvec3 fR_{0.0}, fM_{0.0};
+  double t_ = 0.0;
+};
 
 /// The look-ups and integrands of one ray from C along v with the sun towards l.
 class RayEvaluator {
@@ -187,27 +239,13 @@ public:
     return atC - segmentTransmittance(t) * of(t);
   }
 
-  /// The trapezoid rule with n steps in u over [ta, tb] of the same integrand as trapezoid(), in the
-  /// substitution t = ta + (tb - ta) u^kSkyStepPower (a sky ray's unshadowed rest).
+  /// The integrand of trapezoid() over [ta, tb] with n steps of ViewMarch::cubic (a sky ray's unshadowed
+  /// rest), T(C->P) the segment's densities to ta, then marched.
   glm::dvec3 skyQuadrature(double ta, double tb, int n) const {
     if (!(tb > ta)) return glm::dvec3(0.0);
-    const double len = tb - ta;
-    glm::dvec2 optical = segmentDensity(ta);
-    glm::dvec2 previous(0.0);
-    double tPrevious = ta;
-    glm::dvec3 sum(0.0);
-    for (int k = 0; k <= n; ++k) {
-      const double u = static_cast<double>(k) / n;
-      const double t = ta + len * std::pow(u, kSkyStepPower);
-      const glm::dvec3 P = at(t);
-      const glm::dvec2 d = density(P);
-      if (k > 0) optical += 0.5 * (previous + d) * (t - tPrevious);
-      previous = d;
-      tPrevious = t;
-      const double dtdu = len * kSkyStepPower * std::pow(u, kSkyStepPower - 1);
-      sum += (k == 0 || k == n ? 0.5 : 1.0) * integrand(P, d) * extinguished(optical) * dtdu;
-    }
-    return sum / static_cast<double>(n);
+    ViewMarch march(tables_, C_, v_, l_, ta, segmentDensity(ta));
+    march.cubic(tb, n);
+    return march.rayleigh * phaseR_ + march.mie * phaseM_;
   }
 
   /// Trapezoid rule with n steps over [ta, tb] of the single-scattering integrand (beta_R d_R p_R + beta_M
@@ -438,48 +476,6 @@ double prefilteredVisibility(const glm::dvec3& shadowed, const DirectionalLight&
 
 namespace {
 
-/// The trapezoid rule of the phase-free integrands (beta_R d_R, beta_M d_M) T(C->P) T_sun(P) along C + v t,
-/// T(C->P) from the densities marched from C: add(t) moves to t, adding to `rayleigh` and `mie` (the
-/// aerial perspective volume's slices and the sky-view table's rays; GLSL twin ViewMarch in
-/// passes/atmosphere.comp).
-class ViewMarch {
-public:
-  ViewMarch(const AtmosphereTables& tables, const glm::dvec3& C, const glm::dvec3& v, const glm::dvec3& l)
-      : tables_(tables), p_(tables.parameters), C_(C), v_(v), l_(l) {
-    d_ = densityAt(p_, C);
-    integrand(C, d_, fR_, fM_);
-  }
-  /// One trapezoid step to t: rayleigh += (wPrevious f(t_prev) + w f(t)) / 2, the weights dt (uniform
-  /// steps) or du dt/du at each end (a substitution t(u)); the optical depth takes the step's dt.
-  void step(double t, double wPrevious, double w) {
-    const glm::dvec3 P = C_ + v_ * t;
-    const glm::dvec2 d = densityAt(p_, P);
-    optical_ += 0.5 * (d_ + d) * (t - t_);
-    glm::dvec3 gR, gM;
-    integrand(P, d, gR, gM);
-    rayleigh += 0.5 * (wPrevious * fR_ + w * gR);
-    mie += 0.5 * (wPrevious * fM_ + w * gM);
-    t_ = t;
-    d_ = d;
-    fR_ = gR;
-    fM_ = gM;
-  }
-  glm::dvec3 rayleigh{0.0}, mie{0.0};
-
-private:
-  void integrand(const glm::dvec3& P, const glm::dvec2& d, glm::dvec3& fR, glm::dvec3& fM) const {
-    const glm::dvec3 w = extinguishedBy(p_, optical_) * sunTransmittance(tables_, P, l_);
-    fR = p_.rayleighScattering * d.x * w;
-    fM = p_.mieScattering * d.y * w;
-  }
-  const AtmosphereTables& tables_;
-  const AtmosphereParameters& p_;
-  glm::dvec3 C_, v_, l_;
-  glm::dvec2 d_{0.0}, optical_{0.0};
-  glm::dvec3 fR_{0.0}, fM_{0.0};
-  double t_ = 0.0;
-};
-
 /// The direction of sky-view texel (i, j) (atmosphere.h's rule); its elevation in `elevation`.
 glm::dvec3 skyViewDirection(const AtmosphereViewTables& view, int i, int j, double* elevation) {
   const int W = view.skyViewSize.x, half = view.skyViewSize.y / 2;
@@ -570,12 +566,7 @@ AtmosphereViewTables atmosphereViewTables(const AtmosphereTables& tables,
         end = -b + std::sqrt(std::max(0.0, b * b - (rc - top) * (rc + top)));
       }
       ViewMarch march(tables, C, v, l);
-      const double du = 1.0 / n;
-      const auto weight = [&](double u) { return du * 3.0 * end * u * u; }; // du dt/du
-      for (int k = 1; k <= n; ++k) {                                        // trapezoid in u
-        const double u = static_cast<double>(k) / n;
-        march.step(end * u * u * u, weight(u - du), weight(u));
-      }
+      march.cubic(end, n);
       const std::size_t index = static_cast<std::size_t>(j) * SW + i;
       view.skyRayleigh[index] = glm::vec3(march.rayleigh);
       view.skyMie[index] = glm::vec3(march.mie);
