@@ -106,26 +106,7 @@ void validateRayOptions(const AtmosphereRayOptions& o) {
   if (o.skySteps < 1 || o.skySteps > 1 << 20)
     throw InvalidArgument("AtmosphereRayOptions.skySteps", detail::formatValue(o.skySteps),
                           "must be in [1, 2^20]");
-  if (o.single != AtmosphereSingleScattering::ViewTables && o.single != AtmosphereSingleScattering::Table4D)
-    throw InvalidArgument("AtmosphereRayOptions.single", detail::formatValue(static_cast<int>(o.single)),
-                          "must be one of AtmosphereSingleScattering");
-  const char* axes[] = {"AtmosphereRayOptions.volumeSize.x", "AtmosphereRayOptions.volumeSize.y",
-                        "AtmosphereRayOptions.volumeSize.z"};
-  for (int i = 0; i < 3; ++i)
-    if (o.volumeSize[i] < 2 || o.volumeSize[i] > 1024)
-      throw InvalidArgument(axes[i], detail::formatValue(o.volumeSize[i]), "must be in [2, 1024]");
-  if (o.volumeSteps < 1 || o.volumeSteps > 64)
-    throw InvalidArgument("AtmosphereRayOptions.volumeSteps", detail::formatValue(o.volumeSteps),
-                          "must be in [1, 64]");
-  if (o.skyViewSize.x < 2 || o.skyViewSize.x > 4096)
-    throw InvalidArgument("AtmosphereRayOptions.skyViewSize.x", detail::formatValue(o.skyViewSize.x),
-                          "must be in [2, 4096]");
-  if (o.skyViewSize.y < 4 || o.skyViewSize.y > 4096 || o.skyViewSize.y % 2 != 0)
-    throw InvalidArgument("AtmosphereRayOptions.skyViewSize.y", detail::formatValue(o.skyViewSize.y),
-                          "must be even and in [4, 4096]");
-  if (o.skyViewSteps < 1 || o.skyViewSteps > 4096)
-    throw InvalidArgument("AtmosphereRayOptions.skyViewSteps", detail::formatValue(o.skyViewSteps),
-                          "must be in [1, 4096]");
+  validateViewTables(o);
 }
 
 /// (d_R, d_M) at P (metres around the planet centre): exp(-h / H) with h = max(0, |P| - R).
@@ -310,6 +291,25 @@ double luminance(const glm::dvec3& c) {
 }
 
 } // namespace
+
+// The view tables' fields (atmosphere.h), named after `owner`.
+void validateViewTables(const AtmosphereRayOptions& o, const std::string& owner) {
+  const auto fail = [&](const std::string& field, int value, const char* why) {
+    throw InvalidArgument(owner + "." + field, detail::formatValue(value), why);
+  };
+  if (o.single != AtmosphereSingleScattering::ViewTables && o.single != AtmosphereSingleScattering::Table4D)
+    fail("single", static_cast<int>(o.single), "must be one of AtmosphereSingleScattering");
+  const char* axes[] = {"volumeSize.x", "volumeSize.y", "volumeSize.z"};
+  for (int i = 0; i < 3; ++i)
+    if (o.volumeSize[i] < 2 || o.volumeSize[i] > 1024) fail(axes[i], o.volumeSize[i], "must be in [2, 1024]");
+  if (o.volumeSteps < 1 || o.volumeSteps > 64) fail("volumeSteps", o.volumeSteps, "must be in [1, 64]");
+  if (o.skyViewSize.x < 2 || o.skyViewSize.x > 4096)
+    fail("skyViewSize.x", o.skyViewSize.x, "must be in [2, 4096]");
+  if (o.skyViewSize.y < 4 || o.skyViewSize.y > 4096 || o.skyViewSize.y % 2 != 0)
+    fail("skyViewSize.y", o.skyViewSize.y, "must be even and in [4, 4096]");
+  if (o.skyViewSteps < 1 || o.skyViewSteps > 4096)
+    fail("skyViewSteps", o.skyViewSteps, "must be in [1, 4096]");
+}
 
 // Yusov 2013, Eq. 8 and "Light shafts" (SS-Int, SS-LUT, MS-UnO); rule at the top of this file.
 AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlacement& placement,

@@ -28,9 +28,9 @@ bool walksTrees(AtmosphereShafts shafts) {
   return shafts == AtmosphereShafts::Integrated || shafts == AtmosphereShafts::LitLengthTable;
 }
 
-void checkSteps(const char* parameter, int steps, int most = 4096) {
-  if (steps < 1 || steps > most)
-    throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, " + std::to_string(most) + "]");
+void checkSteps(const char* parameter, int steps) {
+  if (steps < 1 || steps > 4096)
+    throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, 4096]");
 }
 
 /// A GL_TEXTURE_3D (the aerial perspective volume) or GL_TEXTURE_2D (the sky-view table, size.z 0) RGBA32F;
@@ -60,29 +60,11 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
       throw GlError("crep: AtmospherePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
                     " needs more than 16 tree levels");
   }
-  const AtmosphereSingleScattering single = info.options.single;
-  if (single != AtmosphereSingleScattering::ViewTables && single != AtmosphereSingleScattering::Table4D)
-    throw InvalidArgument("AtmospherePass::CreateInfo.options.single",
-                          std::to_string(static_cast<int>(single)),
-                          "must be one of AtmosphereSingleScattering");
-  view_ = single == AtmosphereSingleScattering::ViewTables && info.shafts != AtmosphereShafts::Integrated;
+  validateViewTables(info.options, "AtmospherePass::CreateInfo.options");
+  view_ = info.options.single == AtmosphereSingleScattering::ViewTables &&
+          info.shafts != AtmosphereShafts::Integrated;
   if (view_) {
     const AtmosphereRayOptions& o = info.options;
-    checkSteps("AtmospherePass::CreateInfo.options.volumeSteps", o.volumeSteps, 64);
-    checkSteps("AtmospherePass::CreateInfo.options.skyViewSteps", o.skyViewSteps);
-    const char* axes[] = {"AtmospherePass::CreateInfo.options.volumeSize.x",
-                          "AtmospherePass::CreateInfo.options.volumeSize.y",
-                          "AtmospherePass::CreateInfo.options.volumeSize.z"};
-    for (int i = 0; i < 3; ++i) {
-      const int n = o.volumeSize[i];
-      if (n < 2 || n > 1024) throw InvalidArgument(axes[i], std::to_string(n), "must be in [2, 1024]");
-    }
-    if (o.skyViewSize.x < 2 || o.skyViewSize.x > 4096)
-      throw InvalidArgument("AtmospherePass::CreateInfo.options.skyViewSize.x",
-                            std::to_string(o.skyViewSize.x), "must be in [2, 4096]");
-    if (o.skyViewSize.y < 4 || o.skyViewSize.y > 4096 || o.skyViewSize.y % 2 != 0)
-      throw InvalidArgument("AtmospherePass::CreateInfo.options.skyViewSize.y",
-                            std::to_string(o.skyViewSize.y), "must be even and in [4, 4096]");
     gl::checkTextureSize("AtmospherePass::CreateInfo.options.skyViewSize", o.skyViewSize.x, o.skyViewSize.y);
     volumeRayleigh_ = createViewTable(o.volumeSize);
     volumeMie_ = createViewTable(o.volumeSize);

@@ -340,6 +340,12 @@ TEST_CASE("Atmosphere pass: bad attributes name the field") {
     bad.options.skySteps = 0;
     requireNamed([&] { AtmospherePass p(bad); }, "AtmospherePass::CreateInfo.options.skySteps");
     bad = info;
+    bad.options.volumeSize.z = 1;
+    requireNamed([&] { AtmospherePass p(bad); }, "AtmospherePass::CreateInfo.options.volumeSize.z");
+    bad = info;
+    bad.options.skyViewSize.y = 7;
+    requireNamed([&] { AtmospherePass p(bad); }, "AtmospherePass::CreateInfo.options.skyViewSize.y");
+    bad = info;
     bad.mapWidth = 0;
     requireNamed([&] { AtmospherePass p(bad); }, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
   }

@@ -361,6 +361,11 @@ struct AtmosphereRayOptions {
   int skyViewSteps = 32;             ///< ViewTables: steps of a sky-view ray, in [1, 4096]
 };
 
+/// Throws InvalidArgument naming `owner`.single, .volumeSize.x, ..., .skyViewSteps for a field of the view
+/// tables out of the range its comment states (atmosphereRay, atmosphereViewTables and AtmospherePass check
+/// them so).
+void validateViewTables(const AtmosphereRayOptions& o, const std::string& owner = "AtmosphereRayOptions");
+
 /// The per-frame tables of one camera (Hillaire 2020, Sec. 5.2-5.3), without phase functions. Both hold
 /// integrals from the camera C along a ray of beta_R d_R T(C->P) T_sun(P) (`...Rayleigh`) and
 /// beta_M d_M T(C->P) T_sun(P) (`...Mie`), per unit sun irradiance, RGB: (a)'s integrand without its phase
