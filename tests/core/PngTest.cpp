@@ -1,6 +1,7 @@
 // PNG output. Files are decoded with stb_image (an independent decoder, header-only, from the same
 // Debian package as stb_image_write) to check content and orientation.
 #include "support/image_check.h"
+#include "support/png_read.h"
 
 #include <crep/core/error.h>
 #include <crep/core/image.h>
@@ -16,19 +17,6 @@
 #include <limits>
 #include <string>
 #include <vector>
-
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wold-style-cast"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#define STB_IMAGE_STATIC
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#define STBI_NO_STDIO
-#include <stb/stb_image.h>
-#pragma GCC diagnostic pop
 
 using crep::Image;
 namespace fs = std::filesystem;
@@ -50,26 +38,10 @@ std::uint32_t bigEndian32(const std::vector<std::uint8_t>& b, std::size_t at) {
          (static_cast<std::uint32_t>(b[at + 2]) << 8) | static_cast<std::uint32_t>(b[at + 3]);
 }
 
-struct Decoded {
-  int width = 0, height = 0, channels = 0;
-  std::vector<std::uint8_t> pixels; // top row first
-  int at(int x, int row, int c) const {
-    return pixels[(static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
-                   static_cast<std::size_t>(x)) *
-                      static_cast<std::size_t>(channels) +
-                  static_cast<std::size_t>(c)];
-  }
-};
-
-Decoded decodePng(const fs::path& path) {
-  const std::vector<std::uint8_t> file = readFile(path);
-  Decoded d;
-  stbi_uc* data =
-      stbi_load_from_memory(file.data(), static_cast<int>(file.size()), &d.width, &d.height, &d.channels, 0);
-  REQUIRE_MESSAGE(data != nullptr, "stb_image cannot decode " << path.string());
-  d.pixels.assign(data, data + static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
-                                   static_cast<std::size_t>(d.channels));
-  stbi_image_free(data);
+/// The PNG at `path` in its own channel count (stb_image), required to decode.
+crep::test::Png decodePng(const fs::path& path) {
+  const crep::test::Png d = crep::test::readPng(path, 0);
+  REQUIRE_MESSAGE(d.width > 0, "stb_image cannot decode " << path.string());
   return d;
 }
 
@@ -140,7 +112,7 @@ TEST_CASE("PNG: signature, IHDR size and colour type, content and orientation de
   CHECK(bytes[24] == 8); // bit depth
   CHECK(bytes[25] == 2); // colour type RGB
 
-  const Decoded d = decodePng(path);
+  const crep::test::Png d = decodePng(path);
   REQUIRE(d.width == w);
   REQUIRE(d.height == h);
   REQUIRE(d.channels == 3);
@@ -161,7 +133,7 @@ TEST_CASE("PNG: exposure multiplies before encoding, NaN and Inf become 0") {
   crep::ToneMap toneMap;
   toneMap.exposure = 2.0f;
   crep::writePng(dir / "exposure.png", image, toneMap);
-  const Decoded d = decodePng(dir / "exposure.png");
+  const crep::test::Png d = decodePng(dir / "exposure.png");
   CHECK(d.at(0, 0, 0) == 188); // 0.25 * 2 = 0.5
   CHECK(d.at(1, 0, 0) == 0);
   CHECK(d.at(1, 0, 1) == 188);
@@ -178,14 +150,14 @@ TEST_CASE("PNG: channel mapping: grey, RG, RGB with alpha dropped or kept") {
   SUBCASE("1 channel -> grey") {
     crep::writePng(dir / "grey.png", Image(3, 2, 1, 0.5f));
     CHECK(readFile(dir / "grey.png")[25] == 0);
-    const Decoded d = decodePng(dir / "grey.png");
+    const crep::test::Png d = decodePng(dir / "grey.png");
     REQUIRE(d.channels == 1);
     CHECK(d.at(2, 1, 0) == 188);
   }
   SUBCASE("2 channels -> RGB with blue 0") {
     Image image(3, 2, 2, 1.0f);
     crep::writePng(dir / "rg.png", image);
-    const Decoded d = decodePng(dir / "rg.png");
+    const crep::test::Png d = decodePng(dir / "rg.png");
     REQUIRE(d.channels == 3);
     CHECK(d.at(0, 0, 0) == 255);
     CHECK(d.at(0, 0, 1) == 255);
@@ -202,7 +174,7 @@ TEST_CASE("PNG: channel mapping: grey, RG, RGB with alpha dropped or kept") {
     keep.exposure = 0.5f; // alpha is not exposed
     crep::writePng(dir / "rgba.png", image, keep);
     CHECK(readFile(dir / "rgba.png")[25] == 6);
-    const Decoded d = decodePng(dir / "rgba.png");
+    const crep::test::Png d = decodePng(dir / "rgba.png");
     REQUIRE(d.channels == 4);
     CHECK(d.at(0, 0, 0) == crep::encodeSrgb8(0.25f));
     CHECK(d.at(0, 0, 3) == 128); // floor(0.5 * 255 + 0.5)

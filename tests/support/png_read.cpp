@@ -22,20 +22,19 @@
 
 namespace crep::test {
 
-Png readPng(const std::filesystem::path& path) {
+Png readPng(const std::filesystem::path& path, int channels) {
   std::ifstream in(path, std::ios::binary);
   const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
                                          std::istreambuf_iterator<char>());
   Png png;
-  int channels = 0;
+  int fileChannels = 0;
   unsigned char* data = stbi_load_from_memory(bytes.data(), static_cast<int>(bytes.size()), &png.width,
-                                              &png.height, &channels, 3);
-  if (data) {
-    png.rgb.assign(data, data + static_cast<std::size_t>(png.width) * png.height * 3);
-    stbi_image_free(data);
-  } else {
-    png.width = png.height = 0;
-  }
+                                              &png.height, &fileChannels, channels);
+  if (!data) return {};
+  png.channels = channels > 0 ? channels : fileChannels;
+  png.pixels.assign(data, data + static_cast<std::size_t>(png.width) * static_cast<std::size_t>(png.height) *
+                                     static_cast<std::size_t>(png.channels));
+  stbi_image_free(data);
   return png;
 }
 

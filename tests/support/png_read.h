@@ -1,20 +1,25 @@
-// Reading the tool's PNG outputs back in tests (stb_image): 8-bit RGB, row 0 at the top as in the file.
+// Reading PNGs back in tests (stb_image): 8-bit samples, rows top to bottom as in the file.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <vector>
 
 namespace crep::test {
 
-/// A decoded PNG as 8-bit RGB, rows top to bottom; width = height = 0 when the file does not decode.
+/// A decoded PNG; width = height = 0 when the file does not decode.
 struct Png {
-  int width = 0, height = 0;
-  std::vector<unsigned char> rgb;
-  const unsigned char* at(int x, int y) const {
-    return rgb.data() + (static_cast<std::size_t>(y) * width + x) * 3;
+  int width = 0, height = 0, channels = 0;
+  std::vector<unsigned char> pixels; ///< row-major from the top row, `channels` per pixel
+  int at(int x, int row, int c) const {
+    return pixels[(static_cast<std::size_t>(row) * static_cast<std::size_t>(width) +
+                   static_cast<std::size_t>(x)) *
+                      static_cast<std::size_t>(channels) +
+                  static_cast<std::size_t>(c)];
   }
 };
 
-Png readPng(const std::filesystem::path& path);
+/// The PNG at `path` with `channels` samples per pixel (stb_image converts), or 0 for the file's own.
+Png readPng(const std::filesystem::path& path, int channels = 3);
 
 } // namespace crep::test

@@ -145,10 +145,10 @@ TEST_CASE("crep compare: every title and text line stays within its tile") {
   const crep::test::Png sheet = crep::test::readPng(prefix + ".png");
   const int columns = 4, tile = 80, margin = 8;
   REQUIRE(sheet.width == margin + columns * (tile + margin));
-  const unsigned char* background = sheet.at(0, sheet.height - 1);
   const auto isBackground = [&](int x, int y) {
-    const unsigned char* p = sheet.at(x, y);
-    return p[0] == background[0] && p[1] == background[1] && p[2] == background[2];
+    for (int c = 0; c < 3; ++c)
+      if (sheet.at(x, y, c) != sheet.at(0, sheet.height - 1, c)) return false;
+    return true;
   };
   // The first row of images: the first run of 20 rows that are not background at the first tile's centre
   // (a line of text is at most 10 rows tall).

@@ -25,9 +25,9 @@ using crep::test::runCrep;
 /// Mean absolute difference of two same-size PNGs in 8-bit codes.
 double meanDifference(const Png& a, const Png& b) {
   double sum = 0.0;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i)
-    sum += std::abs(int(a.rgb[i]) - int(b.rgb[i]));
-  return sum / double(a.rgb.size());
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    sum += std::abs(int(a.pixels[i]) - int(b.pixels[i]));
+  return sum / double(a.pixels.size());
 }
 
 const std::string kCommon = "render --size 160x90 --map-size 128 --steps 32 ";
@@ -64,9 +64,9 @@ TEST_CASE("crep render --tonemap: two operators write different PNGs of the fram
   CHECK(ap > 1.0);
   // Not black: the auto exposure brings the frame's log-average to middle grey.
   double sum = 0.0;
-  for (unsigned char v : pa.rgb)
+  for (unsigned char v : pa.pixels)
     sum += v;
-  CHECK(sum / double(pa.rgb.size()) > 20.0);
+  CHECK(sum / double(pa.pixels.size()) > 20.0);
 }
 
 TEST_CASE("crep render --tonemap all: a sheet with one tile per operator") {
