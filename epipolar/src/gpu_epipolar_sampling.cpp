@@ -1,7 +1,8 @@
 // The GPU stage passes of epipolar sampling (crep/epipolar/gpu_epipolar_sampling.h; Yusov 2012, Sec. 6):
-// lines on the CPU (epipolarLines), then passes/epipolar_coordinates.comp (Sec. 6.1),
-// epipolar_refine.comp (Sec. 6.2, Yusov 2013's criterion), epipolar_interpolate.comp (Sec. 6.5),
-// epipolar_unwarp.comp (Sec. 6.6) and epipolar_upscale.comp (Sec. 6.8), with work lists in between.
+// lines on the CPU (epipolarLines), then passes/epipolar/coordinates.comp (Sec. 6.1),
+// passes/epipolar/refine.comp (Sec. 6.2, Yusov 2013's criterion), passes/epipolar/interpolate.comp
+// (Sec. 6.5), passes/epipolar/unwarp.comp (Sec. 6.6) and passes/epipolar/upscale.comp (Sec. 6.8), with work
+// lists in between.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
@@ -94,13 +95,13 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
   targetWidth_ = info.width / o.downscale;
   targetHeight_ = info.height / o.downscale;
 
-  coordinatesProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar_coordinates.comp", {}}});
+  coordinatesProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/coordinates.comp", {}}});
   refineProgram_ = buildProgram(
-      {{ShaderStage::Compute, "passes/epipolar_refine.comp", {{"CREP_SAMPLES", std::to_string(o.samples)}}}});
-  interpolateProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar_interpolate.comp", {}}});
-  unwarpProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar_unwarp.comp", {}}});
+      {{ShaderStage::Compute, "passes/epipolar/refine.comp", {{"CREP_SAMPLES", std::to_string(o.samples)}}}});
+  interpolateProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/interpolate.comp", {}}});
+  unwarpProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/unwarp.comp", {}}});
   if (o.downscale > 1)
-    upscaleProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar_upscale.comp", {}}});
+    upscaleProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/upscale.comp", {}}});
 
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   samplingParams_ = gl::createDynamicBuffer(sizeof(gpu::EpipolarSamplingParams));

@@ -1,4 +1,4 @@
-// The epipolar layout's GPU block and slice table (crep/epipolar/gpu_layout.h, glsl/crep/epipolar.glsl).
+// The epipolar layout's GPU block and slice table (crep/epipolar/gpu_layout.h, glsl/crep/layout.glsl).
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>

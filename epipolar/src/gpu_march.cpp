@@ -1,7 +1,7 @@
 // GPU passes of the marches (crep/epipolar/gpu_march.h) and the shared blocks (gpu_layout.h): min/max
 // trees (Yusov 2012 Sec. 6.3) and the tree / brute-force march along rectified rows (Algorithm 2). The
 // world-space reference march is WorldMarchPass in scatter/ (crep/scatter/gpu_world_march.h). Shaders:
-// passes/minmax_build.comp, passes/march_rectified.comp, crep/epipolar.glsl.
+// passes/epipolar/minmax_build.comp, passes/epipolar/march_rectified.comp, crep/layout.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
@@ -36,7 +36,7 @@ MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
     throw GlError("crep: MinMaxTreePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
                   " needs more than 16 tree levels");
   rowStride_ = MinMaxTrees::rowStrideFor(info.mapWidth);
-  program_ = buildProgram({{ShaderStage::Compute, "passes/minmax_build.comp", {}}});
+  program_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/minmax_build.comp", {}}});
   buffer_ = gl::createBuffer();
   const long long bytes = static_cast<long long>(std::max(rowStride_, 1)) * info.mapHeight * 8;
   glNamedBufferStorage(buffer_.get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
@@ -71,8 +71,8 @@ void MinMaxTreePass::completeUpperLevels() {
     throw InvalidArgument("MinMaxTreePass::CreateInfo.mapWidth", std::to_string(info_.mapWidth),
                           "must exceed 64 texels for completeUpperLevels (no low levels to start from)");
   if (!upperProgram_)
-    upperProgram_ =
-        buildProgram({{ShaderStage::Compute, "passes/minmax_build.comp", {{"CREP_TREE_UPPER_ONLY", "1"}}}});
+    upperProgram_ = buildProgram(
+        {{ShaderStage::Compute, "passes/epipolar/minmax_build.comp", {{"CREP_TREE_UPPER_ONLY", "1"}}}});
   const GLuint p = upperProgram_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
@@ -121,7 +121,7 @@ std::uint32_t RectifiedMarchPass::program(gpu::LayoutKind kind, bool textured, b
   gl::Handle& program = programs_[list ? 1 : 0][textured ? 1 : 0][k];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
-                             "passes/march_rectified.comp",
+                             "passes/epipolar/march_rectified.comp",
                              {{"CREP_MARCH_TREE", info_.mode == Mode::MinMaxTree ? "1" : "0"},
                               {"CREP_LAYOUT", std::to_string(k)},
                               {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},

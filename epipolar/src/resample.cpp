@@ -188,7 +188,7 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   gl::Handle& program = programs_[static_cast<int>(kind)][trees ? 1 : 0];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
-                             "passes/epipolar_resample.comp",
+                             "passes/epipolar/resample.comp",
                              {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
                               {"CREP_RESAMPLE_TREES", trees ? "1" : "0"}}}});
   gpu::MarchParams params;

@@ -16,8 +16,8 @@
 #include "scene_frame.h"
 #include "timings.h"
 
+#include <crep/atmosphere/atmosphere.h>
 #include <crep/core/error.h>
-#include <crep/postfx/atmosphere.h>
 #include <crep/postfx/gpu_tone_mapping.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>

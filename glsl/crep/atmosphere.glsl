@@ -1,8 +1,8 @@
-// crepuscular: the Earth atmosphere's tables and their look-ups (GLSL twin of crep/postfx/atmosphere.h,
+// crepuscular: the Earth atmosphere's tables and their look-ups (GLSL twin of crep/atmosphere/atmosphere.h,
 // whose top comment states the units, frames, parameterisation and packing; float precision).
 //
 // Public include (conventions in crep/common.glsl). An engine reads the tables of AtmosphereTablesPass
-// (crep/postfx/gpu_atmosphere.h) in its own shaders, e.g. the sun's transmittance and the ambient sky
+// (crep/atmosphere/gpu_tables.h) in its own shaders, e.g. the sun's transmittance and the ambient sky
 // light of its terrain shading:
 //   layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
 //   vec3 p = crep_atmospherePosition(crep_atmosphere, worldPosition);
@@ -130,7 +130,7 @@ vec3 crep_sampleAtmosphereTable(sampler3D table, CrepAtmosphereParams a, vec4 co
   return crep_sampleAtmosphereTableRgba(table, a, coords).rgb;
 }
 
-// Single scattering is stored without its phase functions (crep/postfx/atmosphere.h): the single table
+// Single scattering is stored without its phase functions (crep/atmosphere/atmosphere.h): the single table
 // holds S_R in RGB and S_M's red in A, the single Mie table S_M in RGB. With
 // CREP_ATMOSPHERE_COMBINED_MIE 1 (AtmospherePrecomputeOptions::combinedMie) there is no single Mie table
 // and S_M is rebuilt from the single table's texel by Bruneton's 2017 rule (crep::combinedMieScattering).

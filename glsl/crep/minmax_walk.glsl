@@ -1,7 +1,7 @@
 // crepuscular: the min/max tree walk along one row of a rectified map (Chen et al. 2011; Yusov 2012,
-// Algorithm 2 and Sec. 4): the lit sections of a view ray mapped onto its row (crep/epipolar.glsl's
-// crep_mapRowRay), shared by passes/march_rectified.comp (the march, crep::minMaxMarch) and
-// passes/atmosphere.comp (the atmosphere's light shafts, crep::minMaxLitSections). Float precision.
+// Algorithm 2 and Sec. 4): the lit sections of a view ray mapped onto its row (crep/layout.glsl's
+// crep_mapRowRay), shared by passes/epipolar/march_rectified.comp (the march, crep::minMaxMarch) and
+// passes/atmosphere/atmosphere.comp (the atmosphere's light shafts, crep::minMaxLitSections). Float precision.
 //
 // GLSL has no callbacks: the includer declares, BEFORE including this file,
 //   sampler2D rectifiedDepth                      the W x H map (texelFetch, level 0)
@@ -13,7 +13,7 @@
 // own, as every public include must).
 #ifndef CREP_MINMAX_WALK_GLSL
 #define CREP_MINMAX_WALK_GLSL
-#include "crep/epipolar.glsl"
+#include "crep/layout.glsl"
 #ifdef CREP_MINMAX_WALK_INPUTS
 
 #ifndef CREP_MAX_TREE_LEVELS

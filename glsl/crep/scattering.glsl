@@ -37,12 +37,12 @@
 //                              is still read: CREP_NO_FP64 0 means CREP_FP64 1.
 //   CREP_VISIBILITY_TABLE_SAMPLES  Z: read the visibility of every region a ray crosses whole from the
 //                              region visibility table (crep::EvaluateOptions::visibilityTableSamples; built
-//                              by EvaluatePass, or glsl/passes/visibility_table.comp) bound as a sampler2D
+//                              by EvaluatePass, or glsl/passes/prefilter/visibility_table.comp) bound as a sampler2D
 //                              with GL_LINEAR at CREP_VISIBILITY_TABLE_UNIT (default 6); one fetch instead of
 //                              M / 4 per such region. Ignored with CREP_NEAR_PLANE_CORRECTION 1.
 //   CREP_SCATTERING_PREFIX     1 (with CREP_VISIBILITY_TABLE_SAMPLES): read the regions a ray crosses whole
 //                              from the scattering prefix table instead (crep::EvaluateOptions::
-//                              scatteringPrefix; built by EvaluatePass, or glsl/passes/scattering_prefix.comp)
+//                              scatteringPrefix; built by EvaluatePass, or glsl/passes/prefilter/scattering_prefix.comp)
 //                              bound as an RGBA32F sampler2D with GL_LINEAR at CREP_SCATTERING_PREFIX_UNIT
 //                              (default 7): one fetch per pixel, whatever the number of regions crossed.
 //   CREP_LOCAL_SECTIONS        1 (with CREP_LOCAL_LIGHT and CREP_SCATTERING_PREFIX): the last region's
@@ -65,7 +65,7 @@
 //                              V_c = cbar_c clamp(0.5 + a . F_c, 0, 1). Not with CREP_NEAR_PLANE_CORRECTION
 //                              nor with the visibility table alone (use the scattering prefix or no table).
 //   CREP_SCATTERING_NO_EVALUATION  only the math (no block, no sampler): what the prefilter pass uses.
-//   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/epipolar.glsl instead of the projective
+//   CREP_EVAL_LAYOUT           evaluate on a layout block of crep/layout.glsl instead of the projective
 //                              frame of the scattering block: CREP_LAYOUT_PROJECTIVE (0) or
 //                              CREP_LAYOUT_EPIPOLAR (1, the fallback of Klehm et al. 2014, Sec. 4.1). Bind
 //                              the layout block at CREP_LAYOUT_BINDING and, for the epipolar layout, the
@@ -405,7 +405,7 @@ layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegion
 
 #ifdef CREP_EVAL_LAYOUT
 #define CREP_LAYOUT CREP_EVAL_LAYOUT
-#include "epipolar.glsl"
+#include "layout.glsl"
 #endif
 
 #if CREP_LOCAL_LIGHT
@@ -503,7 +503,7 @@ struct CrepEvalRay {
   float u;
   vec4 data;     // projective frame: (y, z, 0, 0)
 #ifdef CREP_EVAL_LAYOUT
-  CrepRowRay rr; // layout: the row ray of crep/epipolar.glsl
+  CrepRowRay rr; // layout: the row ray of crep/layout.glsl
 #endif
 };
 

@@ -98,10 +98,10 @@ DepthAwareResamplePass::DepthAwareResamplePass(const CreateInfo& info) : info_(i
   gl::checkTextureSize("DepthAwareResamplePass::CreateInfo.width/height", info.width, info.height);
   const std::string f = std::to_string(info.factor);
   downsampleProgram_ =
-      buildProgram({{ShaderStage::Compute, "passes/depth_downsample.comp", {{"CREP_FACTOR", f}}}});
+      buildProgram({{ShaderStage::Compute, "passes/pipeline/depth_downsample.comp", {{"CREP_FACTOR", f}}}});
   upsampleProgram_ =
       buildProgram({{ShaderStage::Compute,
-                     "passes/depth_upsample.comp",
+                     "passes/pipeline/depth_upsample.comp",
                      {{"CREP_FACTOR", f}, {"CREP_DEPTH_EPSILON", std::to_string(kUpsampleDepthEpsilon)}}}});
   sampler_ = gl::createClampSampler(GL_NEAREST);
 }

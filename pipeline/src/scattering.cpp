@@ -418,7 +418,7 @@ struct Scattering::Impl {
   /// (the surface radiance's factor in Klehm et al. 2014, Eq. 1).
   void writeTransmittance(const FrameAttribs& f) {
     if (!transmittance) {
-      transmittance = buildProgram({{ShaderStage::Compute, "passes/transmittance.comp", {}}});
+      transmittance = buildProgram({{ShaderStage::Compute, "passes/pipeline/transmittance.comp", {}}});
       transmittanceParams = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
       transmittanceSampler = gl::createClampSampler(GL_NEAREST);
     }
@@ -814,7 +814,7 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
   if (f.spotLights.empty() && f.pointLights.empty()) return;
   if (!m.localScattering) {
     m.localScattering = gl::createTexture2D(GL_RGBA32F, info.width, info.height, "Scattering: local light");
-    m.accumulate = buildProgram({{ShaderStage::Compute, "passes/accumulate.comp", {}}});
+    m.accumulate = buildProgram({{ShaderStage::Compute, "passes/pipeline/accumulate.comp", {}}});
   }
   const auto timed = [&](LightResult& result, const char* name, const auto& work) {
     const Stage s = m.timedStage(name, work);

@@ -1,6 +1,7 @@
 // The froxel fog's GL passes and front door (crep/postfx/gpu_froxel_fog.h; Wronski 2014, "Volumetric
-// Fog"). Shaders: passes/esm_downsample.comp, passes/esm_blur.comp, passes/froxel_light.comp,
-// passes/froxel_accumulate.comp, passes/froxel_temporal.comp, passes/froxel_apply.comp, crep/froxel.glsl.
+// Fog"). Shaders: passes/postfx/esm_downsample.comp, passes/postfx/esm_blur.comp,
+// passes/postfx/froxel_light.comp, passes/postfx/froxel_accumulate.comp, passes/postfx/froxel_temporal.comp,
+// passes/postfx/froxel_apply.comp, crep/froxel.glsl.
 #include <crep/postfx/gpu_froxel_fog.h>
 
 #include <crep/core/error.h>
@@ -153,8 +154,8 @@ gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, cons
 
 EsmPass::EsmPass(const CreateInfo& info) : info_(info) {
   validate(info.options, "EsmPass::CreateInfo.options");
-  downsample_ = buildProgram({{ShaderStage::Compute, "passes/esm_downsample.comp", {}}});
-  blur_ = buildProgram({{ShaderStage::Compute, "passes/esm_blur.comp", {}}});
+  downsample_ = buildProgram({{ShaderStage::Compute, "passes/postfx/esm_downsample.comp", {}}});
+  blur_ = buildProgram({{ShaderStage::Compute, "passes/postfx/esm_blur.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("EsmPass");
@@ -217,7 +218,7 @@ FroxelLightingPass::FroxelLightingPass(const CreateInfo& info) : info_(info) {
     if (!(info.ambient[c] >= 0.0) || !std::isfinite(info.ambient[c]))
       throw InvalidArgument(name(owner, "ambient"), detail::formatValue(info.ambient[c]),
                             "must be finite and >= 0");
-  program_ = buildFroxelProgram("passes/froxel_light.comp", info.format);
+  program_ = buildFroxelProgram("passes/postfx/froxel_light.comp", info.format);
   params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("FroxelLightingPass");
@@ -267,7 +268,7 @@ void FroxelLightingPass::run(const FrameAttribs& f) {
 FroxelAccumulatePass::FroxelAccumulatePass(const CreateInfo& info) : info_(info) {
   requireGrid(info.grid, "FroxelAccumulatePass::CreateInfo");
   validateFroxelFormat(info.format, "FroxelAccumulatePass::CreateInfo");
-  program_ = buildFroxelProgram("passes/froxel_accumulate.comp", info.format);
+  program_ = buildFroxelProgram("passes/postfx/froxel_accumulate.comp", info.format);
   params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
   gl::checkError("FroxelAccumulatePass");
 }
@@ -293,7 +294,7 @@ void FroxelAccumulatePass::run(const FrameAttribs& f) {
 FroxelTemporalPass::FroxelTemporalPass(const CreateInfo& info) : info_(info) {
   requireGrid(info.grid, "FroxelTemporalPass::CreateInfo");
   validateFroxelFormat(info.format, "FroxelTemporalPass::CreateInfo");
-  program_ = buildFroxelProgram("passes/froxel_temporal.comp", info.format);
+  program_ = buildFroxelProgram("passes/postfx/froxel_temporal.comp", info.format);
   params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);
   linear_ = linearClampSampler();
@@ -339,7 +340,7 @@ void FroxelTemporalPass::run(const FrameAttribs& f) {
 
 FroxelApplyPass::FroxelApplyPass(const CreateInfo& info) : info_(info) {
   requireGrid(info.grid, "FroxelApplyPass::CreateInfo");
-  program_ = buildProgram({{ShaderStage::Compute, "passes/froxel_apply.comp", {}}});
+  program_ = buildProgram({{ShaderStage::Compute, "passes/postfx/froxel_apply.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);
   linear_ = linearClampSampler();

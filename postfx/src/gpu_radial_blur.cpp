@@ -1,5 +1,5 @@
 // The GL pass of Mitchell 2007's radial blur (crep/postfx/gpu_radial_blur.h; rules in
-// crep/postfx/radial_blur.h). Shaders: passes/radial_source.comp, passes/radial_blur.comp,
+// crep/postfx/radial_blur.h). Shaders: passes/postfx/radial_source.comp, passes/postfx/radial_blur.comp,
 // crep/radial_blur.glsl, crep/march.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -41,8 +41,8 @@ RadialBlurPass::RadialBlurPass(const CreateInfo& info) : info_(info) {
   std::vector<ShaderDefine> blurDefines = defines;
   if (info.options.mode == RadialBlurMode::OcclusionFraction)
     blurDefines.push_back({"CREP_RADIAL_FRACTION", "1"});
-  sourceProgram_ = buildProgram({{ShaderStage::Compute, "passes/radial_source.comp", defines}});
-  blurProgram_ = buildProgram({{ShaderStage::Compute, "passes/radial_blur.comp", blurDefines}});
+  sourceProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/radial_source.comp", defines}});
+  blurProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/radial_blur.comp", blurDefines}});
   marchParams_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   radialParams_ = gl::createDynamicBuffer(sizeof(gpu::RadialBlurParams));
   nearest_ = gl::createClampSampler(GL_NEAREST);

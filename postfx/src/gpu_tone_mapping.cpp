@@ -1,7 +1,7 @@
 // The GL tone-mapping pass (crep/postfx/gpu_tone_mapping.h): log-average luminance (Reinhard et al. 2002,
 // Eq. 1) by a two-pass reduction, light adaptation (Pattanaik et al. 2000 as in Yusov's demo) and the
-// operators of glsl/crep/tone_mapping.glsl. Shaders: passes/luminance_reduce.comp,
-// passes/luminance_adapt.comp, passes/tone_map.comp.
+// operators of glsl/crep/tone_mapping.glsl. Shaders: passes/postfx/luminance_reduce.comp,
+// passes/postfx/luminance_adapt.comp, passes/tone_map.comp.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/postfx/gpu_tone_mapping.h>
@@ -21,8 +21,8 @@ constexpr const char* kOwner = "ToneMapPass::CreateInfo.options";
 
 ToneMapPass::ToneMapPass(const CreateInfo& info) : info_(info) {
   validate(info.options, kOwner);
-  reduceProgram_ = buildProgram({{ShaderStage::Compute, "passes/luminance_reduce.comp", {}}});
-  adaptProgram_ = buildProgram({{ShaderStage::Compute, "passes/luminance_adapt.comp", {}}});
+  reduceProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_reduce.comp", {}}});
+  adaptProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_adapt.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::ToneMapParams));
   // The state starts zeroed: valid = 0, so the first reduced frame sets the adapted luminance.
   state_ = gl::createBuffer();
@@ -46,7 +46,7 @@ std::uint32_t ToneMapPass::toneMapProgram(std::uint32_t outputFormat) {
   gl::Handle& program = toneMapPrograms_[key];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
-                             "passes/tone_map.comp",
+                             "passes/postfx/tone_map.comp",
                              {{"CREP_TONE_MAP_OPERATOR", std::to_string(static_cast<int>(info_.options.op))},
                               {"CREP_TONE_MAP_FORMAT", rgba8 ? "rgba8" : "rgba32f"},
                               {"CREP_TONE_MAP_SRGB", info_.encodeSrgb ? "1" : "0"}}}});

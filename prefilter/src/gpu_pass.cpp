@@ -1,9 +1,10 @@
 // GPU prefilter and evaluation passes of prefiltered single scattering: Klehm, Seidel, Eisemann 2014,
 // Sec. 3.3 (fused basis transform and weighted prefix filter, Listings 2-3; regions and bases per thread,
 // Table 1; normalized storage, Appendix A) and the per-pixel evaluation (Listing 4). The shaders are
-// glsl/passes/prefilter.comp, glsl/passes/evaluate.comp and the public glsl/crep/scattering.glsl; the
-// host side here validates, computes the per-row weight data in double (gpu::RegionWeights), fills the
-// shared blocks (gpu_structs.h) and dispatches. Contract: crep/prefilter/prefilter.h.
+// glsl/passes/prefilter/prefilter.comp, glsl/passes/prefilter/evaluate.comp and the public
+// glsl/crep/scattering.glsl; the host side here validates, computes the per-row weight data in double
+// (gpu::RegionWeights), fills the shared blocks (gpu_structs.h) and dispatches. Contract:
+// crep/prefilter/prefilter.h.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
@@ -262,7 +263,7 @@ std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& 
                                                bool textured = false) {
   const PrefilterOptions& o = info.options;
   return {{ShaderStage::Compute,
-           "passes/prefilter.comp",
+           "passes/prefilter/prefilter.comp",
            {{"CREP_BASES_PER_INVOCATION", str(basesPerInvocation(info, local))},
             {"CREP_BASIS_FORMAT", imageFormatQualifier(o.format)},
             {"CREP_BASIS_UNORM8", o.format == StorageFormat::RGBA8 ? "1" : "0"},
@@ -528,7 +529,7 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
                                               bool list = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
-       "passes/evaluate.comp",
+       "passes/prefilter/evaluate.comp",
        {{"CREP_BASES", str(info.bases)},
         // A work list's output is RGBA32F (crep/scatter/gpu_sample_list.h) whatever the pass's format.
         {"CREP_OUTPUT_FORMAT", list ? "rgba32f" : storageFormatToken(info.outputFormat)},
@@ -567,7 +568,7 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
                                             bool local = false, bool textured = false) {
   std::vector<ShaderStageSource> stages = {
       {ShaderStage::Compute,
-       "passes/scattering_prefix.comp",
+       "passes/prefilter/scattering_prefix.comp",
        {{"CREP_BASES", str(info.bases)},
         {"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
         {"CREP_TABLE_COEFFICIENTS_BINDING", str(kTableCoefficientsBinding)},
@@ -614,7 +615,7 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
     prefixPrograms_[0] = buildProgram(prefixStages(info, -1));
   else if (usesVisibilityTable(info.options))
     tableProgram_ = buildProgram({{ShaderStage::Compute,
-                                   "passes/visibility_table.comp",
+                                   "passes/prefilter/visibility_table.comp",
                                    {{"CREP_BASES", str(info.bases)},
                                     {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
                                     {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}});

@@ -1,5 +1,5 @@
 // Light textures on the GPU (Klehm et al. 2014, Sec. 3.2 coloured light textures): validation of the
-// caller's texture and projection, and the colour map pass (glsl/passes/light_colors.comp). Rules in
+// caller's texture and projection, and the colour map pass (glsl/passes/scatter/light_colors.comp). Rules in
 // crep/scatter/light_texture.h.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -78,7 +78,7 @@ void LightColorMapPass::run(const FrameAttribs& f) {
   gl::Handle& program = programs_[static_cast<int>(kind)];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
-                             "passes/light_colors.comp",
+                             "passes/scatter/light_colors.comp",
                              {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
   const gpu::LightTextureParams params =
       gpu::makeLightTextureParams(f.lightTexture, level, info_.mapWidth, info_.mapHeight, f.localLight);

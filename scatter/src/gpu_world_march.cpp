@@ -1,5 +1,5 @@
 // The GL pass of the world-space reference march (crep/scatter/gpu_world_march.h; Klehm et al. 2014,
-// Eq. 1 and 3) and the shared march block. Shader: passes/march_reference.comp, crep/march.glsl,
+// Eq. 1 and 3) and the shared march block. Shader: passes/scatter/march_reference.comp, crep/march.glsl,
 // crep/local_light.glsl.
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -115,7 +115,7 @@ void dispatchMarch(int width, int height, const char* what) {
 
 WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
   validate(info.options);
-  program_ = buildProgram({{ShaderStage::Compute, "passes/march_reference.comp", {}}});
+  program_ = buildProgram({{ShaderStage::Compute, "passes/scatter/march_reference.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("WorldMarchPass");
@@ -184,7 +184,7 @@ void WorldMarchPass::run(const FrameAttribs& f) {
     // Light textures (Klehm et al. 2014, Sec. 3.2): the CREP_LIGHT_TEXTURE variant and its block.
     if (!texturedProgram_) {
       texturedProgram_ = buildProgram(
-          {{ShaderStage::Compute, "passes/march_reference.comp", {{"CREP_LIGHT_TEXTURE", "1"}}}});
+          {{ShaderStage::Compute, "passes/scatter/march_reference.comp", {{"CREP_LIGHT_TEXTURE", "1"}}}});
       textureParams_ = gl::createDynamicBuffer(sizeof(gpu::LightTextureParams));
     }
     program = texturedProgram_.get();

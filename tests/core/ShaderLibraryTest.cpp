@@ -376,7 +376,7 @@ TEST_CASE("no shader uses a double type by default: neither its preprocessed sou
   CHECK(compiled >= 15);
   // The check itself: the opt-in CREP_FP64 path does declare doubles, and the test sees them.
   const std::vector<ShaderDefine> opt = {{"CREP_FP64", "1"}};
-  ExpandedShader fp64 = ShaderLibrary::expand("passes/prefilter.comp", opt);
+  ExpandedShader fp64 = ShaderLibrary::expand("passes/prefilter/prefilter.comp", opt);
   const RunResult r = glslang("passes/prefilter.comp.CREP_FP64", "comp", fp64.text, "-G -H");
   REQUIRE(r.exitCode == 0);
   CHECK(contains(r.output, "TypeFloat 64"));

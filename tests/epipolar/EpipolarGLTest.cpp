@@ -506,9 +506,9 @@ TEST_CASE("epipolar GL: uniform and storage blocks match their C++ structs") {
   using gpu::MarchParams;
   using gpu::ProjectiveLayoutParams;
   const gl::Handle projective =
-      buildProgram({{ShaderStage::Compute, "passes/march_rectified.comp", {{"CREP_LAYOUT", "0"}}}});
+      buildProgram({{ShaderStage::Compute, "passes/epipolar/march_rectified.comp", {{"CREP_LAYOUT", "0"}}}});
   const gl::Handle epipolar =
-      buildProgram({{ShaderStage::Compute, "passes/march_rectified.comp", {{"CREP_LAYOUT", "1"}}}});
+      buildProgram({{ShaderStage::Compute, "passes/epipolar/march_rectified.comp", {{"CREP_LAYOUT", "1"}}}});
 #define CREP_CHECK_MEMBER(program, block, type, member)                                                      \
   CHECK(offsetOf(program, std::string(block) + "." #member) == static_cast<GLint>(offsetof(type, member)))
   const GLuint p = projective.get(), e = epipolar.get();
@@ -531,7 +531,8 @@ TEST_CASE("epipolar GL: uniform and storage blocks match their C++ structs") {
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightCone);
   CREP_CHECK_MEMBER(p, "crep_march", MarchParams, lightIntensity);
   // The world march (the one pass that reads the local-light members) sees the same block.
-  const gl::Handle reference = buildProgram({{ShaderStage::Compute, "passes/march_reference.comp", {}}});
+  const gl::Handle reference =
+      buildProgram({{ShaderStage::Compute, "passes/scatter/march_reference.comp", {}}});
   const GLuint w = reference.get();
   CHECK(blockSize(w, "CrepMarchBlock") == static_cast<GLint>(sizeof(MarchParams)));
   CREP_CHECK_MEMBER(w, "crep_march", MarchParams, lightClipFromWorld);

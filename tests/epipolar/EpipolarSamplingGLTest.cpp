@@ -193,7 +193,7 @@ DirectionalLight lightOf(int which) {
 
 TEST_CASE("EpipolarSampling GL: the blocks match their C++ structs") {
   CREP_REQUIRE_GL();
-  const gl::Handle program = buildProgram({{ShaderStage::Compute, "passes/epipolar_unwarp.comp", {}}});
+  const gl::Handle program = buildProgram({{ShaderStage::Compute, "passes/epipolar/unwarp.comp", {}}});
   const GLuint p = program.get();
   const auto uniformOffset = [p](const char* name) {
     const GLuint index = glGetProgramResourceIndex(p, GL_UNIFORM, name);

@@ -133,7 +133,7 @@ TEST_CASE("epipolar march GL: GPU trees are bit-identical to the CPU trees") {
   REQUIRE(oddGpu.size() == oddCpu.data().size());
   CHECK(std::equal(oddGpu.begin(), oddGpu.end(), oddCpu.data().begin()));
   // Rows of 10 levels (1024 texels, and 1000: not a power of two): the build's first phase then covers
-  // levels 1-4 per invocation (glsl/passes/minmax_build.comp), the rest with a barrier per level.
+  // levels 1-4 per invocation (glsl/passes/epipolar/minmax_build.comp), the rest with a barrier per level.
   for (const int wide : {1024, 1000}) {
     CAPTURE(wide);
     Image row(wide, 3, 1);

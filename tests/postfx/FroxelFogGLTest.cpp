@@ -225,8 +225,8 @@ TEST_CASE("FroxelFog GL: CrepFroxelParams offsets match gpu::FroxelParams") {
       {"lightClipFromWorld", offsetof(gpu::FroxelParams, lightClipFromWorld)},
   };
   int found = 0;
-  for (const char* path :
-       {"passes/froxel_light.comp", "passes/froxel_temporal.comp", "passes/esm_downsample.comp"}) {
+  for (const char* path : {"passes/postfx/froxel_light.comp", "passes/postfx/froxel_temporal.comp",
+                           "passes/postfx/esm_downsample.comp"}) {
     const gl::Handle program = buildProgram({{ShaderStage::Compute, path, {}}});
     CHECK(resourceProperty(program.get(), GL_UNIFORM_BLOCK, "CrepFroxelBlock", GL_BUFFER_DATA_SIZE) ==
           static_cast<GLint>(sizeof(gpu::FroxelParams)));

@@ -164,7 +164,7 @@ TEST_CASE("RadialBlurPass: a sun behind the camera adds exactly nothing and NaN 
 
 TEST_CASE("RadialBlurPass: the block has the std140 offsets of its GLSL twin") {
   CREP_REQUIRE_GL();
-  const gl::Handle program = buildProgram({{ShaderStage::Compute, "passes/radial_blur.comp", {}}});
+  const gl::Handle program = buildProgram({{ShaderStage::Compute, "passes/postfx/radial_blur.comp", {}}});
   const GLuint block = glGetProgramResourceIndex(program.get(), GL_UNIFORM_BLOCK, "CrepRadialBlurBlock");
   REQUIRE(block != GL_INVALID_INDEX);
   const GLenum sizeProperty = GL_BUFFER_DATA_SIZE;

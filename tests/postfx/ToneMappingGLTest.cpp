@@ -103,7 +103,7 @@ std::string parameterOf(const std::function<void()>& f) {
 
 TEST_CASE("ToneMapPass: the blocks have the std140 / std430 offsets of their GLSL twins") {
   CREP_REQUIRE_GL();
-  const gl::Handle adapt = buildProgram({{ShaderStage::Compute, "passes/luminance_adapt.comp", {}}});
+  const gl::Handle adapt = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_adapt.comp", {}}});
   const GLuint p = adapt.get();
   CHECK(resourceProperty(p, GL_UNIFORM_BLOCK, "CrepToneMapBlock", GL_BUFFER_DATA_SIZE) ==
         static_cast<GLint>(sizeof(gpu::ToneMapParams)));

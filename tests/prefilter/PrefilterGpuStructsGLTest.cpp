@@ -211,16 +211,16 @@ void main() {
 
   // The passes' own programs declare the same blocks (with their own binding defines): same layout
   // for the members they use.
-  const gl::Handle prefilter = buildProgram({{ShaderStage::Compute, "passes/prefilter.comp", {}}});
+  const gl::Handle prefilter = buildProgram({{ShaderStage::Compute, "passes/prefilter/prefilter.comp", {}}});
   CHECK(checkUniformBlock(prefilter.get(), "CrepPrefilterBlock", "crep_prefilter", kPrefilterMembers,
                           sizeof(gpu::PrefilterParams), false) >= 3);
   checkRegionWeightsBlock(prefilter.get());
   const gl::Handle prefilterLocal =
-      buildProgram({{ShaderStage::Compute, "passes/prefilter.comp", {{"CREP_LOCAL_LIGHT", "1"}}}});
+      buildProgram({{ShaderStage::Compute, "passes/prefilter/prefilter.comp", {{"CREP_LOCAL_LIGHT", "1"}}}});
   CHECK(checkUniformBlock(prefilterLocal.get(), "CrepLocalLightBlock", "crep_localParams", kLocalLightMembers,
                           sizeof(gpu::LocalLightParams), false) == 7);
-  const gl::Handle evaluate =
-      buildProgram({{ShaderStage::Compute, "passes/evaluate.comp", {{"CREP_NEAR_PLANE_CORRECTION", "1"}}}});
+  const gl::Handle evaluate = buildProgram(
+      {{ShaderStage::Compute, "passes/prefilter/evaluate.comp", {{"CREP_NEAR_PLANE_CORRECTION", "1"}}}});
   CHECK(checkUniformBlock(evaluate.get(), "CrepScatteringBlock", "crep_scattering", kScatteringMembers,
                           sizeof(gpu::ScatteringParams), false) >= 12);
   CHECK(checkUniformBlock(evaluate.get(), "CrepEvaluateBlock", "crep_evaluate", kEvaluateMembers,

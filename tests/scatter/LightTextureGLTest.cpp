@@ -340,7 +340,7 @@ TEST_CASE("light texture GL: march_rectified.comp's textured brute force equals 
   const Image tex = twoColourTexture();
   const gl::Handle program =
       buildProgram({{ShaderStage::Compute,
-                     "passes/march_rectified.comp",
+                     "passes/epipolar/march_rectified.comp",
                      {{"CREP_MARCH_TREE", "0"}, {"CREP_LAYOUT", "0"}, {"CREP_LIGHT_TEXTURE", "1"}}}});
   const gl::Handle sampler = gl::createClampSampler(GL_NEAREST);
   for (const bool spot : {false, true}) {

@@ -3,10 +3,10 @@
 #include "gl_session.h"
 #include "methods.h"
 
+#include <crep/atmosphere/gpu_pass.h>
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/gpu_march.h>
-#include <crep/postfx/gpu_atmosphere_pass.h>
 
 #include <epoxy/gl.h>
 

@@ -1,4 +1,4 @@
-// The tool's atmosphere (crep/postfx/atmosphere.h, gpu_atmosphere.h, gpu_atmosphere_pass.h): `crep render
+// The tool's atmosphere (crep/atmosphere/atmosphere.h, gpu_tables.h, gpu_pass.h): `crep render
 // --method atmosphere` places a built-in scene on the Earth, sets the sun by its elevation and azimuth,
 // precomputes (or loads from the disk cache) the scattering tables and evaluates the sky, the aerial
 // perspective and the light shafts of the scene's shadow map with one of the shaft methods (a), (b), (c).
@@ -12,11 +12,11 @@
 #include "frame.h"
 #include "timings.h"
 
+#include <crep/atmosphere/atmosphere.h>
+#include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
 #include <crep/core/light.h>
-#include <crep/postfx/atmosphere.h>
-#include <crep/postfx/gpu_atmosphere.h>
 
 #include <memory>
 #include <optional>

@@ -66,7 +66,7 @@ enum class ShaderStage : std::uint32_t { Vertex, Fragment, Compute };
 
 struct ShaderStageSource {
   ShaderStage stage;
-  std::string path; ///< registered file of the ShaderLibrary, e.g. "passes/prefilter.comp"
+  std::string path; ///< registered file of the ShaderLibrary, e.g. "passes/prefilter/prefilter.comp"
   std::vector<ShaderDefine> defines;
 };
 

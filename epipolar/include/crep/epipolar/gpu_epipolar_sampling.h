@@ -9,8 +9,8 @@
 // stages with any evaluator (a min/max march, the prefiltered evaluation, ...) through an indirect
 // dispatch, without a read-back.
 //
-// Shaders: passes/epipolar_coordinates.comp, epipolar_refine.comp, epipolar_interpolate.comp,
-// epipolar_unwarp.comp, epipolar_upscale.comp. Resources of every stage: gpu::MarchParams at uniform
+// Shaders: passes/epipolar/coordinates.comp, passes/epipolar/refine.comp, passes/epipolar/interpolate.comp,
+// passes/epipolar/unwarp.comp, epipolar_upscale.comp. Resources of every stage: gpu::MarchParams at uniform
 // binding 0 (camera, light, medium: crep/march.glsl), gpu::EpipolarSamplingParams at uniform binding 1, the
 // line table (gpu::EpipolarSamplingLine[]) at storage binding 0, a work list at storage binding 2, the
 // camera depth at texture unit 0 (texelFetch through the pass's own nearest sampler), the pass's own

@@ -1,11 +1,11 @@
 // Blocks shared between the epipolar/ GPU passes (gpu_march.h, resample.h) and their shaders. Each struct
-// has a GLSL twin with the same name prefixed "Crep" in glsl/crep/epipolar.glsl, laid out by std140 (uniform
+// has a GLSL twin with the same name prefixed "Crep" in glsl/crep/layout.glsl, laid out by std140 (uniform
 // blocks) or std430 (storage buffers): 16-byte vectors and matrices only, int instead of bool, a
 // static_assert on the size. tests/epipolar/EpipolarGLTest.cpp ("uniform and storage blocks match their C++
 // structs") compares every member offset with the offsets the driver reports for the linked shaders.
 //
 // A shader of an engine that maps pixels into a rectified map (e.g. to evaluate the prefiltered scattering
-// on the epipolar fallback layout) includes "crep/epipolar.glsl" with CREP_LAYOUT set, and binds a uniform
+// on the epipolar fallback layout) includes "crep/layout.glsl" with CREP_LAYOUT set, and binds a uniform
 // buffer holding makeProjectiveLayoutParams(layout) or makeEpipolarLayoutParams(layout) at
 // CREP_LAYOUT_BINDING (plus, for the epipolar layout, a storage buffer holding makeEpipolarSlices(layout) at
 // CREP_SLICES_BINDING); gpu::LayoutBuffers (crep/scatter/gpu_layout_buffers.h) does both for any layout.

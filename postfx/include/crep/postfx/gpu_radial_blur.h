@@ -1,8 +1,8 @@
 // The GL pass of Mitchell 2007's radial blur (GPU Gems 3 ch. 13; the rule and its CPU reference are in
 // crep/postfx/radial_blur.h). Two compute shaders per frame: the occlusion pre-pass
-// (glsl/passes/radial_source.comp) into a source texture the pass owns (RGBA32F, radialSourceSize of the
-// camera image and options.sourceScale), then the blur (glsl/passes/radial_blur.comp) into the caller's
-// output. Float precision; the source is read with the hardware bilinear filter.
+// (glsl/passes/postfx/radial_source.comp) into a source texture the pass owns (RGBA32F, radialSourceSize of
+// the camera image and options.sourceScale), then the blur (glsl/passes/postfx/radial_blur.comp) into the
+// caller's output. Float precision; the source is read with the hardware bilinear filter.
 //
 // The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
 // buffers, sampler and source texture (RAII); the textures of FrameAttribs are the caller's (non-owning GL

@@ -1,7 +1,8 @@
 // The GL tone-mapping pass: auto exposure from the log-average luminance, temporal light adaptation and
 // the operators of crep/postfx/tone_mapping.h (its rule and CPU reference: luminanceStats,
-// LightAdaptation, toneMapImage), in float. Shaders: passes/luminance_reduce.comp,
-// passes/luminance_adapt.comp, passes/tone_map.comp, the curves in crep/tone_mapping.glsl (public).
+// LightAdaptation, toneMapImage), in float. Shaders: passes/postfx/luminance_reduce.comp,
+// passes/postfx/luminance_adapt.comp, passes/postfx/tone_map.comp, the curves in crep/tone_mapping.glsl
+// (public).
 //
 // One run() per frame:
 //   1. (autoExposure only) luminance_reduce.comp: one partial sum of log(delta + Y) and one count of

@@ -90,7 +90,8 @@ static_assert(sizeof(LocalLightParams) == 16 * 7, "std140 layout of CrepLocalLig
 /// the camera at the region's start, t(0) of the region's DistanceProfile (+inf -> -1: beyond the horizon).
 using RegionRay = glm::vec4;
 
-/// std140 uniform block CrepEvaluateBlock of passes/evaluate.comp: the camera whose depth buffer is read.
+/// std140 uniform block CrepEvaluateBlock of passes/prefilter/evaluate.comp: the camera whose depth buffer is
+/// read.
 struct EvaluateParams {
   glm::vec4 cameraPosition{0.0f};                   ///< xyz: world; w: near plane distance (world units)
   glm::vec4 cameraForward{0.0f, 0.0f, -1.0f, 0.0f}; ///< xyz: unit view direction; w: far plane distance

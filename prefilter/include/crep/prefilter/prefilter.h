@@ -329,7 +329,8 @@ std::vector<double> visibilityTableCoefficients(int samples, int bases, double d
 /// The region visibility table of `basis` (see visibilityTableSamples), in double from the stored values:
 /// index (row * R + region) * Z + s, sample s at normalized ray depth s / (Z - 1), ray coefficients with
 /// `ringing`; a textured basis holds 3 values per cell (index ((row * R + region) * Z + s) * 3 + c, V_c of
-/// "Light textures" above). What EvaluatePass builds on the GPU in float (glsl/passes/visibility_table.comp).
+/// "Light textures" above). What EvaluatePass builds on the GPU in float
+/// (glsl/passes/prefilter/visibility_table.comp).
 std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing);
 
 /// The scattering prefix table (see EvaluateOptions::scatteringPrefix) of `basis` and its region
@@ -337,7 +338,7 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
 /// c, the in-scattering (without the constant C of Eq. 1) of regions 0 .. region - 1 along the ray of texel
 /// row (row + 0.5) / H and normalized depth s / (Z - 1), region r' cut at t_r' = layout.rayDistance(row,
 /// depth, r' / R) (t_0 = 0, each t at least the one before), per channel of `extinction`. What
-/// EvaluatePass builds on the GPU in float (glsl/passes/scattering_prefix.comp).
+/// EvaluatePass builds on the GPU in float (glsl/passes/prefilter/scattering_prefix.comp).
 std::vector<double> scatteringPrefixTable(const FilteredBasis& basis, const std::vector<double>& visibility,
                                           int samples, const glm::dvec3& extinction);
 inline constexpr int kScatteringPrefixChannels = 3;

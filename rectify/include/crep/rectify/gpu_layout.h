@@ -1,4 +1,4 @@
-// The GPU description of a rectified layout: what the GLSL of glsl/crep/epipolar.glsl needs to map world
+// The GPU description of a rectified layout: what the GLSL of glsl/crep/layout.glsl needs to map world
 // points and view rays into a rectified map (CREP_LAYOUT = LayoutKind). Every RectifiedLayout with a GPU
 // mapping serializes itself into a GpuLayoutData (RectifiedLayout::gpuLayoutData()): a std140 layout
 // block and, for layouts with per-row data, a std430 table of rows. A pass uploads the bytes without
@@ -6,7 +6,7 @@
 // above rectify/ can evaluate or march on any layout.
 //
 // The projective block lives here; the epipolar block with EpipolarLayout (crep/epipolar/gpu_layout.h).
-// Each struct has a GLSL twin with the same name prefixed "Crep" in glsl/crep/epipolar.glsl (std140:
+// Each struct has a GLSL twin with the same name prefixed "Crep" in glsl/crep/layout.glsl (std140:
 // 16-byte vectors only, int instead of bool, a static_assert on the size; GL tests compare the offsets).
 #pragma once
 
@@ -25,7 +25,7 @@ namespace gpu {
 /// Largest number of layout regions the layout blocks hold (= RectifyOptions::kMaxSplits).
 inline constexpr int kMaxLayoutRegions = 64;
 
-/// The value of CREP_LAYOUT in glsl/crep/epipolar.glsl.
+/// The value of CREP_LAYOUT in glsl/crep/layout.glsl.
 enum class LayoutKind : std::int32_t {
   Projective = 0, ///< crep::ProjectiveLayout
   Epipolar = 1,   ///< crep::EpipolarLayout

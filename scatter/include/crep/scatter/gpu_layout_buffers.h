@@ -23,7 +23,7 @@ public:
   /// The same for a description already made with requireGpuLayout() (a layout is serialized once per run).
   LayoutKind upload(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
   /// Binds the block at uniform buffer `blockBinding` and, for layouts with a row table, the table at
-  /// storage buffer `rowsBinding` (the defaults of glsl/crep/epipolar.glsl are 1 and 1).
+  /// storage buffer `rowsBinding` (the defaults of glsl/crep/layout.glsl are 1 and 1).
   void bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const;
   LayoutKind kind() const noexcept { return kind_; }
 

@@ -56,7 +56,7 @@ LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const 
                                           int mapWidth, int mapHeight, const LocalLight* localLight);
 } // namespace gpu
 
-/// The colour map pass (crep::lightColorMap on the GPU, glsl/passes/light_colors.comp): a mapWidth x
+/// The colour map pass (crep::lightColorMap on the GPU, glsl/passes/scatter/light_colors.comp): a mapWidth x
 /// mapHeight GL_RGBA32F texture it owns (RGB the colour of each texel's light ray, A = 1).
 class LightColorMapPass {
 public:

@@ -1,0 +1,229 @@
+// The per-frame GL pass of the atmosphere (crep/atmosphere/gpu_pass.h): crep::atmosphereImage's
+// rays in float (Yusov 2013, Eq. 8 and Listings 1-2; shafts (a) and (b) over the min/max trees of Yusov
+// 2012, Algorithm 2). Shader: passes/atmosphere/atmosphere.comp (with crep/atmosphere.glsl,
+// crep/minmax_walk.glsl).
+#include <crep/atmosphere/gpu_pass.h>
+#include <crep/core/error.h>
+#include <crep/core/shader_library.h>
+#include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/gpu_layout.h>
+#include <crep/epipolar/march.h>
+#include <crep/scatter/gpu_world_march.h>
+
+#include <epoxy/gl.h>
+
+#include <string>
+#include <utility>
+
+namespace crep {
+
+namespace {
+
+/// Texture units, uniform and storage bindings of passes/atmosphere/atmosphere.comp (its header comment).
+constexpr GLuint kUnitCameraDepth = 0, kUnitRectifiedDepth = 1, kUnitOpticalDepth = 2, kUnitSingle = 3,
+                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6, kUnitAmbient = 7,
+                 kUnitVolumeRayleigh = 8, kUnitVolumeMie = 9, kUnitSkyRayleigh = 10, kUnitSkyMie = 11;
+constexpr int kUnits = 12; ///< units and bindings unbound afterwards (gl::unbindPassState)
+
+bool walksTrees(AtmosphereShafts shafts) {
+  return shafts == AtmosphereShafts::Integrated || shafts == AtmosphereShafts::LitLengthTable;
+}
+
+void checkSteps(const char* parameter, int steps) {
+  if (steps < 1 || steps > 4096)
+    throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, 4096]");
+}
+
+/// A GL_TEXTURE_3D (the aerial perspective volume) or GL_TEXTURE_2D (the sky-view table, size.z 0) RGBA32F;
+/// read through the pass's linear clamp-to-edge sampler.
+gl::Handle createViewTable(const glm::ivec3& size) {
+  gl::Handle t = gl::createTexture(size.z > 0 ? GL_TEXTURE_3D : GL_TEXTURE_2D);
+  if (size.z > 0)
+    glTextureStorage3D(t.get(), 1, GL_RGBA32F, size.x, size.y, size.z);
+  else
+    glTextureStorage2D(t.get(), 1, GL_RGBA32F, size.x, size.y);
+  return t;
+}
+
+} // namespace
+
+AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
+  info_.options.shafts = info.shafts;
+  checkSteps("AtmospherePass::CreateInfo.options.integrationSteps", info.options.integrationSteps);
+  checkSteps("AtmospherePass::CreateInfo.options.skySteps", info.options.skySteps);
+  const int mode = static_cast<int>(info.shafts);
+  if (mode < 0 || mode > 3)
+    throw InvalidArgument("AtmospherePass::CreateInfo.shafts", std::to_string(mode),
+                          "must be an AtmosphereShafts");
+  if (walksTrees(info.shafts)) {
+    gl::checkTextureSize("AtmospherePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
+    if (MinMaxTrees::levelCount(info.mapWidth) > 16)
+      throw GlError("crep: AtmospherePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
+                    " needs more than 16 tree levels");
+  }
+  validateViewTables(info.options, "AtmospherePass::CreateInfo.options");
+  view_ = info.options.single == AtmosphereSingleScattering::ViewTables &&
+          info.shafts != AtmosphereShafts::Integrated;
+  if (view_) {
+    const AtmosphereRayOptions& o = info.options;
+    gl::checkTextureSize("AtmospherePass::CreateInfo.options.skyViewSize", o.skyViewSize.x, o.skyViewSize.y);
+    volumeRayleigh_ = createViewTable(o.volumeSize);
+    volumeMie_ = createViewTable(o.volumeSize);
+    skyRayleigh_ = createViewTable(glm::ivec3(o.skyViewSize, 0));
+    skyMie_ = createViewTable(glm::ivec3(o.skyViewSize, 0));
+    volumeProgram_ = buildProgram({{ShaderStage::Compute,
+                                    "passes/atmosphere/atmosphere.comp",
+                                    {{"CREP_ATMOSPHERE_VOLUME_PASS", "1"}}}});
+    skyViewProgram_ = buildProgram({{ShaderStage::Compute,
+                                     "passes/atmosphere/atmosphere.comp",
+                                     {{"CREP_ATMOSPHERE_VOLUME_PASS", "2"}}}});
+  }
+  marchParams_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
+  atmosphereParams_ = gl::createDynamicBuffer(sizeof(gpu::AtmosphereParams));
+  nearest_ = gl::createClampSampler(GL_NEAREST);
+  linear_ = gl::createClampSampler(GL_LINEAR);
+  if (!walksTrees(info.shafts)) // the one program of None and (c): compile errors surface here
+    programs_[0][0] = buildProgram({{ShaderStage::Compute,
+                                     "passes/atmosphere/atmosphere.comp",
+                                     {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(mode)},
+                                      {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
+  gl::checkError("AtmospherePass");
+}
+
+void AtmospherePass::run(const FrameAttribs& f) {
+  const AtmosphereShafts shafts = info_.shafts;
+  const bool walk = walksTrees(shafts);
+  if (!f.tables) throw InvalidArgument("AtmospherePass::FrameAttribs.tables", "null", "must be set");
+  if (!f.placement) throw InvalidArgument("AtmospherePass::FrameAttribs.placement", "null", "must be set");
+  if (!f.camera) throw InvalidArgument("AtmospherePass::FrameAttribs.camera", "null", "must be set");
+  if (!f.sun) throw InvalidArgument("AtmospherePass::FrameAttribs.sun", "null", "must be set");
+  const AtmosphereTablesPass::CreateInfo& tables = f.tables->info();
+  try {
+    validate(*f.placement, tables.parameters);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument("AtmospherePass::FrameAttribs.placement", e.what(), "must be valid");
+  }
+  const gl::TextureLevel image =
+      gl::requireTexture2D("AtmospherePass::FrameAttribs.cameraDepth", f.cameraDepth);
+  gl::requireDepthFormat("AtmospherePass::FrameAttribs.cameraDepth", f.cameraDepth);
+  const int width = image.width, height = image.height;
+  gl::requireTexture2D("AtmospherePass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
+  if (f.transmittanceOutput != 0)
+    gl::requireTexture2D("AtmospherePass::FrameAttribs.transmittanceOutput", f.transmittanceOutput, width,
+                         height, GL_RGBA32F);
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  GpuLayoutData layoutData;
+  if (walk) {
+    if (!f.layout)
+      throw InvalidArgument("AtmospherePass::FrameAttribs.layout", "null", "must be set (shafts (a), (b))");
+    layoutData = gpu::requireGpuLayout(*f.layout, "AtmospherePass::FrameAttribs.layout");
+    gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
+    gl::requireTexture2D("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
+    gl::requireDepthFormat("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
+    if (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer))
+      throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
+                            "must be the MinMaxTreePass::treeBuffer() of the map (shafts (a), (b))");
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
+    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
+    if (size < needed)
+      throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
+                            "must hold the trees of a " + std::to_string(W) + " x " + std::to_string(H) +
+                                " map (" + std::to_string(needed) + " bytes)");
+  }
+  const bool prefilteredMode = shafts == AtmosphereShafts::PrefilteredVisibility;
+  if (prefilteredMode) {
+    gl::requireTexture2D("AtmospherePass::FrameAttribs.prefiltered", f.prefiltered, width, height);
+    if (!f.proxyMedium)
+      throw InvalidArgument("AtmospherePass::FrameAttribs.proxyMedium", "null", "must be set (shafts (c))");
+  }
+
+  const bool combined = tables.options.combinedMie;
+  gl::Handle& program = programs_[combined ? 1 : 0][walk ? static_cast<int>(layoutData.kind) : 0];
+  if (!program)
+    program = buildProgram({{ShaderStage::Compute,
+                             "passes/atmosphere/atmosphere.comp",
+                             {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(shafts))},
+                              {"CREP_LAYOUT", std::to_string(static_cast<int>(layoutData.kind))},
+                              {"CREP_ATMOSPHERE_COMBINED_MIE", combined ? "1" : "0"},
+                              {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
+
+  // The march block carries the camera and the sun (and (c)'s proxy medium: the closed form of
+  // prefilteredVisibility); a placeholder medium otherwise (its members are not read).
+  const Medium placeholder({.absorption = glm::dvec3(1.0)});
+  gpu::MarchParams params =
+      gpu::makeMarchParams(*f.camera, *f.sun, prefilteredMode ? *f.proxyMedium : placeholder, width, height,
+                           walk ? W : 0, walk ? H : 0);
+  params.info = glm::ivec4(walk ? MinMaxTrees::levelCount(W) : 0, walk ? MinMaxTrees::rowStrideFor(W) : 0,
+                           info_.options.integrationSteps, info_.options.skySteps);
+  const glm::ivec3 vs = info_.options.volumeSize;
+  const glm::ivec2 ss = info_.options.skyViewSize;
+  if (view_) {
+    params.region = glm::ivec4(vs, info_.options.volumeSteps);
+    params.block = glm::vec4(glm::vec2(ss), static_cast<float>(info_.options.skyViewSteps), 0.0f);
+  }
+  glNamedBufferSubData(marchParams_.get(), 0, sizeof(params), &params);
+  const gpu::AtmosphereParams atmosphere =
+      gpu::atmosphereParams(tables.parameters, tables.options, *f.placement);
+  glNamedBufferSubData(atmosphereParams_.get(), 0, sizeof(atmosphere), &atmosphere);
+  if (view_) { // Hillaire 2020, Sec. 5.2-5.3: the camera's view tables, one ray per invocation
+    glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
+    glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
+    glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
+    glUseProgram(volumeProgram_.get());
+    glBindImageTexture(0, volumeRayleigh_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>((vs.x + 7) / 8), static_cast<GLuint>((vs.y + 7) / 8), 1);
+    glUseProgram(skyViewProgram_.get());
+    glBindImageTexture(0, skyRayleigh_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>((ss.x + 7) / 8), static_cast<GLuint>((ss.y + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+  }
+
+  const GLuint transmittance =
+      f.transmittanceOutput != 0
+          ? f.transmittanceOutput
+          : gl::scratchTexture2D(dummyTransmittance_, dummyWidth_, dummyHeight_, GL_RGBA32F, width, height);
+  glUseProgram(program.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
+  glBindTextureUnit(kUnitCameraDepth, f.cameraDepth);
+  glBindSampler(kUnitCameraDepth, nearest_.get());
+  // The tables keep their own sampling state (linear, clamp to edge: AtmosphereTablesPass).
+  glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
+  glBindTextureUnit(kUnitSingle, f.tables->singleTexture());
+  glBindTextureUnit(kUnitHigherOrders, f.tables->higherOrdersTexture());
+  glBindTextureUnit(kUnitAmbient, f.tables->ambientTexture());
+  // With combinedMie there is no single Mie table (the shader does not read the unit).
+  glBindTextureUnit(kUnitSingleMie, combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
+  if (walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees
+    layoutBuffers_.upload(layoutData, H);
+    layoutBuffers_.bind(1, 1);
+    glBindTextureUnit(kUnitRectifiedDepth, f.rectifiedDepth);
+    glBindSampler(kUnitRectifiedDepth, nearest_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
+  }
+  if (prefilteredMode) {
+    glBindTextureUnit(kUnitPrefiltered, f.prefiltered);
+    glBindSampler(kUnitPrefiltered, nearest_.get());
+  }
+  if (view_) {
+    const std::pair<GLuint, GLuint> views[] = {{kUnitVolumeRayleigh, volumeRayleigh_.get()},
+                                               {kUnitVolumeMie, volumeMie_.get()},
+                                               {kUnitSkyRayleigh, skyRayleigh_.get()},
+                                               {kUnitSkyMie, skyMie_.get()}};
+    for (const auto& [unit, texture] : views) {
+      glBindTextureUnit(unit, texture);
+      glBindSampler(unit, linear_.get());
+    }
+  }
+  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(1, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
+  gl::passOutputBarrier();
+  gl::unbindPassState(kUnits);
+  gl::checkError("AtmospherePass::run");
+}
+
+} // namespace crep

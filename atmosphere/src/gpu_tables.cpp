@@ -1,0 +1,382 @@
+// The atmosphere's tables on the GPU (crep/atmosphere/gpu_tables.h: gpu::atmosphereParams and
+// AtmosphereTablesPass; the CPU reference and the algorithm are crep/atmosphere/atmosphere.h's). Stages, one
+// compute shader each (one texel per invocation): passes/atmosphere/optical_depth.comp,
+// passes/atmosphere/single.comp (L1), passes/atmosphere/scattered.comp (J_n), passes/atmosphere/order.comp
+// (L_n), passes/atmosphere/sum.comp (L_H) and passes/atmosphere/ambient.comp (E_sky); look-ups of
+// glsl/crep/atmosphere.glsl.
+#include <crep/atmosphere/gpu_tables.h>
+#include <crep/core/error.h>
+#include <crep/core/gl_state.h>
+#include <crep/core/shader_library.h>
+
+#include <epoxy/gl.h>
+
+#include <chrono>
+#include <cstring>
+#include <string>
+
+namespace crep {
+
+namespace gpu {
+
+AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
+                                  const AtmospherePlacement& placement) {
+  AtmosphereParams a;
+  a.radii =
+      glm::vec4(static_cast<float>(p.earthRadius), static_cast<float>(p.earthRadius + p.atmosphereHeight),
+                static_cast<float>(p.atmosphereHeight), static_cast<float>(kOccludedDensity));
+  a.rayleighScattering =
+      glm::vec4(glm::vec3(p.rayleighScattering), static_cast<float>(p.rayleighScaleHeight));
+  a.mieScattering = glm::vec4(glm::vec3(p.mieScattering), static_cast<float>(p.mieScaleHeight));
+  a.mieExtinction = glm::vec4(glm::vec3(p.mieScattering + p.mieAbsorption), static_cast<float>(p.mieG));
+  a.tableSize = glm::ivec4(o.size.height, o.size.viewZenith, o.size.sunZenith, o.size.sunView);
+  a.auxSizes = glm::ivec4(o.opticalDepthHeight, o.opticalDepthZenith, o.ambientSize, o.orders);
+  a.placement = glm::vec4(static_cast<float>(placement.metersPerUnit),
+                          static_cast<float>(placement.originAltitude), 0.0f, 0.0f);
+  a.multipleScattering =
+      glm::vec4(static_cast<float>(p.groundAlbedo), static_cast<float>(o.multipleScatteringSize),
+                static_cast<float>(o.multipleScatteringSteps), 0.0f);
+  return a;
+}
+
+} // namespace gpu
+
+namespace {
+
+constexpr const char* kOptions = "AtmospherePrecomputeOptions";
+
+int max3DTextureSize() {
+  GLint v = 0;
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &v);
+  return v;
+}
+
+void requireAtMost(const std::string& parameter, int value, int limit, const char* limitName) {
+  if (value > limit)
+    throw InvalidArgument(parameter, std::to_string(value),
+                          "must be <= " + std::string(limitName) + " (" + std::to_string(limit) + ")");
+}
+
+// A GL_TEXTURE_3D RGBA32F of the packed 4D table, linear filtering and clamp to edge (the look-ups').
+// RGBA32F so that imageStore and the float look-ups match the CPU's float tables; on a real GPU an engine
+// that is short of memory could store RGBA16F (Yusov 2013 does: 32 MB at the default size) at ~1e-3
+// relative precision. Filtering is the hardware's (float weights on llvmpipe; 8-bit fractions on many
+// GPUs, which blur the comparison with the CPU reference, not the image).
+gl::Handle createTable3D(const AtmosphereTableSize& s, GLenum format = GL_RGBA32F) {
+  gl::Handle t = gl::createTexture(GL_TEXTURE_3D);
+  glTextureStorage3D(t.get(), 1, format, s.height, s.viewZenith, s.sunZenith * s.sunView);
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  return t;
+}
+
+gl::Handle createLinearTexture2D(std::uint32_t format, int width, int height) {
+  gl::Handle t = gl::createTexture2D(format, width, height);
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  return t;
+}
+
+GLuint groups(int n, int local) {
+  return static_cast<GLuint>((n + local - 1) / local);
+}
+
+} // namespace
+
+AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info) {
+  validate(info.parameters, info.options);
+  const AtmospherePrecomputeOptions& o = info.options;
+  const std::string size = std::string(kOptions) + ".size.";
+  const int max3D = max3DTextureSize();
+  requireAtMost(size + "height", o.size.height, max3D, "GL_MAX_3D_TEXTURE_SIZE");
+  requireAtMost(size + "viewZenith", o.size.viewZenith, max3D, "GL_MAX_3D_TEXTURE_SIZE");
+  requireAtMost(size + "sunView", o.size.sunZenith * o.size.sunView, max3D, "GL_MAX_3D_TEXTURE_SIZE");
+  const int max2D = gl::maxTextureSize();
+  requireAtMost(std::string(kOptions) + ".opticalDepthHeight", o.opticalDepthHeight, max2D,
+                "GL_MAX_TEXTURE_SIZE");
+  requireAtMost(std::string(kOptions) + ".opticalDepthZenith", o.opticalDepthZenith, max2D,
+                "GL_MAX_TEXTURE_SIZE");
+  requireAtMost(std::string(kOptions) + ".ambientSize", o.ambientSize, max2D, "GL_MAX_TEXTURE_SIZE");
+  gl::checkError("AtmosphereTablesPass (before allocation)");
+  opticalDepth_ = createLinearTexture2D(GL_RG32F, o.opticalDepthHeight, o.opticalDepthZenith);
+  const GLenum format = info.halfFloatTables ? GL_RGBA16F : GL_RGBA32F;
+  single_ = createTable3D(o.size, format);
+  if (!o.combinedMie) singleMie_ = createTable3D(o.size, format);
+  higher_ = createTable3D(o.size, format);
+  ambient_ = createLinearTexture2D(GL_RGBA32F, o.ambientSize, 1);
+  if (usesMultipleScatteringLut(o)) {
+    requireAtMost(std::string(kOptions) + ".multipleScatteringSize", o.multipleScatteringSize, max2D,
+                  "GL_MAX_TEXTURE_SIZE");
+    msLut_ = createLinearTexture2D(GL_RGBA32F, o.multipleScatteringSize, o.multipleScatteringSize);
+  }
+  gl::checkError("AtmosphereTablesPass: allocating the tables");
+}
+
+void AtmosphereTablesPass::compute() {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  const AtmosphereTableSize& s = o.size;
+  const int depth = s.sunZenith * s.sunView;
+  times_.clear();
+  // halfFloatTables: compute into RGBA32F tables, then round them once into the RGBA16F ones (the stages
+  // store to rgba32f images and the orders read the tables they wrote).
+  std::vector<gl::Handle> halves;
+  if (info_.halfFloatTables) {
+    for (gl::Handle* table : {&single_, &singleMie_, &higher_}) {
+      halves.push_back(std::move(*table));
+      if (halves.back()) *table = createTable3D(s);
+    }
+  }
+
+  const gpu::AtmosphereParams params = gpu::atmosphereParams(info_.parameters, o);
+  gl::Handle block = gl::createDynamicBuffer(sizeof params);
+  glNamedBufferSubData(block.get(), 0, sizeof params, &params);
+
+  const auto steps = [](int n) {
+    return std::vector<ShaderDefine>{{"CREP_ATMOSPHERE_STEPS", std::to_string(n)}};
+  };
+  const ShaderDefine combined{"CREP_ATMOSPHERE_COMBINED_MIE", o.combinedMie ? "1" : "0"};
+  const std::vector<ShaderDefine> samples{{"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)},
+                                          combined};
+  const bool lut = usesMultipleScatteringLut(o);
+  const bool orders = o.orders > 1 && !lut;
+  std::vector<ShaderDefine> singleDefines = steps(o.singleSteps);
+  singleDefines.push_back(combined);
+  singleDefines.push_back({"CREP_ATMOSPHERE_MS_LUT", lut ? "1" : "0"});
+  std::vector<ShaderDefine> firstOrder = samples;
+  firstOrder.push_back({"CREP_ATMOSPHERE_FIRST_ORDER", "1"});
+  gl::Handle opticalProgram = buildProgram(
+      {{ShaderStage::Compute, "passes/atmosphere/optical_depth.comp", steps(o.opticalDepthSteps)}});
+  gl::Handle singleProgram =
+      buildProgram({{ShaderStage::Compute, "passes/atmosphere/single.comp", singleDefines}});
+  gl::Handle sumProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere/sum.comp", {}}});
+  const std::vector<ShaderDefine> ambientSamples{
+      {"CREP_ATMOSPHERE_SAMPLES", std::to_string(kAmbientSampleFactor * o.sphereSamples)}, combined};
+  gl::Handle ambientProgram =
+      buildProgram({{ShaderStage::Compute, "passes/atmosphere/ambient.comp", ambientSamples}});
+  gl::Handle scatteredProgram, firstScatteredProgram, orderProgram, msProgram;
+  if (lut) {
+    std::vector<ShaderDefine> msDefines = steps(o.multipleScatteringSteps);
+    msDefines.push_back({"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)});
+    msProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere/ms.comp", msDefines}});
+  }
+  if (orders) {
+    firstScatteredProgram =
+        buildProgram({{ShaderStage::Compute, "passes/atmosphere/scattered.comp", firstOrder}});
+    scatteredProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere/scattered.comp", samples}});
+    orderProgram =
+        buildProgram({{ShaderStage::Compute, "passes/atmosphere/order.comp", steps(o.orderSteps)}});
+  }
+
+  // Each stage ends with glFinish and is timed on the wall clock (GL_TIME_ELAPSED reads ~0 on llvmpipe).
+  glFinish();
+  auto start = std::chrono::steady_clock::now();
+  const auto endStage = [&](std::string name) {
+    glFinish();
+    const auto now = std::chrono::steady_clock::now();
+    times_.emplace_back(std::move(name), std::chrono::duration<double, std::milli>(now - start).count());
+    start = now;
+  };
+  // One dispatch covers a whole table (32 x 128 x 1024 texels at the default size). On a real GPU with a
+  // watchdog (Windows TDR, ~2 s) a J_n dispatch of many sphere samples at a large size may have to be split
+  // into slabs of z; llvmpipe has no watchdog.
+  const auto dispatchTable = [&] {
+    glDispatchCompute(groups(s.height, 4), groups(s.viewZenith, 4), groups(depth, 4));
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+  };
+  const auto sum = [&](GLuint accumulator, GLuint addend) {
+    glUseProgram(sumProgram.get());
+    glBindImageTexture(0, accumulator, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, addend, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    dispatchTable();
+  };
+  const auto copy = [&](GLuint from, GLuint to) {
+    glCopyImageSubData(from, GL_TEXTURE_3D, 0, 0, 0, 0, to, GL_TEXTURE_3D, 0, 0, 0, 0, s.height, s.viewZenith,
+                       depth);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  };
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, block.get());
+  // Samplers of the texture units: none (each texture's own linear, clamp-to-edge state).
+  glBindSampler(0, 0);
+
+  // Optical depth.
+  glUseProgram(opticalProgram.get());
+  glBindImageTexture(0, opticalDepth_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+  glDispatchCompute(groups(o.opticalDepthHeight, 8), groups(o.opticalDepthZenith, 8), 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  endStage("optical depth");
+
+  // Psi_ms (Hillaire 2020, the Lut method).
+  if (lut) {
+    glUseProgram(msProgram.get());
+    glBindTextureUnit(0, opticalDepth_.get());
+    glBindImageTexture(0, msLut_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glDispatchCompute(groups(o.multipleScatteringSize, 8), groups(o.multipleScatteringSize, 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    endStage("multiple scattering LUT");
+  }
+
+  // L1 without its phase functions (S_R, S_M); Lut: L_H in the same march.
+  glUseProgram(singleProgram.get());
+  glBindTextureUnit(0, opticalDepth_.get());
+  glBindImageTexture(0, single_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  if (!o.combinedMie) glBindImageTexture(1, singleMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  if (lut) {
+    glBindTextureUnit(1, msLut_.get());
+    glBindImageTexture(2, higher_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  }
+  dispatchTable();
+  if (o.orders == 1) {
+    // L_H = 0 (timed with single scattering).
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    glClearTexImage(higher_.get(), 0, GL_RGBA, GL_FLOAT, zero);
+  }
+  endStage(lut ? "single scattering and L_H" : "single scattering");
+  // The single Mie unit of the passes that read L1 (the single table itself with combinedMie: not read).
+  const GLuint mieTable = o.combinedMie ? single_.get() : singleMie_.get();
+
+  if (orders) {
+    // J_n and L_n ping-pong through two scratch tables: J_n reads L_(n-1) (L1 or the previous L_n), L_n reads
+    // J_n and overwrites the previous L_n, already added to L_H.
+    gl::Handle scattered = createTable3D(s);
+    gl::Handle order = createTable3D(s);
+    gl::checkError("AtmosphereTablesPass::compute: allocating the scratch tables");
+    for (int n = 2; n <= o.orders; ++n) {
+      const std::string name = "order " + std::to_string(n) + ": ";
+      glUseProgram(n == 2 ? firstScatteredProgram.get() : scatteredProgram.get());
+      glBindTextureUnit(0, n == 2 ? single_.get() : order.get());
+      if (n == 2) { // L1's Mie part and, for the ground's bounce, the optical depth table
+        glBindTextureUnit(1, mieTable);
+        glBindTextureUnit(2, opticalDepth_.get());
+      }
+      glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      dispatchTable();
+      endStage(name + "J");
+      glUseProgram(orderProgram.get());
+      glBindTextureUnit(0, scattered.get());
+      glBindImageTexture(0, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+      dispatchTable();
+      // L_H += L_n (timed with this L stage).
+      if (n == 2)
+        copy(order.get(), higher_.get());
+      else
+        sum(higher_.get(), order.get());
+      endStage(name + "L");
+    }
+  }
+
+  // E_sky.
+  glUseProgram(ambientProgram.get());
+  glBindTextureUnit(0, single_.get());
+  glBindTextureUnit(1, mieTable);
+  glBindTextureUnit(2, higher_.get());
+  glBindImageTexture(0, ambient_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(groups(o.ambientSize, 64), 1, 1);
+  gl::passOutputBarrier();
+  endStage("ambient");
+
+  gl::unbindPassState(3);
+  if (info_.halfFloatTables) { // round to RGBA16F through the host (GL converts float to half on upload)
+    std::vector<float> texels(static_cast<std::size_t>(s.height) * s.viewZenith * depth * 4);
+    const GLsizei bytes = static_cast<GLsizei>(texels.size() * sizeof(float));
+    gl::Handle* tables[] = {&single_, &singleMie_, &higher_};
+    for (int i = 0; i < 3; ++i) {
+      if (!halves[static_cast<std::size_t>(i)]) continue;
+      glGetTextureImage(tables[i]->get(), 0, GL_RGBA, GL_FLOAT, bytes, texels.data());
+      glTextureSubImage3D(halves[static_cast<std::size_t>(i)].get(), 0, 0, 0, 0, s.height, s.viewZenith,
+                          depth, GL_RGBA, GL_FLOAT, texels.data());
+      *tables[i] = std::move(halves[static_cast<std::size_t>(i)]);
+    }
+    endStage("RGBA16F rounding");
+  }
+  gl::checkError("AtmosphereTablesPass::compute");
+}
+
+namespace {
+
+bool sameSize(const AtmosphereTableSize& a, const AtmosphereTableSize& b) {
+  return a.height == b.height && a.viewZenith == b.viewZenith && a.sunZenith == b.sunZenith &&
+         a.sunView == b.sunView;
+}
+
+} // namespace
+
+void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  const auto fail = [](const std::string& why) {
+    throw InvalidArgument("AtmosphereTablesPass::upload.tables", "(tables)", why);
+  };
+  if (atmosphereCacheKey(tables.parameters, tables.options) != atmosphereCacheKey(info_.parameters, o))
+    fail("must have the parameters and options of the pass's CreateInfo");
+  std::vector<std::pair<GLuint, const AtmosphereTable4D*>> targets = {{single_.get(), &tables.single},
+                                                                      {higher_.get(), &tables.higherOrders}};
+  if (!o.combinedMie) targets.emplace_back(singleMie_.get(), &tables.singleMie);
+  for (const auto& [texture, t] : targets)
+    if (!sameSize(t->size, o.size) || t->rgba.size() != t->texels() * 4)
+      fail("4D tables must be of the CreateInfo's size");
+  if (tables.opticalDepth.width() != o.opticalDepthHeight ||
+      tables.opticalDepth.height() != o.opticalDepthZenith || tables.opticalDepth.channels() != 2)
+    fail("opticalDepth must be opticalDepthHeight x opticalDepthZenith with 2 channels");
+  if (tables.ambient.width() != o.ambientSize || tables.ambient.height() != 1 ||
+      tables.ambient.channels() != 3)
+    fail("ambient must be ambientSize x 1 with 3 channels");
+  const bool lut = usesMultipleScatteringLut(o);
+  if (lut && (tables.multipleScatteringLut.width() != o.multipleScatteringSize ||
+              tables.multipleScatteringLut.height() != o.multipleScatteringSize ||
+              tables.multipleScatteringLut.channels() != 3))
+    fail("multipleScatteringLut must be multipleScatteringSize^2 with 3 channels");
+
+  const gl::PixelStoreScope
+      pixelStore; // tightly packed floats, no pixel unpack buffer: whatever the caller left
+  glTextureSubImage2D(opticalDepth_.get(), 0, 0, 0, o.opticalDepthHeight, o.opticalDepthZenith, GL_RG,
+                      GL_FLOAT, tables.opticalDepth.data().data());
+  const int depth = o.size.sunZenith * o.size.sunView;
+  for (const auto& [texture, table] : targets)
+    glTextureSubImage3D(texture, 0, 0, 0, 0, o.size.height, o.size.viewZenith, depth, GL_RGBA, GL_FLOAT,
+                        table->rgba.data());
+  glTextureSubImage2D(ambient_.get(), 0, 0, 0, o.ambientSize, 1, GL_RGB, GL_FLOAT,
+                      tables.ambient.data().data());
+  if (lut)
+    glTextureSubImage2D(msLut_.get(), 0, 0, 0, o.multipleScatteringSize, o.multipleScatteringSize, GL_RGB,
+                        GL_FLOAT, tables.multipleScatteringLut.data().data());
+  gl::passOutputBarrier();
+  gl::checkError("AtmosphereTablesPass::upload");
+}
+
+AtmosphereTables AtmosphereTablesPass::download() const {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  AtmosphereTables t;
+  t.parameters = info_.parameters;
+  t.options = o;
+  t.options.keepOrders = false;
+  const gl::PixelStoreScope
+      pixelStore; // tightly packed floats, no pixel pack buffer: whatever the caller left
+  t.opticalDepth = Image(o.opticalDepthHeight, o.opticalDepthZenith, 2);
+  glGetTextureImage(opticalDepth_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(t.opticalDepth.byteSize()),
+                    t.opticalDepth.data().data());
+  std::vector<std::pair<GLuint, AtmosphereTable4D*>> sources = {{single_.get(), &t.single},
+                                                                {higher_.get(), &t.higherOrders}};
+  if (!o.combinedMie) sources.emplace_back(singleMie_.get(), &t.singleMie);
+  for (const auto& [texture, table] : sources) {
+    table->size = o.size;
+    table->rgba.assign(table->texels() * 4, 0.0f);
+    glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(table->rgba.size() * sizeof(float)),
+                      table->rgba.data());
+  }
+  t.ambient = Image(o.ambientSize, 1, 3);
+  glGetTextureImage(ambient_.get(), 0, GL_RGB, GL_FLOAT, static_cast<GLsizei>(t.ambient.byteSize()),
+                    t.ambient.data().data());
+  if (usesMultipleScatteringLut(o)) {
+    t.multipleScatteringLut = Image(o.multipleScatteringSize, o.multipleScatteringSize, 3);
+    glGetTextureImage(msLut_.get(), 0, GL_RGB, GL_FLOAT,
+                      static_cast<GLsizei>(t.multipleScatteringLut.byteSize()),
+                      t.multipleScatteringLut.data().data());
+  }
+  gl::checkError("AtmosphereTablesPass::download");
+  return t;
+}
+
+} // namespace crep
