@@ -170,7 +170,7 @@ int compareCommand(const std::vector<std::string>& argv) {
     csv << "," << csvField("ms " + st);
   csv << ",ms total\n";
   for (const Result& r : results) {
-    csv << sceneName << "," << size.x << "," << size.y << "," << r.name << "," << r.used << ","
+    csv << sceneName << "," << size.x << "," << size.y << "," << r.name << "," << csvField(r.used) << ","
         << number(r.metrics.relativeRmse) << "," << number(r.metrics.psnr) << ","
         << number(r.metrics.maxAbsError) << "," << number(r.metrics.meanAbsError);
     for (const std::string& st : stages) {

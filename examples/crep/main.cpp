@@ -53,10 +53,11 @@ const char* const kScatter =
             A transmittance)
             --depth FILE.exr    camera depth: OpenGL depth-buffer values in [0, 1] (1 = sky)
             --shadow FILE.exr   the main light's map: depth-buffer values of shadowMap.lightClipFromWorld
-                                (a point light: its six faces stacked, +X at the top; README)
+                                (a point light: its six faces stacked, +X at the top;
+                                docs/FORMATS.md)
             --frame FILE.json   camera, light (directional, spot or point; optional additional spot /
                                 point lights with their own maps), shadow matrix and medium (schema:
-                                README, example: examples/data/frame.json)
+                                docs/FORMATS.md, example: examples/data/frame.json)
             --method M          prefilter (default: the standard map is resampled into the projective
                                 rectification on the CPU) | reference | the other methods below
 @METHOD_OPTIONS@            --out FILE.exr      output (default scattering.exr); never one of the inputs

@@ -1,6 +1,6 @@
 // `crep scatter`: single scattering for users' own data. Inputs: a camera depth EXR (GL depth-buffer
 // values in [0, 1]), a standard shadow map EXR (depth-buffer values of an orthographic light matrix)
-// and a JSON frame description (lib/frame_json.h; README "crep scatter"). Output: a scattering EXR,
+// and a JSON frame description (lib/frame_json.h; docs/FORMATS.md). Output: a scattering EXR,
 // RGB in-scattered radiance and A transmittance.
 //
 // Methods (lib/methods.h registry): `reference` marches every view ray against the user's standard
@@ -47,7 +47,7 @@ std::string shortest(T v) {
   return std::string(buf, r.ptr);
 }
 
-/// The channels a depth EXR is read from (README "crep scatter"): the first present of these, unprefixed.
+/// The channels a depth EXR is read from (docs/FORMATS.md): the first present of these, unprefixed.
 constexpr const char* kDepthChannels[] = {"Y", "Z", "depth", "R"};
 
 /// Reads a depth EXR (channel 0 of crep::readExr: Y, Z, depth or R) and checks every value is a depth-buffer

@@ -100,12 +100,12 @@ TEST_CASE("crep scatter: the example frame file parses (JSON is valid, every fie
   CHECK(j["shadowMap"]["lightClipFromWorld"].size() == 16);
 }
 
-TEST_CASE("crep scatter: the README shows the complete example frame file") {
-  const std::string readme = readText(std::string(CREP_SOURCE_DIR) + "/README.md");
+TEST_CASE("crep scatter: docs/FORMATS.md shows the complete example frame file") {
+  const std::string formats = readText(std::string(CREP_SOURCE_DIR) + "/docs/FORMATS.md");
   std::string example = readText(kExample);
   while (!example.empty() && example.back() == '\n')
     example.pop_back();
-  CHECK(readme.find(example) != std::string::npos);
+  CHECK(formats.find(example) != std::string::npos);
 }
 
 TEST_CASE("crep scatter: missing options and unknown methods are usage errors naming the option") {

@@ -221,8 +221,8 @@ TEST_CASE("crep: numbers and sizes are parsed strictly (decimal, no spaces, no '
   }
 }
 
-TEST_CASE("crep rectify: a field of view below 0.001 degrees is a usage error, help and README list the "
-          "empty status") {
+TEST_CASE("crep rectify: a field of view below 0.001 degrees is a usage error, help and docs/FORMATS.md list "
+          "the empty status") {
   // --fovy-deg 1e-300 used to print the undocumented status "empty".
   for (const char* fovy : {"1e-300", "1e-12", "0.0009", "180", "0"})
     expectFailure(std::string("rectify --fovy-deg ") + fovy, 2, {"--fovy-deg", "[0.001, 180)"});
@@ -233,8 +233,8 @@ TEST_CASE("crep rectify: a field of view below 0.001 degrees is a usage error, h
   // "empty" remains a status of the library (spot and point lights), so both documents list it.
   const auto help = crep::test::runCrep("help");
   CHECK(help.output.find(R"("projective"|"fallback"|"empty")") != std::string::npos);
-  std::ifstream readme(std::string(CREP_SOURCE_DIR) + "/README.md");
-  const std::string text((std::istreambuf_iterator<char>(readme)), std::istreambuf_iterator<char>());
+  std::ifstream formats(std::string(CREP_SOURCE_DIR) + "/docs/FORMATS.md");
+  const std::string text((std::istreambuf_iterator<char>(formats)), std::istreambuf_iterator<char>());
   CHECK(text.find(R"("status": "projective" | "fallback" | "empty")") != std::string::npos);
 }
 

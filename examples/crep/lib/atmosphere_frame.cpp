@@ -41,7 +41,7 @@ const char* const kAtmosphereOptionsHelp =
                                  reference)
             --multiple-scattering M  orders (default: orders 2..N by sphere and ray integrals) | lut
                                  (Hillaire 2020's table of every order >= 2: seconds, not minutes, and
-                                 darker; README, Atmosphere)
+                                 darker; docs/MEASUREMENTS.md, Atmosphere)
             --orders N           orders: scattering orders 1..N (default 4); 1: single scattering only
             --ground-albedo A    the ground's albedo in lut's multiple scattering, in [0, 1]
                                  (default 0.1)

@@ -1,5 +1,5 @@
 // The JSON frame description of `crep scatter` (users' own data) and `crep render --export-frame`.
-// Schema (README "crep scatter: the frame description"; example: examples/data/frame.json):
+// Schema (docs/FORMATS.md, "The frame description"; example: examples/data/frame.json):
 //
 //   {
 //     "version": 1,                                  optional; 1 if given

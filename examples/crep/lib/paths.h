@@ -4,7 +4,7 @@
 // are UsageErrors (exit 2), paths the file system refuses are IoErrors (exit 1); commands check the
 // former first.
 //
-// The output rule (README "The crep tool", "Outputs"; the file-level rule is crep/support/output_file.h):
+// The output rule (docs/TOOL.md, "Outputs"; the file-level rule is crep/support/output_file.h):
 // every output of a command is checked before any of them is written and before any GL work (a symbolic
 // link is followed to its final target, which is replaced and the link kept; a directory, device, FIFO or
 // socket is refused; its directory must exist and accept a new file; an --export-frame folder is created

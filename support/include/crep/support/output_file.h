@@ -1,5 +1,5 @@
 // The one rule for every file the support writers (writeExr, writeExrLayers, writePng, writeTextFile) and
-// the crep tool write (README "The crep tool", "Outputs"):
+// the crep tool write (docs/TOOL.md, "Outputs"):
 //
 //   1. A path that is a symbolic link (a chain of them) is followed to its final target: the target is
 //      replaced and the links stay. A dangling link creates its target.
