@@ -11,7 +11,7 @@
 #
 # Script mode (used by the rule above):
 #   cmake -DGLSL_ROOT=<dir> -DOUTPUT=<file.cpp> -DNAMESPACE=<ns> -DFUNCTION=<name> [-DPREFIX=<p>] -P EmbedGlsl.cmake
-set(CREP_GLSL_PATTERNS *.glsl *.comp *.vert *.frag)
+set(CREP_GLSL_PATTERNS *.glsl *.comp *.vert *.frag *.h)
 
 if(NOT CMAKE_SCRIPT_MODE_FILE)
   set(CREP_EMBED_GLSL_SCRIPT ${CMAKE_CURRENT_LIST_FILE})

@@ -8,6 +8,8 @@
 #include <crep/epipolar/gpu_epipolar_sampling.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -143,9 +145,9 @@ void EpipolarSamplingPass::checkFrame(const FrameAttribs& f) const {
 
 void EpipolarSamplingPass::bindCommon(std::uint32_t program) const {
   glUseProgram(program);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 1, samplingParams_.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, lineBuffer_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EPIPOLAR_SAMPLING_MARCH_BINDING, params_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EPIPOLAR_SAMPLING_PARAMS_BINDING, samplingParams_.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EPIPOLAR_SAMPLING_LINES_BINDING, lineBuffer_.get());
 }
 
 void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
@@ -167,10 +169,12 @@ void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
                        table.data());
 
   bindCommon(coordinatesProgram_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, coordinates_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, unshadowed_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindTextureUnit(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth);
+  glBindSampler(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, sampler_.get());
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_COORDINATES_OUT_IMAGE, coordinates_.get(), 0, GL_FALSE, 0,
+                     GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_OUT_IMAGE, unshadowed_.get(), 0, GL_FALSE, 0,
+                     GL_WRITE_ONLY, GL_R32F);
   glDispatchCompute(groups(o.samples, 64), static_cast<GLuint>(o.slices), 1);
   stageBarrier();
   gl::unbindPassState(4);
@@ -181,10 +185,13 @@ void EpipolarSamplingPass::refine() {
   const EpipolarSamplingOptions& o = info_.options;
   gpu::clearSampleList(sampleBuffer_.get());
   bindCommon(refineProgram_.get());
-  glBindImageTexture(0, coordinates_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, unshadowed_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-  glBindImageTexture(2, sources_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32I);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, sampleBuffer_.get());
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.get(), 0, GL_FALSE, 0,
+                     GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_IN_IMAGE, unshadowed_.get(), 0, GL_FALSE, 0,
+                     GL_READ_ONLY, GL_R32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SOURCES_OUT_IMAGE, sources_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     GL_RG32I);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, sampleBuffer_.get());
   glDispatchCompute(static_cast<GLuint>(o.slices), 1, 1);
   stageBarrier();
   gl::unbindPassState(4);
@@ -195,8 +202,10 @@ void EpipolarSamplingPass::interpolate() {
   const EpipolarSamplingOptions& o = info_.options;
   evaluatorBarrier();
   glUseProgram(interpolateProgram_.get());
-  glBindImageTexture(0, sources_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RG32I);
-  glBindImageTexture(1, samples_.get(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SOURCES_IN_IMAGE, sources_.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
+                     GL_RG32I);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SAMPLES_IMAGE, samples_.get(), 0, GL_FALSE, 0, GL_READ_WRITE,
+                     GL_RGBA32F);
   glDispatchCompute(groups(o.samples, 64), static_cast<GLuint>(o.slices), 1);
   stageBarrier();
   gl::unbindPassState(4);
@@ -210,13 +219,16 @@ void EpipolarSamplingPass::unwarp(const FrameAttribs& f) {
   evaluatorBarrier();
   gpu::clearSampleList(correctionBuffer_.get());
   bindCommon(unwarpProgram_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, coordinates_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, samples_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(2, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(3, targetCoordinates_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, correctionBuffer_.get());
+  glBindTextureUnit(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth);
+  glBindSampler(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, sampler_.get());
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.get(), 0, GL_FALSE, 0,
+                     GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SAMPLES_IN_IMAGE, samples_.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
+                     GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_OUT_IMAGE, targetCoordinates_.get(), 0,
+                     GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, correctionBuffer_.get());
   glDispatchCompute(groups(targetWidth_, 8), groups(targetHeight_, 8), 1);
   stageBarrier();
   gl::unbindPassState(4);
@@ -230,13 +242,17 @@ void EpipolarSamplingPass::upscale(const FrameAttribs& f) {
   evaluatorBarrier();
   gpu::clearSampleList(upscaleBuffer_.get());
   bindCommon(upscaleProgram_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, target_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, targetCoordinates_.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(2, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(3, fullCoordinates_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, upscaleBuffer_.get());
+  glBindTextureUnit(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth);
+  glBindSampler(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, sampler_.get());
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_TARGET_IN_IMAGE, target_.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
+                     GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_IN_IMAGE, targetCoordinates_.get(), 0,
+                     GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
+  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_FULL_COORDINATES_OUT_IMAGE, fullCoordinates_.get(), 0, GL_FALSE,
+                     0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, upscaleBuffer_.get());
   glDispatchCompute(groups(info_.width, 8), groups(info_.height, 8), 1);
   stageBarrier();
   gl::unbindPassState(4);

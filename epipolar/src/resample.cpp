@@ -11,6 +11,8 @@
 
 #include <crep/scatter/gpu_layout_buffers.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -201,17 +203,17 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
   glUseProgram(p);
   glProgramUniformMatrix4fv(p, 0, 1, GL_FALSE, &worldFromClip[0][0]);
   glProgramUniform1f(p, 1, static_cast<float>(projectedPointDistance(*f.layout)));
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  layoutBuffers_.bind(1, 1);
-  glBindTextureUnit(0, f.shadowMap);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_RESAMPLE_MARCH_BINDING, params_.get());
+  layoutBuffers_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+  glBindTextureUnit(CREP_RESAMPLE_SHADOW_MAP_UNIT, f.shadowMap);
+  glBindSampler(CREP_RESAMPLE_SHADOW_MAP_UNIT, sampler_.get());
+  glBindImageTexture(CREP_RESAMPLE_RECTIFIED_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   if (trees) { // one work group of 64 per row, 2^lowLevels texels per invocation
     glProgramUniform4i(p, 2, MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), lowLevels, 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_RESAMPLE_MIN_MAX_BINDING, f.minMaxBuffer);
     glDispatchCompute(static_cast<GLuint>(H), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_RESAMPLE_MIN_MAX_BINDING, 0);
   } else {
     glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
   }

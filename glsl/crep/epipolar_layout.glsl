@@ -1,7 +1,9 @@
 // crepuscular: the epipolar layout of crep/layout.glsl (Klehm et al. 2014, Sec. 4.1; crep::EpipolarLayout).
-// Included by crep/layout.glsl, which defines what it needs; not an include of its own.
+// Included by crep/layout.glsl (include that one); it includes what it needs itself.
 #ifndef CREP_EPIPOLAR_LAYOUT_GLSL
 #define CREP_EPIPOLAR_LAYOUT_GLSL
+
+#include "layout_common.glsl"
 
 #if CREP_LAYOUT == CREP_LAYOUT_EPIPOLAR
 // ---------------------------------------------------------------------------------------------------
@@ -279,12 +281,5 @@ float crep_rowRayDistance(CrepRowRay r, int i, ivec2 mapSize) {
   return (f0 + (f1 - f0) * float(q) / float(n)) * r.dist.x;
 }
 #endif // CREP_LAYOUT_EPIPOLAR
-
-// A view ray (unit dir from the camera, surface distance) -> its row ray; false where the layout cannot
-// map its end point.
-bool crep_mapRowRay(vec3 dir, float surface, ivec2 mapSize, out CrepRowRay r) {
-  vec4 p;
-  return crep_mapRowRayPoint(dir, surface, mapSize, r, p);
-}
 
 #endif // CREP_EPIPOLAR_LAYOUT_GLSL

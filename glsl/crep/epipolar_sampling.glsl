@@ -11,6 +11,7 @@
 // (crep/march.glsl, uniform binding 0) itself if it reads it.
 #ifndef CREP_EPIPOLAR_SAMPLING_GLSL
 #define CREP_EPIPOLAR_SAMPLING_GLSL
+#include "bindings.h"
 
 // gpu::EpipolarSamplingParams.
 struct CrepEpipolarSamplingParams {
@@ -27,7 +28,7 @@ struct CrepEpipolarLine {
   ivec4 info; // x lastValid (-1: no valid sample), y samples with the denser initial step, z that step
 };
 
-layout(std140, binding = 1) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
-layout(std430, binding = 0) readonly buffer CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; };
+layout(std140, binding = CREP_EPIPOLAR_SAMPLING_PARAMS_BINDING) uniform CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; };
+layout(std430, binding = CREP_EPIPOLAR_SAMPLING_LINES_BINDING) readonly buffer CrepEpipolarLinesBlock { CrepEpipolarLine crep_lines[]; };
 
 #endif // CREP_EPIPOLAR_SAMPLING_GLSL

@@ -1,7 +1,9 @@
 // crepuscular: the projective layout of crep/layout.glsl (Klehm et al. 2014, Sec. 4.2; crep::ProjectiveLayout).
-// Included by crep/layout.glsl, which defines what it needs; not an include of its own.
+// Included by crep/layout.glsl (include that one); it includes what it needs itself.
 #ifndef CREP_PROJECTIVE_LAYOUT_GLSL
 #define CREP_PROJECTIVE_LAYOUT_GLSL
+
+#include "layout_common.glsl"
 
 #if CREP_LAYOUT == CREP_LAYOUT_PROJECTIVE
 // ---------------------------------------------------------------------------------------------------

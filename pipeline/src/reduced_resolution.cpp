@@ -5,6 +5,8 @@
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -118,9 +120,9 @@ void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t l
                        GL_R32F);
   glUseProgram(downsampleProgram_.get());
   glProgramUniform2i(downsampleProgram_.get(), 0, lowWidth(), lowHeight());
-  glBindTextureUnit(0, fullDepth);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, lowDepth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindTextureUnit(CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT, fullDepth);
+  glBindSampler(CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT, sampler_.get());
+  glBindImageTexture(CREP_DEPTH_DOWNSAMPLE_LOW_DEPTH_IMAGE, lowDepth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glDispatchCompute(static_cast<GLuint>((lowWidth() + 7) / 8), static_cast<GLuint>((lowHeight() + 7) / 8), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(1);
@@ -155,12 +157,14 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.width, info_.height, lowWidth(), lowHeight());
   glProgramUniform4f(p, 1, depthMap.x, depthMap.y, depthMap.z, depthMap.w);
-  const GLuint textures[3] = {low, lowDepth, fullDepth};
-  for (GLuint unit = 0; unit < 3; ++unit) {
-    glBindTextureUnit(unit, textures[unit]);
+  const std::pair<GLuint, GLuint> textures[3] = {{CREP_DEPTH_UPSAMPLE_LOW_UNIT, low},
+                                                 {CREP_DEPTH_UPSAMPLE_LOW_DEPTH_UNIT, lowDepth},
+                                                 {CREP_DEPTH_UPSAMPLE_FULL_DEPTH_UNIT, fullDepth}};
+  for (const auto& [unit, texture] : textures) {
+    glBindTextureUnit(unit, texture);
     glBindSampler(unit, sampler_.get());
   }
-  glBindImageTexture(0, output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_DEPTH_UPSAMPLE_OUTPUT_IMAGE, output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glDispatchCompute(static_cast<GLuint>((info_.width + 7) / 8), static_cast<GLuint>((info_.height + 7) / 8),
                     1);
   gl::passOutputBarrier();

@@ -9,6 +9,8 @@
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/ray.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <cmath>
@@ -185,19 +187,19 @@ void EsmPass::run(const FrameAttribs& f) {
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
   // Downsample into the ESM, blur x into the scratch texture, blur y back into the ESM.
   glUseProgram(downsample_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.shadowMap);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, esm_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ESM_FROXEL_BINDING, params_.get());
+  glBindTextureUnit(CREP_ESM_SHADOW_MAP_UNIT, f.shadowMap);
+  glBindSampler(CREP_ESM_SHADOW_MAP_UNIT, sampler_.get());
+  glBindImageTexture(CREP_ESM_OUT_IMAGE, esm_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
   glDispatchCompute(static_cast<GLuint>((w + 7) / 8), static_cast<GLuint>((h + 7) / 8), 1);
   if (info_.options.blurRadius > 0) {
     glUseProgram(blur_.get());
     for (int direction = 0; direction < 2; ++direction) {
       glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
       glProgramUniform1i(blur_.get(), 0, direction);
-      glBindTextureUnit(0, direction == 0 ? esm_.get() : scratch_.get());
-      glBindImageTexture(0, direction == 0 ? scratch_.get() : esm_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                         GL_R32F);
+      glBindTextureUnit(CREP_ESM_IN_UNIT, direction == 0 ? esm_.get() : scratch_.get());
+      glBindImageTexture(CREP_ESM_OUT_IMAGE, direction == 0 ? scratch_.get() : esm_.get(), 0, GL_FALSE, 0,
+                         GL_WRITE_ONLY, GL_R32F);
       glDispatchCompute(static_cast<GLuint>((w + 7) / 8), static_cast<GLuint>((h + 7) / 8), 1);
     }
   }
@@ -256,10 +258,10 @@ void FroxelLightingPass::run(const FrameAttribs& f) {
   p.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
   glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.esm);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
+  glBindTextureUnit(CREP_FROXEL_ESM_UNIT, f.esm);
+  glBindSampler(CREP_FROXEL_ESM_UNIT, sampler_.get());
+  glBindImageTexture(CREP_FROXEL_LIGHTING_OUT_IMAGE, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
   dispatch3D(info_.grid, "FroxelLightingPass::run");
 }
 
@@ -284,8 +286,8 @@ void FroxelAccumulatePass::run(const FrameAttribs& f) {
   p.jitter = glm::vec4(glm::vec3(f.jitter), 0.0f);
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
   glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindImageTexture(0, f.volume, 0, GL_TRUE, 0, GL_READ_WRITE, info_.format);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
+  glBindImageTexture(CREP_FROXEL_VOLUME_IMAGE, f.volume, 0, GL_TRUE, 0, GL_READ_WRITE, info_.format);
   dispatch2D(info_.grid.width, info_.grid.height, "FroxelAccumulatePass::run");
 }
 
@@ -327,12 +329,13 @@ void FroxelTemporalPass::run(const FrameAttribs& f) {
   p.jitter = glm::vec4(0.0f, 0.0f, 0.0f, static_cast<float>(useHistory ? f.historyWeight : 0.0));
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
   glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.current);
-  glBindSampler(0, nearest_.get());
-  glBindTextureUnit(1, useHistory ? f.history : f.current); // unused without history (weight 0)
-  glBindSampler(1, linear_.get());
-  glBindImageTexture(0, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
+  glBindTextureUnit(CREP_FROXEL_CURRENT_UNIT, f.current);
+  glBindSampler(CREP_FROXEL_CURRENT_UNIT, nearest_.get());
+  // unused without history (weight 0)
+  glBindTextureUnit(CREP_FROXEL_HISTORY_UNIT, useHistory ? f.history : f.current);
+  glBindSampler(CREP_FROXEL_HISTORY_UNIT, linear_.get());
+  glBindImageTexture(CREP_FROXEL_BLENDED_OUT_IMAGE, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
   dispatch3D(info_.grid, "FroxelTemporalPass::run");
 }
 
@@ -360,12 +363,12 @@ void FroxelApplyPass::run(const FrameAttribs& f) {
   p.sizes = glm::ivec4(depth.width, depth.height, 0, 0);
   glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
   glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindSampler(0, nearest_.get());
-  glBindTextureUnit(1, f.volume);
-  glBindSampler(1, linear_.get());
-  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
+  glBindTextureUnit(CREP_FROXEL_CAMERA_DEPTH_UNIT, f.cameraDepth);
+  glBindSampler(CREP_FROXEL_CAMERA_DEPTH_UNIT, nearest_.get());
+  glBindTextureUnit(CREP_FROXEL_INTEGRATED_UNIT, f.volume);
+  glBindSampler(CREP_FROXEL_INTEGRATED_UNIT, linear_.get());
+  glBindImageTexture(CREP_FROXEL_SCATTERING_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   dispatch2D(depth.width, depth.height, "FroxelApplyPass::run");
 }
 

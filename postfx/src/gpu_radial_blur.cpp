@@ -6,6 +6,8 @@
 #include <crep/postfx/gpu_radial_blur.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <string>
@@ -82,19 +84,19 @@ void RadialBlurPass::run(const FrameAttribs& f) {
 
   // The occlusion pre-pass (Mitchell 2007, Sec. 13.5.1) into the source.
   glUseProgram(sourceProgram_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 1, radialParams_.get());
-  glBindTextureUnit(0, f.cameraDepth);
-  glBindSampler(0, nearest_.get());
-  glBindImageTexture(0, source_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_RADIAL_MARCH_BINDING, marchParams_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_RADIAL_BLUR_BINDING, radialParams_.get());
+  glBindTextureUnit(CREP_RADIAL_CAMERA_DEPTH_UNIT, f.cameraDepth);
+  glBindSampler(CREP_RADIAL_CAMERA_DEPTH_UNIT, nearest_.get());
+  glBindImageTexture(CREP_RADIAL_SOURCE_OUT_IMAGE, source_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glDispatchCompute(groups(size.x), groups(size.y), 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
 
   // The blur (Mitchell 2007, Eq. 4, Sec. 13.4) into the output.
   glUseProgram(blurProgram_.get());
-  glBindTextureUnit(1, source_.get());
-  glBindSampler(1, linear_.get());
-  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindTextureUnit(CREP_RADIAL_SOURCE_UNIT, source_.get());
+  glBindSampler(CREP_RADIAL_SOURCE_UNIT, linear_.get());
+  glBindImageTexture(CREP_RADIAL_SCATTERING_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glDispatchCompute(groups(width), groups(height), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(2);

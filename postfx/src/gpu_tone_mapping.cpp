@@ -6,6 +6,8 @@
 #include <crep/core/shader_library.h>
 #include <crep/postfx/gpu_tone_mapping.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <cmath>
@@ -87,17 +89,17 @@ void ToneMapPass::run(const FrameAttribs& f) {
   glNamedBufferSubData(params_.get(), 0, sizeof params, &params);
 
   const GLuint program = toneMapProgram(out.internalFormat);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.input);
-  glBindSampler(0, sampler_.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, state_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_TONE_MAP_PARAMS_BINDING, params_.get());
+  glBindTextureUnit(CREP_TONE_MAP_HDR_UNIT, f.input);
+  glBindSampler(CREP_TONE_MAP_HDR_UNIT, sampler_.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_TONE_MAP_STATE_BINDING, state_.get());
   if (o.autoExposure) {
     const std::size_t bytes = sizeof(gpu::LuminancePartial) * static_cast<std::size_t>(groupsX * groupsY);
     if (!partials_ || partialsCapacity_ < bytes) {
       partials_ = gl::createDynamicBuffer(bytes);
       partialsCapacity_ = bytes;
     }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, partials_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_TONE_MAP_LUMINANCE_PARTIALS_BINDING, partials_.get());
     glUseProgram(reduceProgram_.get());
     glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -106,7 +108,8 @@ void ToneMapPass::run(const FrameAttribs& f) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   }
   glUseProgram(program);
-  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, out.internalFormat);
+  glBindImageTexture(CREP_TONE_MAP_DISPLAY_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     out.internalFormat);
   glDispatchCompute(static_cast<GLuint>((in.width + 7) / 8), static_cast<GLuint>((in.height + 7) / 8), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(2);

@@ -6,6 +6,8 @@
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/light_texture.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <string>
@@ -85,11 +87,12 @@ void LightColorMapPass::run(const FrameAttribs& f) {
   glNamedBufferSubData(params_.get(), 0, sizeof params, &params);
 
   glUseProgram(program.get());
-  layout_.bind(1, 1);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params_.get());
-  glBindTextureUnit(0, f.lightTexture.texture);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, colors_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  layout_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_LIGHT_COLORS_LIGHT_TEXTURE_BINDING, params_.get());
+  glBindTextureUnit(CREP_LIGHT_COLORS_LIGHT_TEXTURE_UNIT, f.lightTexture.texture);
+  glBindSampler(CREP_LIGHT_COLORS_LIGHT_TEXTURE_UNIT, sampler_.get());
+  glBindImageTexture(CREP_LIGHT_COLORS_COLORS_OUT_IMAGE, colors_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
   glDispatchCompute(static_cast<GLuint>((info_.mapWidth + 7) / 8),
                     static_cast<GLuint>((info_.mapHeight + 7) / 8), 1);
   gl::passOutputBarrier();

@@ -5,6 +5,8 @@
 #include <crep/core/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -72,13 +74,13 @@ void bindMarchResources(std::uint32_t program, std::uint32_t params, std::uint32
                         std::uint32_t map, std::uint32_t sampler, std::uint32_t scattering,
                         std::uint32_t steps) {
   glUseProgram(program);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, params);
-  glBindTextureUnit(0, cameraDepth);
-  glBindTextureUnit(1, map);
-  glBindSampler(0, sampler);
-  glBindSampler(1, sampler);
-  glBindImageTexture(0, scattering, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_MARCH_PARAMS_BINDING, params);
+  glBindTextureUnit(CREP_MARCH_CAMERA_DEPTH_UNIT, cameraDepth);
+  glBindTextureUnit(CREP_MARCH_MAP_UNIT, map);
+  glBindSampler(CREP_MARCH_CAMERA_DEPTH_UNIT, sampler);
+  glBindSampler(CREP_MARCH_MAP_UNIT, sampler);
+  glBindImageTexture(CREP_MARCH_SCATTERING_OUT_IMAGE, scattering, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_MARCH_STEPS_OUT_IMAGE, steps, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
 }
 
 bool setMarchRegion(MarchParams& params, int width, int height, const glm::dvec2& blockCenter,
@@ -195,14 +197,14 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   gpu::bindMarchResources(program, params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,
                           steps);
   if (textured) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, 1, textureParams_.get());
-    glBindTextureUnit(2, f.lightTexture.texture);
-    glBindSampler(2, sampler_.get());
+    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_MARCH_LIGHT_TEXTURE_BINDING, textureParams_.get());
+    glBindTextureUnit(CREP_MARCH_LIGHT_TEXTURE_UNIT, f.lightTexture.texture);
+    glBindSampler(CREP_MARCH_LIGHT_TEXTURE_UNIT, sampler_.get());
   }
   gpu::dispatchMarch(region.z, region.w, "WorldMarchPass::run");
   if (textured) {
-    glBindSampler(2, 0);
-    glBindTextureUnit(2, 0);
+    glBindSampler(CREP_MARCH_LIGHT_TEXTURE_UNIT, 0);
+    glBindTextureUnit(CREP_MARCH_LIGHT_TEXTURE_UNIT, 0);
   }
 }
 

@@ -298,7 +298,7 @@ TEST_CASE("glslangValidator accepts every shader of the library") {
     CAPTURE(path);
     ExpandedShader e = ShaderLibrary::expand(path);
     std::string extension = path.substr(path.rfind('.') + 1);
-    if (extension == "glsl") {
+    if (extension == "glsl" || extension == "h") { // an include (crep/bindings.h is one too)
       // A public include must compile on its own (it is self-contained): as a compute shader.
       e.text += "layout(local_size_x = 1) in;\nvoid main() {}\n";
       extension = "comp";
@@ -353,7 +353,7 @@ TEST_CASE("no shader uses a double type by default: neither its preprocessed sou
       if (!defines.empty() && !contains(e.text, defines.front().name)) continue;
       e = ShaderLibrary::expand(path, defines);
       std::string ext = extension;
-      if (ext == "glsl") {
+      if (ext == "glsl" || ext == "h") {
         e.text += "layout(local_size_x = 1) in;\nvoid main() {}\n";
         ext = "comp";
       }

@@ -4,6 +4,7 @@
 // CREP_ATMOSPHERE_SAMPLES (kAmbientSampleFactor * sphereSamples) Fibonacci directions (lower ones mirrored) of
 // L_M(C, w, l) (w . zenith), times 2 pi / samples; L_M = L1 (the phase-free single tables with their phase
 // functions at w . l) + L_H.
+#include "crep/bindings.h"
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_SAMPLES
@@ -12,11 +13,11 @@
 
 layout(local_size_x = 64) in;
 
-layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler3D crep_single;
-layout(binding = 1) uniform sampler3D crep_singleMie;
-layout(binding = 2) uniform sampler3D crep_higherOrders;
-layout(binding = 0, rgba32f) uniform restrict writeonly image2D crep_ambient;
+layout(std140, binding = CREP_ATMOSPHERE_TABLES_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = CREP_ATMOSPHERE_TABLES_AMBIENT_SINGLE_UNIT) uniform sampler3D crep_single;
+layout(binding = CREP_ATMOSPHERE_TABLES_AMBIENT_SINGLE_MIE_UNIT) uniform sampler3D crep_singleMie;
+layout(binding = CREP_ATMOSPHERE_TABLES_AMBIENT_HIGHER_ORDERS_UNIT) uniform sampler3D crep_higherOrders;
+layout(binding = CREP_ATMOSPHERE_TABLES_AMBIENT_OUTPUT_IMAGE, rgba32f) uniform restrict writeonly image2D crep_ambient;
 
 void main() {
   int i = int(gl_GlobalInvocationID.x);

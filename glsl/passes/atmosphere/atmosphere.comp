@@ -33,6 +33,7 @@
 // the view tables (units 8-11, CREP_ATMOSPHERE_VOLUME),
 // min/max nodes (storage binding 0, (a), (b)); outputs: RGBA32F in-scattering + mean transmittance (image 0),
 // RGBA32F transmittance (image 1).
+#include "crep/bindings.h"
 #ifndef CREP_ATMOSPHERE_SHAFTS
 #define CREP_ATMOSPHERE_SHAFTS 0
 #endif
@@ -62,36 +63,36 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(std140, binding = 2) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 2) uniform sampler2D opticalDepthTable;
-layout(binding = 3) uniform sampler3D singleTable;
-layout(binding = 4) uniform sampler3D higherOrdersTable;
-layout(binding = 5) uniform sampler3D singleMieTable; // not read with CREP_ATMOSPHERE_COMBINED_MIE 1
-layout(binding = 7) uniform sampler2D ambientTable;   // E_sky: the ground beyond the scene
+layout(std140, binding = CREP_ATMOSPHERE_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(std140, binding = CREP_ATMOSPHERE_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = CREP_ATMOSPHERE_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT) uniform sampler2D opticalDepthTable;
+layout(binding = CREP_ATMOSPHERE_SINGLE_TABLE_UNIT) uniform sampler3D singleTable;
+layout(binding = CREP_ATMOSPHERE_HIGHER_ORDERS_TABLE_UNIT) uniform sampler3D higherOrdersTable;
+layout(binding = CREP_ATMOSPHERE_SINGLE_MIE_TABLE_UNIT) uniform sampler3D singleMieTable; // not read with CREP_ATMOSPHERE_COMBINED_MIE 1
+layout(binding = CREP_ATMOSPHERE_AMBIENT_TABLE_UNIT) uniform sampler2D ambientTable;   // E_sky: the ground beyond the scene
 #if CREP_SHAFTS_WALK
-layout(binding = 1) uniform sampler2D rectifiedDepth;
-layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+layout(binding = CREP_ATMOSPHERE_RECTIFIED_DEPTH_UNIT) uniform sampler2D rectifiedDepth;
+layout(std430, binding = CREP_ATMOSPHERE_MIN_MAX_BINDING) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
 #endif
 #if CREP_ATMOSPHERE_SHAFTS == 3
-layout(binding = 6) uniform sampler2D prefiltered;
+layout(binding = CREP_ATMOSPHERE_PREFILTERED_UNIT) uniform sampler2D prefiltered;
 #endif
 #if CREP_ATMOSPHERE_VOLUME_PASS == 1
-layout(binding = 0, rgba32f) uniform writeonly image3D volumeRayleighOut;
-layout(binding = 1, rgba32f) uniform writeonly image3D volumeMieOut;
+layout(binding = CREP_ATMOSPHERE_VOLUME_RAYLEIGH_OUT_IMAGE, rgba32f) uniform writeonly image3D volumeRayleighOut;
+layout(binding = CREP_ATMOSPHERE_VOLUME_MIE_OUT_IMAGE, rgba32f) uniform writeonly image3D volumeMieOut;
 #elif CREP_ATMOSPHERE_VOLUME_PASS == 2
-layout(binding = 0, rgba32f) uniform writeonly image2D skyRayleighOut;
-layout(binding = 1, rgba32f) uniform writeonly image2D skyMieOut;
+layout(binding = CREP_ATMOSPHERE_SKY_RAYLEIGH_OUT_IMAGE, rgba32f) uniform writeonly image2D skyRayleighOut;
+layout(binding = CREP_ATMOSPHERE_SKY_MIE_OUT_IMAGE, rgba32f) uniform writeonly image2D skyMieOut;
 #else
-layout(binding = 0, rgba32f) uniform writeonly image2D inscatteringOut;
-layout(binding = 1, rgba32f) uniform writeonly image2D transmittanceOut;
+layout(binding = CREP_ATMOSPHERE_INSCATTERING_OUT_IMAGE, rgba32f) uniform writeonly image2D inscatteringOut;
+layout(binding = CREP_ATMOSPHERE_TRANSMITTANCE_OUT_IMAGE, rgba32f) uniform writeonly image2D transmittanceOut;
 #endif
 #if CREP_ATMOSPHERE_VOLUME
-layout(binding = 8) uniform sampler3D volumeRayleigh;
-layout(binding = 9) uniform sampler3D volumeMie;
-layout(binding = 10) uniform sampler2D skyRayleigh;
-layout(binding = 11) uniform sampler2D skyMie;
+layout(binding = CREP_ATMOSPHERE_VOLUME_RAYLEIGH_UNIT) uniform sampler3D volumeRayleigh;
+layout(binding = CREP_ATMOSPHERE_VOLUME_MIE_UNIT) uniform sampler3D volumeMie;
+layout(binding = CREP_ATMOSPHERE_SKY_RAYLEIGH_UNIT) uniform sampler2D skyRayleigh;
+layout(binding = CREP_ATMOSPHERE_SKY_MIE_UNIT) uniform sampler2D skyMie;
 #endif
 
 // The ray of this invocation, in metres around the planet centre (atmosphere.h's table frame).

@@ -8,6 +8,7 @@
 // true phase functions where Hillaire takes the isotropic one, plus the sunlit ground's albedo / pi
 // bounce) and the transfer f_ms (the mean of the integral of T(x, y) sigma_s(y)); Psi_ms = L2 / (1 - f_ms).
 // Positions are offsets from x (altitudes from |x|^2 - R^2 without cancellation, as the 4D passes').
+#include "crep/bindings.h"
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_SAMPLES
@@ -19,9 +20,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler2D crep_opticalDepth;
-layout(binding = 0, rgba32f) uniform restrict writeonly image2D crep_output;
+layout(std140, binding = CREP_ATMOSPHERE_TABLES_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = CREP_ATMOSPHERE_TABLES_MS_OPTICAL_DEPTH_UNIT) uniform sampler2D crep_opticalDepth;
+layout(binding = CREP_ATMOSPHERE_TABLES_MS_OUTPUT_IMAGE, rgba32f) uniform restrict writeonly image2D crep_output;
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);

@@ -4,6 +4,7 @@
 // (Rayleigh, Mie) density integrals from altitude h = H_Atm (i / (W - 1))^2 along cos zenith
 // c = -1 + 2 j / (H - 1) to the top of the atmosphere (Yusov 2013's net density table), by the trapezoid
 // rule with CREP_ATMOSPHERE_STEPS steps, or kOccludedDensity in both channels when the ray hits the ground.
+#include "crep/bindings.h"
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_STEPS
@@ -12,8 +13,8 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0, rg32f) uniform restrict writeonly image2D crep_opticalDepth;
+layout(std140, binding = CREP_ATMOSPHERE_TABLES_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = CREP_ATMOSPHERE_TABLES_OPTICAL_DEPTH_OUTPUT_IMAGE, rg32f) uniform restrict writeonly image2D crep_opticalDepth;
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);

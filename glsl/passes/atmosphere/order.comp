@@ -4,6 +4,7 @@
 // the single scattering stage); the camera's density integral is accumulated by the trapezoid rule, the
 // look-ups into J_n keep the texel's side of the horizon (Listing 2); the first one (at C) is at the texel's
 // own coordinates.
+#include "crep/bindings.h"
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_STEPS
@@ -12,9 +13,9 @@
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler3D crep_scattered;
-layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
+layout(std140, binding = CREP_ATMOSPHERE_TABLES_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = CREP_ATMOSPHERE_TABLES_ORDER_SCATTERED_UNIT) uniform sampler3D crep_scattered;
+layout(binding = CREP_ATMOSPHERE_TABLES_ORDER_OUTPUT_IMAGE, rgba32f) uniform restrict writeonly image3D crep_output;
 
 void main() {
   ivec3 p = ivec3(gl_GlobalInvocationID);

@@ -5,6 +5,7 @@
 // fresh coordinates. CREP_ATMOSPHERE_FIRST_ORDER 1 (n = 2): L1 from the phase-free single tables with its
 // phase functions at w . l (crep_sampleSingleScattering), plus the ground's first bounce of the sunlight for
 // the directions that hit the ground (crep::precomputeAtmosphere's groundBounce; optical depth at unit 2).
+#include "crep/bindings.h"
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_SAMPLES
@@ -13,14 +14,14 @@
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(std140, binding = CREP_ATMOSPHERE_TABLES_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
 #ifndef CREP_ATMOSPHERE_FIRST_ORDER
 #define CREP_ATMOSPHERE_FIRST_ORDER 0
 #endif
-layout(binding = 0) uniform sampler3D crep_previousOrder; // n = 2: the single table
+layout(binding = CREP_ATMOSPHERE_TABLES_SCATTERED_PREVIOUS_ORDER_UNIT) uniform sampler3D crep_previousOrder; // n = 2: the single table
 #if CREP_ATMOSPHERE_FIRST_ORDER
-layout(binding = 1) uniform sampler3D crep_singleMie;
-layout(binding = 2) uniform sampler2D crep_opticalDepth;
+layout(binding = CREP_ATMOSPHERE_TABLES_SCATTERED_SINGLE_MIE_UNIT) uniform sampler3D crep_singleMie;
+layout(binding = CREP_ATMOSPHERE_TABLES_SCATTERED_OPTICAL_DEPTH_UNIT) uniform sampler2D crep_opticalDepth;
 
 // T(C->g) (albedo / pi) T_sun(g) max(0, n_g . l) for a direction w from altitude h that hits the ground at g.
 vec3 groundBounce(float h, vec3 w, vec3 sun, float wl) {
@@ -40,7 +41,7 @@ vec3 groundBounce(float h, vec3 w, vec3 sun, float wl) {
          (cosSun * albedo * float(CREP_INV_PI));
 }
 #endif
-layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
+layout(binding = CREP_ATMOSPHERE_TABLES_SCATTERED_OUTPUT_IMAGE, rgba32f) uniform restrict writeonly image3D crep_output;
 
 void main() {
   ivec3 p = ivec3(gl_GlobalInvocationID);

@@ -8,6 +8,7 @@
 // steps from its point C to the ground (lower alpha half) or the top of the atmosphere (upper half); the
 // camera's density integral is accumulated by the trapezoid rule over the steps so far (Listing 5's way),
 // the sun's transmittance comes from the optical depth table.
+#include "crep/bindings.h"
 #include "crep/atmosphere.glsl"
 
 #ifndef CREP_ATMOSPHERE_STEPS
@@ -16,18 +17,18 @@
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-layout(std140, binding = 0) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
-layout(binding = 0) uniform sampler2D crep_opticalDepth;
-layout(binding = 0, rgba32f) uniform restrict writeonly image3D crep_output;
+layout(std140, binding = CREP_ATMOSPHERE_TABLES_PARAMS_BINDING) uniform CrepAtmosphereBlock { CrepAtmosphereParams crep_atmosphere; };
+layout(binding = CREP_ATMOSPHERE_TABLES_SINGLE_OPTICAL_DEPTH_UNIT) uniform sampler2D crep_opticalDepth;
+layout(binding = CREP_ATMOSPHERE_TABLES_SINGLE_OUTPUT_IMAGE, rgba32f) uniform restrict writeonly image3D crep_output;
 #if !CREP_ATMOSPHERE_COMBINED_MIE
-layout(binding = 1, rgba32f) uniform restrict writeonly image3D crep_outputMie;
+layout(binding = CREP_ATMOSPHERE_TABLES_SINGLE_OUTPUT_MIE_IMAGE, rgba32f) uniform restrict writeonly image3D crep_outputMie;
 #endif
 #ifndef CREP_ATMOSPHERE_MS_LUT
 #define CREP_ATMOSPHERE_MS_LUT 0
 #endif
 #if CREP_ATMOSPHERE_MS_LUT
-layout(binding = 1) uniform sampler2D crep_msLut; // Psi_ms
-layout(binding = 2, rgba32f) uniform restrict writeonly image3D crep_outputHigher;
+layout(binding = CREP_ATMOSPHERE_TABLES_SINGLE_MS_LUT_UNIT) uniform sampler2D crep_msLut; // Psi_ms
+layout(binding = CREP_ATMOSPHERE_TABLES_SINGLE_OUTPUT_HIGHER_IMAGE, rgba32f) uniform restrict writeonly image3D crep_outputHigher;
 #endif
 
 void main() {

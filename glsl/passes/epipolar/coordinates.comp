@@ -11,15 +11,16 @@
 //
 // Resources: MarchParams (uniform 0), EpipolarSamplingParams (uniform 1), line table (storage 0), camera
 // depth (texture unit 0, texelFetch), outputs: coordinates RGBA32F (image 0), U R32F (image 1).
+#include "crep/bindings.h"
 #include "crep/radial_blur.glsl"
 #include "crep/epipolar_sampling.glsl"
 
 layout(local_size_x = 64, local_size_y = 1) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 0, rgba32f) uniform writeonly image2D coordinatesOut;
-layout(binding = 1, r32f) uniform writeonly image2D unshadowedOut;
+layout(std140, binding = CREP_EPIPOLAR_SAMPLING_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_EPIPOLAR_SAMPLING_COORDINATES_OUT_IMAGE, rgba32f) uniform writeonly image2D coordinatesOut;
+layout(binding = CREP_EPIPOLAR_SAMPLING_UNSHADOWED_OUT_IMAGE, r32f) uniform writeonly image2D unshadowedOut;
 
 void main() {
   ivec2 t = ivec2(gl_GlobalInvocationID.xy); // (k, i)

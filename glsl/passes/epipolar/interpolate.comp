@@ -7,10 +7,11 @@
 // writes, so the in-place reads and writes do not overlap.
 //
 // Resources: sources RG32I (image 0, read), samples RGBA32F (image 1, read and written).
+#include "crep/bindings.h"
 layout(local_size_x = 64, local_size_y = 1) in;
 
-layout(binding = 0, rg32i) uniform readonly iimage2D sourcesIn;
-layout(binding = 1, rgba32f) uniform image2D samples;
+layout(binding = CREP_EPIPOLAR_SAMPLING_SOURCES_IN_IMAGE, rg32i) uniform readonly iimage2D sourcesIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_SAMPLES_IMAGE, rgba32f) uniform image2D samples;
 
 void main() {
   ivec2 t = ivec2(gl_GlobalInvocationID.xy);

@@ -19,6 +19,7 @@
 // or two on real GPUs, every lane busy: the list is compacted) dispatched indirectly; texture unit 0 holds
 // the list's coordinates (x, y, d, z) instead of the camera depth, the ray is crep_screenRay at (x, y) to
 // depth d, and the outputs are written at the entry's texel only.
+#include "crep/bindings.h"
 #include "crep/layout.glsl"
 #include "crep/local_light.glsl"
 #include "crep/phase.glsl"
@@ -41,17 +42,17 @@ layout(local_size_x = CREP_SAMPLE_LIST_GROUP_SIZE) in;
 layout(local_size_x = 8, local_size_y = 8) in;
 #endif
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth; // CREP_SAMPLE_LIST: the list's coordinates (x, y, d, z)
-layout(binding = 1) uniform sampler2D rectifiedDepth;
+layout(std140, binding = CREP_MARCH_PARAMS_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_MARCH_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth; // CREP_SAMPLE_LIST: the list's coordinates (x, y, d, z)
+layout(binding = CREP_MARCH_MAP_UNIT) uniform sampler2D rectifiedDepth;
 #if CREP_MARCH_TREE
-layout(std430, binding = 0) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+layout(std430, binding = CREP_MARCH_MIN_MAX_BINDING) readonly buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
 #endif
 #if CREP_LIGHT_TEXTURE
-layout(binding = 2) uniform sampler2D crep_lightColors; // W x H, rgb: each texel's light-ray colour
+layout(binding = CREP_MARCH_LIGHT_COLORS_UNIT) uniform sampler2D crep_lightColors; // W x H, rgb: each texel's light-ray colour
 #endif
-layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
-layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
+layout(binding = CREP_MARCH_SCATTERING_OUT_IMAGE, rgba32f) uniform writeonly image2D scatteringOut;
+layout(binding = CREP_MARCH_STEPS_OUT_IMAGE, r32f) uniform writeonly image2D stepsOut;
 
 bool local = false;
 CrepLocalLight localLight;

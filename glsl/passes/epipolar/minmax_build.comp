@@ -15,14 +15,15 @@
 
 // CREP_TREE_UPPER_ONLY 1: levels 1..C are in the buffer already (written by the epipolar resampling,
 // passes/epipolar/resample.comp with CREP_RESAMPLE_TREES); only levels C + 1..L are built, the map is not read.
+#include "crep/bindings.h"
 #ifndef CREP_TREE_UPPER_ONLY
 #define CREP_TREE_UPPER_ONLY 0
 #endif
 
 layout(local_size_x = 64) in;
 
-layout(binding = 0) uniform sampler2D rectifiedDepth;
-layout(std430, binding = 0) buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+layout(binding = CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT) uniform sampler2D rectifiedDepth;
+layout(std430, binding = CREP_MIN_MAX_TREE_MIN_MAX_BINDING) buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
 layout(location = 0) uniform ivec4 sizes;
 
 // Node m of level l from level l - 1 (size `below`, at offset offBelow) or, for l = 1, from the texels.

@@ -14,6 +14,7 @@
 //
 // Resources: EpipolarSamplingParams (uniform 1), line table (storage 0), sample list (storage 2),
 // coordinates RGBA32F (image 0, read), U R32F (image 1, read), sources RG32I (image 2, written).
+#include "crep/bindings.h"
 #include "crep/sample_list.glsl"
 #include "crep/epipolar_sampling.glsl"
 
@@ -24,9 +25,9 @@
 
 layout(local_size_x = CREP_SAMPLES) in;
 
-layout(binding = 0, rgba32f) uniform readonly image2D coordinatesIn;
-layout(binding = 1, r32f) uniform readonly image2D unshadowedIn;
-layout(binding = 2, rg32i) uniform writeonly iimage2D sourcesOut;
+layout(binding = CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, rgba32f) uniform readonly image2D coordinatesIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_UNSHADOWED_IN_IMAGE, r32f) uniform readonly image2D unshadowedIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_SOURCES_OUT_IMAGE, rg32i) uniform writeonly iimage2D sourcesOut;
 
 shared uint flags[CREP_FLAG_WORDS]; // bit j: a break between samples j and j + 1
 shared float lineZ[CREP_SAMPLES], lineU[CREP_SAMPLES];

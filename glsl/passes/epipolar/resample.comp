@@ -18,6 +18,7 @@
 // reading back only nodes it wrote itself (no barrier). MinMaxTreePass::completeUpperLevels builds the rest.
 // Saves the tree pass's second read of the map (chosen for GPUs: the map is read once; measured on llvmpipe
 // in README "Sun in view").
+#include "crep/bindings.h"
 #include "crep/layout.glsl"
 
 #ifndef CREP_RESAMPLE_TREES
@@ -26,15 +27,15 @@
 
 #if CREP_RESAMPLE_TREES
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+layout(std430, binding = CREP_RESAMPLE_MIN_MAX_BINDING) buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
 layout(location = 2) uniform ivec4 treeInfo; // L, row stride, C, 0
 #else
 layout(local_size_x = 8, local_size_y = 8) in;
 #endif
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D shadowMap;
-layout(binding = 0, r32f) uniform writeonly image2D rectifiedOut;
+layout(std140, binding = CREP_RESAMPLE_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_RESAMPLE_SHADOW_MAP_UNIT) uniform sampler2D shadowMap;
+layout(binding = CREP_RESAMPLE_RECTIFIED_OUT_IMAGE, r32f) uniform writeonly image2D rectifiedOut;
 layout(location = 0) uniform mat4 worldFromLightClip;
 layout(location = 1) uniform float projectedDistance;
 

@@ -17,18 +17,19 @@
 // (storage 0), correction list (storage 2), camera depth (texture unit 0), coordinates RGBA32F (image 0,
 // read), samples RGBA32F (image 1, read), output RGBA32F (image 2, written), target coordinates RGBA32F
 // (image 3, written).
+#include "crep/bindings.h"
 #include "crep/march.glsl"
 #include "crep/sample_list.glsl"
 #include "crep/epipolar_sampling.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 0, rgba32f) uniform readonly image2D coordinatesIn;
-layout(binding = 1, rgba32f) uniform readonly image2D samplesIn;
-layout(binding = 2, rgba32f) uniform writeonly image2D output_;
-layout(binding = 3, rgba32f) uniform writeonly image2D targetCoordinatesOut;
+layout(std140, binding = CREP_EPIPOLAR_SAMPLING_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, rgba32f) uniform readonly image2D coordinatesIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_SAMPLES_IN_IMAGE, rgba32f) uniform readonly image2D samplesIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, rgba32f) uniform writeonly image2D output_;
+layout(binding = CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_OUT_IMAGE, rgba32f) uniform writeonly image2D targetCoordinatesOut;
 
 // EpipolarLines::borderSigma: the border parameter of a border point X, on the side it is nearest to
 // (ties: left, bottom, right, top).

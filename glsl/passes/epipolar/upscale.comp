@@ -11,18 +11,19 @@
 // Resources: MarchParams (uniform 0), EpipolarSamplingParams (uniform 1), correction list (storage 2),
 // camera depth (texture unit 0), target RGBA32F (image 0, read), target coordinates RGBA32F (image 1,
 // read), output RGBA32F (image 2, written), full-resolution coordinates RGBA32F (image 3, written).
+#include "crep/bindings.h"
 #include "crep/march.glsl"
 #include "crep/sample_list.glsl"
 #include "crep/epipolar_sampling.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 0, rgba32f) uniform readonly image2D targetIn;
-layout(binding = 1, rgba32f) uniform readonly image2D targetCoordinatesIn;
-layout(binding = 2, rgba32f) uniform writeonly image2D output_;
-layout(binding = 3, rgba32f) uniform writeonly image2D fullCoordinatesOut;
+layout(std140, binding = CREP_EPIPOLAR_SAMPLING_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_EPIPOLAR_SAMPLING_TARGET_IN_IMAGE, rgba32f) uniform readonly image2D targetIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_IN_IMAGE, rgba32f) uniform readonly image2D targetCoordinatesIn;
+layout(binding = CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, rgba32f) uniform writeonly image2D output_;
+layout(binding = CREP_EPIPOLAR_SAMPLING_FULL_COORDINATES_OUT_IMAGE, rgba32f) uniform writeonly image2D fullCoordinatesOut;
 
 void main() {
   ivec2 q = ivec2(gl_GlobalInvocationID.xy);

@@ -2,12 +2,13 @@
 // Checkerboard min/max depth downsample of the reduced-resolution evaluation (crep::downsampleDepth,
 // crep/pipeline/reduced_resolution.h): low pixel (i, j) takes the minimum of its f x f block of depth-buffer
 // values where i + j is even, the maximum where it is odd. Driven by crep::DepthAwareResamplePass.
+#include "crep/bindings.h"
 #ifndef CREP_FACTOR
 #define CREP_FACTOR 2
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0) uniform sampler2D crep_fullDepth;
-layout(binding = 0, r32f) uniform writeonly restrict image2D crep_lowDepth;
+layout(binding = CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT) uniform sampler2D crep_fullDepth;
+layout(binding = CREP_DEPTH_DOWNSAMPLE_LOW_DEPTH_IMAGE, r32f) uniform writeonly restrict image2D crep_lowDepth;
 layout(location = 0) uniform ivec2 crep_lowSize;
 
 void main() {

@@ -2,6 +2,7 @@
 // Depth-aware (joint bilateral) upsample of the reduced-resolution evaluation (crep::depthAwareUpsample,
 // crep/pipeline/reduced_resolution.h): the four low pixels of the bilinear footprint, weights bilinear /
 // (e + |Z - Z_k| / Z) with view-space depths Z. Driven by crep::DepthAwareResamplePass.
+#include "crep/bindings.h"
 #ifndef CREP_FACTOR
 #define CREP_FACTOR 2
 #endif
@@ -10,10 +11,10 @@
 #define CREP_DEPTH_EPSILON 0.01
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0) uniform sampler2D crep_low;       // RGBA32F, low size
-layout(binding = 1) uniform sampler2D crep_lowDepth;  // R32F, low size
-layout(binding = 2) uniform sampler2D crep_fullDepth; // full size
-layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_output;
+layout(binding = CREP_DEPTH_UPSAMPLE_LOW_UNIT) uniform sampler2D crep_low;       // RGBA32F, low size
+layout(binding = CREP_DEPTH_UPSAMPLE_LOW_DEPTH_UNIT) uniform sampler2D crep_lowDepth;  // R32F, low size
+layout(binding = CREP_DEPTH_UPSAMPLE_FULL_DEPTH_UNIT) uniform sampler2D crep_fullDepth; // full size
+layout(binding = CREP_DEPTH_UPSAMPLE_OUTPUT_IMAGE, rgba32f) uniform writeonly restrict image2D crep_output;
 layout(location = 0) uniform ivec4 crep_sizes;        // full width, height, low width, height
 layout(location = 1) uniform vec4 crep_cameraDepthMap; // crep_cameraViewDepth's map of the camera
 

@@ -6,13 +6,14 @@
 //
 // Resources: params block (binding 0: the camera members, sizes.xy the camera image, extinction.w the grey
 // extinction), camera depth (unit 0, texelFetch), output: RGBA32F (image 0).
+#include "crep/bindings.h"
 #include "crep/march.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
+layout(std140, binding = CREP_MARCH_PARAMS_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_MARCH_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_MARCH_SCATTERING_OUT_IMAGE, rgba32f) uniform writeonly image2D scatteringOut;
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);

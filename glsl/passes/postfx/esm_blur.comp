@@ -4,14 +4,15 @@
 // clamped to the edge, of exp(c z) of the stored log-space depths z, evaluated in log space around the
 // window's largest z.
 // Resources: params block (binding 0), input ESM (unit 0, texelFetch), output R32F (image 0).
+#include "crep/bindings.h"
 #include "crep/froxel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(std140, binding = CREP_ESM_FROXEL_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
 layout(location = 0) uniform int crep_direction;
-layout(binding = 0) uniform sampler2D esmIn;
-layout(binding = 0, r32f) uniform writeonly image2D esmOut;
+layout(binding = CREP_ESM_IN_UNIT) uniform sampler2D esmIn;
+layout(binding = CREP_ESM_OUT_IMAGE, r32f) uniform writeonly image2D esmOut;
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);

@@ -4,13 +4,14 @@
 // / c over its f x f block of shadow-map texels (clipped at the map's edge), evaluated around the block's
 // largest d (log-space filtering: no float overflow for any c). A NaN texel counts as empty (d = 1).
 // Resources: params block (binding 0), shadow map (unit 0, texelFetch), output R32F (image 0).
+#include "crep/bindings.h"
 #include "crep/froxel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
-layout(binding = 0) uniform sampler2D shadowMap;
-layout(binding = 0, r32f) uniform writeonly image2D esmOut;
+layout(std140, binding = CREP_ESM_FROXEL_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(binding = CREP_ESM_SHADOW_MAP_UNIT) uniform sampler2D shadowMap;
+layout(binding = CREP_ESM_OUT_IMAGE, r32f) uniform writeonly image2D esmOut;
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);

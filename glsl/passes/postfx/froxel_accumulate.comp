@@ -9,6 +9,7 @@
 // threads of a workgroup walk neighbouring columns in lock step, so every step of the loop reads and
 // writes one contiguous 8 x 8 tile of a slice (coalesced on a GPU).
 // Resources: params block (binding 0), the volume (image 0, CREP_FROXEL_FORMAT, read and written).
+#include "crep/bindings.h"
 #include "crep/froxel.glsl"
 #include "crep/ray.glsl"
 
@@ -18,8 +19,8 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
-layout(binding = 0, CREP_FROXEL_FORMAT) uniform restrict image3D volume;
+layout(std140, binding = CREP_FROXEL_PARAMS_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(binding = CREP_FROXEL_VOLUME_IMAGE, CREP_FROXEL_FORMAT) uniform restrict image3D volume;
 
 vec3 crep_L;
 float crep_tau;

@@ -8,15 +8,16 @@
 // transmittance. A NaN camera depth is the sky (crep_cameraViewDepth).
 // Resources: params block (binding 0), camera depth (unit 0, texelFetch), integrated volume (unit 1,
 // linear sampler, clamp to edge), output RGBA32F (image 0).
+#include "crep/bindings.h"
 #include "crep/common.glsl"
 #include "crep/froxel.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 1) uniform sampler3D integrated;
-layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
+layout(std140, binding = CREP_FROXEL_PARAMS_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(binding = CREP_FROXEL_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_FROXEL_INTEGRATED_UNIT) uniform sampler3D integrated;
+layout(binding = CREP_FROXEL_SCATTERING_OUT_IMAGE, rgba32f) uniform writeonly image2D scatteringOut;
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);

@@ -6,6 +6,7 @@
 // Resources: params block (binding 0), ESM (unit 0, texelFetch: the bilinear weights are computed here in
 // full float precision, where a GPU's texture unit would round them to 8 bits), output volume (image 0,
 // CREP_FROXEL_FORMAT).
+#include "crep/bindings.h"
 #include "crep/common.glsl"
 #include "crep/froxel.glsl"
 #include "crep/phase.glsl"
@@ -16,9 +17,9 @@
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
-layout(binding = 0) uniform sampler2D esm;
-layout(binding = 0, CREP_FROXEL_FORMAT) uniform writeonly image3D lightingOut;
+layout(std140, binding = CREP_FROXEL_PARAMS_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(binding = CREP_FROXEL_ESM_UNIT) uniform sampler2D esm;
+layout(binding = CREP_FROXEL_LIGHTING_OUT_IMAGE, CREP_FROXEL_FORMAT) uniform writeonly image3D lightingOut;
 
 // crep::esmVisibility: clamp(exp(c (z + bias - d_r)), 0, 1) with z the bilinear mean of exp(c z_i) taken
 // in log space around the largest texel; lit outside the map.

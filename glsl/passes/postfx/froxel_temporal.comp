@@ -8,6 +8,7 @@
 // history value ever reaches the output.
 // Resources: params block (binding 0), current integrated volume (unit 0, texelFetch), history (unit 1,
 // linear sampler, clamp to edge), output (image 0, CREP_FROXEL_FORMAT).
+#include "crep/bindings.h"
 #include "crep/froxel.glsl"
 
 #ifndef CREP_FROXEL_FORMAT
@@ -16,10 +17,10 @@
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 
-layout(std140, binding = 0) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
-layout(binding = 0) uniform sampler3D current;
-layout(binding = 1) uniform sampler3D history;
-layout(binding = 0, CREP_FROXEL_FORMAT) uniform writeonly image3D blendedOut;
+layout(std140, binding = CREP_FROXEL_PARAMS_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+layout(binding = CREP_FROXEL_CURRENT_UNIT) uniform sampler3D current;
+layout(binding = CREP_FROXEL_HISTORY_UNIT) uniform sampler3D history;
+layout(binding = CREP_FROXEL_BLENDED_OUT_IMAGE, CREP_FROXEL_FORMAT) uniform writeonly image3D blendedOut;
 
 bool crep_finite(vec4 v) { return !any(isnan(v)) && !any(isinf(v)); }
 

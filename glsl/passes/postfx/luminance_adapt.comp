@@ -5,14 +5,15 @@
 // (Pattanaik et al. 2000's exponential lag, as in Yusov's demo; the factor comes from the CPU in double).
 // Reset or the first frame: La = Lt. A frame without a finite pixel keeps La. Then the exposure scale
 // middleGrey / La (Reinhard et al. 2002, Eq. 2). Nothing is read back to the CPU.
+#include "crep/bindings.h"
 #include "crep/tone_mapping.glsl"
 
 #define CREP_ADAPT_THREADS 256
 layout(local_size_x = CREP_ADAPT_THREADS) in;
 
-layout(std140, binding = 0) uniform CrepToneMapBlock { CrepToneMapParams crep_toneMap; };
-layout(std430, binding = 0) restrict readonly buffer CrepLuminancePartials { CrepLuminancePartial crep_partials[]; };
-layout(std430, binding = 1) restrict buffer CrepToneMapStateBlock { CrepToneMapState crep_state; };
+layout(std140, binding = CREP_TONE_MAP_PARAMS_BINDING) uniform CrepToneMapBlock { CrepToneMapParams crep_toneMap; };
+layout(std430, binding = CREP_TONE_MAP_LUMINANCE_PARTIALS_BINDING) restrict readonly buffer CrepLuminancePartials { CrepLuminancePartial crep_partials[]; };
+layout(std430, binding = CREP_TONE_MAP_STATE_BINDING) restrict buffer CrepToneMapStateBlock { CrepToneMapState crep_state; };
 
 shared float crep_sharedLogSum[CREP_ADAPT_THREADS];
 shared uint crep_sharedCount[CREP_ADAPT_THREADS];

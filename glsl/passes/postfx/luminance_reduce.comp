@@ -7,6 +7,7 @@
 // GPU choice: a 16 x 16 workgroup where each invocation first sums 4 x 4 pixels strided by 16 (neighbouring
 // invocations read neighbouring texels: coalesced fetches), then a tree reduction in shared memory
 // (log2(256) = 8 barrier steps). Float sums: each partial adds at most 4096 terms.
+#include "crep/bindings.h"
 #include "crep/tone_mapping.glsl"
 
 #ifndef CREP_LUMINANCE_GROUP
@@ -18,9 +19,9 @@
 
 layout(local_size_x = CREP_LUMINANCE_GROUP, local_size_y = CREP_LUMINANCE_GROUP) in;
 
-layout(std140, binding = 0) uniform CrepToneMapBlock { CrepToneMapParams crep_toneMap; };
-layout(std430, binding = 0) restrict writeonly buffer CrepLuminancePartials { CrepLuminancePartial crep_partials[]; };
-layout(binding = 0) uniform sampler2D crep_hdr;
+layout(std140, binding = CREP_TONE_MAP_PARAMS_BINDING) uniform CrepToneMapBlock { CrepToneMapParams crep_toneMap; };
+layout(std430, binding = CREP_TONE_MAP_LUMINANCE_PARTIALS_BINDING) restrict writeonly buffer CrepLuminancePartials { CrepLuminancePartial crep_partials[]; };
+layout(binding = CREP_TONE_MAP_HDR_UNIT) uniform sampler2D crep_hdr;
 
 shared float crep_sharedLogSum[CREP_LUMINANCE_THREADS];
 shared uint crep_sharedCount[CREP_LUMINANCE_THREADS];

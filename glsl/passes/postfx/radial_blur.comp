@@ -8,6 +8,7 @@
 // Resources: CrepMarchBlock (binding 0: camera, medium; sizes.xy = camera image), CrepRadialBlurBlock
 // (binding 1), camera depth (texture unit 0, texelFetch), source (texture unit 1, bilinear, clamp to edge),
 // output RGBA32F (image unit 0).
+#include "crep/bindings.h"
 #include "crep/radial_blur.glsl"
 
 #ifndef CREP_RADIAL_GROUP
@@ -18,11 +19,11 @@
 #endif
 layout(local_size_x = CREP_RADIAL_GROUP, local_size_y = CREP_RADIAL_GROUP) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(std140, binding = 1) uniform CrepRadialBlurBlock { CrepRadialBlurParams crep_radial; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 1) uniform sampler2D radialSource;
-layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
+layout(std140, binding = CREP_RADIAL_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(std140, binding = CREP_RADIAL_BLUR_BINDING) uniform CrepRadialBlurBlock { CrepRadialBlurParams crep_radial; };
+layout(binding = CREP_RADIAL_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_RADIAL_SOURCE_UNIT) uniform sampler2D radialSource;
+layout(binding = CREP_RADIAL_SCATTERING_OUT_IMAGE, rgba32f) uniform writeonly image2D scatteringOut;
 
 void main() {
   ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);

@@ -6,6 +6,7 @@
 // plane, the closed form of crep::unshadowedScattering; geometry: 0), A = the sky fraction.
 // Resources: CrepMarchBlock (binding 0: camera, light, medium; sizes.xy = camera image), CrepRadialBlurBlock
 // (binding 1), camera depth (texture unit 0, texelFetch), source output RGBA32F (image unit 0).
+#include "crep/bindings.h"
 #include "crep/radial_blur.glsl"
 
 #ifndef CREP_RADIAL_GROUP
@@ -13,10 +14,10 @@
 #endif
 layout(local_size_x = CREP_RADIAL_GROUP, local_size_y = CREP_RADIAL_GROUP) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(std140, binding = 1) uniform CrepRadialBlurBlock { CrepRadialBlurParams crep_radial; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 0, rgba32f) uniform writeonly image2D sourceOut;
+layout(std140, binding = CREP_RADIAL_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(std140, binding = CREP_RADIAL_BLUR_BINDING) uniform CrepRadialBlurBlock { CrepRadialBlurParams crep_radial; };
+layout(binding = CREP_RADIAL_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_RADIAL_SOURCE_OUT_IMAGE, rgba32f) uniform writeonly image2D sourceOut;
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);

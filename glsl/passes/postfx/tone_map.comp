@@ -4,6 +4,7 @@
 // encoding with CREP_TONE_MAP_SRGB), alpha 1. The exposure is the state buffer's (auto exposure) or the
 // block's manual one. Variants: CREP_TONE_MAP_OPERATOR (compile-time constant: the operator's branch is
 // all that remains), CREP_TONE_MAP_FORMAT (the output image's format qualifier, rgba8 or rgba32f).
+#include "crep/bindings.h"
 #include "crep/tone_mapping.glsl"
 
 #ifndef CREP_TONE_MAP_OPERATOR
@@ -18,10 +19,10 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepToneMapBlock { CrepToneMapParams crep_toneMap; };
-layout(std430, binding = 1) restrict readonly buffer CrepToneMapStateBlock { CrepToneMapState crep_state; };
-layout(binding = 0) uniform sampler2D crep_hdr;
-layout(binding = 0, CREP_TONE_MAP_FORMAT) uniform restrict writeonly image2D crep_display;
+layout(std140, binding = CREP_TONE_MAP_PARAMS_BINDING) uniform CrepToneMapBlock { CrepToneMapParams crep_toneMap; };
+layout(std430, binding = CREP_TONE_MAP_STATE_BINDING) restrict readonly buffer CrepToneMapStateBlock { CrepToneMapState crep_state; };
+layout(binding = CREP_TONE_MAP_HDR_UNIT) uniform sampler2D crep_hdr;
+layout(binding = CREP_TONE_MAP_DISPLAY_IMAGE, CREP_TONE_MAP_FORMAT) uniform restrict writeonly image2D crep_display;
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);

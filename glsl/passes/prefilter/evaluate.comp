@@ -6,6 +6,7 @@
 // RGB in-scattered radiance, A grey transmittance to the surface. Driven by crep::EvaluatePass. With
 // CREP_FROXELS 1 the same evaluation fills a froxel volume (Wronski 2014's frustum-aligned cells), one
 // invocation per cell, each ray ending at its cell's sample depth (crep::evaluateFroxels).
+#include "crep/bindings.h"
 #ifndef CREP_OUTPUT_FORMAT
 #define CREP_OUTPUT_FORMAT rgba32f // rgba32f or rgba16f
 #endif
@@ -46,18 +47,18 @@ layout(std140, binding = CREP_EVALUATE_BINDING) uniform CrepEvaluateBlock { Crep
 // ray would fetch the same row at columns far apart).
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y, local_size_z = 1) in;
 // RGBA16F or RGBA32F: a writeonly image needs no format qualifier (GLSL 4.50), so one program serves both.
-layout(binding = 0) uniform writeonly restrict image3D crep_froxelsOut;
+layout(binding = CREP_EVALUATE_FROXELS_OUT_IMAGE) uniform writeonly restrict image3D crep_froxelsOut;
 layout(location = 0) uniform vec4 crep_froxelJitter; // xyz: the sample's offset in cells
 layout(location = 1) uniform vec2 crep_froxelRange;  // the volume's (near, far) view depth (FroxelDepthRange)
 #elif CREP_SAMPLE_LIST
 #include "crep/sample_list.glsl"
 layout(local_size_x = CREP_SAMPLE_LIST_GROUP_SIZE) in;
 layout(binding = CREP_CAMERA_DEPTH_UNIT) uniform sampler2D crep_cameraDepth; // the list's (x, y, d, z)
-layout(binding = 0, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
+layout(binding = CREP_EVALUATE_SCATTERING_OUT_IMAGE, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
 #else
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y) in;
 layout(binding = CREP_CAMERA_DEPTH_UNIT) uniform sampler2D crep_cameraDepth; // depth-buffer values in [0, 1]
-layout(binding = 0, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
+layout(binding = CREP_EVALUATE_SCATTERING_OUT_IMAGE, CREP_OUTPUT_FORMAT) uniform writeonly restrict image2D crep_scatteringOut;
 #endif
 
 // The pixel ray's rule (crep::pixelRay, crep/scatter/ray.h) for NDC (x, y) and view depth Z: the in-scattering

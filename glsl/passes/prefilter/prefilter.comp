@@ -9,6 +9,7 @@
 // factors: bases per invocation, regions per row). Driven by crep::PrefilterPass (gpu_pass.h).
 // CREP_LIGHT_TEXTURE 1: a light texture's colour map in the weights, one basis per colour channel and the
 // prefix mean colour (crep/prefilter/prefilter.h, "Light textures"; Klehm et al. 2014, Sec. 3.2).
+#include "crep/bindings.h"
 #define CREP_SCATTERING_NO_EVALUATION
 #include "crep/scattering.glsl"
 
@@ -47,19 +48,19 @@
 
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y, local_size_z = CREP_LOCAL_SIZE_Z) in;
 
-layout(binding = 0) uniform sampler2D crep_rectifiedDepth; // W x H depth-buffer values in [0, 1]
-layout(binding = 0, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray crep_filteredBasisOut;
-layout(std140, binding = 0) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
-layout(std430, binding = 0) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
+layout(binding = CREP_PREFILTER_RECTIFIED_DEPTH_UNIT) uniform sampler2D crep_rectifiedDepth; // W x H depth-buffer values in [0, 1]
+layout(binding = CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray crep_filteredBasisOut;
+layout(std140, binding = CREP_PREFILTER_PARAMS_BINDING) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
+layout(std430, binding = CREP_PREFILTER_REGION_WEIGHTS_BINDING) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
 #if CREP_LIGHT_TEXTURE
 // Light textures (crep/prefilter/prefilter.h, "Light textures"): the colour map (W x H, rgb) in, the prefix
 // mean colour cbar out (RGBA16F, A = 1); the basis array holds 3 ceil(M / 4) layers, colour c from layer c L.
-layout(binding = 1) uniform sampler2D crep_lightColors;
-layout(binding = 1, rgba32f) uniform writeonly restrict image2D crep_meanColorOut;
+layout(binding = CREP_PREFILTER_LIGHT_COLORS_UNIT) uniform sampler2D crep_lightColors;
+layout(binding = CREP_PREFILTER_MEAN_COLOR_OUT_IMAGE, rgba32f) uniform writeonly restrict image2D crep_meanColorOut;
 #endif
 #if CREP_LOCAL_LIGHT
-layout(std140, binding = 1) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
-layout(std430, binding = 1) readonly restrict buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; };
+layout(std140, binding = CREP_PREFILTER_LOCAL_LIGHT_BINDING) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
+layout(std430, binding = CREP_PREFILTER_REGION_RAYS_BINDING) readonly restrict buffer CrepRegionRaysBlock { vec4 crep_regionRays[]; };
 
 // The light-side factor at distance tau from the region's start along its reference ray (crep_regionDistance;
 // 0 beyond the horizon, tau < 0).

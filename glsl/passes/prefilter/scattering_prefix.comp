@@ -22,6 +22,7 @@
 // channel, cbar_c clamp(0.5 + a(z_s) . F_c, 0, 1) with F_c in layers [c L, (c + 1) L) and cbar at the
 // region's last texel (crep::visibilityTable of a textured basis).
 // Driven by crep::EvaluatePass.
+#include "crep/bindings.h"
 #ifndef CREP_BASES
 #define CREP_BASES 32
 #endif
@@ -42,10 +43,10 @@
 #define CREP_PREFIX_LAYERS ((CREP_BASES + 3) / 4)
 
 layout(local_size_x = 64) in;
-layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_prefixOut; // width R Z, height H
+layout(binding = CREP_SCATTERING_PREFIX_PREFIX_OUT_IMAGE, rgba32f) uniform writeonly restrict image2D crep_prefixOut; // width R Z, height H
 #if CREP_LOCAL_LIGHT && CREP_LOCAL_SECTIONS
 // The local section table: region r's unshadowed in-scattering along the sample ray (same layout).
-layout(binding = 1, rgba32f) uniform writeonly restrict image2D crep_sectionOut;
+layout(binding = CREP_SCATTERING_PREFIX_SECTION_OUT_IMAGE, rgba32f) uniform writeonly restrict image2D crep_sectionOut;
 #endif
 // a(z_s) of sample s, layer l at index s * layers + l (Eq. 8 order, zero beyond M).
 layout(std430, binding = CREP_TABLE_COEFFICIENTS_BINDING) readonly restrict buffer CrepTableCoefficients {

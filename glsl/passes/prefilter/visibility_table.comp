@@ -11,6 +11,7 @@
 // fetches + Z M multiply-adds) in all. Used only with EvaluateOptions::scatteringPrefix = false (the
 // default builds the scattering prefix table, passes/prefilter/scattering_prefix.comp, which includes this step).
 // Driven by crep::EvaluatePass.
+#include "crep/bindings.h"
 #ifndef CREP_BASES
 #define CREP_BASES 32
 #endif
@@ -23,10 +24,10 @@
 #define CREP_TABLE_LAYERS ((CREP_BASES + 3) / 4)
 
 layout(local_size_x = 64) in;
-layout(binding = 0) uniform sampler2DArray crep_basis;                    // the filtered basis (stored e)
-layout(binding = 0, r32f) uniform writeonly restrict image2D crep_tableOut; // width R Z, height H
+layout(binding = CREP_VISIBILITY_TABLE_BASIS_UNIT) uniform sampler2DArray crep_basis;                    // the filtered basis (stored e)
+layout(binding = CREP_VISIBILITY_TABLE_TABLE_OUT_IMAGE, r32f) uniform writeonly restrict image2D crep_tableOut; // width R Z, height H
 // a(z_s) of sample s, layer l at index s * layers + l (Eq. 8 order, zero beyond M).
-layout(std430, binding = 0) readonly restrict buffer CrepTableCoefficients { vec4 crep_tableA[]; };
+layout(std430, binding = CREP_VISIBILITY_TABLE_TABLE_COEFFICIENTS_BINDING) readonly restrict buffer CrepTableCoefficients { vec4 crep_tableA[]; };
 layout(location = 0) uniform ivec4 crep_tableSize; // x H, y R, z n (texels per region)
 
 void main() {

@@ -7,14 +7,15 @@
 // lightRay: axisX + y axisY + (zeta / rho) axisZ), and the epipolar one (the sun). Texels without a light
 // ray (beyond the far end of a directional map: zeta <= 0) get 0. Output: RGBA32F (A = 1).
 // Driven by crep::LightColorMapPass.
+#include "crep/bindings.h"
 #include "crep/layout.glsl"
 #include "crep/light_texture.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0) uniform sampler2D crep_lightTexture;
-layout(binding = 0, rgba32f) uniform writeonly restrict image2D crep_colorsOut;
-layout(std140, binding = 0) uniform CrepLightTextureBlock { CrepLightTextureParams crep_lightTextureParams; };
+layout(binding = CREP_LIGHT_COLORS_LIGHT_TEXTURE_UNIT) uniform sampler2D crep_lightTexture;
+layout(binding = CREP_LIGHT_COLORS_COLORS_OUT_IMAGE, rgba32f) uniform writeonly restrict image2D crep_colorsOut;
+layout(std140, binding = CREP_LIGHT_COLORS_LIGHT_TEXTURE_BINDING) uniform CrepLightTextureBlock { CrepLightTextureParams crep_lightTextureParams; };
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);

@@ -15,6 +15,7 @@
 // CREP_LIGHT_TEXTURE 1: a light texture (crep/scatter/light_texture.h) at texture unit 2 with its block
 // (CrepLightTextureParams) at uniform binding 1; each lit part times the texture's colour at its midpoint
 // (crep::worldSpaceMarch with a LightTexture).
+#include "crep/bindings.h"
 #include "crep/local_light.glsl"
 #include "crep/march.glsl"
 #include "crep/phase.glsl"
@@ -24,17 +25,17 @@
 #endif
 #if CREP_LIGHT_TEXTURE
 #include "crep/light_texture.glsl"
-layout(std140, binding = 1) uniform CrepLightTextureBlock { CrepLightTextureParams crep_lightTextureParams; };
-layout(binding = 2) uniform sampler2D crep_lightTexture;
+layout(std140, binding = CREP_MARCH_LIGHT_TEXTURE_BINDING) uniform CrepLightTextureBlock { CrepLightTextureParams crep_lightTextureParams; };
+layout(binding = CREP_MARCH_LIGHT_TEXTURE_UNIT) uniform sampler2D crep_lightTexture;
 #endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std140, binding = 0) uniform CrepMarchBlock { CrepMarchParams crep_march; };
-layout(binding = 0) uniform sampler2D cameraDepth;
-layout(binding = 1) uniform sampler2D shadowMap;
-layout(binding = 0, rgba32f) uniform writeonly image2D scatteringOut;
-layout(binding = 1, r32f) uniform writeonly image2D stepsOut;
+layout(std140, binding = CREP_MARCH_PARAMS_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
+layout(binding = CREP_MARCH_CAMERA_DEPTH_UNIT) uniform sampler2D cameraDepth;
+layout(binding = CREP_MARCH_MAP_UNIT) uniform sampler2D shadowMap;
+layout(binding = CREP_MARCH_SCATTERING_OUT_IMAGE, rgba32f) uniform writeonly image2D scatteringOut;
+layout(binding = CREP_MARCH_STEPS_OUT_IMAGE, r32f) uniform writeonly image2D stepsOut;
 
 int crep_lookups = 0;
 
