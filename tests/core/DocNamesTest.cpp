@@ -19,8 +19,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kModules = {"core",      "rectify",  "scatter", "epipolar",
-                                           "prefilter", "pipeline", "postfx"};
+const std::vector<std::string> kModules = {"core",      "rectify",  "scatter",    "epipolar",
+                                           "prefilter", "pipeline", "atmosphere", "postfx"};
 
 std::string readAll(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
