@@ -346,6 +346,28 @@ bool squareMapOk(const BenchOptions& o, const char* what, int multiple) {
   return false;
 }
 
+/// The slow marches --quick leaves out (tens of times the prefiltered frame, seconds a frame on llvmpipe).
+constexpr const char* kSlowMarches[] = {"reference", "brute"};
+
+/// `names` (every method of the registry when empty) without the slow marches with --quick; `note` says
+/// which were left out ("" when none).
+std::vector<std::string> quickMethods(const BenchOptions& o, std::vector<std::string> names,
+                                      std::string& note) {
+  note.clear();
+  if (!o.quick) return names;
+  if (names.empty())
+    for (const tool::Method& m : tool::methodRegistry())
+      names.push_back(m.name);
+  const auto slow = [](const std::string& name) {
+    return std::find(std::begin(kSlowMarches), std::end(kSlowMarches), name) != std::end(kSlowMarches);
+  };
+  for (const std::string& name : names)
+    if (slow(name)) note += (note.empty() ? "" : ", ") + name;
+  std::erase_if(names, slow);
+  if (!note.empty()) note = "(--quick leaves out the slow marches: " + note + ")\n";
+  return names;
+}
+
 /// Every method of the registry on the same frame: median per-frame milliseconds and the ratio to the
 /// prefiltered method.
 void methodsSideBySide(const BenchOptions& o) {
@@ -353,13 +375,15 @@ void methodsSideBySide(const BenchOptions& o) {
   if (!squareMapOk(o, "methods side by side", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   double mapMs = 0.0;
-  const std::vector<MethodRow> rows = runMethods(o, o.scene, {}, repeat, mapMs);
+  std::string note;
+  const std::vector<MethodRow> rows = runMethods(o, o.scene, quickMethods(o, {}, note), repeat, mapMs);
   std::printf(
       "\nmethods side by side (scene %s, %dx%d, map %d^2, M = %d, reference %d steps; per-frame ms = sum of\n"
       "the median per-frame stages of %d runs after a warm-up; the rectified shadow pass, %.2f ms, is "
       "shared):\n",
       o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.bases, settings.steps, repeat, mapMs);
   printRows(rows);
+  std::printf("%s", note.c_str());
 }
 
 /// A method's per-frame milliseconds with its shadow input (the stage perFrameStage leaves out: the
@@ -382,7 +406,7 @@ void sunInView(const BenchOptions& o) {
   if (!squareMapOk(o, "sun in view", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   std::vector<std::pair<int, int>> sizes = {{o.screenWidth, o.screenHeight}};
-  if (o.screenWidth != 640 || o.screenHeight != 360) sizes.push_back({640, 360});
+  if (!o.quick && (o.screenWidth != 640 || o.screenHeight != 360)) sizes.push_back({640, 360});
   for (const auto& [w, h] : sizes) {
     BenchOptions sized = o;
     sized.screenWidth = w;
@@ -486,8 +510,9 @@ void postEffects(const BenchOptions& o) {
 /// the sampling's cost scales with the number of slices and of samples per slice (the run's size).
 void epipolarSamplingBench(const BenchOptions& o) {
   if (!squareMapOk(o, "epipolar sampling", Scattering::CreateInfo{}.mapSizeMultiple())) return;
-  const std::vector<std::string> methods = {"epipolar-sampling", "epipolar-prefilter", "minmax", "prefilter",
-                                            "brute"};
+  std::string note;
+  const std::vector<std::string> methods =
+      quickMethods(o, {"epipolar-sampling", "epipolar-prefilter", "minmax", "prefilter", "brute"}, note);
   // The seed's size (2560x1600) joins the default 1920x1080 run; a smaller --size runs at that size only.
   std::vector<std::pair<int, int>> sizes = {{o.screenWidth, o.screenHeight}};
   if (!o.quick && o.screenWidth == 1920 && o.screenHeight == 1080) sizes.push_back({2560, 1600});
@@ -506,13 +531,17 @@ void epipolarSamplingBench(const BenchOptions& o) {
                   "per-frame ms as above):\n",
                   scene.c_str(), w, h, o.mapWidth, d.slices, d.samples, d.initialStep);
       printRows(rows);
+      std::printf("%s", note.c_str());
       const double yusov = msOf(rows, "epipolar-sampling"), minmax = msOf(rows, "minmax"),
                    brute = msOf(rows, "brute"), hybrid = msOf(rows, "epipolar-prefilter"),
                    prefilter = msOf(rows, "prefilter");
+      char bruteRatio[64] = "";
+      if (brute > 0.0 && yusov > 0.0)
+        std::snprintf(bruteRatio, sizeof bruteRatio, ", brute / epipolar-sampling %.2f", brute / yusov);
       if (yusov > 0.0 && hybrid > 0.0)
-        std::printf("ratios: minmax / epipolar-sampling %.2f, brute / epipolar-sampling %.2f, "
+        std::printf("ratios: minmax / epipolar-sampling %.2f%s, "
                     "prefilter / epipolar-prefilter %.2f, epipolar-prefilter / epipolar-sampling %.2f\n",
-                    minmax / yusov, brute / yusov, prefilter / hybrid, hybrid / yusov);
+                    minmax / yusov, bruteRatio, prefilter / hybrid, hybrid / yusov);
     }
   // Scaling with slices and samples (the run's size and scene).
   std::printf(
@@ -606,7 +635,7 @@ double atmosphereFrameMs(tool::SceneFrame& frame, const tool::MethodSettings& se
 }
 
 /// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per stage,
-/// side by side in one run: the default (4 orders on the 32x32x32x8 table of the higher orders; 16x64x32x8
+/// side by side in one run: the default (4 orders on the 32x32x32x8 table of the higher orders; 8x16x16x4
 /// with --quick), Hillaire 2020's multiple scattering table at the same size (the option) and the 4 orders
 /// on Yusov's 32x128x64x16 table (the reference; not with --quick); then the per-frame cost of the sky,
 /// aerial perspective and shafts with each shaft method on the terrain at the run's size (median of the
@@ -615,7 +644,7 @@ double atmosphereFrameMs(tool::SceneFrame& frame, const tool::MethodSettings& se
 void atmosphereBench(const BenchOptions& o) {
   tool::AtmosphereSettings s;
   s.cacheDirectory.clear(); // always compute: the precomputation's cost is the point
-  if (o.quick) s.tables.size = {16, 64, 32, 8};
+  if (o.quick) s.tables.size = {8, 16, 16, 4};
   const AtmosphereTableRuns tables = atmosphereTableRuns(o, s);
 
   // Per frame: the terrain at 20 degrees of sun elevation, the scene's sun azimuth.
@@ -1278,14 +1307,13 @@ void passesSection(BenchRun& run) {
 void localLightsSection(BenchRun& run) {
   localLights(run.options);
   localLightScene(run.options);
-  if (run.named) localLightScaling(run.options);
+  if (run.named || run.options.quick) localLightScaling(run.options);
 }
 
 /// Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8), relative to the run's map
-/// and M (measured by the passes section, else here first). Not with --quick.
+/// and M (measured by the passes section, else here first). --quick: the half-height and M = 16 rows.
 void scalingSection(BenchRun& run) {
   const BenchOptions& o = run.options;
-  if (o.quick) return;
   const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases;
   const Setup& s = run.setup();
   if (!run.passTimes) run.passTimes = timeGpu(s, bases, o.repeat);
@@ -1299,6 +1327,10 @@ void scalingSection(BenchRun& run) {
   };
   std::vector<Row> rows = {{mapW / 2, mapH, bases}, {mapW * 2, mapH, bases}, {mapW, mapH / 2, bases},
                            {mapW, mapH * 2, bases}, {mapW, mapH, 16},        {mapW, mapH, 64}};
+  if (o.quick) {
+    rows = {{mapW, mapH, 16}};
+    if (mapH >= 2) rows.insert(rows.begin(), {mapW, mapH / 2, bases});
+  }
   for (const Row& r : rows) {
     std::optional<Setup> resized;
     if (r.w != mapW || r.h != mapH)
@@ -1326,13 +1358,13 @@ double paperTable1(int regions, int basesPerInvocation) {
 }
 
 /// Table 1's study: the GPU prefilter at the run's map and M for regions per split x bases per invocation.
-/// Not with --quick.
+/// --quick: 1 and 2 regions per split.
 void parallelizationSection(BenchRun& run) {
   const BenchOptions& o = run.options;
-  if (o.quick) return;
   const Setup& s = run.setup();
   const std::vector<int> perInvocation = {4, 8, 16, 32};
-  const std::vector<int> regions = {1, 2, kMaxRegionsPerSplit};
+  const std::vector<int> regions =
+      o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, kMaxRegionsPerSplit};
   std::printf("\nparallelization (Table 1; GPU prefilter ms):\n%-10s", "regions");
   for (int bpi : perInvocation)
     std::printf(" %8d", bpi);
@@ -1400,7 +1432,12 @@ void writeTablePlot(const BenchRun& run) {
 }
 
 /// What --quick does (BenchOptions::quick), for --help.
-constexpr const char* kQuickHelp = "--quick: one size, no Table 1/2 rows";
+constexpr const char* kQuickHelp =
+    "--quick: every section once at a reduced cost (a smoke test): --size 640x360\n"
+    "  --map 512x512 --repeat 1 unless given; no second screen size; no reference or brute\n"
+    "  march; 3 of the 7 slices x samples rows; atmosphere tables at 8x16x16x4 and no 4D\n"
+    "  reference table; local-lights with its spot scaling; Table 2's half-height and\n"
+    "  M = 16 rows; Table 1 at 1 and 2 regions per split";
 
 /// Sections whose rows --plot draws.
 constexpr const char* kPlotSections[] = {"scaling", "parallelization"};
@@ -1412,7 +1449,7 @@ const std::vector<BenchSection>& benchSections() {
       {"passes", "CPU reference vs GPU prefilter and evaluation, limits, bandwidth", passesSection},
       {"memory", "GPU memory per map size, crep::Scattering::memoryBytes()",
        [](BenchRun& r) { memoryTable(r.options); }},
-      {"local-lights", "a spot vs the sun, the spot scene; when named: 1-8 spots", localLightsSection},
+      {"local-lights", "a spot vs the sun, the spot scene; named or --quick: 1-8 spots", localLightsSection},
       {"light-textures", "the stained-glass sun with and without its light texture",
        [](BenchRun& r) { lightTextures(r.options); }},
       {"constant-cost", "the GPU passes on the four projective scenes, interleaved",
@@ -1486,9 +1523,10 @@ std::vector<std::string> parseSections(const std::string& value) {
 /// The --map size: the rectification's splits lie side by side in the map (SplitLayout::Regions); without
 /// --quick the parallelization rows split each into up to kMaxRegionsPerSplit regions and the scaling rows
 /// halve the width (a multiple of splits * kMaxRegionsPerSplit halves to a multiple of splits) and double
-/// the width and the height (the map is read back as an image).
+/// the width and the height (the map is read back as an image); --quick's rows keep the width and halve
+/// the height only when it is at least 2.
 glm::ivec2 parseMapSize(const tool::Args& args, bool quick) {
-  const glm::ivec2 fallback(1024, 1024);
+  const glm::ivec2 fallback = quick ? glm::ivec2(512, 512) : glm::ivec2(1024, 1024);
   const int scale = quick ? 1 : 2;
   const glm::ivec2 map = args.size("map", fallback, Image::kMaxDimension / scale, Image::kMaxPixels / scale);
   const int splits = Scattering::CreateInfo{}.rectify.splits,
@@ -1500,10 +1538,10 @@ glm::ivec2 parseMapSize(const tool::Args& args, bool quick) {
                            " splits side by side" +
                            (quick ? ", " + std::to_string(perSplit) + " prefilter regions each)"
                                   : std::string(", each in up to ") + std::to_string(kMaxRegionsPerSplit) +
-                                        " regions in the parallelization rows; --quick omits them)"));
+                                        " regions in the parallelization rows; --quick runs 1 and 2)"));
   if (map.y < scale)
     throw tool::UsageError("option --map: height " + std::to_string(map.y) +
-                           " must be at least 2 (halved by the scaling rows; --quick omits them)");
+                           " must be at least 2 (halved by the scaling rows; --quick skips that row)");
   return map;
 }
 
@@ -1516,7 +1554,8 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   tool::requireSceneName(o.scene); // a usage error before any GL work
   o.quick = args.has("quick");
   const glm::ivec2 size =
-      args.size("size", glm::ivec2(o.screenWidth, o.screenHeight), Image::kMaxDimension, Image::kMaxPixels);
+      args.size("size", o.quick ? glm::ivec2(640, 360) : glm::ivec2(o.screenWidth, o.screenHeight),
+                Image::kMaxDimension, Image::kMaxPixels);
   const glm::ivec2 map = parseMapSize(args, o.quick);
   o.screenWidth = size.x;
   o.screenHeight = size.y;
@@ -1524,7 +1563,7 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.mapHeight = map.y;
   o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
   if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
-  o.repeat = args.integer("repeat", o.repeat, 1, 1000);
+  o.repeat = args.integer("repeat", o.quick ? 1 : o.repeat, 1, 1000);
   o.plot = args.string("plot", "");
   if (args.has("section")) o.sections = parseSections(args.string("section", ""));
   if (!o.plot.empty()) {
@@ -1532,7 +1571,8 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
       if (!o.sections.empty() && std::find(o.sections.begin(), o.sections.end(), needed) == o.sections.end())
         throw tool::UsageError("option --plot: needs the sections scaling and parallelization (the whole "
                                "suite or --section scaling,parallelization)");
-    if (o.quick) throw tool::UsageError("option --plot: needs the Table 1/2 rows, which --quick omits");
+    if (o.quick)
+      throw tool::UsageError("option --plot: needs the Table 1/2 rows in full, which --quick reduces");
     if (!o.plot.ends_with(".svg")) throw tool::UsageError("option --plot: must end in .svg");
     tool::requireOutputFile({"--plot", o.plot}); // the output rule, before any work
   }

@@ -17,9 +17,11 @@ struct BenchOptions {
   int screenWidth = 1920, screenHeight = 1080;
   int mapWidth = 1024, mapHeight = 1024;
   int bases = 32;
-  int repeat = 5;     ///< runs per measurement (median)
-  bool quick = false; ///< one size only: no Table 1/2 rows, one CPU run
-  std::string plot;   ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
+  int repeat = 5; ///< runs per measurement (median)
+  /// A smoke test of every section at a reduced cost (benchHelp(), bench/README.md): smaller default sizes,
+  /// one run per measurement, no extra sizes, no slow marches or atmosphere reference table, fewer rows.
+  bool quick = false;
+  std::string plot; ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
   /// The sections to run, in the suite's order (benchSections()); empty: the whole suite.
   std::vector<std::string> sections;
 };

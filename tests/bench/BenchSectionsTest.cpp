@@ -60,3 +60,20 @@ TEST_CASE("bench --section: an unknown or empty name is a usage error listing th
       CHECK(message.find(s.name) != std::string::npos);
   }
 }
+
+TEST_CASE("bench --quick: smaller default sizes and one run, explicit options kept") {
+  const crep::bench::BenchOptions quick = parseBenchOptions({"--quick"});
+  CHECK(quick.screenWidth == 640);
+  CHECK(quick.screenHeight == 360);
+  CHECK(quick.mapWidth == 512);
+  CHECK(quick.repeat == 1);
+  const crep::bench::BenchOptions sized =
+      parseBenchOptions({"--quick", "--size", "320x180", "--map", "256x256", "--repeat", "3"});
+  CHECK(sized.screenWidth == 320);
+  CHECK(sized.mapWidth == 256);
+  CHECK(sized.repeat == 3);
+  const crep::bench::BenchOptions full = parseBenchOptions({});
+  CHECK(full.screenWidth == 1920);
+  CHECK(full.mapWidth == 1024);
+  CHECK(full.repeat == 5);
+}
