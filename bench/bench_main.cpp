@@ -2,6 +2,7 @@
 // same suite. Prints ratios measured side by side in one run; never asserts on time.
 //
 // usage: crep_bench [--scene NAME] [--size WxH] [--map WxH] [--bases M] [--repeat N] [--quick]
+//                   [--plot FILE.svg] [--section NAME[,NAME...]] (`crep bench --help` lists the sections)
 #include "args.h"
 #include "bench_suite.h"
 

@@ -162,98 +162,101 @@ int perInvocationFor(int requested, int bases) {
   return std::min(requested, (bases + 3) / 4 * 4);
 }
 
-GpuTimes timeGpu(const Setup& s, int bases, StorageFormat format, int repeat,
-                 int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit,
-                 int basesPerInvocation = PrefilterOptions{}.basesPerInvocation, bool limits = false) {
+/// What timeGpu measures: the passes at the set-up's map with these options.
+struct GpuRun {
+  int regionsPerSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
+  int basesPerInvocation = PrefilterOptions{}.basesPerInvocation;
+  bool evaluate = true; ///< false: the prefilter alone (GpuTimes::evaluate stays 0)
+  bool limits = false;  ///< the passes stripped to their memory traffic and the evaluation variants
+};
+
+/// Median ms of `repeat` runs of a GL pass, after one warm-up run (shader specialization on first dispatch).
+double timePass(int repeat, const std::function<void()>& pass) {
+  pass();
+  glFinish();
+  return medianMs(repeat, [&] {
+    pass();
+    glFinish();
+  });
+}
+
+/// GpuTimes' limits and evaluation variants (`info`, `evalInfo`: the measured passes' create infos).
+void timeGpuLimits(PrefilterPass::CreateInfo info, EvaluatePass::CreateInfo evalInfo,
+                   const PrefilterPass::FrameAttribs& frame, const EvaluatePass::FrameAttribs& ev, int bases,
+                   int repeat, GpuTimes& t) {
+  // The same passes with memoryLimit: the same reads and writes (prefilter) and the same fetches and
+  // store (evaluation) without the math; the evaluation limit reads the real filtered basis.
+  info.memoryLimit = true;
+  evalInfo.memoryLimit = true;
+  PrefilterPass prefilterLimit(info);
+  EvaluatePass evaluateLimit(evalInfo);
+  prefilterLimit.run(frame);
+  evaluateLimit.run(ev);
+  glFinish();
+  t.prefilterLimit = medianMs(repeat, [&] {
+    prefilterLimit.run(frame);
+    glFinish();
+  });
+  t.evaluateLimit = medianMs(repeat, [&] {
+    evaluateLimit.run(ev);
+    glFinish();
+  });
+  for (const int perInvocation : {4, 8, 16, 32}) {
+    PrefilterPass::CreateInfo writer = info;
+    writer.options.basesPerInvocation = perInvocationFor(perInvocation, bases);
+    PrefilterPass writeOnly(writer);
+    const double ms = timePass(repeat, [&] { writeOnly.run(frame); });
+    if (t.prefilterLimitFastestBases == 0 || ms < t.prefilterLimitFastest) {
+      t.prefilterLimitFastest = ms;
+      t.prefilterLimitFastestBases = writer.options.basesPerInvocation;
+    }
+  }
+  const auto timeVariant = [&](const EvaluateOptions& options, const EvaluatePass::FrameAttribs& attribs) {
+    EvaluatePass::CreateInfo vi;
+    vi.bases = bases;
+    vi.options = options;
+    EvaluatePass variant(vi);
+    return timePass(repeat, [&] { variant.run(attribs); });
+  };
+  EvaluateOptions perRegion, direct;
+  perRegion.scatteringPrefix = false;
+  direct.visibilityTableSamples = 0;
+  t.evaluatePerRegion = timeVariant(perRegion, ev);
+  t.evaluateDirect = timeVariant(direct, ev);
+  const gl::Handle tinyDepth = gl::createTexture2D(GL_R32F, 8, 8),
+                   tinyOut = gl::createTexture2D(GL_RGBA32F, 8, 8);
+  const std::vector<float> half(64, 0.5f);
+  glTextureSubImage2D(tinyDepth.get(), 0, 0, 0, 8, 8, GL_RED, GL_FLOAT, half.data());
+  EvaluatePass::FrameAttribs tiny = ev;
+  tiny.cameraDepth = tinyDepth.get();
+  tiny.output = tinyOut.get();
+  t.evaluateTablesOnly = timeVariant(EvaluateOptions{}, tiny);
+  t.evaluateVisibilityTableOnly = timeVariant(perRegion, tiny);
+}
+
+/// The GPU prefilter (RGBA8) and evaluation of a set-up's frame at M = `bases`: medians of `repeat` runs.
+GpuTimes timeGpu(const Setup& s, int bases, int repeat, const GpuRun& run = {}) {
   PrefilterPass::CreateInfo info;
   info.mapWidth = s.mapW;
   info.mapHeight = s.mapH;
   info.options.bases = bases;
-  info.options.format = format;
-  info.options.regionsPerSplit = regionsPerSplit;
-  info.options.basesPerInvocation = perInvocationFor(basesPerInvocation, bases);
+  info.options.format = StorageFormat::RGBA8;
+  info.options.regionsPerSplit = run.regionsPerSplit;
+  info.options.basesPerInvocation = perInvocationFor(run.basesPerInvocation, bases);
   PrefilterPass prefilter(info);
-  EvaluatePass::CreateInfo evalInfo;
-  evalInfo.bases = bases;
-  EvaluatePass evaluate(evalInfo);
   PrefilterPass::FrameAttribs frame;
   frame.rectifiedDepth = s.rectified.get();
   frame.layout = s.layout.get();
   frame.medium = &s.scene.medium;
-  prefilter.run(frame); // warm-up (shader specialization on first dispatch)
-  glFinish();
   GpuTimes t{};
-  t.prefilter = medianMs(repeat, [&] {
-    prefilter.run(frame);
-    glFinish();
-  });
+  t.prefilter = timePass(repeat, [&] { prefilter.run(frame); });
+  if (!run.evaluate) return t;
+  EvaluatePass::CreateInfo evalInfo;
+  evalInfo.bases = bases;
+  EvaluatePass evaluate(evalInfo);
   const EvaluatePass::FrameAttribs ev = evaluateAttribs(s, prefilter.filteredBasis());
-  evaluate.run(ev);
-  glFinish();
-  t.evaluate = medianMs(repeat, [&] {
-    evaluate.run(ev);
-    glFinish();
-  });
-  if (limits) {
-    // The same passes with memoryLimit: the same reads and writes (prefilter) and the same fetches and
-    // store (evaluation) without the math; the evaluation limit reads the real filtered basis.
-    info.memoryLimit = true;
-    evalInfo.memoryLimit = true;
-    PrefilterPass prefilterLimit(info);
-    EvaluatePass evaluateLimit(evalInfo);
-    prefilterLimit.run(frame);
-    evaluateLimit.run(ev);
-    glFinish();
-    t.prefilterLimit = medianMs(repeat, [&] {
-      prefilterLimit.run(frame);
-      glFinish();
-    });
-    t.evaluateLimit = medianMs(repeat, [&] {
-      evaluateLimit.run(ev);
-      glFinish();
-    });
-    for (const int perInvocation : {4, 8, 16, 32}) {
-      PrefilterPass::CreateInfo writer = info;
-      writer.options.basesPerInvocation = perInvocationFor(perInvocation, bases);
-      PrefilterPass writeOnly(writer);
-      writeOnly.run(frame);
-      glFinish();
-      const double ms = medianMs(repeat, [&] {
-        writeOnly.run(frame);
-        glFinish();
-      });
-      if (t.prefilterLimitFastestBases == 0 || ms < t.prefilterLimitFastest) {
-        t.prefilterLimitFastest = ms;
-        t.prefilterLimitFastestBases = writer.options.basesPerInvocation;
-      }
-    }
-    const auto timeVariant = [&](const EvaluateOptions& options, const EvaluatePass::FrameAttribs& attribs) {
-      EvaluatePass::CreateInfo vi;
-      vi.bases = bases;
-      vi.options = options;
-      EvaluatePass variant(vi);
-      variant.run(attribs);
-      glFinish();
-      return medianMs(repeat, [&] {
-        variant.run(attribs);
-        glFinish();
-      });
-    };
-    EvaluateOptions perRegion, direct;
-    perRegion.scatteringPrefix = false;
-    direct.visibilityTableSamples = 0;
-    t.evaluatePerRegion = timeVariant(perRegion, ev);
-    t.evaluateDirect = timeVariant(direct, ev);
-    const gl::Handle tinyDepth = gl::createTexture2D(GL_R32F, 8, 8),
-                     tinyOut = gl::createTexture2D(GL_RGBA32F, 8, 8);
-    const std::vector<float> half(64, 0.5f);
-    glTextureSubImage2D(tinyDepth.get(), 0, 0, 0, 8, 8, GL_RED, GL_FLOAT, half.data());
-    EvaluatePass::FrameAttribs tiny = ev;
-    tiny.cameraDepth = tinyDepth.get();
-    tiny.output = tinyOut.get();
-    t.evaluateTablesOnly = timeVariant(EvaluateOptions{}, tiny);
-    t.evaluateVisibilityTableOnly = timeVariant(perRegion, tiny);
-  }
+  t.evaluate = timePass(repeat, [&] { evaluate.run(ev); });
+  if (run.limits) timeGpuLimits(info, evalInfo, frame, ev, bases, repeat, t);
   return t;
 }
 
@@ -343,6 +346,28 @@ bool squareMapOk(const BenchOptions& o, const char* what, int multiple) {
   return false;
 }
 
+/// The slow marches --quick leaves out (tens of times the prefiltered frame, seconds a frame on llvmpipe).
+constexpr const char* kSlowMarches[] = {"reference", "brute"};
+
+/// `names` (every method of the registry when empty) without the slow marches with --quick; `note` says
+/// which were left out ("" when none).
+std::vector<std::string> quickMethods(const BenchOptions& o, std::vector<std::string> names,
+                                      std::string& note) {
+  note.clear();
+  if (!o.quick) return names;
+  if (names.empty())
+    for (const tool::Method& m : tool::methodRegistry())
+      names.push_back(m.name);
+  const auto slow = [](const std::string& name) {
+    return std::find(std::begin(kSlowMarches), std::end(kSlowMarches), name) != std::end(kSlowMarches);
+  };
+  for (const std::string& name : names)
+    if (slow(name)) note += (note.empty() ? "" : ", ") + name;
+  std::erase_if(names, slow);
+  if (!note.empty()) note = "(--quick leaves out the slow marches: " + note + ")\n";
+  return names;
+}
+
 /// Every method of the registry on the same frame: median per-frame milliseconds and the ratio to the
 /// prefiltered method.
 void methodsSideBySide(const BenchOptions& o) {
@@ -350,13 +375,15 @@ void methodsSideBySide(const BenchOptions& o) {
   if (!squareMapOk(o, "methods side by side", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   double mapMs = 0.0;
-  const std::vector<MethodRow> rows = runMethods(o, o.scene, {}, repeat, mapMs);
+  std::string note;
+  const std::vector<MethodRow> rows = runMethods(o, o.scene, quickMethods(o, {}, note), repeat, mapMs);
   std::printf(
       "\nmethods side by side (scene %s, %dx%d, map %d^2, M = %d, reference %d steps; per-frame ms = sum of\n"
       "the median per-frame stages of %d runs after a warm-up; the rectified shadow pass, %.2f ms, is "
       "shared):\n",
       o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.bases, settings.steps, repeat, mapMs);
   printRows(rows);
+  std::printf("%s", note.c_str());
 }
 
 /// A method's per-frame milliseconds with its shadow input (the stage perFrameStage leaves out: the
@@ -379,7 +406,7 @@ void sunInView(const BenchOptions& o) {
   if (!squareMapOk(o, "sun in view", Scattering::CreateInfo{}.mapSizeMultiple())) return;
   const int repeat = std::max(1, std::min(o.repeat, 3));
   std::vector<std::pair<int, int>> sizes = {{o.screenWidth, o.screenHeight}};
-  if (o.screenWidth != 640 || o.screenHeight != 360) sizes.push_back({640, 360});
+  if (!o.quick && (o.screenWidth != 640 || o.screenHeight != 360)) sizes.push_back({640, 360});
   for (const auto& [w, h] : sizes) {
     BenchOptions sized = o;
     sized.screenWidth = w;
@@ -483,8 +510,9 @@ void postEffects(const BenchOptions& o) {
 /// the sampling's cost scales with the number of slices and of samples per slice (the run's size).
 void epipolarSamplingBench(const BenchOptions& o) {
   if (!squareMapOk(o, "epipolar sampling", Scattering::CreateInfo{}.mapSizeMultiple())) return;
-  const std::vector<std::string> methods = {"epipolar-sampling", "epipolar-prefilter", "minmax", "prefilter",
-                                            "brute"};
+  std::string note;
+  const std::vector<std::string> methods =
+      quickMethods(o, {"epipolar-sampling", "epipolar-prefilter", "minmax", "prefilter", "brute"}, note);
   // The seed's size (2560x1600) joins the default 1920x1080 run; a smaller --size runs at that size only.
   std::vector<std::pair<int, int>> sizes = {{o.screenWidth, o.screenHeight}};
   if (!o.quick && o.screenWidth == 1920 && o.screenHeight == 1080) sizes.push_back({2560, 1600});
@@ -503,13 +531,17 @@ void epipolarSamplingBench(const BenchOptions& o) {
                   "per-frame ms as above):\n",
                   scene.c_str(), w, h, o.mapWidth, d.slices, d.samples, d.initialStep);
       printRows(rows);
+      std::printf("%s", note.c_str());
       const double yusov = msOf(rows, "epipolar-sampling"), minmax = msOf(rows, "minmax"),
                    brute = msOf(rows, "brute"), hybrid = msOf(rows, "epipolar-prefilter"),
                    prefilter = msOf(rows, "prefilter");
+      char bruteRatio[64] = "";
+      if (brute > 0.0 && yusov > 0.0)
+        std::snprintf(bruteRatio, sizeof bruteRatio, ", brute / epipolar-sampling %.2f", brute / yusov);
       if (yusov > 0.0 && hybrid > 0.0)
-        std::printf("ratios: minmax / epipolar-sampling %.2f, brute / epipolar-sampling %.2f, "
+        std::printf("ratios: minmax / epipolar-sampling %.2f%s, "
                     "prefilter / epipolar-prefilter %.2f, epipolar-prefilter / epipolar-sampling %.2f\n",
-                    minmax / yusov, brute / yusov, prefilter / hybrid, hybrid / yusov);
+                    minmax / yusov, bruteRatio, prefilter / hybrid, hybrid / yusov);
     }
   // Scaling with slices and samples (the run's size and scene).
   std::printf(
@@ -532,17 +564,13 @@ void epipolarSamplingBench(const BenchOptions& o) {
   }
 }
 
-/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per stage,
-/// side by side in one run: the default (4 orders on the 32x32x32x8 table of the higher orders; 16x64x32x8
-/// with --quick), Hillaire 2020's multiple scattering table at the same size (the option) and the 4 orders
-/// on Yusov's 32x128x64x16 table (the reference; not with --quick); then the per-frame cost of the sky,
-/// aerial perspective and shafts with each shaft method on the terrain at the run's size (median of the
-/// per-frame sums of `repeat` runs after a warm-up; "setup" stages excluded), and None through Eq. 8 on the
-/// reference table for comparison.
-void atmosphereBench(const BenchOptions& o) {
-  tool::AtmosphereSettings s;
-  s.cacheDirectory.clear(); // always compute: the precomputation's cost is the point
-  if (o.quick) s.tables.size = {16, 64, 32, 8};
+/// The atmosphere tables of atmosphereBench computed from scratch side by side, their stages printed:
+/// the default's and, without --quick, the reference (Yusov's size).
+struct AtmosphereTableRuns {
+  std::optional<tool::AtmosphereTableSet> kept, reference;
+};
+
+AtmosphereTableRuns atmosphereTableRuns(const BenchOptions& o, const tool::AtmosphereSettings& s) {
   struct TableRun {
     const char* name;
     AtmosphereMultipleScattering method;
@@ -555,7 +583,7 @@ void atmosphereBench(const BenchOptions& o) {
     runs.push_back({"4 orders on Yusov's table (the reference)", AtmosphereMultipleScattering::Orders,
                     AtmosphereTableSize{32, 128, 64, 16}});
   std::vector<double> totals;
-  std::optional<tool::AtmosphereTableSet> kept, reference;
+  AtmosphereTableRuns kept;
   for (const TableRun& run : runs) {
     tool::AtmosphereSettings m = s;
     m.tables.multipleScattering = run.method;
@@ -576,13 +604,48 @@ void atmosphereBench(const BenchOptions& o) {
     }
     std::printf("  %-28s %10.1f\n", "total", total);
     totals.push_back(total);
-    if (&run == &runs.front()) kept.emplace(std::move(tables));
-    if (&run == &runs.back() && runs.size() > 2) reference.emplace(std::move(tables));
+    if (&run == &runs.front()) kept.kept.emplace(std::move(tables));
+    if (&run == &runs.back() && runs.size() > 2) kept.reference.emplace(std::move(tables));
   }
   std::printf("  to the default: LUT %.3f", totals[1] / totals[0]);
   if (totals.size() > 2) std::printf(", reference %.3f", totals[2] / totals[0]);
   std::printf("\n");
-  const tool::AtmosphereTableSet& tables = *kept;
+  return kept;
+}
+
+/// The median per-frame ms of the atmosphere on `frame` (its stages summed, "setup" stages excluded) of
+/// `repeat` runs after a warm-up (programs, textures); `stages` receives each stage's ms of those runs.
+double atmosphereFrameMs(tool::SceneFrame& frame, const tool::MethodSettings& settings,
+                         const tool::AtmosphereSettings& s, const AtmosphereTablesPass& tables, int repeat,
+                         std::map<std::string, std::vector<double>>& stages) {
+  std::vector<double> sums;
+  for (int run = 0; run <= repeat; ++run) {
+    tool::StageTimings t;
+    (void)tool::runAtmosphere(*frame.frame, settings, s, tables, t);
+    if (run == 0) continue; // warm-up
+    double sum = 0.0;
+    for (const auto& row : t.rows()) {
+      if (row.stage.find("setup") != std::string::npos) continue;
+      sum += row.ms;
+      stages[row.stage].push_back(row.ms);
+    }
+    sums.push_back(sum);
+  }
+  return median(sums);
+}
+
+/// The atmosphere (Yusov 2013 tables after Bruneton and Neyret 2008): the tables' precomputation per stage,
+/// side by side in one run: the default (4 orders on the 32x32x32x8 table of the higher orders; 8x16x16x4
+/// with --quick), Hillaire 2020's multiple scattering table at the same size (the option) and the 4 orders
+/// on Yusov's 32x128x64x16 table (the reference; not with --quick); then the per-frame cost of the sky,
+/// aerial perspective and shafts with each shaft method on the terrain at the run's size (median of the
+/// per-frame sums of `repeat` runs after a warm-up; "setup" stages excluded), and None through Eq. 8 on the
+/// reference table for comparison.
+void atmosphereBench(const BenchOptions& o) {
+  tool::AtmosphereSettings s;
+  s.cacheDirectory.clear(); // always compute: the precomputation's cost is the point
+  if (o.quick) s.tables.size = {8, 16, 16, 4};
+  const AtmosphereTableRuns tables = atmosphereTableRuns(o, s);
 
   // Per frame: the terrain at 20 degrees of sun elevation, the scene's sun azimuth.
   const std::string scene = "terrain";
@@ -607,24 +670,8 @@ void atmosphereBench(const BenchOptions& o) {
        {AtmosphereShafts::None, AtmosphereShafts::Integrated, AtmosphereShafts::LitLengthTable,
         AtmosphereShafts::PrefilteredVisibility}) {
     s.shafts = shafts;
-    std::vector<double> sums;
     std::map<std::string, std::vector<double>> stages;
-    for (int run = 0; run <= repeat; ++run) {
-      tool::StageTimings t;
-      (void)tool::runAtmosphere(*frame.frame, settings, s, *tables.pass, t);
-      if (run == 0) continue; // warm-up: programs, textures
-      double sum = 0.0;
-      for (const auto& row : t.rows()) {
-        if (row.stage.find("setup") != std::string::npos) continue;
-        sum += row.ms;
-        stages[row.stage].push_back(row.ms);
-      }
-      sums.push_back(sum);
-    }
-    const auto median = [](std::vector<double> v) {
-      std::sort(v.begin(), v.end());
-      return v[v.size() / 2];
-    };
+    perFrame[shafts] = atmosphereFrameMs(frame, settings, s, *tables.kept->pass, repeat, stages);
     std::string breakdown;
     for (const auto& [stage, ms] : stages) {
       char buffer[160];
@@ -632,24 +679,16 @@ void atmosphereBench(const BenchOptions& o) {
                     median(ms));
       breakdown += buffer;
     }
-    perFrame[shafts] = median(sums);
     std::printf("  %-12s %10.1f   %s\n", tool::atmosphereShaftsName(shafts), perFrame[shafts],
                 breakdown.c_str());
   }
-  if (reference) { // None through Eq. 8 on the reference table (the single scattering of earlier versions)
+  if (tables.reference) { // None through Eq. 8 on the reference table (the single scattering of earlier
+                          // versions)
     s.shafts = AtmosphereShafts::None;
     s.ray.single = AtmosphereSingleScattering::Table4D;
-    std::vector<double> sums;
-    for (int run = 0; run <= repeat; ++run) {
-      tool::StageTimings t;
-      (void)tool::runAtmosphere(*frame.frame, settings, s, *reference->pass, t);
-      double sum = 0.0;
-      for (const auto& row : t.rows())
-        if (row.stage.find("setup") == std::string::npos) sum += row.ms;
-      if (run > 0) sums.push_back(sum);
-    }
-    std::sort(sums.begin(), sums.end());
-    std::printf("  %-12s %10.1f   (Eq. 8 on the reference table)\n", "none (4D)", sums[sums.size() / 2]);
+    std::map<std::string, std::vector<double>> stages;
+    std::printf("  %-12s %10.1f   (Eq. 8 on the reference table)\n", "none (4D)",
+                atmosphereFrameMs(frame, settings, s, *tables.reference->pass, repeat, stages));
   }
   const double a = perFrame[AtmosphereShafts::Integrated];
   if (a > 0.0)
@@ -779,59 +818,6 @@ void reducedResolution(const BenchOptions& o) {
     std::printf("%-7.2f %12.2f %12.2f %12.2f %12.2f %11.2f%%\n", scale, evaluate, resample, frame,
                 frame / fullMs, 100.0 * compareImages(image, full, c).relativeRmse);
   }
-}
-
-} // namespace
-
-BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
-  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot", "section"}, {"quick"});
-  BenchOptions o;
-  o.scene = args.string("scene", o.scene);
-  tool::requireSceneName(o.scene); // a usage error before any GL work
-  o.quick = args.has("quick");
-  const glm::ivec2 size =
-      args.size("size", {o.screenWidth, o.screenHeight}, Image::kMaxDimension, Image::kMaxPixels);
-  // The map is read back as an image; without --quick the scaling rows also use twice its width and
-  // twice its height, and half its width.
-  const int scale = o.quick ? 1 : 2;
-  const glm::ivec2 map =
-      args.size("map", {o.mapWidth, o.mapHeight}, Image::kMaxDimension / scale, Image::kMaxPixels / scale);
-  // The rectification's splits lie side by side in the map (SplitLayout::Regions); without --quick the
-  // parallelization rows split each into up to kMaxRegionsPerSplit regions and the scaling rows halve
-  // the width (a multiple of splits * kMaxRegionsPerSplit halves to a multiple of splits).
-  const int splits = Scattering::CreateInfo{}.rectify.splits,
-            perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
-  const int multiple = splits * (o.quick ? perSplit : std::max(perSplit, kMaxRegionsPerSplit));
-  if (map.x % multiple != 0)
-    throw tool::UsageError("option --map: width " + std::to_string(map.x) + " must be a multiple of " +
-                           std::to_string(multiple) + " (the rectification's " + std::to_string(splits) +
-                           " splits side by side" +
-                           (o.quick ? ", " + std::to_string(perSplit) + " prefilter regions each)"
-                                    : std::string(", each in up to ") + std::to_string(kMaxRegionsPerSplit) +
-                                          " regions in the parallelization rows; --quick omits them)"));
-  if (map.y < scale)
-    throw tool::UsageError("option --map: height " + std::to_string(map.y) +
-                           " must be at least 2 (halved by the scaling rows; --quick omits them)");
-  o.screenWidth = size.x;
-  o.screenHeight = size.y;
-  o.mapWidth = map.x;
-  o.mapHeight = map.y;
-  o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
-  if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
-  o.repeat = args.integer("repeat", o.repeat, 1, 1000);
-  o.plot = args.string("plot", "");
-  o.section = args.string("section", "");
-  if (!o.section.empty() && o.section != "epipolar-sampling" && o.section != "atmosphere" &&
-      o.section != "sun-in-view" && o.section != "local-lights")
-    throw tool::UsageError("option --section: '" + o.section +
-                           "' is not epipolar-sampling, sun-in-view, atmosphere or local-lights");
-  if (!o.section.empty() && !o.plot.empty())
-    throw tool::UsageError("option --plot: needs the whole suite, not --section");
-  if (!o.plot.empty() && o.quick)
-    throw tool::UsageError("option --plot: needs the Table 1/2 rows, which --quick omits");
-  if (!o.plot.empty() && !o.plot.ends_with(".svg")) throw tool::UsageError("option --plot: must end in .svg");
-  if (!o.plot.empty()) tool::requireOutputFile({"--plot", o.plot}); // the output rule, before any work
-  return o;
 }
 
 /// Constant cost (Klehm et al. 2014, Sec. 5): the GPU prefilter and evaluation of the four projective
@@ -1171,70 +1157,56 @@ void printHowMeasured(const BenchOptions& o) {
       o.repeat);
 }
 
-void runBenchSuite(const BenchOptions& o) {
-  scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
-  tool::StageTimings contextTimings;
-  tool::ensureGlContext("bench", false, contextTimings);
-  const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases, repeat = o.repeat;
-  std::printf("crep bench: scene %s | screen %dx%d | map %dx%d | M = %d | median of %d runs\n",
-              o.scene.c_str(), o.screenWidth, o.screenHeight, mapW, mapH, bases, repeat);
-  if (o.section == "epipolar-sampling") { // one section alone (its own frames, its own sizes)
-    epipolarSamplingBench(o);
-    printHowMeasured(o);
-    return;
-  }
-  if (o.section == "sun-in-view") {
-    sunInView(o);
-    printHowMeasured(o);
-    return;
-  }
-  if (o.section == "atmosphere") {
-    atmosphereBench(o);
-    printHowMeasured(o);
-    return;
-  }
-  if (o.section == "local-lights") {
-    localLights(o);
-    localLightScene(o);
-    localLightScaling(o);
-    printHowMeasured(o);
-    return;
-  }
-  const Setup s = makeSetup(o.scene, o.screenWidth, o.screenHeight, mapW, mapH);
+/// Memory copies of the bytes the prefilter writes (W x H x ceil(M / 4) RGBA8 texels).
+struct CopyTimes {
+  std::size_t bytes = 0;
+  double memcpyMs = 0.0, gpuCopyMs = 0.0; ///< memcpy (CPU), glCopyImageSubData (GPU)
+};
 
-  // Memory copy baselines over the bytes the prefilter writes (W x H x ceil(M / 4) RGBA8 texels).
-  const std::size_t outBytes = std::size_t(mapW) * mapH * std::size_t(layerCount(bases)) * 4;
-  std::vector<unsigned char> src(outBytes, 1), dst(outBytes);
-  const double memcpyMs = medianMs(repeat, [&] { std::memcpy(dst.data(), src.data(), outBytes); });
+CopyTimes timeCopies(const BenchOptions& o) {
+  const int mapW = o.mapWidth, mapH = o.mapHeight, layers = layerCount(o.bases);
+  CopyTimes c;
+  c.bytes = std::size_t(mapW) * mapH * std::size_t(layers) * 4;
+  std::vector<unsigned char> src(c.bytes, 1), dst(c.bytes);
+  c.memcpyMs = medianMs(o.repeat, [&] { std::memcpy(dst.data(), src.data(), c.bytes); });
   gl::Handle a = gl::createTexture(GL_TEXTURE_2D_ARRAY), b = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(a.get(), 1, GL_RGBA8, mapW, mapH, layerCount(bases));
-  glTextureStorage3D(b.get(), 1, GL_RGBA8, mapW, mapH, layerCount(bases));
-  const double gpuCopyMs = medianMs(repeat, [&] {
+  glTextureStorage3D(a.get(), 1, GL_RGBA8, mapW, mapH, layers);
+  glTextureStorage3D(b.get(), 1, GL_RGBA8, mapW, mapH, layers);
+  c.gpuCopyMs = medianMs(o.repeat, [&] {
     glCopyImageSubData(a.get(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, b.get(), GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
-                       mapW, mapH, layerCount(bases));
+                       mapW, mapH, layers);
     glFinish();
   });
+  return c;
+}
 
-  // CPU reference (all cores) vs GPU pass, same inputs.
+/// The CPU reference (all cores) of the prefilter and the evaluation on a set-up's frame.
+struct CpuTimes {
+  double prefilter = 0.0, evaluate = 0.0;
+};
+
+CpuTimes timeCpu(const BenchOptions& o, const Setup& s) {
   PrefilterOptions options = Scattering::CreateInfo{}.prefilter;
-  options.bases = bases;
+  options.bases = o.bases;
   const RectifiedMap map = makeRectifiedMap(s.layout, s.rectifiedImage);
   FilteredBasis basis;
-  const int cpuRepeat = o.quick ? 1 : std::max(1, repeat / 2);
-  const double cpuPrefilterMs = medianMs(cpuRepeat, [&] { basis = prefilter(map, s.scene.medium, options); });
-  const double cpuEvaluateMs = medianMs(cpuRepeat, [&] {
+  const int cpuRepeat = o.quick ? 1 : std::max(1, o.repeat / 2);
+  CpuTimes t;
+  t.prefilter = medianMs(cpuRepeat, [&] { basis = prefilter(map, s.scene.medium, options); });
+  t.evaluate = medianMs(cpuRepeat, [&] {
     const Image img = evaluate(basis, s.cameraDepthImage, s.scene.camera, s.scene.sun, s.scene.medium);
     (void)img;
   });
-  const int perInvocation = PrefilterOptions{}.basesPerInvocation;
-  const GpuTimes gpu = timeGpu(s, bases, StorageFormat::RGBA8, repeat,
-                               Scattering::CreateInfo{}.prefilter.regionsPerSplit, perInvocation, true);
+  return t;
+}
 
+/// CPU vs GPU per stage, the limits and the evaluation variants.
+void printPassTimes(const CpuTimes& cpu, const GpuTimes& gpu) {
   std::printf("\n%-34s %12s %12s %10s\n", "stage", "CPU ms", "GPU ms", "CPU/GPU");
-  std::printf("%-34s %12.2f %12.2f %10.2f\n", "prefilter", cpuPrefilterMs, gpu.prefilter,
-              cpuPrefilterMs / gpu.prefilter);
-  std::printf("%-34s %12.2f %12.2f %10.2f\n", "evaluate", cpuEvaluateMs, gpu.evaluate,
-              cpuEvaluateMs / gpu.evaluate);
+  std::printf("%-34s %12.2f %12.2f %10.2f\n", "prefilter", cpu.prefilter, gpu.prefilter,
+              cpu.prefilter / gpu.prefilter);
+  std::printf("%-34s %12.2f %12.2f %10.2f\n", "evaluate", cpu.evaluate, gpu.evaluate,
+              cpu.evaluate / gpu.evaluate);
   std::printf("\nlimits (the same pass stripped to its memory traffic, same run; goals: prefilter <= 2x,\n"
               "evaluation <= 1.3x):\n");
   std::printf(
@@ -1243,7 +1215,7 @@ void runBenchSuite(const BenchOptions& o) {
   std::printf(
       "              (%d bases per invocation, the default; the fastest write-only, %d per invocation: "
       "%.2f ms, ratio %.2f)\n",
-      perInvocation, gpu.prefilterLimitFastestBases, gpu.prefilterLimitFastest,
+      PrefilterOptions{}.basesPerInvocation, gpu.prefilterLimitFastestBases, gpu.prefilterLimitFastest,
       gpu.prefilter / gpu.prefilterLimitFastest);
   std::printf(
       "  evaluate    %8.2f ms   fetch-only (same fetches and store, no math)    %8.2f ms   ratio %.2f\n",
@@ -1254,7 +1226,10 @@ void runBenchSuite(const BenchOptions& o) {
       "loop over the visibility table %.2f ms (%.2fx); no table %.2f ms (%.2fx)\n",
       gpu.evaluate, gpu.evaluateTablesOnly, gpu.evaluateVisibilityTableOnly, gpu.evaluatePerRegion,
       gpu.evaluatePerRegion / gpu.evaluate, gpu.evaluateDirect, gpu.evaluateDirect / gpu.evaluate);
-  const int perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
+}
+
+void printProfile(const BenchOptions& o, const Setup& s) {
+  const int perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit, bases = o.bases;
   const EvaluationProfile profile = profileEvaluation(s, perSplit);
   std::printf(
       "\nevaluation profile (%s, %d prefilter regions): %.2f regions crossed per pixel on average, at most\n"
@@ -1268,118 +1243,356 @@ void runBenchSuite(const BenchOptions& o) {
   for (std::size_t i = 0; i < profile.histogram.size(); ++i)
     if (profile.histogram[i] >= 0.0005) std::printf(" %zu: %.1f%%", i + 1, 100.0 * profile.histogram[i]);
   std::printf("\n");
-  const double mib = double(outBytes) / (1024.0 * 1024.0);
+}
+
+void printBandwidth(const CopyTimes& c, const CpuTimes& cpu, const GpuTimes& gpu) {
+  const double mib = double(c.bytes) / (1024.0 * 1024.0);
   std::printf("\nbandwidth over the %.1f MiB the prefilter writes (RGBA8):\n", mib);
-  std::printf("  memcpy (CPU)          %8.2f ms  %8.0f MiB/s\n", memcpyMs, mib / (memcpyMs / 1000.0));
-  std::printf("  glCopyImageSubData    %8.2f ms  %8.0f MiB/s\n", gpuCopyMs, mib / (gpuCopyMs / 1000.0));
+  std::printf("  memcpy (CPU)          %8.2f ms  %8.0f MiB/s\n", c.memcpyMs, mib / (c.memcpyMs / 1000.0));
+  std::printf("  glCopyImageSubData    %8.2f ms  %8.0f MiB/s\n", c.gpuCopyMs, mib / (c.gpuCopyMs / 1000.0));
   std::printf("  GPU prefilter         %8.2f ms  %8.0f MiB/s  (%.1f%% of the GPU copy)\n", gpu.prefilter,
-              mib / (gpu.prefilter / 1000.0), 100.0 * gpuCopyMs / gpu.prefilter);
-  std::printf("  CPU prefilter         %8.2f ms  %8.0f MiB/s  (%.1f%% of memcpy)\n", cpuPrefilterMs,
-              mib / (cpuPrefilterMs / 1000.0), 100.0 * memcpyMs / cpuPrefilterMs);
+              mib / (gpu.prefilter / 1000.0), 100.0 * c.gpuCopyMs / gpu.prefilter);
+  std::printf("  CPU prefilter         %8.2f ms  %8.0f MiB/s  (%.1f%% of memcpy)\n", cpu.prefilter,
+              mib / (cpu.prefilter / 1000.0), 100.0 * c.memcpyMs / cpu.prefilter);
+}
 
-  memoryTable(o);
-  localLights(o);
-  localLightScene(o);
-  lightTextures(o);
-  constantCost(o);
-  reducedResolution(o);
-  methodsSideBySide(o);
-  sunInView(o);
-  postEffects(o);
-  epipolarSamplingBench(o);
-  atmosphereBench(o);
+/// The Table 1/2 rows of a run for --plot: names and times relative to the run's map and M.
+struct TablePlot {
+  std::vector<std::string> scaleNames;
+  std::vector<double> scalePrefilter, scaleEvaluate;
+  std::vector<std::string> parNames;
+  std::vector<double> parOurs, parPaper;
+};
 
-  if (!o.quick) {
-    // Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8).
-    std::printf("\nscaling (GPU pass, RGBA8; ratio = time / time of the %dx%d, M = %d row):\n", mapW, mapH,
-                bases);
-    std::printf("%-18s %6s %12s %12s %8s\n", "map", "M", "prefilter ms", "evaluate ms", "ratio");
-    const double base = gpu.prefilter + gpu.evaluate;
-    std::vector<std::string> scaleNames;
-    std::vector<double> scalePrefilter, scaleEvaluate;
-    struct Row {
-      int w, h, m;
-    };
-    const Row rows[] = {{mapW / 2, mapH, bases}, {mapW * 2, mapH, bases}, {mapW, mapH / 2, bases},
-                        {mapW, mapH * 2, bases}, {mapW, mapH, 16},        {mapW, mapH, 64}};
-    for (const Row& r : rows) {
-      std::optional<Setup> resized;
-      if (r.w != mapW || r.h != mapH)
-        resized.emplace(makeSetup(o.scene, o.screenWidth, o.screenHeight, r.w, r.h));
-      const Setup& use = resized ? *resized : s;
-      const GpuTimes t = timeGpu(use, r.m, StorageFormat::RGBA8, repeat);
-      std::printf("%6dx%-11d %6d %12.2f %12.2f %8.2f\n", r.w, r.h, r.m, t.prefilter, t.evaluate,
-                  (t.prefilter + t.evaluate) / base);
-      scaleNames.push_back(r.m != bases ? "M " + std::to_string(r.m)
-                                        : std::to_string(r.w) + "x" + std::to_string(r.h));
-      scalePrefilter.push_back(t.prefilter / gpu.prefilter);
-      scaleEvaluate.push_back(t.evaluate / gpu.evaluate);
-    }
-    // Table 1's study: regions per split x bases per invocation.
-    std::printf("\nparallelization (Table 1; GPU prefilter ms):\n%-10s", "regions");
-    for (int bpi : {4, 8, 16, 32})
-      std::printf(" %8d", bpi);
-    std::printf("   <- bases per invocation\n");
-    std::vector<std::string> parNames;
-    std::vector<double> parOurs, parPaper;
-    double parBase = 0.0;
-    // The paper's Table 1 (NVIDIA Titan, San Miguel): prefix-sum ms for (regions, bases per thread).
-    const auto paperTable1 = [](int p, int bpi) {
-      const double t[4][3] = {{1.85, 2.49, 4.05}, {1.19, 1.37, 2.03}, {1.50, 0.93, 1.32}, {1.28, 1.16, 1.10}};
-      const int row = p - 1, col = bpi == 4 ? 0 : bpi == 8 ? 1 : bpi == 16 ? 2 : -1;
-      return row >= 0 && row < 4 && col >= 0 ? t[row][col] / 1.85 : -1.0;
-    };
-    for (int p : {1, 2, kMaxRegionsPerSplit}) {
-      std::printf("%-10d", p);
-      for (int bpi : {4, 8, 16, 32}) {
-        if (bpi > bases || bases % bpi != 0) {
-          std::printf(" %8s", "-");
-          continue;
-        }
-        const double ms = timeGpu(s, bases, StorageFormat::RGBA8, repeat, p, bpi).prefilter;
-        std::printf(" %8.2f", ms);
-        if (parBase == 0.0) parBase = ms;
-        parNames.push_back(std::to_string(p) + "/" + std::to_string(bpi));
-        parOurs.push_back(ms / parBase);
-        parPaper.push_back(paperTable1(p, bpi));
-      }
-      std::printf("\n");
-    }
-    if (!o.plot.empty()) {
-      // The paper's Table 2 (prefix sum and scattering relative to its 1024x1024, M = 32 row), where it has
-      // the row; our rows are relative to this run's map and M (the paper's are for 1024^2 too).
-      const auto paperTable2 = [&](const std::string& name, bool prefix) -> double {
-        if (mapW != 1024 || mapH != 1024 || bases != 32) return -1.0;
-        if (name == "512x1024") return prefix ? 0.54 / 0.94 : 1.47 / 1.30;
-        if (name == "2048x1024") return prefix ? 2.17 / 0.94 : 1.31 / 1.30;
-        if (name == "1024x512") return prefix ? 0.97 / 0.94 : 1.47 / 1.30;
-        if (name == "M 16") return prefix ? 0.96 / 0.94 : 0.92 / 1.30;
-        if (name == "M 64") return prefix ? 3.07 / 0.94 : 2.63 / 1.30;
-        return -1.0;
-      };
-      std::vector<double> paperPrefilter, paperEvaluate;
-      for (const std::string& n : scaleNames) {
-        paperPrefilter.push_back(paperTable2(n, true));
-        paperEvaluate.push_back(paperTable2(n, false));
-      }
-      const std::string ours = "crepuscular, llvmpipe";
-      const std::string paper = "Klehm et al. 2014, NVIDIA Titan";
-      writeBarChartSvg(o.plot,
-                       "Table 2 and Table 1 shapes: time relative to the " + std::to_string(mapW) + "x" +
-                           std::to_string(mapH) + ", M = " + std::to_string(bases) + " row (" + o.scene +
-                           ", " + std::to_string(o.screenWidth) + "x" + std::to_string(o.screenHeight) + ")",
-                       {{"prefilter vs map size and M (Table 2)",
-                         scaleNames,
-                         {{ours, "#d95f02", scalePrefilter}, {paper, "#7570b3", paperPrefilter}}},
-                        {"evaluation vs map size and M (Table 2)",
-                         scaleNames,
-                         {{ours, "#d95f02", scaleEvaluate}, {paper, "#7570b3", paperEvaluate}}},
-                        {"prefilter: regions / bases per invocation (Table 1)",
-                         parNames,
-                         {{ours, "#d95f02", parOurs}, {paper, "#7570b3", parPaper}}}});
-      std::printf("\nwrote %s (the Table 1/2 rows above beside the paper's)\n", o.plot.c_str());
-    }
+} // namespace
+
+class BenchRun {
+public:
+  BenchRun(const BenchOptions& o, bool chosen) : options(o), named(chosen) {}
+  const BenchOptions& options;
+  const bool named; ///< the sections were chosen with --section
+  /// The run's scene at its screen and map sizes, made on first use and shared by the sections.
+  const Setup& setup() {
+    if (!setup_)
+      setup_.emplace(makeSetup(options.scene, options.screenWidth, options.screenHeight, options.mapWidth,
+                               options.mapHeight));
+    return *setup_;
   }
+  std::optional<GpuTimes> passTimes; ///< the GPU passes at the run's map and M (the scaling rows' base)
+  TablePlot plot;
+
+private:
+  std::optional<Setup> setup_;
+};
+
+namespace {
+
+/// The prefilter and evaluation at the run's sizes: CPU reference (all cores) vs GPU pass on the same
+/// inputs, the passes beside their memory-traffic limits, the evaluation variants and profile, and the
+/// bandwidth of the prefilter against memory copies of the bytes it writes.
+void passesSection(BenchRun& run) {
+  const BenchOptions& o = run.options;
+  const Setup& s = run.setup();
+  const CopyTimes copies = timeCopies(o);
+  const CpuTimes cpu = timeCpu(o, s);
+  GpuRun limits;
+  limits.limits = true;
+  const GpuTimes gpu = timeGpu(s, o.bases, o.repeat, limits);
+  run.passTimes = gpu;
+  printPassTimes(cpu, gpu);
+  printProfile(o, s);
+  printBandwidth(copies, cpu, gpu);
+}
+
+void localLightsSection(BenchRun& run) {
+  localLights(run.options);
+  localLightScene(run.options);
+  if (run.named || run.options.quick) localLightScaling(run.options);
+}
+
+/// Table 2's rows: scaling with map width, map height and M (GPU pass, RGBA8), relative to the run's map
+/// and M (measured by the passes section, else here first). --quick: the half-height and M = 16 rows.
+void scalingSection(BenchRun& run) {
+  const BenchOptions& o = run.options;
+  const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases;
+  const Setup& s = run.setup();
+  if (!run.passTimes) run.passTimes = timeGpu(s, bases, o.repeat);
+  const GpuTimes gpu = *run.passTimes;
+  std::printf("\nscaling (GPU pass, RGBA8; ratio = time / time of the %dx%d, M = %d row):\n", mapW, mapH,
+              bases);
+  std::printf("%-18s %6s %12s %12s %8s\n", "map", "M", "prefilter ms", "evaluate ms", "ratio");
+  const double base = gpu.prefilter + gpu.evaluate;
+  struct Row {
+    int w, h, m;
+  };
+  std::vector<Row> rows = {{mapW / 2, mapH, bases}, {mapW * 2, mapH, bases}, {mapW, mapH / 2, bases},
+                           {mapW, mapH * 2, bases}, {mapW, mapH, 16},        {mapW, mapH, 64}};
+  if (o.quick) {
+    rows = {{mapW, mapH, 16}};
+    if (mapH >= 2) rows.insert(rows.begin(), {mapW, mapH / 2, bases});
+  }
+  for (const Row& r : rows) {
+    std::optional<Setup> resized;
+    if (r.w != mapW || r.h != mapH)
+      resized.emplace(makeSetup(o.scene, o.screenWidth, o.screenHeight, r.w, r.h));
+    const Setup& use = resized ? *resized : s;
+    const GpuTimes t = timeGpu(use, r.m, o.repeat);
+    std::printf("%6dx%-11d %6d %12.2f %12.2f %8.2f\n", r.w, r.h, r.m, t.prefilter, t.evaluate,
+                (t.prefilter + t.evaluate) / base);
+    run.plot.scaleNames.push_back(r.m != bases ? "M " + std::to_string(r.m)
+                                               : std::to_string(r.w) + "x" + std::to_string(r.h));
+    run.plot.scalePrefilter.push_back(t.prefilter / gpu.prefilter);
+    run.plot.scaleEvaluate.push_back(t.evaluate / gpu.evaluate);
+  }
+}
+
+/// The paper's Table 1 (NVIDIA Titan, San Miguel): prefix-sum ms for (regions, bases per thread), relative
+/// to its first cell; -1 where it has none.
+double paperTable1(int regions, int basesPerInvocation) {
+  const double t[4][3] = {{1.85, 2.49, 4.05}, {1.19, 1.37, 2.03}, {1.50, 0.93, 1.32}, {1.28, 1.16, 1.10}};
+  const int row = regions - 1, col = basesPerInvocation == 4    ? 0
+                                     : basesPerInvocation == 8  ? 1
+                                     : basesPerInvocation == 16 ? 2
+                                                                : -1;
+  return row >= 0 && row < 4 && col >= 0 ? t[row][col] / 1.85 : -1.0;
+}
+
+/// Table 1's study: the GPU prefilter at the run's map and M for regions per split x bases per invocation.
+/// --quick: 1 and 2 regions per split.
+void parallelizationSection(BenchRun& run) {
+  const BenchOptions& o = run.options;
+  const Setup& s = run.setup();
+  const std::vector<int> perInvocation = {4, 8, 16, 32};
+  const std::vector<int> regions =
+      o.quick ? std::vector<int>{1, 2} : std::vector<int>{1, 2, kMaxRegionsPerSplit};
+  std::printf("\nparallelization (Table 1; GPU prefilter ms):\n%-10s", "regions");
+  for (int bpi : perInvocation)
+    std::printf(" %8d", bpi);
+  std::printf("   <- bases per invocation\n");
+  double parBase = 0.0;
+  for (int p : regions) {
+    std::printf("%-10d", p);
+    for (int bpi : perInvocation) {
+      if (bpi > o.bases || o.bases % bpi != 0) {
+        std::printf(" %8s", "-");
+        continue;
+      }
+      GpuRun cell;
+      cell.regionsPerSplit = p;
+      cell.basesPerInvocation = bpi;
+      cell.evaluate = false;
+      const double ms = timeGpu(s, o.bases, o.repeat, cell).prefilter;
+      std::printf(" %8.2f", ms);
+      if (parBase == 0.0) parBase = ms;
+      run.plot.parNames.push_back(std::to_string(p) + "/" + std::to_string(bpi));
+      run.plot.parOurs.push_back(ms / parBase);
+      run.plot.parPaper.push_back(paperTable1(p, bpi));
+    }
+    std::printf("\n");
+  }
+}
+
+/// --plot: the Table 1/2 rows of the run beside the paper's, as an SVG bar chart.
+void writeTablePlot(const BenchRun& run) {
+  const BenchOptions& o = run.options;
+  const int mapW = o.mapWidth, mapH = o.mapHeight, bases = o.bases;
+  // The paper's Table 2 (prefix sum and scattering relative to its 1024x1024, M = 32 row), where it has
+  // the row; our rows are relative to this run's map and M (the paper's are for 1024^2 too).
+  const auto paperTable2 = [&](const std::string& name, bool prefix) -> double {
+    if (mapW != 1024 || mapH != 1024 || bases != 32) return -1.0;
+    if (name == "512x1024") return prefix ? 0.54 / 0.94 : 1.47 / 1.30;
+    if (name == "2048x1024") return prefix ? 2.17 / 0.94 : 1.31 / 1.30;
+    if (name == "1024x512") return prefix ? 0.97 / 0.94 : 1.47 / 1.30;
+    if (name == "M 16") return prefix ? 0.96 / 0.94 : 0.92 / 1.30;
+    if (name == "M 64") return prefix ? 3.07 / 0.94 : 2.63 / 1.30;
+    return -1.0;
+  };
+  const TablePlot& p = run.plot;
+  std::vector<double> paperPrefilter, paperEvaluate;
+  for (const std::string& n : p.scaleNames) {
+    paperPrefilter.push_back(paperTable2(n, true));
+    paperEvaluate.push_back(paperTable2(n, false));
+  }
+  const std::string ours = "crepuscular, llvmpipe";
+  const std::string paper = "Klehm et al. 2014, NVIDIA Titan";
+  writeBarChartSvg(o.plot,
+                   "Table 2 and Table 1 shapes: time relative to the " + std::to_string(mapW) + "x" +
+                       std::to_string(mapH) + ", M = " + std::to_string(bases) + " row (" + o.scene + ", " +
+                       std::to_string(o.screenWidth) + "x" + std::to_string(o.screenHeight) + ")",
+                   {{"prefilter vs map size and M (Table 2)",
+                     p.scaleNames,
+                     {{ours, "#d95f02", p.scalePrefilter}, {paper, "#7570b3", paperPrefilter}}},
+                    {"evaluation vs map size and M (Table 2)",
+                     p.scaleNames,
+                     {{ours, "#d95f02", p.scaleEvaluate}, {paper, "#7570b3", paperEvaluate}}},
+                    {"prefilter: regions / bases per invocation (Table 1)",
+                     p.parNames,
+                     {{ours, "#d95f02", p.parOurs}, {paper, "#7570b3", p.parPaper}}}});
+  std::printf("\nwrote %s (the Table 1/2 rows above beside the paper's)\n", o.plot.c_str());
+}
+
+/// What --quick does (BenchOptions::quick), for --help.
+constexpr const char* kQuickHelp =
+    "--quick: every section once at a reduced cost (a smoke test): --size 640x360\n"
+    "  --map 512x512 --repeat 1 unless given; no second screen size; no reference or brute\n"
+    "  march; 3 of the 7 slices x samples rows; atmosphere tables at 8x16x16x4 and no 4D\n"
+    "  reference table; local-lights with its spot scaling; Table 2's half-height and\n"
+    "  M = 16 rows; Table 1 at 1 and 2 regions per split";
+
+/// Sections whose rows --plot draws.
+constexpr const char* kPlotSections[] = {"scaling", "parallelization"};
+
+} // namespace
+
+const std::vector<BenchSection>& benchSections() {
+  static const std::vector<BenchSection> sections = {
+      {"passes", "CPU reference vs GPU prefilter and evaluation, limits, bandwidth", passesSection},
+      {"memory", "GPU memory per map size, crep::Scattering::memoryBytes()",
+       [](BenchRun& r) { memoryTable(r.options); }},
+      {"local-lights", "a spot vs the sun, the spot scene; named or --quick: 1-8 spots", localLightsSection},
+      {"light-textures", "the stained-glass sun with and without its light texture",
+       [](BenchRun& r) { lightTextures(r.options); }},
+      {"constant-cost", "the GPU passes on the four projective scenes, interleaved",
+       [](BenchRun& r) { constantCost(r.options); }},
+      {"reduced-resolution", "crep::Scattering at evaluation scales 1, 0.5 and 0.25",
+       [](BenchRun& r) { reducedResolution(r.options); }},
+      {"methods", "every method of the tool's registry on the same frame",
+       [](BenchRun& r) { methodsSideBySide(r.options); }},
+      {"sun-in-view", "the sunset scene (epipolar) vs the forest's projective frame",
+       [](BenchRun& r) { sunInView(r.options); }},
+      {"post-effects", "radial blur and froxel fog beside the prefiltered method",
+       [](BenchRun& r) { postEffects(r.options); }},
+      {"epipolar-sampling", "Yusov's sampling, the hybrid and their peers; slices x samples",
+       [](BenchRun& r) { epipolarSamplingBench(r.options); }},
+      {"atmosphere", "atmosphere tables from scratch; sky and shafts per frame",
+       [](BenchRun& r) { atmosphereBench(r.options); }},
+      {"scaling", "Table 2: the GPU passes vs map width, map height and M", scalingSection},
+      {"parallelization", "Table 1: prefilter regions per split x bases per invocation",
+       parallelizationSection},
+  };
+  return sections;
+}
+
+std::string benchHelp() {
+  const std::string indent(12, ' ');
+  std::string text;
+  const auto line = [&](const std::string& s) { text += indent + s + "\n"; };
+  line("--scene NAME (forest) --size WxH (1920x1080) --map WxH (1024x1024)");
+  line("--bases M (32; any even M in [4, 128]) --repeat N (5); the --map width is a");
+  line("multiple of 32 (16 with --quick); --plot FILE.svg writes the Table 1/2 rows as a");
+  line("chart beside the paper's (needs the scaling and parallelization sections, not --quick)");
+  std::string quick = kQuickHelp;
+  for (std::size_t at = 0, next; at < quick.size(); at = next + 1) {
+    next = quick.find('\n', at);
+    if (next == std::string::npos) next = quick.size();
+    line(quick.substr(at, next - at));
+  }
+  line("--section NAME[,NAME...]: those sections alone (in the suite's order); the sections,");
+  line("in the order the whole suite runs them:");
+  for (const BenchSection& s : benchSections()) {
+    std::string name = s.name;
+    name.resize(std::max<std::size_t>(name.size(), 18), ' ');
+    line("  " + name + " " + s.summary);
+  }
+  return text;
+}
+
+namespace {
+
+/// --section's value: the names of benchSections() in the suite's order (a name given twice runs once).
+std::vector<std::string> parseSections(const std::string& value) {
+  std::vector<std::string> given;
+  for (std::size_t at = 0, next; at <= value.size(); at = next + 1) {
+    next = value.find(',', at);
+    if (next == std::string::npos) next = value.size();
+    given.push_back(value.substr(at, next - at));
+  }
+  std::string valid;
+  for (const BenchSection& s : benchSections())
+    valid += std::string(valid.empty() ? "" : ", ") + s.name;
+  for (const std::string& name : given)
+    if (std::none_of(benchSections().begin(), benchSections().end(),
+                     [&](const BenchSection& s) { return name == s.name; }))
+      throw tool::UsageError("option --section: '" + name + "' is not a section; the sections: " + valid);
+  std::vector<std::string> sections;
+  for (const BenchSection& s : benchSections())
+    if (std::find(given.begin(), given.end(), s.name) != given.end()) sections.push_back(s.name);
+  return sections;
+}
+
+/// The --map size: the rectification's splits lie side by side in the map (SplitLayout::Regions); without
+/// --quick the parallelization rows split each into up to kMaxRegionsPerSplit regions and the scaling rows
+/// halve the width (a multiple of splits * kMaxRegionsPerSplit halves to a multiple of splits) and double
+/// the width and the height (the map is read back as an image); --quick's rows keep the width and halve
+/// the height only when it is at least 2.
+glm::ivec2 parseMapSize(const tool::Args& args, bool quick) {
+  const glm::ivec2 fallback = quick ? glm::ivec2(512, 512) : glm::ivec2(1024, 1024);
+  const int scale = quick ? 1 : 2;
+  const glm::ivec2 map = args.size("map", fallback, Image::kMaxDimension / scale, Image::kMaxPixels / scale);
+  const int splits = Scattering::CreateInfo{}.rectify.splits,
+            perSplit = Scattering::CreateInfo{}.prefilter.regionsPerSplit;
+  const int multiple = splits * (quick ? perSplit : std::max(perSplit, kMaxRegionsPerSplit));
+  if (map.x % multiple != 0)
+    throw tool::UsageError("option --map: width " + std::to_string(map.x) + " must be a multiple of " +
+                           std::to_string(multiple) + " (the rectification's " + std::to_string(splits) +
+                           " splits side by side" +
+                           (quick ? ", " + std::to_string(perSplit) + " prefilter regions each)"
+                                  : std::string(", each in up to ") + std::to_string(kMaxRegionsPerSplit) +
+                                        " regions in the parallelization rows; --quick runs 1 and 2)"));
+  if (map.y < scale)
+    throw tool::UsageError("option --map: height " + std::to_string(map.y) +
+                           " must be at least 2 (halved by the scaling rows; --quick skips that row)");
+  return map;
+}
+
+} // namespace
+
+BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
+  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot", "section"}, {"quick"});
+  BenchOptions o;
+  o.scene = args.string("scene", o.scene);
+  tool::requireSceneName(o.scene); // a usage error before any GL work
+  o.quick = args.has("quick");
+  const glm::ivec2 size =
+      args.size("size", o.quick ? glm::ivec2(640, 360) : glm::ivec2(o.screenWidth, o.screenHeight),
+                Image::kMaxDimension, Image::kMaxPixels);
+  const glm::ivec2 map = parseMapSize(args, o.quick);
+  o.screenWidth = size.x;
+  o.screenHeight = size.y;
+  o.mapWidth = map.x;
+  o.mapHeight = map.y;
+  o.bases = args.integer("bases", o.bases, kMinBases, kMaxBases);
+  if (o.bases % 2 != 0) throw tool::UsageError("option --bases: must be even");
+  o.repeat = args.integer("repeat", o.quick ? 1 : o.repeat, 1, 1000);
+  o.plot = args.string("plot", "");
+  if (args.has("section")) o.sections = parseSections(args.string("section", ""));
+  if (!o.plot.empty()) {
+    for (const char* needed : kPlotSections)
+      if (!o.sections.empty() && std::find(o.sections.begin(), o.sections.end(), needed) == o.sections.end())
+        throw tool::UsageError("option --plot: needs the sections scaling and parallelization (the whole "
+                               "suite or --section scaling,parallelization)");
+    if (o.quick)
+      throw tool::UsageError("option --plot: needs the Table 1/2 rows in full, which --quick reduces");
+    if (!o.plot.ends_with(".svg")) throw tool::UsageError("option --plot: must end in .svg");
+    tool::requireOutputFile({"--plot", o.plot}); // the output rule, before any work
+  }
+  return o;
+}
+
+void runBenchSuite(const BenchOptions& o) {
+  scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
+  tool::StageTimings contextTimings;
+  tool::ensureGlContext("bench", false, contextTimings);
+  std::printf("crep bench: scene %s | screen %dx%d | map %dx%d | M = %d | median of %d runs\n",
+              o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.mapHeight, o.bases, o.repeat);
+  BenchRun run(o, !o.sections.empty());
+  for (const BenchSection& section : benchSections())
+    if (o.sections.empty() ||
+        std::find(o.sections.begin(), o.sections.end(), section.name) != o.sections.end()) {
+      section.run(run);
+      std::fflush(stdout); // a section at a time through a pipe (`crep bench | tee`), not 4 KiB blocks
+    }
+  if (!o.plot.empty()) writeTablePlot(run);
   printHowMeasured(o);
 }
 

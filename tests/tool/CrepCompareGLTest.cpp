@@ -230,19 +230,49 @@ TEST_CASE(
 }
 
 #if CREP_TOOL_HAS_BENCH // bench/ built: it adds `crep bench`
-TEST_CASE("crep bench --quick: CPU vs GPU, methods side by side, bandwidth") {
+TEST_CASE("crep bench --quick: every section at a reduced cost, the slow marches left out") {
   CREP_REQUIRE_GL();
-  const auto r = crep::test::runCrep("bench --quick --size 160x90 --map 128x128 --repeat 1");
+  // stdout alone: the methods' warnings on stderr would land between stdout's buffered blocks.
+  const auto r = crep::test::runCrep("bench --quick --size 160x90 --map 128x128 2>/dev/null; exit $?");
   INFO(r.output);
   REQUIRE(r.status == 0);
+  CHECK(r.output.find("median of 1 runs") != std::string::npos); // --quick: --repeat 1 unless given
   for (const char* text : {"CPU/GPU", "prefilter", "evaluate", "bandwidth", "methods side by side",
                            "reference", "vs prefilter", "how measured"})
     CHECK(r.output.find(text) != std::string::npos);
-  CHECK(r.output.find("Table 1") == std::string::npos); // --quick: no tables
-  for (const char* text : {"limits", "fetch-only", "write-only", "evaluation profile", "GPU memory",
-                           "reduced resolution", "sun in view", "constant cost", "epipolar sampling",
-                           "epipolar sampling scaling", "minmax / epipolar-sampling"})
-    CHECK(r.output.find(text) != std::string::npos);
+  // One heading per section of the suite, in its order (benchSections()).
+  std::size_t at = 0;
+  for (const char* text : {"\nlimits (",
+                           "write-only",
+                           "fetch-only",
+                           "\nevaluation profile",
+                           "\nbandwidth over",
+                           "\nGPU memory",
+                           "\nlocal lights (",
+                           "\nlocal lights, spot scene",
+                           "\nlocal lights, scaling",
+                           "\nlight textures (",
+                           "\nconstant cost (",
+                           "\nreduced resolution",
+                           "\nmethods side by side (",
+                           "\nsun in view (",
+                           "\npost effects (",
+                           "\nepipolar sampling (",
+                           "minmax / epipolar-sampling",
+                           "\nepipolar sampling scaling",
+                           "\natmosphere tables from scratch",
+                           "\natmosphere per frame",
+                           "\nscaling (GPU pass",
+                           "\nparallelization (Table 1",
+                           "\nhow measured"}) {
+    INFO(text);
+    const std::size_t found = r.output.find(text, at);
+    CHECK(found != std::string::npos);
+    if (found != std::string::npos) at = found;
+  }
+  CHECK(r.output.find("(--quick leaves out the slow marches: reference, brute)") != std::string::npos);
+  CHECK(r.output.find("4 orders on Yusov's table (the reference)") == std::string::npos);
+  CHECK(r.output.find("brute-force march") == std::string::npos);
 }
 
 TEST_CASE("crep bench --section local-lights: the local-light sections alone and the spot scaling rows") {
@@ -280,7 +310,8 @@ TEST_CASE("crep bench --section local-lights: the local-light sections alone and
   CHECK(bad.status == 2);
   CHECK(bad.output.find("local-lights") != std::string::npos);
   const auto help = crep::test::runCrep("bench --help");
-  CHECK(help.output.find("--section local-lights") != std::string::npos);
+  CHECK(help.output.find("--section NAME[,NAME...]") != std::string::npos);
+  CHECK(help.output.find("  local-lights ") != std::string::npos);
 }
 
 TEST_CASE("crep bench --plot: the Table 1/2 rows as an SVG chart beside the paper's") {
@@ -288,7 +319,11 @@ TEST_CASE("crep bench --plot: the Table 1/2 rows as an SVG chart beside the pape
   // testOutputDir() creates the folder: --plot's folder must exist (checked before the suite runs).
   const std::string svg = (crep::test::testOutputDir() / "bench-tables.svg").string();
   std::remove(svg.c_str());
-  const auto r = crep::test::runCrep("bench --size 160x90 --map 128x128 --repeat 1 --plot " + svg);
+  // The two sections whose rows it draws (the whole suite also does; its atmosphere reference table alone
+  // takes minutes).
+  const auto r = crep::test::runCrep("bench --section scaling,parallelization --size 160x90 --map 128x128 "
+                                     "--repeat 1 --plot " +
+                                     svg);
   INFO(r.output);
   REQUIRE(r.status == 0);
   CHECK(r.output.find("Table 1") != std::string::npos);
@@ -307,8 +342,11 @@ TEST_CASE("crep bench --plot: the Table 1/2 rows as an SVG chart beside the pape
     ++bars;
   CHECK(bars >= 12 + 12);
   CHECK(r.output.find("wrote " + svg) != std::string::npos);
-  const auto bad = crep::test::runCrep("bench --quick --plot " + svg);
-  CHECK(bad.status == 2);
-  CHECK(bad.output.find("--plot") != std::string::npos);
+  CHECK(r.output.find("bandwidth over") == std::string::npos); // those sections alone
+  for (const char* args : {"bench --quick --plot ", "bench --section scaling --plot "}) {
+    const auto bad = crep::test::runCrep(args + svg);
+    CHECK(bad.status == 2);
+    CHECK(bad.output.find("--plot") != std::string::npos);
+  }
 }
 #endif
