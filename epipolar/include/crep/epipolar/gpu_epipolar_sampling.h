@@ -1,29 +1,7 @@
-// The GPU stage passes of Yusov's epipolar sampling (Yusov 2012, Sec. 6; the in-scattering refinement
-// criterion of Yusov 2013): sample placement along epipolar lines, refinement, interpolation, unwarping to
-// the (downscaled) screen and upscaling, as OpenGL 4.5 compute shaders in float precision. Their CPU
-// references (double) and the rules are in crep/epipolar/epipolar_sampling.h; the lines themselves are
-// computed there on the CPU each frame (epipolarLines) and uploaded.
-//
-// The pass does not evaluate any scattering: the samples to ray-march and the pixels to correct are
-// produced on the GPU as work lists (crep/scatter/gpu_sample_list.h) that the caller evaluates between the
-// stages with any evaluator (a min/max march, the prefiltered evaluation, ...) through an indirect
-// dispatch, without a read-back.
-//
-// Shaders: passes/epipolar/coordinates.comp, passes/epipolar/refine.comp, passes/epipolar/interpolate.comp,
-// passes/epipolar/unwarp.comp, epipolar_upscale.comp. Resources of every stage: gpu::MarchParams at uniform
-// binding 0 (camera, light, medium: crep/march.glsl), gpu::EpipolarSamplingParams at uniform binding 1, the
-// line table (gpu::EpipolarSamplingLine[]) at storage binding 0, a work list at storage binding 2, the
-// camera depth at texture unit 0 (texelFetch through the pass's own nearest sampler), the pass's own
-// textures at image units 0-3.
-//
-// The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
-// buffers, textures and sampler (RAII); the textures of FrameAttribs are the caller's (non-owning GL
-// names). Every stage leaves program 0; texture units 0-3 with no texture and no sampler; image units 0-3,
-// uniform and storage buffer bindings 0-3 unbound (gl::unbindPassState(4)); and issues
-// gl::passOutputBarrier() plus GL_COMMAND_BARRIER_BIT, so its outputs and lists can be read by texture
-// fetches, image loads, storage reads, indirect dispatches and read-backs. Each stage that consumes an
-// evaluator's output (interpolate, unwarp, upscale) first issues the image / texture-fetch barriers for it.
-// A NaN camera depth is the sky (far plane), as in the other passes.
+// Yusov's epipolar sampling on the GPU (Yusov 2012, Sec. 6; Yusov 2013): the stage passes as OpenGL 4.5
+// compute shaders in float, the samples to evaluate as GPU work lists (crep/scatter/gpu_sample_list.h).
+// Stages, bindings, GL state left: epipolar/README.md, "crep/epipolar/gpu_epipolar_sampling.h".
+// Requires a current OpenGL 4.5 context (never owns one); FrameAttribs' textures are the caller's.
 #pragma once
 
 #include <cstddef>
@@ -42,9 +20,8 @@
 namespace crep {
 namespace gpu {
 
-/// std140 block CrepEpipolarSamplingBlock { CrepEpipolarSamplingParams crep_sampling; } (uniform binding 1)
-/// of the stage passes, declared in glsl/crep/epipolar_sampling.glsl (with the line table). Pixel
-/// coordinates, origin at the bottom-left.
+/// std140 twin of CrepEpipolarSamplingParams (glsl/crep/epipolar_sampling.glsl, uniform binding 1).
+/// Pixel coordinates, origin at the bottom-left.
 struct EpipolarSamplingParams {
   /// xy: epipole e (pixels, full resolution); z: arcBegin, w: arcLength (border pixels)
   glm::vec4 epipole{0.0f};
@@ -71,7 +48,7 @@ EpipolarSamplingParams makeEpipolarSamplingParams(const EpipolarLines& lines,
 
 } // namespace gpu
 
-/// Epipolar sampling on the GPU (see top): one object per camera image size and options.
+/// Epipolar sampling on the GPU: one object per camera image size and options.
 class EpipolarSamplingPass {
 public:
   struct CreateInfo {
@@ -83,19 +60,17 @@ public:
     const Camera* camera = nullptr;
     const DirectionalLight* light = nullptr;
     const Medium* medium = nullptr;
-    /// GL_TEXTURE_2D W x H of depth-buffer values of `camera` (GL_DEPTH_COMPONENT32F, _24,
-    /// GL_DEPTH24_STENCIL8, GL_DEPTH32F_STENCIL8 or GL_R32F), read with texelFetch
+    /// GL_TEXTURE_2D W x H of depth-buffer values of `camera` (a depth format or GL_R32F)
     std::uint32_t cameraDepth = 0;
     std::uint32_t output = 0; ///< GL_RGBA32F W x H: the in-scattering (RGB) and transmittance (A)
   };
-  /// Throws InvalidArgument naming the field ("EpipolarSamplingPass::CreateInfo.width", "...height",
-  /// "EpipolarSamplingPass::CreateInfo.options.samples", ...), GlError beyond the GL limits (texture size,
-  /// compute work group size for options.samples, 65535 texels per list axis) or ShaderError.
+  /// Throws InvalidArgument naming the field ("EpipolarSamplingPass::CreateInfo.width", ...), GlError
+  /// beyond the GL limits (README) or ShaderError. One-time: builds five programs, O(Ns N + W H) memory.
   explicit EpipolarSamplingPass(const CreateInfo& info);
 
-  // The stages of one frame in order; the caller evaluates each list between them.
-  /// Lines on the CPU (epipolarLines), uploaded; the coordinates pass (Ns x N coordinates and U).
-  /// Throws InvalidArgument naming the field of FrameAttribs (null pointers, sizes, formats).
+  // The stages of one frame in order; the caller evaluates each list between them. Per frame.
+  /// Lines on the CPU (epipolarLines), uploaded; the coordinates pass. Throws InvalidArgument naming the
+  /// FrameAttribs field.
   void placeSamples(const FrameAttribs& frame);
   /// The refinement pass (Yusov 2012, Sec. 6.2): sourcesTexture() and sampleList().
   void refine();
@@ -103,21 +78,16 @@ public:
   const gpu::SampleList& sampleList() const noexcept { return sampleList_; }
   /// Interpolates the samples that were not marched, in place in sampleTexture() (Yusov 2012, Sec. 6.5).
   void interpolate();
-  /// Unwarps the samples (Yusov 2012, Sec. 6.6) into FrameAttribs::output (F = 1) or targetTexture()
-  /// (F > 1), the target coordinates into targetCoordinatesTexture(), the pixels to correct into
-  /// correctionList().
+  /// Unwarps (Yusov 2012, Sec. 6.6) into FrameAttribs::output (F = 1) or targetTexture() (F > 1).
   void unwarp(const FrameAttribs& frame);
-  /// coordinates = targetCoordinatesTexture(), output = FrameAttribs::output (F = 1; set by unwarp) or
-  /// targetTexture().
+  /// coordinates = targetCoordinatesTexture(), output = the unwarp's target.
   const gpu::SampleList& correctionList() const noexcept { return correctionList_; }
-  /// F > 1 only (a no-op for F = 1): the bilateral upscale of the target into FrameAttribs::output (Yusov
-  /// 2012, Sec. 6.8), the pixels to correct into upscaleCorrectionList().
+  /// F > 1 only: bilateral upscale into FrameAttribs::output (Yusov 2012, Sec. 6.8).
   void upscale(const FrameAttribs& frame);
-  /// coordinates = a W x H coordinate texture (written at the entries only), output = FrameAttribs::output.
+  /// coordinates = a W x H texture (written at the entries only), output = FrameAttribs::output.
   const gpu::SampleList& upscaleCorrectionList() const noexcept { return upscaleList_; }
 
-  /// All of the above with one evaluator, called with sampleList(), correctionList() and (F > 1)
-  /// upscaleCorrectionList().
+  /// All stages with one evaluator, called with each list in turn.
   void run(const FrameAttribs& frame, const std::function<void(const gpu::SampleList&)>& evaluate);
 
   struct Statistics {

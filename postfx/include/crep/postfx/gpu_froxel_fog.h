@@ -1,26 +1,6 @@
-// The froxel fog on the GPU (Wronski 2014, "Volumetric Fog"): the GL passes of the stages whose CPU
-// references and rules are in crep/postfx/froxel_fog.h (rules 1-5), and the front door FroxelFog that runs
-// them once per frame and owns the volumes.
-//
-//   EsmPass              esm_downsample.comp + esm_blur.comp (x, then y)   rule 1   -> R32F ESM
-//   FroxelLightingPass   froxel_light.comp, one thread per cell            rule 2   -> lighting volume
-//   FroxelAccumulatePass froxel_accumulate.comp, one thread per column     rule 3   (in place) -> integrated
-//   FroxelTemporalPass   froxel_temporal.comp, one thread per cell         rule 5   -> blended volume
-//   FroxelApplyPass      froxel_apply.comp, one thread per pixel           rule 4   -> RGBA32F image
-//
-// Volumes are GL_TEXTURE_3D of the grid's size in GL_RGBA16F (default: 8 bytes per cell, 7.4 MB at 160 x 90
-// x 64) or GL_RGBA32F (16 bytes per cell, for tests against the CPU references). An integrated volume holds
-// at texel (x, y, z), for the cell's sample point, RGB = the in-scattered radiance from the camera to that
-// point along the pixel ray through it, A = the grey transmittance exp(-sbar d) to it: the format shared
-// with the prefiltered fill of crep::Scattering (Scattering::FrameAttribs::froxels). Float precision.
-//
-// Every pass requires a current OpenGL 4.5 context and never creates or owns one; it owns its programs,
-// buffers and samplers (RAII); the textures of FrameAttribs are the caller's. Each leaves program 0, texture
-// units, samplers, image units and uniform buffer bindings 0-1 unbound (gl::unbindPassState(2)) and issues
-// gl::passOutputBarrier(). NaN inputs never crash a pass: a NaN shadow-map texel counts as empty (lit), a
-// NaN camera depth as the sky, non-finite lighting is stored as 0 and the temporal pass never lets a
-// non-finite value through (rule 5). Sizes are the textures' own, checked against the grid; a grid beyond
-// GL_MAX_3D_TEXTURE_SIZE is an InvalidArgument naming the grid field.
+// The froxel fog on the GPU (Wronski 2014, "Volumetric Fog"): the GL passes of froxel_fog.h's rules 1-5
+// and the front door FroxelFog. Every pass requires a current OpenGL 4.5 context (never owns one). Volume
+// format, GL state left, NaN inputs: postfx/README.md, "crep/postfx/gpu_froxel_fog.h".
 #pragma once
 
 #include <array>
@@ -79,12 +59,10 @@ FroxelCamera froxelCamera(const Camera& camera);
 
 /// Throws InvalidArgument naming `owner`.format unless `format` is GL_RGBA16F or GL_RGBA32F.
 void validateFroxelFormat(std::uint32_t format, const char* owner);
-/// A GL_TEXTURE_3D of the grid's size in `format`, after checking the grid (validate) and
-/// GL_MAX_3D_TEXTURE_SIZE (InvalidArgument naming `owner`.grid.width / height / depth).
+/// A GL_TEXTURE_3D of the grid's size in `format` (InvalidArgument naming `owner`.grid.width / ...).
 gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, const char* owner);
 
-/// Rule 1 on the GPU: the ESM of a standard shadow map (downsample, then the separable box blur). Owns
-/// its R32F textures (reallocated when the map's size changes).
+/// Rule 1 on the GPU: the ESM of a standard shadow map. Owns two R32F textures. Per frame, O(map texels).
 class EsmPass {
 public:
   struct CreateInfo {
@@ -205,17 +183,9 @@ private:
   gl::Handle program_, params_, nearest_, linear_;
 };
 
-/// The froxel fog of one view (Wronski 2014): one run() per frame. Esm mode: ESM from the standard shadow
-/// map, lighting, accumulation; Prefiltered mode: the integrated volume filled by crep::Scattering (Klehm et
-/// al. 2014's prefiltered scattering at every sample point; Scattering::FrameAttribs::froxels with volume =
-/// currentVolume(), grid = CreateInfo::grid, jitter = jitter(frameIndex)). Both then: the temporal pass
-/// (when historyWeight > 0) and the per-pixel apply (when an output is given). The blended volume stays
-/// readable by the engine (volume()) for forward-shaded transparent surfaces and particles: composite
-/// surface * A + RGB at the surface's own (u, v, w).
-///
-/// Memory (memoryBytes()): the current volume, plus two ping-pong history volumes when historyWeight > 0,
-/// at 8 (RGBA16F) or 16 (RGBA32F) bytes per cell, plus the ESM (two R32F textures of ceil(W/f) x ceil(H/f)).
-/// Default 160 x 90 x 64 in RGBA16F with temporal: 3 x 7,372,800 = 22,118,400 bytes plus the ESM.
+/// The froxel fog of one view (Wronski 2014), one run() per frame: Esm mode (ESM, lighting, accumulation)
+/// or Prefiltered mode (filled by crep::Scattering, Klehm et al. 2014); then temporal and apply (README).
+/// Memory: 1 volume, 3 with temporal (8 or 16 bytes per cell), plus the ESM. Per frame, O(cells + pixels).
 class FroxelFog {
 public:
   enum class Mode { Esm, Prefiltered };
@@ -232,7 +202,7 @@ public:
     glm::dvec3 ambient{0.0}; ///< isotropic ambient radiance per channel, >= 0 (default 0)
     TemporalOptions temporal;
     std::uint32_t format = 0x881A; ///< GL_RGBA16F (default) or GL_RGBA32F
-    /// Per-stage GPU times with GL_TIME_ELAPSED queries (waits for each stage: a stall, for tools only).
+    /// Per-stage GPU times with GL_TIME_ELAPSED queries (a stall per stage: tools only).
     bool timings = false;
   };
   struct FrameAttribs {
@@ -255,19 +225,14 @@ public:
   /// Throws InvalidArgument naming "FroxelFog::FrameAttribs.<field>".
   void run(const FrameAttribs& frame);
 
-  /// The integrated volume's sample offset of frame `frameIndex` in cells (what the fill of Mode::Prefiltered
-  /// is given): with temporal jitter froxelJitter(frameIndex) across the image and 0 in depth (the end
-  /// points of the integrals stay on the slice centres: jittering them in depth adds noise, the integrated
-  /// value grows across a slice), else 0.
+  /// The integrated volume's sample offset of frame `frameIndex` in cells (for Mode::Prefiltered's fill):
+  /// froxelJitter(frameIndex) across the image, 0 in depth; 0 without temporal jitter.
   glm::dvec3 jitter(int frameIndex) const;
-  /// Where Mode::Esm lights each cell: froxelJitter(frameIndex) in all three axes with temporal jitter (the
-  /// lighting is anti-aliased in depth too; the accumulation treats each cell's lighting as constant over
-  /// the cell and integrates to the cell centres' depth), else 0.
+  /// Where Mode::Esm lights each cell: froxelJitter(frameIndex) in all three axes, or 0 (README).
   glm::dvec3 lightingJitter(int frameIndex) const;
   /// The volume the lighting and accumulation (or crep::Scattering's fill) write: GL_TEXTURE_3D.
   std::uint32_t currentVolume() const noexcept { return current_.get(); }
-  /// The integrated volume of the last run() (the blended one with temporal), for the engine's own lookups:
-  /// sample offset 0 with temporal, jitter(frameIndex) = 0 without.
+  /// The integrated volume of the last run() (blended with temporal), sample offset 0, for the engine.
   std::uint32_t volume() const noexcept { return volume_; }
   std::size_t memoryBytes() const noexcept;
   /// GPU milliseconds of the last run's stages (CreateInfo::timings; 0 for stages not run).

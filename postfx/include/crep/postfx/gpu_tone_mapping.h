@@ -1,25 +1,6 @@
-// The GL tone-mapping pass: auto exposure from the log-average luminance, temporal light adaptation and
-// the operators of crep/postfx/tone_mapping.h (its rule and CPU reference: luminanceStats,
-// LightAdaptation, toneMapImage), in float. Shaders: passes/postfx/luminance_reduce.comp,
-// passes/postfx/luminance_adapt.comp, passes/postfx/tone_map.comp, the curves in crep/tone_mapping.glsl
-// (public).
-//
-// One run() per frame:
-//   1. (autoExposure only) luminance_reduce.comp: one partial sum of log(delta + Y) and one count of
-//      finite pixels per 64 x 64 block of the input (16 x 16 workgroups, 4 x 4 pixels per invocation,
-//      shared-memory tree reduction);
-//   2. (autoExposure only) luminance_adapt.comp: one workgroup adds the partials, takes the log-average
-//      and steps the adapted luminance and exposure scale in the pass's state buffer (gpu::ToneMapState);
-//   3. tone_map.comp: every pixel through the operator with that scale (or the manual exposure).
-// GPU choice: a two-pass reduction into a storage buffer rather than Yusov's mip chain of a 64 x 64
-// luminance image: it reads the full-resolution input once (no resampling, so it is the exact CPU sum up
-// to float order) and its cost is one pass over the input plus a dispatch of one workgroup. The state
-// never leaves the GPU: auto exposure costs no readback (readState() exists for tests and debugging).
-//
-// The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
-// buffers and sampler (RAII); FrameAttribs' textures are the caller's (non-owning GL names). It leaves
-// program 0, texture unit 0 with no texture and no sampler, image unit 0, uniform buffer binding 0 and
-// storage buffer bindings 0-1 unbound (gl::unbindPassState(2)) and issues gl::passOutputBarrier().
+// ToneMapPass: auto exposure from a GPU log-average reduction, light adaptation kept on the GPU, and the
+// operators of tone_mapping.h (its CPU reference), in float. Requires a current OpenGL 4.5 context (never
+// owns one). Stages, GL state left: postfx/README.md, "crep/postfx/gpu_tone_mapping.h".
 #pragma once
 
 #include <cstdint>
@@ -33,7 +14,7 @@
 namespace crep {
 namespace gpu {
 
-/// std140 block CrepToneMapBlock { CrepToneMapParams crep_toneMap; } (glsl/crep/tone_mapping.glsl).
+/// std140 twin of CrepToneMapParams (glsl/crep/tone_mapping.glsl).
 struct ToneMapParams {
   glm::vec4 curve{0.0f};      ///< x middleGrey, y whitePoint, z saturation, w manual exposure
   glm::vec4 adaptation{0.0f}; ///< x 1 - exp(-dt / tau) (double on the CPU, then float); yzw 0
@@ -49,8 +30,7 @@ struct LuminancePartial {
 };
 static_assert(sizeof(LuminancePartial) == 8, "std430 CrepLuminancePartial");
 
-/// std430 block of the adaptation state (CrepToneMapState), ToneMapPass::stateBuffer(); an engine may
-/// bind it in its own shaders (e.g. a bloom threshold relative to the exposure).
+/// std430 twin of CrepToneMapState: ToneMapPass::stateBuffer(), bindable by an engine's shaders.
 struct ToneMapState {
   float adaptedLuminance = 0.0f; ///< La, the luminance the exposure follows
   float targetLuminance = 0.0f;  ///< the last frame's log-average (La when it had no finite pixel)
@@ -70,8 +50,7 @@ public:
   struct CreateInfo {
     /// Operator and knobs (validated: InvalidArgument naming "ToneMapPass::CreateInfo.options.<field>").
     ToneMapOptions options;
-    /// Write encoded values (crep_srgbEncode, IEC 61966-2-1; for an 8-bit texture shown as is) instead of
-    /// linear.
+    /// Write values encoded by crep_srgbEncode (IEC 61966-2-1) instead of linear.
     bool encodeSrgb = false;
   };
   struct FrameAttribs {
@@ -81,24 +60,21 @@ public:
     std::uint32_t output = 0;
     /// Seconds since the previous frame (finite, >= 0): the adaptation step.
     double dt = 0.0;
-    /// Forget the adaptation state: the adapted luminance jumps to this frame's log-average (e.g. a
-    /// camera cut). The first frame with a finite pixel after construction always starts this way.
+    /// Forget the adaptation state: jump to this frame's log-average (e.g. a camera cut).
     bool resetAdaptation = false;
   };
 
   explicit ToneMapPass(const CreateInfo& info);
-  /// Tone-maps one frame (steps 1-3 of the file comment; 1-2 only with autoExposure). Throws
-  /// InvalidArgument naming the FrameAttribs field ("ToneMapPass::FrameAttribs.input", ".output", ".dt").
+  /// Tone-maps one frame. Throws InvalidArgument naming the FrameAttribs field. Per frame, O(pixels).
   void run(const FrameAttribs& frame);
 
-  /// Changes the operator and knobs between frames (validated as in the constructor, naming
-  /// "ToneMapPass::options"); the adaptation state is kept. A new operator's program is built on first use.
+  /// Changes the knobs between frames (InvalidArgument naming "ToneMapPass::options"); state kept.
   void setOptions(const ToneMapOptions& options);
   const ToneMapOptions& options() const { return info_.options; }
 
   /// The GL storage buffer holding gpu::ToneMapState (owned by the pass).
   std::uint32_t stateBuffer() const { return state_.get(); }
-  /// Reads the state back (glGetNamedBufferSubData: a pipeline stall; for tests and debugging).
+  /// Reads the state back (a pipeline stall; for tests and debugging).
   gpu::ToneMapState readState() const;
 
 private:

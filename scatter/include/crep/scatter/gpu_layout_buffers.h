@@ -1,6 +1,5 @@
 // Upload of any rectified layout's GPU description (crep/rectify/gpu_layout.h) into GL buffers, for the
-// passes that map pixels into a rectified map on the GPU (the marches and resampling of epipolar/, the
-// evaluation of prefilter/). Requires a current OpenGL 4.5 context; owns its two buffers (RAII).
+// passes that map pixels into a rectified map. Requires a current OpenGL 4.5 context; owns its buffers.
 #pragma once
 
 #include <cstdint>
@@ -15,15 +14,12 @@ GpuLayoutData requireGpuLayout(const RectifiedLayout& layout, const char* parame
 
 class LayoutBuffers {
 public:
-  /// Uploads `layout`'s block and row table for a map of `mapHeight` rows. Throws InvalidArgument naming
-  /// `parameter` when the layout has no GPU mapping, has more than kMaxLayoutRegions regions, or needs a
-  /// different map height (an EpipolarLayout: one row per slice). Returns the layout's kind (the value of
-  /// CREP_LAYOUT for the shader).
+  /// Uploads `layout`'s block and row table for a map of `mapHeight` rows; returns its kind (CREP_LAYOUT).
+  /// Throws InvalidArgument naming `parameter` (README). Per frame, O(rows).
   LayoutKind upload(const RectifiedLayout& layout, int mapHeight, const char* parameter = "layout");
   /// The same for a description already made with requireGpuLayout() (a layout is serialized once per run).
   LayoutKind upload(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
-  /// Binds the block at uniform buffer `blockBinding` and, for layouts with a row table, the table at
-  /// storage buffer `rowsBinding` (the defaults of glsl/crep/layout.glsl are 1 and 1).
+  /// Binds the block at uniform buffer `blockBinding` and any row table at storage buffer `rowsBinding`.
   void bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const;
   LayoutKind kind() const noexcept { return kind_; }
 

@@ -1,11 +1,6 @@
-// Light textures on the GPU (crep/scatter/light_texture.h has the rule; Klehm et al. 2014, Sec. 3.2
-// coloured light textures): the texture as the passes take it (GpuLightTexture, the caller's GL texture and
-// its projection) and LightColorMapPass, which makes the colour map of a rectified map (one RGB colour per
-// texel, the texture at the texel's light ray: crep::lightColorMap's rule in float) for the prefilter
-// (PrefilterPass::FrameAttribs::lightColors) and the rectified marches.
-//
-// GL state: LightColorMapPass::run binds texture unit 0 (+ sampler), image unit 0, uniform buffer 0 and,
-// for the layout, uniform buffer 1 and storage buffer 1 (gpu::LayoutBuffers), and unbinds them (0).
+// Light textures on the GPU (Klehm et al. 2014, Sec. 3.2 coloured light textures; the rule is
+// light_texture.h's): GpuLightTexture and LightColorMapPass, the colour map of a rectified map.
+// Requires a current OpenGL 4.5 context. GL state: scatter/README.md, "crep/scatter/gpu_light_texture.h".
 #pragma once
 
 #include <cstddef>
@@ -24,8 +19,7 @@ namespace crep {
 
 namespace gpu {
 
-/// std140 block CrepLightTextureBlock { CrepLightTextureParams ...; } of glsl/crep/light_texture.glsl (the
-/// colour map pass and the textured world march).
+/// std140 twin of CrepLightTextureParams (glsl/crep/light_texture.glsl).
 struct LightTextureParams {
   glm::mat4 textureClipFromWorld{1.0f}; ///< LightTexture::textureClipFromWorld
   glm::ivec4 size{0};                   ///< xy: texture size (texels); zw: colour map size (colour map pass)
@@ -37,27 +31,22 @@ static_assert(sizeof(LightTextureParams) == 96, "std140 CrepLightTextureParams")
 
 /// A light texture on the GPU (crep::LightTexture's rule): non-owning.
 struct GpuLightTexture {
-  /// The caller's GL_TEXTURE_2D: linear RGB in channels r, g, b, any colour format read as float (e.g.
-  /// GL_RGBA8, GL_RGBA16F, GL_RGBA32F), values >= 0; level 0 is read with texelFetch (its own filtering
-  /// and wrap modes do not matter: the shader interpolates bilinearly with clamp to edge).
+  /// The caller's GL_TEXTURE_2D: linear RGB >= 0, any colour format read as float; level 0 (README).
   std::uint32_t texture = 0;
   glm::dmat4 textureClipFromWorld{1.0}; ///< LightTexture::textureClipFromWorld (along the light's rays)
 };
 
 namespace gpu {
-/// Checks a GpuLightTexture for `light`: the texture is a GL_TEXTURE_2D (InvalidArgument naming
-/// `<field>.texture`), the projection finite and along the light's rays (`<field>.textureClipFromWorld`,
-/// validateLightProjection). Returns the texture's level 0.
+/// Throws InvalidArgument naming `<field>.texture` (not a GL_TEXTURE_2D) or `<field>.textureClipFromWorld`
+/// (validateLightProjection). Returns the texture's level 0.
 gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
                                          const LocalLight* localLight, std::string_view field);
-/// The block of `texture` (of level 0 `level`) for a colour map of mapWidth x mapHeight; lightPosition
-/// from `localLight` (or w = 0).
+/// The block of `texture` (level 0 `level`) for a mapWidth x mapHeight colour map; w = 0 without localLight.
 LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gl::TextureLevel& level,
                                           int mapWidth, int mapHeight, const LocalLight* localLight);
 } // namespace gpu
 
-/// The colour map pass (crep::lightColorMap on the GPU, glsl/passes/scatter/light_colors.comp): a mapWidth x
-/// mapHeight GL_RGBA32F texture it owns (RGB the colour of each texel's light ray, A = 1).
+/// crep::lightColorMap on the GPU into a mapWidth x mapHeight GL_RGBA32F texture it owns (A = 1).
 class LightColorMapPass {
 public:
   struct CreateInfo {
@@ -65,21 +54,18 @@ public:
     int mapHeight = 1024; ///< H
   };
   struct FrameAttribs {
-    /// The map's layout: a ProjectiveLayout (directional or local light) or any layout with a GPU mapping
-    /// (the epipolar one, for the sun). Not owned.
+    /// The map's layout: any layout with a GPU mapping. Not owned.
     const RectifiedLayout* layout = nullptr;
     GpuLightTexture lightTexture; ///< the texture and its projection
-    /// The light: exactly one of `light` (directional) and `localLight` (a spot, or one point-light face;
-    /// its rectification's ProjectiveLayout).
+    /// Exactly one of `light` and `localLight` (a spot or point-light face, on a ProjectiveLayout).
     const DirectionalLight* light = nullptr;
     const LocalLight* localLight = nullptr;
   };
 
   /// Throws InvalidArgument ("LightColorMapPass::CreateInfo.mapWidth" / ".mapHeight") for sizes <= 0,
-  /// GlError beyond GL_MAX_TEXTURE_SIZE; allocates the colour map.
+  /// GlError beyond GL_MAX_TEXTURE_SIZE. One-time: 16 bytes per texel.
   explicit LightColorMapPass(const CreateInfo& info);
-  /// Writes colorMapTexture(). Throws InvalidArgument naming the FrameAttribs field (null layout, both or
-  /// neither light, a local light without a ProjectiveLayout, the texture, the projection).
+  /// Writes colorMapTexture(). Throws InvalidArgument naming the FrameAttribs field. Per frame, O(W H).
   void run(const FrameAttribs& frame);
 
   /// GL_TEXTURE_2D, GL_RGBA32F, mapWidth x mapHeight (nearest filtering, clamp to edge).

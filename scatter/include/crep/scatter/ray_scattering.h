@@ -1,28 +1,6 @@
-// The in-scattering of one camera view ray over sections of it, for every light type (Klehm et al. 2014,
-// Eq. 1; Sec. 3.2 "Local Lights" and "Angular-dependency for Sources"): what every method multiplies by
-// its visibility. For a view ray x(t) = o + t v (v unit, from the camera) and a lit section [ta, tb]:
-//
-//   S(ta, tb) = integral_ta^tb exp(-sigma t) sigma_s p(theta(t)) E(t) dt        (per RGB channel)
-//
-// with theta the scattering angle (cos theta = dot(light travel direction at x, -v)) and E the light
-// reaching x without occluders:
-//   directional  E = irradiance                       -> S = C (exp(-sigma ta) - exp(-sigma tb)) / sigma
-//                                                        (crep/scatter/ray.h; closed form)
-//   spot         E = I s(a) exp(-sigma d) / d^2        d = |x - L|, a the angle of x - L to the axis,
-//                                                        s the spot falloff (crep::spotFalloff)
-//   point face   E = I exp(-sigma d) / d^2             on the part of the ray whose direction from the
-//                                                        light lies in the face's sector, else 0
-// d is clamped below at the light's near plane (the light is a ball of that radius: a ray through the
-// light's position stays finite, and nothing nearer than the near plane is in its shadow map).
-//
-// Local lights have no closed form (the angular falloff, the phase function and exp(-sigma d) vary along
-// the ray). S is integrated in the angle gamma of x seen from the light, measured from the point of the
-// ray nearest the light (t = t0 + h tan gamma, d = h / cos gamma, dt / d^2 = dgamma / h): the 1 / d^2 peak
-// becomes a constant, the phase function is a function of gamma alone. Breakpoints at the near-ball, the
-// cone angles (inner, outer) and the sector planes split the range into smooth pieces; each piece is cut
-// into parts of at most gammaStep radians (the phase peak's width (1 - |g|) / 2, at most pi / 32) and
-// integrated with 8-point Gauss-Legendre. Relative error below 1e-9 on the tests' rays (against an
-// independent adaptive quadrature in t).
+// The in-scattering S(ta, tb) of one camera view ray for every light type (Klehm et al. 2014, Eq. 1;
+// Sec. 3.2 "Local Lights" and "Angular-dependency for Sources"). The integrand per light type and the
+// quadrature of local lights: scatter/README.md, "crep/scatter/ray_scattering.h".
 #pragma once
 
 #include <vector>
@@ -34,10 +12,8 @@
 
 namespace crep {
 
-/// Which light-side factors a local light's prefilter weights carry along a region's reference ray (Klehm
-/// et al. 2014, Sec. 3.2: "each visibility function is simply weighted by the light's contribution"). The
-/// evaluation restores each ray's exact in-scattering per region in every mode; the mode only decides how
-/// the visibility inside a region is averaged.
+/// Which light-side factors a local light's prefilter weights carry along a region's reference ray
+/// (Klehm et al. 2014, Sec. 3.2): changes only how the visibility inside a region is averaged.
 enum class LocalLightWeights {
   Full,    ///< phase x angular falloff x exp(-s d) / d^2 of the reference ray
   Angular, ///< the angular falloff (and the point face's sector) only
@@ -61,13 +37,12 @@ struct LocalLight {
   /// Radiant intensity toward unit direction w (falloff and sector applied).
   glm::dvec3 intensityToward(const glm::dvec3& w) const;
   /// The grey light-side factor of the integrand at `point` on a view ray of unit direction `v` (the
-  /// prefilter's weights, Klehm et al. 2014, Sec. 3.2): mean_c(sigma_s p(theta))_c * mean_c(I_c falloff) *
-  /// exp(-s d) / d^2 with s the grey extinction and d clamped below at the near plane.
+  /// prefilter's weights, Klehm et al. 2014, Sec. 3.2; README).
   double weightFactor(const Medium& medium, double greyExtinction, const glm::dvec3& point,
                       const glm::dvec3& v, LocalLightWeights weights = LocalLightWeights::Full) const;
 };
 
-/// S(ta, tb) of one view ray (see top).
+/// S(ta, tb) of one view ray: closed form (directional), 8-point Gauss-Legendre per part (local lights).
 class RayScattering {
 public:
   RayScattering(const DirectionalLight& light, const Medium& medium, const glm::dvec3& origin,
@@ -79,15 +54,10 @@ public:
   glm::dvec3 segment(double ta, double tb) const;
   /// The integrand exp(-sigma t) sigma_s p(theta(t)) E(t) at t (per channel).
   glm::dvec3 density(double t) const;
-  /// The sorted cuts of [ta, tb] into the pieces segment() integrates, ends included: the near ball's,
-  /// the cone angles' (inner, outer) and the sector planes' crossings inside it ({ta, tb} for a
-  /// directional light, empty when tb <= ta).
+  /// The sorted cuts of [ta, tb] into the pieces segment() integrates, ends included (empty if tb <= ta).
   std::vector<double> breakpoints(double ta, double tb) const;
-  /// The share of S(ta, tEnd) that [ta, tb] holds (ta <= tb <= tEnd), per channel, by Simpson's rule in
-  /// gamma on each side of tb over the part of [ta, tEnd] the light reaches (its outer cone or sector; all
-  /// of it for a ray through the near ball): 5 integrand values. Exact where the integrand in gamma is a
-  /// cubic; 1 when the light reaches the part only before tb. Local lights only (1 for a directional light).
-  /// The rule of the GPU evaluation's last region with a section table (crep_localPartialShare).
+  /// The share of S(ta, tEnd) that [ta, tb] holds, per channel, by Simpson's rule in gamma (5 integrand
+  /// values; README); 1 for a directional light. The rule of crep_localPartialShare.
   glm::dvec3 partialShare(double ta, double tb, double tEnd) const;
 
 private:

@@ -1,27 +1,7 @@
-// Marches of camera view rays along the rows of a rectified map (Klehm et al. 2014, Sec. 2.2: in a
-// rectified map every view ray is one texel row at constant depth), on the rays and with the output of
-// crep/scatter/ray.h. The brute-force march here is the reference every rectified method is measured
-// against on the same map (the prefiltered evaluation, the min/max tree march of epipolar/); the
-// scaffolding (marchRectifiedRows) is shared with the tree march so both integrate identical sections.
-//
-// ---------------------------------------------------------------------------------------------------
-// Rule. P = layout.toRectified(camera.position() + s v) gives the ray's row, its depth z_r (clamped to
-// [0, 1]: 1 is "behind every stored occluder") and the region k and column u of its end. Texel row
-// j = clamp(floor(row H), 0, H - 1); the ray crosses texels 0..e of that row, e = k n + clamp(ceil(u n) - 1,
-// 0, n - 1) (K regions of n = W / K texels). Texel i is lit iff depth(i, j) >= z_r (the GL_LESS shadow
-// test). Its section of the ray is [T(i), T(i + 1)] with the ray's own world distances (the layout's
-// DistanceProfile, exact):
-//   T(0) = 0 (region 0 starts at the camera: the part in front of the map takes the first texel's test),
-//   T(e + 1) = s,
-//   T(r n) = clamp(layout.rayDistance(row, z_r, r / K), T((r - 1) n), s) at region boundaries,
-//   T(r n + q) = clamp(layout.rayProfile(row, z_r, r)(q / n), T(r n), T((r + 1) n)) inside region r.
-// With the near-plane correction every section is clipped to [t_n, s] (texels in front of the near plane
-// contribute nothing). Pixels whose end point the layout cannot map (toRectified throws) are unshadowed.
-// Steps (MarchResult::steps) of the brute-force march: texels visited (e + 1); unmapped pixels: 0.
-// Light textures (crep/scatter/light_texture.h): with a colour map (lightColorMap(): one RGB colour per
-// texel, the texture at the texel's light ray) every lit section is split at the texel boundaries T(i) and
-// each part [max(ta, T(i)), min(tb, T(i + 1))] of positive length is integrated times the colour of texel
-// (i, j). Unmapped pixels stay unshadowed and uncoloured.
+// Marches of camera view rays along the rows of a rectified map (Klehm et al. 2014, Sec. 2.2): the
+// brute-force march, the reference of every rectified method on the same map, and its scaffolding, shared
+// with epipolar/'s tree march. The rule (rows, T(i), light textures): scatter/README.md,
+// "crep/scatter/rectified_march.h".
 #pragma once
 
 #include <algorithm>
@@ -47,7 +27,7 @@
 
 namespace crep {
 
-/// One pixel's ray mapped onto its row (rule at the top).
+/// One pixel's ray mapped onto its row.
 struct RowRay {
   double row = 0.0;   ///< normalized row of the ray
   double depth = 0.0; ///< z_r, clamped to [0, 1]
@@ -59,7 +39,7 @@ struct RowRay {
 bool mapRowRay(const RectifiedLayout& layout, const glm::dvec3& origin, const PixelRay& ray, int width,
                int height, RowRay& out);
 
-/// T(i) of the rule at the top: the ray's own world distance at texel boundary i.
+/// T(i): the ray's own world distance at texel boundary i.
 class RowDistances {
 public:
   RowDistances(const RectifiedLayout& layout, const RowRay& ray, int width, double surface);
@@ -72,14 +52,8 @@ private:
   std::vector<DistanceProfile> profiles_;
 };
 
-/// The scaffolding of the rectified marches over any ray source (no validation: the callers below
-/// validate first): `count` rays, ray i = rayOf(i) stored at texel (i % width, i / width) of the w x h
-/// result (count = width * height), in chunks of `chunk` consecutive rays run in parallel. Maps every ray
-/// and calls walk(const RowRay&, const RowDistances&, litSection, int& steps), where litSection(ta, tb) adds
-/// the lit section [ta, tb] (clipped to the integration range). Unmapped rays are unshadowed. `Light` is
-/// DirectionalLight (sections integrated as transmittance integrals, times C) or LocalLight (sections
-/// integrated by RayScattering: the same integrand as every other method, exactly per section). With
-/// `lightColors` (a colour map of the map's size) each lit section is coloured per texel (rule at the top).
+/// The scaffolding over any ray source (no validation): ray i = rayOf(i) at texel (i % width, i / width),
+/// walk(RowRay, RowDistances, litSection, steps) per ray, chunks of `chunk` rays in parallel (README).
 template <class Light, class RayOf, class Walk>
 MarchResult marchRectifiedRays(const RectifiedMap& map, int width, int height, int chunk,
                                const Camera& camera, const Light& light, const Medium& medium,
@@ -152,10 +126,8 @@ MarchResult marchRectifiedRays(const RectifiedMap& map, int width, int height, i
   return out;
 }
 
-/// The per-pixel scaffolding of the rectified marches: validates the inputs (map, "cameraDepth",
-/// options), then marchRectifiedRays on every pixel's ray (pixelRay), one image row per chunk.
-/// With `lightColors` (a colour map of the map's size, validated: InvalidArgument "lightColors") each lit
-/// section is coloured per texel (rule at the top).
+/// Validates the map, "cameraDepth", the options and "lightColors", then marchRectifiedRays on every
+/// pixel's ray (pixelRay), one image row per chunk.
 template <class Light, class Walk>
 MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                                const Light& light, const Medium& medium, const MarchOptions& options,
@@ -174,12 +146,8 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
       walk);
 }
 
-/// The same scaffolding at screen samples (Yusov 2012, Sec. 6.4: the marched samples of epipolar
-/// sampling): validates the map, the samples (validateScreenSamples: "samples[i]", "width", "height"),
-/// the options and `lightColors`, then marches ray i = screenRay(camera, width, height, samples[i]) into
-/// texel (i, 0) of a samples.size() x 1 result (an empty MarchResult for no samples; at most
-/// Image::kMaxDimension samples per call, else InvalidArgument "samples"). At pixel centres
-/// with the pixels' depth-buffer values it gives marchRectifiedRows' values bit for bit.
+/// The same at screen samples (Yusov 2012, Sec. 6.4): ray i = screenRay at samples[i] into texel (i, 0);
+/// at most Image::kMaxDimension samples (InvalidArgument "samples"); bit for bit at pixel centres.
 template <class Light, class Walk>
 MarchResult marchRectifiedSamples(const RectifiedMap& map, std::span<const ScreenSample> samples, int width,
                                   int height, const Camera& camera, const Light& light, const Medium& medium,
@@ -210,17 +178,15 @@ MarchResult marchRectifiedRows(const RectifiedMap& map, const Image& cameraDepth
   return marchRectifiedRows(map, cameraDepth, camera, light, medium, options, nullptr, walk);
 }
 
-/// The brute-force march (rule at the top), texel by texel: the reference of every method on the same map.
-/// Throws InvalidArgument for an invalid map (validate(RectifiedMap)), camera depth ("cameraDepth") or
-/// options.
+/// The brute-force march, texel by texel: the reference of every method on the same map. Throws
+/// InvalidArgument for the map, "cameraDepth" or the options. O(pixels x texels crossed).
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const DirectionalLight& light, const Medium& medium,
                             const MarchOptions& options = {});
 /// The same for a local light (a spot, or one point-light face, on a map of its rectification).
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const LocalLight& light, const Medium& medium, const MarchOptions& options = {});
-/// The brute-force march with a light texture's colour map (lightColorMap() of the map's layout and size;
-/// rule at the top), for the directional light ...
+/// With a light texture's colour map (lightColorMap() of the map's layout and size), directional ...
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const DirectionalLight& light, const Medium& medium, const Image& lightColors,
                             const MarchOptions& options = {});
@@ -228,10 +194,8 @@ MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, c
 MarchResult bruteForceMarch(const RectifiedMap& map, const Image& cameraDepth, const Camera& camera,
                             const LocalLight& light, const Medium& medium, const Image& lightColors,
                             const MarchOptions& options = {});
-/// The brute-force march of the rays through screen samples of a width x height camera image
-/// (marchRectifiedSamples: ray i = screenRay at samples[i]; result images samples.size() x 1, empty for no
-/// samples): the reference of epipolar sampling's marched samples (Yusov 2012, Sec. 6.4). Throws
-/// InvalidArgument for the map, "samples[i]", "width" / "height" or the options.
+/// At screen samples (Yusov 2012, Sec. 6.4; results samples.size() x 1). Throws InvalidArgument for the
+/// map, "samples[i]", "width" / "height" or the options.
 MarchResult bruteForceMarch(const RectifiedMap& map, std::span<const ScreenSample> samples, int width,
                             int height, const Camera& camera, const DirectionalLight& light,
                             const Medium& medium, const MarchOptions& options = {});

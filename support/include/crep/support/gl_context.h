@@ -1,6 +1,5 @@
-// Headless OpenGL 4.5 core context through EGL's surfaceless platform (Mesa), for the crep tool,
-// the tests and the benchmarks. Library passes never create or own a context: an engine calls them
-// with its own context current.
+// Headless OpenGL 4.5 core context through EGL's surfaceless platform (Mesa), for the crep tool, the tests
+// and the benchmarks; library passes never create one. Lifetime rules: support/README.md.
 #pragma once
 
 #include <cstdint>
@@ -22,22 +21,15 @@ struct GlContextOptions {
   int minorVersion = 5;
   /// Debug context with synchronous KHR_debug output; messages go to `debugCallback`.
   bool debug = false;
-  /// Called for each debug message (debug contexts only), synchronously inside the GL call that
-  /// caused it; must not throw (an exception is caught and reported on stderr). Default: GL errors
-  /// are printed to stderr.
+  /// Called synchronously for each debug message (debug contexts); must not throw. Default: errors to stderr.
   std::function<void(const GlDebugMessage&)> debugCallback;
 };
 
-/// Owns an EGL display connection and a surfaceless OpenGL context, current on the creating thread
-/// for its whole lifetime. Not copyable, not movable. A GlContext created while another context is
-/// current makes that one current again when it is destroyed; the EGL display is terminated when
-/// the last GlContext of the process is destroyed. Terminating the display unloads Mesa's driver;
-/// under LeakSanitizer the driver's own allocations are then reported from "<unknown module>", so
-/// sanitized programs keep one context for the process lifetime (as the crep tool and the tests do).
+/// An EGL display and a surfaceless context, current on the creating thread for its whole lifetime; not
+/// copyable or movable. What destruction restores, and LeakSanitizer: README.
 class GlContext {
 public:
-  /// Throws GlUnavailable with a message naming the failing step (no EGL, no surfaceless platform,
-  /// no OpenGL 4.5 core context).
+  /// Throws GlUnavailable naming the failing step. One-time: loads the driver.
   explicit GlContext(const GlContextOptions& options = {});
   ~GlContext();
   GlContext(const GlContext&) = delete;

@@ -1,17 +1,6 @@
-// The one rule for every file the support writers (writeExr, writeExrLayers, writePng, writeTextFile) and
-// the crep tool write (docs/TOOL.md, "Outputs"):
-//
-//   1. A path that is a symbolic link (a chain of them) is followed to its final target: the target is
-//      replaced and the links stay. A dangling link creates its target.
-//   2. A path (or final target) that exists and is not a regular file is refused with IoError naming it:
-//      a directory, a character or block device (/dev/null), a FIFO, a socket. Nothing is written.
-//   3. The content is written to a temporary file in the target's directory ("<target>.crep-XXXXXX.partial",
-//      created exclusively; an existing target's permission bits are kept, a new file gets 0666 & ~umask)
-//      and renamed over the target: a reader never sees a partial file, and a failure (full disk, I/O
-//      error, exception) removes the temporary and leaves the target as it was.
-//
-// PendingOutput is the rule's building block for commands that write several files all or nothing: each
-// file is written to its temporary, and only when every one is written are they renamed (commit()).
+// The one output rule of every file the support writers and the crep tool write: symbolic links followed,
+// anything but a regular file refused, a temporary renamed over the target. Rules 1-3:
+// support/README.md, "crep/support/output_file.h".
 #pragma once
 
 #include <filesystem>
@@ -21,19 +10,15 @@
 
 namespace crep {
 
-/// Where a write to `path` lands under the rule above: the final target of its symbolic links (the path
-/// itself when it is no link). Throws IoError naming `path` when it or its target exists and is not a
-/// regular file, when a link chain is longer than 40 or cannot be read, or when the target's directory does
-/// not exist or is not a directory.
+/// Where a write to `path` lands: the final target of its symbolic links. Throws IoError naming `path`
+/// (not a regular file, a broken or too long link chain, no target directory).
 std::filesystem::path resolveOutputTarget(const std::filesystem::path& path);
 
-/// A temporary file next to an output's target (rule 3), renamed over the target by commit(); removed by
-/// discard() or the destructor when not committed.
+/// A temporary file next to an output's target (rule 3), renamed over it by commit(), else removed.
 class PendingOutput {
 public:
   PendingOutput() = default;
-  /// Resolves `path` (resolveOutputTarget) and creates the temporary, empty. IoError naming `path` when the
-  /// temporary cannot be created (no permission, read-only file system, ...).
+  /// Resolves `path` and creates the temporary, empty; IoError naming `path` if it cannot be created.
   explicit PendingOutput(const std::filesystem::path& path);
   PendingOutput(PendingOutput&& other) noexcept;
   PendingOutput& operator=(PendingOutput&& other) noexcept;
@@ -46,8 +31,7 @@ public:
   const std::filesystem::path& temporary() const noexcept { return temporary_; } ///< write here
   bool pending() const noexcept { return !temporary_.empty(); } ///< a temporary exists, not committed
 
-  /// Renames the temporary over the target (re-checking rule 2 first). IoError naming the path on failure
-  /// (the temporary is then removed).
+  /// Renames the temporary over the target (rule 2 re-checked); IoError naming the path on failure.
   void commit();
   /// Removes the temporary (no-op when there is none).
   void discard() noexcept;
@@ -56,8 +40,7 @@ private:
   std::filesystem::path path_, target_, temporary_;
 };
 
-/// Writes `path` by the rule: `write` fills the temporary file it is given (any exception it throws
-/// propagates after the temporary is removed), then the temporary is renamed over the target.
+/// Writes `path` by the rule: `write` fills the temporary (its exceptions propagate), then the rename.
 void writeOutputFile(const std::filesystem::path& path,
                      const std::function<void(const std::filesystem::path& temporary)>& write);
 

@@ -1,6 +1,5 @@
-// Built-in procedural scenes used by the crep tool, the tests and the benchmarks. Each scene is a
-// triangle mesh with a default camera, sun direction and medium, plus an exact CPU ray cast so tests
-// can compute ground truth without any shadow map.
+// Built-in procedural scenes (tool, tests, benchmarks): a mesh, a default camera, sun and medium, and an
+// exact CPU ray cast for ground truth. The scenes: examples/README.md, "crep/scenes/scene.h".
 #pragma once
 
 #include <cstdint>
@@ -30,8 +29,7 @@ struct Box {
   glm::dvec3 min, max;
 };
 
-/// A light texture of a scene (crep/scatter/light_texture.h): linear RGB, row 0 at the bottom, and its
-/// projection along the light's rays.
+/// A light texture of a scene (crep/scatter/light_texture.h) and its projection along the light's rays.
 struct SceneLightTexture {
   Image rgb;
   glm::dmat4 textureClipFromWorld{1.0};
@@ -53,16 +51,11 @@ struct Scene {
   std::optional<SceneLightTexture> sunTexture;
 };
 
-/// The sunlit scenes accepted by makeScene: "colonnade" (default), "forest", "terrain", "boxes" (an
-/// analytic arrangement: a ground plane and a few boxes, for exact tests), "sunset" (the forest looking
-/// toward a low sun behind the canopy: the sun in view, an epipolar-layout frame).
+/// The sunlit scenes accepted by makeScene ("colonnade" the default; README).
 std::vector<std::string> sceneNames();
-/// The scenes with local lights, also accepted by makeScene: "colonnade-night" (the colonnade without a
-/// sun, three spot lamps outside the view shining through the pillars and along the hall).
+/// The scenes with local lights ("colonnade-night"), also accepted by makeScene.
 std::vector<std::string> localLightSceneNames();
-/// The scenes with a light texture, also accepted by makeScene: "stained-glass" (a hall whose side wall has a
-/// large window; the sun shines through it, textured with a procedural stained-glass pattern projected
-/// orthographically over the window).
+/// The scenes with a light texture ("stained-glass"), also accepted by makeScene.
 std::vector<std::string> lightTextureSceneNames();
 /// Builds a scene. `aspect` sets the default camera's aspect ratio. Throws InvalidArgument naming
 /// "scene" for an unknown name.
@@ -72,8 +65,7 @@ Scene makeScene(std::string_view name, double aspect = 16.0 / 9.0);
 void appendBox(Mesh& mesh, const Box& box);
 void appendQuad(Mesh& mesh, const glm::dvec3& corner, const glm::dvec3& edgeU, const glm::dvec3& edgeV);
 
-/// Exact first hit of the ray origin + t * direction (direction need not be unit) against the
-/// mesh's triangles for t in (tMin, tMax); returns t. Uses a BVH built on first use.
+/// Exact first hit t in (tMin, tMax) of origin + t * direction (any length) on the mesh; BVH on first use.
 class RayCaster {
 public:
   explicit RayCaster(const Mesh& mesh);
@@ -91,9 +83,8 @@ private:
 } // namespace crep::scenes
 
 namespace crep::scenes {
-/// A standard (non-rectified) orthographic light matrix for a directional light: looks along the
-/// light direction and tightly encloses the axis-aligned box [boundsMin, boundsMax], so every caster
-/// of the scene is in the map. OpenGL clip conventions (depth-buffer value 0 nearest to the light).
+/// An orthographic light matrix along the light that tightly encloses [boundsMin, boundsMax] (OpenGL clip
+/// conventions: depth-buffer value 0 nearest to the light).
 glm::dmat4 standardLightClipFromWorld(const DirectionalLight& light, const glm::dvec3& boundsMin,
                                       const glm::dvec3& boundsMax);
 } // namespace crep::scenes
