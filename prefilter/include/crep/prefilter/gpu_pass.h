@@ -152,8 +152,8 @@ public:
     const RectifiedLayout* layout = nullptr;
     /// e.g. PrefilterPass::filteredBasis(); a textured one needs the prefix table or no table (README).
     FilteredBasisView basis;
-    /// Instead of `light`: the local light the basis was prefiltered for (PrefilterPass::FrameAttribs::
-    /// localLight); its projective or epipolar layout; no near-plane correction.
+    /// Instead of `light`: the local light the basis was prefiltered for, on its projective or epipolar
+    /// layout; no near-plane correction.
     const LocalLight* localLight = nullptr;
     /// A volume to fill from the same per-frame table (directional light only). Cost: O(cells), one dispatch.
     FroxelTarget froxels{};
