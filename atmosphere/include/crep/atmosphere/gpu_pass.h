@@ -1,17 +1,6 @@
-// The per-frame GL pass of the atmosphere: the sky, aerial perspective and light shafts of one camera image
-// (crep::atmosphereImage in crep/atmosphere/atmosphere.h is its CPU reference and holds the rules; this pass
-// follows them in float). One compute shader, glsl/passes/atmosphere/atmosphere.comp, with a variant per
-// AtmosphereShafts mode (CREP_ATMOSPHERE_SHAFTS 0..3) and per rectified layout kind; it reads the tables of
-// an AtmosphereTablesPass (crep/atmosphere/gpu_tables.h) through glsl/crep/atmosphere.glsl and, for the
-// shafts (a) and (b), walks the min/max trees of the scene's rectified shadow map with
-// glsl/crep/minmax_walk.glsl (the walk of RectifiedMarchPass, crep/epipolar/gpu_march.h).
-//
-// The pass requires a current OpenGL 4.5 context and never creates or owns one. It owns its programs,
-// buffers and samplers (RAII); the textures and buffers of FrameAttribs are the caller's (non-owning GL
-// names). Depth textures hold depth-buffer values in [0, 1] (read with texelFetch through the pass's own
-// nearest sampler); a camera depth value >= 1 (or NaN) is the sky. It leaves program 0, texture units 0-11
-// with no texture and no sampler, image units 0-1, uniform buffer bindings 0-2 and storage buffer bindings
-// 0-1 unbound (gl::unbindPassState) and issues gl::passOutputBarrier().
+// The per-frame GL pass of the atmosphere: sky, aerial perspective and light shafts of one camera image, the
+// rules of crep::atmosphereImage in float (atmosphere/README.md, "gpu_pass.h"). Requires a current OpenGL 4.5
+// context, never creates or owns one; the FrameAttribs' textures and buffers are the caller's.
 #pragma once
 
 #include <cstdint>
@@ -27,65 +16,46 @@
 
 namespace crep {
 
-/// The atmosphere's in-scattering and transmittance of every pixel of a camera image (atmosphereImage on
-/// the GPU), with the light shafts of AtmosphereRayOptions::shafts.
+/// atmosphereImage on the GPU. Leaves program 0, texture units 0-11, image units 0-1, uniform buffers 0-2
+/// and storage buffers 0-1 unbound, and issues gl::passOutputBarrier().
 class AtmospherePass {
 public:
   struct CreateInfo {
-    /// The shafts mode (one program per pass; AtmosphereRayOptions::shafts of `options` is ignored).
-    AtmosphereShafts shafts = AtmosphereShafts::None;
-    /// The steps of (a): integrationSteps and skySteps, each in [1, 4096] (InvalidArgument
-    /// "AtmospherePass::CreateInfo.options.integrationSteps" / ".skySteps"); uniforms, not compiled in.
-    /// None, (b), (c): `single` (default ViewTables: crep::atmosphereViewTables computed on the GPU each
-    /// run, two volumeSize 3D and two skyViewSize 2D RGBA32F textures: 2.6 mebibytes at the defaults),
-    /// volumeSize, volumeSteps, skyViewSize, skyViewSteps (InvalidArgument naming the field).
+    AtmosphereShafts shafts = AtmosphereShafts::None; ///< one program per pass (options.shafts is ignored)
+    /// (a): integrationSteps, skySteps in [1, 4096]; None, (b), (c): `single` and the view tables' sizes and
+    /// steps (ViewTables: computed each run, 2.6 mebibytes at the defaults).
     AtmosphereRayOptions options;
-    /// (a), (b): the rectified map's size W x H in texels (> 0, <= GL_MAX_TEXTURE_SIZE, at most 16 tree
-    /// levels); ignored (may be 0) for None and (c).
+    /// (a), (b): the rectified map's W x H texels (> 0, at most 16 tree levels); 0 for None and (c).
     int mapWidth = 0, mapHeight = 0;
   };
   /// Per-frame inputs: non-owning; the pointers are not stored.
   struct FrameAttribs {
-    /// The tables (computed or uploaded); their parameters are the atmosphere's.
-    const AtmosphereTablesPass* tables = nullptr;
+    const AtmosphereTablesPass* tables = nullptr;   ///< computed or uploaded; their parameters rule
     const AtmospherePlacement* placement = nullptr; ///< validated against the tables' parameters
     const Camera* camera = nullptr;
     const DirectionalLight* sun = nullptr; ///< its direction and irradiance
-    /// GL_TEXTURE_2D of depth-buffer values of `camera` (its convention; 1 = sky); the image size is its
-    /// size.
+    /// GL_TEXTURE_2D of depth-buffer values of `camera` (>= 1 or NaN: sky); its size is the image's.
     std::uint32_t cameraDepth = 0;
-    /// (a), (b): the rectified shadow map as RectifiedMarchPass::FrameAttribs takes it: its layout (a
-    /// ProjectiveLayout or an EpipolarLayout), the mapWidth x mapHeight depth texture and
-    /// MinMaxTreePass::treeBuffer() of it. Not read by None and (c).
+    /// (a), (b): the rectified map as RectifiedMarchPass takes it: layout, depth texture, min/max trees.
     const RectifiedLayout* layout = nullptr;
     std::uint32_t rectifiedDepth = 0;
     std::uint32_t minMaxBuffer = 0;
-    /// (c): the prefiltered (or any shadowed) homogeneous-medium result of `sun` in `proxyMedium` for this
-    /// camera (crep::Scattering / EvaluatePass output: GL_TEXTURE_2D, RGB radiance, the size of
-    /// cameraDepth), and that medium; the visibility of each pixel is prefilteredVisibility of its texel.
-    /// Not read by the other modes.
+    /// (c): crep::Scattering's output for this camera and `sun` in `proxyMedium` (cameraDepth's size).
     std::uint32_t prefiltered = 0;
     const Medium* proxyMedium = nullptr;
-    /// GL_RGBA32F, the size of cameraDepth: RGB the in-scattered radiance, A the mean RGB transmittance
-    /// (AtmosphereImage::inscattering).
+    /// GL_RGBA32F of cameraDepth's size: AtmosphereImage::inscattering.
     std::uint32_t output = 0;
-    /// GL_RGBA32F, the size of cameraDepth: RGB the transmittance (AtmosphereImage::transmittance), A 1;
-    /// or 0 (not written).
+    /// GL_RGBA32F of cameraDepth's size: RGB AtmosphereImage::transmittance, A 1; or 0 (not written).
     std::uint32_t transmittanceOutput = 0;
   };
 
-  /// Validates (InvalidArgument "AtmospherePass::CreateInfo.options.integrationSteps", ".skySteps",
-  /// ".mapWidth/mapHeight"; GlError beyond the GL limits) and builds the program.
+  /// One-time: validates (InvalidArgument naming the field; GlError beyond GL limits), builds the program.
   explicit AtmospherePass(const CreateInfo& info);
-  /// Throws InvalidArgument naming the field of FrameAttribs ("AtmospherePass::FrameAttribs.tables", ...)
-  /// for a null pointer or zero name the mode reads, sizes that do not match, wrong output formats, a
-  /// layout with no GPU mapping, an invalid placement.
+  /// Per frame, O(pixels). Throws InvalidArgument naming the FrameAttribs field (README).
   void run(const FrameAttribs& frame);
 
   const CreateInfo& info() const noexcept { return info_; }
-  /// The view tables of the last run, RGB crep::AtmosphereViewTables' volumeRayleigh / volumeMie
-  /// (GL_TEXTURE_3D RGBA32F) and skyRayleigh / skyMie (GL_TEXTURE_2D RGBA32F), A 0; 0 without them (shafts
-  /// (a), or options.single Table4D).
+  /// The last run's view tables (RGB as crep::AtmosphereViewTables', RGBA32F 3D / 2D), 0 without them.
   std::uint32_t volumeRayleighTexture() const noexcept { return volumeRayleigh_.get(); }
   std::uint32_t volumeMieTexture() const noexcept { return volumeMie_.get(); }
   std::uint32_t skyRayleighTexture() const noexcept { return skyRayleigh_.get(); }
@@ -96,8 +66,7 @@ private:
   bool view_ = false;
   gl::Handle volumeProgram_, skyViewProgram_, volumeRayleigh_, volumeMie_, skyRayleigh_, skyMie_;
   gpu::LayoutBuffers layoutBuffers_;
-  /// [combinedMie][layout kind] ((a), (b)); [.][0] for None and (c)
-  gl::Handle programs_[2][2];
+  gl::Handle programs_[2][2]; ///< [combinedMie][layout kind] ((a), (b)); [.][0] for None and (c)
   gl::Handle marchParams_, atmosphereParams_, nearest_, linear_, dummyTransmittance_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };

@@ -1,11 +1,6 @@
-// The GL passes of the atmosphere (crep/atmosphere/atmosphere.h: the CPU reference, its conventions and
-// rules): AtmosphereTablesPass computes (or uploads) the precomputed tables, AtmospherePass evaluates the
-// sky, aerial perspective and light shafts of one camera image per frame. Float precision; the look-ups are
-// glsl/crep/atmosphere.glsl (public: an engine includes it to read the tables in its own shaders, e.g. the
-// sun's transmittance and the ambient sky light of its terrain shading).
-//
-// The passes require a current OpenGL 4.5 context and never create or own one. They own their programs,
-// buffers and table textures (RAII); the textures of FrameAttribs are the caller's (non-owning GL names).
+// The atmosphere's tables on the GPU (crep/atmosphere/atmosphere.h: the CPU reference and its rules), in
+// float; glsl/crep/atmosphere.glsl reads them (public: engines include it). Requires a current OpenGL 4.5
+// context, never creates or owns one (atmosphere/README.md, "gpu_tables.h").
 #pragma once
 
 #include <cstdint>
@@ -34,8 +29,7 @@ struct AtmosphereParams {
   glm::ivec4 tableSize{0};            ///< N_h, N_alpha, N_phi, N_theta
   glm::ivec4 auxSizes{0}; ///< optical depth width (altitude), height (zenith); ambient size; orders
   glm::vec4 placement{1.0f, 0.0f, 0.0f, 0.0f}; ///< x: metersPerUnit; y: originAltitude; zw: 0
-  /// x: ground albedo; y: Psi_ms texels per side; z: Psi_ms steps per ray (sizes exact in float); w: 0
-  glm::vec4 multipleScattering{0.0f};
+  glm::vec4 multipleScattering{0.0f}; ///< x: ground albedo; y: Psi_ms texels per side; z: its steps; w: 0
 };
 static_assert(sizeof(AtmosphereParams) == 128, "std140 CrepAtmosphereParams");
 
@@ -45,38 +39,24 @@ AtmosphereParams atmosphereParams(const AtmosphereParameters& p, const Atmospher
 
 } // namespace gpu
 
-/// The tables on the GPU: textures owned by the pass, sized by CreateInfo.
-///   opticalDepthTexture(): GL_TEXTURE_2D GL_RG32F, opticalDepthHeight x opticalDepthZenith;
-///   single/singleMie/higherOrdersTexture(): GL_TEXTURE_3D GL_RGBA32F (GL_RGBA16F with halfFloatTables),
-///     N_h x N_alpha x (N_phi N_theta)
-///     (the packing of atmosphere.h: single scattering without its phase functions, `single` RGB Rayleigh
-///     and A Mie's red, `singleMie` RGB Mie; singleMieTexture() is 0 with options.combinedMie), linear
-///     filtering, clamp to edge;
-///   ambientTexture(): GL_TEXTURE_2D GL_RGBA32F, ambientSize x 1;
-///   multipleScatteringLutTexture(): GL_TEXTURE_2D GL_RGBA32F, multipleScatteringSize^2, linear, clamp to
-///     edge (Psi_ms; 0 unless usesMultipleScatteringLut).
-/// 4D tables take 16 bytes per texel (8 with halfFloatTables): 4 mebibytes each at the default size, 64 at
-/// Yusov's 32 x 128 x 64 x 16 (three, two with combinedMie, plus two of the same size while computing more
-/// than one order, and three more with halfFloatTables).
+/// The tables on the GPU, in textures the pass owns, sized by CreateInfo (formats, memory: README). The 4D
+/// tables take 16 bytes per texel (8 with halfFloatTables).
 class AtmosphereTablesPass {
 public:
   struct CreateInfo {
     AtmosphereParameters parameters;
     AtmospherePrecomputeOptions options; ///< keepOrders is ignored
-    /// The three 4D tables as GL_RGBA16F: half the memory, each value rounded once to half precision
-    /// (relative 2^-11) after compute() in RGBA32F or in upload(); download() returns the rounded values.
+    /// The 4D tables as GL_RGBA16F: half the memory, each value rounded once (relative 2^-11).
     bool halfFloatTables = false;
   };
-  /// Validates both (InvalidArgument naming the field; sizes beyond the GL limits name the size field) and
-  /// allocates the textures. Throws GlError when allocation fails.
+  /// Validates (InvalidArgument naming the field, also beyond GL limits), allocates (GlError on failure).
   explicit AtmosphereTablesPass(const CreateInfo& info);
 
-  /// Computes every table on the GPU (the steps of atmosphere.h's top, in float). Wall-clock milliseconds
-  /// per stage ("optical depth", "single scattering", "order 2: J", "order 2: L", ..., "ambient") are in
-  /// stageTimes() afterwards.
+  /// One-time per atmosphere: computes every table (atmosphere.h's steps, in float); stageTimes() then
+  /// holds the wall-clock milliseconds per stage.
   void compute();
-  /// Uploads tables computed on the CPU or loaded from a cache (sizes and parameters must match CreateInfo:
-  /// InvalidArgument "AtmosphereTablesPass::upload.tables" otherwise).
+  /// Uploads CPU or cached tables matching CreateInfo (InvalidArgument
+  /// "AtmosphereTablesPass::upload.tables").
   void upload(const AtmosphereTables& tables);
   /// Reads every table back (orders stays empty).
   AtmosphereTables download() const;

@@ -1,18 +1,6 @@
-// Perspective camera in double precision: the view looks down -Z of view space, depth-buffer values in
-// [0, 1] (glDepthRange(0, 1)). Matrices are named target-from-source: clip = clipFromView() *
-// viewFromWorld() * world.
-//
-// Engine conventions (Camera::fromMatrices): the engine's own viewFromWorld and clipFromView, with
-//   - clip depth [-w, w] (GL's default) or [0, w] (glClipControl(..., GL_ZERO_TO_ONE), Vulkan, Metal),
-//   - standard or reversed depth (near -> 1, far -> 0; GL_GREATER, cleared to 0), detected,
-//   - a finite or an infinite far plane (detected; the scattering is then integrated up to maxDistance,
-//     which every pass uses as the far distance and the sky's distance),
-//   - off-centre projections: sub-pixel jitter (TAA) and asymmetric frusta (VR), detected.
-// The depth-buffer value d of a surface at view distance Z depends only on near, far and reversal, not on
-// the clip convention: standard d = (1/n - 1/Z) / (1/n - 1/f), reversed d = (1/Z - 1/f) / (1/n - 1/f)
-// (1/f = 0 for an infinite far plane). Accepted depth textures: any format the GL samples as a float in
-// [0, 1] (GL_DEPTH_COMPONENT32F, GL_DEPTH24_STENCIL8 / GL_DEPTH_COMPONENT24 read as depth, GL_R32F).
-// The constructor and lookAt() make the symmetric GL camera of the tools and tests.
+// Perspective camera in double precision: view down -Z, depth-buffer values in [0, 1], matrices named
+// target-from-source. Engine conventions accepted by Camera::fromMatrices (clip depth, reversed-Z, infinite
+// far, off-centre) and the depth formula: core/README.md, "camera.h".
 #pragma once
 
 #include <array>
@@ -45,13 +33,9 @@ public:
   static Camera lookAt(const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& up,
                        double fovY, double aspect, double near, double far);
 
-  /// The camera of an engine's matrices (see top). `viewFromWorld`: rigid (rotation + translation).
-  /// `clipFromView`: a perspective projection in the `clipDepth` convention, standard or reversed, finite
-  /// or infinite far, possibly off-centre. `maxDistance` > near: how far the scattering is integrated (the
-  /// sky's distance); required with an infinite far plane; with a finite one 0 means the far plane and a
-  /// larger value is clamped to it. Throws InvalidArgument naming "Camera.viewFromWorld",
-  /// "Camera.clipFromView" or "Camera.maxDistance" (non-finite values, not rigid, not a perspective
-  /// projection, near >= far, no maxDistance with an infinite far plane).
+  /// The camera of an engine's matrices: rigid `viewFromWorld`, perspective `clipFromView` in `clipDepth`;
+  /// `maxDistance` > near is the integration distance (needed with an infinite far plane; 0 = the far
+  /// plane). InvalidArgument naming "Camera.viewFromWorld", "Camera.clipFromView" or "Camera.maxDistance".
   static Camera fromMatrices(const glm::dmat4& viewFromWorld, const glm::dmat4& clipFromView,
                              ClipDepth clipDepth = ClipDepth::NegativeOneToOne, double maxDistance = 0.0);
 

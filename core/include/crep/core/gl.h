@@ -1,6 +1,5 @@
-// Small GL helpers shared by the passes, the scenes and the tests. GL object names are
-// std::uint32_t (GLuint) and enums std::uint32_t (GLenum): no loader header here. Every function
-// requires a current OpenGL 4.5 context (the caller's or GlContext).
+// Small GL helpers shared by the passes, the scenes and the tests; GL names and enums are std::uint32_t (no
+// loader header). Every function requires a current OpenGL 4.5 context (the caller's or GlContext).
 #pragma once
 
 #include <cstddef>
@@ -63,7 +62,8 @@ Handle createTexture2D(std::uint32_t internalFormat, int width, int height,
                        const char* parameter = "texture size");
 
 /// A sampler with `filter` (GL_NEAREST or GL_LINEAR) for minification and magnification, clamp to edge in
-/// s, t and r, no depth comparison: texelFetch / texture read the raw values whatever the texture's compare mode.
+/// s, t and r, no depth comparison: texelFetch / texture read the raw values whatever the texture's compare
+/// mode.
 Handle createClampSampler(std::uint32_t filter);
 /// A buffer of `bytes` bytes with GL_DYNAMIC_STORAGE_BIT (filled with glNamedBufferSubData).
 Handle createDynamicBuffer(std::size_t bytes);
@@ -81,10 +81,8 @@ struct TextureLevel {
   int width = 0, height = 0, depth = 0;
   std::uint32_t internalFormat = 0;
 };
-/// The target, size and format of `texture`'s level 0; InvalidArgument naming `parameter` if `texture` is
-/// 0 or not an existing texture. The passes read the sizes of the textures they are given from the
-/// textures themselves (no per-frame size fields), and check them against each other and their
-/// create-infos.
+/// The target, size and format of `texture`'s level 0 (how the passes learn sizes); InvalidArgument naming
+/// `parameter` if `texture` is 0 or not an existing texture.
 TextureLevel textureLevel(const char* parameter, std::uint32_t texture);
 /// textureLevel(), and InvalidArgument naming `parameter` unless the target is GL_TEXTURE_2D.
 TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture);
@@ -94,14 +92,11 @@ TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture);
 void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
                       std::uint32_t internalFormat = 0);
 
-/// Throws InvalidArgument naming `parameter` unless `texture` (an existing texture) can be read as depth:
-/// a depth format (GL_DEPTH_COMPONENT16/24/32/32F, GL_DEPTH24_STENCIL8, GL_DEPTH32F_STENCIL8) sampled as
-/// depth (GL_DEPTH_STENCIL_TEXTURE_MODE = GL_DEPTH_COMPONENT), or GL_R32F. Camera depth, shadow maps and
-/// rectified maps: a colour, half-float, integer or stencil texture would be read as garbage.
+/// Throws InvalidArgument naming `parameter` unless `texture` reads as depth: a depth format sampled as
+/// depth, or GL_R32F (camera depth, shadow and rectified maps).
 void requireDepthFormat(const char* parameter, std::uint32_t texture);
-/// Throws InvalidArgument naming `parameter` unless `texture` (an existing texture) has a colour format
-/// read as float: floating point, unsigned or signed normalized (GL_RGBA8, GL_SRGB8_ALPHA8, GL_RGBA16F,
-/// GL_RGB32F, ...); not depth, stencil or integer. Light textures.
+/// Throws InvalidArgument naming `parameter` unless `texture` has a colour format read as float (float or
+/// normalized; not depth, stencil or integer): light textures.
 void requireColorFormat(const char* parameter, std::uint32_t texture);
 
 /// The state the compute passes of the library leave behind: program 0; texture units, samplers, image

@@ -1,12 +1,6 @@
-// The library's GL state contract (docs/GL_STATE.md has the whole of it: what each pass sets, restores
-// and requires of the caller). Two scopes, used by every pass that rasterizes or transfers pixels:
-//   - DepthPassScope: the fixed-function state a depth-only pass depends on, whatever the engine left
-//     (reversed-Z clip control, a polygon offset, a scissor box, rasterizer discard, ...): saved, set to
-//     the contract's values, restored on destruction;
-//   - PixelStoreScope: the pack/unpack state and pixel buffer bindings of texture uploads and readbacks.
-// GL names and enums are std::uint32_t / int (no loader header here). Requires a current OpenGL 4.5
-// context. GPU note: each scope reads ~40 values with glGet*; drivers that run GL on a worker thread
-// (NVIDIA's threaded optimization) may synchronise on them, once per scope, not per draw.
+// The library's GL state contract (docs/GL_STATE.md): DepthPassScope for depth-only passes, PixelStoreScope
+// for uploads and readbacks; each saves, sets and restores the state (core/README.md, "gl_state.h"). GL names
+// and enums are std::uint32_t / int. Requires a current OpenGL 4.5 context.
 #pragma once
 
 #include <cstdint>
@@ -14,10 +8,8 @@
 
 namespace crep::gl {
 
-/// The raster state of the contract that decides what a depth-only pass writes: the values GL holds for
-/// viewport / scissor / depth range index 0 and the global ones. Single-sampled, depth-only targets make
-/// the colour, blend, stencil and multisample state irrelevant (GL 4.5 core, Sec. 14.3.1, 17.3), so it is
-/// not part of it.
+/// The raster state that decides what a depth-only pass writes (index 0 of viewport, scissor and depth
+/// range, and the global state; colour, blend, stencil and multisample state do not matter).
 struct RasterState {
   int drawFramebuffer = 0;
   float viewport[4] = {0, 0, 0, 0}; ///< index 0
@@ -52,14 +44,8 @@ struct DepthPassState {
   bool cullBackFaces = false; ///< GL_CULL_FACE (GL_BACK, GL_CCW); off: a rectification may mirror winding
 };
 
-/// Scope of a depth-only pass into `framebuffer` (a single-sampled depth attachment). The constructor
-/// throws GlError when the caller left a state that cannot be overridden (requireNoActiveTransformFeedback),
-/// saves the caller's RasterState and sets the contract's: `framebuffer` as the draw
-/// framebuffer; clip control GL_LOWER_LEFT / GL_NEGATIVE_ONE_TO_ONE; depth range (0, 1); depth test on
-/// with GL_LESS and writes; depth clamp per `state`; GL_FILL without polygon offset or smoothing; culling
-/// per `state`; rasterizer discard, clip distances, depth bounds test and conservative rasterization off;
-/// scissor test on with the scissor box equal to the viewport (setViewport). The destructor restores the
-/// caller's values, also when an exception leaves the scope.
+/// Scope of a depth-only pass into `framebuffer`: saves the caller's RasterState, sets the contract's, and
+/// restores it on destruction, also on an exception. GlError for an active transform feedback.
 class DepthPassScope {
 public:
   DepthPassScope(std::uint32_t framebuffer, int width, int height, const DepthPassState& state = {});
@@ -77,10 +63,8 @@ private:
   RasterState saved_, set_;
 };
 
-/// Saves the pixel pack and unpack state (alignment, row length, skip pixels/rows/images, image height,
-/// swap bytes, LSB first) and the GL_PIXEL_PACK_BUFFER / GL_PIXEL_UNPACK_BUFFER bindings, sets GL's
-/// defaults with alignment 1 and no pixel buffer bound (client memory is tightly packed), restores them on
-/// destruction. Used around every glTextureSubImage* / glGetTextureSubImage of the library.
+/// Saves the pixel pack / unpack state and pixel buffer bindings, sets GL's defaults with alignment 1 and no
+/// pixel buffer (tightly packed client memory), restores them on destruction; around every transfer.
 class PixelStoreScope {
 public:
   PixelStoreScope();
@@ -92,18 +76,13 @@ private:
   int pack_[8] = {}, unpack_[8] = {}, packBuffer_ = 0, unpackBuffer_ = 0;
 };
 
-/// Throws GlError naming `owner` when a transform feedback is active and not paused: it would capture the
-/// library's draws and makes every glUseProgram of its passes fail; the library cannot set it aside without
-/// changing what the engine records.
+/// Throws GlError naming `owner` when a transform feedback is active and not paused (it cannot be set aside).
 void requireNoActiveTransformFeedback(const char* owner);
 
-/// Throws GlError naming `owner` and the errors when GL errors are pending before a call of the library
-/// (the caller's earlier GL calls raised them; glGetError() pops them, so they are reported here rather
-/// than blamed on the library's first check).
+/// Throws GlError naming `owner` and the errors when GL errors are pending before a call of the library.
 void requireNoPendingError(const char* owner);
 
-/// GL_TIME_ELAPSED queries do not nest: throws GlError naming `owner` when the caller has one active (the
-/// library's stage timers would fail part way through a frame).
+/// Throws GlError naming `owner` when the caller has a GL_TIME_ELAPSED query active (they do not nest).
 void requireNoActiveTimerQuery(const char* owner);
 
 } // namespace crep::gl

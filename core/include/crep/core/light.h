@@ -37,17 +37,12 @@ struct SpotLightParams {
   double nearPlane = -1.0; ///< near plane of its shadow frustum, in (0, range); -1: range * 1e-3
 };
 
-/// A cone light at `position` (a local light: Klehm et al. 2014, Sec. 3.2 "Local Lights", "Angular-dependency
-/// for Sources"). Radiant intensity toward direction w (unit): intensity() * falloff(dot(w, direction())),
-/// with the smooth angular falloff s(t) = t^2 (3 - 2 t), t = clamp((cos a - cos outer) / (cos inner - cos
-/// outer), 0, 1) for the angle a to the axis; irradiance at distance d on a facing surface in vacuum is
-/// that / d^2 (in a medium, times exp(-sigma_t d)). Its shadow map is the perspective frustum of
-/// lightClipFromWorld(): square, half angle outerConeAngle in both axial planes, from nearPlane to range.
+/// A cone light (Klehm et al. 2014, Sec. 3.2 "Local Lights"): intensity() * falloff(cos a) toward angle a
+/// from the axis, / d^2 at distance d; shadow frustum lightClipFromWorld() (core/README.md, "light.h").
 class SpotLight {
 public:
-  /// Throws InvalidArgument naming the field ("SpotLight.innerConeAngle", "SpotLight.outerConeAngle" (also
-  /// when the angles are out of order), "SpotLight.intensity", "SpotLight.color", "SpotLight.range",
-  /// "SpotLight.nearPlane", "SpotLight.direction", "SpotLight.position").
+  /// Throws InvalidArgument naming the field ("SpotLight.innerConeAngle", "SpotLight.outerConeAngle" also
+  /// for angles out of order, ".intensity", ".color", ".range", ".nearPlane", ".direction", ".position").
   explicit SpotLight(const SpotLightParams& params);
 
   const glm::dvec3& position() const noexcept { return position_; }
@@ -87,11 +82,8 @@ struct PointLightParams {
   double nearPlane = -1.0; ///< near plane of the frusta, in (0, range); -1: range * 1e-3
 };
 
-/// An omnidirectional light as six spot faces (Klehm et al. 2014, Sec. 3.2 "Local Lights": six spotlights,
-/// one per cube-map sector, contributions added). Face i in GL cube-map order +X, -X, +Y, -Y, +Z, -Z covers
-/// the directions w with |w_j| <= |w_axis| for its axis (ties belong to the first face in that order, so
-/// every direction belongs to exactly one face); its shadow map is faceClipFromWorld(i), a 90 degree square
-/// perspective frustum from nearPlane to range.
+/// An omnidirectional light as six spot faces in GL cube-map order (Klehm et al. 2014, Sec. 3.2 "Local
+/// Lights"), each direction in exactly one face; face i's shadow frustum is faceClipFromWorld(i).
 class PointLight {
 public:
   /// Throws InvalidArgument naming the field ("PointLight.position", ".color", ".intensity", ".range",

@@ -1,10 +1,6 @@
-// The shader library: shader sources embedded into the binaries at build time (no file is read at run
-// time). The runtime library serves its own files (glsl/: the public includes crep/*.glsl and the
-// passes of its modules); a program adds its own embedded sets with addFiles() (cmake/EmbedGlsl.cmake
-// generates them), and every registered file can include every other one. `#include "path"`
-// directives are resolved here, relative to the including file first and then to the root of the
-// paths; each file is included once per expansion. `#line` markers keep compiler messages pointing at
-// the real file and line; variants are made by prepended #defines (shaders give defaults with #ifndef).
+// The shader library: GLSL sources embedded at build time (no file read at run time), the library's own and
+// those a program adds with addFiles(); `#include "path"` resolved, `#line` markers kept, variants by
+// prepended #defines. Rules: core/README.md, "shader_library.h".
 #pragma once
 
 #include <cstdint>
@@ -43,17 +39,10 @@ public:
     std::string_view path; ///< relative to its set's root, e.g. "crep/common.glsl" (glsl/crep/common.glsl)
     std::string_view source;
   };
-  /// Every registered file (the library's own and those added with addFiles()), sorted by path. The
-  /// span stays valid for the life of the process, even after a later addFiles() (which makes a new
-  /// table; files() then returns the new one).
+  /// Every registered file, sorted by path; the span stays valid for the life of the process.
   static std::span<const File> files();
-  /// Registers more embedded files, e.g. an application's own shaders (cmake/EmbedGlsl.cmake). The
-  /// views must stay valid for the life of the process (static storage, as generated). Paths are
-  /// relative ("passes/scene.vert"), without "." or ".." segments; their includes may name any
-  /// registered file, e.g. "crep/common.glsl". Registering a file again (same path, same source
-  /// storage) does nothing, so a set may be registered by every user. Throws ShaderError for an
-  /// invalid path or a path already registered with another source (files never shadow each other).
-  /// Thread-safe.
+  /// Registers more embedded files (cmake/EmbedGlsl.cmake); the views must live as long as the process.
+  /// Thread-safe. ShaderError for a bad path or one already registered with another source.
   static void addFiles(std::span<const File> files);
   /// Source of one file. Throws ShaderError for an unknown path.
   static std::string_view source(std::string_view path);

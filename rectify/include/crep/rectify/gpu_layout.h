@@ -1,13 +1,6 @@
-// The GPU description of a rectified layout: what the GLSL of glsl/crep/layout.glsl needs to map world
-// points and view rays into a rectified map (CREP_LAYOUT = LayoutKind). Every RectifiedLayout with a GPU
-// mapping serializes itself into a GpuLayoutData (RectifiedLayout::gpuLayoutData()): a std140 layout
-// block and, for layouts with per-row data, a std430 table of rows. A pass uploads the bytes without
-// knowing the concrete layout (gpu::LayoutBuffers, crep/scatter/gpu_layout_buffers.h), so every module
-// above rectify/ can evaluate or march on any layout.
-//
-// The projective block lives here; the epipolar block with EpipolarLayout (crep/epipolar/gpu_layout.h).
-// Each struct has a GLSL twin with the same name prefixed "Crep" in glsl/crep/layout.glsl (std140:
-// 16-byte vectors only, int instead of bool, a static_assert on the size; GL tests compare the offsets).
+// The GPU description of a rectified layout (glsl/crep/layout.glsl, CREP_LAYOUT = LayoutKind): a std140
+// block and an optional std430 row table, uploaded without knowing the layout (rectify/README.md,
+// "gpu_layout.h").
 #pragma once
 
 #include <cstddef>
@@ -22,7 +15,7 @@ class ProjectiveLayout; // crep/rectify/rectified_map.h
 
 namespace gpu {
 
-/// Largest number of layout regions the layout blocks hold (= RectifyOptions::kMaxSplits).
+/// Largest number of layout regions the blocks hold (= RectifyOptions::kMaxSplits).
 inline constexpr int kMaxLayoutRegions = 64;
 
 /// The value of CREP_LAYOUT in glsl/crep/layout.glsl.
@@ -44,13 +37,12 @@ struct ProjectiveLayoutParams {
 static_assert(sizeof(ProjectiveLayoutParams) == 16 * (6 + kMaxLayoutRegions),
               "std140 CrepProjectiveLayoutParams");
 
-/// The block of a projective layout (regionCount() <= kMaxLayoutRegions, else InvalidArgument
-/// "ProjectiveLayout.regionCount").
+/// The block of a projective layout; InvalidArgument "ProjectiveLayout.regionCount" beyond kMaxLayoutRegions.
 ProjectiveLayoutParams makeProjectiveLayoutParams(const ProjectiveLayout& layout);
 
 } // namespace gpu
 
-/// A layout serialized for the GPU (see the top).
+/// A layout serialized for the GPU (RectifiedLayout::gpuLayoutData()).
 struct GpuLayoutData {
   gpu::LayoutKind kind = gpu::LayoutKind::Projective;
   std::vector<std::byte> block; ///< the std140 layout block (CREP_LAYOUT_BINDING)
