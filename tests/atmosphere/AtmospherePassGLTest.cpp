@@ -1,9 +1,9 @@
 // AtmospherePass (crep/atmosphere/gpu_pass.h) against its CPU reference crep::atmosphereImage on a
 // built-in scene with a real rectified shadow map: both sides read the same tables (computed once on the
 // GPU and downloaded) and the same map (rendered on the GPU, read back for the CPU trees and sections).
-#include "epipolar/epipolar_test_util.h"
-#include "epipolar/gl_scene_util.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/gl_scene_maps.h"
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_pass.h>

@@ -3,7 +3,7 @@
 // an independent brute-force single-scattering integral (densityIntegral for both transmittances, no tables),
 // exact identities of lit sections and lit lengths, prefilteredVisibility's closed form, and atmosphereImage
 // against atmosphereRay per pixel.
-#include "atmosphere_test_util.h"
+#include "atmosphere/atmosphere_test_util.h"
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/core/error.h>

@@ -6,8 +6,8 @@
 // to the image plane (epipole clamped to 1e5 px: nearly parallel lines). Evaluator: the test shader
 // tests/glsl/epipolar_sampling_eval.comp, (0.01 x, 0.01 y, 0.05 z, 1) of each list entry, and the same
 // function on the CPU.
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

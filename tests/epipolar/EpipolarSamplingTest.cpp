@@ -3,7 +3,7 @@
 // image and an independent closed form, the refinement rules on hand-made samples, exact interpolation of
 // linear fields, the bilateral unwarp (constant fields, a thin bar, the corrections), the whole pipeline
 // against the per-pixel closed form for F = 1, 2, 4, and the option checks.
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar_sampling.h>

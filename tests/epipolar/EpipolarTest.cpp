@@ -2,7 +2,7 @@
 // properties over random camera / light configurations (view rays keep row and depth, light rays keep row
 // and column, everything visible maps into the map, distances are the closed form), the slice count rule
 // (no pixel farther than half a pixel from its slice), the epipole cases, bad input.
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

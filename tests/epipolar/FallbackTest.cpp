@@ -2,8 +2,8 @@
 // a standard shadow map of an analytic occluder (an infinite plane) resampled into the epipolar layout and
 // into the projective layout, marched and prefiltered (prefilter/'s evaluation, unchanged), against the
 // closed form and against the projective pipeline on a configuration where both are valid.
-#include "epipolar_test_util.h"
-#include "support/image_check.h"
+#include "common/analytic_reference.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

@@ -2,7 +2,7 @@
 // minMaxMarch integrates (Yusov 2012, Algorithm 2), checked by integrating them again (Klehm et al. 2014,
 // Eq. 1 and 3 per section) against minMaxMarch's own image, and by their shape (ascending, disjoint,
 // inside [start, surface]; a map without occluders gives each ray the single section [start, surface]).
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/march.h>

@@ -1,11 +1,11 @@
 // A local light in the view prefiltered on its epipolar layout (EpipolarLayout for the light's position;
 // Klehm et al. 2014, Sec. 3.2 on the Sec. 4.1 layout): the GPU prefilter and evaluation against the CPU
 // references (crep::prefilter and crep::evaluate with the LocalLight on the same map) and against the
-// closed form of the analytic wall scene (scatter/local_light_util.h), for a spot and a point-light face.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/gl_fixture.h"
+// closed form of the analytic wall scene (common/local_light_scene.h), for a spot and a point-light face.
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>

@@ -4,11 +4,11 @@
 // textured brute-force march (same map), and a constant colour map c against c times the untextured march,
 // for the sun's window and a spot light's gobo on the analytic plane scenes (160x90, map 256x128).
 // The first test case needs no GL context (CPU only).
-#include "epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/gpu_march.h>

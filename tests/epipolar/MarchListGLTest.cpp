@@ -3,13 +3,13 @@
 // pass's output bit for bit (tree and brute force); a list of arbitrary continuous positions matches the
 // CPU minMaxMarch at those samples (crep::screenRay's rays) within the GPU-vs-CPU march tolerance of
 // MarchGLTest; only the entries' texels are written; an empty list writes nothing. The lists are filled
-// from the CPU (support/sample_list_util.h: header, then the entries).
-#include "epipolar_test_util.h"
-#include "gl_scene_util.h"
-#include "scatter/local_light_util.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/sample_list_util.h"
+// from the CPU (common/sample_list_util.h: header, then the entries).
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/gl_scene_maps.h"
+#include "common/image_check.h"
+#include "common/local_light_scene.h"
+#include "common/sample_list_util.h"
 
 #include <crep/core/gl.h>
 #include <crep/epipolar/epipolar.h>
@@ -37,7 +37,7 @@ namespace {
 constexpr int kWidth = 160, kHeight = 90;        // camera image
 constexpr int kMapWidth = 256, kMapHeight = 128; // projective map (4 splits of 64 columns)
 
-/// The scene and its GPU-rendered map at the sizes above (gl_scene_util.h).
+/// The scene and its GPU-rendered map at the sizes above (common/gl_scene_maps.h).
 SceneMaps renderScene(const std::string& name) {
   return renderSceneMaps(name, kWidth, kHeight, kMapWidth, kMapHeight);
 }

@@ -2,7 +2,7 @@
 // crep::bruteForceMarch): the rays of epipolar sampling's marched samples (Yusov 2012, Sec. 6.1 and 6.4).
 // At pixel centres they are the per-pixel functions bit for bit; anywhere else the tree march equals the
 // brute-force march of the same rays; bad samples get a named InvalidArgument.
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

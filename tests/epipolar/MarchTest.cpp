@@ -2,8 +2,8 @@
 // crep/scatter/world_march.h): min/max trees, the tree march against the brute-force march of the same
 // rows (Yusov 2012, Algorithm 2), both against closed forms (Klehm et al. 2014, Eq. 1, 3); the world-space
 // reference march against the closed forms of an empty medium and of a half-space shadow.
-#include "epipolar_test_util.h"
-#include "support/image_check.h"
+#include "common/analytic_reference.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/march.h>

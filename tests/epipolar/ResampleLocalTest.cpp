@@ -1,12 +1,12 @@
 // Point resampling of a local light's perspective shadow map into its projective rectified map (Klehm et al.
 // 2014, Sec. 4.1's rule on the layout of Sec. 3.2 "Local Lights"; crep/epipolar/resample.h), on the CPU:
-// the analytic scene's wall (a half-space, local_light_util.h) seen by the spot light and a point-light face,
-// its perspective map computed in closed form, resampled, against the exact rectified depth of the wall's hit
-// on every texel's light ray; and validateLocalLightMatrix / the layout's choice of check, bad matrices
-// named.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+// the analytic scene's wall (a half-space, common/local_light_scene.h) seen by the spot light and a
+// point-light face, its perspective map computed in closed form, resampled, against the exact rectified depth
+// of the wall's hit on every texel's light ray; and validateLocalLightMatrix / the layout's choice of check,
+// bad matrices named.
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/local_light_scene.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

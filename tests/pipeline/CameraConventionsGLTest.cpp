@@ -9,11 +9,11 @@
 // read, never the scattering. The world march (crep::WorldMarchPass, march.glsl) is checked the same way
 // for (b). Last, (d) on an epipolar frame (the sun in view) through crep::Scattering, against the
 // world-space reference.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
-#include "../prefilter/prefilter_gpu_util.h"
-#include "scattering_frame.h"
+#include "common/prefilter_gpu.h"
+#include "pipeline/scattering_frame.h"
 
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>

@@ -4,7 +4,7 @@
 // scissor keeps the clear inside its split; the same loop without the scissor wipes the splits drawn
 // before, which the negative control shows), leave the caller's raster state as it was, and reject bad
 // input by name.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/pipeline/rectified_shadow_pass.h>

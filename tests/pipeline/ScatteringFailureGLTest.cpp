@@ -5,8 +5,8 @@
 // moved-from object is valid but empty. Textures of the wrong target, format class, or aliasing the output
 // are named; a light texture's non-finite texels read as 0 (the GPU's rule), and one scaled by 1e6 scales
 // the prefiltered frame by 1e6 (no half-float clipping).
+#include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl_state.h>

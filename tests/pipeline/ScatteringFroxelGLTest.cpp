@@ -5,8 +5,8 @@
 // accuracy against a world-space reference at the cells is measured inside and outside the epipole block
 // (marched per pixel, prefiltered in the volume). Bad targets are named. 160 x 90 screens, 256^2 maps,
 // grids of 40 x 24 x 16 cells.
+#include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

@@ -2,9 +2,9 @@
 // run by hand on projective frames, the prefiltered method on fallback frames (sun in view, sun behind the
 // camera) close to the world-space reference, with either shadow input; bad input named; GL state kept.
 // 160 x 90 screens, 256^2 maps.
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

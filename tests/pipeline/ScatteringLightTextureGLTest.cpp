@@ -5,9 +5,9 @@
 // view) and on an off-screen spot against the textured world-space reference (WorldMarchPass with the
 // texture, 1024^2 shadow map, 256 steps), per channel; the epipolar variant of LightColorMapPass against
 // crep::lightColorMap; reduced-resolution evaluation; bad input named. 160x90, map 512.
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

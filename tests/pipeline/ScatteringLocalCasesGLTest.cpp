@@ -5,9 +5,9 @@
 // world-space reference of the same light (WorldMarchPass against the light's own perspective shadow
 // maps, 1024^2, 256 steps): relative RMSE within the built-in scenes' 2% goal. A light whose cones miss
 // the camera frustum must cost nothing and add exactly zero. Colonnade at night (zero sun).
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/scatter/ray_scattering.h>

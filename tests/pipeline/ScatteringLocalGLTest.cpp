@@ -3,9 +3,9 @@
 // view (not projective: prefiltered on its epipolar layout) and a point light (six faces), each against the
 // world-space reference march of the same light (WorldMarchPass with the light's own perspective shadow maps,
 // 1024^2, 256 steps). The directional light has zero irradiance, so the output is the local lights' alone.
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 

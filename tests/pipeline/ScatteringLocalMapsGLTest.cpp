@@ -6,9 +6,9 @@
 // rendered beforehand and no drawCasters, in a night frame (FrameAttribs::light null). (a) and (b) differ
 // only by the point resampling; both are compared with the world-space reference march of the same light. Bad
 // spans and maps are named.
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/scatter/ray_scattering.h>

@@ -6,8 +6,8 @@
 // the world-space reference; the brute-force march over the defaults' map gives the map's own error. The
 // figures decide where the thresholds stay (README "Sun in view"): beyond them the epipolar layout is the
 // more accurate one, so no split placement should keep those frames projective.
+#include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/pipeline/scattering.h>
 #include <crep/rectify/rectify.h>

@@ -3,8 +3,8 @@
 // shadow map; FroxelFog end to end against the closed form of the homogeneous unshadowed medium; temporal
 // convergence with a static camera; flicker under a slow pan against the world-space reference; NaN
 // containment; the block's std140 offsets; bad options named.
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>

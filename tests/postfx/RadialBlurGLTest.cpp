@@ -2,8 +2,8 @@
 // analytic frame (a ground plane with a row of pillars, the sun in view), full and reduced source
 // resolution, odd workgroup sizes, both modes; a sun behind the camera adds exactly nothing; NaN depth stays
 // finite; the block's std140 offsets; bad input names the field.
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>

@@ -3,7 +3,7 @@
 // toneMapImage per pixel (RGBA32F, RGBA8, sRGB-encoded), manual exposure, light adaptation's time
 // constant and frame-rate independence on the GPU state, NaN/Inf pixels, the GL state left behind and bad
 // input named.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

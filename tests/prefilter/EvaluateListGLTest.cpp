@@ -2,12 +2,12 @@
 // evaluation of epipolar sampling's marched samples and corrections (Yusov 2012, Sec. 6.4 and 6.7). A list of
 // every pixel centre gives the per-pixel pass's output bit for bit (projective and epipolar layouts, default
 // options and the near-plane correction); a list of some pixels writes those texels only. The lists are
-// filled from the CPU (support/sample_list_util.h: header, then the entries).
-#include "epipolar/epipolar_test_util.h"
-#include "epipolar/gl_scene_util.h"
-#include "scatter/local_light_util.h"
-#include "support/gl_fixture.h"
-#include "support/sample_list_util.h"
+// filled from the CPU (common/sample_list_util.h: header, then the entries).
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/gl_scene_maps.h"
+#include "common/local_light_scene.h"
+#include "common/sample_list_util.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

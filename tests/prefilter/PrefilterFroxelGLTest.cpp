@@ -8,10 +8,10 @@
 // per-pixel evaluation the same ray end as the volume (a standard depth buffer near 1 would lose up to
 // 6e-8 Z / near of it). Map 256 x 64, 2 splits x 2 prefilter regions; grid 32 x 18 x 16 (camera image of
 // the same 32 x 18 for the per-pixel runs).
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
-#include "prefilter_gpu_util.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/prefilter/gpu_pass.h>

@@ -24,10 +24,10 @@
 //     RGBA32F basis, the same evaluation matches to float precision.
 //     nearest sampling: a row or column index can flip where float and double disagree on which side
 //     of a texel boundary a ray lies; at most 0.5% of the samples may differ by more than 2e-5 peak.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
-#include "prefilter_gpu_util.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/prefilter/gpu_pass.h>

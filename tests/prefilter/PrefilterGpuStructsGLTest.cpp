@@ -3,9 +3,9 @@
 // C++ offsetof / sizeof (std140 / std430 rules). And the public include crep/scattering.glsl used the way
 // an engine uses it: its files registered with GL_ARB_shading_language_include, #included by a
 // fragment shader that is not part of the library, drawn, and compared with the EvaluatePass image.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
-#include "prefilter_gpu_util.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>

@@ -4,8 +4,8 @@
 // evaluation (Klehm et al. 2014, Sec. 3) against a brute-force march over the same rectified map with
 // exact per-ray transmittance (crep/scatter/rectified_march.h bruteForceMarch). Small sizes: 160 x 90 screen,
 // 256 x 128 map.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>

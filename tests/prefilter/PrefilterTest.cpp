@@ -10,8 +10,8 @@
 #include <crep/scatter/rectified_march.h>
 #include <crep/support/image_compare.h>
 
-#include "support/analytic_scene.h"
-#include "support/image_check.h"
+#include "common/analytic_scene.h"
+#include "common/image_check.h"
 
 #include <doctest/doctest.h>
 

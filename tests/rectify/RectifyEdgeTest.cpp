@@ -4,7 +4,7 @@
 #include <crep/rectify/json.h>
 #include <crep/rectify/rectify.h>
 
-#include "rectify_checks.h"
+#include "rectify/rectify_checks.h"
 
 #include <doctest/doctest.h>
 

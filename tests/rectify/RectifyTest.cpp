@@ -5,7 +5,7 @@
 #include <crep/core/error.h>
 #include <crep/rectify/rectify.h>
 
-#include "rectify_checks.h"
+#include "rectify/rectify_checks.h"
 
 #include <doctest/doctest.h>
 

@@ -4,7 +4,7 @@
 #include <crep/core/error.h>
 #include <crep/rectify/rectify.h>
 
-#include "rectify_test_util.h"
+#include "rectify/rectify_test_util.h"
 
 #include <doctest/doctest.h>
 

@@ -5,11 +5,11 @@
 // with the scattering prefix table and without a table) and the textured world march (WorldMarchPass::
 // FrameAttribs::lightTexture vs crep::worldSpaceMarch), for the sun's window and a spot light's gobo; the
 // modes without a textured variant reject it by name.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>

@@ -4,9 +4,9 @@
 // and a two-colour texture (left half red, right half blue) over the sun's window and over a spot light's
 // cone is prefiltered within the untextured method's own error of the brute-force march over the same map
 // and of the world march (relative RMSE per channel stated). Bad textures are named.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/local_light_scene.h"
 
 #include <crep/core/error.h>
 #include <crep/prefilter/prefilter.h>

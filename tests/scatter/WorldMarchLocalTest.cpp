@@ -3,9 +3,9 @@
 // spot or point light on its lit side. The lit part of every view ray is known exactly (the plane), and
 // its in-scattering is RayScattering::segment (tested against an independent quadrature in
 // RayScatteringTest), so the march's own error is its shadow-map visibility.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/local_light_scene.h"
 
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scatter/world_march.h>

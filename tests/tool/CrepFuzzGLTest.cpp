@@ -11,9 +11,9 @@
 // 128, few march steps), and a time budget after which no new case starts (on slow builds: sanitizers).
 // CREP_FUZZ_SEED overrides the seed (a failing case prints its seed, index and arguments); CREP_FUZZ_VERBOSE
 // prints every case with its exit status and last line.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

@@ -5,9 +5,9 @@
 // matrix that maps no visible point into the map warns, camera.maxDistance beyond a finite far plane is
 // clamped. Also the froxel-prefilter warnings name froxel-prefilter, and `crep bench --bases M` runs for
 // every even M.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

@@ -4,8 +4,8 @@
 // written and before the GL context exists; usage errors exit 2 naming the option the user set; inputs the
 // documentation does not allow (depth EXRs without a Y, Z, depth or R channel, a JSON file with a NUL byte)
 // are refused naming the file.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

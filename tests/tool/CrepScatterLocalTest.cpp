@@ -1,8 +1,8 @@
 // `crep scatter` with spot and point lights (frame_json.h "Local lights"): every domain check of the new
 // optional fields fails before any GL work with exit status 1 and a message naming the JSON path or the
 // file, never a crash. The valid frames themselves run in CrepScatterLocalGLTest.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

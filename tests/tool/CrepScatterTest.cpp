@@ -1,8 +1,8 @@
 // `crep scatter` failure paths: every check of the inputs happens before any GL work, so these run
 // without a context. Each bad input must exit 1 (2 for command-line misuse) with a message naming the
 // field or the file, never crash.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

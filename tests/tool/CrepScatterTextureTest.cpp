@@ -1,8 +1,8 @@
 // `crep scatter` with light textures (frame_json.h "Light textures"): every check of the optional fields
 // light.texture / light.textureClipFromWorld (and a spot entry's) fails before any GL work with exit status
 // 1 and a message naming the JSON path, never a crash. The valid frames run in CrepScatterTextureGLTest.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

@@ -1,7 +1,7 @@
 // End-to-end tests of the crep tool: run the built binary as a user would.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/support/exr.h>
 

@@ -1,6 +1,6 @@
 // End-to-end tests of the crep tool that need no GL: usage errors and `crep rectify`.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/core/camera.h>
 

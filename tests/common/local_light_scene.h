@@ -1,10 +1,10 @@
-// The analytic scene of the local-light tests: the ground camera of support/analytic_scene.h, a wall
+// The analytic scene of the local-light tests: the ground camera of common/analytic_scene.h, a wall
 // (half-space x > 2 shadowed) and a spot and a point light on its lit side; the closed form of the lit part
 // of every view ray (the wall plane cuts it exactly) integrated by RayScattering (itself checked against an
 // independent quadrature of Eq. 1 in RayScatteringTest).
 #pragma once
 
-#include "support/analytic_scene.h"
+#include "common/analytic_scene.h"
 
 #include <crep/core/camera.h>
 #include <crep/core/image.h>

@@ -1,24 +1,23 @@
 // The GPU prefilter pass for local lights (PrefilterPass::FrameAttribs::localLight, CREP_LOCAL_LIGHT)
 // against the CPU reference crep::prefilter(map, medium, LocalLight) on the analytic spot light's map
-// (scatter/local_light_util.h): the stored basis, RGBA32F, value by value.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/gl_fixture.h"
+// (common/local_light_scene.h): the stored basis, RGBA32F, value by value.
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
-#include <crep/epipolar/gpu_march.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
-#include <crep/scatter/rectified_march.h>
 
 #include <epoxy/gl.h>
 
 #include <doctest/doctest.h>
 
 #include <memory>
+#include <string>
 
 using namespace crep;
 using namespace crep::test;
@@ -145,47 +144,5 @@ TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation an
       CHECK(vsCpu.relativeRmse < 1e-3); // RGBA8 basis read through GL_LINEAR with 8-bit weights
       CHECK(vsTruth.relativeRmse < 0.01);
     }
-  }
-}
-
-TEST_CASE("rectified marches GL, local lights: brute force and min/max equal the CPU brute-force march") {
-  CREP_REQUIRE_GL();
-  constexpr int W = 512, H = 256, w = 160, h = 90;
-  const Camera camera = groundCamera(w, h);
-  const Image depth = groundDepth(camera, w, h);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
-  const SpotLight spot = analyticSpot();
-  const LocalLight light = LocalLight::spot(spot);
-  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
-  const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-  const gl::Handle mapTexture = uploadR32F(map.depth);
-  const gl::Handle depthTexture = uploadR32F(depth);
-  const Image cpu = bruteForceMarch(map, depth, camera, light, medium).scattering;
-  MinMaxTreePass trees({W, H});
-  trees.run(mapTexture.get());
-  for (const auto mode : {RectifiedMarchPass::Mode::BruteForce, RectifiedMarchPass::Mode::MinMaxTree}) {
-    const std::string name = mode == RectifiedMarchPass::Mode::BruteForce ? "brute force" : "min/max";
-    RectifiedMarchPass pass({W, H, mode});
-    const gl::Handle out = createTexture2D(GL_RGBA32F, w, h);
-    RectifiedMarchPass::FrameAttribs a;
-    a.layout = layout.get();
-    a.camera = &camera;
-    a.medium = &medium;
-    a.cameraDepth = depthTexture.get();
-    a.rectifiedDepth = mapTexture.get();
-    a.minMaxBuffer = trees.treeBuffer();
-    a.output = out.get();
-    a.localLight = &light;
-    pass.run(a);
-    const ImageMetrics m = rgbMetrics(readRgbaTexture(out.get(), w, h), cpu);
-    report("spot light, GPU " + name + " march vs CPU brute force", m);
-    CHECK(m.nanCount == 0);
-    CHECK(m.relativeRmse < 1e-4); // float sections and distances against double
-    const DirectionalLight sun = test::sideLight();
-    a.light = &sun;
-    CHECK_THROWS_WITH_AS(pass.run(a), doctest::Contains("RectifiedMarchPass::FrameAttribs.light/localLight"),
-                         crep::InvalidArgument);
   }
 }

@@ -1,4 +1,4 @@
-#include "support/tool_runner.h"
+#include "common/tool_runner.h"
 
 #include <algorithm>
 #include <array>
