@@ -1,8 +1,8 @@
-// The marches on the built-in scenes (issue 5): projective rectified maps rasterized with the split
-// matrices (SceneRenderer, GL_DEPTH_CLAMP), camera depth rasterized too. CPU: the min/max march equals the
-// brute-force march of the same map to float precision, with fewer steps on terrain than on forest. GPU
-// (compute passes on llvmpipe): trees bit-identical to the CPU's, tree march = brute-force march, both
-// against the CPU reference; the world-space march pass against the CPU world-space march.
+// The marches on the built-in scenes: projective rectified maps rasterized with the split matrices
+// (SceneRenderer, GL_DEPTH_CLAMP), camera depth rasterized too. CPU: the min/max march equals the brute-force
+// march of the same map to float precision, with fewer steps on terrain than on forest. GPU (compute passes
+// on llvmpipe): trees bit-identical to the CPU's, tree march = brute-force march, both against the CPU
+// reference; the world-space march pass against the CPU world-space march.
 #include "common/analytic_reference.h"
 #include "common/gl_fixture.h"
 #include "common/gl_scene_maps.h"

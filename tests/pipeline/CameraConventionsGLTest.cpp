@@ -1,5 +1,5 @@
-// Engine camera conventions end to end on the GPU (issue "engine conventions", part 2): the same scene and
-// the same prefiltered basis evaluated through
+// Engine camera conventions end to end on the GPU (on the CPU: Camera::fromMatrices in
+// tests/core/CameraTest.cpp): the same scene and the same prefiltered basis evaluated through
 //   (a) the tools' GL camera (symmetric, [-1, 1] clip depth, finite far, depth cleared to 1),
 //   (b) the engine matrices of a reversed-Z, [0, 1] clip depth camera with an infinite far plane and
 //       maxDistance = (a)'s far plane, its depth buffer holding near / Z (cleared to 0),

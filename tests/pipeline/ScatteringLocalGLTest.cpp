@@ -63,9 +63,9 @@ TEST_CASE(
     report(std::string("spot light ") + k.name + ": Scattering vs world-space reference", m);
     CHECK(m.nanCount == 0);
     CHECK(m.peak > 0.0);
-    // The issue's goal for both: within 2% of the world-space reference. Measured 0.52% off screen, 0.76% in
-    // view (on its epipolar layout, depth warp 0.03, the epipole block of 1% of the diagonal; 1.35% without
-    // the block, 3.2% with the sun's depth warp 0.1).
+    // The local lights' accuracy goal for both: within 2% of the world-space reference. Measured 0.52% off
+    // screen, 0.76% in view (on its epipolar layout, depth warp 0.03, the epipole block of 1% of the
+    // diagonal; 1.35% without the block, 3.2% with the sun's depth warp 0.1).
     bool block = false;
     for (const Scattering::Stage& stage : r.stages)
       block = block || stage.name == "local light: epipole block (world march)";
@@ -128,10 +128,10 @@ TEST_CASE("Scattering with local lights: a point light's six faces and a spot ad
   report("point light (six faces) added to the sun: Scattering - sun vs world-space references", m);
   CHECK(m.peak > 0.0);
   CHECK(m.nanCount == 0);
-  // The built-in scenes' goal (issue "local lights"): within 2% of the world-space reference. Measured
-  // 1.17% with Scattering::CreateInfo::localLightBases = 64 and localLightTableSamples = 64 (the defaults;
-  // 1.08% with 128 samples); 2.67% with M = 32, where the
-  // Fourier depth resolution smoothed the pillars' shadow steps of the faces seen from close by.
+  // The built-in scenes' goal for local lights: within 2% of the world-space reference. Measured 1.17% with
+  // Scattering::CreateInfo::localLightBases = 64 and localLightTableSamples = 64 (the defaults; 1.08% with
+  // 128 samples); 2.67% with M = 32, where the Fourier depth resolution smoothed the pillars' shadow steps of
+  // the faces seen from close by.
   CHECK(m.relativeRmse < 0.02);
   // Local lights need drawCasters.
   Scattering::FrameAttribs noCasters = f.attribs(false, true);

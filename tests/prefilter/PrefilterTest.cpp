@@ -516,9 +516,9 @@ TEST_CASE("prefilter: bad input gets a named InvalidArgument") {
 
 TEST_CASE("prefilter: the region visibility table keeps the analytic ground truth within 0.1%") {
   // EvaluateOptions::visibilityTableSamples: the regions a ray crosses whole read their visibility from a
-  // table over (row, depth) instead of the basis. Against the closed forms of (a) and (b), with the
-  // library's splits (8 x 2 prefilter regions) and the former 4 x 1: the table may not cost more than 0.1%
-  // relative RMSE (issue "performance", item 3). The table itself is tested against its definition.
+  // table over (row, depth) instead of the basis. Against the closed forms of (a) and (b), with the library's
+  // splits (8 x 2 prefilter regions) and the former 4 x 1: the table may not cost more than 0.1% relative
+  // RMSE (the price of the table's speed). The table itself is tested against its definition.
   const Camera camera = test::groundCamera();
   const DirectionalLight light = test::sideLight();
   const Medium medium = test::colouredMedium();

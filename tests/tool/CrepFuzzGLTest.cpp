@@ -1,6 +1,6 @@
-// A seeded fuzz test of the crep tool (issue 28): random command lines over the tool's real options and
-// values, mutations of the example JSON frame, truncated and bit-flipped EXR inputs. Every case runs the
-// built tool in a fresh folder (inputs, a FIFO, a folder, a file, a symbolic link) and must
+// A seeded fuzz test of the crep tool: random command lines over the tool's real options and values,
+// mutations of the example JSON frame, truncated and bit-flipped EXR inputs. Every case runs the built tool
+// in a fresh folder (inputs, a FIFO, a folder, a file, a symbolic link) and must
 //   - end with exit status 0, 1 or 2: never a signal, never a hang (60 s per case);
 //   - leave no partial output: no temporary of the output rule anywhere, and when the status is not 0 the
 //     folder exactly as it was (no new file, no changed or removed file);

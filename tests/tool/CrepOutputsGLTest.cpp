@@ -1,10 +1,9 @@
-// The crep tool's output rule on commands that run (README "The crep tool", "Outputs"; issue 28): a symbolic
-// link as an output keeps the link and replaces its final target (its permission bits kept, a dangling link's
-// target created); a command whose later output fails leaves none of its outputs (and no temporary, and an
-// older file at an output path untouched); and the checks of the frame that only warn or clamp: a shadow
-// matrix that maps no visible point into the map warns, camera.maxDistance beyond a finite far plane is
-// clamped. Also the froxel-prefilter warnings name froxel-prefilter, and `crep bench --bases M` runs for
-// every even M.
+// The crep tool's output rule on commands that run (README "The crep tool", "Outputs"): a symbolic link as an
+// output keeps the link and replaces its final target (its permission bits kept, a dangling link's target
+// created); a command whose later output fails leaves none of its outputs (and no temporary, and an older
+// file at an output path untouched); and the checks of the frame that only warn or clamp: a shadow matrix
+// that maps no visible point into the map warns, camera.maxDistance beyond a finite far plane is clamped.
+// Also the froxel-prefilter warnings name froxel-prefilter, and `crep bench --bases M` runs for every even M.
 #include "common/gl_fixture.h"
 #include "common/image_check.h"
 #include "common/tool_runner.h"

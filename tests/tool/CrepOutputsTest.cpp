@@ -1,6 +1,6 @@
-// The crep tool's output rule and usage errors that need no GL (README "The crep tool", "Outputs"; issue 28):
-// an output that is a FIFO, a device, a socket or a directory (itself or its link's target) is refused naming
-// the option and the path and stays what it was; every output folder and path is checked before any output is
+// The crep tool's output rule and usage errors that need no GL (README "The crep tool", "Outputs"): an output
+// that is a FIFO, a device, a socket or a directory (itself or its link's target) is refused naming the
+// option and the path and stays what it was; every output folder and path is checked before any output is
 // written and before the GL context exists; usage errors exit 2 naming the option the user set; inputs the
 // documentation does not allow (depth EXRs without a Y, Z, depth or R channel, a JSON file with a NUL byte)
 // are refused naming the file.

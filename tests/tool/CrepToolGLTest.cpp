@@ -88,7 +88,7 @@ TEST_CASE(
   CREP_REQUIRE_GL();
   crep::test::TempDir dir;
   const std::string out = " --out '" + (dir / "x").string() + "'";
-  // Used to exit 1 after creating the GL context ("invalid scene = cathedral"); issue 28.
+  // Used to exit 1 after creating the GL context ("invalid scene = cathedral"): usage errors come first.
   const RunResult unknown = runCrep("render --scene cathedral --size 16x9" + out);
   INFO(unknown.output);
   CHECK(unknown.status == 2);
