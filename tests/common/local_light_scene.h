@@ -10,6 +10,7 @@
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scatter/ray.h>
 #include <crep/scatter/ray_scattering.h>
 
@@ -18,6 +19,22 @@
 #include <vector>
 
 namespace crep::test {
+
+/// What the local-light tests see: the ground camera (width x height), its ground depth, the coloured medium
+/// and the rectify options of their layouts (8 splits).
+struct LocalLightView {
+  Camera camera;
+  Image depth;
+  Medium medium;
+  RectifyOptions rectify;
+};
+
+inline LocalLightView localLightView(int width, int height) {
+  LocalLightView v{groundCamera(width, height), {}, colouredMedium(), {}};
+  v.depth = groundDepth(v.camera, width, height);
+  v.rectify.splits = 8;
+  return v;
+}
 
 /// The occluder: x > 2 is shadowed (the lights are at x < 2).
 inline HalfSpace wall() {

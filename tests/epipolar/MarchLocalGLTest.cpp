@@ -25,11 +25,7 @@ using namespace crep::test;
 TEST_CASE("rectified marches GL, local lights: brute force and min/max equal the CPU brute-force march") {
   CREP_REQUIRE_GL();
   constexpr int W = 512, H = 256, w = 160, h = 90;
-  const Camera camera = groundCamera(w, h);
-  const Image depth = groundDepth(camera, w, h);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
+  const auto [camera, depth, medium, ro] = localLightView(w, h);
   const SpotLight spot = analyticSpot();
   const LocalLight light = LocalLight::spot(spot);
   const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));

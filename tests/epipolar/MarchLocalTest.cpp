@@ -23,12 +23,8 @@ constexpr int kW = 160, kH = 90;
 } // namespace
 
 TEST_CASE("rectified marches, spot light: brute force and min/max on the same map against the closed form") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const SpotLight spot = analyticSpot();
-  RectifyOptions ro;
-  ro.splits = 8;
   const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
   const RectifiedMap map = castRectifiedMap(layout, 1024, 512, wallHitFromLight);
   const LocalLight light = LocalLight::spot(spot);

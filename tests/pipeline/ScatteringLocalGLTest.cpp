@@ -30,7 +30,6 @@ TEST_CASE(
   ScatteringFixture f("colonnade");
   f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0))); // night: the local lights alone
   const Camera& c = f.scene.camera;
-  const glm::dvec3 target = c.position() + 14.0 * c.forward();
   struct Case {
     const char* name;
     glm::dvec3 position;
@@ -42,13 +41,7 @@ TEST_CASE(
                         Case{"in view", c.position() + 9.0 * c.forward() + 1.5 * c.up() - 1.0 * c.right(),
                              RectifyStatus::Fallback}}) {
     CAPTURE(std::string(k.name));
-    const SpotLight spot({.position = k.position,
-                          .direction = target - k.position,
-                          .innerConeAngle = 0.35,
-                          .outerConeAngle = 0.55,
-                          .color = {1.0, 0.85, 0.6},
-                          .intensity = 150.0,
-                          .range = 80.0});
+    const SpotLight spot = spotToward(c, k.position);
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.spotLights = std::span<const SpotLight>(&spot, 1);
     const Scattering::FrameResult r = scattering.run(a);

@@ -18,31 +18,41 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 using namespace crep;
 using namespace crep::test;
 
+namespace {
+
+/// A local light of the analytic scene with its rectification for the camera.
+struct Case {
+  const char* name;
+  Rectification rect;
+  LocalLight light;
+};
+
+/// The analytic spot and the analytic point light's face +X.
+std::vector<Case> spotAndFace(const Camera& camera, const RectifyOptions& ro) {
+  const SpotLight spot = analyticSpot();
+  const PointLight point = analyticPoint();
+  return {
+      Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
+      Case{"point light face +X", rectifyPointLight(camera, point, ro)[0], LocalLight::pointFace(point, 0)}};
+}
+
+} // namespace
+
 TEST_CASE("prefilter GL, local lights: the GPU basis equals the CPU reference (spot light, point face)") {
   CREP_REQUIRE_GL();
   constexpr int W = 256, H = 128;
-  const Camera camera = groundCamera(160, 90);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
+  const auto [camera, depth, medium, ro] = localLightView(160, 90);
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   o.format = StorageFormat::RGBA32F;
   PrefilterPass pass({.mapWidth = W, .mapHeight = H, .options = o});
   const SpotLight spot = analyticSpot();
-  const PointLight point = analyticPoint();
-  struct Case {
-    const char* name;
-    Rectification rect;
-    LocalLight light;
-  };
-  for (const Case& k : {Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
-                        Case{"point light face +X", rectifyPointLight(camera, point, ro)[0],
-                             LocalLight::pointFace(point, 0)}}) {
+  for (const Case& k : spotAndFace(camera, ro)) {
     CAPTURE(std::string(k.name));
     REQUIRE(k.rect.projective());
     const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
@@ -79,51 +89,26 @@ TEST_CASE("prefilter GL, local lights: the GPU basis equals the CPU reference (s
 TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation and the closed form") {
   CREP_REQUIRE_GL();
   constexpr int W = 512, H = 256, w = 160, h = 90;
-  const Camera camera = groundCamera(w, h);
-  const Image depth = groundDepth(camera, w, h);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
+  const auto [camera, depth, medium, ro] = localLightView(w, h);
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   PrefilterPass prefilterPass({.mapWidth = W, .mapHeight = H, .options = o});
   const gl::Handle depthTexture = uploadR32F(depth);
-  const SpotLight spot = analyticSpot();
-  const PointLight point = analyticPoint();
-  struct Case {
-    const char* name;
-    Rectification rect;
-    LocalLight light;
-  };
   for (const int variant : {0, 1, 2}) {
     // Prefix table or per-region loop; the sections by the quadrature or in closed form (airlight table).
     const bool prefixTable = variant != 1, closedForm = variant == 2;
     EvaluateOptions eo;
     eo.scatteringPrefix = prefixTable;
     EvaluatePass evaluatePass({.options = eo, .localClosedForm = closedForm});
-    for (const Case& k : {Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
-                          Case{"point light face +X", rectifyPointLight(camera, point, ro)[0],
-                               LocalLight::pointFace(point, 0)}}) {
+    for (const Case& k : spotAndFace(camera, ro)) {
       const std::string name = std::string(k.name) + (prefixTable ? ", prefix table" : ", per-region table") +
                                (closedForm ? ", closed form" : "");
       CAPTURE(name);
       REQUIRE(k.rect.projective());
       const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
       const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-      const gl::Handle texture = uploadR32F(map.depth);
-      prefilterPass.run({.rectifiedDepth = texture.get(),
-                         .layout = layout.get(),
-                         .medium = &medium,
-                         .localLight = &k.light});
-      const gl::Handle out = createTexture2D(GL_RGBA32F, w, h);
-      evaluatePass.run({.cameraDepth = depthTexture.get(),
-                        .output = out.get(),
-                        .camera = &camera,
-                        .medium = &medium,
-                        .layout = layout.get(),
-                        .basis = prefilterPass.filteredBasis(),
-                        .localLight = &k.light});
-      const Image gpu = readRgbaTexture(out.get(), w, h);
+      const Image gpu = prefilterEvaluateLocal(prefilterPass, evaluatePass, map, layout.get(), camera,
+                                               depthTexture.get(), w, h, medium, k.light);
       const Image cpu = evaluate(prefilter(map, medium, k.light, o), depth, camera, k.light, medium, eo);
       const ImageMetrics vsCpu = rgbMetrics(gpu, cpu);
       if (prefixTable) {

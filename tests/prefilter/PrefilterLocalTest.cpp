@@ -5,6 +5,7 @@
 #include "common/analytic_reference.h"
 #include "common/analytic_scene.h"
 #include "common/local_light_scene.h"
+#include "prefilter/colonnade_point_light.h"
 
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
@@ -42,12 +43,8 @@ Image prefiltered(const Rectification& rect, const LocalLight& light, const Came
 } // namespace
 
 TEST_CASE("prefiltered spot light: closed forms without and with the half-space shadow") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const SpotLight spot = analyticSpot();
-  RectifyOptions ro;
-  ro.splits = 8;
   const Rectification rect = rectify(camera, spot, ro);
   REQUIRE(rect.projective());
   const LocalLight light = LocalLight::spot(spot);
@@ -64,12 +61,8 @@ TEST_CASE("prefiltered spot light: closed forms without and with the half-space 
 }
 
 TEST_CASE("prefiltered point light: six faces against the closed form, no seam at the face borders") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const PointLight point = analyticPoint();
-  RectifyOptions ro;
-  ro.splits = 8;
   const std::array<Rectification, 6> faces = rectifyPointLight(camera, point, ro);
   Image sum(kW, kH, 4);
   std::vector<LocalLight> lights;
@@ -137,13 +130,8 @@ TEST_CASE("prefiltered point light: every region's reference ray is finite where
   // furthest instead.
   const scenes::Scene scene = scenes::makeScene("colonnade", 160.0 / 90.0);
   const Camera& c = scene.camera;
-  const PointLight point({.position = c.position() - 5.0 * c.right() + 3.0 * c.up() - 3.0 * c.forward(),
-                          .color = {1.0, 0.8, 0.6},
-                          .intensity = 60.0,
-                          .range = 80.0});
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto faces = rectifyPointLight(c, point, ro);
+  const PointLight point = colonnadePointLight(c);
+  const auto faces = colonnadePointFaces(c, point);
   REQUIRE(faces[5].projective());
   const ProjectiveLayout layout(faces[5]);
   const int H = 512, P = 2, K = layout.regionCount();

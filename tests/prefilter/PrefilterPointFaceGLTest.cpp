@@ -8,6 +8,7 @@
 #include "common/analytic_reference.h"
 #include "common/gl_fixture.h"
 #include "common/prefilter_gpu.h"
+#include "prefilter/colonnade_point_light.h"
 
 #include <crep/core/gl.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
@@ -46,13 +47,8 @@ TEST_CASE("prefiltered point light faces on the colonnade: GPU and CPU against t
   CREP_REQUIRE_GL();
   SceneDepth f("colonnade");
   const Camera& c = f.scene.camera;
-  const PointLight point({.position = c.position() - 5.0 * c.right() + 3.0 * c.up() - 3.0 * c.forward(),
-                          .color = {1.0, 0.8, 0.6},
-                          .intensity = 60.0,
-                          .range = 80.0});
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto faces = rectifyPointLight(c, point, ro);
+  const PointLight point = colonnadePointLight(c);
+  const auto faces = colonnadePointFaces(c, point);
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   const Image camDepth = gl::readTexture(f.cameraDepth.get(), kWidth, kHeight, gl::TexelData::Depth);

@@ -50,14 +50,8 @@ bool startsWithPng(const fs::path& p) {
 }
 
 /// Scatter inputs for the example frame (depth 160x90 at 0.9, shadow 256x256 at 1, the example JSON).
-struct ScatterInputs {
-  crep::test::TempDir dir{"crep-outputs-gl"};
-  ScatterInputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
-    writeText(dir / "frame.json", readText(kExample));
-  }
-  std::string path(const std::string& name) const { return (dir / name).string(); }
+struct ScatterInputs : ScatterFolder {
+  ScatterInputs() : ScatterFolder("crep-outputs-gl") { writeExampleFrame(); }
   std::vector<std::string> args(const std::string& frame, const std::string& out) const {
     return {"scatter", "--depth", path("depth.exr"), "--shadow",  path("shadow.exr"), "--frame", path(frame),
             "--out",   path(out), "--method",        "reference", "--steps",          "8"};

@@ -52,14 +52,8 @@ void expectEarlyFailure(const ArgvResult& r, int status, std::initializer_list<s
 }
 
 /// Valid scatter inputs for the example frame: depth.exr (160x90, 0.9), shadow.exr (256x256, 1), frame.json.
-struct ScatterInputs {
-  crep::test::TempDir dir{"crep-outputs"};
-  ScatterInputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
-    writeText(dir / "frame.json", readText(kExample));
-  }
-  std::string path(const std::string& name) const { return (dir / name).string(); }
+struct ScatterInputs : ScatterFolder {
+  ScatterInputs() : ScatterFolder("crep-outputs") { writeExampleFrame(); }
   std::vector<std::string> args(std::initializer_list<std::string> extra) const {
     std::vector<std::string> a = {"scatter",          "--depth", path("depth.exr"), "--shadow",
                                   path("shadow.exr"), "--frame", path("frame.json")};
