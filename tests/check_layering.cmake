@@ -9,7 +9,7 @@ cmake_minimum_required(VERSION 3.25)
 #    folder is found by what it names: <crep/<name>/...> -> the folder holding include/crep/<name>/;
 #    a quoted "path" -> the file it resolves to (relative to the includer first, then any header of the
 #    tree whose path ends with it: the include directories of the targets, e.g. "bench_suite.h" ->
-#    bench/suite/, "frame.h" -> examples/crep/lib/, "support/gl_fixture.h" -> tests/support/).
+#    bench/suite/, "frame.h" -> examples/crep/lib/, "common/gl_fixture.h" -> tests/common/).
 #
 # 3. Shaders: every file of glsl/ (embedded into the runtime library) is used by the library: its name
 #    appears in a library module's source or in another glsl/ file. Tool shaders live in examples/glsl/,

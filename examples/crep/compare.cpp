@@ -90,76 +90,90 @@ std::vector<std::string> selectedMethods(const Args& args) {
   return names;
 }
 
-} // namespace
+/// The command line of `crep compare`, checked.
+struct CompareArgs {
+  std::string sceneName;
+  glm::ivec2 size{0};
+  MethodSettings settings;
+  double exposure = 0.0, amplify = 0.0;
+  int tileWidth = 0;
+  std::vector<std::string> names; ///< the methods, the reference first
+  std::string out, csvPath, pngPath;
+  bool debugGl = false;
+};
 
-int compareCommand(const std::vector<std::string>& argv) {
+/// Parses and checks the command line: the scene, the sizes (the contact sheet within the image limits),
+/// the methods and the output prefix.
+CompareArgs parseCompareArgs(const std::vector<std::string>& argv) {
   std::set<std::string> valued = {"scene", "size", "out", "exposure", "amplify", "tile-width", "methods"};
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
   valued.erase("method");
   const Args args(argv, valued, {"debug-gl"});
-  const std::string sceneName = args.string("scene", "colonnade");
-  requireSceneName(sceneName); // before the default --out (crep-compare-<scene>) is derived from it
-  const glm::ivec2 size = args.size("size", {640, 360}, Image::kMaxDimension, Image::kMaxPixels);
-  MethodSettings settings = methodSettings(args);
-  if (!args.has("steps")) settings.steps = 512;
-  const double exposure = exposureOption(args);
-  const double amplify = args.number("amplify", 20.0);
+  CompareArgs o;
+  o.sceneName = args.string("scene", "colonnade");
+  requireSceneName(o.sceneName); // before the default --out (crep-compare-<scene>) is derived from it
+  o.size = args.size("size", {640, 360}, Image::kMaxDimension, Image::kMaxPixels);
+  o.settings = methodSettings(args);
+  if (!args.has("steps")) o.settings.steps = 512;
+  o.exposure = exposureOption(args);
+  o.amplify = args.number("amplify", 20.0);
   // Bounded so that the legend prints a plain number; at 1e6 float rounding of the images (relative
   // 6e-8) already fills 6% of the heat map's scale.
-  if (!(amplify > 0.0 && amplify <= 1e6)) throw UsageError("option --amplify: must be in (0, 1e6]");
+  if (!(o.amplify > 0.0 && o.amplify <= 1e6)) throw UsageError("option --amplify: must be in (0, 1e6]");
   // Default: the image width within the accepted tile widths (a 1-pixel wide image is shown 16 wide).
-  const int tileWidth =
-      args.integer("tile-width", std::clamp(size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);
-  const std::vector<std::string> names = selectedMethods(args);
-  requireMethodImageSize(settings, names, size,
+  o.tileWidth =
+      args.integer("tile-width", std::clamp(o.size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);
+  o.names = selectedMethods(args);
+  const glm::ivec2 size = o.size;
+  requireMethodImageSize(o.settings, o.names, size,
                          "--size " + std::to_string(size.x) + "x" + std::to_string(size.y), false);
-  const glm::ivec2 sheetBound = sheetSizeBound(tileWidth, size, static_cast<int>(names.size()));
+  const glm::ivec2 sheetBound = sheetSizeBound(o.tileWidth, size, static_cast<int>(o.names.size()));
   if (sheetBound.y > Image::kMaxDimension ||
       static_cast<long long>(sheetBound.x) * sheetBound.y > Image::kMaxPixels)
     throw UsageError(
-        "option --tile-width: tiles " + std::to_string(tileWidth) + " wide for --size " +
+        "option --tile-width: tiles " + std::to_string(o.tileWidth) + " wide for --size " +
         std::to_string(size.x) + "x" + std::to_string(size.y) + " make a contact sheet of up to " +
         std::to_string(sheetBound.x) + "x" + std::to_string(sheetBound.y) +
         " pixels, beyond the image limits (" + std::to_string(Image::kMaxDimension) + " per side, " +
         std::to_string(Image::kMaxPixels) + " pixels): use a smaller --tile-width or a wider --size");
-  const std::string out = args.string("out", "crep-compare-" + sceneName);
-  requireOutputPrefix({"--out", out});
-  const std::string csvPath = out + ".csv", pngPath = out + ".png";
-  // Both outputs checked now, written at the end, all or nothing (paths.h "The output rule").
-  OutputFiles outputs;
-  outputs.addFile({"--out", pngPath});
-  outputs.addFile({"--out", csvPath});
+  o.out = args.string("out", "crep-compare-" + o.sceneName);
+  requireOutputPrefix({"--out", o.out});
+  o.csvPath = o.out + ".csv";
+  o.pngPath = o.out + ".png";
+  o.debugGl = args.has("debug-gl");
+  return o;
+}
 
-  StageTimings timings;
-  if (isatty(2)) timings.setProgress("crep compare");
-  ensureGlContext("compare", args.has("debug-gl"), timings);
-  SceneFrame s = makeSceneFrame(sceneName, size.x, size.y, settings.mapSize, timings);
+/// Every method on the frame: its scattering and composited images and timings, and its metrics against
+/// the first method's image (the reference).
+std::vector<Result> runMethods(const CompareArgs& o, SceneFrame& s) {
   FrameInputs& frame = *s.frame;
-
   std::vector<Result> results;
-  for (const std::string& name : names) {
+  for (const std::string& name : o.names) {
     if (isatty(2)) std::fprintf(stderr, "crep compare: method %s ...\n", name.c_str());
-    MethodOutput o = runMethod(name, frame, settings);
-    gl::Handle composite = compositeImage(frame, s.color.get(), o.scattering.get());
+    MethodOutput m = runMethod(name, frame, o.settings);
+    gl::Handle composite = compositeImage(frame, s.color.get(), m.scattering.get());
     Result r{name,
-             o.used,
-             o.detail,
-             readRgba(o.scattering.get(), size.x, size.y),
-             readRgba(composite.get(), size.x, size.y),
+             m.used,
+             m.detail,
+             readRgba(m.scattering.get(), o.size.x, o.size.y),
+             readRgba(composite.get(), o.size.x, o.size.y),
              {},
-             o.timings};
+             m.timings};
     checkGlErrors(name.c_str());
     requireFinite(r.scattering, "the scattering image of " + name);
     results.push_back(std::move(r));
   }
   const Image& reference = results.front().scattering;
-  CompareOptions compareOptions;
+  crep::CompareOptions compareOptions;
   compareOptions.channels = 3;
   for (Result& r : results)
     r.metrics = compareImages(r.scattering, reference, compareOptions);
-  const double peak = results.front().metrics.peak;
+  return results;
+}
 
-  // CSV: one row per method; a column per stage any method has (empty where it has none).
+/// The CSV: one row per method; a column per stage any method has (empty where it has none).
+std::string compareCsv(const CompareArgs& o, const std::vector<Result>& results) {
   std::vector<std::string> stages;
   for (const Result& r : results)
     for (const auto& row : r.timings.rows())
@@ -170,7 +184,7 @@ int compareCommand(const std::vector<std::string>& argv) {
     csv << "," << csvField("ms " + st);
   csv << ",ms total\n";
   for (const Result& r : results) {
-    csv << sceneName << "," << size.x << "," << size.y << "," << r.name << "," << csvField(r.used) << ","
+    csv << o.sceneName << "," << o.size.x << "," << o.size.y << "," << r.name << "," << csvField(r.used) << ","
         << number(r.metrics.relativeRmse) << "," << number(r.metrics.psnr) << ","
         << number(r.metrics.maxAbsError) << "," << number(r.metrics.meanAbsError);
     for (const std::string& st : stages) {
@@ -186,11 +200,16 @@ int compareCommand(const std::vector<std::string>& argv) {
     }
     csv << "," << fixed(r.timings.total(), 3) << "\n";
   }
-  outputs.write(csvPath, [&](const std::filesystem::path& file) { writeTextFile(file, csv.str()); });
+  return csv.str();
+}
 
-  // Contact sheet.
+/// The contact sheet's columns: each method's composite, its error heat map against the reference (the
+/// first), metrics and timings, every text line clipped to the tile.
+std::vector<SheetColumn> sheetColumns(const CompareArgs& o, const std::vector<Result>& results) {
+  const Image& reference = results.front().scattering;
+  const double peak = results.front().metrics.peak;
   std::vector<SheetColumn> columns;
-  const std::size_t maxChars = static_cast<std::size_t>(std::max(8, tileWidth / 6));
+  const std::size_t maxChars = static_cast<std::size_t>(std::max(8, o.tileWidth / 6));
   auto clip = [&](std::string line) {
     if (line.size() > maxChars) line = line.substr(0, maxChars - 3) + "...";
     return line;
@@ -200,7 +219,7 @@ int compareCommand(const std::vector<std::string>& argv) {
     SheetColumn c;
     c.title = r.name + (r.used != r.name ? " (ran " + r.used + ")" : "");
     c.image = r.composite;
-    if (i > 0) c.heat = heatMap(r.scattering, reference, peak, amplify);
+    if (i > 0) c.heat = heatMap(r.scattering, reference, peak, o.amplify);
     c.lines.push_back(clip(r.detail));
     if (i > 0) {
       c.lines.push_back(clip("rel RMSE " + fixed(100.0 * r.metrics.relativeRmse, 2) + "%   PSNR " +
@@ -216,24 +235,52 @@ int compareCommand(const std::vector<std::string>& argv) {
     c.lines.push_back(clip("total: " + fixed(r.timings.total(), 1) + " ms"));
     columns.push_back(std::move(c));
   }
-  const std::string header = "crep compare: scene " + sceneName + ", " + std::to_string(size.x) + "x" +
-                             std::to_string(size.y) + ", map " + std::to_string(settings.mapSize) +
-                             "^2, M = " + std::to_string(settings.prefilter.bases) +
-                             ", reference = world-space march, " + std::to_string(settings.steps) +
-                             " steps; GL renderer: " + glRenderer();
-  const Image sheet = composeSheet(header, columns, tileWidth, exposure, amplify);
-  outputs.write(pngPath, [&](const std::filesystem::path& file) { writePng(file, sheet); });
-  outputs.commit();
+  return columns;
+}
 
-  std::printf("crep compare: scene %s, %dx%d, map %d^2, reference %d march steps\n", sceneName.c_str(),
-              size.x, size.y, settings.mapSize, settings.steps);
+/// The contact sheet: the header line over the columns.
+Image contactSheet(const CompareArgs& o, const std::vector<Result>& results) {
+  const std::string header = "crep compare: scene " + o.sceneName + ", " + std::to_string(o.size.x) + "x" +
+                             std::to_string(o.size.y) + ", map " + std::to_string(o.settings.mapSize) +
+                             "^2, M = " + std::to_string(o.settings.prefilter.bases) +
+                             ", reference = world-space march, " + std::to_string(o.settings.steps) +
+                             " steps; GL renderer: " + glRenderer();
+  return composeSheet(header, sheetColumns(o, results), o.tileWidth, o.exposure, o.amplify);
+}
+
+/// The summary on stdout: one line per method.
+void printSummary(const CompareArgs& o, const std::vector<Result>& results) {
+  std::printf("crep compare: scene %s, %dx%d, map %d^2, reference %d march steps\n", o.sceneName.c_str(),
+              o.size.x, o.size.y, o.settings.mapSize, o.settings.steps);
   std::printf("%-12s %-12s %10s %10s %12s %12s\n", "method", "ran", "rel RMSE", "PSNR dB", "max error",
               "total ms");
   for (const Result& r : results)
     std::printf("%-12s %-12s %9.3f%% %10s %12s %12.1f\n", r.name.c_str(), r.used.c_str(),
                 100.0 * r.metrics.relativeRmse, number(r.metrics.psnr).c_str(),
                 number(r.metrics.maxAbsError).c_str(), r.timings.total());
-  std::printf("wrote %s (contact sheet) and %s\n", pngPath.c_str(), csvPath.c_str());
+  std::printf("wrote %s (contact sheet) and %s\n", o.pngPath.c_str(), o.csvPath.c_str());
+}
+
+} // namespace
+
+int compareCommand(const std::vector<std::string>& argv) {
+  const CompareArgs o = parseCompareArgs(argv);
+  // Both outputs checked now, written at the end, all or nothing (paths.h "The output rule").
+  OutputFiles outputs;
+  outputs.addFile({"--out", o.pngPath});
+  outputs.addFile({"--out", o.csvPath});
+
+  StageTimings timings;
+  if (isatty(2)) timings.setProgress("crep compare");
+  ensureGlContext("compare", o.debugGl, timings);
+  SceneFrame s = makeSceneFrame(o.sceneName, o.size.x, o.size.y, o.settings.mapSize, timings);
+  const std::vector<Result> results = runMethods(o, s);
+  const std::string csv = compareCsv(o, results);
+  outputs.write(o.csvPath, [&](const std::filesystem::path& file) { writeTextFile(file, csv); });
+  const Image sheet = contactSheet(o, results);
+  outputs.write(o.pngPath, [&](const std::filesystem::path& file) { writePng(file, sheet); });
+  outputs.commit();
+  printSummary(o, results);
   return 0;
 }
 

@@ -139,44 +139,77 @@ void warnIfShadowMapMissesView(const Camera& camera, const Image& depth, const g
       framePath.c_str(), points, depthPath.c_str(), shortest(camera.far()).c_str());
 }
 
-} // namespace
+/// The command line of `crep scatter`, checked: every option's value, then the files.
+struct ScatterArgs {
+  std::string depthPath, shadowPath, framePath;
+  std::string method;
+  MethodSettings settings;
+  std::string out;
+  std::optional<std::string> png; ///< --png
+  double exposure = 0.0;
+  bool debugGl = false;
+  std::vector<PathOption> inputs, outputs;
+};
 
-int scatterCommand(const std::vector<std::string>& argv) {
+/// Parses the command line (usage errors first), then checks the files: inputs that are directories,
+/// outputs that cannot be written or would overwrite an input fail here, before anything is read or
+/// written. Every output is added to `files`, written at the end, all or nothing (paths.h "The output rule").
+ScatterArgs parseScatterArgs(const std::vector<std::string>& argv, OutputFiles& files) {
   std::set<std::string> valued = {"depth", "shadow", "frame", "out", "png", "exposure"};
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
   const Args args(argv, valued, {"debug-gl"});
   for (const char* required : {"depth", "shadow", "frame"})
     if (!args.has(required))
       throw UsageError(std::string("option --") + required + " is required (see crep help)");
-  const std::string depthPath = args.string("depth", ""), shadowPath = args.string("shadow", "");
-  const std::string framePath = args.string("frame", "");
-  const std::string method = args.string("method", "prefilter");
-  findMethod(method);
-  const MethodSettings settings = methodSettings(args);
-  const std::string out = args.string("out", "scattering.exr");
-  const double exposure = exposureOption(args);
-  // Files: inputs that are directories, outputs that cannot be written or would overwrite an input fail
-  // here, before anything is read or written.
-  const std::vector<PathOption> inputs = {
-      {"--depth", depthPath}, {"--shadow", shadowPath}, {"--frame", framePath}};
-  std::vector<PathOption> outputs = {{"--out", out}};
-  if (args.has("png")) outputs.push_back({"--png", args.string("png", "")});
-  for (const PathOption& p : inputs)
+  ScatterArgs o;
+  o.depthPath = args.string("depth", "");
+  o.shadowPath = args.string("shadow", "");
+  o.framePath = args.string("frame", "");
+  o.method = args.string("method", "prefilter");
+  findMethod(o.method);
+  o.settings = methodSettings(args);
+  o.out = args.string("out", "scattering.exr");
+  o.exposure = exposureOption(args);
+  o.debugGl = args.has("debug-gl");
+  if (args.has("png")) o.png = args.string("png", "");
+  o.inputs = {{"--depth", o.depthPath}, {"--shadow", o.shadowPath}, {"--frame", o.framePath}};
+  o.outputs = {{"--out", o.out}};
+  if (o.png) o.outputs.push_back({"--png", *o.png});
+  for (const PathOption& p : o.inputs)
     requireNonEmpty(p);
-  for (const PathOption& p : outputs)
+  for (const PathOption& p : o.outputs)
     requireNonEmpty(p);
-  requireDistinctFiles(outputs, inputs); // usage errors above, file system below
-  // Every output checked now, written at the end, all or nothing (paths.h "The output rule").
-  OutputFiles files;
-  for (const PathOption& p : outputs)
+  requireDistinctFiles(o.outputs, o.inputs); // usage errors above, file system below
+  for (const PathOption& p : o.outputs)
     files.addFile(p);
-  for (const PathOption& p : inputs)
+  for (const PathOption& p : o.inputs)
     requireInputFile(p, p.option != "--frame"); // EXRs: regular files; the JSON may come from a pipe
+  return o;
+}
 
-  StageTimings timings;
-  if (isatty(2)) timings.setProgress("crep scatter");
-  // Everything about the inputs is checked before any GL work.
-  const FrameDescription desc = timings.time("read frame json", [&] {
+/// The requirement of a library InvalidArgument about a light matrix, without its prefix.
+std::string matrixRequirement(const InvalidArgument& e) {
+  std::string what = e.what(); // "crep: invalid lightClipFromWorld = <value> (<requirement>)"
+  const std::string prefix = "crep: invalid lightClipFromWorld = ";
+  if (what.starts_with(prefix)) what = what.substr(prefix.size());
+  return what;
+}
+
+/// The JSON frame description and what it describes, checked (format errors name the file and the field).
+struct ScatterFrame {
+  FrameDescription desc;
+  Camera camera;
+  bool directional;
+  /// A night frame (the main light a spot or point light) has no directional light: `light` is unused.
+  DirectionalLight light;
+  Medium medium;
+  std::vector<FrameLocalLight> localLights;
+};
+
+/// Reads the frame description and checks every light matrix with the library's own checks (crep::Scattering
+/// applies them to the maps it is given), after the JSON's.
+ScatterFrame readScatterFrame(const std::string& framePath, StageTimings& timings) {
+  FrameDescription desc = timings.time("read frame json", [&] {
     try {
       return readFrameDescription(framePath);
     } catch (const IoError& e) {
@@ -185,27 +218,19 @@ int scatterCommand(const std::vector<std::string>& argv) {
   });
   const Camera camera = cameraOf(desc, framePath);
   const bool directional = desc.lightType == LightType::Directional;
-  // A night frame (the main light a spot or point light): no directional light; `light` is unused.
   const DirectionalLight light =
       directional ? lightOf(desc, framePath) : DirectionalLight(glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(0.0));
   const Medium medium = mediumOf(desc, framePath);
-  const std::vector<FrameLocalLight> localLights = localLightsOf(desc, framePath);
-  const auto strip = [](const InvalidArgument& e) {
-    std::string what = e.what(); // "crep: invalid lightClipFromWorld = <value> (<requirement>)"
-    const std::string prefix = "crep: invalid lightClipFromWorld = ";
-    if (what.starts_with(prefix)) what = what.substr(prefix.size());
-    return what;
-  };
+  std::vector<FrameLocalLight> localLights = localLightsOf(desc, framePath);
   if (directional) {
     try {
       validateLightMatrix(desc.lightClipFromWorld, light.direction());
     } catch (const InvalidArgument& e) {
-      throw FormatError(framePath + ": shadowMap.lightClipFromWorld: " + strip(e));
+      throw FormatError(framePath + ": shadowMap.lightClipFromWorld: " + matrixRequirement(e));
     }
   }
   for (const FrameLocalLight& l : localLights)
     for (std::size_t k = 0; k < l.lightClipFromWorld.size(); ++k) {
-      // The library's own check (crep::Scattering applies it to the maps it is given), after the JSON's.
       try {
         validateLocalLightMatrix(l.lightClipFromWorld[k], l.spot ? l.spot->position() : l.point->position());
       } catch (const InvalidArgument& e) {
@@ -215,68 +240,75 @@ int scatterCommand(const std::vector<std::string>& argv) {
                                                         !desc.localLight.faceClipFromWorld
                                                     ? " (default)"
                                                     : "");
-        throw FormatError(framePath + ": " + field + ": " + strip(e));
+        throw FormatError(framePath + ": " + field + ": " + matrixRequirement(e));
       }
     }
-  // The additional lights' shadow EXRs, relative to the JSON file; they must not be outputs either.
+  return {std::move(desc), camera, directional, light, medium, std::move(localLights)};
+}
+
+/// The frame's images, read and checked before any GL work.
+struct ScatterImages {
+  Image depth, shadow;
+  /// The directional light's texture and the local lights' (localTextures[i] is localLights[i]'s, or empty).
+  std::optional<FrameLightTexture> sunTexture;
+  Image sunTextureImage;
+  std::vector<std::optional<FrameLightTexture>> localTextures;
+  std::vector<Image> localTextureImages;
+  std::vector<Image> localShadows; ///< each local light's map: the main light's is --shadow
+};
+
+/// The additional lights' shadow EXRs, relative to the JSON file: they must exist and must not be outputs.
+std::vector<PathOption> localShadowFiles(const ScatterArgs& o, const ScatterFrame& f) {
   std::vector<PathOption> lightFiles;
-  for (const FrameLocalLight& l : localLights)
+  for (const FrameLocalLight& l : f.localLights)
     if (!l.shadowFile.empty()) {
-      const std::filesystem::path file = std::filesystem::path(framePath).parent_path() / l.shadowFile;
+      const std::filesystem::path file = std::filesystem::path(o.framePath).parent_path() / l.shadowFile;
       lightFiles.push_back({l.shadowPath + ".file", file.string()});
       std::error_code ec;
       if (!std::filesystem::exists(file, ec))
-        throw IoError(framePath + ": " + l.shadowPath + ".file: '" + file.string() + "' does not exist");
+        throw IoError(o.framePath + ": " + l.shadowPath + ".file: '" + file.string() + "' does not exist");
       requireInputFile(lightFiles.back(), true);
     }
-  requireDistinctFiles(outputs, lightFiles);
-  // Light textures (frame_json.h "Light textures"): the directional light's and the spots', their
-  // projections checked along the light's rays, the EXRs relative to the JSON file read and checked here,
-  // before any GL work. textures[i] is localLights[i]'s (or empty).
-  const std::filesystem::path jsonDir = std::filesystem::path(framePath).parent_path();
+  requireDistinctFiles(o.outputs, lightFiles);
+  return lightFiles;
+}
+
+/// Light textures (frame_json.h "Light textures"): the directional light's and the spots', their
+/// projections checked along the light's rays, the EXRs relative to the JSON file read and checked.
+void readLightTextures(const ScatterArgs& o, const ScatterFrame& f, ScatterImages& images,
+                       StageTimings& timings) {
+  const std::filesystem::path jsonDir = std::filesystem::path(o.framePath).parent_path();
   std::vector<PathOption> textureFiles;
   const auto readTexture = [&](const FrameLightTexture& t) {
     const std::string field = t.path + ".texture";
     const std::filesystem::path file = jsonDir / t.file;
     textureFiles.push_back({field, file.string()});
-    requireDistinctFiles(outputs, {textureFiles.back()});
-    requireInputFile({framePath + ": " + field, file.string()}, true);
-    return timings.time("read light texture", [&] { return readLightTexture(file, field, framePath); });
+    requireDistinctFiles(o.outputs, {textureFiles.back()});
+    requireInputFile({o.framePath + ": " + field, file.string()}, true);
+    return timings.time("read light texture", [&] { return readLightTexture(file, field, o.framePath); });
   };
-  std::optional<FrameLightTexture> sunTexture = lightTextureOf(desc, framePath);
-  Image sunTextureImage;
-  if (sunTexture) sunTextureImage = readTexture(*sunTexture);
-  std::vector<std::optional<FrameLightTexture>> localTextures;
-  std::vector<Image> localTextureImages;
-  for (const FrameLocalLight& l : localLights) {
-    localTextures.push_back(lightTextureOf(l, framePath));
-    localTextureImages.push_back(localTextures.back() ? readTexture(*localTextures.back()) : Image());
+  images.sunTexture = lightTextureOf(f.desc, o.framePath);
+  if (images.sunTexture) images.sunTextureImage = readTexture(*images.sunTexture);
+  for (const FrameLocalLight& l : f.localLights) {
+    images.localTextures.push_back(lightTextureOf(l, o.framePath));
+    images.localTextureImages.push_back(
+        images.localTextures.back() ? readTexture(*images.localTextures.back()) : Image());
   }
-  const Image depth =
-      timings.time("read depth exr", [&] { return readDepthExr("--depth", depthPath, "camera depth"); });
-  const Image shadow =
-      timings.time("read shadow exr", [&] { return readDepthExr("--shadow", shadowPath, "shadow map"); });
-  if (desc.cameraSize && (desc.cameraSize->x != depth.width() || desc.cameraSize->y != depth.height()))
-    throw FormatError(framePath + ": camera.size " + sizeText(desc.cameraSize->x, desc.cameraSize->y) +
-                      " does not match the depth image '" + depthPath + "' (" +
-                      sizeText(depth.width(), depth.height()) + ")");
-  if (directional && desc.shadowSize &&
-      (desc.shadowSize->x != shadow.width() || desc.shadowSize->y != shadow.height()))
-    throw FormatError(framePath + ": shadowMap.size " + sizeText(desc.shadowSize->x, desc.shadowSize->y) +
-                      " does not match the shadow map '" + shadowPath + "' (" +
-                      sizeText(shadow.width(), shadow.height()) + ")");
-  // Each local light's map: the main light's is --shadow, the others' their files.
-  std::vector<Image> localShadows;
-  for (std::size_t i = 0, file = 0; i < localLights.size(); ++i) {
-    const FrameLocalLight& l = localLights[i];
+}
+
+/// Each local light's map (the main light's is --shadow, the others' their files), its size checked.
+void readLocalShadows(const ScatterArgs& o, const ScatterFrame& f, const std::vector<PathOption>& lightFiles,
+                      ScatterImages& images, StageTimings& timings) {
+  for (std::size_t i = 0, file = 0; i < f.localLights.size(); ++i) {
+    const FrameLocalLight& l = f.localLights[i];
     const bool main = l.shadowFile.empty();
-    const std::string option = main ? "--shadow" : framePath + ": " + l.shadowPath + ".file";
-    const std::string path = main ? shadowPath : lightFiles[file++].path;
-    Image image = main ? shadow : timings.time("read shadow exr (local lights)", [&] {
+    const std::string option = main ? "--shadow" : o.framePath + ": " + l.shadowPath + ".file";
+    const std::string path = main ? o.shadowPath : lightFiles[file++].path;
+    Image image = main ? images.shadow : timings.time("read shadow exr (local lights)", [&] {
       return readDepthExr(option, path, "local light shadow map");
     });
     if (l.shadowSize && (l.shadowSize->x != image.width() || l.shadowSize->y != image.height()))
-      throw FormatError(framePath + ": " + l.shadowPath + ".size " +
+      throw FormatError(o.framePath + ": " + l.shadowPath + ".size " +
                         sizeText(l.shadowSize->x, l.shadowSize->y) + " does not match the shadow map '" +
                         path + "' (" + sizeText(image.width(), image.height()) + ")");
     if (l.point && image.height() != 6 * image.width())
@@ -284,93 +316,155 @@ int scatterCommand(const std::vector<std::string>& argv) {
                         "; the point light " + l.path +
                         " needs its six faces stacked top to bottom (+X, -X, +Y, -Y, +Z, -Z): S x 6 S");
     requireNotEnclosed(image, option + ": '" + path + "' (shadow map of " + l.path + ")");
-    localShadows.push_back(std::move(image));
+    images.localShadows.push_back(std::move(image));
   }
+}
+
+/// The JSON's camera.size and shadowMap.size against the images.
+void checkImageSizes(const ScatterArgs& o, const ScatterFrame& f, const ScatterImages& images) {
+  const Image &depth = images.depth, &shadow = images.shadow;
+  const FrameDescription& desc = f.desc;
+  if (desc.cameraSize && (desc.cameraSize->x != depth.width() || desc.cameraSize->y != depth.height()))
+    throw FormatError(o.framePath + ": camera.size " + sizeText(desc.cameraSize->x, desc.cameraSize->y) +
+                      " does not match the depth image '" + o.depthPath + "' (" +
+                      sizeText(depth.width(), depth.height()) + ")");
+  if (f.directional && desc.shadowSize &&
+      (desc.shadowSize->x != shadow.width() || desc.shadowSize->y != shadow.height()))
+    throw FormatError(o.framePath + ": shadowMap.size " + sizeText(desc.shadowSize->x, desc.shadowSize->y) +
+                      " does not match the shadow map '" + o.shadowPath + "' (" +
+                      sizeText(shadow.width(), shadow.height()) + ")");
+}
+
+/// The method's image size limits and the camera's aspect ratio against the depth image.
+void checkCameraImage(const ScatterArgs& o, const ScatterFrame& f, const Image& depth) {
   requireMethodImageSize(
-      settings, {method}, {depth.width(), depth.height()},
-      "the depth image '" + depthPath + "' (" + sizeText(depth.width(), depth.height()) + ")", true);
+      o.settings, {o.method}, {depth.width(), depth.height()},
+      "the depth image '" + o.depthPath + "' (" + sizeText(depth.width(), depth.height()) + ")", true);
   const double imageAspect = double(depth.width()) / double(depth.height());
-  const glm::dvec4& tangents = camera.tangents(); // the frustum's own extent (off-centre ones too)
+  const glm::dvec4& tangents = f.camera.tangents(); // the frustum's own extent (off-centre ones too)
   const double frustumAspect = (tangents.y - tangents.x) / (tangents.w - tangents.z);
   if (std::abs(frustumAspect / imageAspect - 1.0) > 0.01)
-    throw FormatError(framePath + ": camera.clipFromView has aspect ratio " + shortest(frustumAspect) +
-                      ", which does not match the depth image '" + depthPath + "' (" +
+    throw FormatError(o.framePath + ": camera.clipFromView has aspect ratio " + shortest(frustumAspect) +
+                      ", which does not match the depth image '" + o.depthPath + "' (" +
                       sizeText(depth.width(), depth.height()) + ", aspect " + shortest(imageAspect) + ")");
+}
 
-  if (directional) warnIfShadowMapMissesView(camera, depth, desc.lightClipFromWorld, framePath, depthPath);
+/// Reads and checks every image of the frame (the light files, the textures, the depth and shadow EXRs,
+/// the local lights' maps), before any GL work.
+ScatterImages readScatterImages(const ScatterArgs& o, const ScatterFrame& f, StageTimings& timings) {
+  const std::vector<PathOption> lightFiles = localShadowFiles(o, f);
+  ScatterImages images;
+  readLightTextures(o, f, images, timings);
+  images.depth =
+      timings.time("read depth exr", [&] { return readDepthExr("--depth", o.depthPath, "camera depth"); });
+  images.shadow =
+      timings.time("read shadow exr", [&] { return readDepthExr("--shadow", o.shadowPath, "shadow map"); });
+  checkImageSizes(o, f, images);
+  readLocalShadows(o, f, lightFiles, images, timings);
+  checkCameraImage(o, f, images.depth);
+  return images;
+}
 
-  ensureGlContext("scatter", args.has("debug-gl"), timings);
-  FrameInputs frame(camera, light, medium);
-  frame.width = depth.width();
-  frame.height = depth.height();
-  timings.time("upload", [&] {
-    frame.cameraDepth = uploadR32F(depth, "--depth");
-    frame.shadowMap = uploadR32F(shadow, "--shadow");
-  });
-  frame.shadowWidth = shadow.width();
-  frame.shadowHeight = shadow.height();
-  frame.lightClipFromWorld = desc.lightClipFromWorld;
-  frame.shadowBias = desc.shadowBias;
-  frame.directional = directional;
-  if (directional) frame.shadowImage = shadow;
-  if (sunTexture)
-    frame.lightTexture =
-        makeLightTextureMap(std::move(sunTextureImage), sunTexture->textureClipFromWorld, "light.texture");
-  timings.time("upload (local lights)", [&] {
-    for (std::size_t i = 0; i < localLights.size(); ++i) {
-      const FrameLocalLight& l = localLights[i];
-      const auto add = [&](std::vector<LocalShadowMap>& maps, Image image, const glm::dmat4& matrix) {
-        LocalShadowMap m;
-        m.texture = uploadR32F(image, "--shadow");
-        m.width = image.width();
-        m.height = image.height();
-        m.lightClipFromWorld = matrix;
-        m.bias = l.shadowBias;
-        m.image = std::move(image);
-        maps.push_back(std::move(m));
-      };
-      if (l.spot) {
-        if (localTextures[i]) {
-          frame.spotTextures.resize(frame.spotLights.size() + 1);
-          frame.spotTextures.back() =
-              makeLightTextureMap(std::move(localTextureImages[i]), localTextures[i]->textureClipFromWorld,
-                                  "texture of a spot light");
-        }
-        frame.spotLights.push_back(*l.spot);
-        add(frame.spotShadows, localShadows[i], l.lightClipFromWorld[0]);
-      } else {
-        frame.pointLights.push_back(*l.point);
-        for (int k = 0; k < 6; ++k)
-          add(frame.pointShadows, pointFace(localShadows[i], k),
-              l.lightClipFromWorld[static_cast<std::size_t>(k)]);
+/// The local lights' maps and textures uploaded into `frame` (a point light's six faces from its stacked
+/// map).
+void uploadLocalLights(const ScatterFrame& f, ScatterImages& images, FrameInputs& frame) {
+  for (std::size_t i = 0; i < f.localLights.size(); ++i) {
+    const FrameLocalLight& l = f.localLights[i];
+    const auto add = [&](std::vector<LocalShadowMap>& maps, Image image, const glm::dmat4& matrix) {
+      LocalShadowMap m;
+      m.texture = uploadR32F(image, "--shadow");
+      m.width = image.width();
+      m.height = image.height();
+      m.lightClipFromWorld = matrix;
+      m.bias = l.shadowBias;
+      m.image = std::move(image);
+      maps.push_back(std::move(m));
+    };
+    if (l.spot) {
+      if (images.localTextures[i]) {
+        frame.spotTextures.resize(frame.spotLights.size() + 1);
+        frame.spotTextures.back() =
+            makeLightTextureMap(std::move(images.localTextureImages[i]),
+                                images.localTextures[i]->textureClipFromWorld, "texture of a spot light");
       }
+      frame.spotLights.push_back(*l.spot);
+      add(frame.spotShadows, images.localShadows[i], l.lightClipFromWorld[0]);
+    } else {
+      frame.pointLights.push_back(*l.point);
+      for (int k = 0; k < 6; ++k)
+        add(frame.pointShadows, pointFace(images.localShadows[i], k),
+            l.lightClipFromWorld[static_cast<std::size_t>(k)]);
     }
-  });
+  }
+}
 
+/// The GL context and the frame on the GPU: depth, shadow map, light texture, local lights.
+FrameInputs uploadScatterFrame(const ScatterArgs& o, const ScatterFrame& f, ScatterImages& images,
+                               StageTimings& timings) {
+  ensureGlContext("scatter", o.debugGl, timings);
+  FrameInputs frame(f.camera, f.light, f.medium);
+  frame.width = images.depth.width();
+  frame.height = images.depth.height();
+  timings.time("upload", [&] {
+    frame.cameraDepth = uploadR32F(images.depth, "--depth");
+    frame.shadowMap = uploadR32F(images.shadow, "--shadow");
+  });
+  frame.shadowWidth = images.shadow.width();
+  frame.shadowHeight = images.shadow.height();
+  frame.lightClipFromWorld = f.desc.lightClipFromWorld;
+  frame.shadowBias = f.desc.shadowBias;
+  frame.directional = f.directional;
+  if (f.directional) frame.shadowImage = images.shadow;
+  if (images.sunTexture)
+    frame.lightTexture = makeLightTextureMap(std::move(images.sunTextureImage),
+                                             images.sunTexture->textureClipFromWorld, "light.texture");
+  timings.time("upload (local lights)", [&] { uploadLocalLights(f, images, frame); });
   if (!frame.spotTextures.empty()) frame.spotTextures.resize(frame.spotLights.size());
-  MethodOutput result = runMethod(method, frame, settings);
+  return frame;
+}
+
+/// Runs the method, writes the EXR (and the PNG), all or nothing, and prints what was done.
+void runAndWrite(const ScatterArgs& o, FrameInputs& frame, OutputFiles& files, StageTimings& timings) {
+  MethodOutput result = runMethod(o.method, frame, o.settings);
   timings.append(result.timings.rows());
   const Image scattering =
       timings.time("readback", [&] { return readRgba(result.scattering.get(), frame.width, frame.height); });
   checkGlErrors("scattering");
   requireFinite(scattering, "the scattering image");
   timings.time("write exr", [&] {
-    files.write(out,
+    files.write(o.out,
                 [&](const std::filesystem::path& file) { writeExr(file, scattering, ExrPixelType::Float); });
   });
-  if (args.has("png"))
+  if (o.png)
     timings.time("write png", [&] {
-      files.write(args.string("png", ""), [&](const std::filesystem::path& file) {
-        writePng(file, scattering, ToneMap{static_cast<float>(exposure)});
+      files.write(*o.png, [&](const std::filesystem::path& file) {
+        writePng(file, scattering, ToneMap{static_cast<float>(o.exposure)});
       });
     });
   files.commit();
 
-  std::printf("crep scatter: %s, %dx%d, method %s (%s)\n", framePath.c_str(), frame.width, frame.height,
+  std::printf("crep scatter: %s, %dx%d, method %s (%s)\n", o.framePath.c_str(), frame.width, frame.height,
               result.used.c_str(), result.detail.c_str());
   timings.print(stdout);
-  std::printf("wrote %s (RGB in-scattered radiance, A transmittance)%s%s\n", out.c_str(),
-              args.has("png") ? " and " : "", args.has("png") ? args.string("png", "").c_str() : "");
+  std::printf("wrote %s (RGB in-scattered radiance, A transmittance)%s%s\n", o.out.c_str(),
+              o.png ? " and " : "", o.png ? o.png->c_str() : "");
+}
+
+} // namespace
+
+int scatterCommand(const std::vector<std::string>& argv) {
+  OutputFiles files;
+  const ScatterArgs options = parseScatterArgs(argv, files);
+  StageTimings timings;
+  if (isatty(2)) timings.setProgress("crep scatter");
+  // Everything about the inputs is checked before any GL work.
+  const ScatterFrame frame = readScatterFrame(options.framePath, timings);
+  ScatterImages images = readScatterImages(options, frame, timings);
+  if (frame.directional)
+    warnIfShadowMapMissesView(frame.camera, images.depth, frame.desc.lightClipFromWorld, options.framePath,
+                              options.depthPath);
+  FrameInputs inputs = uploadScatterFrame(options, frame, images, timings);
+  runAndWrite(options, inputs, files, timings);
   return 0;
 }
 

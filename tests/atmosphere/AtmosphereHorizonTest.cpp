@@ -3,7 +3,7 @@
 // Eq. 8's two look-ups (at the camera and at the segment's end, on one side of the horizon: Listing 2) must
 // change smoothly while the view direction sweeps through the horizon. The sky itself does jump there (below
 // the horizon the table's rays end on a black ground), which AtmospherePhysicsTest reports.
-#include "atmosphere_test_util.h"
+#include "atmosphere/atmosphere_test_util.h"
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/core/light.h>

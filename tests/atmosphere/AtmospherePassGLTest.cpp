@@ -1,9 +1,10 @@
 // AtmospherePass (crep/atmosphere/gpu_pass.h) against its CPU reference crep::atmosphereImage on a
 // built-in scene with a real rectified shadow map: both sides read the same tables (computed once on the
 // GPU and downloaded) and the same map (rendered on the GPU, read back for the CPU trees and sections).
-#include "epipolar/epipolar_test_util.h"
-#include "epipolar/gl_scene_util.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/gl_scene_maps.h"
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_pass.h>
@@ -179,16 +180,6 @@ const char* modeName(AtmosphereShafts m) {
     return "(c) PrefilteredVisibility";
   }
   return "?";
-}
-
-template <class F>
-void requireNamed(const F& f, const std::string& parameter) {
-  try {
-    f();
-    FAIL("no exception for " << parameter);
-  } catch (const InvalidArgument& e) {
-    CHECK(e.parameter() == parameter);
-  }
 }
 
 } // namespace

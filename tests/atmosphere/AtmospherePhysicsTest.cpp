@@ -1,9 +1,9 @@
-// Physics of the CPU atmosphere tables (crep/atmosphere/atmosphere.h; issue 16's tests): the single
-// scattering of a thin homogeneous Rayleigh layer against its closed form written here, the energy of the
-// scattering orders and the convergence of their sum, look-ups at texel centres reproduce the table, the sky
-// is continuous on each side of the horizon in a sweep of view directions through it, and the colours and
-// ambient light are physically sane (blue zenith at noon, red horizon next to a low sun, twilight zenith
-// darker than the horizon below the sun, no ambient light at night).
+// Physics of the CPU atmosphere tables (crep/atmosphere/atmosphere.h): the single scattering of a thin
+// homogeneous Rayleigh layer against its closed form written here, the energy of the scattering orders and
+// the convergence of their sum, look-ups at texel centres reproduce the table, the sky is continuous on each
+// side of the horizon in a sweep of view directions through it, and the colours and ambient light are
+// physically sane (blue zenith at noon, red horizon next to a low sun, twilight zenith darker than the
+// horizon below the sun, no ambient light at night).
 #include <crep/atmosphere/atmosphere.h>
 
 #include <doctest/doctest.h>

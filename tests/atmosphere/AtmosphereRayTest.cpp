@@ -3,7 +3,9 @@
 // an independent brute-force single-scattering integral (densityIntegral for both transmittances, no tables),
 // exact identities of lit sections and lit lengths, prefilteredVisibility's closed form, and atmosphereImage
 // against atmosphereRay per pixel.
-#include "atmosphere_test_util.h"
+#include "common/error_checks.h"
+
+#include "atmosphere/atmosphere_test_util.h"
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/core/error.h>
@@ -17,6 +19,7 @@
 #include <vector>
 
 using namespace crep;
+using crep::test::invalidParameter;
 
 namespace {
 
@@ -566,53 +569,47 @@ TEST_CASE("Atmosphere ray: atmosphereImage equals atmosphereRay per pixel") {
     CHECK(mismatches == 0);
   }
   // Validation names the parameter.
-  const auto parameter = [](const auto& f) -> std::string {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return "";
-  };
   AtmosphereRayOptions a;
   a.shafts = AtmosphereShafts::Integrated;
-  CHECK(parameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, a); }) ==
+  CHECK(invalidParameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, a); }) ==
         "atmosphereImage.shadowing");
-  CHECK(parameter([&] {
+  CHECK(invalidParameter([&] {
           atmosphereImage(tables(), placement(), camera, sun(), depth, std::vector<AtmosphereShadowing>(5),
                           {});
         }) == "atmosphereImage.shadowing");
-  CHECK(parameter([&] { atmosphereImage(tables(), placement(), camera, sun(), Image(), {}, {}); }) ==
+  CHECK(invalidParameter([&] { atmosphereImage(tables(), placement(), camera, sun(), Image(), {}, {}); }) ==
         "cameraDepth");
-  CHECK(parameter([&] { atmosphereImage(tables(), placement(), camera, sun(), Image(w, h, 2), {}, {}); }) ==
-        "cameraDepth");
+  CHECK(invalidParameter([&] {
+          atmosphereImage(tables(), placement(), camera, sun(), Image(w, h, 2), {}, {});
+        }) == "cameraDepth");
   AtmospherePlacement bad;
   bad.metersPerUnit = 0.0;
-  CHECK(parameter([&] { atmosphereImage(tables(), bad, camera, sun(), depth, {}, {}); }) ==
+  CHECK(invalidParameter([&] { atmosphereImage(tables(), bad, camera, sun(), depth, {}, {}); }) ==
         "AtmospherePlacement.metersPerUnit");
   AtmosphereRayOptions zero;
   zero.integrationSteps = 0;
-  CHECK(parameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, zero); }) ==
+  CHECK(invalidParameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, zero); }) ==
         "AtmosphereRayOptions.integrationSteps");
   AtmosphereRayOptions flat;
   flat.volumeSize.z = 1;
-  CHECK(parameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, flat); }) ==
+  CHECK(invalidParameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, flat); }) ==
         "AtmosphereRayOptions.volumeSize.z");
   AtmosphereRayOptions huge;
   huge.volumeSize.x = 4096;
-  CHECK(parameter([&] { atmosphereViewTables(tables(), placement(), camera, sun(), huge); }) ==
+  CHECK(invalidParameter([&] { atmosphereViewTables(tables(), placement(), camera, sun(), huge); }) ==
         "AtmosphereRayOptions.volumeSize.x");
   AtmosphereRayOptions noSteps;
   noSteps.volumeSteps = 0;
-  CHECK(parameter([&] { atmosphereViewTables(tables(), placement(), camera, sun(), noSteps); }) ==
+  CHECK(invalidParameter([&] { atmosphereViewTables(tables(), placement(), camera, sun(), noSteps); }) ==
         "AtmosphereRayOptions.volumeSteps");
   AtmosphereRayOptions badMode;
   badMode.single = static_cast<AtmosphereSingleScattering>(7);
-  CHECK(parameter([&] { atmosphereImage(tables(), placement(), camera, sun(), depth, {}, badMode); }) ==
-        "AtmosphereRayOptions.single");
+  CHECK(invalidParameter([&] {
+          atmosphereImage(tables(), placement(), camera, sun(), depth, {}, badMode);
+        }) == "AtmosphereRayOptions.single");
   AtmosphereRayOptions odd;
   odd.skyViewSize.y = 7;
-  CHECK(parameter([&] { atmosphereViewTables(tables(), placement(), camera, sun(), odd); }) ==
+  CHECK(invalidParameter([&] { atmosphereViewTables(tables(), placement(), camera, sun(), odd); }) ==
         "AtmosphereRayOptions.skyViewSize.y");
 }
 

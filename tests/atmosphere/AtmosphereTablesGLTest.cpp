@@ -2,7 +2,7 @@
 // (crep/atmosphere/atmosphere.h, precomputeAtmosphere): every table of a small atmosphere computed on the GPU
 // vs the CPU, upload/download round trip, the public GLSL look-ups (glsl/crep/atmosphere.glsl) vs the CPU
 // look-ups on the same tables, the block's layout, and bad create-infos named.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>

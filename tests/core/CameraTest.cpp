@@ -1,3 +1,5 @@
+#include "common/error_checks.h"
+
 #include <crep/core/camera.h>
 #include <crep/core/error.h>
 
@@ -9,6 +11,7 @@
 #include <string>
 
 using crep::Camera;
+using crep::test::requireNamedInMessage;
 
 namespace {
 const double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -17,18 +20,6 @@ const double kInf = std::numeric_limits<double>::infinity();
 glm::dvec3 project(const glm::dmat4& clipFromWorld, const glm::dvec3& p) {
   const glm::dvec4 c = clipFromWorld * glm::dvec4(p, 1.0);
   return glm::dvec3(c) / c.w;
-}
-
-// Expects InvalidArgument whose parameter is `parameter` and whose message names it.
-template <class F>
-void expectInvalid(const std::string& parameter, F&& f) {
-  try {
-    f();
-    FAIL("expected InvalidArgument for " << parameter);
-  } catch (const crep::InvalidArgument& e) {
-    CHECK(e.parameter() == parameter);
-    CHECK(std::string(e.what()).find(parameter) != std::string::npos);
-  }
 }
 
 Camera makeCamera() {
@@ -90,25 +81,37 @@ TEST_CASE("Camera: rayDirection and linearDepth invert the projection") {
 
 TEST_CASE("Camera: invalid parameters throw InvalidArgument naming the parameter") {
   const glm::dquat q(1, 0, 0, 0);
-  expectInvalid("Camera.position", [&] { Camera({kNan, 0, 0}, q, 1.0, 1.0, 0.1, 10.0); });
-  expectInvalid("Camera.orientation", [&] {
-    Camera({0, 0, 0}, glm::dquat(0, 0, 0, 0), 1.0, 1.0, 0.1, 10.0);
-  });
-  expectInvalid("Camera.fovY", [&] { Camera({0, 0, 0}, q, 0.0, 1.0, 0.1, 10.0); });
-  expectInvalid("Camera.fovY", [&] { Camera({0, 0, 0}, q, std::numbers::pi, 1.0, 0.1, 10.0); });
-  expectInvalid("Camera.fovY", [&] { Camera({0, 0, 0}, q, kNan, 1.0, 0.1, 10.0); });
-  expectInvalid("Camera.aspect", [&] { Camera({0, 0, 0}, q, 1.0, 0.0, 0.1, 10.0); });
-  expectInvalid("Camera.aspect", [&] { Camera({0, 0, 0}, q, 1.0, -2.0, 0.1, 10.0); });
-  expectInvalid("Camera.near", [&] { Camera({0, 0, 0}, q, 1.0, 1.0, 0.0, 10.0); });
-  expectInvalid("Camera.near", [&] { Camera({0, 0, 0}, q, 1.0, 1.0, -1.0, 10.0); });
-  expectInvalid("Camera.far", [&] { Camera({0, 0, 0}, q, 1.0, 1.0, 1.0, 1.0); });
-  expectInvalid("Camera.far", [&] { Camera({0, 0, 0}, q, 1.0, 1.0, 1.0, 0.5); });
-  expectInvalid("Camera.far", [&] { Camera({0, 0, 0}, q, 1.0, 1.0, 1.0, kInf); });
-  expectInvalid("Camera.target", [&] {
-    Camera::lookAt({1, 1, 1}, {1, 1, 1}, {0, 1, 0}, 1.0, 1.0, 0.1, 10.0);
-  });
-  expectInvalid("Camera.up", [&] { Camera::lookAt({0, 0, 0}, {0, 5, 0}, {0, 1, 0}, 1.0, 1.0, 0.1, 10.0); });
-  expectInvalid("Camera.up", [&] { Camera::lookAt({0, 0, 0}, {0, 0, -1}, {0, 0, 0}, 1.0, 1.0, 0.1, 10.0); });
+  requireNamedInMessage([&] { Camera({kNan, 0, 0}, q, 1.0, 1.0, 0.1, 10.0); }, "Camera.position");
+  requireNamedInMessage(
+      [&] {
+        Camera({0, 0, 0}, glm::dquat(0, 0, 0, 0), 1.0, 1.0, 0.1, 10.0);
+      },
+      "Camera.orientation");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 0.0, 1.0, 0.1, 10.0); }, "Camera.fovY");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, std::numbers::pi, 1.0, 0.1, 10.0); }, "Camera.fovY");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, kNan, 1.0, 0.1, 10.0); }, "Camera.fovY");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, 0.0, 0.1, 10.0); }, "Camera.aspect");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, -2.0, 0.1, 10.0); }, "Camera.aspect");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, 1.0, 0.0, 10.0); }, "Camera.near");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, 1.0, -1.0, 10.0); }, "Camera.near");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, 1.0, 1.0, 1.0); }, "Camera.far");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, 1.0, 1.0, 0.5); }, "Camera.far");
+  requireNamedInMessage([&] { Camera({0, 0, 0}, q, 1.0, 1.0, 1.0, kInf); }, "Camera.far");
+  requireNamedInMessage(
+      [&] {
+        Camera::lookAt({1, 1, 1}, {1, 1, 1}, {0, 1, 0}, 1.0, 1.0, 0.1, 10.0);
+      },
+      "Camera.target");
+  requireNamedInMessage(
+      [&] {
+        Camera::lookAt({0, 0, 0}, {0, 5, 0}, {0, 1, 0}, 1.0, 1.0, 0.1, 10.0);
+      },
+      "Camera.up");
+  requireNamedInMessage(
+      [&] {
+        Camera::lookAt({0, 0, 0}, {0, 0, -1}, {0, 0, 0}, 1.0, 1.0, 0.1, 10.0);
+      },
+      "Camera.up");
   // The message carries the offending value.
   try {
     Camera({0, 0, 0}, q, 1.0, 1.0, -0.5, 10.0);
@@ -264,19 +267,20 @@ TEST_CASE("Camera::fromMatrices: bad matrices are named") {
   glm::dmat4 p = c.clipFromView();
   glm::dmat4 nan = p;
   nan[1][1] = kNan;
-  expectInvalid("Camera.clipFromView", [&] { Camera::fromMatrices(c.viewFromWorld(), nan); });
+  requireNamedInMessage([&] { Camera::fromMatrices(c.viewFromWorld(), nan); }, "Camera.clipFromView");
   glm::dmat4 ortho(1.0);
   ortho[2][2] = -0.1;
-  expectInvalid("Camera.clipFromView", [&] { Camera::fromMatrices(c.viewFromWorld(), ortho); });
+  requireNamedInMessage([&] { Camera::fromMatrices(c.viewFromWorld(), ortho); }, "Camera.clipFromView");
   glm::dmat4 scaled = c.viewFromWorld();
   scaled[0] *= 2.0;
-  expectInvalid("Camera.viewFromWorld", [&] { Camera::fromMatrices(scaled, p); });
+  requireNamedInMessage([&] { Camera::fromMatrices(scaled, p); }, "Camera.viewFromWorld");
   const glm::dmat4 inf = reversedInfinite(1.0, 1.5, 0.1);
-  expectInvalid("Camera.maxDistance",
-                [&] { Camera::fromMatrices(c.viewFromWorld(), inf, crep::ClipDepth::ZeroToOne); });
-  expectInvalid("Camera.maxDistance",
-                [&] { Camera::fromMatrices(c.viewFromWorld(), inf, crep::ClipDepth::ZeroToOne, 0.05); });
+  requireNamedInMessage([&] { Camera::fromMatrices(c.viewFromWorld(), inf, crep::ClipDepth::ZeroToOne); },
+                        "Camera.maxDistance");
+  requireNamedInMessage(
+      [&] { Camera::fromMatrices(c.viewFromWorld(), inf, crep::ClipDepth::ZeroToOne, 0.05); },
+      "Camera.maxDistance");
   glm::dmat4 flipped = p; // near behind the camera
   flipped[3][2] = -flipped[3][2];
-  expectInvalid("Camera.clipFromView", [&] { Camera::fromMatrices(c.viewFromWorld(), flipped); });
+  requireNamedInMessage([&] { Camera::fromMatrices(c.viewFromWorld(), flipped); }, "Camera.clipFromView");
 }

@@ -1,3 +1,5 @@
+#include "common/error_checks.h"
+
 #include <crep/core/error.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
@@ -10,19 +12,10 @@
 #include <string>
 #include <vector>
 
+using crep::test::requireNamedInMessage;
+
 namespace {
 const double kNan = std::numeric_limits<double>::quiet_NaN();
-
-template <class F>
-void expectInvalid(const std::string& parameter, F&& f) {
-  try {
-    f();
-    FAIL("expected InvalidArgument for " << parameter);
-  } catch (const crep::InvalidArgument& e) {
-    CHECK(e.parameter() == parameter);
-    CHECK(std::string(e.what()).find(parameter) != std::string::npos);
-  }
-}
 
 // Integral of a phase function over the sphere, 2 pi * int_{-1}^{1} p(mu) d mu (Simpson, 20000 panels).
 template <class P>
@@ -51,9 +44,13 @@ TEST_CASE("DirectionalLight: direction normalized, invalid input named") {
   const crep::DirectionalLight light({0, -3, 4}, {1, 2, 3});
   CHECK(glm::length(light.direction()) == doctest::Approx(1.0).epsilon(1e-15));
   CHECK(light.direction().y == doctest::Approx(-0.6));
-  expectInvalid("DirectionalLight.direction", [] { crep::DirectionalLight({0, 0, 0}); });
-  expectInvalid("DirectionalLight.direction", [] { crep::DirectionalLight({kNan, 1, 0}); });
-  expectInvalid("DirectionalLight.irradiance", [] { crep::DirectionalLight({0, -1, 0}, {-1, 0, 0}); });
+  requireNamedInMessage([] { crep::DirectionalLight({0, 0, 0}); }, "DirectionalLight.direction");
+  requireNamedInMessage([] { crep::DirectionalLight({kNan, 1, 0}); }, "DirectionalLight.direction");
+  requireNamedInMessage(
+      [] {
+        crep::DirectionalLight({0, -1, 0}, {-1, 0, 0});
+      },
+      "DirectionalLight.irradiance");
 }
 
 TEST_CASE("anyOrthogonal: unit and orthogonal for every axis and sign") {
@@ -99,20 +96,21 @@ TEST_CASE("SpotLight: cone maps to the NDC square, invalid input named") {
       crep::SpotLight{p};
     };
   };
-  expectInvalid("SpotLight.outerConeAngle", spotWith([](P& p) { p.outerConeAngle = 0.0; }));
-  expectInvalid("SpotLight.outerConeAngle", spotWith([](P& p) { p.outerConeAngle = 1.6; }));
-  expectInvalid("SpotLight.outerConeAngle", spotWith([](P& p) { p.outerConeAngle = kNan; }));
-  expectInvalid("SpotLight.innerConeAngle", spotWith([](P& p) { p.innerConeAngle = 0.6; })); // out of order
-  expectInvalid("SpotLight.innerConeAngle", spotWith([](P& p) { p.innerConeAngle = 0.5; }));
-  expectInvalid("SpotLight.innerConeAngle", spotWith([](P& p) { p.innerConeAngle = 0.0; }));
-  expectInvalid("SpotLight.intensity", spotWith([](P& p) { p.intensity = 0.0; }));
-  expectInvalid("SpotLight.intensity", spotWith([](P& p) { p.intensity = kNan; }));
-  expectInvalid("SpotLight.color", spotWith([](P& p) { p.color = {0, 0, 0}; }));
-  expectInvalid("SpotLight.color", spotWith([](P& p) { p.color = {1, -1, 0}; }));
-  expectInvalid("SpotLight.range", spotWith([](P& p) { p.range = 0.0; }));
-  expectInvalid("SpotLight.direction", spotWith([](P& p) { p.direction = {0, 0, 0}; }));
-  expectInvalid("SpotLight.position", spotWith([](P& p) { p.position = {kNan, 0, 0}; }));
-  expectInvalid("SpotLight.nearPlane", spotWith([](P& p) { p.nearPlane = 20.0; }));
+  requireNamedInMessage(spotWith([](P& p) { p.outerConeAngle = 0.0; }), "SpotLight.outerConeAngle");
+  requireNamedInMessage(spotWith([](P& p) { p.outerConeAngle = 1.6; }), "SpotLight.outerConeAngle");
+  requireNamedInMessage(spotWith([](P& p) { p.outerConeAngle = kNan; }), "SpotLight.outerConeAngle");
+  requireNamedInMessage(spotWith([](P& p) { p.innerConeAngle = 0.6; }),
+                        "SpotLight.innerConeAngle"); // out of order
+  requireNamedInMessage(spotWith([](P& p) { p.innerConeAngle = 0.5; }), "SpotLight.innerConeAngle");
+  requireNamedInMessage(spotWith([](P& p) { p.innerConeAngle = 0.0; }), "SpotLight.innerConeAngle");
+  requireNamedInMessage(spotWith([](P& p) { p.intensity = 0.0; }), "SpotLight.intensity");
+  requireNamedInMessage(spotWith([](P& p) { p.intensity = kNan; }), "SpotLight.intensity");
+  requireNamedInMessage(spotWith([](P& p) { p.color = {0, 0, 0}; }), "SpotLight.color");
+  requireNamedInMessage(spotWith([](P& p) { p.color = {1, -1, 0}; }), "SpotLight.color");
+  requireNamedInMessage(spotWith([](P& p) { p.range = 0.0; }), "SpotLight.range");
+  requireNamedInMessage(spotWith([](P& p) { p.direction = {0, 0, 0}; }), "SpotLight.direction");
+  requireNamedInMessage(spotWith([](P& p) { p.position = {kNan, 0, 0}; }), "SpotLight.position");
+  requireNamedInMessage(spotWith([](P& p) { p.nearPlane = 20.0; }), "SpotLight.nearPlane");
 }
 
 TEST_CASE("Phase functions are normalized over the sphere") {
@@ -144,25 +142,33 @@ TEST_CASE("Medium: extinction derived, scatteringTimesPhase combines HG and Rayl
 }
 
 TEST_CASE("Medium: invalid coefficients are named") {
-  expectInvalid("Medium.mieScattering", [] { crep::Medium({.mieScattering = {-0.1, 0.1, 0.1}}); });
-  expectInvalid("Medium.mieScattering", [] { crep::Medium({.mieScattering = {kNan, 0.1, 0.1}}); });
-  expectInvalid("Medium.absorption", [] {
-    crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .absorption = {0, -1e-3, 0}});
-  });
-  expectInvalid("Medium.rayleighScattering", [] {
-    crep::Medium({.mieScattering = {0.1, 0.1, 0.1},
-                  .hgG = 0.0,
-                  .rayleighScattering = {0, 0, -1},
-                  .absorption = {0, 0, 0}});
-  });
-  expectInvalid("Medium.hgG", [] {
-    crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .hgG = 1.0, .absorption = {0, 0, 0}});
-  });
-  expectInvalid("Medium.hgG", [] {
-    crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .hgG = kNan, .absorption = {0, 0, 0}});
-  });
-  expectInvalid("Medium.extinction.g", [] { crep::Medium({.mieScattering = {0.1, 0.0, 0.1}}); });
-  expectInvalid("Medium.extinction.r", [] { crep::Medium({.mieScattering = {0, 0, 0}}); });
+  requireNamedInMessage([] { crep::Medium({.mieScattering = {-0.1, 0.1, 0.1}}); }, "Medium.mieScattering");
+  requireNamedInMessage([] { crep::Medium({.mieScattering = {kNan, 0.1, 0.1}}); }, "Medium.mieScattering");
+  requireNamedInMessage(
+      [] {
+        crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .absorption = {0, -1e-3, 0}});
+      },
+      "Medium.absorption");
+  requireNamedInMessage(
+      [] {
+        crep::Medium({.mieScattering = {0.1, 0.1, 0.1},
+                      .hgG = 0.0,
+                      .rayleighScattering = {0, 0, -1},
+                      .absorption = {0, 0, 0}});
+      },
+      "Medium.rayleighScattering");
+  requireNamedInMessage(
+      [] {
+        crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .hgG = 1.0, .absorption = {0, 0, 0}});
+      },
+      "Medium.hgG");
+  requireNamedInMessage(
+      [] {
+        crep::Medium({.mieScattering = {0.1, 0.1, 0.1}, .hgG = kNan, .absorption = {0, 0, 0}});
+      },
+      "Medium.hgG");
+  requireNamedInMessage([] { crep::Medium({.mieScattering = {0.1, 0.0, 0.1}}); }, "Medium.extinction.g");
+  requireNamedInMessage([] { crep::Medium({.mieScattering = {0, 0, 0}}); }, "Medium.extinction.r");
 }
 
 TEST_CASE("orthographicLightClipFromWorld: covers the points, looks along the light") {
@@ -248,8 +254,8 @@ TEST_CASE("PointLight: faces partition the directions, face frusta look along th
     CHECK(std::abs(q.y / q.w) <= 1.0);
   }
   CHECK(crep::PointLight::faceOf({1, 1, 1}) == 0); // ties: the first face in cube-map order
-  expectInvalid("PointLight.intensity", [] { crep::PointLight({.intensity = -1.0}); });
-  expectInvalid("PointLight.range", [] { crep::PointLight({.range = 0.0}); });
-  expectInvalid("PointLight.nearPlane", [] { crep::PointLight({.range = 1.0, .nearPlane = 2.0}); });
-  expectInvalid("PointLight.color", [] { crep::PointLight({.color = {0, 0, 0}}); });
+  requireNamedInMessage([] { crep::PointLight({.intensity = -1.0}); }, "PointLight.intensity");
+  requireNamedInMessage([] { crep::PointLight({.range = 0.0}); }, "PointLight.range");
+  requireNamedInMessage([] { crep::PointLight({.range = 1.0, .nearPlane = 2.0}); }, "PointLight.nearPlane");
+  requireNamedInMessage([] { crep::PointLight({.color = {0, 0, 0}}); }, "PointLight.color");
 }

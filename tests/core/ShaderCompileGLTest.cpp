@@ -1,6 +1,6 @@
 // Every shader of the library compiles and links on the driver (Mesa llvmpipe here); compile errors
 // point at the real file and line; define variants work; the public includes agree with the CPU.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

@@ -1,11 +1,11 @@
-// The epipolar fallback on the GPU and on the built-in scenes (issue 5): the resampling pass against the CPU
+// The epipolar fallback on the GPU and on the built-in scenes: the resampling pass against the CPU
 // resampling, the marches on the epipolar layout against the CPU, the fallback against the projective
-// pipeline where both are valid, and a light sweep through the view direction (epipole across the
-// screen, then behind the camera) with the projective path where it is valid and the fallback (plus the
-// epipole block) elsewhere: finite images, close to the world-space reference, no flash at the switch.
-#include "epipolar_test_util.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+// pipeline where both are valid, and a light sweep through the view direction (epipole across the screen,
+// then behind the camera) with the projective path where it is valid and the fallback (plus the epipole
+// block) elsewhere: finite images, close to the world-space reference, no flash at the switch.
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

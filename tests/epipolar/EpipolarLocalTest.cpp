@@ -2,8 +2,8 @@
 // on the Sec. 4.1 layout): the RectifiedLayout contract checked on random cameras and light positions in,
 // near and behind the view, against the geometry itself (points on view rays and light rays), not against
 // the layout's own formulas.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
+#include "common/analytic_reference.h"
+#include "common/local_light_scene.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>

@@ -6,8 +6,9 @@
 // to the image plane (epipole clamped to 1e5 px: nearly parallel lines). Evaluator: the test shader
 // tests/glsl/epipolar_sampling_eval.comp, (0.01 x, 0.01 y, 0.05 z, 1) of each list entry, and the same
 // function on the CPU.
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_scene.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
@@ -531,57 +532,51 @@ TEST_CASE("EpipolarSampling GL: run leaves no pixel unwritten and counts like th
 
 TEST_CASE("EpipolarSampling GL: validation names the field") {
   CREP_REQUIRE_GL();
-  const auto parameterOf = [](const auto& call) -> std::string {
-    try {
-      call();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return "no exception";
-  };
   EpipolarSamplingOptions o = smallOptions();
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] {
           EpipolarSamplingPass({0, kHeight, o});
         }) == "EpipolarSamplingPass::CreateInfo.width");
   o.samples = 48;
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] {
           EpipolarSamplingPass({kWidth, kHeight, o});
         }) == "EpipolarSamplingPass::CreateInfo.options.samples");
   o = smallOptions(4);
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] {
           EpipolarSamplingPass({kWidth, 90, o});
         }) == "EpipolarSamplingPass::CreateInfo.height");
-  CHECK(parameterOf([&] { EpipolarSamplingPass({162, 88, o}); }) == "EpipolarSamplingPass::CreateInfo.width");
+  CHECK(invalidParameter([&] {
+          EpipolarSamplingPass({162, 88, o});
+        }) == "EpipolarSamplingPass::CreateInfo.width");
 
   Scene scene(sideLight());
   EpipolarSamplingPass pass({kWidth, kHeight, smallOptions()});
   EpipolarSamplingPass::FrameAttribs f = scene.frame();
   f.camera = nullptr;
-  CHECK(parameterOf([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.camera");
+  CHECK(invalidParameter([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.camera");
   f = scene.frame();
   f.light = nullptr;
-  CHECK(parameterOf([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.light");
+  CHECK(invalidParameter([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.light");
   f = scene.frame();
   f.medium = nullptr;
-  CHECK(parameterOf([&] { pass.unwarp(f); }) == "EpipolarSamplingPass::FrameAttribs.medium");
+  CHECK(invalidParameter([&] { pass.unwarp(f); }) == "EpipolarSamplingPass::FrameAttribs.medium");
   f = scene.frame();
   f.cameraDepth = 0;
-  CHECK(parameterOf([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.cameraDepth");
+  CHECK(invalidParameter([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.cameraDepth");
   const gl::Handle small = gl::createTexture2D(GL_RGBA32F, 80, 45);
   const gl::Handle rgba8 = gl::createTexture2D(GL_RGBA8, kWidth, kHeight);
   f = scene.frame();
   f.cameraDepth = small.get();
-  CHECK(parameterOf([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.cameraDepth");
+  CHECK(invalidParameter([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.cameraDepth");
   f = scene.frame();
   f.cameraDepth = rgba8.get();
-  CHECK(parameterOf([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.cameraDepth");
+  CHECK(invalidParameter([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.cameraDepth");
   f = scene.frame();
   f.output = rgba8.get();
-  CHECK(parameterOf([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.output");
+  CHECK(invalidParameter([&] { pass.placeSamples(f); }) == "EpipolarSamplingPass::FrameAttribs.output");
   f.output = small.get();
-  CHECK(parameterOf([&] { pass.unwarp(f); }) == "EpipolarSamplingPass::FrameAttribs.output");
+  CHECK(invalidParameter([&] { pass.unwarp(f); }) == "EpipolarSamplingPass::FrameAttribs.output");
   f = scene.frame();
-  CHECK(parameterOf([&] { pass.run(f, {}); }) == "EpipolarSamplingPass::run.evaluate");
+  CHECK(invalidParameter([&] { pass.run(f, {}); }) == "EpipolarSamplingPass::run.evaluate");
   CHECK(pass.memoryBytes() > static_cast<std::size_t>(64 * 128 * 44));
   gl::checkError("validation");
 }

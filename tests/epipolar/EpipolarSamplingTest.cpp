@@ -3,7 +3,8 @@
 // image and an independent closed form, the refinement rules on hand-made samples, exact interpolation of
 // linear fields, the bilateral unwarp (constant fields, a thin bar, the corrections), the whole pipeline
 // against the per-pixel closed form for F = 1, 2, 4, and the option checks.
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar_sampling.h>
@@ -857,21 +858,13 @@ TEST_CASE("EpipolarSampling pipeline: every output pixel is written (constant ev
 }
 
 TEST_CASE("EpipolarSampling validate: each option and size out of range names its field") {
-  const auto parameter = [](const auto& f) {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return std::string("no exception");
-  };
   const auto bad = [&](auto change) {
     EpipolarSamplingOptions o;
     change(o);
-    return parameter([&] { validate(o); });
+    return invalidParameter([&] { validate(o); });
   };
   const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
-  CHECK(parameter([] { validate(EpipolarSamplingOptions{}); }) == "no exception");
+  CHECK(invalidParameter([] { validate(EpipolarSamplingOptions{}); }) == "no exception");
   CHECK(bad([](auto& o) { o.slices = 0; }) == "EpipolarSamplingOptions.slices");
   CHECK(bad([](auto& o) { o.slices = 16385; }) == "EpipolarSamplingOptions.slices");
   CHECK(bad([](auto& o) { o.samples = 48; }) == "EpipolarSamplingOptions.samples");
@@ -892,7 +885,7 @@ TEST_CASE("EpipolarSampling validate: each option and size out of range names it
   CHECK(bad([](auto& o) { o.downscale = 3; }) == "EpipolarSamplingOptions.downscale");
   EpipolarSamplingOptions o;
   o.downscale = 0;
-  CHECK(parameter([&] { validate(o, "EpipolarSamplingPass::CreateInfo.options"); }) ==
+  CHECK(invalidParameter([&] { validate(o, "EpipolarSamplingPass::CreateInfo.options"); }) ==
         "EpipolarSamplingPass::CreateInfo.options.downscale");
 
   // Sizes.
@@ -902,34 +895,36 @@ TEST_CASE("EpipolarSampling validate: each option and size out of range names it
   o.slices = 16;
   o.samples = 32;
   o.downscale = 4;
-  CHECK(parameter([&] { epipolarLines(camera, light, 0, 64, o); }) == "width");
-  CHECK(parameter([&] { epipolarLines(camera, light, 98, 64, o); }) == "width");
-  CHECK(parameter([&] { epipolarLines(camera, light, 96, 66, o); }) == "height");
+  CHECK(invalidParameter([&] { epipolarLines(camera, light, 0, 64, o); }) == "width");
+  CHECK(invalidParameter([&] { epipolarLines(camera, light, 98, 64, o); }) == "width");
+  CHECK(invalidParameter([&] { epipolarLines(camera, light, 96, 66, o); }) == "height");
   const EpipolarLines lines = epipolarLines(camera, light, 96, 64, o);
   const Image depth = groundDepth(camera, 96, 64);
-  CHECK(parameter([&] {
+  CHECK(invalidParameter([&] {
           epipolarSamples(lines, groundDepth(camera, 64, 64), camera, light, colouredMedium());
         }) == "cameraDepth");
   Image badDepth = depth;
   badDepth.at(3, 3) = 2.0f;
-  CHECK(parameter([&] { epipolarSamples(lines, badDepth, camera, light, colouredMedium()); }) ==
+  CHECK(invalidParameter([&] { epipolarSamples(lines, badDepth, camera, light, colouredMedium()); }) ==
         "cameraDepth");
   const EpipolarSamples samples = epipolarSamples(lines, depth, camera, light, colouredMedium());
   const std::vector<glm::ivec2> sources = refineSamples(samples, lines, o);
   EpipolarSamples wrong = samples;
   wrong.unshadowed = Image(32, 15, 1);
-  CHECK(parameter([&] { refineSamples(wrong, lines, o); }) == "refineSamples.samples.unshadowed");
-  CHECK(parameter([&] { interpolateSamples(sources, Image(32, 15, 4)); }) == "interpolateSamples.marched");
+  CHECK(invalidParameter([&] { refineSamples(wrong, lines, o); }) == "refineSamples.samples.unshadowed");
+  CHECK(invalidParameter([&] { interpolateSamples(sources, Image(32, 15, 4)); }) ==
+        "interpolateSamples.marched");
   const Image interpolated = interpolateSamples(sources, Image(32, 16, 4));
-  CHECK(parameter([&] { unwarpSamples(lines, samples, Image(32, 16, 3), depth, camera, o); }) ==
+  CHECK(invalidParameter([&] { unwarpSamples(lines, samples, Image(32, 16, 3), depth, camera, o); }) ==
         "unwarpSamples.interpolated");
   const UnwarpResult target = unwarpSamples(lines, samples, interpolated, depth, camera, o);
   CHECK(target.image.width() == 24);
   CHECK(target.image.height() == 16);
   EpipolarSamplingOptions o2 = o;
   o2.downscale = 2;
-  CHECK(parameter([&] { upscaleSamples(target, depth, camera, o2); }) == "upscaleSamples.target.image");
-  CHECK(parameter([&] {
+  CHECK(invalidParameter([&] { upscaleSamples(target, depth, camera, o2); }) ==
+        "upscaleSamples.target.image");
+  CHECK(invalidParameter([&] {
           epipolarSampling(camera, light, colouredMedium(), groundDepth(camera, 90, 64), o,
                            [](double, double, double) { return glm::dvec4(0.0); });
         }) == "width");

@@ -2,7 +2,8 @@
 // properties over random camera / light configurations (view rays keep row and depth, light rays keep row
 // and column, everything visible maps into the map, distances are the closed form), the slice count rule
 // (no pixel farther than half a pixel from its slice), the epipole cases, bad input.
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
@@ -274,35 +275,30 @@ TEST_CASE("epipolar layout: profiles and reference rays follow the contract of r
 TEST_CASE("epipolar layout: bad input gets a named InvalidArgument") {
   const Camera camera = groundCamera(16, 9);
   const DirectionalLight light = sideLight();
-  const auto parameter = [](const auto& f) {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return std::string("no exception");
-  };
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 0, 9); }) == "EpipolarLayout.screenSize");
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, Image::kMaxDimension + 1); }) ==
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 0, 9); }) == "EpipolarLayout.screenSize");
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 16, Image::kMaxDimension + 1); }) ==
         "EpipolarLayout.screenSize");
   EpipolarOptions o;
   o.regions = 0;
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.regions");
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.regions");
   o = {};
   o.slicesPerBorderPixel = std::nan("");
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) ==
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) ==
         "EpipolarOptions.slicesPerBorderPixel");
   o = {};
   o.slices = -1;
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.slices");
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.slices");
   o = {};
   o.epipoleBlockRadius = -1.0;
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.epipoleBlockRadius");
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) ==
+        "EpipolarOptions.epipoleBlockRadius");
   o = {};
   o.maxBlockPixels = -1;
-  CHECK(parameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) == "EpipolarOptions.maxBlockPixels");
+  CHECK(invalidParameter([&] { EpipolarLayout(camera, light, 16, 9, o); }) ==
+        "EpipolarOptions.maxBlockPixels");
   const EpipolarLayout L(camera, light, 16, 9);
-  CHECK(parameter([&] { L.toRectified(camera.position()); }) == "EpipolarLayout.toRectified.world");
-  CHECK(parameter([&] { L.toRectified(glm::dvec3(std::nan(""))); }) == "EpipolarLayout.toRectified.world");
-  CHECK(parameter([&] { L.rayProfile(0.5, 0.5, 4); }) == "EpipolarLayout.region");
+  CHECK(invalidParameter([&] { L.toRectified(camera.position()); }) == "EpipolarLayout.toRectified.world");
+  CHECK(invalidParameter([&] { L.toRectified(glm::dvec3(std::nan(""))); }) ==
+        "EpipolarLayout.toRectified.world");
+  CHECK(invalidParameter([&] { L.rayProfile(0.5, 0.5, 4); }) == "EpipolarLayout.region");
 }

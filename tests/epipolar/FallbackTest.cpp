@@ -2,8 +2,9 @@
 // a standard shadow map of an analytic occluder (an infinite plane) resampled into the epipolar layout and
 // into the projective layout, marched and prefiltered (prefilter/'s evaluation, unchanged), against the
 // closed form and against the projective pipeline on a configuration where both are valid.
-#include "epipolar_test_util.h"
-#include "support/image_check.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
@@ -151,29 +152,22 @@ TEST_CASE("epipolar fallback: bad input to the resampling gets a named InvalidAr
   const Setup s;
   const auto layout = std::make_shared<const EpipolarLayout>(s.camera, s.light, 160, 90);
   const int H = layout->sliceCount();
-  const auto parameter = [](const auto& f) {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return std::string("no exception");
-  };
   const Image shadow(64, 64, 1, 1.0f);
-  CHECK(parameter([&] { resampleShadowMap(nullptr, 64, H, shadow, s.lightMatrix); }) ==
+  CHECK(invalidParameter([&] { resampleShadowMap(nullptr, 64, H, shadow, s.lightMatrix); }) ==
         "resampleShadowMap.layout");
-  CHECK(parameter([&] { resampleShadowMap(layout, 0, H, shadow, s.lightMatrix); }) ==
+  CHECK(invalidParameter([&] { resampleShadowMap(layout, 0, H, shadow, s.lightMatrix); }) ==
         "resampleShadowMap.size");
-  CHECK(parameter([&] { resampleShadowMap(layout, 64, H + 1, shadow, s.lightMatrix); }) ==
+  CHECK(invalidParameter([&] { resampleShadowMap(layout, 64, H + 1, shadow, s.lightMatrix); }) ==
         "resampleShadowMap.size");
-  CHECK(parameter([&] { resampleShadowMap(layout, 64, H, Image(), s.lightMatrix); }) == "shadowDepth");
+  CHECK(invalidParameter([&] { resampleShadowMap(layout, 64, H, Image(), s.lightMatrix); }) == "shadowDepth");
   Image nan = shadow;
   nan.at(3, 3) = std::numeric_limits<float>::quiet_NaN();
-  CHECK(parameter([&] { resampleShadowMap(layout, 64, H, nan, s.lightMatrix); }) == "shadowDepth");
-  CHECK(parameter([&] { resampleShadowMap(layout, 64, H, shadow, s.camera.clipFromWorld()); }) ==
+  CHECK(invalidParameter([&] { resampleShadowMap(layout, 64, H, nan, s.lightMatrix); }) == "shadowDepth");
+  CHECK(invalidParameter([&] { resampleShadowMap(layout, 64, H, shadow, s.camera.clipFromWorld()); }) ==
         "lightClipFromWorld"); // perspective
   const glm::dmat4 wrongDirection = analyticLightMatrix(DirectionalLight(glm::dvec3(0.0, -1.0, 0.0)));
-  CHECK(parameter([&] { resampleShadowMap(layout, 64, H, shadow, wrongDirection); }) == "lightClipFromWorld");
+  CHECK(invalidParameter([&] { resampleShadowMap(layout, 64, H, shadow, wrongDirection); }) ==
+        "lightClipFromWorld");
 }
 
 TEST_CASE("epipolar fallback: the depth warp moves resolution, never the shadows (march identity)") {

@@ -2,7 +2,8 @@
 // minMaxMarch integrates (Yusov 2012, Algorithm 2), checked by integrating them again (Klehm et al. 2014,
 // Eq. 1 and 3 per section) against minMaxMarch's own image, and by their shape (ascending, disjoint,
 // inside [start, surface]; a map without occluders gives each ray the single section [start, surface]).
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/march.h>
@@ -129,16 +130,8 @@ TEST_CASE("epipolar lit sections: validation names the parameter and threads do 
   const Image depth = groundDepth(camera, 24, 16);
   const RectifiedMap map = makeRectifiedMap(projectiveLayout(camera, light, 2), randomRunsDepth(64, 32, 5));
   const MinMaxTrees trees(map.depth, 1);
-  const auto parameter = [](const auto& f) -> std::string {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return "";
-  };
-  CHECK(parameter([&] { minMaxLitSections(map, trees, Image(), camera); }) == "cameraDepth");
-  CHECK(parameter([&] { minMaxLitSections(map, MinMaxTrees(Image(16, 8, 1)), depth, camera); }) ==
+  CHECK(invalidParameter([&] { minMaxLitSections(map, trees, Image(), camera); }) == "cameraDepth");
+  CHECK(invalidParameter([&] { minMaxLitSections(map, MinMaxTrees(Image(16, 8, 1)), depth, camera); }) ==
         "MinMaxTrees");
   MarchOptions one, three;
   one.threads = 1;

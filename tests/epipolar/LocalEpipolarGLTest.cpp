@@ -1,11 +1,11 @@
 // A local light in the view prefiltered on its epipolar layout (EpipolarLayout for the light's position;
 // Klehm et al. 2014, Sec. 3.2 on the Sec. 4.1 layout): the GPU prefilter and evaluation against the CPU
 // references (crep::prefilter and crep::evaluate with the LocalLight on the same map) and against the
-// closed form of the analytic wall scene (scatter/local_light_util.h), for a spot and a point-light face.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/gl_fixture.h"
+// closed form of the analytic wall scene (common/local_light_scene.h), for a spot and a point-light face.
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
@@ -32,9 +32,7 @@ TEST_CASE(
     "evaluate GL, a local light in view on its epipolar layout: GPU equals CPU, CPU near the closed form") {
   CREP_REQUIRE_GL();
   constexpr int W = 256, H = 256, w = 160, h = 90;
-  const Camera camera = groundCamera(w, h);
-  const Image depth = groundDepth(camera, w, h);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(w, h);
   PrefilterOptions o;
   o.regionsPerSplit = 4;
   PrefilterPass prefilterPass({.mapWidth = W, .mapHeight = H, .options = o});
@@ -55,18 +53,8 @@ TEST_CASE(
     const auto layout = std::make_shared<const EpipolarLayout>(camera, k.light.position, w, h, eo);
     REQUIRE(layout->epipoleOnScreen());
     const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-    const gl::Handle texture = uploadR32F(map.depth);
-    prefilterPass.run(
-        {.rectifiedDepth = texture.get(), .layout = layout.get(), .medium = &medium, .localLight = &k.light});
-    const gl::Handle out = createTexture2D(GL_RGBA32F, w, h);
-    evaluatePass.run({.cameraDepth = depthTexture.get(),
-                      .output = out.get(),
-                      .camera = &camera,
-                      .medium = &medium,
-                      .layout = layout.get(),
-                      .basis = prefilterPass.filteredBasis(),
-                      .localLight = &k.light});
-    const Image gpu = readRgbaTexture(out.get(), w, h);
+    const Image gpu = prefilterEvaluateLocal(prefilterPass, evaluatePass, map, layout.get(), camera,
+                                             depthTexture.get(), w, h, medium, k.light);
     const Image cpu = evaluate(prefilter(map, medium, k.light, o), depth, camera, k.light, medium, {});
     const ImageMetrics vsCpu = rgbMetrics(gpu, cpu);
     const ImageMetrics cpuVsTruth = rgbMetrics(cpu, closedFormLocal(depth, camera, {k.light}, medium, true));

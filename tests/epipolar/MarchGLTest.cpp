@@ -1,12 +1,12 @@
-// The marches on the built-in scenes (issue 5): projective rectified maps rasterized with the split
-// matrices (SceneRenderer, GL_DEPTH_CLAMP), camera depth rasterized too. CPU: the min/max march equals the
-// brute-force march of the same map to float precision, with fewer steps on terrain than on forest. GPU
-// (compute passes on llvmpipe): trees bit-identical to the CPU's, tree march = brute-force march, both
-// against the CPU reference; the world-space march pass against the CPU world-space march.
-#include "epipolar_test_util.h"
-#include "gl_scene_util.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+// The marches on the built-in scenes: projective rectified maps rasterized with the split matrices
+// (SceneRenderer, GL_DEPTH_CLAMP), camera depth rasterized too. CPU: the min/max march equals the brute-force
+// march of the same map to float precision, with fewer steps on terrain than on forest. GPU (compute passes
+// on llvmpipe): trees bit-identical to the CPU's, tree march = brute-force march, both against the CPU
+// reference; the world-space march pass against the CPU world-space march.
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/gl_scene_maps.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
@@ -30,7 +30,7 @@ namespace {
 constexpr int kWidth = 160, kHeight = 90;        // camera image
 constexpr int kMapWidth = 256, kMapHeight = 128; // rectified map (4 splits of 64 columns)
 
-/// The scene and its GPU-rendered map at the sizes above (gl_scene_util.h).
+/// The scene and its GPU-rendered map at the sizes above (common/gl_scene_maps.h).
 SceneMaps renderScene(const std::string& name) {
   return renderSceneMaps(name, kWidth, kHeight, kMapWidth, kMapHeight);
 }

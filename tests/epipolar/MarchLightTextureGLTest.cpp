@@ -4,11 +4,12 @@
 // textured brute-force march (same map), and a constant colour map c against c times the untextured march,
 // for the sun's window and a spot light's gobo on the analytic plane scenes (160x90, map 256x128).
 // The first test case needs no GL context (CPU only).
-#include "epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
+#include "common/light_texture_frames.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/gpu_march.h>
@@ -36,68 +37,7 @@ namespace {
 
 constexpr int kW = 160, kH = 90, kMapW = 256, kMapH = 128;
 
-/// Left half red, right half blue (64^2), its edge through the view.
-Image twoColourTexture() {
-  Image t(64, 64, 3);
-  for (int j = 0; j < 64; ++j)
-    for (int i = 0; i < 64; ++i) {
-      const glm::vec3 c = i < 32 ? glm::vec3(1.0f, 0.1f, 0.05f) : glm::vec3(0.05f, 0.1f, 1.0f);
-      for (int k = 0; k < 3; ++k)
-        t.at(i, j, k) = c[k];
-    }
-  return t;
-}
-
-/// An RGB image as a GL_RGBA32F texture (A = 1).
-gl::Handle uploadRgb(const Image& image) {
-  Image rgba(image.width(), image.height(), 4, 1.0f);
-  for (int j = 0; j < image.height(); ++j)
-    for (int i = 0; i < image.width(); ++i)
-      for (int k = 0; k < 3; ++k)
-        rgba.at(i, j, k) = image.at(i, j, k);
-  gl::Handle t = gl::createTexture2D(GL_RGBA32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RGBA, GL_FLOAT, rgba.data().data());
-  return t;
-}
-
-/// The analytic frame of one light (the light-texture tests' frames): layout, map, texture projection.
-struct Frame {
-  Camera camera = groundCamera(kW, kH);
-  Image depth = groundDepth(camera, kW, kH);
-  Medium medium = colouredMedium();
-  DirectionalLight sun = sideLight();
-  std::optional<LocalLight> local;
-  std::shared_ptr<const ProjectiveLayout> layout;
-  RectifiedMap map;
-  glm::dmat4 textureClipFromWorld{1.0};
-};
-
-Frame sunFrame() {
-  Frame f;
-  f.layout = projectiveLayout(f.camera, f.sun, 8);
-  const HalfSpace plane;
-  f.map = castRectifiedMap(f.layout, kMapW, kMapH, [&](const LightRay& ray) { return planeHit(plane, ray); });
-  const glm::dvec3 target(0.0, 1.0, -12.0);
-  f.textureClipFromWorld = glm::ortho(-40.0, 40.0, -40.0, 40.0, 1.0, 400.0) *
-                           glm::lookAt(target - 100.0 * f.sun.direction(), target, glm::dvec3(0.0, 1.0, 0.0));
-  return f;
-}
-
-Frame spotFrame() {
-  Frame f;
-  const SpotLight spot = analyticSpot();
-  f.local = LocalLight::spot(spot);
-  RectifyOptions ro;
-  ro.splits = 8;
-  f.layout = std::make_shared<const ProjectiveLayout>(rectify(f.camera, spot, ro));
-  f.map = castRectifiedMap(f.layout, kMapW, kMapH, wallHitFromLight);
-  f.textureClipFromWorld =
-      glm::perspective(glm::radians(90.0), 1.0, 0.1, 100.0) *
-      glm::lookAt(spot.position(), glm::dvec3(2.0, 0.0, -6.0), glm::dvec3(0.0, 1.0, 0.0));
-  return f;
-}
-
-MarchResult cpuBrute(const Frame& f, const Image* colors) {
+MarchResult cpuBrute(const LightTextureFrame& f, const Image* colors) {
   if (f.local)
     return colors ? bruteForceMarch(f.map, f.depth, f.camera, *f.local, f.medium, *colors)
                   : bruteForceMarch(f.map, f.depth, f.camera, *f.local, f.medium);
@@ -105,7 +45,7 @@ MarchResult cpuBrute(const Frame& f, const Image* colors) {
                 : bruteForceMarch(f.map, f.depth, f.camera, f.sun, f.medium);
 }
 
-MarchResult cpuMinMax(const Frame& f, const Image* colors) {
+MarchResult cpuMinMax(const LightTextureFrame& f, const Image* colors) {
   if (f.local)
     return colors ? minMaxMarch(f.map, f.depth, f.camera, *f.local, f.medium, *colors)
                   : minMaxMarch(f.map, f.depth, f.camera, *f.local, f.medium);
@@ -154,7 +94,7 @@ Image constantColors(const glm::vec3& c) {
 }
 
 /// RectifiedMarchPass on a frame's map (0 colour map: untextured).
-Image gpuMarch(const Frame& f, RectifiedMarchPass::Mode mode, std::uint32_t lightColors,
+Image gpuMarch(const LightTextureFrame& f, RectifiedMarchPass::Mode mode, std::uint32_t lightColors,
                Image* steps = nullptr) {
   const gl::Handle map = uploadR32F(f.map.depth), cameraDepth = uploadR32F(f.depth);
   MinMaxTreePass trees({kMapW, kMapH});
@@ -192,7 +132,7 @@ TEST_CASE("march light texture: the CPU min/max march with a colour map equals t
   for (const bool spot : {false, true}) {
     const std::string name = spot ? "spot gobo" : "sun window";
     CAPTURE(name);
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image colors = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
     const MarchResult brute = cpuBrute(f, &colors), tree = cpuMinMax(f, &colors);
     // The tree's lit nodes are split at the same texel boundaries into the same parts, added in the same
@@ -229,7 +169,7 @@ TEST_CASE("march light texture GL: RectifiedMarchPass with lightColors equals th
   CREP_REQUIRE_GL();
   const Image tex = twoColourTexture();
   for (const bool spot : {false, true}) {
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image colors = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
     const gl::Handle colorTexture = uploadRgb(colors);
     const MarchResult cpu = cpuBrute(f, &colors);
@@ -274,7 +214,7 @@ TEST_CASE("march light texture GL: RectifiedMarchPass with lightColors equals th
   }
 
   // Bad input: a colour map that is not the map's size is named.
-  const Frame f = sunFrame();
+  const LightTextureFrame f = sunTextureFrame(kW, kH, kMapW, kMapH);
   const gl::Handle wrong = uploadRgb(Image(kMapW / 2, kMapH, 3, 1.0f));
   CHECK_THROWS_WITH_AS(gpuMarch(f, RectifiedMarchPass::Mode::BruteForce, wrong.get()),
                        doctest::Contains("RectifiedMarchPass::FrameAttribs.lightColors"), InvalidArgument);

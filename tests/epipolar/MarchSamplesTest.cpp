@@ -2,7 +2,8 @@
 // crep::bruteForceMarch): the rays of epipolar sampling's marched samples (Yusov 2012, Sec. 6.1 and 6.4).
 // At pixel centres they are the per-pixel functions bit for bit; anywhere else the tree march equals the
 // brute-force march of the same rays; bad samples get a named InvalidArgument.
-#include "epipolar_test_util.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
@@ -64,15 +65,6 @@ int bitDifferences(const Image& image, const Image& samples) {
       for (int c = 0; c < image.channels(); ++c)
         if (!sameBits(image.at(x, y, c), samples.at(x + y * image.width(), 0, c))) ++differ;
   return differ;
-}
-
-std::string parameterOf(const auto& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.parameter();
-  }
-  return "no exception";
 }
 
 } // namespace
@@ -172,18 +164,20 @@ TEST_CASE("march samples: bad samples get a named InvalidArgument") {
        {ScreenSample{nan, 3.0, 0.5}, ScreenSample{4.0, inf, 0.5}, ScreenSample{4.0, 3.0, nan},
         ScreenSample{4.0, 3.0, 1.5}, ScreenSample{4.0, 3.0, -0.1}}) {
     samples[3] = bad;
-    CHECK(parameterOf([&] { minMaxMarch(map, trees, samples, 16, 9, camera, light, medium); }) ==
+    CHECK(invalidParameter([&] { minMaxMarch(map, trees, samples, 16, 9, camera, light, medium); }) ==
           "samples[3]");
-    CHECK(parameterOf([&] { bruteForceMarch(map, samples, 16, 9, camera, light, medium); }) == "samples[3]");
+    CHECK(invalidParameter([&] { bruteForceMarch(map, samples, 16, 9, camera, light, medium); }) ==
+          "samples[3]");
   }
   samples[3] = {4.0, 3.0, 0.5};
-  CHECK(parameterOf([&] { bruteForceMarch(map, samples, 0, 9, camera, light, medium); }) == "width");
-  CHECK(parameterOf([&] { minMaxMarch(map, trees, samples, 16, -1, camera, light, medium); }) == "height");
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] { bruteForceMarch(map, samples, 0, 9, camera, light, medium); }) == "width");
+  CHECK(invalidParameter([&] { minMaxMarch(map, trees, samples, 16, -1, camera, light, medium); }) ==
+        "height");
+  CHECK(invalidParameter([&] {
           minMaxMarch(map, MinMaxTrees(Image(16, 8, 1)), samples, 16, 9, camera, light, medium);
         }) == "MinMaxTrees");
   const std::vector<ScreenSample> tooMany(static_cast<std::size_t>(Image::kMaxDimension) + 1);
-  CHECK(parameterOf([&] { bruteForceMarch(map, tooMany, 16, 9, camera, light, medium); }) == "samples");
+  CHECK(invalidParameter([&] { bruteForceMarch(map, tooMany, 16, 9, camera, light, medium); }) == "samples");
   // No samples: an empty result.
   CHECK(
       bruteForceMarch(map, std::span<const ScreenSample>(), 16, 9, camera, light, medium).scattering.empty());

@@ -2,8 +2,9 @@
 // crep/scatter/world_march.h): min/max trees, the tree march against the brute-force march of the same
 // rows (Yusov 2012, Algorithm 2), both against closed forms (Klehm et al. 2014, Eq. 1, 3); the world-space
 // reference march against the closed forms of an empty medium and of a half-space shadow.
-#include "epipolar_test_util.h"
-#include "support/image_check.h"
+#include "common/analytic_reference.h"
+#include "common/error_checks.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/march.h>
@@ -164,38 +165,35 @@ TEST_CASE("epipolar march: bad input gets a named InvalidArgument") {
   const Medium medium = colouredMedium();
   Image depth = groundDepth(camera, 16, 9);
   const RectifiedMap map = makeRectifiedMap(projectiveLayout(camera, light, 2), Image(32, 8, 1, 1.0f));
-  const auto parameter = [](const auto& f) {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return std::string("no exception");
-  };
-  CHECK(parameter([&] { minMaxMarch(map, Image(), camera, light, medium); }) == "cameraDepth");
+  CHECK(invalidParameter([&] { minMaxMarch(map, Image(), camera, light, medium); }) == "cameraDepth");
   depth.at(3, 4) = std::numeric_limits<float>::quiet_NaN();
-  CHECK(parameter([&] { bruteForceMarch(map, depth, camera, light, medium); }) == "cameraDepth");
+  CHECK(invalidParameter([&] { bruteForceMarch(map, depth, camera, light, medium); }) == "cameraDepth");
   depth.at(3, 4) = 0.5f;
   RectifiedMap bad = map;
   bad.depth.at(5, 5) = std::numeric_limits<float>::quiet_NaN();
-  CHECK(parameter([&] { minMaxMarch(bad, depth, camera, light, medium); }) == "RectifiedMap.depth");
-  CHECK(parameter([&] { minMaxMarch(map, MinMaxTrees(Image(16, 8, 1)), depth, camera, light, medium); }) ==
-        "MinMaxTrees");
+  CHECK(invalidParameter([&] { minMaxMarch(bad, depth, camera, light, medium); }) == "RectifiedMap.depth");
+  CHECK(invalidParameter([&] {
+          minMaxMarch(map, MinMaxTrees(Image(16, 8, 1)), depth, camera, light, medium);
+        }) == "MinMaxTrees");
   MarchOptions o;
   o.threads = -1;
-  CHECK(parameter([&] { bruteForceMarch(map, depth, camera, light, medium, o); }) == "MarchOptions.threads");
+  CHECK(invalidParameter([&] { bruteForceMarch(map, depth, camera, light, medium, o); }) ==
+        "MarchOptions.threads");
   Image shadow(8, 8, 1, 1.0f);
   shadow.at(1, 2) = std::numeric_limits<float>::quiet_NaN();
   const glm::dmat4 M = analyticLightMatrix(light);
-  CHECK(parameter([&] { worldSpaceMarch(shadow, M, depth, camera, light, medium); }) == "shadowDepth");
-  CHECK(parameter([&] { worldSpaceMarch(Image(), M, depth, camera, light, medium); }) == "shadowDepth");
+  CHECK(invalidParameter([&] { worldSpaceMarch(shadow, M, depth, camera, light, medium); }) == "shadowDepth");
+  CHECK(invalidParameter([&] { worldSpaceMarch(Image(), M, depth, camera, light, medium); }) ==
+        "shadowDepth");
   glm::dmat4 nanMatrix = M;
   nanMatrix[1][2] = std::numeric_limits<double>::infinity();
-  CHECK(parameter([&] { worldSpaceMarch(Image(8, 8, 1, 1.0f), nanMatrix, depth, camera, light, medium); }) ==
-        "lightClipFromWorld");
+  CHECK(invalidParameter([&] {
+          worldSpaceMarch(Image(8, 8, 1, 1.0f), nanMatrix, depth, camera, light, medium);
+        }) == "lightClipFromWorld");
   WorldMarchOptions w;
   w.steps = 0;
-  CHECK(parameter([&] { worldSpaceMarch(Image(8, 8, 1, 1.0f), M, depth, camera, light, medium, w); }) ==
-        "WorldMarchOptions.steps");
-  CHECK(parameter([] { MinMaxTrees(Image(4, 4, 2)); }) == "MinMaxTrees.depth");
+  CHECK(invalidParameter([&] {
+          worldSpaceMarch(Image(8, 8, 1, 1.0f), M, depth, camera, light, medium, w);
+        }) == "WorldMarchOptions.steps");
+  CHECK(invalidParameter([] { MinMaxTrees(Image(4, 4, 2)); }) == "MinMaxTrees.depth");
 }

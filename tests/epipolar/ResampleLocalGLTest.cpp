@@ -3,7 +3,7 @@
 // scene: the CPU resampling of the spot light's / point-light face's own perspective map (1024^2) against the
 // same casters rasterized directly into the rectified layout (RectifiedShadowPass), the GL pass against the
 // CPU reference, and bad matrices named.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

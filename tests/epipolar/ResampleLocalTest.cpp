@@ -1,12 +1,13 @@
 // Point resampling of a local light's perspective shadow map into its projective rectified map (Klehm et al.
 // 2014, Sec. 4.1's rule on the layout of Sec. 3.2 "Local Lights"; crep/epipolar/resample.h), on the CPU:
-// the analytic scene's wall (a half-space, local_light_util.h) seen by the spot light and a point-light face,
-// its perspective map computed in closed form, resampled, against the exact rectified depth of the wall's hit
-// on every texel's light ray; and validateLocalLightMatrix / the layout's choice of check, bad matrices
-// named.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+// the analytic scene's wall (a half-space, common/local_light_scene.h) seen by the spot light and a
+// point-light face, its perspective map computed in closed form, resampled, against the exact rectified depth
+// of the wall's hit on every texel's light ray; and validateLocalLightMatrix / the layout's choice of check,
+// bad matrices named.
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/error_checks.h"
+#include "common/local_light_scene.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
@@ -26,15 +27,6 @@ using namespace crep;
 using namespace crep::test;
 
 namespace {
-
-std::string parameterOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.parameter();
-  }
-  return "no exception";
-}
 
 struct Agreement {
   int compared = 0, excluded = 0, differing = 0, hits = 0;
@@ -161,20 +153,20 @@ TEST_CASE("resample local lights: validateLocalLightMatrix accepts the lights' m
   const glm::dmat4 M = spot.lightClipFromWorld();
   const glm::dvec3 L = spot.position();
   // A centre 1 unit (3e-4 of |L|) off the light: rejected, as is one 1% off.
-  CHECK(parameterOf([&] { validateLocalLightMatrix(M, L + glm::dvec3(1.0, 0.0, 0.0)); }) ==
+  CHECK(invalidParameter([&] { validateLocalLightMatrix(M, L + glm::dvec3(1.0, 0.0, 0.0)); }) ==
         "lightClipFromWorld");
-  CHECK(parameterOf([&] { validateLocalLightMatrix(M, L * 1.01); }) == "lightClipFromWorld");
+  CHECK(invalidParameter([&] { validateLocalLightMatrix(M, L * 1.01); }) == "lightClipFromWorld");
   // An orthographic matrix (clip w = 1 everywhere) is not a perspective one.
   const glm::dmat4 ortho = glm::orthoRH_NO(-10.0, 10.0, -10.0, 10.0, 0.1, 100.0) *
                            glm::lookAtRH(L, L + glm::dvec3(0.3, -1.0, 0.2), glm::dvec3(1.0, 0.0, 0.0));
-  CHECK(parameterOf([&] { validateLocalLightMatrix(ortho, L); }) == "lightClipFromWorld");
+  CHECK(invalidParameter([&] { validateLocalLightMatrix(ortho, L); }) == "lightClipFromWorld");
   glm::dmat4 nan = M;
   nan[2][1] = std::nan("");
-  CHECK(parameterOf([&] { validateLocalLightMatrix(nan, L); }) == "lightClipFromWorld");
+  CHECK(invalidParameter([&] { validateLocalLightMatrix(nan, L); }) == "lightClipFromWorld");
   glm::dmat4 singular = M;
   singular[2] = singular[0];
-  CHECK(parameterOf([&] { validateLocalLightMatrix(singular, L); }) == "lightClipFromWorld");
-  CHECK(parameterOf([&] { validateLocalLightMatrix(M, glm::dvec3(std::nan(""), 0.0, 0.0)); }) ==
+  CHECK(invalidParameter([&] { validateLocalLightMatrix(singular, L); }) == "lightClipFromWorld");
+  CHECK(invalidParameter([&] { validateLocalLightMatrix(M, glm::dvec3(std::nan(""), 0.0, 0.0)); }) ==
         "lightPosition");
   const std::string message = [&] {
     try {
@@ -207,11 +199,12 @@ TEST_CASE("resample local lights: resampleShadowMap takes the check of the layou
   const glm::dmat4 ortho = analyticLightMatrix(sun);
   // A local light's layout wants a perspective matrix centred at the light, a directional one an
   // orthographic matrix along the light.
-  CHECK(parameterOf([&] { resampleShadowMap(local, 64, 64, shadow, ortho); }) == "lightClipFromWorld");
-  CHECK(parameterOf([&] { resampleShadowMap(local, 64, 64, shadow, camera.clipFromWorld()); }) ==
+  CHECK(invalidParameter([&] { resampleShadowMap(local, 64, 64, shadow, ortho); }) == "lightClipFromWorld");
+  CHECK(invalidParameter([&] { resampleShadowMap(local, 64, 64, shadow, camera.clipFromWorld()); }) ==
         "lightClipFromWorld");
-  CHECK(parameterOf([&] { resampleShadowMap(directional, 64, 64, shadow, spot.lightClipFromWorld()); }) ==
-        "lightClipFromWorld");
+  CHECK(invalidParameter([&] {
+          resampleShadowMap(directional, 64, 64, shadow, spot.lightClipFromWorld());
+        }) == "lightClipFromWorld");
   CHECK_NOTHROW(resampleShadowMap(local, 64, 64, shadow, spot.lightClipFromWorld()));
   CHECK_NOTHROW(resampleShadowMap(directional, 64, 64, shadow, ortho));
   // An empty map resamples to "nothing casts" everywhere.

@@ -1,5 +1,5 @@
-// Engine camera conventions end to end on the GPU (issue "engine conventions", part 2): the same scene and
-// the same prefiltered basis evaluated through
+// Engine camera conventions end to end on the GPU (on the CPU: Camera::fromMatrices in
+// tests/core/CameraTest.cpp): the same scene and the same prefiltered basis evaluated through
 //   (a) the tools' GL camera (symmetric, [-1, 1] clip depth, finite far, depth cleared to 1),
 //   (b) the engine matrices of a reversed-Z, [0, 1] clip depth camera with an infinite far plane and
 //       maxDistance = (a)'s far plane, its depth buffer holding near / Z (cleared to 0),
@@ -9,11 +9,11 @@
 // read, never the scattering. The world march (crep::WorldMarchPass, march.glsl) is checked the same way
 // for (b). Last, (d) on an epipolar frame (the sun in view) through crep::Scattering, against the
 // world-space reference.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
-#include "../prefilter/prefilter_gpu_util.h"
-#include "scattering_frame.h"
+#include "common/prefilter_gpu.h"
+#include "pipeline/scattering_frame.h"
 
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>

@@ -12,8 +12,8 @@
 // and shows the map changes for each state the contract sets: the comparison above would catch a pass that
 // forgot it. States the contract leaves alone because a depth-only, single-sampled target ignores them
 // (colour, stencil, blend, multisample) change nothing.
+#include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl_state.h>

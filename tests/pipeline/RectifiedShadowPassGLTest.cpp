@@ -4,7 +4,8 @@
 // scissor keeps the clear inside its split; the same loop without the scissor wipes the splits drawn
 // before, which the negative control shows), leave the caller's raster state as it was, and reject bad
 // input by name.
-#include "support/gl_fixture.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
@@ -20,6 +21,7 @@
 #include <string>
 
 using namespace crep;
+using crep::test::invalidParameter;
 using namespace crep::scenes;
 
 namespace {
@@ -31,15 +33,6 @@ int differingTexels(const Image& a, const Image& b) {
   for (std::size_t i = 0; i < a.data().size(); ++i)
     if (a.data()[i] != b.data()[i]) ++n;
   return n;
-}
-
-std::string parameterOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.parameter();
-  }
-  return "no exception";
 }
 
 } // namespace
@@ -154,25 +147,29 @@ TEST_CASE("RectifiedShadowPass: restores the caller's raster state and names bad
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
 
-  CHECK(parameterOf([&] { pass.run({nullptr, draw}); }) == "RectifiedShadowPass::FrameAttribs.rectification");
-  CHECK(parameterOf([&] { pass.run({&r, {}}); }) == "RectifiedShadowPass::FrameAttribs.drawCasters");
+  CHECK(invalidParameter([&] {
+          pass.run({nullptr, draw});
+        }) == "RectifiedShadowPass::FrameAttribs.rectification");
+  CHECK(invalidParameter([&] { pass.run({&r, {}}); }) == "RectifiedShadowPass::FrameAttribs.drawCasters");
   Rectification fallback = r;
   fallback.status = RectifyStatus::Fallback;
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] {
           pass.run({&fallback, draw});
         }) == "RectifiedShadowPass::FrameAttribs.rectification");
   Rectification layers = r;
   layers.layout = SplitLayout::Layers;
-  CHECK(parameterOf([&] { pass.run({&layers, draw}); }) == "RectifiedShadowPass::FrameAttribs.rectification");
+  CHECK(invalidParameter([&] {
+          pass.run({&layers, draw});
+        }) == "RectifiedShadowPass::FrameAttribs.rectification");
   const gl::Handle small = createDepthTexture(kW / 2, kH);
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] {
           pass.run({&r, draw, small.get()});
         }) == "RectifiedShadowPass::FrameAttribs.depthTexture");
   const gl::Handle colour = gl::createTexture2D(GL_RGBA8, kW, kH);
-  CHECK(parameterOf([&] {
+  CHECK(invalidParameter([&] {
           pass.run({&r, draw, colour.get()});
         }) == "RectifiedShadowPass::FrameAttribs.depthTexture");
   RectifiedShadowPass odd({kW + 1, kH});
-  CHECK(parameterOf([&] { odd.run({&r, draw}); }) == "RectifiedShadowPass::CreateInfo.mapWidth");
-  CHECK(parameterOf([&] { RectifiedShadowPass({0, kH}); }).find("RectifiedShadowPass::CreateInfo") == 0);
+  CHECK(invalidParameter([&] { odd.run({&r, draw}); }) == "RectifiedShadowPass::CreateInfo.mapWidth");
+  CHECK(invalidParameter([&] { RectifiedShadowPass({0, kH}); }).find("RectifiedShadowPass::CreateInfo") == 0);
 }

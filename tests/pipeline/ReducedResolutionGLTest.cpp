@@ -1,8 +1,8 @@
 // Reduced-resolution evaluation on the GPU (crep/pipeline/reduced_resolution.h): the passes against the CPU
 // rules, and crep::Scattering at half resolution against full resolution on every built-in scene, over the
 // whole image and at depth edges (160 x 90, 256^2 maps).
+#include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/gl.h>
 #include <crep/pipeline/reduced_resolution.h>

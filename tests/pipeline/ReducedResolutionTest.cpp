@@ -1,6 +1,8 @@
 // Reduced-resolution evaluation, CPU rules (crep/pipeline/reduced_resolution.h): the checkerboard min/max
 // depth downsample, the depth-aware upsample reducing exactly to the bilinear upsample on a constant depth,
 // and keeping each side of a depth edge; bad input named.
+#include "common/error_checks.h"
+
 #include <crep/core/camera.h>
 #include <crep/core/error.h>
 #include <crep/pipeline/reduced_resolution.h>
@@ -12,6 +14,7 @@
 #include <string>
 
 using namespace crep;
+using crep::test::invalidParameter;
 
 namespace {
 
@@ -29,15 +32,6 @@ double bilinear(const Image& low, int f, int x, int y, int c) {
   };
   return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
          fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
-}
-
-std::string parameterOf(const auto& call) {
-  try {
-    call();
-  } catch (const InvalidArgument& e) {
-    return e.parameter();
-  }
-  return "(no error)";
 }
 
 } // namespace
@@ -119,11 +113,11 @@ TEST_CASE("reduced resolution: the upsample keeps each side of a depth edge") {
 
 TEST_CASE("reduced resolution: bad input is named") {
   const Image d(8, 8, 1, 0.5f);
-  CHECK(parameterOf([&] { downsampleDepth(d, 3); }) == "downsampleDepth.factor");
-  CHECK(parameterOf([&] { downsampleDepth(Image(6, 8, 1, 0.5f), 4); }) == "downsampleDepth.depth");
+  CHECK(invalidParameter([&] { downsampleDepth(d, 3); }) == "downsampleDepth.factor");
+  CHECK(invalidParameter([&] { downsampleDepth(Image(6, 8, 1, 0.5f), 4); }) == "downsampleDepth.depth");
   const Image lowDepth = downsampleDepth(d, 2);
-  CHECK(parameterOf([&] { depthAwareUpsample(Image(3, 4, 4), lowDepth, d, testCamera(), 2); }) ==
+  CHECK(invalidParameter([&] { depthAwareUpsample(Image(3, 4, 4), lowDepth, d, testCamera(), 2); }) ==
         "depthAwareUpsample.low");
-  CHECK(parameterOf([&] { depthAwareUpsample(Image(4, 4, 4), Image(2, 2, 1), d, testCamera(), 2); }) ==
+  CHECK(invalidParameter([&] { depthAwareUpsample(Image(4, 4, 4), Image(2, 2, 1), d, testCamera(), 2); }) ==
         "depthAwareUpsample.lowDepth");
 }

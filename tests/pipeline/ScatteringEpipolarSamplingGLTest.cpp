@@ -2,9 +2,9 @@
 // Yusov's method (Method::MinMaxMarch) and the hybrid (Method::Prefiltered) on the built-in scenes and on
 // sun-in-view frames against the world-space reference; the selected samples marched exactly as the
 // per-pixel min/max march marches a ray; no pixel left unwritten; the error around depth edges.
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
 
 #include <crep/epipolar/epipolar_sampling.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>

@@ -5,8 +5,9 @@
 // moved-from object is valid but empty. Textures of the wrong target, format class, or aliasing the output
 // are named; a light texture's non-finite texels read as 0 (the GPU's rule), and one scaled by 1e6 scales
 // the prefiltered frame by 1e6 (no half-float clipping).
+#include "common/gl_fixture.h"
+#include "common/gl_util.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl_state.h>
@@ -63,14 +64,6 @@ void checkContextClean(const gl::RasterState& before) {
 struct ExpectGlErrors {
   ScopedGlDebugCallback quiet{[](const GlDebugMessage&) {}};
 };
-
-/// An RGBA32F texture of `image` (4 channels).
-gl::Handle uploadRgba(const Image& image) {
-  gl::Handle t = gl::createTexture2D(GL_RGBA32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RGBA, GL_FLOAT,
-                      image.data().data());
-  return t;
-}
 
 /// A light texture over the colonnade's sun: left half warm, right half cool (8 x 8).
 Image windowTexture(float scale) {

@@ -2,9 +2,10 @@
 // run by hand on projective frames, the prefiltered method on fallback frames (sun in view, sun behind the
 // camera) close to the world-space reference, with either shadow input; bad input named; GL state kept.
 // 160 x 90 screens, 256^2 maps.
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
@@ -105,44 +106,36 @@ TEST_CASE("Scattering: fallback frames are prefiltered on the epipolar layout, c
 TEST_CASE("Scattering: bad input is named, GL state is restored") {
   CREP_REQUIRE_GL();
   ScatteringFixture f("boxes");
-  const auto parameterOf = [](const auto& call) -> std::string {
-    try {
-      call();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return "(no error)";
-  };
   Scattering::CreateInfo bad = smallInfo();
   bad.mapSize = 250; // not a multiple of 4 splits
-  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.mapSize");
+  CHECK(invalidParameter([&] { Scattering s(bad); }) == "Scattering::CreateInfo.mapSize");
   bad = smallInfo();
   bad.rectify.layout = SplitLayout::Layers;
-  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.rectify.layout");
+  CHECK(invalidParameter([&] { Scattering s(bad); }) == "Scattering::CreateInfo.rectify.layout");
   bad = smallInfo();
   bad.prefilter.bases = 3;
-  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.prefilter.bases");
+  CHECK(invalidParameter([&] { Scattering s(bad); }) == "Scattering::CreateInfo.prefilter.bases");
   bad = smallInfo();
   bad.epipoleBlockMaxPixels = -1;
-  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.epipoleBlockMaxPixels");
+  CHECK(invalidParameter([&] { Scattering s(bad); }) == "Scattering::CreateInfo.epipoleBlockMaxPixels");
   bad = smallInfo();
   bad.epipoleBlockMethod = static_cast<Scattering::EpipoleBlockMethod>(7);
-  CHECK(parameterOf([&] { Scattering s(bad); }) == "Scattering::CreateInfo.epipoleBlockMethod");
+  CHECK(invalidParameter([&] { Scattering s(bad); }) == "Scattering::CreateInfo.epipoleBlockMethod");
 
   Scattering scattering(smallInfo());
   Scattering::FrameAttribs a = f.attribs(true, false);
   a.camera = nullptr;
-  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.camera");
+  CHECK(invalidParameter([&] { scattering.run(a); }) == "Scattering::FrameAttribs.camera");
   a = f.attribs(false, false);
-  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.drawCasters/shadowMap");
+  CHECK(invalidParameter([&] { scattering.run(a); }) == "Scattering::FrameAttribs.drawCasters/shadowMap");
   const gl::Handle rgba8 = gl::createTexture2D(GL_RGBA8, kWidth, kHeight);
   a = f.attribs(true, false);
   a.output = rgba8.get();
-  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.output");
+  CHECK(invalidParameter([&] { scattering.run(a); }) == "Scattering::FrameAttribs.output");
   const gl::Handle small = scenes::createDepthTexture(kWidth / 2, kHeight);
   a = f.attribs(true, false);
   a.cameraDepth = small.get();
-  CHECK(parameterOf([&] { scattering.run(a); }) == "Scattering::FrameAttribs.cameraDepth");
+  CHECK(invalidParameter([&] { scattering.run(a); }) == "Scattering::FrameAttribs.cameraDepth");
 
   // The raster state the shadow pass changes is the caller's again afterwards.
   const gl::Handle fb = gl::createFramebuffer();

@@ -5,9 +5,10 @@
 // view) and on an off-screen spot against the textured world-space reference (WorldMarchPass with the
 // texture, 1024^2 shadow map, 256 steps), per channel; the epipolar variant of LightColorMapPass against
 // crep::lightColorMap; reduced-resolution evaluation; bad input named. 160x90, map 512.
+#include "common/gl_fixture.h"
+#include "common/light_texture_frames.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/epipolar/epipolar.h>
@@ -36,30 +37,6 @@ Scattering::CreateInfo textureInfo() {
   Scattering::CreateInfo info = smallInfo();
   info.mapSize = kTextureMap;
   return info;
-}
-
-/// Left half red, right half blue (64^2).
-Image twoColourTexture() {
-  Image t(64, 64, 3);
-  for (int j = 0; j < 64; ++j)
-    for (int i = 0; i < 64; ++i) {
-      const glm::vec3 c = i < 32 ? glm::vec3(1.0f, 0.1f, 0.05f) : glm::vec3(0.05f, 0.1f, 1.0f);
-      for (int k = 0; k < 3; ++k)
-        t.at(i, j, k) = c[k];
-    }
-  return t;
-}
-
-/// An RGB image as a GL_RGBA32F texture (A = 1).
-gl::Handle uploadRgb(const Image& image) {
-  Image rgba(image.width(), image.height(), 4, 1.0f);
-  for (int j = 0; j < image.height(); ++j)
-    for (int i = 0; i < image.width(); ++i)
-      for (int k = 0; k < 3; ++k)
-        rgba.at(i, j, k) = image.at(i, j, k);
-  gl::Handle t = gl::createTexture2D(GL_RGBA32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RGBA, GL_FLOAT, rgba.data().data());
-  return t;
 }
 
 /// The sun's window: an orthographic projection along the sun, 60 world units wide, centred on the point 14

@@ -3,9 +3,9 @@
 // view (not projective: prefiltered on its epipolar layout) and a point light (six faces), each against the
 // world-space reference march of the same light (WorldMarchPass with the light's own perspective shadow maps,
 // 1024^2, 256 steps). The directional light has zero irradiance, so the output is the local lights' alone.
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 
@@ -30,7 +30,6 @@ TEST_CASE(
   ScatteringFixture f("colonnade");
   f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0))); // night: the local lights alone
   const Camera& c = f.scene.camera;
-  const glm::dvec3 target = c.position() + 14.0 * c.forward();
   struct Case {
     const char* name;
     glm::dvec3 position;
@@ -42,13 +41,7 @@ TEST_CASE(
                         Case{"in view", c.position() + 9.0 * c.forward() + 1.5 * c.up() - 1.0 * c.right(),
                              RectifyStatus::Fallback}}) {
     CAPTURE(std::string(k.name));
-    const SpotLight spot({.position = k.position,
-                          .direction = target - k.position,
-                          .innerConeAngle = 0.35,
-                          .outerConeAngle = 0.55,
-                          .color = {1.0, 0.85, 0.6},
-                          .intensity = 150.0,
-                          .range = 80.0});
+    const SpotLight spot = spotToward(c, k.position);
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.spotLights = std::span<const SpotLight>(&spot, 1);
     const Scattering::FrameResult r = scattering.run(a);
@@ -63,9 +56,9 @@ TEST_CASE(
     report(std::string("spot light ") + k.name + ": Scattering vs world-space reference", m);
     CHECK(m.nanCount == 0);
     CHECK(m.peak > 0.0);
-    // The issue's goal for both: within 2% of the world-space reference. Measured 0.52% off screen, 0.76% in
-    // view (on its epipolar layout, depth warp 0.03, the epipole block of 1% of the diagonal; 1.35% without
-    // the block, 3.2% with the sun's depth warp 0.1).
+    // The local lights' accuracy goal for both: within 2% of the world-space reference. Measured 0.52% off
+    // screen, 0.76% in view (on its epipolar layout, depth warp 0.03, the epipole block of 1% of the
+    // diagonal; 1.35% without the block, 3.2% with the sun's depth warp 0.1).
     bool block = false;
     for (const Scattering::Stage& stage : r.stages)
       block = block || stage.name == "local light: epipole block (world march)";
@@ -128,10 +121,10 @@ TEST_CASE("Scattering with local lights: a point light's six faces and a spot ad
   report("point light (six faces) added to the sun: Scattering - sun vs world-space references", m);
   CHECK(m.peak > 0.0);
   CHECK(m.nanCount == 0);
-  // The built-in scenes' goal (issue "local lights"): within 2% of the world-space reference. Measured
-  // 1.17% with Scattering::CreateInfo::localLightBases = 64 and localLightTableSamples = 64 (the defaults;
-  // 1.08% with 128 samples); 2.67% with M = 32, where the
-  // Fourier depth resolution smoothed the pillars' shadow steps of the faces seen from close by.
+  // The built-in scenes' goal for local lights: within 2% of the world-space reference. Measured 1.17% with
+  // Scattering::CreateInfo::localLightBases = 64 and localLightTableSamples = 64 (the defaults; 1.08% with
+  // 128 samples); 2.67% with M = 32, where the Fourier depth resolution smoothed the pillars' shadow steps of
+  // the faces seen from close by.
   CHECK(m.relativeRmse < 0.02);
   // Local lights need drawCasters.
   Scattering::FrameAttribs noCasters = f.attribs(false, true);

@@ -6,9 +6,10 @@
 // rendered beforehand and no drawCasters, in a night frame (FrameAttribs::light null). (a) and (b) differ
 // only by the point resampling; both are compared with the world-space reference march of the same light. Bad
 // spans and maps are named.
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/scatter/ray_scattering.h>
@@ -70,15 +71,6 @@ std::vector<glm::dmat4> glCubeFaceMatrices(const PointLight& point) {
   return out;
 }
 
-std::string parameterOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.parameter();
-  }
-  return "no exception";
-}
-
 } // namespace
 
 TEST_CASE("Scattering local lights from the engine's perspective maps: spot lights off screen and in view "
@@ -87,7 +79,6 @@ TEST_CASE("Scattering local lights from the engine's perspective maps: spot ligh
   ScatteringFixture f("colonnade");
   f.setLight(DirectionalLight(f.scene.sun.direction(), glm::dvec3(0.0))); // (a): zero irradiance
   const Camera& c = f.scene.camera;
-  const glm::dvec3 target = c.position() + 14.0 * c.forward();
   struct Case {
     const char* name;
     glm::dvec3 position;
@@ -102,13 +93,7 @@ TEST_CASE("Scattering local lights from the engine's perspective maps: spot ligh
         Case{"in view", c.position() + 9.0 * c.forward() + 1.5 * c.up() - 1.0 * c.right(),
              RectifyStatus::Fallback, 1e-4}}) {
     CAPTURE(std::string(k.name));
-    const SpotLight spot({.position = k.position,
-                          .direction = target - k.position,
-                          .innerConeAngle = 0.35,
-                          .outerConeAngle = 0.55,
-                          .color = {1.0, 0.85, 0.6},
-                          .intensity = 150.0,
-                          .range = 80.0});
+    const SpotLight spot = spotToward(c, k.position);
     // (a) drawCasters, the zero-irradiance sun.
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.spotLights = std::span<const SpotLight>(&spot, 1);
@@ -271,7 +256,7 @@ TEST_CASE("Scattering local lights from the engine's perspective maps: a night f
     faces.push_back(point.faceClipFromWorld(k));
   const EngineMaps pointMaps(f, faces);
   const auto run = [&](const auto& edit) {
-    return parameterOf([&] {
+    return invalidParameter([&] {
       Scattering::FrameAttribs a = f.attribs(false, false);
       a.light = nullptr;
       a.spotLights = std::span<const SpotLight>(&spot, 1);

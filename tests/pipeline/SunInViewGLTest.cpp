@@ -1,11 +1,11 @@
-// The prefiltered method next to the sun (issue "every frame prefiltered", accuracy goals): with the sun in
-// view on every built-in scene and on the analytic ground (closed form), the light just outside the screen
-// and behind the camera, a light sweep through the view, and a slow camera strafe on a fallback frame.
-// crep::Scattering with its defaults except the map (1024^2, so the map's own error, reported as the
-// brute-force march over the same map, stays below the goal); 160 x 90 screens.
+// The prefiltered method next to the sun (the accuracy goals of a prefiltered frame): with the sun in view on
+// every built-in scene and on the analytic ground (closed form), the light just outside the screen and behind
+// the camera, a light sweep through the view, and a slow camera strafe on a fallback frame. crep::Scattering
+// with its defaults except the map (1024^2, so the map's own error, reported as the brute-force march over
+// the same map, stays below the goal); 160 x 90 screens.
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
 
 #include <crep/core/gl.h>
 #include <crep/epipolar/epipolar.h>

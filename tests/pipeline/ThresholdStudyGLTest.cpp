@@ -1,13 +1,13 @@
-// The projective path next to its fallback thresholds (issue "every frame prefiltered", item 3): frames whose
-// angular span is just below / above rectify()'s 150 degrees and whose epipole angle is just above / below
-// its 5 degrees, found among random sun directions above the horizon for the forest's camera (60 degree,
-// 16:9). Each runs through crep::Scattering with the default thresholds (projective below them, the
-// epipolar layout above) and with the thresholds relaxed (projective wherever the matrix exists), against
-// the world-space reference; the brute-force march over the defaults' map gives the map's own error. The
-// figures decide where the thresholds stay (README "Sun in view"): beyond them the epipolar layout is the
-// more accurate one, so no split placement should keep those frames projective.
+// The projective path next to its fallback thresholds (where the prefiltered frame switches layout): frames
+// whose angular span is just below / above rectify()'s 150 degrees and whose epipole angle is just above /
+// below its 5 degrees, found among random sun directions above the horizon for the forest's camera (60
+// degree, 16:9). Each runs through crep::Scattering with the default thresholds (projective below them, the
+// epipolar layout above) and with the thresholds relaxed (projective wherever the matrix exists), against the
+// world-space reference; the brute-force march over the defaults' map gives the map's own error. The figures
+// decide where the thresholds stay (README "Sun in view"): beyond them the epipolar layout is the more
+// accurate one, so no split placement should keep those frames projective.
+#include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
-#include "support/gl_fixture.h"
 
 #include <crep/pipeline/scattering.h>
 #include <crep/rectify/rectify.h>
@@ -86,7 +86,7 @@ TEST_CASE("threshold study: the projective path next to the span and epipole-ang
         CHECK(m.relativeRmse < 0.02);
         CHECK(m.relativeRmse < mp.relativeRmse);
       } else {
-        // Inside them: no goal of the issue; measured 0.9-3.0% (the map itself 0.5-1.9%). 4 splits without
+        // Inside them: no accuracy goal; measured 0.9-3.0% (the map itself 0.5-1.9%). 4 splits without
         // regions per split gave up to 12% (README "Sun in view").
         CHECK(a.layout == Scattering::Layout::Projective);
         CHECK(m.relativeRmse < 0.035);

@@ -4,7 +4,7 @@
 // CPU); metrics near the epipole and the brute-force march over the map a frame used.
 #pragma once
 
-#include "epipolar/epipolar_test_util.h"
+#include "common/analytic_reference.h"
 
 #include <crep/core/gl.h>
 #include <crep/epipolar/epipolar.h>

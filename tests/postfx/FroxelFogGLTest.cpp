@@ -3,8 +3,10 @@
 // shadow map; FroxelFog end to end against the closed form of the homogeneous unshadowed medium; temporal
 // convergence with a static camera; flicker under a slow pan against the world-space reference; NaN
 // containment; the block's std140 offsets; bad options named.
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_scene.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/gl_util.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -27,17 +29,14 @@
 #include <vector>
 
 using namespace crep;
+using crep::test::requireNamed;
+using crep::test::resourceProperty;
+using crep::test::uploadR32F;
 
 namespace {
 
 constexpr int kW = 64, kH = 36;
 const FroxelGrid kGrid{32, 18, 16, 0.5, 60.0};
-
-gl::Handle uploadR32F(const Image& image) {
-  gl::Handle t = gl::createTexture2D(GL_R32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RED, GL_FLOAT, image.data().data());
-  return t;
-}
 
 gl::Handle uploadVolume(const FroxelVolume& v) {
   gl::Handle t = createFroxelVolume({v.width, v.height, v.depth, 0.0, 0.0}, GL_RGBA32F, "test");
@@ -169,28 +168,10 @@ Camera panned(double degrees) {
                 base.far());
 }
 
-GLint resourceProperty(GLuint program, GLenum interface, const std::string& name, GLenum property) {
-  const GLuint index = glGetProgramResourceIndex(program, interface, name.c_str());
-  if (index == GL_INVALID_INDEX) return -1;
-  GLint value = -1;
-  glGetProgramResourceiv(program, interface, index, 1, &property, 1, nullptr, &value);
-  return value;
-}
-
 std::string fmt(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", v);
   return b;
-}
-
-template <class F>
-void requireNamed(const F& f, const std::string& parameter) {
-  try {
-    f();
-    FAIL(std::string(std::string("no exception for ") + parameter));
-  } catch (const InvalidArgument& e) {
-    CHECK(e.parameter() == parameter);
-  }
 }
 
 } // namespace

@@ -3,6 +3,8 @@
 // (crep::unshadowedScattering) at second order in the slice spacing, the ESM reproduces the exponential
 // test on a constant map, the temporal blend keeps a static history and never propagates NaN, bad options
 // are named.
+#include "common/error_checks.h"
+
 #include <crep/core/error.h>
 #include <crep/postfx/froxel_fog.h>
 #include <crep/scatter/ray.h>
@@ -14,6 +16,7 @@
 #include <string>
 
 using namespace crep;
+using crep::test::requireNamed;
 
 namespace {
 
@@ -229,45 +232,38 @@ TEST_CASE("Froxel temporal: static history kept, reprojection outside rejected, 
 }
 
 TEST_CASE("Froxel fog options: bad values are named") {
-  const auto named = [](auto&& f, const std::string& parameter) {
-    try {
-      f();
-      FAIL("no exception for " << parameter);
-    } catch (const InvalidArgument& e) {
-      CHECK(e.parameter() == parameter);
-    }
-  };
   EsmOptions o;
   o.exponent = 2e4;
-  named([&] { validate(o, "X.esm"); }, "X.esm.exponent");
+  requireNamed([&] { validate(o, "X.esm"); }, "X.esm.exponent");
   o = {};
   o.downsample = 0;
-  named([&] { validate(o, "X.esm"); }, "X.esm.downsample");
+  requireNamed([&] { validate(o, "X.esm"); }, "X.esm.downsample");
   o = {};
   o.blurRadius = -1;
-  named([&] { validate(o, "X.esm"); }, "X.esm.blurRadius");
+  requireNamed([&] { validate(o, "X.esm"); }, "X.esm.blurRadius");
   o = {};
   o.bias = std::nan("");
-  named([&] { validate(o, "X.esm"); }, "X.esm.bias");
+  requireNamed([&] { validate(o, "X.esm"); }, "X.esm.bias");
   FroxelDensity d;
   d.heightFalloff = -1.0;
-  named([&] { validate(d, "X.density"); }, "X.density.heightFalloff");
+  requireNamed([&] { validate(d, "X.density"); }, "X.density.heightFalloff");
   d = {};
   d.noiseAmplitude = 2.0;
-  named([&] { validate(d, "X.density"); }, "X.density.noiseAmplitude");
+  requireNamed([&] { validate(d, "X.density"); }, "X.density.noiseAmplitude");
   d = {};
   d.noiseFrequency = 0.0;
-  named([&] { validate(d, "X.density"); }, "X.density.noiseFrequency");
+  requireNamed([&] { validate(d, "X.density"); }, "X.density.noiseFrequency");
   Image bad(4, 4, 1, 0.5f);
   bad.at(1, 1) = std::nanf("");
-  named([&] { buildEsm(bad, glm::dmat4(1.0), {}); }, "shadowDepth");
-  named([&] { esmDepthExponent({}, glm::dmat4(0.0)); }, "lightClipFromWorld");
+  requireNamed([&] { buildEsm(bad, glm::dmat4(1.0), {}); }, "shadowDepth");
+  requireNamed([&] { esmDepthExponent({}, glm::dmat4(0.0)); }, "lightClipFromWorld");
   const Camera cam = fogCamera();
   FroxelGrid grid{4, 4, 4, 0.0, 0.0};
   FroxelVolume v(4, 4, 3);
-  named([&] { froxelAccumulate(v, grid, cam, fogMedium(), glm::dvec3(0.0)); }, "froxelAccumulate.lighting");
+  requireNamed([&] { froxelAccumulate(v, grid, cam, fogMedium(), glm::dvec3(0.0)); },
+               "froxelAccumulate.lighting");
   FroxelVolume ok(4, 4, 4);
-  named([&] { froxelTemporal(ok, &ok, grid, cam, cam, 1.0); }, "froxelTemporal.historyWeight");
-  named([&] { froxelAccumulate(ok, grid, cam, fogMedium(), glm::dvec3(0.7, 0.0, 0.0)); },
-        "froxelAccumulate.jitter");
+  requireNamed([&] { froxelTemporal(ok, &ok, grid, cam, cam, 1.0); }, "froxelTemporal.historyWeight");
+  requireNamed([&] { froxelAccumulate(ok, grid, cam, fogMedium(), glm::dvec3(0.7, 0.0, 0.0)); },
+               "froxelAccumulate.jitter");
 }

@@ -2,8 +2,10 @@
 // analytic frame (a ground plane with a row of pillars, the sun in view), full and reduced source
 // resolution, odd workgroup sizes, both modes; a sun behind the camera adds exactly nothing; NaN depth stays
 // finite; the block's std140 offsets; bad input names the field.
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_scene.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/gl_util.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -19,6 +21,9 @@
 #include <string>
 
 using namespace crep;
+using crep::test::requireNamed;
+using crep::test::resourceProperty;
+using crep::test::uploadR32F;
 
 namespace {
 
@@ -32,16 +37,10 @@ Image pillarDepth(const Camera& camera, int w, int h) {
   return depth;
 }
 
-gl::Handle uploadDepth(const Image& depth) {
-  gl::Handle t = gl::createTexture2D(GL_R32F, depth.width(), depth.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, depth.width(), depth.height(), GL_RED, GL_FLOAT, depth.data().data());
-  return t;
-}
-
 Image runGpu(const RadialBlurPass::CreateInfo& info, const Image& depth, const Camera& camera,
              const DirectionalLight& light, const Medium& medium) {
   RadialBlurPass pass(info);
-  const gl::Handle depthTexture = uploadDepth(depth);
+  const gl::Handle depthTexture = uploadR32F(depth);
   const gl::Handle output = gl::createTexture2D(GL_RGBA32F, depth.width(), depth.height());
   RadialBlurPass::FrameAttribs f;
   f.camera = &camera;
@@ -56,24 +55,6 @@ Image runGpu(const RadialBlurPass::CreateInfo& info, const Image& depth, const C
 /// The sun at NDC (x, y) of the camera (the light travels toward the camera).
 DirectionalLight sunAt(const Camera& camera, double x, double y) {
   return DirectionalLight(-camera.rayDirection(x, y), glm::dvec3(2.0, 1.8, 1.5));
-}
-
-GLint resourceProperty(GLuint program, GLenum interface, const std::string& name, GLenum property) {
-  const GLuint index = glGetProgramResourceIndex(program, interface, name.c_str());
-  if (index == GL_INVALID_INDEX) return -1;
-  GLint value = -1;
-  glGetProgramResourceiv(program, interface, index, 1, &property, 1, nullptr, &value);
-  return value;
-}
-
-template <class F>
-void expectParameter(const std::string& name, F&& f) {
-  try {
-    f();
-    FAIL("no exception, expected one naming " << name);
-  } catch (const InvalidArgument& e) {
-    CHECK(e.parameter() == name);
-  }
 }
 
 } // namespace
@@ -193,19 +174,19 @@ TEST_CASE("RadialBlurPass: bad input names the field") {
   {
     RadialBlurPass::CreateInfo info;
     info.options.decay = 1.5;
-    expectParameter("RadialBlurPass::CreateInfo.options.decay", [&] { RadialBlurPass p(info); });
+    requireNamed([&] { RadialBlurPass p(info); }, "RadialBlurPass::CreateInfo.options.decay");
     info = {};
     info.options.samples = 0;
-    expectParameter("RadialBlurPass::CreateInfo.options.samples", [&] { RadialBlurPass p(info); });
+    requireNamed([&] { RadialBlurPass p(info); }, "RadialBlurPass::CreateInfo.options.samples");
     info = {};
     info.options.density = std::nan("");
-    expectParameter("RadialBlurPass::CreateInfo.options.density", [&] { RadialBlurPass p(info); });
+    requireNamed([&] { RadialBlurPass p(info); }, "RadialBlurPass::CreateInfo.options.density");
     info = {};
     info.workgroupSize = 33;
-    expectParameter("RadialBlurPass::CreateInfo.workgroupSize", [&] { RadialBlurPass p(info); });
+    requireNamed([&] { RadialBlurPass p(info); }, "RadialBlurPass::CreateInfo.workgroupSize");
   }
   RadialBlurPass pass({});
-  const gl::Handle depth = uploadDepth(Image(w, h, 1, 1.0f));
+  const gl::Handle depth = uploadR32F(Image(w, h, 1, 1.0f));
   const gl::Handle output = gl::createTexture2D(GL_RGBA32F, w, h);
   const gl::Handle small = gl::createTexture2D(GL_RGBA32F, w / 2, h);
   const gl::Handle rgba8 = gl::createTexture2D(GL_RGBA8, w, h);
@@ -218,26 +199,26 @@ TEST_CASE("RadialBlurPass: bad input names the field") {
   CHECK_NOTHROW(pass.run(good));
   auto f = good;
   f.camera = nullptr;
-  expectParameter("RadialBlurPass::FrameAttribs.camera", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.camera");
   f = good;
   f.light = nullptr;
-  expectParameter("RadialBlurPass::FrameAttribs.light", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.light");
   f = good;
   f.medium = nullptr;
-  expectParameter("RadialBlurPass::FrameAttribs.medium", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.medium");
   f = good;
   f.cameraDepth = 0;
-  expectParameter("RadialBlurPass::FrameAttribs.cameraDepth", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.cameraDepth");
   f = good;
   f.cameraDepth = rgba8.get(); // not a depth format
-  expectParameter("RadialBlurPass::FrameAttribs.cameraDepth", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.cameraDepth");
   f = good;
   f.output = 0;
-  expectParameter("RadialBlurPass::FrameAttribs.output", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.output");
   f = good;
   f.output = small.get(); // wrong size
-  expectParameter("RadialBlurPass::FrameAttribs.output", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.output");
   f = good;
   f.output = rgba8.get(); // wrong format
-  expectParameter("RadialBlurPass::FrameAttribs.output", [&] { pass.run(f); });
+  requireNamed([&] { pass.run(f); }, "RadialBlurPass::FrameAttribs.output");
 }

@@ -2,10 +2,10 @@
 // GPU prefilter of a map resampled into an EpipolarLayout and the GPU evaluation through the layout's
 // block (CREP_EVAL_LAYOUT), against the CPU reference prefilter() + evaluate() of the same map. Sun in
 // view (epipole on screen) and sun behind the camera (anti-epipole on screen). 160 x 90 screen.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>

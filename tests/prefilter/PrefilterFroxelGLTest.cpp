@@ -8,10 +8,12 @@
 // per-pixel evaluation the same ray end as the volume (a standard depth buffer near 1 would lose up to
 // 6e-8 Z / near of it). Map 256 x 64, 2 splits x 2 prefilter regions; grid 32 x 18 x 16 (camera image of
 // the same 32 x 18 for the per-pixel runs).
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/gl_util.h"
+#include "common/image_check.h"
 
-#include "prefilter_gpu_util.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/prefilter/gpu_pass.h>
@@ -92,21 +94,6 @@ PrefilterOptions prefilterOptions(StorageFormat format = StorageFormat::RGBA32F)
   o.regionsPerSplit = 2;
   o.format = format;
   return o;
-}
-
-/// A GL_TEXTURE_3D volume of the grid's size.
-gl::Handle createVolume(const FroxelGrid& grid, GLenum format = GL_RGBA32F) {
-  gl::Handle v = gl::createTexture(GL_TEXTURE_3D);
-  glTextureStorage3D(v.get(), 1, format, grid.width, grid.height, grid.depth);
-  return v;
-}
-
-/// The volume read back as evaluateFroxels lays it out: width x (height depth), slice z at rows z height.
-Image readVolume(std::uint32_t volume, const FroxelGrid& grid) {
-  Image out(grid.width, grid.height * grid.depth, 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(volume, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.byteSize()), out.data().data());
-  return out;
 }
 
 /// Number of samples that differ at all between two images of the same shape.
@@ -443,44 +430,35 @@ TEST_CASE("prefilter froxels: bad targets throw errors naming the field") {
   EvaluatePass pass(EvaluatePass::CreateInfo{});
   const FroxelGrid grid = smallGrid();
   const gl::Handle volume = createVolume(grid);
-  const auto throwsNaming = [&](const std::string& field, const std::function<void()>& run) {
-    CAPTURE(field);
-    bool named = false;
-    try {
-      run();
-    } catch (const InvalidArgument& e) {
-      named = std::string(e.what()).find(field) != std::string::npos;
-      if (!named) MESSAGE(std::string(std::string("message: ") + e.what()));
-    }
-    CHECK(named);
-  };
   const auto run = [&](std::uint32_t v, FroxelGrid g, glm::dvec3 j) {
     return [&, v, g, j] { fill(pass, s, basis.view, v, g, j); };
   };
   // No target at all: output 0 and volume 0 -> the per-pixel targets are required.
-  throwsNaming("EvaluatePass::FrameAttribs.cameraDepth", run(0, grid, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.cameraDepth", run(0, grid, glm::dvec3(0.0)));
   FroxelGrid bad = grid;
   bad.depth = 0;
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.grid.depth", run(volume.get(), bad, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.grid.depth",
+                      run(volume.get(), bad, glm::dvec3(0.0)));
   bad = grid;
   bad.farDepth = std::nan("");
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.grid.farDepth", run(volume.get(), bad, glm::dvec3(0.0)));
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.jitter",
-               run(volume.get(), grid, glm::dvec3(0.0, std::nan(""), 0.0)));
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.jitter",
-               run(volume.get(), grid, glm::dvec3(0.7, 0.0, 0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.grid.farDepth",
+                      run(volume.get(), bad, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.jitter",
+                      run(volume.get(), grid, glm::dvec3(0.0, std::nan(""), 0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.jitter",
+                      run(volume.get(), grid, glm::dvec3(0.7, 0.0, 0.0)));
   // Wrong size, wrong format, wrong target, not a texture.
   bad = grid;
   bad.depth = kGridD + 1;
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.volume", run(volume.get(), bad, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.volume", run(volume.get(), bad, glm::dvec3(0.0)));
   const gl::Handle rgba8 = createVolume(grid, GL_RGBA8);
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.volume", run(rgba8.get(), grid, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.volume", run(rgba8.get(), grid, glm::dvec3(0.0)));
   const gl::Handle flat = gl::createTexture2D(GL_RGBA32F, kGridW, kGridH);
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.volume", run(flat.get(), grid, glm::dvec3(0.0)));
-  throwsNaming("EvaluatePass::FrameAttribs.froxels.volume", run(987654, grid, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.volume", run(flat.get(), grid, glm::dvec3(0.0)));
+  requireMessageNames("EvaluatePass::FrameAttribs.froxels.volume", run(987654, grid, glm::dvec3(0.0)));
   // A table reused that was never built for this pass.
   EvaluatePass fresh(EvaluatePass::CreateInfo{});
-  throwsNaming("EvaluatePass::FrameAttribs.reuseTable", [&] {
+  requireMessageNames("EvaluatePass::FrameAttribs.reuseTable", [&] {
     EvaluatePass::FrameAttribs f;
     f.camera = &s.camera;
     f.light = &s.scene.sun;

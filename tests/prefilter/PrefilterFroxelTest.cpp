@@ -8,7 +8,7 @@
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/froxel_grid.h>
 
-#include "support/analytic_scene.h"
+#include "common/analytic_scene.h"
 
 #include <doctest/doctest.h>
 

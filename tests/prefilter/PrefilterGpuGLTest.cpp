@@ -24,10 +24,11 @@
 //     RGBA32F basis, the same evaluation matches to float precision.
 //     nearest sampling: a row or column index can flip where float and double disagree on which side
 //     of a texel boundary a ray lies; at most 0.5% of the samples may differ by more than 2e-5 peak.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+#include "common/error_checks.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
-#include "prefilter_gpu_util.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/prefilter/gpu_pass.h>
@@ -38,6 +39,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -109,15 +111,7 @@ gl::Handle runEvaluate(const GpuScene& s, const EvaluatePass::CreateInfo& info,
   EvaluatePass pass(info);
   gl::Handle out = createTexture2D(info.outputFormat == StorageFormat::RGBA16F ? GL_RGBA16F : GL_RGBA32F,
                                    kScreenW, kScreenH);
-  EvaluatePass::FrameAttribs frame;
-  frame.cameraDepth = s.depthTexture.get();
-  frame.output = out.get();
-  frame.camera = &s.scene.camera;
-  frame.light = &s.scene.sun;
-  frame.medium = &s.scene.medium;
-  frame.layout = s.layout.get();
-  frame.basis = basis;
-  pass.run(frame);
+  pass.run(sunEvaluation(s, basis, out.get()));
   return out;
 }
 
@@ -353,15 +347,7 @@ TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random conte
     checkBasis(pass, cpu, std::string(name) + ", RGBA8");
     EvaluatePass e({});
     const gl::Handle out = createTexture2D(GL_RGBA32F, 97, 61);
-    EvaluatePass::FrameAttribs frame;
-    frame.cameraDepth = other.depthTexture.get();
-    frame.output = out.get();
-    frame.camera = &other.scene.camera;
-    frame.light = &other.scene.sun;
-    frame.medium = &other.scene.medium;
-    frame.layout = other.layout.get();
-    frame.basis = pass.filteredBasis();
-    e.run(frame);
+    e.run(sunEvaluation(other, pass.filteredBasis(), out.get()));
     EvalTolerance t = evalTolerance(o.options.format, Sampling::Bilinear);
     t.fractionOver = 5e-3; // one stored value one step off (see the basis test) moves a few pixels
     checkEvaluation(readRgbaTexture(out.get(), 97, 61),
@@ -376,23 +362,9 @@ TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random conte
 namespace {
 
 template <class F>
-std::string invalidParameter(F&& f) {
-  try {
-    f();
-  } catch (const InvalidArgument& e) {
-    return e.parameter();
-  }
-  return "(no InvalidArgument)";
-}
-
-template <class F>
 std::string glErrorMessage(F&& f) {
-  try {
-    f();
-  } catch (const GlError& e) {
-    return e.what();
-  }
-  return "(no GlError)";
+  const std::optional<GlError> e = thrown<GlError>(f);
+  return e ? e->what() : "(no GlError)";
 }
 
 } // namespace

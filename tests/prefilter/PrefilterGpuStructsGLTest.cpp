@@ -3,9 +3,10 @@
 // C++ offsetof / sizeof (std140 / std430 rules). And the public include crep/scattering.glsl used the way
 // an engine uses it: its files registered with GL_ARB_shading_language_include, #included by a
 // fragment shader that is not part of the library, drawn, and compared with the EvaluatePass image.
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
+#include "common/gl_util.h"
 
-#include "prefilter_gpu_util.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -64,15 +65,6 @@ gl::Handle linkProgram(const std::vector<std::pair<GLenum, std::string>>& source
     FAIL("link error: " << log);
   }
   return program;
-}
-
-/// One property of a program resource; -1 when the resource is not active.
-GLint resourceProperty(GLuint program, GLenum interface, const std::string& name, GLenum property) {
-  const GLuint index = glGetProgramResourceIndex(program, interface, name.c_str());
-  if (index == GL_INVALID_INDEX) return -1;
-  GLint value = -1;
-  glGetProgramResourceiv(program, interface, index, 1, &property, 1, nullptr, &value);
-  return value;
 }
 
 struct Member {
@@ -280,15 +272,7 @@ void main() {
   prefilterPass.run(pf);
   EvaluatePass evaluatePass({});
   const gl::Handle reference = createTexture2D(GL_RGBA32F, w, h);
-  EvaluatePass::FrameAttribs ef;
-  ef.cameraDepth = s.depthTexture.get();
-  ef.output = reference.get();
-  ef.camera = &s.scene.camera;
-  ef.light = &s.scene.sun;
-  ef.medium = &s.scene.medium;
-  ef.layout = s.layout.get();
-  ef.basis = prefilterPass.filteredBasis();
-  evaluatePass.run(ef);
+  evaluatePass.run(sunEvaluation(s, prefilterPass.filteredBasis(), reference.get()));
   const Image expected = readRgbaTexture(reference.get(), w, h);
 
   const gpu::ScatteringParams params =

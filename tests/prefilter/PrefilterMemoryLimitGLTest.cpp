@@ -6,8 +6,8 @@
 // layers x regions crossed without the region visibility table, and (regions crossed - 1) table fetches
 // (the table's write-only pass writes 1) + layers with it; compared with the regions counted on the CPU by
 // the layout (the rule of crep::evaluate: the surface point's region, all before it crossed).
-#include "prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/gl.h>
 #include <crep/prefilter/gpu_pass.h>

@@ -1,11 +1,11 @@
-// Ground truth (c) of issue 4: the built-in scenes, rectified map rendered on the GPU with the split
-// matrices (as an engine does: one depth texture, one viewport per split, GL_DEPTH_CLAMP; see
+// The prefilter's ground truth on real geometry: the built-in scenes, rectified map rendered on the GPU with
+// the split matrices (as an engine does: one depth texture, one viewport per split, GL_DEPTH_CLAMP; see
 // tests/rectify/RectifyGLTest.cpp) and the camera depth rasterized too; the CPU reference prefilter +
-// evaluation (Klehm et al. 2014, Sec. 3) against a brute-force march over the same rectified map with
-// exact per-ray transmittance (crep/scatter/rectified_march.h bruteForceMarch). Small sizes: 160 x 90 screen,
-// 256 x 128 map.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
+// evaluation (Klehm et al. 2014, Sec. 3) against a brute-force march over the same rectified map with exact
+// per-ray transmittance (crep/scatter/rectified_march.h bruteForceMarch). Small sizes: 160 x 90 screen, 256 x
+// 128 map.
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
 
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
@@ -35,7 +35,8 @@ void checkScene(const std::string& name, double maxRelativeRmse, double minPsnr)
   options.splits = 4;
   Rectification r = rectify(scene.camera, scene.sun, options);
   if (!r.projective()) {
-    MESSAGE(name << ": not projective (" << r.message << "); the epipolar fallback is another issue");
+    MESSAGE(name << ": not projective (" << r.message
+                 << "); the epipolar fallback is tested in tests/epipolar/");
     return;
   }
   auto layout = std::make_shared<const ProjectiveLayout>(std::move(r));

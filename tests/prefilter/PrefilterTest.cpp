@@ -10,8 +10,9 @@
 #include <crep/scatter/rectified_march.h>
 #include <crep/support/image_compare.h>
 
-#include "support/analytic_scene.h"
-#include "support/image_check.h"
+#include "common/analytic_scene.h"
+#include "common/error_checks.h"
+#include "common/image_check.h"
 
 #include <doctest/doctest.h>
 
@@ -23,6 +24,7 @@
 #include <vector>
 
 using namespace crep;
+using crep::test::invalidParameter;
 
 namespace {
 
@@ -472,53 +474,46 @@ TEST_CASE("prefilter: bad input gets a named InvalidArgument") {
   const DirectionalLight light = test::sideLight();
   const Medium medium = test::colouredMedium();
   const auto layout = test::projectiveLayout(camera, light);
-  const auto parameterOf = [](const auto& f) -> std::string {
-    try {
-      f();
-    } catch (const InvalidArgument& e) {
-      return e.parameter();
-    }
-    return "no exception";
-  };
   Image bad(64, 8, 1, 0.5f);
   bad.at(3, 2) = std::nanf("");
-  CHECK(parameterOf([&] { makeRectifiedMap(layout, bad); }) == "RectifiedMap.depth");
-  CHECK(parameterOf([&] { makeRectifiedMap(layout, Image(66, 8, 1)); }) == "RectifiedMap.depth");
-  CHECK(parameterOf([&] { makeRectifiedMap(nullptr, Image(64, 8, 1)); }) == "RectifiedMap.layout");
+  CHECK(invalidParameter([&] { makeRectifiedMap(layout, bad); }) == "RectifiedMap.depth");
+  CHECK(invalidParameter([&] { makeRectifiedMap(layout, Image(66, 8, 1)); }) == "RectifiedMap.depth");
+  CHECK(invalidParameter([&] { makeRectifiedMap(nullptr, Image(64, 8, 1)); }) == "RectifiedMap.layout");
   const RectifiedMap map = makeRectifiedMap(layout, Image(64, 8, 1, 1.0f));
   PrefilterOptions o;
   o.bases = 33;
-  CHECK(parameterOf([&] { prefilter(map, medium, o); }) == "PrefilterOptions.bases");
+  CHECK(invalidParameter([&] { prefilter(map, medium, o); }) == "PrefilterOptions.bases");
   o = {};
   o.regionsPerSplit = 3; // 64 is not a multiple of 12
-  CHECK(parameterOf([&] { prefilter(map, medium, o); }) == "RectifiedMap.depth");
+  CHECK(invalidParameter([&] { prefilter(map, medium, o); }) == "RectifiedMap.depth");
   o = {};
   o.depthMargin = 0.3;
-  CHECK(parameterOf([&] { prefilter(map, medium, o); }) == "PrefilterOptions.depthMargin");
+  CHECK(invalidParameter([&] { prefilter(map, medium, o); }) == "PrefilterOptions.depthMargin");
   o = {};
   o.threads = -1;
-  CHECK(parameterOf([&] { prefilter(map, medium, o); }) == "PrefilterOptions.threads");
-  CHECK(parameterOf([&] { prefilter(map, -1.0); }) == "extinction");
+  CHECK(invalidParameter([&] { prefilter(map, medium, o); }) == "PrefilterOptions.threads");
+  CHECK(invalidParameter([&] { prefilter(map, -1.0); }) == "extinction");
   const FilteredBasis basis = prefilter(map, medium);
   Image depth(16, 9, 1, 0.5f);
   depth.at(1, 1) = 1.5f;
-  CHECK(parameterOf([&] { evaluate(basis, depth, camera, light, medium); }) == "cameraDepth");
-  CHECK(parameterOf([&] { evaluate(basis, Image(), camera, light, medium); }) == "cameraDepth");
+  CHECK(invalidParameter([&] { evaluate(basis, depth, camera, light, medium); }) == "cameraDepth");
+  CHECK(invalidParameter([&] { evaluate(basis, Image(), camera, light, medium); }) == "cameraDepth");
   FilteredBasis broken = basis;
   broken.texels.pop_back();
-  CHECK(parameterOf([&] { evaluate(broken, Image(16, 9, 1, 1.0f), camera, light, medium); }) ==
+  CHECK(invalidParameter([&] { evaluate(broken, Image(16, 9, 1, 1.0f), camera, light, medium); }) ==
         "FilteredBasis");
   // The contract needs the splits side by side.
   RectifyOptions layers;
   layers.layout = SplitLayout::Layers;
-  CHECK(parameterOf([&] { ProjectiveLayout(rectify(camera, light, layers)); }) == "Rectification.layout");
+  CHECK(invalidParameter([&] { ProjectiveLayout(rectify(camera, light, layers)); }) ==
+        "Rectification.layout");
 }
 
 TEST_CASE("prefilter: the region visibility table keeps the analytic ground truth within 0.1%") {
   // EvaluateOptions::visibilityTableSamples: the regions a ray crosses whole read their visibility from a
-  // table over (row, depth) instead of the basis. Against the closed forms of (a) and (b), with the
-  // library's splits (8 x 2 prefilter regions) and the former 4 x 1: the table may not cost more than 0.1%
-  // relative RMSE (issue "performance", item 3). The table itself is tested against its definition.
+  // table over (row, depth) instead of the basis. Against the closed forms of (a) and (b), with the library's
+  // splits (8 x 2 prefilter regions) and the former 4 x 1: the table may not cost more than 0.1% relative
+  // RMSE (the price of the table's speed). The table itself is tested against its definition.
   const Camera camera = test::groundCamera();
   const DirectionalLight light = test::sideLight();
   const Medium medium = test::colouredMedium();

@@ -1,10 +1,10 @@
 // Edge cases, continuity near the fallback switch, reference rays (Sec. 3.2), distances, Eq. 12, the
-// JSON form and input validation of the projective rectification (issue 3).
+// JSON form and input validation of the projective rectification.
 #include <crep/core/error.h>
 #include <crep/rectify/json.h>
 #include <crep/rectify/rectify.h>
 
-#include "rectify_checks.h"
+#include "rectify/rectify_checks.h"
 
 #include <doctest/doctest.h>
 

@@ -1,9 +1,9 @@
-// How often a frame falls back, by reason (issue "every frame prefiltered", item 3): 10^4 uniformly random
-// sun directions for a 60 degree 16:9 camera (near 0.1, far 100). The impossible case (a view ray parallel
-// to the light: the light's line through the camera meets the frustum) has a closed form: the two
-// directions of that line fall in the frustum's solid angle Omega = 4 asin(sin a sin b) (a, b the half
-// angles), so its probability is 2 Omega / (4 pi); the test checks the sampled fraction against it within
-// 4 binomial standard deviations. The other fractions are printed for the README ("Fallback").
+// How often a frame falls back, by reason: 10^4 uniformly random sun directions for a 60 degree 16:9 camera
+// (near 0.1, far 100). The impossible case (a view ray parallel to the light: the light's line through the
+// camera meets the frustum) has a closed form: the two directions of that line fall in the frustum's solid
+// angle Omega = 4 asin(sin a sin b) (a, b the half angles), so its probability is 2 Omega / (4 pi); the test
+// checks the sampled fraction against it within 4 binomial standard deviations. The other fractions are
+// printed for the README ("Fallback").
 #include <crep/rectify/rectify.h>
 
 #include <doctest/doctest.h>

@@ -1,8 +1,8 @@
-// GL test of the projective rectification (issue 3): the built-in analytic arrangement (boxes over a
-// plane) rasterized with each split's rectClipFromWorld, as an engine would (one depth texture, one
-// viewport per split, GL_DEPTH_CLAMP), stores at every sampled texel the depth of the first occluder
-// along that texel's light ray, computed on the CPU by an exact ray cast.
-#include "support/gl_fixture.h"
+// GL test of the projective rectification: the built-in analytic arrangement (boxes over a plane) rasterized
+// with each split's rectClipFromWorld, as an engine would (one depth texture, one viewport per split,
+// GL_DEPTH_CLAMP), stores at every sampled texel the depth of the first occluder along that texel's light
+// ray, computed on the CPU by an exact ray cast.
+#include "common/gl_fixture.h"
 
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>

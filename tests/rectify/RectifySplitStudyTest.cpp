@@ -4,7 +4,7 @@
 // the construction that invalidates the documented numbers fails here.
 #include <crep/rectify/rectify.h>
 
-#include "rectify_test_util.h"
+#include "rectify/rectify_test_util.h"
 
 #include <doctest/doctest.h>
 

@@ -1,11 +1,11 @@
-// Property tests of the projective rectification (issue 3): over 10,000 random cameras and lights
-// (fixed seeds, double precision), view rays keep one row and depth, light rays one (column, row),
-// the lit region maps into the unit cube of exactly one split with tight bounds and no gaps, nothing
-// is NaN or Inf, and the usable/unusable decision matches independent brute-force checks.
+// Property tests of the projective rectification: over 10,000 random cameras and lights (fixed seeds, double
+// precision), view rays keep one row and depth, light rays one (column, row), the lit region maps into the
+// unit cube of exactly one split with tight bounds and no gaps, nothing is NaN or Inf, and the
+// usable/unusable decision matches independent brute-force checks.
 #include <crep/core/error.h>
 #include <crep/rectify/rectify.h>
 
-#include "rectify_checks.h"
+#include "rectify/rectify_checks.h"
 
 #include <doctest/doctest.h>
 

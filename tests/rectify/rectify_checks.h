@@ -1,10 +1,12 @@
-// The property checks of issue 3 shared by the rectify/ test files (doctest assertions).
+// The properties of a projective rectification (crep/rectify/rectify.h), checked by the rectify/ test files
+// (doctest assertions): rows and depths kept along view rays, (column, row) along light rays, the lit region
+// inside exactly one split's unit cube, finite values.
 #pragma once
 
 #include <crep/core/error.h>
 #include <crep/rectify/rectify.h>
 
-#include "rectify_test_util.h"
+#include "rectify/rectify_test_util.h"
 
 #include <doctest/doctest.h>
 
@@ -67,7 +69,7 @@ inline glm::dvec3 regionPoint(const Rectification& r, std::mt19937_64& rng) {
   return p / sum;
 }
 
-/// Checks every property of issue 3 on one projective rectification. `lightPoint(p, t)` returns the
+/// Checks every property above on one projective rectification. `lightPoint(p, t)` returns the
 /// point of p's light ray at parameter t (t = 0: p itself); `inRegion` is an independent test of
 /// region membership used for rejection-sampled frustum points.
 inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19937_64& rng,
@@ -191,10 +193,10 @@ inline void checkProjective(const Rectification& r, const Camera& cam, std::mt19
   }
 }
 
-/// Asserts the worst deviations. `tol` is 1e-9 (issue 3) for configurations that pass the default
-/// thresholds; near the degenerate cone the rounding of the input points themselves is amplified by the
-/// conditioning (1 / cos(span / 2) up to 1146 at 179.9 degrees, 1 / sin(epipole angle)), and the sweeps
-/// that go there state 1e-8.
+/// Asserts the worst deviations. `tol` is 1e-9 (the rectification's accuracy goal) for configurations that
+/// pass the default thresholds; near the degenerate cone the rounding of the input points themselves is
+/// amplified by the conditioning (1 / cos(span / 2) up to 1146 at 179.9 degrees, 1 / sin(epipole angle)), and
+/// the sweeps that go there state 1e-8.
 inline void report(const char* name, const Worst& w, double seconds, bool verbose = true, double tol = 1e-9) {
   if (verbose)
     MESSAGE(std::string(name) << ": " << w.projective << " projective, " << w.fallback << " fallback, "

@@ -44,7 +44,8 @@ inline glm::dvec3 randomUnit(std::mt19937_64& rng) {
   }
 }
 
-/// The ranges: fov 20-120 degrees, aspect 0.5-3, near in [1e-3, 1], far in [1, 1e5].
+/// The ranges an engine's camera may take: fov 20-120 degrees, aspect 0.5-3, near in [1e-3, 1], far in [1,
+/// 1e5].
 inline Camera randomCamera(std::mt19937_64& rng) {
   std::normal_distribution<double> n;
   const glm::dvec3 pos(uniform(rng, -10, 10), uniform(rng, -10, 10), uniform(rng, -10, 10));

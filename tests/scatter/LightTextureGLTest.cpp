@@ -5,11 +5,12 @@
 // with the scattering prefix table and without a table) and the textured world march (WorldMarchPass::
 // FrameAttribs::lightTexture vs crep::worldSpaceMarch), for the sun's window and a spot light's gobo; the
 // modes without a textured variant reject it by name.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
+#include "common/light_texture_frames.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
@@ -41,70 +42,6 @@ namespace {
 
 constexpr int kW = 160, kH = 90, kMapW = 256, kMapH = 128;
 
-Image twoColourTexture() {
-  Image t(64, 64, 3);
-  for (int j = 0; j < 64; ++j)
-    for (int i = 0; i < 64; ++i) {
-      const glm::vec3 c = i < 32 ? glm::vec3(1.0f, 0.1f, 0.05f) : glm::vec3(0.05f, 0.1f, 1.0f);
-      for (int k = 0; k < 3; ++k)
-        t.at(i, j, k) = c[k];
-    }
-  return t;
-}
-
-/// An RGB image as a GL_RGBA32F texture (A = 1).
-gl::Handle uploadRgb(const Image& image) {
-  Image rgba(image.width(), image.height(), 4, 1.0f);
-  for (int j = 0; j < image.height(); ++j)
-    for (int i = 0; i < image.width(); ++i)
-      for (int k = 0; k < 3; ++k)
-        rgba.at(i, j, k) = image.at(i, j, k);
-  gl::Handle t = gl::createTexture2D(GL_RGBA32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RGBA, GL_FLOAT, rgba.data().data());
-  return t;
-}
-
-/// The analytic frame of one light: layout, map, texture projection, shadow matrix.
-struct Frame {
-  Camera camera = groundCamera(kW, kH);
-  Image depth = groundDepth(camera, kW, kH);
-  Medium medium = colouredMedium();
-  DirectionalLight sun = sideLight();
-  std::optional<LocalLight> local;
-  std::shared_ptr<const ProjectiveLayout> layout;
-  RectifiedMap map;
-  glm::dmat4 textureClipFromWorld{1.0}, shadowClipFromWorld{1.0};
-  HalfSpace plane;
-};
-
-Frame sunFrame() {
-  Frame f;
-  f.layout = projectiveLayout(f.camera, f.sun, 8);
-  f.map =
-      castRectifiedMap(f.layout, kMapW, kMapH, [&](const LightRay& ray) { return planeHit(f.plane, ray); });
-  const glm::dvec3 target(0.0, 1.0, -12.0);
-  f.textureClipFromWorld = glm::ortho(-40.0, 40.0, -40.0, 40.0, 1.0, 400.0) *
-                           glm::lookAt(target - 100.0 * f.sun.direction(), target, glm::dvec3(0.0, 1.0, 0.0));
-  f.shadowClipFromWorld = analyticLightMatrix(f.sun);
-  return f;
-}
-
-Frame spotFrame() {
-  Frame f;
-  const SpotLight spot = analyticSpot();
-  f.local = LocalLight::spot(spot);
-  RectifyOptions ro;
-  ro.splits = 8;
-  f.layout = std::make_shared<const ProjectiveLayout>(rectify(f.camera, spot, ro));
-  f.map = castRectifiedMap(f.layout, kMapW, kMapH, wallHitFromLight);
-  f.textureClipFromWorld =
-      glm::perspective(glm::radians(90.0), 1.0, 0.1, 100.0) *
-      glm::lookAt(spot.position(), glm::dvec3(2.0, 0.0, -6.0), glm::dvec3(0.0, 1.0, 0.0));
-  f.shadowClipFromWorld = spot.lightClipFromWorld();
-  f.plane = wall();
-  return f;
-}
-
 PrefilterOptions prefilterOptions(StorageFormat format) {
   PrefilterOptions o;
   o.regionsPerSplit = 2;
@@ -132,7 +69,7 @@ TEST_CASE("light texture GL: the colour map pass equals lightColorMap (sun windo
   LightColorMapPass pass({.mapWidth = kMapW, .mapHeight = kMapH});
   for (const bool spot : {false, true}) {
     CAPTURE(spot);
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image cpu = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
     LightColorMapPass::FrameAttribs a{.layout = f.layout.get(),
                                       .lightTexture = {texture.get(), f.textureClipFromWorld}};
@@ -157,7 +94,7 @@ TEST_CASE("light texture GL: the textured prefilter equals the CPU reference (3 
   PrefilterPass pass({.mapWidth = kMapW, .mapHeight = kMapH, .options = o});
   for (const bool spot : {false, true}) {
     CAPTURE(spot);
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image colors = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
     const FilteredBasis cpu =
         spot ? prefilter(f.map, f.medium, *f.local, colors, o) : prefilter(f.map, f.medium, colors, o);
@@ -191,7 +128,7 @@ TEST_CASE("light texture GL: the textured prefilter equals the CPU reference (3 
   }
 
   // c = 1 everywhere: the textured bases are the untextured one, bit for bit, on the GPU too.
-  const Frame f = sunFrame();
+  const LightTextureFrame f = sunTextureFrame(kW, kH, kMapW, kMapH);
   const gl::Handle depth = uploadR32F(f.map.depth);
   const gl::Handle ones = uploadRgb(Image(kMapW, kMapH, 3, 1.0f));
   pass.run({.rectifiedDepth = depth.get(), .layout = f.layout.get(), .medium = &f.medium});
@@ -220,7 +157,7 @@ TEST_CASE("light texture GL: the textured evaluation equals the CPU evaluation (
   const PrefilterOptions o = prefilterOptions(StorageFormat::RGBA8);
   PrefilterPass prefilterPass({.mapWidth = kMapW, .mapHeight = kMapH, .options = o});
   for (const bool spot : {false, true}) {
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image colors = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
     const FilteredBasis basis =
         spot ? prefilter(f.map, f.medium, *f.local, colors, o) : prefilter(f.map, f.medium, colors, o);
@@ -261,7 +198,7 @@ TEST_CASE("light texture GL: the textured evaluation equals the CPU evaluation (
   }
 
   // Modes without a textured variant reject the basis by name.
-  const Frame f = sunFrame();
+  const LightTextureFrame f = sunTextureFrame(kW, kH, kMapW, kMapH);
   const gl::Handle depth = uploadR32F(f.map.depth), cameraDepth = uploadR32F(f.depth);
   const gl::Handle ones = uploadRgb(Image(kMapW, kMapH, 3, 1.0f));
   prefilterPass.run({.rectifiedDepth = depth.get(),
@@ -292,7 +229,7 @@ TEST_CASE("light texture GL: the textured world march equals the CPU world march
   WorldMarchPass pass({.options = {.steps = 64, .refinements = 12}});
   for (const bool spot : {false, true}) {
     CAPTURE(spot);
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image shadow = halfSpaceShadowMap(f.plane, f.shadowClipFromWorld, 512);
     const gl::Handle shadowTexture = uploadR32F(shadow), cameraDepth = uploadR32F(f.depth);
     const gl::Handle out = createTexture2D(GL_RGBA32F, kW, kH);
@@ -324,8 +261,7 @@ TEST_CASE("light texture GL: the textured world march equals the CPU world march
     CHECK(m.relativeRmse < 2e-3);
 
     // A projection that does not follow the light's rays is named.
-    a.lightTexture.textureClipFromWorld =
-        spot ? sunFrame().textureClipFromWorld : spotFrame().textureClipFromWorld;
+    a.lightTexture.textureClipFromWorld = lightTextureFrame(!spot, kW, kH, kMapW, kMapH).textureClipFromWorld;
     CHECK_THROWS_WITH_AS(pass.run(a),
                          doctest::Contains("WorldMarchPass::FrameAttribs.lightTexture.textureClipFromWorld"),
                          InvalidArgument);
@@ -345,7 +281,7 @@ TEST_CASE("light texture GL: march_rectified.comp's textured brute force equals 
   const gl::Handle sampler = gl::createClampSampler(GL_NEAREST);
   for (const bool spot : {false, true}) {
     CAPTURE(spot);
-    const Frame f = spot ? spotFrame() : sunFrame();
+    const LightTextureFrame f = lightTextureFrame(spot, kW, kH, kMapW, kMapH);
     const Image colors = lightColorMap({&tex, f.textureClipFromWorld}, *f.layout, kMapW, kMapH);
     const gl::Handle map = uploadR32F(f.map.depth), cameraDepth = uploadR32F(f.depth),
                      colorTexture = uploadRgb(colors);

@@ -4,9 +4,10 @@
 // and a two-colour texture (left half red, right half blue) over the sun's window and over a spot light's
 // cone is prefiltered within the untextured method's own error of the brute-force march over the same map
 // and of the world march (relative RMSE per channel stated). Bad textures are named.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/light_texture_frames.h"
+#include "common/local_light_scene.h"
 
 #include <crep/core/error.h>
 #include <crep/prefilter/prefilter.h>
@@ -38,40 +39,6 @@ PrefilterOptions prefilterOptions() {
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   return o;
-}
-
-Image constantTexture(const glm::dvec3& c) {
-  Image t(4, 4, 3);
-  for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i)
-      for (int k = 0; k < 3; ++k)
-        t.at(i, j, k) = static_cast<float>(c[k]);
-  return t;
-}
-
-/// 64 x 64: the left half red, the right half blue (a little of every channel in both).
-Image twoColourTexture() {
-  Image t(64, 64, 3);
-  for (int j = 0; j < 64; ++j)
-    for (int i = 0; i < 64; ++i) {
-      const glm::vec3 c = i < 32 ? glm::vec3(1.0f, 0.1f, 0.05f) : glm::vec3(0.05f, 0.1f, 1.0f);
-      for (int k = 0; k < 3; ++k)
-        t.at(i, j, k) = c[k];
-    }
-  return t;
-}
-
-/// A stained-glass window over the sun: an orthographic projection along the light, 80 x 80 units
-/// centred on `target` (the colour edge, the texture's middle column, runs through it).
-glm::dmat4 sunWindow(const DirectionalLight& light, const glm::dvec3& target) {
-  return glm::ortho(-40.0, 40.0, -40.0, 40.0, 1.0, 400.0) *
-         glm::lookAt(target - 100.0 * light.direction(), target, glm::dvec3(0.0, 1.0, 0.0));
-}
-
-/// A gobo of a spot light: a 90-degree perspective projection from the light aimed at `target`.
-glm::dmat4 spotGobo(const SpotLight& spot, const glm::dvec3& target) {
-  return glm::perspective(glm::radians(90.0), 1.0, 0.1, 100.0) *
-         glm::lookAt(spot.position(), target, glm::dvec3(0.0, 1.0, 0.0));
 }
 
 bool identical(const Image& a, const Image& b) {
@@ -175,19 +142,83 @@ std::vector<EvaluateOptions> evaluateVariants(bool nearPlane) {
   return v;
 }
 
+/// The methods for the sun and for a local light, with a colour map / light texture or without.
+FilteredBasis prefilterWith(const LightTextureFrame& f, const Image* colors) {
+  if (f.local)
+    return colors ? prefilter(f.map, f.medium, *f.local, *colors, prefilterOptions())
+                  : prefilter(f.map, f.medium, *f.local, prefilterOptions());
+  return colors ? prefilter(f.map, f.medium, *colors, prefilterOptions())
+                : prefilter(f.map, f.medium, prefilterOptions());
+}
+Image evaluateWith(const LightTextureFrame& f, const FilteredBasis& basis) {
+  return f.local ? evaluate(basis, f.depth, f.camera, *f.local, f.medium)
+                 : evaluate(basis, f.depth, f.camera, f.sun, f.medium);
+}
+Image bruteWith(const LightTextureFrame& f, const Image* colors) {
+  if (f.local)
+    return (colors ? bruteForceMarch(f.map, f.depth, f.camera, *f.local, f.medium, *colors)
+                   : bruteForceMarch(f.map, f.depth, f.camera, *f.local, f.medium))
+        .scattering;
+  return (colors ? bruteForceMarch(f.map, f.depth, f.camera, f.sun, f.medium, *colors)
+                 : bruteForceMarch(f.map, f.depth, f.camera, f.sun, f.medium))
+      .scattering;
+}
+Image worldWith(const LightTextureFrame& f, const Image& shadow, const LightTexture* texture) {
+  const glm::dmat4& M = f.shadowClipFromWorld;
+  const WorldMarchOptions o{.steps = 256, .bias = 1e-5};
+  if (f.local)
+    return (texture ? worldSpaceMarch(shadow, M, f.depth, f.camera, *f.local, f.medium, *texture, o)
+                    : worldSpaceMarch(shadow, M, f.depth, f.camera, *f.local, f.medium, o))
+        .scattering;
+  return (texture ? worldSpaceMarch(shadow, M, f.depth, f.camera, f.sun, f.medium, *texture, o)
+                  : worldSpaceMarch(shadow, M, f.depth, f.camera, f.sun, f.medium, o))
+      .scattering;
+}
+
+/// The two-colour texture over the frame's light (`what`: "sun, two-colour window", ...): the texture
+/// colours the frame, and the textured method is prefiltered within the untextured method's own error of
+/// the brute-force march over the same map and of the world march (relative RMSE per channel printed).
+void checkTwoColour(const LightTextureFrame& f, const std::string& what) {
+  const Image tex = twoColourTexture();
+  const LightTexture texture{&tex, f.textureClipFromWorld};
+  const Image colors = lightColorMap(texture, *f.layout, kMapW, kMapH);
+  const Image shadow = halfSpaceShadowMap(f.plane, f.shadowClipFromWorld, kShadow);
+
+  const Image ours = evaluateWith(f, prefilterWith(f, &colors));
+  const Image brute = bruteWith(f, &colors);
+  const Image world = worldWith(f, shadow, &texture);
+  const Image plainOurs = evaluateWith(f, prefilterWith(f, nullptr));
+  const Image plainBrute = bruteWith(f, nullptr);
+  const Image plainWorld = worldWith(f, shadow, nullptr);
+
+  checkBothColours(brute, plainBrute);
+
+  const glm::dvec3 eBrute = channelRelativeRmse(ours, brute), eWorld = channelRelativeRmse(ours, world);
+  const glm::dvec3 eMaps = channelRelativeRmse(brute, world);
+  const glm::dvec3 pBrute = channelRelativeRmse(plainOurs, plainBrute),
+                   pWorld = channelRelativeRmse(plainOurs, plainWorld);
+  MESSAGE(what << ": prefiltered vs brute force (same map) " << str(eBrute) << "; untextured "
+               << str(pBrute));
+  MESSAGE(what << ": prefiltered vs world march " << str(eWorld) << "; untextured " << str(pWorld));
+  MESSAGE(what << ": brute force vs world march (the map's own error) " << str(eMaps));
+  // Each prefilter region averages its texels' colours with the reference ray's transmittance weights, as
+  // it averages their visibility; the colour edge adds to the shadow edges (goal: the untextured figure).
+  CHECK(maxOf(eBrute) < 0.02);
+  CHECK(eBrute.y < 1.1 * pBrute.y + 0.001);
+  CHECK(maxOf(eWorld) < 0.02);
+}
+
 } // namespace
 
 TEST_CASE("light texture: a constant texture is c times the untextured result in every method (sun)") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
-  const DirectionalLight light = sideLight();
-  const auto layout = projectiveLayout(camera, light, 8);
-  const HalfSpace plane;
-  const RectifiedMap map =
-      castRectifiedMap(layout, kMapW, kMapH, [&](const LightRay& ray) { return planeHit(plane, ray); });
-  const glm::dmat4 M = analyticLightMatrix(light);
-  const Image shadow = halfSpaceShadowMap(plane, M, 256);
+  const LightTextureFrame f = sunTextureFrame(kW, kH, kMapW, kMapH);
+  const Camera& camera = f.camera;
+  const Image& depth = f.depth;
+  const Medium& medium = f.medium;
+  const DirectionalLight& light = f.sun;
+  const RectifiedMap& map = f.map;
+  const glm::dmat4& M = f.shadowClipFromWorld;
+  const Image shadow = halfSpaceShadowMap(f.plane, M, 256);
   const FilteredBasis plain = prefilter(map, medium, prefilterOptions());
   const MarchResult brute = bruteForceMarch(map, depth, camera, light, medium);
   const MarchResult world = worldSpaceMarch(shadow, M, depth, camera, light, medium, {.steps = 32});
@@ -195,7 +226,7 @@ TEST_CASE("light texture: a constant texture is c times the untextured result in
     CAPTURE(c.y);
     const Image tex = constantTexture(c);
     const LightTexture texture{&tex, M};
-    const Image colors = lightColorMap(texture, *layout, kMapW, kMapH);
+    const Image colors = lightColorMap(texture, *f.layout, kMapW, kMapH);
     bool colorsAreC = true;
     for (int j = 0; j < kMapH; ++j)
       for (int i = 0; i < kMapW; ++i)
@@ -221,17 +252,14 @@ TEST_CASE("light texture: a constant texture is c times the untextured result in
 }
 
 TEST_CASE("light texture: a constant texture is c times the untextured result in every method (spot)") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
-  const SpotLight spot = analyticSpot();
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
-  const RectifiedMap map = castRectifiedMap(layout, kMapW, kMapH, wallHitFromLight);
-  const LocalLight light = LocalLight::spot(spot);
-  const glm::dmat4 M = spot.lightClipFromWorld();
-  const Image shadow = halfSpaceShadowMap(wall(), M, 256);
+  const LightTextureFrame f = spotTextureFrame(kW, kH, kMapW, kMapH);
+  const Camera& camera = f.camera;
+  const Image& depth = f.depth;
+  const Medium& medium = f.medium;
+  const LocalLight& light = *f.local;
+  const RectifiedMap& map = f.map;
+  const glm::dmat4& M = f.shadowClipFromWorld;
+  const Image shadow = halfSpaceShadowMap(f.plane, M, 256);
   const FilteredBasis plain = prefilter(map, medium, light, prefilterOptions());
   const MarchResult brute = bruteForceMarch(map, depth, camera, light, medium);
   const MarchResult world = worldSpaceMarch(shadow, M, depth, camera, light, medium, {.steps = 32});
@@ -239,7 +267,7 @@ TEST_CASE("light texture: a constant texture is c times the untextured result in
     CAPTURE(c.y);
     const Image tex = constantTexture(c);
     const LightTexture texture{&tex, M};
-    const Image colors = lightColorMap(texture, *layout, kMapW, kMapH);
+    const Image colors = lightColorMap(texture, *f.layout, kMapW, kMapH);
     const FilteredBasis textured = prefilter(map, medium, light, colors, prefilterOptions());
     CHECK(textured.localLight);
     // Texels whose light ray points behind the spot (colour 0) carry no light untextured either; the
@@ -266,92 +294,12 @@ TEST_CASE("light texture: a constant texture is c times the untextured result in
 }
 
 TEST_CASE("light texture: a two-colour window over the sun, prefiltered vs brute force and world march") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
-  const DirectionalLight light = sideLight();
-  const auto layout = projectiveLayout(camera, light, 8);
-  const HalfSpace plane;
-  const RectifiedMap map =
-      castRectifiedMap(layout, kMapW, kMapH, [&](const LightRay& ray) { return planeHit(plane, ray); });
-  const glm::dmat4 M = analyticLightMatrix(light);
-  const Image tex = twoColourTexture();
-  const LightTexture texture{&tex, sunWindow(light, {0.0, 1.0, -12.0})};
-  const Image colors = lightColorMap(texture, *layout, kMapW, kMapH);
-  const Image shadow = halfSpaceShadowMap(plane, M, kShadow);
-
-  const Image ours =
-      evaluate(prefilter(map, medium, colors, prefilterOptions()), depth, camera, light, medium);
-  const Image brute = bruteForceMarch(map, depth, camera, light, medium, colors).scattering;
-  const Image world =
-      worldSpaceMarch(shadow, M, depth, camera, light, medium, texture, {.steps = 256, .bias = 1e-5})
-          .scattering;
-  const Image plainOurs = evaluate(prefilter(map, medium, prefilterOptions()), depth, camera, light, medium);
-  const Image plainBrute = bruteForceMarch(map, depth, camera, light, medium).scattering;
-  const Image plainWorld =
-      worldSpaceMarch(shadow, M, depth, camera, light, medium, {.steps = 256, .bias = 1e-5}).scattering;
-
-  checkBothColours(brute, plainBrute);
-
-  const glm::dvec3 eBrute = channelRelativeRmse(ours, brute), eWorld = channelRelativeRmse(ours, world);
-  const glm::dvec3 eMaps = channelRelativeRmse(brute, world);
-  const glm::dvec3 pBrute = channelRelativeRmse(plainOurs, plainBrute),
-                   pWorld = channelRelativeRmse(plainOurs, plainWorld);
-  MESSAGE("sun, two-colour window: prefiltered vs brute force (same map) " << str(eBrute) << "; untextured "
-                                                                           << str(pBrute));
-  MESSAGE("sun, two-colour window: prefiltered vs world march " << str(eWorld) << "; untextured "
-                                                                << str(pWorld));
-  MESSAGE("sun, two-colour window: brute force vs world march (the map's own error) " << str(eMaps));
-  // Each prefilter region averages its texels' colours with the reference ray's transmittance weights, as
-  // it averages their visibility; the colour edge adds to the shadow edges (goal: the untextured figure).
-  CHECK(maxOf(eBrute) < 0.02);
-  CHECK(eBrute.y < 1.1 * pBrute.y + 0.001);
-  CHECK(maxOf(eWorld) < 0.02);
+  checkTwoColour(sunTextureFrame(kW, kH, kMapW, kMapH), "sun, two-colour window");
 }
 
 TEST_CASE(
     "light texture: a two-colour gobo over a spot light's cone, prefiltered vs brute force and world march") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
-  const SpotLight spot = analyticSpot();
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
-  const RectifiedMap map = castRectifiedMap(layout, kMapW, kMapH, wallHitFromLight);
-  const LocalLight light = LocalLight::spot(spot);
-  const glm::dmat4 M = spot.lightClipFromWorld();
-  const Image tex = twoColourTexture();
-  const LightTexture texture{&tex, spotGobo(spot, {2.0, 0.0, -6.0})};
-  const Image colors = lightColorMap(texture, *layout, kMapW, kMapH);
-  const Image shadow = halfSpaceShadowMap(wall(), M, kShadow);
-
-  const Image ours =
-      evaluate(prefilter(map, medium, light, colors, prefilterOptions()), depth, camera, light, medium);
-  const Image brute = bruteForceMarch(map, depth, camera, light, medium, colors).scattering;
-  const Image world =
-      worldSpaceMarch(shadow, M, depth, camera, light, medium, texture, {.steps = 256, .bias = 1e-5})
-          .scattering;
-  const Image plainOurs =
-      evaluate(prefilter(map, medium, light, prefilterOptions()), depth, camera, light, medium);
-  const Image plainBrute = bruteForceMarch(map, depth, camera, light, medium).scattering;
-  const Image plainWorld =
-      worldSpaceMarch(shadow, M, depth, camera, light, medium, {.steps = 256, .bias = 1e-5}).scattering;
-
-  checkBothColours(brute, plainBrute);
-
-  const glm::dvec3 eBrute = channelRelativeRmse(ours, brute), eWorld = channelRelativeRmse(ours, world);
-  const glm::dvec3 eMaps = channelRelativeRmse(brute, world);
-  const glm::dvec3 pBrute = channelRelativeRmse(plainOurs, plainBrute),
-                   pWorld = channelRelativeRmse(plainOurs, plainWorld);
-  MESSAGE("spot, two-colour gobo: prefiltered vs brute force (same map) " << str(eBrute) << "; untextured "
-                                                                          << str(pBrute));
-  MESSAGE("spot, two-colour gobo: prefiltered vs world march " << str(eWorld) << "; untextured "
-                                                               << str(pWorld));
-  MESSAGE("spot, two-colour gobo: brute force vs world march (the map's own error) " << str(eMaps));
-  CHECK(maxOf(eBrute) < 0.02);
-  CHECK(eBrute.y < 1.1 * pBrute.y + 0.001);
-  CHECK(maxOf(eWorld) < 0.02);
+  checkTwoColour(spotTextureFrame(kW, kH, kMapW, kMapH), "spot, two-colour gobo");
 }
 
 TEST_CASE("light texture: missing, empty or bad textures and colour maps are named") {

@@ -7,10 +7,10 @@
 // positions where the visibility is sampled. A sample within float rounding of the shadow edge can take
 // the other side, and the bisection then lands in a neighbouring interval (at most one section of s / N):
 // those pixels are counted and left out of a masked metric; the rest must agree to float precision.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/analytic_scene.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

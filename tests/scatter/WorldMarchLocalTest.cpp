@@ -3,9 +3,9 @@
 // spot or point light on its lit side. The lit part of every view ray is known exactly (the plane), and
 // its in-scattering is RayScattering::segment (tested against an independent quadrature in
 // RayScatteringTest), so the march's own error is its shadow-map visibility.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/local_light_scene.h"
 
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scatter/world_march.h>
@@ -22,9 +22,7 @@ constexpr int kW = 96, kH = 54, kShadow = 1024;
 } // namespace
 
 TEST_CASE("world march, spot light: the half-space shadow's closed form within 0.5%, unoccluded exactly") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const SpotLight spot = analyticSpot();
   const LocalLight light = LocalLight::spot(spot);
   const glm::dmat4 M = spot.lightClipFromWorld();
@@ -55,9 +53,7 @@ TEST_CASE("world march, spot light: the half-space shadow's closed form within 0
 }
 
 TEST_CASE("world march, point light: six faces add up to the closed form, no seam at the face borders") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const PointLight point = analyticPoint();
   std::vector<LocalLight> faces;
   Image sum(kW, kH, 4);

@@ -1,11 +1,11 @@
-// `crep render --scene terrain --method atmosphere`: physical sanity of the sky through the tool (the issue's
-// checks, on the linear EXR: noon zenith B > G > R, the horizon next to a sun 2 degrees up R > B, the
-// twilight zenith darker than the horizon below the sun), every shaft method end to end, the table cache
-// (a second run loads bit-identical images; a corrupt file is recomputed with a warning) and usage errors.
-// Small images and tables: the figures are the table's and the method's, not the size's.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+// `crep render --scene terrain --method atmosphere`: physical sanity of the sky through the tool (the sky's
+// colour checks, on the linear EXR: noon zenith B > G > R, the horizon next to a sun 2 degrees up R > B, the
+// twilight zenith darker than the horizon below the sun), every shaft method end to end, the table cache (a
+// second run loads bit-identical images; a corrupt file is recomputed with a warning) and usage errors. Small
+// images and tables: the figures are the table's and the method's, not the size's.
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/core/image.h>
 #include <crep/support/exr.h>

@@ -1,8 +1,8 @@
 // `crep compare` and `crep bench` end to end at test sizes.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/png_read.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/png_read.h"
+#include "common/tool_runner.h"
 
 #include <doctest/doctest.h>
 

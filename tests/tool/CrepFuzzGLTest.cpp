@@ -1,6 +1,6 @@
-// A seeded fuzz test of the crep tool (issue 28): random command lines over the tool's real options and
-// values, mutations of the example JSON frame, truncated and bit-flipped EXR inputs. Every case runs the
-// built tool in a fresh folder (inputs, a FIFO, a folder, a file, a symbolic link) and must
+// A seeded fuzz test of the crep tool: random command lines over the tool's real options and values,
+// mutations of the example JSON frame, truncated and bit-flipped EXR inputs. Every case runs the built tool
+// in a fresh folder (inputs, a FIFO, a folder, a file, a symbolic link) and must
 //   - end with exit status 0, 1 or 2: never a signal, never a hang (60 s per case);
 //   - leave no partial output: no temporary of the output rule anywhere, and when the status is not 0 the
 //     folder exactly as it was (no new file, no changed or removed file);
@@ -11,9 +11,9 @@
 // 128, few march steps), and a time budget after which no new case starts (on slow builds: sanitizers).
 // CREP_FUZZ_SEED overrides the seed (a failing case prints its seed, index and arguments); CREP_FUZZ_VERBOSE
 // prints every case with its exit status and last line.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>

@@ -1,13 +1,12 @@
-// The crep tool's output rule on commands that run (README "The crep tool", "Outputs"; issue 28): a symbolic
-// link as an output keeps the link and replaces its final target (its permission bits kept, a dangling link's
-// target created); a command whose later output fails leaves none of its outputs (and no temporary, and an
-// older file at an output path untouched); and the checks of the frame that only warn or clamp: a shadow
-// matrix that maps no visible point into the map warns, camera.maxDistance beyond a finite far plane is
-// clamped. Also the froxel-prefilter warnings name froxel-prefilter, and `crep bench --bases M` runs for
-// every even M.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+// The crep tool's output rule on commands that run (README "The crep tool", "Outputs"): a symbolic link as an
+// output keeps the link and replaces its final target (its permission bits kept, a dangling link's target
+// created); a command whose later output fails leaves none of its outputs (and no temporary, and an older
+// file at an output path untouched); and the checks of the frame that only warn or clamp: a shadow matrix
+// that maps no visible point into the map warns, camera.maxDistance beyond a finite far plane is clamped.
+// Also the froxel-prefilter warnings name froxel-prefilter, and `crep bench --bases M` runs for every even M.
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
@@ -51,14 +50,8 @@ bool startsWithPng(const fs::path& p) {
 }
 
 /// Scatter inputs for the example frame (depth 160x90 at 0.9, shadow 256x256 at 1, the example JSON).
-struct ScatterInputs {
-  crep::test::TempDir dir{"crep-outputs-gl"};
-  ScatterInputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
-    writeText(dir / "frame.json", readText(kExample));
-  }
-  std::string path(const std::string& name) const { return (dir / name).string(); }
+struct ScatterInputs : ScatterFolder {
+  ScatterInputs() : ScatterFolder("crep-outputs-gl") { writeExampleFrame(); }
   std::vector<std::string> args(const std::string& frame, const std::string& out) const {
     return {"scatter", "--depth", path("depth.exr"), "--shadow",  path("shadow.exr"), "--frame", path(frame),
             "--out",   path(out), "--method",        "reference", "--steps",          "8"};

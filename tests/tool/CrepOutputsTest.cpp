@@ -1,11 +1,11 @@
-// The crep tool's output rule and usage errors that need no GL (README "The crep tool", "Outputs"; issue 28):
-// an output that is a FIFO, a device, a socket or a directory (itself or its link's target) is refused naming
-// the option and the path and stays what it was; every output folder and path is checked before any output is
+// The crep tool's output rule and usage errors that need no GL (README "The crep tool", "Outputs"): an output
+// that is a FIFO, a device, a socket or a directory (itself or its link's target) is refused naming the
+// option and the path and stays what it was; every output folder and path is checked before any output is
 // written and before the GL context exists; usage errors exit 2 naming the option the user set; inputs the
 // documentation does not allow (depth EXRs without a Y, Z, depth or R channel, a JSON file with a NUL byte)
 // are refused naming the file.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
@@ -52,14 +52,8 @@ void expectEarlyFailure(const ArgvResult& r, int status, std::initializer_list<s
 }
 
 /// Valid scatter inputs for the example frame: depth.exr (160x90, 0.9), shadow.exr (256x256, 1), frame.json.
-struct ScatterInputs {
-  crep::test::TempDir dir{"crep-outputs"};
-  ScatterInputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
-    writeText(dir / "frame.json", readText(kExample));
-  }
-  std::string path(const std::string& name) const { return (dir / name).string(); }
+struct ScatterInputs : ScatterFolder {
+  ScatterInputs() : ScatterFolder("crep-outputs") { writeExampleFrame(); }
   std::vector<std::string> args(std::initializer_list<std::string> extra) const {
     std::vector<std::string> a = {"scatter",          "--depth", path("depth.exr"), "--shadow",
                                   path("shadow.exr"), "--frame", path("frame.json")};

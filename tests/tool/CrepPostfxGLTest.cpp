@@ -2,9 +2,9 @@
 // sunlit scene gives finite, non-negative, non-zero in-scattering and a transmittance in [0, 1] with the
 // method's stage in the report; a frame without a sun (colonnade-night) runs with a warning on stderr and
 // adds no in-scattering (the medium's transmittance stays).
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/support/exr.h>
 

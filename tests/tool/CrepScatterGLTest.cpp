@@ -1,8 +1,8 @@
 // `crep scatter` end to end: the README's example frame against a closed form, and the round trip
 // render -> --export-frame -> scatter against the direct render.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/core/camera.h>
 #include <crep/core/light.h>

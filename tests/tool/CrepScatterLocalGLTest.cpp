@@ -3,9 +3,9 @@
 // (six faces stacked as the README documents), each run with the reference and the prefiltered method and
 // compared with each other and with the library's CPU world-space reference (crep::worldSpaceMarch with a
 // LocalLight, double precision) on the same files.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/camera.h>

@@ -1,8 +1,8 @@
 // `crep scatter` with spot and point lights (frame_json.h "Local lights"): every domain check of the new
 // optional fields fails before any GL work with exit status 1 and a message naming the JSON path or the
 // file, never a crash. The valid frames themselves run in CrepScatterLocalGLTest.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
@@ -26,12 +26,9 @@ using namespace crep::test::frame_json;
 /// A directory with a spot-light frame (the example's camera and medium, light.type "spot") plus one
 /// additional point light in "lights": depth.exr (160x90, 0.9), shadow.exr (the spot's, 128x128, empty),
 /// point.exr (the point light's six 32x32 faces stacked: 32x192, empty).
-struct SpotInputs {
-  crep::test::TempDir dir{"crep-scatter-local"};
+struct SpotInputs : ScatterFolder {
   Json frame;
-  SpotInputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(128, 128, 1, 1.0f), crep::ExrPixelType::Float);
+  SpotInputs() : ScatterFolder("crep-scatter-local", 128) {
     crep::writeExr(dir / "point.exr", crep::Image(32, 192, 1, 1.0f), crep::ExrPixelType::Float);
     frame = Json::parse(readText(kExample));
     const crep::SpotLight s = exampleSpot();
@@ -44,26 +41,13 @@ struct SpotInputs {
                                         {"range", 50},
                                         {"shadowMap", {{"file", "point.exr"}}}}});
   }
-  std::string path(const char* name) const { return (dir / name).string(); }
   std::string args() const {
     return "scatter --depth '" + path("depth.exr") + "' --shadow '" + path("shadow.exr") + "' --frame '" +
            path("frame.json") + "' --out '" + path("out.exr") + "'";
   }
   /// Writes frame.json as the frame with `edit` applied.
-  void write(const std::function<void(Json&)>& edit) const {
-    Json j = frame;
-    edit(j);
-    std::ofstream(dir / "frame.json", std::ios::binary) << j.dump(2);
-  }
+  void write(const std::function<void(Json&)>& edit) const { writeFrame(frame, edit); }
 };
-
-void expectFailure(const crep::test::ToolResult& r, int status, std::initializer_list<std::string> mentions) {
-  INFO(r.output);
-  CHECK(r.status == status);
-  for (const std::string& m : mentions)
-    CHECK(r.output.find(m) != std::string::npos);
-  CHECK(r.output.find("unexpected error") == std::string::npos);
-}
 
 } // namespace
 

@@ -1,8 +1,8 @@
 // `crep scatter` failure paths: every check of the inputs happens before any GL work, so these run
 // without a context. Each bad input must exit 1 (2 for command-line misuse) with a message naming the
 // field or the file, never crash.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
@@ -27,14 +27,8 @@ using namespace crep::test::frame_json;
 
 /// A directory with valid inputs for the example frame: depth.exr (160x90, a constant 0.9),
 /// shadow.exr (256x256, empty: 1) and frame.json (the example).
-struct Inputs {
-  crep::test::TempDir dir{"crep-scatter"};
-  Inputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
-    writeText(dir / "frame.json", readText(kExample));
-  }
-  std::string path(const char* name) const { return (dir / name).string(); }
+struct Inputs : ScatterFolder {
+  Inputs() : ScatterFolder("crep-scatter") { writeExampleFrame(); }
   /// The arguments of a scatter run on these inputs (plus `extra`).
   std::string args(const std::string& extra = "") const {
     return "scatter --depth '" + path("depth.exr") + "' --shadow '" + path("shadow.exr") + "' --frame '" +
@@ -42,9 +36,7 @@ struct Inputs {
   }
   /// Rewrites frame.json with `edit` applied to the example.
   void editJson(const std::function<void(Json&)>& edit) const {
-    Json j = Json::parse(readText(kExample));
-    edit(j);
-    writeText(dir / "frame.json", j.dump(2));
+    writeFrame(Json::parse(readText(kExample)), edit);
   }
 };
 
@@ -80,14 +72,6 @@ void shortenChunks(const std::filesystem::path& path, std::uint32_t keep) {
     out += in.substr(chunk + 8, keep);
   }
   writeText(path, out);
-}
-
-void expectFailure(const crep::test::ToolResult& r, int status, std::initializer_list<const char*> mentions) {
-  INFO(r.output);
-  CHECK(r.status == status);
-  for (const char* m : mentions)
-    CHECK(r.output.find(m) != std::string::npos);
-  CHECK(r.output.find("unexpected error") == std::string::npos);
 }
 
 } // namespace

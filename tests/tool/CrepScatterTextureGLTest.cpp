@@ -3,9 +3,9 @@
 // the texture as an RGB EXR) read back by `crep scatter`; a constant white texture gives the untextured
 // image with every method; a two-colour texture over the colonnade (default projection: the shadow
 // matrix): the rectified methods against the world-space reference.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/support/exr.h>
 #include <crep/support/image_compare.h>

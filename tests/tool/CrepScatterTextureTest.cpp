@@ -1,8 +1,8 @@
 // `crep scatter` with light textures (frame_json.h "Light textures"): every check of the optional fields
 // light.texture / light.textureClipFromWorld (and a spot entry's) fails before any GL work with exit status
 // 1 and a message naming the JSON path, never a crash. The valid frames run in CrepScatterTextureGLTest.
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 #include "tool/frame_json_util.h"
 
 #include <crep/core/image.h>
@@ -28,12 +28,9 @@ using namespace crep::test::frame_json;
 /// The example frame (a directional light) with light.texture "window.exr" (8x8 RGB), plus the inputs:
 /// depth.exr (160x90, 0.9), shadow.exr (256x256, empty), and bad textures: grey.exr (1 channel),
 /// nan.exr / negative.exr (one bad texel), corrupt.exr (not an EXR), spot.exr (a spot's map, 64x64).
-struct TextureInputs {
-  crep::test::TempDir dir{"crep-scatter-texture"};
+struct TextureInputs : ScatterFolder {
   Json frame;
-  TextureInputs() {
-    crep::writeExr(dir / "depth.exr", crep::Image(160, 90, 1, 0.9f), crep::ExrPixelType::Float);
-    crep::writeExr(dir / "shadow.exr", crep::Image(256, 256, 1, 1.0f), crep::ExrPixelType::Float);
+  TextureInputs() : ScatterFolder("crep-scatter-texture") {
     crep::writeExr(dir / "spot.exr", crep::Image(64, 64, 1, 1.0f), crep::ExrPixelType::Float);
     crep::writeExr(dir / "window.exr", crep::Image(8, 8, 3, 0.5f), crep::ExrPixelType::Float);
     crep::writeExr(dir / "grey.exr", crep::Image(8, 8, 1, 0.5f), crep::ExrPixelType::Float);
@@ -46,16 +43,11 @@ struct TextureInputs {
     frame = Json::parse(readText(kExample));
     frame["light"]["texture"] = "window.exr";
   }
-  std::string path(const char* name) const { return (dir / name).string(); }
   std::string args(const char* out = "out.exr") const {
     return "scatter --method reference --depth '" + path("depth.exr") + "' --shadow '" + path("shadow.exr") +
            "' --frame '" + path("frame.json") + "' --out '" + path(out) + "'";
   }
-  void write(const std::function<void(Json&)>& edit) const {
-    Json j = frame;
-    edit(j);
-    std::ofstream(dir / "frame.json", std::ios::binary) << j.dump(2);
-  }
+  void write(const std::function<void(Json&)>& edit) const { writeFrame(frame, edit); }
 };
 
 /// A spot entry of "lights" (its map spot.exr) with a texture.
@@ -65,13 +57,6 @@ Json spotEntry() {
   e["shadowMap"] = {{"file", "spot.exr"},
                     {"lightClipFromWorld", matrixJson(exampleSpot().lightClipFromWorld())}};
   return e;
-}
-
-void expectFailure(const crep::test::ToolResult& r, int status, const std::string& mention) {
-  INFO(r.output);
-  CHECK(r.status == status);
-  CHECK(r.output.find(mention) != std::string::npos);
-  CHECK(r.output.find("unexpected error") == std::string::npos);
 }
 
 } // namespace
@@ -183,7 +168,7 @@ TEST_CASE("crep scatter light textures: every check names the JSON path") {
   for (const Case& c : cases) {
     CAPTURE(c.name);
     in.write(c.edit);
-    expectFailure(crep::test::runCrep(in.args()), 1, c.mentions);
+    expectFailure(crep::test::runCrep(in.args()), 1, {c.mentions});
     CHECK(!std::filesystem::exists(in.dir / "out.exr"));
   }
 }
@@ -201,5 +186,5 @@ TEST_CASE("crep scatter light textures: the texture as the output is a usage err
 TEST_CASE("crep scatter light textures: an unknown field next to the texture is still an error") {
   const TextureInputs in;
   in.write([](Json& j) { j["light"]["textures"] = "window.exr"; });
-  expectFailure(crep::test::runCrep(in.args()), 1, "light.textures: unknown field");
+  expectFailure(crep::test::runCrep(in.args()), 1, {"light.textures: unknown field"});
 }

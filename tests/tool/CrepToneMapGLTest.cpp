@@ -1,9 +1,9 @@
 // `crep render --tonemap`: the PNG through ToneMapPass with a chosen operator, `--tonemap all` as a sheet
 // of every operator, usage errors for unknown names (listing them) and for knobs without --tonemap.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/png_read.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/png_read.h"
+#include "common/tool_runner.h"
 
 #include <crep/postfx/tone_mapping.h>
 

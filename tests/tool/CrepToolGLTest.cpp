@@ -1,7 +1,7 @@
 // End-to-end tests of the crep tool: run the built binary as a user would.
-#include "support/gl_fixture.h"
-#include "support/image_check.h"
-#include "support/tool_runner.h"
+#include "common/gl_fixture.h"
+#include "common/image_check.h"
+#include "common/tool_runner.h"
 
 #include <crep/support/exr.h>
 
@@ -88,7 +88,7 @@ TEST_CASE(
   CREP_REQUIRE_GL();
   crep::test::TempDir dir;
   const std::string out = " --out '" + (dir / "x").string() + "'";
-  // Used to exit 1 after creating the GL context ("invalid scene = cathedral"); issue 28.
+  // Used to exit 1 after creating the GL context ("invalid scene = cathedral"): usage errors come first.
   const RunResult unknown = runCrep("render --scene cathedral --size 16x9" + out);
   INFO(unknown.output);
   CHECK(unknown.status == 2);

@@ -1,15 +1,20 @@
 // Helpers of the crep tool tests that write frame descriptions (examples/crep/lib/frame_json.h): the
-// example frame, text files and JSON conversions, the spot light of the local-light and texture frames, and
-// the listing of a folder (what a command left behind).
+// example frame, text files and JSON conversions, the spot light of the local-light and texture frames, the
+// listing of a folder (what a command left behind), and a folder of `crep scatter` inputs.
 #pragma once
 
+#include "common/image_check.h"
+
+#include <crep/core/image.h>
 #include <crep/core/light.h>
+#include <crep/support/exr.h>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -75,5 +80,23 @@ inline Json exampleSpotJson() {
               {"color", Json::array({1.0, 0.9, 0.8})},
               {"intensity", 30}};
 }
+
+/// A temporary folder (`prefix`) of `crep scatter` inputs: depth.exr (160x90, a constant 0.9) and shadow.exr
+/// (shadowSize^2, empty: 1); callers add the frame (writeFrame) and other files.
+struct ScatterFolder {
+  explicit ScatterFolder(const std::string& prefix, int shadowSize = 256) : dir(prefix) {
+    writeExr(dir / "depth.exr", Image(160, 90, 1, 0.9f), ExrPixelType::Float);
+    writeExr(dir / "shadow.exr", Image(shadowSize, shadowSize, 1, 1.0f), ExrPixelType::Float);
+  }
+  TempDir dir;
+  std::string path(const std::string& name) const { return (dir / name).string(); }
+  /// Writes frame.json: the example frame as it is.
+  void writeExampleFrame() const { writeText(dir / "frame.json", readText(kExample)); }
+  /// Writes frame.json: `frame` with `edit` applied.
+  void writeFrame(Json frame, const std::function<void(Json&)>& edit = {}) const {
+    if (edit) edit(frame);
+    writeText(dir / "frame.json", frame.dump(2));
+  }
+};
 
 } // namespace crep::test::frame_json

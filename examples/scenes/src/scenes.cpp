@@ -253,149 +253,125 @@ std::vector<std::string> lightTextureSceneNames() {
   return {"stained-glass"};
 }
 
+namespace {
+
+constexpr double kFov = 60.0 * std::numbers::pi / 180.0;
+
+/// A scene of one mesh under the sun (no local lights, no light texture), its bounds computed.
+Scene sunScene(const char* name, Mesh mesh, const Camera& camera, const DirectionalLight& sun,
+               const Medium& medium) {
+  Scene s{name, std::move(mesh), camera, sun, medium, {}, {}, true, {}, {}, {}};
+  computeBounds(s);
+  return s;
+}
+
+Scene colonnadeScene(double aspect) {
+  return sunScene(
+      "colonnade", colonnadeMesh(),
+      Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, kFov, aspect, 0.1, 120.0),
+      DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(5.0, 4.6, 4.0)),
+      Medium({.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}));
+}
+
+Scene forestScene(double aspect) {
+  return sunScene(
+      "forest", forestMesh(),
+      Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, kFov, aspect, 0.1, 150.0),
+      DirectionalLight(glm::dvec3(-0.45, -0.6, -0.65), glm::dvec3(4.0, 3.8, 3.4)),
+      Medium({.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}));
+}
+
+Scene terrainScene(double aspect) {
+  return sunScene("terrain", terrainMesh(),
+                  Camera::lookAt({0.0, 12.0, 40.0}, {0.0, 6.0, -40.0}, {0, 1, 0}, kFov, aspect, 0.1, 200.0),
+                  DirectionalLight(glm::dvec3(0.8, -0.45, 0.2), glm::dvec3(4.0, 3.5, 2.8)),
+                  Medium({.mieScattering = glm::dvec3(0.012, 0.014, 0.018),
+                          .hgG = 0.5,
+                          .rayleighScattering = glm::dvec3(0.002, 0.004, 0.008),
+                          .absorption = glm::dvec3(0.002)}));
+}
+
+Scene boxesScene(double aspect) {
+  return sunScene("boxes", boxesMesh(),
+                  Camera::lookAt({0.0, 3.0, 10.0}, {0.0, 1.5, -5.0}, {0, 1, 0}, kFov, aspect, 0.1, 60.0),
+                  DirectionalLight(glm::dvec3(0.5, -0.8, -0.3), glm::dvec3(3.0)), defaultMedium());
+}
+
+/// The forest toward a low sun behind the canopy: the sun is in view (about 12 degrees up, 10 degrees
+/// right of the view axis), so every frame takes the epipolar layout; the classic god-ray picture.
+Scene sunsetScene(double aspect) {
+  return sunScene(
+      "sunset", forestMesh(),
+      Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, kFov, aspect, 0.1, 150.0),
+      DirectionalLight(-glm::normalize(glm::dvec3(0.18, 0.22, -1.0)), glm::dvec3(6.0, 4.4, 2.8)),
+      Medium({.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}));
+}
+
+/// The colonnade at night (Klehm et al. 2014, Sec. 3.2 "Local Lights"): no sun; three warm spot lamps
+/// outside the view, each projective: two outside the rows of pillars behind the camera shining in
+/// through them, one above and behind the camera shining down the hall past the roof beams.
+Scene colonnadeNightScene(double aspect) {
+  Scene s{
+      "colonnade-night",
+      colonnadeMesh(),
+      Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, kFov, aspect, 0.1, 120.0),
+      DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(0.0)),
+      Medium({.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}),
+      {},
+      {},
+      false,
+      {},
+      {},
+      {}};
+  const auto lamp = [](const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& color) {
+    return SpotLight({.position = position,
+                      .direction = target - position,
+                      .innerConeAngle = 20.0 * std::numbers::pi / 180.0,
+                      .outerConeAngle = 30.0 * std::numbers::pi / 180.0,
+                      .color = color,
+                      .intensity = 1000.0,
+                      .range = 70.0,
+                      .nearPlane = 0.3});
+  };
+  s.spotLights.push_back(lamp({-11.0, 7.5, 16.0}, {0.0, 0.0, 0.0}, {1.0, 0.75, 0.45}));
+  s.spotLights.push_back(lamp({9.0, 8.5, 20.0}, {2.0, 0.0, 0.0}, {1.0, 0.8, 0.55}));
+  s.spotLights.push_back(lamp({0.0, 8.8, 26.0}, {0.0, 0.0, 6.0}, {0.7, 0.8, 1.0}));
+  computeBounds(s);
+  return s;
+}
+
+/// Light textures (Klehm et al. 2014, Sec. 3.2; Yusov 2012's coloured shafts): a hall lit only through a
+/// large window in its side wall; the sun, low and from the side, textured with a procedural
+/// stained-glass pattern projected orthographically over the window, paints coloured shafts across
+/// the hall and coloured patches on its floor and far wall.
+Scene stainedGlassScene(double aspect) {
+  Scene s{
+      "stained-glass",
+      stainedGlassMesh(),
+      Camera::lookAt({-9.0, 2.0, 9.0}, {2.0, 6.0, -10.0}, {0, 1, 0}, kFov, aspect, 0.1, 120.0),
+      DirectionalLight(glm::dvec3(-0.75, -0.5, -0.22), glm::dvec3(10.0, 9.5, 8.5)),
+      Medium({.mieScattering = glm::dvec3(0.05, 0.052, 0.055), .hgG = 0.55, .absorption = glm::dvec3(0.004)}),
+      {},
+      {},
+      true,
+      {},
+      {},
+      {}};
+  s.sunTexture = SceneLightTexture{stainedGlassTexture(128), windowTextureClipFromWorld(s.sun)};
+  computeBounds(s);
+  return s;
+}
+
+} // namespace
+
 Scene makeScene(std::string_view name, double aspect) {
-  const double fov = 60.0 * std::numbers::pi / 180.0;
-  if (name == "colonnade") {
-    Scene s{
-        "colonnade",
-        colonnadeMesh(),
-        Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
-        DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(5.0, 4.6, 4.0)),
-        Medium(
-            {.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}),
-        {},
-        {},
-        true,
-        {},
-        {},
-        {}};
-    computeBounds(s);
-    return s;
-  }
-  if (name == "forest") {
-    Scene s{
-        "forest",
-        forestMesh(),
-        Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
-        DirectionalLight(glm::dvec3(-0.45, -0.6, -0.65), glm::dvec3(4.0, 3.8, 3.4)),
-        Medium(
-            {.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}),
-        {},
-        {},
-        true,
-        {},
-        {},
-        {}};
-    computeBounds(s);
-    return s;
-  }
-  if (name == "terrain") {
-    Scene s{"terrain",
-            terrainMesh(),
-            Camera::lookAt({0.0, 12.0, 40.0}, {0.0, 6.0, -40.0}, {0, 1, 0}, fov, aspect, 0.1, 200.0),
-            DirectionalLight(glm::dvec3(0.8, -0.45, 0.2), glm::dvec3(4.0, 3.5, 2.8)),
-            Medium({.mieScattering = glm::dvec3(0.012, 0.014, 0.018),
-                    .hgG = 0.5,
-                    .rayleighScattering = glm::dvec3(0.002, 0.004, 0.008),
-                    .absorption = glm::dvec3(0.002)}),
-            {},
-            {},
-            true,
-            {},
-            {},
-            {}};
-    computeBounds(s);
-    return s;
-  }
-  if (name == "boxes") {
-    Scene s{"boxes",
-            boxesMesh(),
-            Camera::lookAt({0.0, 3.0, 10.0}, {0.0, 1.5, -5.0}, {0, 1, 0}, fov, aspect, 0.1, 60.0),
-            DirectionalLight(glm::dvec3(0.5, -0.8, -0.3), glm::dvec3(3.0)),
-            defaultMedium(),
-            {},
-            {},
-            true,
-            {},
-            {},
-            {}};
-    computeBounds(s);
-    return s;
-  }
-  if (name == "sunset") {
-    // The forest toward a low sun behind the canopy: the sun is in view (about 12 degrees up, 10 degrees
-    // right of the view axis), so every frame takes the epipolar layout; the classic god-ray picture.
-    Scene s{
-        "sunset",
-        forestMesh(),
-        Camera::lookAt({0.0, 2.0, 28.0}, {0.0, 6.0, -30.0}, {0, 1, 0}, fov, aspect, 0.1, 150.0),
-        DirectionalLight(-glm::normalize(glm::dvec3(0.18, 0.22, -1.0)), glm::dvec3(6.0, 4.4, 2.8)),
-        Medium(
-            {.mieScattering = glm::dvec3(0.025, 0.027, 0.03), .hgG = 0.7, .absorption = glm::dvec3(0.005)}),
-        {},
-        {},
-        true,
-        {},
-        {},
-        {}};
-    computeBounds(s);
-    return s;
-  }
-  if (name == "colonnade-night") {
-    // The colonnade at night (Klehm et al. 2014, Sec. 3.2 "Local Lights"): no sun; three warm spot lamps
-    // outside the view, each projective: two outside the rows of pillars behind the camera shining in
-    // through them, one above and behind the camera shining down the hall past the roof beams.
-    Scene s{
-        "colonnade-night",
-        colonnadeMesh(),
-        Camera::lookAt({-2.0, 2.0, 22.0}, {1.0, 4.5, -20.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
-        DirectionalLight(glm::dvec3(0.75, -0.55, 0.35), glm::dvec3(0.0)),
-        Medium(
-            {.mieScattering = glm::dvec3(0.04, 0.042, 0.045), .hgG = 0.5, .absorption = glm::dvec3(0.004)}),
-        {},
-        {},
-        false,
-        {},
-        {},
-        {}};
-    const auto lamp = [](const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& color) {
-      return SpotLight({.position = position,
-                        .direction = target - position,
-                        .innerConeAngle = 20.0 * std::numbers::pi / 180.0,
-                        .outerConeAngle = 30.0 * std::numbers::pi / 180.0,
-                        .color = color,
-                        .intensity = 1000.0,
-                        .range = 70.0,
-                        .nearPlane = 0.3});
-    };
-    s.spotLights.push_back(lamp({-11.0, 7.5, 16.0}, {0.0, 0.0, 0.0}, {1.0, 0.75, 0.45}));
-    s.spotLights.push_back(lamp({9.0, 8.5, 20.0}, {2.0, 0.0, 0.0}, {1.0, 0.8, 0.55}));
-    s.spotLights.push_back(lamp({0.0, 8.8, 26.0}, {0.0, 0.0, 6.0}, {0.7, 0.8, 1.0}));
-    computeBounds(s);
-    return s;
-  }
-  if (name == "stained-glass") {
-    // Light textures (Klehm et al. 2014, Sec. 3.2; Yusov 2012's coloured shafts): a hall lit only through a
-    // large window in its side wall; the sun, low and from the side, textured with a procedural
-    // stained-glass pattern projected orthographically over the window, paints coloured shafts across
-    // the hall and coloured patches on its floor and far wall.
-    Scene s{
-        "stained-glass",
-        stainedGlassMesh(),
-        Camera::lookAt({-9.0, 2.0, 9.0}, {2.0, 6.0, -10.0}, {0, 1, 0}, fov, aspect, 0.1, 120.0),
-        DirectionalLight(glm::dvec3(-0.75, -0.5, -0.22), glm::dvec3(10.0, 9.5, 8.5)),
-        Medium(
-            {.mieScattering = glm::dvec3(0.05, 0.052, 0.055), .hgG = 0.55, .absorption = glm::dvec3(0.004)}),
-        {},
-        {},
-        true,
-        {},
-        {},
-        {}};
-    s.sunTexture = SceneLightTexture{stainedGlassTexture(128), windowTextureClipFromWorld(s.sun)};
-    computeBounds(s);
-    return s;
-  }
+  if (name == "colonnade") return colonnadeScene(aspect);
+  if (name == "forest") return forestScene(aspect);
+  if (name == "terrain") return terrainScene(aspect);
+  if (name == "boxes") return boxesScene(aspect);
+  if (name == "sunset") return sunsetScene(aspect);
+  if (name == "colonnade-night") return colonnadeNightScene(aspect);
+  if (name == "stained-glass") return stainedGlassScene(aspect);
   throw InvalidArgument("scene", std::string(name),
                         "must be one of colonnade, forest, terrain, boxes, sunset, colonnade-night, "
                         "stained-glass");

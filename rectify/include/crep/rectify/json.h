@@ -1,4 +1,4 @@
-// JSON form of a rectification, as printed by `crep rectify`.
+// JSON form of a rectification, as printed by `crep rectify` (the interface the tool exposes).
 #pragma once
 
 #include <string>

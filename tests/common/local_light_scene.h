@@ -1,15 +1,16 @@
-// The analytic scene of the local-light tests: the ground camera of support/analytic_scene.h, a wall
+// The analytic scene of the local-light tests: the ground camera of common/analytic_scene.h, a wall
 // (half-space x > 2 shadowed) and a spot and a point light on its lit side; the closed form of the lit part
 // of every view ray (the wall plane cuts it exactly) integrated by RayScattering (itself checked against an
 // independent quadrature of Eq. 1 in RayScatteringTest).
 #pragma once
 
-#include "support/analytic_scene.h"
+#include "common/analytic_scene.h"
 
 #include <crep/core/camera.h>
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/rectify/rectify.h>
 #include <crep/scatter/ray.h>
 #include <crep/scatter/ray_scattering.h>
 
@@ -18,6 +19,22 @@
 #include <vector>
 
 namespace crep::test {
+
+/// What the local-light tests see: the ground camera (width x height), its ground depth, the coloured medium
+/// and the rectify options of their layouts (8 splits).
+struct LocalLightView {
+  Camera camera;
+  Image depth;
+  Medium medium;
+  RectifyOptions rectify;
+};
+
+inline LocalLightView localLightView(int width, int height) {
+  LocalLightView v{groundCamera(width, height), {}, colouredMedium(), {}};
+  v.depth = groundDepth(v.camera, width, height);
+  v.rectify.splits = 8;
+  return v;
+}
 
 /// The occluder: x > 2 is shadowed (the lights are at x < 2).
 inline HalfSpace wall() {

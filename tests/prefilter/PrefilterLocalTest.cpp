@@ -1,16 +1,15 @@
 // The prefiltered method for local lights on the CPU (crep::prefilter(map, medium, LocalLight) and
-// crep::evaluate(..., LocalLight)): the spot and point light of the analytic scene (scatter/
-// local_light_util.h) against their closed forms, unoccluded and with the half-space shadow of the wall;
-// the point light's six faces added, and the error along the face borders compared with the rest.
-#include "epipolar/epipolar_test_util.h"
-#include "scatter/local_light_util.h"
-#include "support/analytic_scene.h"
+// crep::evaluate(..., LocalLight)): the spot and point light of the analytic scene
+// (common/local_light_scene.h) against their closed forms, unoccluded and with the half-space shadow of the
+// wall; the point light's six faces added, and the error along the face borders compared with the rest.
+#include "common/analytic_reference.h"
+#include "common/analytic_scene.h"
+#include "common/local_light_scene.h"
+#include "prefilter/colonnade_point_light.h"
 
-#include <crep/epipolar/march.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
-#include <crep/scatter/rectified_march.h>
 #include <crep/scenes/scene.h>
 
 #include <doctest/doctest.h>
@@ -44,12 +43,8 @@ Image prefiltered(const Rectification& rect, const LocalLight& light, const Came
 } // namespace
 
 TEST_CASE("prefiltered spot light: closed forms without and with the half-space shadow") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const SpotLight spot = analyticSpot();
-  RectifyOptions ro;
-  ro.splits = 8;
   const Rectification rect = rectify(camera, spot, ro);
   REQUIRE(rect.projective());
   const LocalLight light = LocalLight::spot(spot);
@@ -66,12 +61,8 @@ TEST_CASE("prefiltered spot light: closed forms without and with the half-space 
 }
 
 TEST_CASE("prefiltered point light: six faces against the closed form, no seam at the face borders") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
+  const auto [camera, depth, medium, ro] = localLightView(kW, kH);
   const PointLight point = analyticPoint();
-  RectifyOptions ro;
-  ro.splits = 8;
   const std::array<Rectification, 6> faces = rectifyPointLight(camera, point, ro);
   Image sum(kW, kH, 4);
   std::vector<LocalLight> lights;
@@ -130,46 +121,17 @@ TEST_CASE("prefiltered point light: six faces against the closed form, no seam a
   CHECK(border <= 1.5 * other + 1e-3);
 }
 
-TEST_CASE("rectified marches, spot light: brute force and min/max on the same map against the closed form") {
-  const Camera camera = groundCamera(kW, kH);
-  const Image depth = groundDepth(camera, kW, kH);
-  const Medium medium = colouredMedium();
-  const SpotLight spot = analyticSpot();
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
-  const RectifiedMap map = castRectifiedMap(layout, 1024, 512, wallHitFromLight);
-  const LocalLight light = LocalLight::spot(spot);
-  const MarchResult brute = bruteForceMarch(map, depth, camera, light, medium);
-  const MarchResult tree = minMaxMarch(map, depth, camera, light, medium);
-  const Image truth = closedFormLocal(depth, camera, {light}, medium, true);
-  const ImageMetrics mb = rgbMetrics(brute.scattering, truth), mt = rgbMetrics(tree.scattering, truth);
-  report("spot light, half-space shadow: brute-force march over the rectified map vs closed form", mb);
-  report("spot light, half-space shadow: min/max march vs closed form", mt);
-  MESSAGE("steps per pixel: brute force " << brute.meanSteps() << ", min/max " << tree.meanSteps());
-  CHECK(mb.relativeRmse < 0.005);
-  CHECK(mt.relativeRmse < 0.005);
-  // The tree only skips texels of equal visibility: the same lit sections, summed in larger pieces.
-  CHECK(rgbMetrics(tree.scattering, brute.scattering).relativeRmse < 1e-6);
-  CHECK(tree.meanSteps() < brute.meanSteps());
-}
-
 TEST_CASE("prefiltered point light: every region's reference ray is finite where the row's rays cross it") {
   // Regression (colonnade, point light 3 units behind the camera, face -Z): the row's reference ray (depth
   // ~0.3 of [0.003, 0.95]) reached its horizon (t = +inf) in the middle of the map while the row's
   // shallower rays crossed the rest of it, so the exact weights of those texels were 0 and the prefiltered
-  // face showed a lit wedge (24% from the brute-force march over the same map; tests/pipeline/
+  // face showed a lit wedge (24% from the brute-force march over the same map; tests/prefilter/
   // PrefilterPointFaceGLTest.cpp). ProjectiveLayout::regionReferenceDepth takes the row's ray reaching
   // furthest instead.
   const scenes::Scene scene = scenes::makeScene("colonnade", 160.0 / 90.0);
   const Camera& c = scene.camera;
-  const PointLight point({.position = c.position() - 5.0 * c.right() + 3.0 * c.up() - 3.0 * c.forward(),
-                          .color = {1.0, 0.8, 0.6},
-                          .intensity = 60.0,
-                          .range = 80.0});
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto faces = rectifyPointLight(c, point, ro);
+  const PointLight point = colonnadePointLight(c);
+  const auto faces = colonnadePointFaces(c, point);
   REQUIRE(faces[5].projective());
   const ProjectiveLayout layout(faces[5]);
   const int H = 512, P = 2, K = layout.regionCount();

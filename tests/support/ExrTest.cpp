@@ -1,7 +1,7 @@
 // EXR reading/writing. Expectations are independent of OpenEXR where it matters: a small
 // hand-written encoder of uncompressed EXR files (scanline, tiled, multi-part) provides files with
 // known content for the reader, and the writer's uncompressed output is parsed byte by byte.
-#include "support/image_check.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/core/image.h>

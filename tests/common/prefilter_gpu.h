@@ -1,7 +1,10 @@
-// Shared helpers of the GPU prefilter tests (tests/prefilter/PrefilterGpu*GLTest.cpp): a rectified map
-// and a camera depth buffer rendered from a built-in scene (one GL texture each, read back for the CPU
-// reference), texture read-back and upload of filtered bases, and basis comparison.
+// GPU prefilter fixtures (the prefilter/ GL tests, and the textured and local-light prefilter tests of
+// scatter/, epipolar/ and pipeline/): a rectified map and a camera depth buffer rendered from a built-in
+// scene (one GL texture each, read back for the CPU reference), a CPU filtered basis uploaded, and the
+// comparison of a GPU basis with the CPU one per storage format. GL tests only.
 #pragma once
+
+#include "common/gl_util.h"
 
 #include <crep/core/gl.h>
 #include <crep/core/image.h>
@@ -129,35 +132,6 @@ inline GpuScene renderGpuScene(const std::string& sceneName, int mapWidth, int m
   return s;
 }
 
-/// Every texel of a texture array (layers * height * width * 4 floats, layer-major: the order of
-/// FilteredBasis::texels).
-inline std::vector<float> readTextureArray(std::uint32_t texture, int width, int height, int layers) {
-  std::vector<float> out(static_cast<std::size_t>(layers) * static_cast<std::size_t>(height) *
-                         static_cast<std::size_t>(width) * 4);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(float)),
-                    out.data());
-  return out;
-}
-
-/// A 4-channel image of an RGBA 2D texture.
-inline Image readRgbaTexture(std::uint32_t texture, int width, int height) {
-  return gl::readTexture(texture, width, height, gl::TexelData::Rgba);
-}
-
-/// A GL_TEXTURE_2D of `format` (GL enum) with nearest filtering, clamp to edge.
-inline gl::Handle createTexture2D(std::uint32_t format, int width, int height) {
-  return gl::createTexture2D(format, width, height);
-}
-
-/// A GL_R32F texture holding channel 0 of a 1-channel image (camera depth, rectified or shadow map).
-inline gl::Handle uploadR32F(const Image& image) {
-  REQUIRE(image.channels() == 1);
-  gl::Handle t = gl::createTexture2D(GL_R32F, image.width(), image.height());
-  glTextureSubImage2D(t.get(), 0, 0, 0, image.width(), image.height(), GL_RED, GL_FLOAT, image.data().data());
-  return t;
-}
-
 inline UploadedBasis uploadBasis(const FilteredBasis& basis, StorageFormat format) {
   UploadedBasis u;
   const GLenum internal = format == StorageFormat::RGBA8     ? GL_RGBA8
@@ -188,6 +162,42 @@ inline UploadedBasis uploadBasis(const FilteredBasis& basis, StorageFormat forma
   u.view.extinction = basis.extinction;
   u.view.depthMargin = basis.depthMargin;
   return u;
+}
+
+/// EvaluatePass's attributes for the sun of `s` with `basis`: the scene's camera depth, camera, sun, medium
+/// and layout; the output texture is `output`.
+inline EvaluatePass::FrameAttribs sunEvaluation(const GpuScene& s, const FilteredBasisView& basis,
+                                                std::uint32_t output) {
+  EvaluatePass::FrameAttribs f;
+  f.cameraDepth = s.depthTexture.get();
+  f.output = output;
+  f.camera = &s.scene.camera;
+  f.light = &s.scene.sun;
+  f.medium = &s.scene.medium;
+  f.layout = s.layout.get();
+  f.basis = basis;
+  return f;
+}
+
+/// A local light's map prefiltered and evaluated on the GPU: `map` uploaded (R32F) and run through
+/// `prefilterPass` on `layout`, the basis evaluated by `evaluatePass` over the camera depth texture
+/// `cameraDepth` (width x height); the image read back.
+inline Image prefilterEvaluateLocal(PrefilterPass& prefilterPass, EvaluatePass& evaluatePass,
+                                    const RectifiedMap& map, const RectifiedLayout* layout,
+                                    const Camera& camera, std::uint32_t cameraDepth, int width, int height,
+                                    const Medium& medium, const LocalLight& light) {
+  const gl::Handle texture = uploadR32F(map.depth);
+  prefilterPass.run(
+      {.rectifiedDepth = texture.get(), .layout = layout, .medium = &medium, .localLight = &light});
+  const gl::Handle out = createTexture2D(GL_RGBA32F, width, height);
+  evaluatePass.run({.cameraDepth = cameraDepth,
+                    .output = out.get(),
+                    .camera = &camera,
+                    .medium = &medium,
+                    .layout = layout,
+                    .basis = prefilterPass.filteredBasis(),
+                    .localLight = &light});
+  return readRgbaTexture(out.get(), width, height);
 }
 
 inline std::string describe(const BasisDifference& d) {

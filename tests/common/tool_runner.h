@@ -1,6 +1,7 @@
 // Runs the built crep tool as a user would (tests of tests/tool/).
 #pragma once
 
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,10 @@ struct ToolResult {
 
 /// Runs `<crep> <args>` through the shell (args are shell words) and captures its output.
 ToolResult runCrep(const std::string& args);
+
+/// Checks a failed run: the exit status, every one of `mentions` in the output, no "unexpected error" (an
+/// exception the tool did not name).
+void expectFailure(const ToolResult& r, int status, std::initializer_list<std::string> mentions);
 
 /// How runCrepArgv runs the tool.
 struct RunOptions {

@@ -1,4 +1,4 @@
-#include "support/png_read.h"
+#include "common/png_read.h"
 
 #include <fstream>
 #include <iterator>

@@ -1,12 +1,12 @@
 // GL fixtures of the GPU march and work-list tests (tests/epipolar/MarchGLTest.cpp, MarchListGLTest.cpp,
 // tests/prefilter/EvaluateListGLTest.cpp): a built-in scene with its projective rectified map rasterized
 // on the GPU (SceneRenderer, GL_DEPTH_CLAMP) and the march attributes over it; the analytic spot-light
-// scene of tests/scatter/local_light_util.h with its map cast exactly, map and depth uploaded. GL tests
+// scene of tests/common/local_light_scene.h with its map cast exactly, map and depth uploaded. GL tests
 // only.
 #pragma once
 
-#include "epipolar_test_util.h"
-#include "scatter/local_light_util.h"
+#include "common/analytic_reference.h"
+#include "common/local_light_scene.h"
 
 #include <crep/core/gl.h>
 #include <crep/epipolar/gpu_march.h>

@@ -4,6 +4,8 @@
 // comparisons of a list's output against the per-pixel pass's, bit for bit. GL tests only (needs a context).
 #pragma once
 
+#include "common/analytic_reference.h"
+
 #include <crep/core/gl.h>
 #include <crep/core/image.h>
 #include <crep/scatter/gpu_sample_list.h>
@@ -85,6 +87,20 @@ inline int bitDifferences(const Image& a, const Image& b) {
   for (std::size_t i = 0; i < a.data().size(); ++i)
     if (!sameBits(a.data()[i], b.data()[i])) ++differ;
   return differ;
+}
+
+/// A pass's list variant against its per-pixel output on every pixel of a camera depth image: `run(list)`
+/// runs the pass into `output` (RGBA, the depth's size) for list = nullptr, else into the list's output.
+/// The two agree bit for bit, and the image is not black.
+inline void checkListEqualsPerPixel(const Image& depth, std::uint32_t output,
+                                    const std::function<void(const gpu::SampleList*)>& run) {
+  run(nullptr);
+  const TestList list = makePixelList(depth, texelsWhere(depth.width(), depth.height()));
+  run(&list.list);
+  const Image perPixel = gl::readTexture(output, depth.width(), depth.height(), gl::TexelData::Rgba);
+  const Image listed = gl::readTexture(list.output.get(), depth.width(), depth.height(), gl::TexelData::Rgba);
+  CHECK(bitDifferences(listed, perPixel) == 0);
+  CHECK(rgbMetrics(perPixel, perPixel).peak > 0.0);
 }
 
 /// What a list wrote, against the per-pixel output: values left NaN at entries, values written elsewhere,

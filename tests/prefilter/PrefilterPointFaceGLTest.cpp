@@ -5,27 +5,50 @@
 // whatever the light-side weights. Each region of a local light now takes the row's ray reaching furthest
 // (ProjectiveLayout::regionReferenceDepth): 4.4%, the rest being the Fourier depth resolution (16 bases;
 // 1.4% with 128) and the reference ray's step drifting along the row.
-#include "pipeline/scattering_frame.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "support/gl_fixture.h"
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/prefilter_gpu.h"
+#include "prefilter/colonnade_point_light.h"
 
+#include <crep/core/gl.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/scatter/rectified_march.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+
+#include <doctest/doctest.h>
+#include <epoxy/gl.h>
+
+#include <memory>
+#include <string>
 
 using namespace crep;
 using namespace crep::test;
 
+namespace {
+
+constexpr int kWidth = 160, kHeight = 90;
+
+/// A built-in scene at kWidth x kHeight with its camera depth rasterized.
+struct SceneDepth {
+  explicit SceneDepth(const std::string& name)
+      : scene(scenes::makeScene(name, double(kWidth) / kHeight)), renderer(scene.mesh),
+        cameraDepth(scenes::createDepthTexture(kWidth, kHeight)) {
+    renderer.renderDepth(scene.camera.clipFromWorld(), cameraDepth.get(), 0, 0, 0, kWidth, kHeight);
+  }
+  scenes::Scene scene;
+  scenes::SceneRenderer renderer;
+  gl::Handle cameraDepth;
+};
+
+} // namespace
+
 TEST_CASE("prefiltered point light faces on the colonnade: GPU and CPU against the brute-force march") {
   CREP_REQUIRE_GL();
-  ScatteringFixture f("colonnade");
+  SceneDepth f("colonnade");
   const Camera& c = f.scene.camera;
-  const PointLight point({.position = c.position() - 5.0 * c.right() + 3.0 * c.up() - 3.0 * c.forward(),
-                          .color = {1.0, 0.8, 0.6},
-                          .intensity = 60.0,
-                          .range = 80.0});
-  RectifyOptions ro;
-  ro.splits = 8;
-  const auto faces = rectifyPointLight(c, point, ro);
+  const PointLight point = colonnadePointLight(c);
+  const auto faces = colonnadePointFaces(c, point);
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   const Image camDepth = gl::readTexture(f.cameraDepth.get(), kWidth, kHeight, gl::TexelData::Depth);

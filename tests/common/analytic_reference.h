@@ -1,6 +1,6 @@
-// Shared helpers of the epipolar/ tests: the analytic setup (a camera over a ground plane, an infinite
-// plane occluder) with closed-form single scattering that uses none of the code under test, synthetic
-// maps, and image metrics helpers.
+// References on the analytic setup (common/analytic_scene.h: a camera over a ground plane, an infinite plane
+// occluder), for the tests of every module that marches or prefilters: closed-form single scattering that
+// uses none of the code under test, the occluder's shadow map, synthetic maps, and image metrics.
 #pragma once
 
 #include <crep/core/camera.h>
@@ -12,7 +12,7 @@
 #include <crep/scenes/scene.h>
 #include <crep/support/image_compare.h>
 
-#include "support/analytic_scene.h"
+#include "common/analytic_scene.h"
 
 #include <doctest/doctest.h>
 

@@ -1,6 +1,6 @@
 // Self-tests of the image comparison: the metric definitions on hand-computable cases, and that
 // tolerances catch a single changed sample while accepting small noise.
-#include "support/image_check.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/core/image.h>

@@ -1,4 +1,6 @@
-#include "support/tool_runner.h"
+#include "common/tool_runner.h"
+
+#include <doctest/doctest.h>
 
 #include <algorithm>
 #include <array>
@@ -34,6 +36,14 @@ ToolResult runCrep(const std::string& args) {
 #else
   throw std::runtime_error("runCrep(" + args + "): built without the crep tool (CREP_BUILD_TOOLS=OFF)");
 #endif
+}
+
+void expectFailure(const ToolResult& r, int status, std::initializer_list<std::string> mentions) {
+  INFO(r.output);
+  CHECK(r.status == status);
+  for (const std::string& m : mentions)
+    CHECK(r.output.find(m) != std::string::npos);
+  CHECK(r.output.find("unexpected error") == std::string::npos);
 }
 
 ArgvResult runCrepArgv(const std::vector<std::string>& args, const RunOptions& options) {

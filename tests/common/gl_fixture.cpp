@@ -1,4 +1,4 @@
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 

@@ -1,5 +1,5 @@
 // The headless context and the GL helpers (crep/support/gl_context.h, crep/core/gl.h).
-#include "support/gl_fixture.h"
+#include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl.h>

@@ -1,49 +1,58 @@
 // The GPU prefilter pass for local lights (PrefilterPass::FrameAttribs::localLight, CREP_LOCAL_LIGHT)
 // against the CPU reference crep::prefilter(map, medium, LocalLight) on the analytic spot light's map
-// (scatter/local_light_util.h): the stored basis, RGBA32F, value by value.
-#include "epipolar/epipolar_test_util.h"
-#include "prefilter/prefilter_gpu_util.h"
-#include "scatter/local_light_util.h"
-#include "support/gl_fixture.h"
+// (common/local_light_scene.h): the stored basis, RGBA32F, value by value.
+#include "common/analytic_reference.h"
+#include "common/gl_fixture.h"
+#include "common/local_light_scene.h"
+#include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
-#include <crep/epipolar/gpu_march.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
-#include <crep/scatter/rectified_march.h>
 
 #include <epoxy/gl.h>
 
 #include <doctest/doctest.h>
 
 #include <memory>
+#include <string>
+#include <vector>
 
 using namespace crep;
 using namespace crep::test;
 
+namespace {
+
+/// A local light of the analytic scene with its rectification for the camera.
+struct Case {
+  const char* name;
+  Rectification rect;
+  LocalLight light;
+};
+
+/// The analytic spot and the analytic point light's face +X.
+std::vector<Case> spotAndFace(const Camera& camera, const RectifyOptions& ro) {
+  const SpotLight spot = analyticSpot();
+  const PointLight point = analyticPoint();
+  return {
+      Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
+      Case{"point light face +X", rectifyPointLight(camera, point, ro)[0], LocalLight::pointFace(point, 0)}};
+}
+
+} // namespace
+
 TEST_CASE("prefilter GL, local lights: the GPU basis equals the CPU reference (spot light, point face)") {
   CREP_REQUIRE_GL();
   constexpr int W = 256, H = 128;
-  const Camera camera = groundCamera(160, 90);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
+  const auto [camera, depth, medium, ro] = localLightView(160, 90);
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   o.format = StorageFormat::RGBA32F;
   PrefilterPass pass({.mapWidth = W, .mapHeight = H, .options = o});
   const SpotLight spot = analyticSpot();
-  const PointLight point = analyticPoint();
-  struct Case {
-    const char* name;
-    Rectification rect;
-    LocalLight light;
-  };
-  for (const Case& k : {Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
-                        Case{"point light face +X", rectifyPointLight(camera, point, ro)[0],
-                             LocalLight::pointFace(point, 0)}}) {
+  for (const Case& k : spotAndFace(camera, ro)) {
     CAPTURE(std::string(k.name));
     REQUIRE(k.rect.projective());
     const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
@@ -80,51 +89,26 @@ TEST_CASE("prefilter GL, local lights: the GPU basis equals the CPU reference (s
 TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation and the closed form") {
   CREP_REQUIRE_GL();
   constexpr int W = 512, H = 256, w = 160, h = 90;
-  const Camera camera = groundCamera(w, h);
-  const Image depth = groundDepth(camera, w, h);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
+  const auto [camera, depth, medium, ro] = localLightView(w, h);
   PrefilterOptions o;
   o.regionsPerSplit = 2;
   PrefilterPass prefilterPass({.mapWidth = W, .mapHeight = H, .options = o});
   const gl::Handle depthTexture = uploadR32F(depth);
-  const SpotLight spot = analyticSpot();
-  const PointLight point = analyticPoint();
-  struct Case {
-    const char* name;
-    Rectification rect;
-    LocalLight light;
-  };
   for (const int variant : {0, 1, 2}) {
     // Prefix table or per-region loop; the sections by the quadrature or in closed form (airlight table).
     const bool prefixTable = variant != 1, closedForm = variant == 2;
     EvaluateOptions eo;
     eo.scatteringPrefix = prefixTable;
     EvaluatePass evaluatePass({.options = eo, .localClosedForm = closedForm});
-    for (const Case& k : {Case{"spot light", rectify(camera, spot, ro), LocalLight::spot(spot)},
-                          Case{"point light face +X", rectifyPointLight(camera, point, ro)[0],
-                               LocalLight::pointFace(point, 0)}}) {
+    for (const Case& k : spotAndFace(camera, ro)) {
       const std::string name = std::string(k.name) + (prefixTable ? ", prefix table" : ", per-region table") +
                                (closedForm ? ", closed form" : "");
       CAPTURE(name);
       REQUIRE(k.rect.projective());
       const auto layout = std::make_shared<const ProjectiveLayout>(k.rect);
       const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-      const gl::Handle texture = uploadR32F(map.depth);
-      prefilterPass.run({.rectifiedDepth = texture.get(),
-                         .layout = layout.get(),
-                         .medium = &medium,
-                         .localLight = &k.light});
-      const gl::Handle out = createTexture2D(GL_RGBA32F, w, h);
-      evaluatePass.run({.cameraDepth = depthTexture.get(),
-                        .output = out.get(),
-                        .camera = &camera,
-                        .medium = &medium,
-                        .layout = layout.get(),
-                        .basis = prefilterPass.filteredBasis(),
-                        .localLight = &k.light});
-      const Image gpu = readRgbaTexture(out.get(), w, h);
+      const Image gpu = prefilterEvaluateLocal(prefilterPass, evaluatePass, map, layout.get(), camera,
+                                               depthTexture.get(), w, h, medium, k.light);
       const Image cpu = evaluate(prefilter(map, medium, k.light, o), depth, camera, k.light, medium, eo);
       const ImageMetrics vsCpu = rgbMetrics(gpu, cpu);
       if (prefixTable) {
@@ -145,47 +129,5 @@ TEST_CASE("evaluate GL, local lights: the GPU image equals the CPU evaluation an
       CHECK(vsCpu.relativeRmse < 1e-3); // RGBA8 basis read through GL_LINEAR with 8-bit weights
       CHECK(vsTruth.relativeRmse < 0.01);
     }
-  }
-}
-
-TEST_CASE("rectified marches GL, local lights: brute force and min/max equal the CPU brute-force march") {
-  CREP_REQUIRE_GL();
-  constexpr int W = 512, H = 256, w = 160, h = 90;
-  const Camera camera = groundCamera(w, h);
-  const Image depth = groundDepth(camera, w, h);
-  const Medium medium = colouredMedium();
-  RectifyOptions ro;
-  ro.splits = 8;
-  const SpotLight spot = analyticSpot();
-  const LocalLight light = LocalLight::spot(spot);
-  const auto layout = std::make_shared<const ProjectiveLayout>(rectify(camera, spot, ro));
-  const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
-  const gl::Handle mapTexture = uploadR32F(map.depth);
-  const gl::Handle depthTexture = uploadR32F(depth);
-  const Image cpu = bruteForceMarch(map, depth, camera, light, medium).scattering;
-  MinMaxTreePass trees({W, H});
-  trees.run(mapTexture.get());
-  for (const auto mode : {RectifiedMarchPass::Mode::BruteForce, RectifiedMarchPass::Mode::MinMaxTree}) {
-    const std::string name = mode == RectifiedMarchPass::Mode::BruteForce ? "brute force" : "min/max";
-    RectifiedMarchPass pass({W, H, mode});
-    const gl::Handle out = createTexture2D(GL_RGBA32F, w, h);
-    RectifiedMarchPass::FrameAttribs a;
-    a.layout = layout.get();
-    a.camera = &camera;
-    a.medium = &medium;
-    a.cameraDepth = depthTexture.get();
-    a.rectifiedDepth = mapTexture.get();
-    a.minMaxBuffer = trees.treeBuffer();
-    a.output = out.get();
-    a.localLight = &light;
-    pass.run(a);
-    const ImageMetrics m = rgbMetrics(readRgbaTexture(out.get(), w, h), cpu);
-    report("spot light, GPU " + name + " march vs CPU brute force", m);
-    CHECK(m.nanCount == 0);
-    CHECK(m.relativeRmse < 1e-4); // float sections and distances against double
-    const DirectionalLight sun = test::sideLight();
-    a.light = &sun;
-    CHECK_THROWS_WITH_AS(pass.run(a), doctest::Contains("RectifiedMarchPass::FrameAttribs.light/localLight"),
-                         crep::InvalidArgument);
   }
 }

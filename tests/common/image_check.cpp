@@ -1,4 +1,4 @@
-#include "support/image_check.h"
+#include "common/image_check.h"
 
 #include <crep/core/error.h>
 #include <crep/support/exr.h>

@@ -1,7 +1,7 @@
 // PNG output. Files are decoded with stb_image (an independent decoder, header-only, from the same
 // Debian package as stb_image_write) to check content and orientation.
-#include "support/image_check.h"
-#include "support/png_read.h"
+#include "common/image_check.h"
+#include "common/png_read.h"
 
 #include <crep/core/error.h>
 #include <crep/core/image.h>
