@@ -8,13 +8,6 @@
 
 namespace crep {
 
-namespace {
-[[noreturn]] void invalid(const std::string& parameter, const std::string& value,
-                          const std::string& requirement) {
-  throw InvalidArgument(parameter, value, requirement);
-}
-} // namespace
-
 RectifiedShadowPass::RectifiedShadowPass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("RectifiedShadowPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   framebuffer_ = gl::createFramebuffer();

@@ -44,10 +44,6 @@ const char* layoutToken(Scattering::Layout layout) {
 
 namespace {
 
-void invalid(const std::string& parameter, const std::string& value, const std::string& requirement) {
-  throw InvalidArgument(parameter, value, requirement);
-}
-
 const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   gl::checkTextureSize("Scattering::CreateInfo.width/height", info.width, info.height);
   gl::checkTextureSize("Scattering::CreateInfo.mapSize", info.mapSize, info.mapSize);
@@ -159,7 +155,7 @@ void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map
                       std::span<const glm::dvec3> directions, const std::string& what) {
   gl::requireTexture2D((field + ".texture").c_str(), map.texture);
   gl::requireDepthFormat((field + ".texture").c_str(), map.texture);
-  if (!std::isfinite(map.bias)) invalid(field + ".bias", detail::formatValue(map.bias), "must be finite");
+  requireFinite(field + ".bias", map.bias);
   try {
     validateLocalLightMatrix(map.lightClipFromWorld, position);
   } catch (const InvalidArgument& e) {
@@ -574,9 +570,7 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
   if (f.shadowMap) {
     gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
     gl::requireDepthFormat("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
-    if (!std::isfinite(f.shadowMap->bias))
-      invalid("Scattering::FrameAttribs.shadowMap.bias", detail::formatValue(f.shadowMap->bias),
-              "must be finite");
+    requireFinite("Scattering::FrameAttribs.shadowMap.bias", f.shadowMap->bias);
     try {
       validateLightMatrix(f.shadowMap->lightClipFromWorld, f.light->direction());
     } catch (const InvalidArgument& e) {

@@ -58,11 +58,6 @@ std::string str(long long v) {
   return std::to_string(v);
 }
 
-[[noreturn]] void invalid(const std::string& parameter, const std::string& value,
-                          const std::string& requirement) {
-  throw InvalidArgument(parameter, value, requirement);
-}
-
 int getInteger(GLenum pname) {
   GLint v = 0;
   glGetIntegerv(pname, &v);

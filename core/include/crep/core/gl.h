@@ -63,7 +63,8 @@ Handle createTexture2D(std::uint32_t internalFormat, int width, int height,
                        const char* parameter = "texture size");
 
 /// A sampler with `filter` (GL_NEAREST or GL_LINEAR) for minification and magnification, clamp to edge in
-/// s, t and r, no depth comparison: texelFetch / texture read the raw values whatever the texture's compare mode.
+/// s, t and r, no depth comparison: texelFetch / texture read the raw values whatever the texture's compare
+/// mode.
 Handle createClampSampler(std::uint32_t filter);
 /// A buffer of `bytes` bytes with GL_DYNAMIC_STORAGE_BIT (filled with glNamedBufferSubData).
 Handle createDynamicBuffer(std::size_t bytes);
@@ -93,6 +94,10 @@ TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture);
 /// is width x height (sizes > 0) and, when `internalFormat` is not 0, of that internal format.
 void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
                       std::uint32_t internalFormat = 0);
+
+/// GL_BUFFER_SIZE of `buffer`, bytes; InvalidArgument(parameter, its name, requirement) if it is 0 or not an
+/// existing buffer.
+long long requireBuffer(const char* parameter, std::uint32_t buffer, const std::string& requirement);
 
 /// Throws InvalidArgument naming `parameter` unless `texture` (an existing texture) can be read as depth:
 /// a depth format (GL_DEPTH_COMPONENT16/24/32/32F, GL_DEPTH24_STENCIL8, GL_DEPTH32F_STENCIL8) sampled as
