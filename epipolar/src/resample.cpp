@@ -21,10 +21,7 @@
 namespace crep {
 
 void validateLightMatrix(const glm::dmat4& M, const glm::dvec3& lightDirection) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(M[c][r]))
-        throw InvalidArgument("lightClipFromWorld", detail::formatValue(M[c][r]), "must be finite");
+  requireFinite("lightClipFromWorld", M);
   if (M[0][3] != 0.0 || M[1][3] != 0.0 || M[2][3] != 0.0 || M[3][3] == 0.0)
     throw InvalidArgument("lightClipFromWorld", "a perspective matrix",
                           "must be affine (an orthographic shadow matrix: last row 0 0 0 w)");
@@ -46,12 +43,8 @@ void validateLightMatrix(const glm::dmat4& M, const glm::dvec3& lightDirection) 
 // A perspective projection centred at the light (Klehm et al. 2014, Sec. 3.2 "Local Lights": the light's
 // own shadow frustum): clip x = y = w = 0 at the light position.
 void validateLocalLightMatrix(const glm::dmat4& M, const glm::dvec3& lightPosition) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(M[c][r]))
-        throw InvalidArgument("lightClipFromWorld", detail::formatValue(M[c][r]), "must be finite");
-  if (!std::isfinite(lightPosition.x) || !std::isfinite(lightPosition.y) || !std::isfinite(lightPosition.z))
-    throw InvalidArgument("lightPosition", "not finite", "must be finite");
+  requireFinite("lightClipFromWorld", M);
+  requireFinite("lightPosition", lightPosition);
   if (std::abs(glm::determinant(M)) < 1e-300)
     throw InvalidArgument("lightClipFromWorld", "a singular matrix", "must be invertible");
   // Each of rows x, y, w must vanish at the light: the light is the centre of projection, every light ray

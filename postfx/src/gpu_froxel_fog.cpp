@@ -38,22 +38,10 @@ gl::Handle buildFroxelProgram(const char* path, std::uint32_t format) {
   return buildProgram({{ShaderStage::Compute, path, {{"CREP_FROXEL_FORMAT", formatQualifier(format)}}}});
 }
 
-void requireFinite3(const glm::dvec3& v, const std::string& parameter) {
-  for (int c = 0; c < 3; ++c)
-    if (!std::isfinite(v[c])) throw InvalidArgument(parameter, detail::formatValue(v[c]), "must be finite");
-}
-
 void requireJitter(const glm::dvec3& j, const std::string& parameter) {
   for (int c = 0; c < 3; ++c)
     if (!(j[c] >= -0.5 && j[c] <= 0.5))
       throw InvalidArgument(parameter, detail::formatValue(j[c]), "cells, each component in [-0.5, 0.5]");
-}
-
-void requireMatrix(const glm::dmat4& m, const std::string& parameter) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r]))
-        throw InvalidArgument(parameter, detail::formatValue(m[c][r]), "must be finite");
 }
 
 /// A caller's volume: an existing GL_TEXTURE_3D of the grid's size (and `format` when not 0).
@@ -167,7 +155,7 @@ std::size_t EsmPass::memoryBytes() const noexcept {
 void EsmPass::run(const FrameAttribs& f) {
   const gl::TextureLevel map = gl::requireTexture2D("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
   gl::requireDepthFormat("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
-  requireMatrix(f.lightClipFromWorld, "EsmPass::FrameAttribs.lightClipFromWorld");
+  requireFinite("EsmPass::FrameAttribs.lightClipFromWorld", f.lightClipFromWorld);
   const double c = esmDepthExponent(info_.options, f.lightClipFromWorld);
   const int factor = info_.options.downsample;
   const int w = (map.width + factor - 1) / factor, h = (map.height + factor - 1) / factor;
@@ -229,14 +217,14 @@ void FroxelLightingPass::run(const FrameAttribs& f) {
     throw InvalidArgument(name(owner, "camera/light/medium"), "null", "must be set");
   requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
   requireJitter(f.jitter, name(owner, "jitter"));
-  requireFinite3(f.noiseOffset, name(owner, "noiseOffset"));
+  requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   gl::TextureLevel esm;
   if (f.esm != 0) {
     esm = gl::requireTexture2D(name(owner, "esm").c_str(), f.esm);
     if (esm.internalFormat != GL_R32F)
       throw InvalidArgument(name(owner, "esm"), "internal format " + std::to_string(esm.internalFormat),
                             "must be GL_R32F (EsmPass::esm())");
-    requireMatrix(f.lightClipFromWorld, name(owner, "lightClipFromWorld"));
+    requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
@@ -434,11 +422,11 @@ void FroxelFog::run(const FrameAttribs& f) {
   }
   if (f.mode == Mode::Esm && f.shadowMap != 0) {
     gl::requireTexture2D(name(owner, "shadowMap").c_str(), f.shadowMap);
-    requireMatrix(f.lightClipFromWorld, name(owner, "lightClipFromWorld"));
+    requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
   if (f.mode == Mode::Prefiltered)
     requireVolume(name(owner, "mode"), current_.get(), info_.grid, info_.format);
-  requireFinite3(f.noiseOffset, name(owner, "noiseOffset"));
+  requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   froxelDepthRange(info_.grid, *f.camera, "FroxelFog::CreateInfo");
   if (f.previousCamera) froxelDepthRange(info_.grid, *f.previousCamera, "FroxelFog::CreateInfo");
   timings_ = Timings{};

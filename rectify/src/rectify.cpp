@@ -514,12 +514,7 @@ Rectification rectify(const Camera& camera, const SpotLight& light, const Rectif
 std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::dvec3& position, double range,
                                                const RectifyOptions& options, double nearPlane) {
   validate(options);
-  for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(position[i]))
-      throw InvalidArgument("PointLight.position",
-                            "(" + detail::formatValue(position.x) + ", " + detail::formatValue(position.y) +
-                                ", " + detail::formatValue(position.z) + ")",
-                            "components must be finite");
+  requireFinite("PointLight.position", position);
   requirePositive("PointLight.range", range);
   const double near = nearPlane <= 0.0 ? range * 1e-3 : nearPlane;
   if (!std::isfinite(near) || !(near < range))

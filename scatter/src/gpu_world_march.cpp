@@ -137,11 +137,7 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   gl::requireTexture2D("WorldMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   if (f.stepsOutput != 0)
     gl::requireTexture2D("WorldMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, width, height, GL_R32F);
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(f.lightClipFromWorld[c][r]))
-        throw InvalidArgument("WorldMarchPass::FrameAttribs.lightClipFromWorld",
-                              detail::formatValue(f.lightClipFromWorld[c][r]), "must be finite");
+  requireFinite("WorldMarchPass::FrameAttribs.lightClipFromWorld", f.lightClipFromWorld);
   if (const LocalLight* l = f.localLight) {
     const auto finite3 = [](const glm::dvec3& v) {
       return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -156,8 +152,7 @@ void WorldMarchPass::run(const FrameAttribs& f) {
       throw InvalidArgument("WorldMarchPass::FrameAttribs.localLight->face", detail::formatValue(l->face),
                             "must be -1 or a point light face in [0, 5]");
   }
-  if (!std::isfinite(f.bias))
-    throw InvalidArgument("WorldMarchPass::FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
+  requireFinite("WorldMarchPass::FrameAttribs.bias", f.bias);
   const bool textured = f.lightTexture.texture != 0;
   gl::TextureLevel textureLevel;
   if (textured)
