@@ -29,12 +29,27 @@ LayoutKind layoutKind(const RectifiedLayout& layout) {
 // ---------------------------------------------------------------------------------------------------
 // MinMaxTreePass
 
+void requireTreeLevels(const char* parameter, int mapWidth) {
+  if (MinMaxTrees::levelCount(mapWidth) > 16)
+    throw GlError("crep: " + std::string(parameter) + " " + std::to_string(mapWidth) +
+                  " needs more than 16 tree levels");
+}
+
+void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
+                         const std::string& use) {
+  const long long size = gl::requireBuffer(
+      parameter, buffer, "must be the MinMaxTreePass::treeBuffer() of the map (" + use + ")");
+  const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(mapWidth)) * mapHeight * 8;
+  if (size < needed)
+    invalid(parameter, std::to_string(size) + " bytes",
+            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(mapWidth) + " x " +
+                std::to_string(mapHeight) + " map (" + std::to_string(needed) + " bytes)");
+}
+
 MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("MinMaxTreePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
+  requireTreeLevels("MinMaxTreePass::CreateInfo.mapWidth", info.mapWidth);
   levels_ = MinMaxTrees::levelCount(info.mapWidth);
-  if (levels_ > 16)
-    throw GlError("crep: MinMaxTreePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
-                  " needs more than 16 tree levels");
   rowStride_ = MinMaxTrees::rowStrideFor(info.mapWidth);
   program_ = buildProgram({{ShaderStage::Compute, "passes/minmax_build.comp", {}}});
   buffer_ = gl::createBuffer();
@@ -105,9 +120,7 @@ constexpr GLuint kListBinding = 2;
 
 RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
-  if (MinMaxTrees::levelCount(info.mapWidth) > 16)
-    throw GlError("crep: RectifiedMarchPass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
-                  " needs more than 16 tree levels");
+  requireTreeLevels("RectifiedMarchPass::CreateInfo.mapWidth", info.mapWidth);
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("RectifiedMarchPass");
@@ -171,18 +184,9 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   if (f.lightColors != 0)
     gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.lightColors", f.lightColors, W, H);
   const bool tree = info_.mode == Mode::MinMaxTree;
-  if (tree && (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer)))
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
-                          "must be the MinMaxTreePass::treeBuffer() of the map (MinMaxTree mode)");
-  if (tree) {
-    GLint64 size = 0;
-    glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
-    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
-    if (size < needed)
-      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
-                            "must hold the trees of a " + std::to_string(W) + " x " + std::to_string(H) +
-                                " map (" + std::to_string(needed) + " bytes)");
-  }
+  if (tree)
+    requireMinMaxBuffer("RectifiedMarchPass::FrameAttribs.minMaxBuffer", f.minMaxBuffer, W, H,
+                        "MinMaxTree mode");
 
   const bool textured = f.lightColors != 0;
   const GLuint program = this->program(kind, textured, list != nullptr);

@@ -169,13 +169,8 @@ void ShadowResamplePass::run(const FrameAttribs& f) {
     if (lowLevels < 1)
       throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
                             "needs a map wider than 64 texels (no low tree levels below the top 6)");
-    GLint64 size = 0;
-    if (glIsBuffer(f.minMaxBuffer)) glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
-    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
-    if (size < needed)
-      throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
-                            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(W) + " x " +
-                                std::to_string(H) + " map (" + std::to_string(needed) + " bytes)");
+    requireMinMaxBuffer("ShadowResamplePass::FrameAttribs.minMaxBuffer", f.minMaxBuffer, W, H,
+                        "its low levels are written here");
   }
   const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
   gl::Handle& program = programs_[static_cast<int>(kind)][trees ? 1 : 0];

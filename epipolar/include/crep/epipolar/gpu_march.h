@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -72,6 +73,14 @@ private:
   int levels_ = 0, rowStride_ = 0;
   gl::Handle program_, upperProgram_, buffer_, sampler_;
 };
+
+/// GlError naming `parameter` (a map width field) when a map of `mapWidth` columns needs more than the 16
+/// tree levels the GPU walk supports.
+void requireTreeLevels(const char* parameter, int mapWidth);
+/// Throws InvalidArgument naming `parameter` unless `buffer` is an existing buffer large enough for the trees
+/// of a mapWidth x mapHeight map (MinMaxTreePass::treeBuffer() of it); `use` says what reads them.
+void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
+                         const std::string& use);
 
 /// The march of every camera pixel's view ray along its row of a rectified map (march.h "Rectified
 /// marches"), with the map's min/max trees (MinMaxTree) or texel by texel (BruteForce).
