@@ -87,14 +87,6 @@ bool sphereRoots(const glm::dvec3& o, const glm::dvec3& v, double r, double& t0,
   return true;
 }
 
-void requireFiniteVector(const char* name, const glm::dvec3& x) {
-  if (!(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z)))
-    throw InvalidArgument(name,
-                          "(" + detail::formatValue(x.x) + ", " + detail::formatValue(x.y) + ", " +
-                              detail::formatValue(x.z) + ")",
-                          "must be finite");
-}
-
 void validateRayOptions(const AtmosphereRayOptions& o) {
   if (o.shafts != AtmosphereShafts::None && o.shafts != AtmosphereShafts::Integrated &&
       o.shafts != AtmosphereShafts::LitLengthTable && o.shafts != AtmosphereShafts::PrefilteredVisibility)
@@ -319,8 +311,8 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
                             const AtmosphereViewTables* view) {
   validate(placement, tables.parameters);
   validateRayOptions(options);
-  requireFiniteVector("origin", origin);
-  requireFiniteVector("direction", direction);
+  requireFinite("origin", origin);
+  requireFinite("direction", direction);
   const double dirLength = glm::length(direction);
   if (!(dirLength > 0.0)) throw InvalidArgument("direction", "zero length", "must be a non-zero direction");
   if (!(surface >= 0.0) || !std::isfinite(surface))

@@ -5,6 +5,7 @@
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
+#include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/postfx/gpu_atmosphere_pass.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -56,9 +57,7 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
                           "must be an AtmosphereShafts");
   if (walksTrees(info.shafts)) {
     gl::checkTextureSize("AtmospherePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
-    if (MinMaxTrees::levelCount(info.mapWidth) > 16)
-      throw GlError("crep: AtmospherePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
-                    " needs more than 16 tree levels");
+    requireTreeLevels("AtmospherePass::CreateInfo.mapWidth", info.mapWidth);
   }
   validateViewTables(info.options, "AtmospherePass::CreateInfo.options");
   view_ = info.options.single == AtmosphereSingleScattering::ViewTables &&
@@ -117,16 +116,7 @@ void AtmospherePass::run(const FrameAttribs& f) {
     gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
     gl::requireTexture2D("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
     gl::requireDepthFormat("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
-    if (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer))
-      throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
-                            "must be the MinMaxTreePass::treeBuffer() of the map (shafts (a), (b))");
-    GLint64 size = 0;
-    glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
-    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
-    if (size < needed)
-      throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
-                            "must hold the trees of a " + std::to_string(W) + " x " + std::to_string(H) +
-                                " map (" + std::to_string(needed) + " bytes)");
+    requireMinMaxBuffer("AtmospherePass::FrameAttribs.minMaxBuffer", f.minMaxBuffer, W, H, "shafts (a), (b)");
   }
   const bool prefilteredMode = shafts == AtmosphereShafts::PrefilteredVisibility;
   if (prefilteredMode) {
