@@ -22,6 +22,8 @@ public:
   LayoutKind upload(const RectifiedLayout& layout, int mapHeight, const char* parameter = "layout");
   /// The same for a description already made with requireGpuLayout() (a layout is serialized once per run).
   LayoutKind upload(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
+  /// Throws InvalidArgument as upload() does for `data` and `mapHeight`, without uploading.
+  static void requireUploadable(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
   /// Binds the block at uniform buffer `blockBinding` and, for layouts with a row table, the table at
   /// storage buffer `rowsBinding` (the defaults of glsl/crep/epipolar.glsl are 1 and 1).
   void bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const;
