@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include <crep/core/camera.h>
@@ -121,6 +122,9 @@ public:
     /// then describes them (FilteredBasisView::textured).
     std::uint32_t lightColors = 0;
   };
+  /// Throws what run(frame) would before its first GL change: InvalidArgument naming the field after
+  /// `owner`, GlError when a light texture's basis exceeds GL_MAX_ARRAY_TEXTURE_LAYERS.
+  void validate(const FrameAttribs& frame, std::string_view owner = "PrefilterPass::FrameAttribs") const;
 
   /// Validates `info` (InvalidArgument naming the field, e.g. "PrefilterPass::CreateInfo.options.bases";
   /// GlError naming it when a size exceeds GL_MAX_TEXTURE_SIZE, GL_MAX_ARRAY_TEXTURE_LAYERS or the compute
@@ -157,6 +161,14 @@ public:
   FilteredBasisView filteredBasis() const;
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+  void prepareTextured(bool local);
+  std::size_t upload(const FrameAttribs& frame, const Plan& plan);
+  void uploadLocalLight(const FrameAttribs& frame, const Plan& plan,
+                        const std::vector<DistanceProfile>& profiles);
+  void dispatch(const FrameAttribs& frame, const Plan& plan, std::size_t weightBytes);
+
   CreateInfo info_;
   gl::Handle program_, programLocal_, texture_, sampler_, paramsBuffer_, weightsBuffer_, localBuffer_,
       raysBuffer_;
@@ -261,6 +273,9 @@ public:
     /// InvalidArgument "EvaluatePass::FrameAttribs.imageWidth/imageHeight"). Ignored without a list.
     int imageWidth = 0, imageHeight = 0;
   };
+  /// Throws what run(frame) would before its first GL change: InvalidArgument naming the field after
+  /// `owner` (GlError beyond the froxel dispatch's workgroup limits).
+  void validate(const FrameAttribs& frame, std::string_view owner = "EvaluatePass::FrameAttribs") const;
 
   /// Validates `info` (InvalidArgument naming the field, GlError beyond the workgroup limits) and
   /// compiles the program.
@@ -284,6 +299,16 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+  void uploadLocalLight(const FrameAttribs& frame);
+  std::uint32_t evaluationProgram(const Plan& plan);
+  void uploadTableCoefficients(double depthMargin);
+  void buildTable(const FilteredBasisView& basis, const Plan& plan);
+  void bindEvaluation(const FrameAttribs& frame, const Plan& plan, std::uint32_t program);
+  void dispatchFroxels(const FrameAttribs& frame, const Plan& plan, gpu::EvaluateParams params);
+  void unbindEvaluation(const Plan& plan);
+
   CreateInfo info_;
   gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
   /// The local-light variants (CREP_LOCAL_LIGHT): evaluation and scattering prefix programs on the
