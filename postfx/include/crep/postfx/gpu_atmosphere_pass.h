@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
@@ -73,6 +74,8 @@ public:
     /// or 0 (not written).
     std::uint32_t transmittanceOutput = 0;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "AtmospherePass::FrameAttribs") const;
 
   /// Validates (InvalidArgument "AtmospherePass::CreateInfo.options.integrationSteps", ".skySteps",
   /// ".mapWidth/mapHeight"; GlError beyond the GL limits) and builds the program.
@@ -92,6 +95,12 @@ public:
   std::uint32_t skyMieTexture() const noexcept { return skyMie_.get(); }
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+  void uploadBlocks(const FrameAttribs& frame, const Plan& plan);
+  void computeViewTables(const AtmosphereTablesPass& tables);
+  void dispatchImage(const FrameAttribs& frame, const Plan& plan, std::uint32_t program);
+
   CreateInfo info_;
   bool view_ = false;
   gl::Handle volumeProgram_, skyViewProgram_, volumeRayleigh_, volumeMie_, skyRayleigh_, skyMie_;
