@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -160,6 +161,8 @@ public:
     /// (InvalidArgument naming "WorldMarchPass::FrameAttribs.lightTexture.textureClipFromWorld").
     GpuLightTexture lightTexture;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "WorldMarchPass::FrameAttribs") const;
   /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
   explicit WorldMarchPass(const CreateInfo& info);
   /// Throws InvalidArgument naming the FrameAttribs field ("WorldMarchPass::FrameAttribs.light/localLight"
@@ -167,6 +170,9 @@ public:
   void run(const FrameAttribs& frame);
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+
   CreateInfo info_;
   gl::Handle program_, params_, sampler_, dummySteps_;
   gl::Handle texturedProgram_, textureParams_; ///< light textures, on first use
