@@ -147,47 +147,66 @@ void RectifiedMarchPass::prepare(gpu::LayoutKind kind, bool textured, bool list)
   program(kind, textured, list);
 }
 
-void RectifiedMarchPass::run(const FrameAttribs& f) {
-  if (!f.layout) throw InvalidArgument("RectifiedMarchPass::FrameAttribs.layout", "null", "must be set");
-  if (!f.camera || !f.medium)
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.camera/medium", "null", "must be set");
+/// A validated frame of the march (RectifiedMarchPass::validate) and what run() derives from it.
+struct RectifiedMarchPass::Plan {
+  GpuLayoutData layoutData;        ///< the map's layout block, serialized once per run
+  int width = 0, height = 0;       ///< the camera image
+  int outWidth = 0, outHeight = 0; ///< the textures written: the image's, or the list's
+};
+
+void RectifiedMarchPass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.layout) invalid(p + "layout", "null", "must be set");
+  if (!f.camera || !f.medium) invalid(p + "camera/medium", "null", "must be set");
   if ((f.light == nullptr) == (f.localLight == nullptr))
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.light/localLight",
-                          f.light ? "both set" : "both null", "exactly one must be set");
-  const GpuLayoutData layoutData = gpu::requireGpuLayout(*f.layout); // serialized once per run
-  const gpu::LayoutKind kind = layoutData.kind;
+    invalid(p + "light/localLight", f.light ? "both set" : "both null", "exactly one must be set");
+  Plan plan;
+  plan.layoutData = gpu::requireGpuLayout(*f.layout);
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "RectifiedMarchPass::CreateInfo.mapWidth/mapHeight");
   // The image size is the camera depth texture's own (gl::textureLevel); with a work list, imageWidth x
   // imageHeight when given, and the outputs are the list's.
   const gpu::SampleList* list = f.list;
   const gl::TextureLevel image =
-      list
-          ? gpu::listImageSize(f.imageWidth, f.imageHeight, f.cameraDepth, "RectifiedMarchPass::FrameAttribs")
-          : gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  const int width = image.width, height = image.height;
-  gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-  gl::requireDepthFormat("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
-  if (!list) gl::requireDepthFormat("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  // The textures written: the image's, or the list's (its output and coordinates).
-  int outWidth = width, outHeight = height;
+      list ? gpu::listImageSize(f.imageWidth, f.imageHeight, f.cameraDepth, std::string(owner))
+           : gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
+  plan.width = plan.outWidth = image.width;
+  plan.height = plan.outHeight = image.height;
+  gl::requireTexture2D((p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
+  gl::requireDepthFormat((p + "rectifiedDepth").c_str(), f.rectifiedDepth);
+  if (!list) gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
   if (list) {
-    gpu::validateSampleList(*list, "RectifiedMarchPass::FrameAttribs.list");
-    outWidth = list->width;
-    outHeight = list->height;
+    gpu::validateSampleList(*list, p + "list");
+    plan.outWidth = list->width;
+    plan.outHeight = list->height;
   } else {
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
+    gl::requireTexture2D((p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
   }
   if (f.stepsOutput != 0)
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, outWidth, outHeight,
-                         GL_R32F);
-  if (f.lightColors != 0)
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.lightColors", f.lightColors, W, H);
-  const bool tree = info_.mode == Mode::MinMaxTree;
-  if (tree)
-    requireMinMaxBuffer("RectifiedMarchPass::FrameAttribs.minMaxBuffer", f.minMaxBuffer, W, H,
-                        "MinMaxTree mode");
+    gl::requireTexture2D((p + "stepsOutput").c_str(), f.stepsOutput, plan.outWidth, plan.outHeight, GL_R32F);
+  if (f.lightColors != 0) gl::requireTexture2D((p + "lightColors").c_str(), f.lightColors, W, H);
+  if (info_.mode == Mode::MinMaxTree)
+    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "MinMaxTree mode");
+  if (list && f.blockRadius >= 0.0)
+    invalid(p + "blockRadius", detail::formatValue(f.blockRadius),
+            "must be -1 with a work list (the list says which texels to march)");
+  if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
+    invalid(p + "blockCenter/blockRadius", detail::formatValue(f.blockRadius), "must be finite");
+  gpu::LayoutBuffers::requireUploadable(plan.layoutData, H);
+  return plan;
+}
 
+void RectifiedMarchPass::run(const FrameAttribs& f) {
+  const Plan p = plan(f, "RectifiedMarchPass::FrameAttribs");
+  const gpu::LayoutKind kind = p.layoutData.kind;
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  const int width = p.width, height = p.height;
+  const gpu::SampleList* list = f.list;
+  const bool tree = info_.mode == Mode::MinMaxTree;
   const bool textured = f.lightColors != 0;
   const GLuint program = this->program(kind, textured, list != nullptr);
 
@@ -195,18 +214,15 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
       f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
                    : gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
-  if (list && f.blockRadius >= 0.0)
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.blockRadius", detail::formatValue(f.blockRadius),
-                          "must be -1 with a work list (the list says which texels to march)");
   if (!gpu::setMarchRegion(params, width, height, f.blockCenter, list ? -1.0 : f.blockRadius,
                            "RectifiedMarchPass::FrameAttribs"))
     return; // the block misses the image
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-  layoutBuffers_.upload(layoutData, H);
+  layoutBuffers_.upload(p.layoutData, H);
 
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, outWidth, outHeight);
+                                                                 GL_R32F, p.outWidth, p.outHeight);
   // A work list reads its coordinates at the camera depth's unit and writes its own output.
   gpu::bindMarchResources(program, params_.get(), list ? list->coordinates : f.cameraDepth, f.rectifiedDepth,
                           sampler_.get(), list ? list->output : f.output, steps);

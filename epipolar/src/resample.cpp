@@ -153,26 +153,45 @@ ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
   gl::checkError("ShadowResamplePass");
 }
 
-void ShadowResamplePass::run(const FrameAttribs& f) {
-  if (!f.layout) throw InvalidArgument("ShadowResamplePass::FrameAttribs.layout", "null", "must be set");
+/// A validated frame of the pass (ShadowResamplePass::validate) and what run() derives from it.
+struct ShadowResamplePass::Plan {
+  gl::TextureLevel shadow;  ///< the standard shadow map's level 0
+  GpuLayoutData layoutData; ///< the map's layout block
+};
+
+void ShadowResamplePass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+ShadowResamplePass::Plan ShadowResamplePass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.layout) invalid(p + "layout", "null", "must be set");
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
-  const gl::TextureLevel shadow =
-      gl::requireTexture2D("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
-  gl::requireDepthFormat("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
-  gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);
+  Plan plan;
+  plan.shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
+  gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
+  gl::requireTexture2D((p + "output").c_str(), f.output, W, H, GL_R32F);
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
-
-  const bool trees = f.minMaxBuffer != 0;
-  const int lowLevels = MinMaxTreePass::lowLevels(W);
-  if (trees) {
-    if (lowLevels < 1)
-      throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
-                            "needs a map wider than 64 texels (no low tree levels below the top 6)");
-    requireMinMaxBuffer("ShadowResamplePass::FrameAttribs.minMaxBuffer", f.minMaxBuffer, W, H,
+  if (f.minMaxBuffer != 0) {
+    if (MinMaxTreePass::lowLevels(W) < 1)
+      invalid(p + "minMaxBuffer", std::to_string(f.minMaxBuffer),
+              "needs a map wider than 64 texels (no low tree levels below the top 6)");
+    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H,
                         "its low levels are written here");
   }
-  const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
+  plan.layoutData = gpu::requireGpuLayout(*f.layout);
+  gpu::LayoutBuffers::requireUploadable(plan.layoutData, H);
+  return plan;
+}
+
+void ShadowResamplePass::run(const FrameAttribs& f) {
+  const Plan checked = plan(f, "ShadowResamplePass::FrameAttribs");
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  const gl::TextureLevel& shadow = checked.shadow;
+  const bool trees = f.minMaxBuffer != 0;
+  const int lowLevels = MinMaxTreePass::lowLevels(W);
+  const gpu::LayoutKind kind = layoutBuffers_.upload(checked.layoutData, H);
   gl::Handle& program = programs_[static_cast<int>(kind)][trees ? 1 : 0];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,

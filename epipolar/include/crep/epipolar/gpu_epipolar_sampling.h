@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -88,6 +89,10 @@ public:
     std::uint32_t cameraDepth = 0;
     std::uint32_t output = 0; ///< GL_RGBA32F W x H: the in-scattering (RGB) and transmittance (A)
   };
+  /// Throws what placeSamples, unwarp and upscale would for `frame`: InvalidArgument naming the field after
+  /// `owner`.
+  void validate(const FrameAttribs& frame,
+                std::string_view owner = "EpipolarSamplingPass::FrameAttribs") const;
   /// Throws InvalidArgument naming the field ("EpipolarSamplingPass::CreateInfo.width", "...height",
   /// "EpipolarSamplingPass::CreateInfo.options.samples", ...), GlError beyond the GL limits (texture size,
   /// compute work group size for options.samples, 65535 texels per list axis) or ShaderError.
@@ -146,7 +151,6 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
-  void checkFrame(const FrameAttribs& frame) const;
   void bindCommon(std::uint32_t program) const;
 
   CreateInfo info_;

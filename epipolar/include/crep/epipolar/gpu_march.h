@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -141,6 +142,8 @@ public:
     glm::dvec2 blockCenter{0.0};
     double blockRadius = -1.0;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "RectifiedMarchPass::FrameAttribs") const;
   /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
   /// MinMaxTreePass.
   explicit RectifiedMarchPass(const CreateInfo& info);
@@ -153,6 +156,8 @@ public:
   void prepare(gpu::LayoutKind kind, bool textured = false, bool list = false);
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
   std::uint32_t program(gpu::LayoutKind kind, bool textured, bool list);
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -95,6 +96,8 @@ public:
     /// The map is read once instead of twice: for crep::Scattering's tree-marched epipole block.
     std::uint32_t minMaxBuffer = 0;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "ShadowResamplePass::FrameAttribs") const;
   /// Throws InvalidArgument ("ShadowResamplePass::CreateInfo.mapWidth/mapHeight") for sizes <= 0, GlError
   /// beyond GL_MAX_TEXTURE_SIZE.
   explicit ShadowResamplePass(const CreateInfo& info);
@@ -102,6 +105,9 @@ public:
   void run(const FrameAttribs& frame);
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
   gl::Handle programs_[2][2], params_, sampler_; ///< [layout kind][with the trees' low levels]
