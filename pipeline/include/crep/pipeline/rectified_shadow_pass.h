@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -41,6 +42,10 @@ public:
     /// D24 works since the depth is linear in the depth slope); 0 = the pass's own D32F texture.
     std::uint32_t depthTexture = 0;
   };
+  /// Throws what run(frame) would before drawing: InvalidArgument naming the field after `owner` (a
+  /// depthTexture of a colour format is found when run() attaches it).
+  void validate(const FrameAttribs& frame,
+                std::string_view owner = "RectifiedShadowPass::FrameAttribs") const;
 
   /// Throws InvalidArgument naming the field for sizes < 1 or beyond GL_MAX_TEXTURE_SIZE.
   explicit RectifiedShadowPass(const CreateInfo& info);
