@@ -23,6 +23,7 @@
 
 #include <cstdint>
 #include <map>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -84,6 +85,8 @@ public:
     /// camera cut). The first frame with a finite pixel after construction always starts this way.
     bool resetAdaptation = false;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "ToneMapPass::FrameAttribs") const;
 
   explicit ToneMapPass(const CreateInfo& info);
   /// Tone-maps one frame (steps 1-3 of the file comment; 1-2 only with autoExposure). Throws
