@@ -59,8 +59,7 @@ SpotLight::SpotLight(const SpotLightParams& p)
   if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range_))
     throw InvalidArgument("SpotLight.nearPlane", detail::formatValue(p.nearPlane), "must be in (0, range)");
   requireColor("SpotLight.color", p.color);
-  if (!std::isfinite(p.intensity) || !(p.intensity > 0.0))
-    throw InvalidArgument("SpotLight.intensity", detail::formatValue(p.intensity), "must be finite and > 0");
+  requirePositive("SpotLight.intensity", p.intensity);
   if (!(std::max({p.color.x, p.color.y, p.color.z}) > 0.0))
     throw InvalidArgument("SpotLight.color", "(0, 0, 0)", "at least one channel must be > 0");
   cosInner_ = std::cos(inner_);
@@ -95,8 +94,7 @@ PointLight::PointLight(const PointLightParams& p)
   requireColor("PointLight.color", p.color);
   if (!(std::max({p.color.x, p.color.y, p.color.z}) > 0.0))
     throw InvalidArgument("PointLight.color", "(0, 0, 0)", "at least one channel must be > 0");
-  if (!std::isfinite(p.intensity) || !(p.intensity > 0.0))
-    throw InvalidArgument("PointLight.intensity", detail::formatValue(p.intensity), "must be finite and > 0");
+  requirePositive("PointLight.intensity", p.intensity);
 }
 
 glm::dvec3 PointLight::faceAxis(int face) {

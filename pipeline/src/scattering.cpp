@@ -82,15 +82,11 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.mapSize", std::to_string(info.mapSize),
             "must be a multiple of epipolarRegions * prefilter.regionsPerSplit = " +
                 std::to_string(epipolarRegions));
-  if (!(info.localLightDepthWarp >= 0.0 && std::isfinite(info.localLightDepthWarp)))
-    invalid("Scattering::CreateInfo.localLightDepthWarp", detail::formatValue(info.localLightDepthWarp),
-            "must be finite and >= 0");
+  requireNonNegative("Scattering::CreateInfo.localLightDepthWarp", info.localLightDepthWarp);
   if (!(info.epipolarDepthWarp >= 0.0 && std::isfinite(info.epipolarDepthWarp)))
     invalid("Scattering::CreateInfo.epipolarDepthWarp", detail::formatValue(info.epipolarDepthWarp),
             "must be finite and >= 0 (radians; 0 = linear depth)");
-  if (!(info.ownShadowMapBias >= 0.0 && std::isfinite(info.ownShadowMapBias)))
-    invalid("Scattering::CreateInfo.ownShadowMapBias", detail::formatValue(info.ownShadowMapBias),
-            "must be finite and >= 0");
+  requireNonNegative("Scattering::CreateInfo.ownShadowMapBias", info.ownShadowMapBias);
   if (info.evaluationScale != 1.0 && info.evaluationScale != 0.5 && info.evaluationScale != 0.25)
     invalid("Scattering::CreateInfo.evaluationScale", detail::formatValue(info.evaluationScale),
             "must be 1, 0.5 or 0.25");

@@ -290,8 +290,7 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
   validate(map);
   validate(options);
   if (colors) validateLightColors(*colors, map.width(), map.height(), "lightColors");
-  if (!(extinction >= 0.0) || !std::isfinite(extinction))
-    throw InvalidArgument("extinction", detail::formatValue(extinction), "must be finite and >= 0");
+  requireNonNegative("extinction", extinction);
   const int W = map.width(), H = map.height(), M = options.bases;
   const int R = map.layout->regionCount() * options.regionsPerSplit;
   if (W % R != 0)

@@ -91,8 +91,7 @@ void validate(const RectifyOptions& o) {
 }
 
 std::vector<double> splitPositions(double xmin, double xmax, int splits, SplitScheme scheme, double blend) {
-  if (!std::isfinite(xmin) || !(xmin > 0.0))
-    throw InvalidArgument("splitPositions.xmin", detail::formatValue(xmin), "must be finite and > 0");
+  requirePositive("splitPositions.xmin", xmin);
   if (!std::isfinite(xmax) || !(xmax > xmin))
     throw InvalidArgument("splitPositions.xmax", detail::formatValue(xmax), "must be finite and > xmin");
   RectifyOptions o;
