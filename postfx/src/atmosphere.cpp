@@ -39,8 +39,7 @@ std::string field(const char* owner, const char* name) {
 }
 
 void requirePositiveField(const char* owner, const char* name, double v) {
-  if (!(std::isfinite(v) && v > 0.0))
-    throw InvalidArgument(field(owner, name), detail::formatValue(v), "must be finite and > 0");
+  requirePositive(field(owner, name), v);
 }
 
 void requireCoefficient(const char* name, const glm::dvec3& c) {

@@ -452,8 +452,7 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
   requireFinite("direction", direction);
   const double dirLength = glm::length(direction);
   if (!(dirLength > 0.0)) throw InvalidArgument("direction", "zero length", "must be a non-zero direction");
-  if (!(surface >= 0.0) || !std::isfinite(surface))
-    throw InvalidArgument("surface", detail::formatValue(surface), "must be finite and >= 0");
+  requireNonNegative("surface", surface);
 
   const AtmosphereParameters& p = tables.parameters;
   const double mpu = placement.metersPerUnit;
