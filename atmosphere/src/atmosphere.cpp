@@ -39,8 +39,7 @@ std::string field(const char* owner, const char* name) {
 }
 
 void requirePositiveField(const char* owner, const char* name, double v) {
-  if (!(std::isfinite(v) && v > 0.0))
-    throw InvalidArgument(field(owner, name), detail::formatValue(v), "must be finite and > 0");
+  requirePositive(field(owner, name), v);
 }
 
 void requireCoefficient(const char* name, const glm::dvec3& c) {
@@ -743,6 +742,80 @@ glm::dvec3 atmospherePosition(const AtmospherePlacement& placement, const Atmosp
 
 // --- Precomputation ---------------------------------------------------------------------------------------
 
+namespace {
+
+/// The optical depth table: net (Rayleigh, Mie) density from each height and zenith cosine to the top of
+/// the atmosphere (occluded rays: kOccludedDensity).
+Image opticalDepthTable(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o, int threads) {
+  const double R = p.earthRadius;
+  const double top = R + p.atmosphereHeight;
+  const int w = o.opticalDepthHeight;
+  const int hgt = o.opticalDepthZenith;
+  Image table(w, hgt, 2);
+  parallelRows(hgt, threads, [&](int j) {
+    const double c = -1.0 + 2.0 * j / (hgt - 1);
+    const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
+    for (int i = 0; i < w; ++i) {
+      const double u = static_cast<double>(i) / (w - 1);
+      const double r0 = R + p.atmosphereHeight * u * u;
+      glm::dvec2 d(kOccludedDensity);
+      if (!(c < 0.0 && r0 * r0 * (c * c - 1.0) + R * R >= 0.0)) {
+        const glm::dvec3 a(0.0, r0, 0.0);
+        const glm::dvec3 b = a + glm::dvec3(s, c, 0.0) * farRoot(r0, c, top);
+        d = densityIntegral(p, a, b, o.opticalDepthSteps);
+      }
+      table.at(i, j, 0) = static_cast<float>(d.x);
+      table.at(i, j, 1) = static_cast<float>(d.y);
+    }
+  });
+  return table;
+}
+
+/// Hillaire 2020's multiple scattering table Psi_ms (the Lut method) from the optical depth of `t`.
+Image multipleScatteringTable(const AtmosphereTables& t, int threads) {
+  const AtmosphereParameters& p = t.parameters;
+  const AtmospherePrecomputeOptions& o = t.options;
+  const int m = o.multipleScatteringSize;
+  Image table(m, m, 3);
+  parallelRows(m, threads, [&](int j) {
+    const double mu = -1.0 + 2.0 * j / (m - 1);
+    for (int i = 0; i < m; ++i) {
+      const double u = static_cast<double>(i) / (m - 1);
+      const glm::dvec3 psi =
+          multipleScatteringAt(t, p.atmosphereHeight * u * u, mu, o.sphereSamples, o.multipleScatteringSteps);
+      for (int ch = 0; ch < 3; ++ch)
+        table.at(i, j, ch) = static_cast<float>(psi[ch]);
+    }
+  });
+  return table;
+}
+
+/// Eq. 3 / Listing 6: ambient sky light at 20 m from L_M of `t`, per sun zenith cosine.
+Image ambientTable(const AtmosphereTables& t, int threads) {
+  const AtmospherePrecomputeOptions& o = t.options;
+  const int na = o.ambientSize;
+  Image table(na, 1, 3);
+  const glm::dvec3 c(0.0, t.parameters.earthRadius + 20.0, 0.0);
+  parallelRows(na, threads, [&](int i) {
+    const double cp = -1.0 + 2.0 * i / (na - 1);
+    const glm::dvec3 l(std::sqrt(std::max(0.0, 1.0 - cp * cp)), cp, 0.0);
+    glm::dvec3 sum(0.0);
+    const int samples = kAmbientSampleFactor * o.sphereSamples;
+    for (int k = 0; k < samples; ++k) {
+      glm::dvec3 w = fibonacciSphereDirection(k, samples);
+      w.y = std::abs(w.y);
+      glm::dvec4 coords(-1.0);
+      sum += lookUpMultipleScattering(t, c, w, l, coords) * w.y;
+    }
+    sum *= 2.0 * kPi / samples;
+    for (int ch = 0; ch < 3; ++ch)
+      table.at(i, 0, ch) = static_cast<float>(sum[ch]);
+  });
+  return table;
+}
+
+} // namespace
+
 // Yusov 2013, "Multiple Scattering" steps 1-3 and Eq. 3.
 AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const AtmospherePrecomputeOptions& o,
                                       int threads) {
@@ -750,48 +823,13 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
   AtmosphereTables t;
   t.parameters = p;
   t.options = o;
-  const double R = p.earthRadius;
-  const double top = R + p.atmosphereHeight;
 
   // Net density to the top of the atmosphere (occluded rays: kOccludedDensity).
-  {
-    const int w = o.opticalDepthHeight;
-    const int hgt = o.opticalDepthZenith;
-    t.opticalDepth = Image(w, hgt, 2);
-    parallelRows(hgt, threads, [&](int j) {
-      const double c = -1.0 + 2.0 * j / (hgt - 1);
-      const double s = std::sqrt(std::max(0.0, 1.0 - c * c));
-      for (int i = 0; i < w; ++i) {
-        const double u = static_cast<double>(i) / (w - 1);
-        const double r0 = R + p.atmosphereHeight * u * u;
-        glm::dvec2 d(kOccludedDensity);
-        if (!(c < 0.0 && r0 * r0 * (c * c - 1.0) + R * R >= 0.0)) {
-          const glm::dvec3 a(0.0, r0, 0.0);
-          const glm::dvec3 b = a + glm::dvec3(s, c, 0.0) * farRoot(r0, c, top);
-          d = densityIntegral(p, a, b, o.opticalDepthSteps);
-        }
-        t.opticalDepth.at(i, j, 0) = static_cast<float>(d.x);
-        t.opticalDepth.at(i, j, 1) = static_cast<float>(d.y);
-      }
-    });
-  }
+  t.opticalDepth = opticalDepthTable(p, o, threads);
 
   // Hillaire 2020's multiple scattering table (the Lut method; L_H from it below).
   const bool lut = usesMultipleScatteringLut(o);
-  if (lut) {
-    const int m = o.multipleScatteringSize;
-    t.multipleScatteringLut = Image(m, m, 3);
-    parallelRows(m, threads, [&](int j) {
-      const double mu = -1.0 + 2.0 * j / (m - 1);
-      for (int i = 0; i < m; ++i) {
-        const double u = static_cast<double>(i) / (m - 1);
-        const glm::dvec3 psi = multipleScatteringAt(t, p.atmosphereHeight * u * u, mu, o.sphereSamples,
-                                                    o.multipleScatteringSteps);
-        for (int ch = 0; ch < 3; ++ch)
-          t.multipleScatteringLut.at(i, j, ch) = static_cast<float>(psi[ch]);
-      }
-    });
-  }
+  if (lut) t.multipleScatteringLut = multipleScatteringTable(t, threads);
 
   const AtmosphereTableSize& size = o.size;
   const std::size_t n = emptyTable(size).texels();
@@ -842,26 +880,7 @@ AtmosphereTables precomputeAtmosphere(const AtmosphereParameters& p, const Atmos
   }
 
   // Eq. 3 / Listing 6: ambient sky light at 20 m from L_M.
-  {
-    const int na = o.ambientSize;
-    t.ambient = Image(na, 1, 3);
-    const glm::dvec3 c(0.0, R + 20.0, 0.0);
-    parallelRows(na, threads, [&](int i) {
-      const double cp = -1.0 + 2.0 * i / (na - 1);
-      const glm::dvec3 l(std::sqrt(std::max(0.0, 1.0 - cp * cp)), cp, 0.0);
-      glm::dvec3 sum(0.0);
-      const int samples = kAmbientSampleFactor * o.sphereSamples;
-      for (int k = 0; k < samples; ++k) {
-        glm::dvec3 w = fibonacciSphereDirection(k, samples);
-        w.y = std::abs(w.y);
-        glm::dvec4 coords(-1.0);
-        sum += lookUpMultipleScattering(t, c, w, l, coords) * w.y;
-      }
-      sum *= 2.0 * kPi / samples;
-      for (int ch = 0; ch < 3; ++ch)
-        t.ambient.at(i, 0, ch) = static_cast<float>(sum[ch]);
-    });
-  }
+  t.ambient = ambientTable(t, threads);
   return t;
 }
 

@@ -7,6 +7,7 @@
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
+#include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -57,9 +58,7 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
                           "must be an AtmosphereShafts");
   if (walksTrees(info.shafts)) {
     gl::checkTextureSize("AtmospherePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
-    if (MinMaxTrees::levelCount(info.mapWidth) > 16)
-      throw GlError("crep: AtmospherePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
-                    " needs more than 16 tree levels");
+    requireTreeLevels("AtmospherePass::CreateInfo.mapWidth", info.mapWidth);
   }
   validateViewTables(info.options, "AtmospherePass::CreateInfo.options");
   view_ = info.options.single == AtmosphereSingleScattering::ViewTables &&
@@ -90,102 +89,119 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
   gl::checkError("AtmospherePass");
 }
 
-void AtmospherePass::run(const FrameAttribs& f) {
-  const AtmosphereShafts shafts = info_.shafts;
-  const bool walk = walksTrees(shafts);
-  if (!f.tables) throw InvalidArgument("AtmospherePass::FrameAttribs.tables", "null", "must be set");
-  if (!f.placement) throw InvalidArgument("AtmospherePass::FrameAttribs.placement", "null", "must be set");
-  if (!f.camera) throw InvalidArgument("AtmospherePass::FrameAttribs.camera", "null", "must be set");
-  if (!f.sun) throw InvalidArgument("AtmospherePass::FrameAttribs.sun", "null", "must be set");
-  const AtmosphereTablesPass::CreateInfo& tables = f.tables->info();
-  try {
-    validate(*f.placement, tables.parameters);
-  } catch (const InvalidArgument& e) {
-    throw InvalidArgument("AtmospherePass::FrameAttribs.placement", e.what(), "must be valid");
-  }
-  const gl::TextureLevel image =
-      gl::requireTexture2D("AtmospherePass::FrameAttribs.cameraDepth", f.cameraDepth);
-  gl::requireDepthFormat("AtmospherePass::FrameAttribs.cameraDepth", f.cameraDepth);
-  const int width = image.width, height = image.height;
-  gl::requireTexture2D("AtmospherePass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
-  if (f.transmittanceOutput != 0)
-    gl::requireTexture2D("AtmospherePass::FrameAttribs.transmittanceOutput", f.transmittanceOutput, width,
-                         height, GL_RGBA32F);
-  const int W = info_.mapWidth, H = info_.mapHeight;
-  GpuLayoutData layoutData;
-  if (walk) {
-    if (!f.layout)
-      throw InvalidArgument("AtmospherePass::FrameAttribs.layout", "null", "must be set (shafts (a), (b))");
-    layoutData = gpu::requireGpuLayout(*f.layout, "AtmospherePass::FrameAttribs.layout");
-    gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
-    gl::requireTexture2D("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-    gl::requireDepthFormat("AtmospherePass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
-    if (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer))
-      throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
-                            "must be the MinMaxTreePass::treeBuffer() of the map (shafts (a), (b))");
-    GLint64 size = 0;
-    glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
-    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
-    if (size < needed)
-      throw InvalidArgument("AtmospherePass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
-                            "must hold the trees of a " + std::to_string(W) + " x " + std::to_string(H) +
-                                " map (" + std::to_string(needed) + " bytes)");
-  }
-  const bool prefilteredMode = shafts == AtmosphereShafts::PrefilteredVisibility;
-  if (prefilteredMode) {
-    gl::requireTexture2D("AtmospherePass::FrameAttribs.prefiltered", f.prefiltered, width, height);
-    if (!f.proxyMedium)
-      throw InvalidArgument("AtmospherePass::FrameAttribs.proxyMedium", "null", "must be set (shafts (c))");
-  }
+/// A validated frame of the pass (AtmospherePass::validate) and what run() derives from it.
+struct AtmospherePass::Plan {
+  bool walk = false;         ///< shafts (a), (b): the map's min/max trees walked
+  bool prefiltered = false;  ///< shafts (c)
+  int width = 0, height = 0; ///< the camera image's size
+  GpuLayoutData layoutData;  ///< walk: the map's layout block
+};
 
-  const bool combined = tables.options.combinedMie;
-  gl::Handle& program = programs_[combined ? 1 : 0][walk ? static_cast<int>(layoutData.kind) : 0];
+void AtmospherePass::validate(const FrameAttribs& f, std::string_view owner) const {
+  plan(f, owner);
+}
+
+AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  Plan plan;
+  plan.walk = walksTrees(info_.shafts);
+  if (!f.tables) invalid(p + "tables", "null", "must be set");
+  if (!f.placement) invalid(p + "placement", "null", "must be set");
+  if (!f.camera) invalid(p + "camera", "null", "must be set");
+  if (!f.sun) invalid(p + "sun", "null", "must be set");
+  try {
+    crep::validate(*f.placement, f.tables->info().parameters);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(p + "placement", e.what(), "must be valid");
+  }
+  const gl::TextureLevel image = gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
+  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+  plan.width = image.width;
+  plan.height = image.height;
+  gl::requireTexture2D((p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
+  if (f.transmittanceOutput != 0)
+    gl::requireTexture2D((p + "transmittanceOutput").c_str(), f.transmittanceOutput, plan.width, plan.height,
+                         GL_RGBA32F);
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  if (plan.walk) {
+    if (!f.layout) invalid(p + "layout", "null", "must be set (shafts (a), (b))");
+    plan.layoutData = gpu::requireGpuLayout(*f.layout, (p + "layout").c_str());
+    gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
+    gl::requireTexture2D((p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
+    gl::requireDepthFormat((p + "rectifiedDepth").c_str(), f.rectifiedDepth);
+    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "shafts (a), (b)");
+    gpu::LayoutBuffers::requireUploadable(plan.layoutData, H);
+  }
+  plan.prefiltered = info_.shafts == AtmosphereShafts::PrefilteredVisibility;
+  if (plan.prefiltered) {
+    gl::requireTexture2D((p + "prefiltered").c_str(), f.prefiltered, plan.width, plan.height);
+    if (!f.proxyMedium) invalid(p + "proxyMedium", "null", "must be set (shafts (c))");
+  }
+  return plan;
+}
+
+void AtmospherePass::run(const FrameAttribs& f) {
+  const Plan p = plan(f, "AtmospherePass::FrameAttribs");
+  const bool combined = f.tables->info().options.combinedMie;
+  gl::Handle& program = programs_[combined ? 1 : 0][p.walk ? static_cast<int>(p.layoutData.kind) : 0];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
                              "passes/atmosphere/atmosphere.comp",
-                             {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(shafts))},
-                              {"CREP_LAYOUT", std::to_string(static_cast<int>(layoutData.kind))},
+                             {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(info_.shafts))},
+                              {"CREP_LAYOUT", std::to_string(static_cast<int>(p.layoutData.kind))},
                               {"CREP_ATMOSPHERE_COMBINED_MIE", combined ? "1" : "0"},
                               {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
+  uploadBlocks(f, p);
+  if (view_) computeViewTables(*f.tables);
+  dispatchImage(f, p, program.get());
+}
 
+void AtmospherePass::uploadBlocks(const FrameAttribs& f, const Plan& p) {
+  const int W = info_.mapWidth;
   // The march block carries the camera and the sun (and (c)'s proxy medium: the closed form of
   // prefilteredVisibility); a placeholder medium otherwise (its members are not read).
   const Medium placeholder({.absorption = glm::dvec3(1.0)});
   gpu::MarchParams params =
-      gpu::makeMarchParams(*f.camera, *f.sun, prefilteredMode ? *f.proxyMedium : placeholder, width, height,
-                           walk ? W : 0, walk ? H : 0);
-  params.info = glm::ivec4(walk ? MinMaxTrees::levelCount(W) : 0, walk ? MinMaxTrees::rowStrideFor(W) : 0,
+      gpu::makeMarchParams(*f.camera, *f.sun, p.prefiltered ? *f.proxyMedium : placeholder, p.width, p.height,
+                           p.walk ? W : 0, p.walk ? info_.mapHeight : 0);
+  params.info = glm::ivec4(p.walk ? MinMaxTrees::levelCount(W) : 0, p.walk ? MinMaxTrees::rowStrideFor(W) : 0,
                            info_.options.integrationSteps, info_.options.skySteps);
-  const glm::ivec3 vs = info_.options.volumeSize;
-  const glm::ivec2 ss = info_.options.skyViewSize;
   if (view_) {
-    params.region = glm::ivec4(vs, info_.options.volumeSteps);
-    params.block = glm::vec4(glm::vec2(ss), static_cast<float>(info_.options.skyViewSteps), 0.0f);
+    params.region = glm::ivec4(info_.options.volumeSize, info_.options.volumeSteps);
+    params.block =
+        glm::vec4(glm::vec2(info_.options.skyViewSize), static_cast<float>(info_.options.skyViewSteps), 0.0f);
   }
   glNamedBufferSubData(marchParams_.get(), 0, sizeof(params), &params);
+  const AtmosphereTablesPass::CreateInfo& tables = f.tables->info();
   const gpu::AtmosphereParams atmosphere =
       gpu::atmosphereParams(tables.parameters, tables.options, *f.placement);
   glNamedBufferSubData(atmosphereParams_.get(), 0, sizeof(atmosphere), &atmosphere);
-  if (view_) { // Hillaire 2020, Sec. 5.2-5.3: the camera's view tables, one ray per invocation
-    glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
-    glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
-    glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
-    glUseProgram(volumeProgram_.get());
-    glBindImageTexture(0, volumeRayleigh_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(static_cast<GLuint>((vs.x + 7) / 8), static_cast<GLuint>((vs.y + 7) / 8), 1);
-    glUseProgram(skyViewProgram_.get());
-    glBindImageTexture(0, skyRayleigh_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(static_cast<GLuint>((ss.x + 7) / 8), static_cast<GLuint>((ss.y + 7) / 8), 1);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-  }
+}
 
-  const GLuint transmittance =
-      f.transmittanceOutput != 0
-          ? f.transmittanceOutput
-          : gl::scratchTexture2D(dummyTransmittance_, dummyWidth_, dummyHeight_, GL_RGBA32F, width, height);
-  glUseProgram(program.get());
+// Hillaire 2020, Sec. 5.2-5.3: the camera's view tables, one ray per invocation.
+void AtmospherePass::computeViewTables(const AtmosphereTablesPass& tables) {
+  const glm::ivec3 vs = info_.options.volumeSize;
+  const glm::ivec2 ss = info_.options.skyViewSize;
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
+  glBindTextureUnit(kUnitOpticalDepth, tables.opticalDepthTexture());
+  glUseProgram(volumeProgram_.get());
+  glBindImageTexture(0, volumeRayleigh_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(1, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((vs.x + 7) / 8), static_cast<GLuint>((vs.y + 7) / 8), 1);
+  glUseProgram(skyViewProgram_.get());
+  glBindImageTexture(0, skyRayleigh_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(1, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((ss.x + 7) / 8), static_cast<GLuint>((ss.y + 7) / 8), 1);
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+void AtmospherePass::dispatchImage(const FrameAttribs& f, const Plan& p, std::uint32_t program) {
+  const GLuint transmittance = f.transmittanceOutput != 0
+                                   ? f.transmittanceOutput
+                                   : gl::scratchTexture2D(dummyTransmittance_, dummyWidth_, dummyHeight_,
+                                                          GL_RGBA32F, p.width, p.height);
+  glUseProgram(program);
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
   glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
   glBindTextureUnit(kUnitCameraDepth, f.cameraDepth);
@@ -196,15 +212,16 @@ void AtmospherePass::run(const FrameAttribs& f) {
   glBindTextureUnit(kUnitHigherOrders, f.tables->higherOrdersTexture());
   glBindTextureUnit(kUnitAmbient, f.tables->ambientTexture());
   // With combinedMie there is no single Mie table (the shader does not read the unit).
+  const bool combined = f.tables->info().options.combinedMie;
   glBindTextureUnit(kUnitSingleMie, combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
-  if (walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees
-    layoutBuffers_.upload(layoutData, H);
+  if (p.walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees
+    layoutBuffers_.upload(p.layoutData, info_.mapHeight);
     layoutBuffers_.bind(1, 1);
     glBindTextureUnit(kUnitRectifiedDepth, f.rectifiedDepth);
     glBindSampler(kUnitRectifiedDepth, nearest_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
   }
-  if (prefilteredMode) {
+  if (p.prefiltered) {
     glBindTextureUnit(kUnitPrefiltered, f.prefiltered);
     glBindSampler(kUnitPrefiltered, nearest_.get());
   }
@@ -220,7 +237,7 @@ void AtmospherePass::run(const FrameAttribs& f) {
   }
   glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glBindImageTexture(1, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
+  glDispatchCompute(static_cast<GLuint>((p.width + 7) / 8), static_cast<GLuint>((p.height + 7) / 8), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(kUnits);
   gl::checkError("AtmospherePass::run");

@@ -14,6 +14,8 @@
 #include <chrono>
 #include <cstring>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace crep {
 
@@ -115,25 +117,15 @@ AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info)
   gl::checkError("AtmosphereTablesPass: allocating the tables");
 }
 
-void AtmosphereTablesPass::compute() {
-  const AtmospherePrecomputeOptions& o = info_.options;
-  const AtmosphereTableSize& s = o.size;
-  const int depth = s.sunZenith * s.sunView;
-  times_.clear();
-  // halfFloatTables: compute into RGBA32F tables, then round them once into the RGBA16F ones (the stages
-  // store to rgba32f images and the orders read the tables they wrote).
-  std::vector<gl::Handle> halves;
-  if (info_.halfFloatTables) {
-    for (gl::Handle* table : {&single_, &singleMie_, &higher_}) {
-      halves.push_back(std::move(*table));
-      if (halves.back()) *table = createTable3D(s);
-    }
-  }
+namespace {
 
-  const gpu::AtmosphereParams params = gpu::atmosphereParams(info_.parameters, o);
-  gl::Handle block = gl::createDynamicBuffer(sizeof params);
-  glNamedBufferSubData(block.get(), 0, sizeof params, &params);
+/// The programs of the table stages (one compute shader each, one texel per invocation) for `o`: the J_n /
+/// L_n ones with more than one order by Orders, the Psi_ms one with the Lut method.
+struct TablePrograms {
+  gl::Handle optical, single, sum, ambient, firstScattered, scattered, order, ms;
+};
 
+TablePrograms buildTablePrograms(const AtmospherePrecomputeOptions& o) {
   const auto steps = [](int n) {
     return std::vector<ShaderDefine>{{"CREP_ATMOSPHERE_STEPS", std::to_string(n)}};
   };
@@ -141,156 +133,211 @@ void AtmosphereTablesPass::compute() {
   const std::vector<ShaderDefine> samples{{"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)},
                                           combined};
   const bool lut = usesMultipleScatteringLut(o);
-  const bool orders = o.orders > 1 && !lut;
   std::vector<ShaderDefine> singleDefines = steps(o.singleSteps);
   singleDefines.push_back(combined);
   singleDefines.push_back({"CREP_ATMOSPHERE_MS_LUT", lut ? "1" : "0"});
   std::vector<ShaderDefine> firstOrder = samples;
   firstOrder.push_back({"CREP_ATMOSPHERE_FIRST_ORDER", "1"});
-  gl::Handle opticalProgram = buildProgram(
+  TablePrograms p;
+  p.optical = buildProgram(
       {{ShaderStage::Compute, "passes/atmosphere/optical_depth.comp", steps(o.opticalDepthSteps)}});
-  gl::Handle singleProgram =
-      buildProgram({{ShaderStage::Compute, "passes/atmosphere/single.comp", singleDefines}});
-  gl::Handle sumProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere/sum.comp", {}}});
+  p.single = buildProgram({{ShaderStage::Compute, "passes/atmosphere/single.comp", singleDefines}});
+  p.sum = buildProgram({{ShaderStage::Compute, "passes/atmosphere/sum.comp", {}}});
   const std::vector<ShaderDefine> ambientSamples{
       {"CREP_ATMOSPHERE_SAMPLES", std::to_string(kAmbientSampleFactor * o.sphereSamples)}, combined};
-  gl::Handle ambientProgram =
-      buildProgram({{ShaderStage::Compute, "passes/atmosphere/ambient.comp", ambientSamples}});
-  gl::Handle scatteredProgram, firstScatteredProgram, orderProgram, msProgram;
+  p.ambient = buildProgram({{ShaderStage::Compute, "passes/atmosphere/ambient.comp", ambientSamples}});
   if (lut) {
     std::vector<ShaderDefine> msDefines = steps(o.multipleScatteringSteps);
     msDefines.push_back({"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)});
-    msProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere/ms.comp", msDefines}});
+    p.ms = buildProgram({{ShaderStage::Compute, "passes/atmosphere/ms.comp", msDefines}});
   }
-  if (orders) {
-    firstScatteredProgram =
-        buildProgram({{ShaderStage::Compute, "passes/atmosphere/scattered.comp", firstOrder}});
-    scatteredProgram = buildProgram({{ShaderStage::Compute, "passes/atmosphere/scattered.comp", samples}});
-    orderProgram =
-        buildProgram({{ShaderStage::Compute, "passes/atmosphere/order.comp", steps(o.orderSteps)}});
+  if (o.orders > 1 && !lut) {
+    p.firstScattered = buildProgram({{ShaderStage::Compute, "passes/atmosphere/scattered.comp", firstOrder}});
+    p.scattered = buildProgram({{ShaderStage::Compute, "passes/atmosphere/scattered.comp", samples}});
+    p.order = buildProgram({{ShaderStage::Compute, "passes/atmosphere/order.comp", steps(o.orderSteps)}});
   }
+  return p;
+}
 
-  // Each stage ends with glFinish and is timed on the wall clock (GL_TIME_ELAPSED reads ~0 on llvmpipe).
-  glFinish();
-  auto start = std::chrono::steady_clock::now();
-  const auto endStage = [&](std::string name) {
+/// Each stage ends with glFinish and is timed on the wall clock (GL_TIME_ELAPSED reads ~0 on llvmpipe).
+class StageClock {
+public:
+  explicit StageClock(std::vector<std::pair<std::string, double>>& times) : times_(times) {
+    glFinish();
+    start_ = std::chrono::steady_clock::now();
+  }
+  void end(std::string name) {
     glFinish();
     const auto now = std::chrono::steady_clock::now();
-    times_.emplace_back(std::move(name), std::chrono::duration<double, std::milli>(now - start).count());
-    start = now;
-  };
-  // One dispatch covers a whole table (32 x 128 x 1024 texels at the default size). On a real GPU with a
-  // watchdog (Windows TDR, ~2 s) a J_n dispatch of many sphere samples at a large size may have to be split
-  // into slabs of z; llvmpipe has no watchdog.
-  const auto dispatchTable = [&] {
-    glDispatchCompute(groups(s.height, 4), groups(s.viewZenith, 4), groups(depth, 4));
+    times_.emplace_back(std::move(name), std::chrono::duration<double, std::milli>(now - start_).count());
+    start_ = now;
+  }
+
+private:
+  std::vector<std::pair<std::string, double>>& times_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Dispatches over a whole packed 4D table of size `s`. One dispatch covers a whole table (32 x 128 x 1024
+/// texels at the default size). On a real GPU with a watchdog (Windows TDR, ~2 s) a J_n dispatch of many
+/// sphere samples at a large size may have to be split into slabs of z; llvmpipe has no watchdog.
+struct TableDispatch {
+  const AtmosphereTableSize& s;
+  int depth() const { return s.sunZenith * s.sunView; }
+  void dispatch() const {
+    glDispatchCompute(groups(s.height, 4), groups(s.viewZenith, 4), groups(depth(), 4));
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
-  };
-  const auto sum = [&](GLuint accumulator, GLuint addend) {
-    glUseProgram(sumProgram.get());
+  }
+  /// accumulator += addend with the sum program.
+  void sum(GLuint program, GLuint accumulator, GLuint addend) const {
+    glUseProgram(program);
     glBindImageTexture(0, accumulator, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, addend, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
-    dispatchTable();
-  };
-  const auto copy = [&](GLuint from, GLuint to) {
+    dispatch();
+  }
+  void copy(GLuint from, GLuint to) const {
     glCopyImageSubData(from, GL_TEXTURE_3D, 0, 0, 0, 0, to, GL_TEXTURE_3D, 0, 0, 0, 0, s.height, s.viewZenith,
-                       depth);
+                       depth());
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  };
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, block.get());
-  // Samplers of the texture units: none (each texture's own linear, clamp-to-edge state).
-  glBindSampler(0, 0);
+  }
+};
 
+/// The pass's tables, as the stages read and write them.
+struct TableTextures {
+  GLuint opticalDepth, msLut, single, singleMie, higher;
+};
+
+// The optical depth, Psi_ms (Hillaire 2020, the Lut method), L1 without its phase functions (S_R, S_M) and,
+// with the Lut method, L_H in the same march.
+void computeSingle(const AtmospherePrecomputeOptions& o, const TableTextures& t,
+                   const TablePrograms& programs, StageClock& clock) {
+  const bool lut = usesMultipleScatteringLut(o);
   // Optical depth.
-  glUseProgram(opticalProgram.get());
-  glBindImageTexture(0, opticalDepth_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+  glUseProgram(programs.optical.get());
+  glBindImageTexture(0, t.opticalDepth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
   glDispatchCompute(groups(o.opticalDepthHeight, 8), groups(o.opticalDepthZenith, 8), 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-  endStage("optical depth");
+  clock.end("optical depth");
 
   // Psi_ms (Hillaire 2020, the Lut method).
   if (lut) {
-    glUseProgram(msProgram.get());
-    glBindTextureUnit(0, opticalDepth_.get());
-    glBindImageTexture(0, msLut_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUseProgram(programs.ms.get());
+    glBindTextureUnit(0, t.opticalDepth);
+    glBindImageTexture(0, t.msLut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(groups(o.multipleScatteringSize, 8), groups(o.multipleScatteringSize, 8), 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-    endStage("multiple scattering LUT");
+    clock.end("multiple scattering LUT");
   }
 
   // L1 without its phase functions (S_R, S_M); Lut: L_H in the same march.
-  glUseProgram(singleProgram.get());
-  glBindTextureUnit(0, opticalDepth_.get());
-  glBindImageTexture(0, single_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  if (!o.combinedMie) glBindImageTexture(1, singleMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glUseProgram(programs.single.get());
+  glBindTextureUnit(0, t.opticalDepth);
+  glBindImageTexture(0, t.single, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  if (!o.combinedMie) glBindImageTexture(1, t.singleMie, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   if (lut) {
-    glBindTextureUnit(1, msLut_.get());
-    glBindImageTexture(2, higher_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(1, t.msLut);
+    glBindImageTexture(2, t.higher, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   }
-  dispatchTable();
+  TableDispatch{o.size}.dispatch();
   if (o.orders == 1) {
     // L_H = 0 (timed with single scattering).
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    glClearTexImage(higher_.get(), 0, GL_RGBA, GL_FLOAT, zero);
+    glClearTexImage(t.higher, 0, GL_RGBA, GL_FLOAT, zero);
   }
-  endStage(lut ? "single scattering and L_H" : "single scattering");
-  // The single Mie unit of the passes that read L1 (the single table itself with combinedMie: not read).
-  const GLuint mieTable = o.combinedMie ? single_.get() : singleMie_.get();
+  clock.end(lut ? "single scattering and L_H" : "single scattering");
+}
 
-  if (orders) {
-    // J_n and L_n ping-pong through two scratch tables: J_n reads L_(n-1) (L1 or the previous L_n), L_n reads
-    // J_n and overwrites the previous L_n, already added to L_H.
-    gl::Handle scattered = createTable3D(s);
-    gl::Handle order = createTable3D(s);
-    gl::checkError("AtmosphereTablesPass::compute: allocating the scratch tables");
-    for (int n = 2; n <= o.orders; ++n) {
-      const std::string name = "order " + std::to_string(n) + ": ";
-      glUseProgram(n == 2 ? firstScatteredProgram.get() : scatteredProgram.get());
-      glBindTextureUnit(0, n == 2 ? single_.get() : order.get());
-      if (n == 2) { // L1's Mie part and, for the ground's bounce, the optical depth table
-        glBindTextureUnit(1, mieTable);
-        glBindTextureUnit(2, opticalDepth_.get());
-      }
-      glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-      dispatchTable();
-      endStage(name + "J");
-      glUseProgram(orderProgram.get());
-      glBindTextureUnit(0, scattered.get());
-      glBindImageTexture(0, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-      dispatchTable();
-      // L_H += L_n (timed with this L stage).
-      if (n == 2)
-        copy(order.get(), higher_.get());
-      else
-        sum(higher_.get(), order.get());
-      endStage(name + "L");
+// J_n and L_n ping-pong through two scratch tables: J_n reads L_(n-1) (L1 or the previous L_n), L_n reads J_n
+// and overwrites the previous L_n, already added to L_H.
+void computeOrders(const AtmospherePrecomputeOptions& o, const TableTextures& t,
+                   const TablePrograms& programs, StageClock& clock) {
+  const TableDispatch table{o.size};
+  // The single Mie unit of the passes that read L1 (the single table itself with combinedMie: not read).
+  const GLuint mieTable = o.combinedMie ? t.single : t.singleMie;
+  gl::Handle scattered = createTable3D(o.size);
+  gl::Handle order = createTable3D(o.size);
+  gl::checkError("AtmosphereTablesPass::compute: allocating the scratch tables");
+  for (int n = 2; n <= o.orders; ++n) {
+    const std::string name = "order " + std::to_string(n) + ": ";
+    glUseProgram(n == 2 ? programs.firstScattered.get() : programs.scattered.get());
+    glBindTextureUnit(0, n == 2 ? t.single : order.get());
+    if (n == 2) { // L1's Mie part and, for the ground's bounce, the optical depth table
+      glBindTextureUnit(1, mieTable);
+      glBindTextureUnit(2, t.opticalDepth);
+    }
+    glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    table.dispatch();
+    clock.end(name + "J");
+    glUseProgram(programs.order.get());
+    glBindTextureUnit(0, scattered.get());
+    glBindImageTexture(0, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    table.dispatch();
+    // L_H += L_n (timed with this L stage).
+    if (n == 2)
+      table.copy(order.get(), t.higher);
+    else
+      table.sum(programs.sum.get(), t.higher, order.get());
+    clock.end(name + "L");
+  }
+}
+
+// halfFloatTables: the RGBA32F tables rounded to the RGBA16F ones through the host (GL converts float to half
+// on upload), which then replace them.
+void roundToHalf(const AtmosphereTableSize& s, gl::Handle* const (&tables)[3],
+                 std::vector<gl::Handle>& halves) {
+  const int depth = s.sunZenith * s.sunView;
+  std::vector<float> texels(static_cast<std::size_t>(s.height) * s.viewZenith * depth * 4);
+  const GLsizei bytes = static_cast<GLsizei>(texels.size() * sizeof(float));
+  for (int i = 0; i < 3; ++i) {
+    if (!halves[static_cast<std::size_t>(i)]) continue;
+    glGetTextureImage(tables[i]->get(), 0, GL_RGBA, GL_FLOAT, bytes, texels.data());
+    glTextureSubImage3D(halves[static_cast<std::size_t>(i)].get(), 0, 0, 0, 0, s.height, s.viewZenith, depth,
+                        GL_RGBA, GL_FLOAT, texels.data());
+    *tables[i] = std::move(halves[static_cast<std::size_t>(i)]);
+  }
+}
+} // namespace
+
+void AtmosphereTablesPass::compute() {
+  const AtmospherePrecomputeOptions& o = info_.options;
+  times_.clear();
+  // halfFloatTables: compute into RGBA32F tables, then round them once into the RGBA16F ones (the stages
+  // store to rgba32f images and the orders read the tables they wrote).
+  std::vector<gl::Handle> halves;
+  if (info_.halfFloatTables) {
+    for (gl::Handle* table : {&single_, &singleMie_, &higher_}) {
+      halves.push_back(std::move(*table));
+      if (halves.back()) *table = createTable3D(o.size);
     }
   }
+  const gpu::AtmosphereParams params = gpu::atmosphereParams(info_.parameters, o);
+  gl::Handle block = gl::createDynamicBuffer(sizeof params);
+  glNamedBufferSubData(block.get(), 0, sizeof params, &params);
+  const TablePrograms programs = buildTablePrograms(o);
+
+  StageClock clock(times_);
+  glBindBufferBase(GL_UNIFORM_BUFFER, 0, block.get());
+  // Samplers of the texture units: none (each texture's own linear, clamp-to-edge state).
+  glBindSampler(0, 0);
+  const TableTextures t{opticalDepth_.get(), msLut_.get(), single_.get(), singleMie_.get(), higher_.get()};
+  computeSingle(o, t, programs, clock);
+  if (o.orders > 1 && !usesMultipleScatteringLut(o)) computeOrders(o, t, programs, clock);
 
   // E_sky.
-  glUseProgram(ambientProgram.get());
+  glUseProgram(programs.ambient.get());
   glBindTextureUnit(0, single_.get());
-  glBindTextureUnit(1, mieTable);
+  glBindTextureUnit(1, o.combinedMie ? single_.get() : singleMie_.get());
   glBindTextureUnit(2, higher_.get());
   glBindImageTexture(0, ambient_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
   glDispatchCompute(groups(o.ambientSize, 64), 1, 1);
   gl::passOutputBarrier();
-  endStage("ambient");
+  clock.end("ambient");
 
   gl::unbindPassState(3);
-  if (info_.halfFloatTables) { // round to RGBA16F through the host (GL converts float to half on upload)
-    std::vector<float> texels(static_cast<std::size_t>(s.height) * s.viewZenith * depth * 4);
-    const GLsizei bytes = static_cast<GLsizei>(texels.size() * sizeof(float));
-    gl::Handle* tables[] = {&single_, &singleMie_, &higher_};
-    for (int i = 0; i < 3; ++i) {
-      if (!halves[static_cast<std::size_t>(i)]) continue;
-      glGetTextureImage(tables[i]->get(), 0, GL_RGBA, GL_FLOAT, bytes, texels.data());
-      glTextureSubImage3D(halves[static_cast<std::size_t>(i)].get(), 0, 0, 0, 0, s.height, s.viewZenith,
-                          depth, GL_RGBA, GL_FLOAT, texels.data());
-      *tables[i] = std::move(halves[static_cast<std::size_t>(i)]);
-    }
-    endStage("RGBA16F rounding");
+  if (info_.halfFloatTables) {
+    roundToHalf(o.size, {&single_, &singleMie_, &higher_}, halves);
+    clock.end("RGBA16F rounding");
   }
   gl::checkError("AtmosphereTablesPass::compute");
 }

@@ -87,14 +87,6 @@ bool sphereRoots(const glm::dvec3& o, const glm::dvec3& v, double r, double& t0,
   return true;
 }
 
-void requireFiniteVector(const char* name, const glm::dvec3& x) {
-  if (!(std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z)))
-    throw InvalidArgument(name,
-                          "(" + detail::formatValue(x.x) + ", " + detail::formatValue(x.y) + ", " +
-                              detail::formatValue(x.z) + ")",
-                          "must be finite");
-}
-
 void validateRayOptions(const AtmosphereRayOptions& o) {
   if (o.shafts != AtmosphereShafts::None && o.shafts != AtmosphereShafts::Integrated &&
       o.shafts != AtmosphereShafts::LitLengthTable && o.shafts != AtmosphereShafts::PrefilteredVisibility)
@@ -290,6 +282,143 @@ double luminance(const glm::dvec3& c) {
   return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
 }
 
+/// Where a ray of atmosphereRay runs, in meters along it from C: Yusov's restrained camera (a camera above
+/// the atmosphere starts where its ray enters it), the ends of Eq. 8.
+struct RayGeometry {
+  glm::dvec3 C{0.0};           ///< the ray's start in the planet frame (meters)
+  double enter = 0.0;          ///< meters from the camera to C
+  double tX = 0.0, tTop = 0.0; ///< the end of the atmosphere or the ground (t_X); the top of the atmosphere
+  double sm = 0.0;             ///< the surface
+  double sEnd = 0.0;           ///< s_F (sky) or s_E
+  bool hitsGround = false;
+};
+
+/// The geometry of the ray from `C` along `v`, or nothing when it misses the atmosphere.
+std::optional<RayGeometry> rayGeometry(const AtmosphereParameters& p, glm::dvec3 C, const glm::dvec3& v,
+                                       double surfaceMeters, bool sky) {
+  const double R = p.earthRadius, top = R + p.atmosphereHeight;
+  RayGeometry g;
+  double t0 = 0.0, t1 = 0.0;
+  if (glm::length(C) > top) {
+    if (!sphereRoots(C, v, top, t0, t1) || !(t1 > 0.0)) return std::nullopt; // misses the atmosphere
+    g.enter = std::max(0.0, t0);
+    C += v * g.enter;
+  }
+  g.C = C;
+  if (sphereRoots(C, v, top, t0, t1)) g.tTop = std::max(0.0, t1);
+  g.tX = g.tTop;
+  if (sphereRoots(C, v, R, t0, t1) && t0 > 0.0) {
+    g.hitsGround = true;
+    g.tX = std::min(t0, g.tTop);
+  }
+  g.sm = std::max(0.0, surfaceMeters - g.enter);
+  g.sEnd = sky ? std::min(g.sm, g.tX) : std::min(g.sm, g.tTop); // s_F or s_E
+  return g;
+}
+
+/// The terms of one ray's radiance (Yusov 2013, Eq. 8 and "Light shafts"), each added in the order of the
+/// rule at the top of this file.
+struct RayTerms {
+  const AtmosphereTables& tables;
+  const AtmosphereShadowing& shadowing;
+  const AtmosphereRayOptions& options;
+  const RayGeometry& g;
+  double mpu = 1.0;
+  bool sky = false;
+  bool fromView = false; ///< the view tables: None, (b), (c) with a camera in the atmosphere
+
+  /// The table-based part of the radiance (all but (a)'s integrated single scattering and the view tables'
+  /// part) of the ray of `r`.
+  glm::dvec3 tablePart(RayEvaluator& r) const {
+    const double sEnd = g.sEnd;
+    const auto multiple = [&](double t) { return r.multiple(t); };
+    const auto higher = [&](double t) { return r.lookUp(tables.higherOrders, t); };
+    if (fromView) return sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd); // L_H only
+    if (options.shafts == AtmosphereShafts::None) return sky ? r.multiple(0.0) : r.eq8(multiple, sEnd);
+    // Unoccluded higher orders (MS-UnO).
+    glm::dvec3 part = sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd);
+    if (options.shafts == AtmosphereShafts::LitLengthTable) {
+      // SS-LUT: Eq. 8 with L1 between the first lit point and the end of the lit length.
+      const double litLength = std::max(0.0, shadowing.litLength) * mpu;
+      if (litLength > 0.0) {
+        const double first = shadowing.firstLit * mpu - g.enter;
+        const double a = std::clamp(first, 0.0, sEnd);
+        const double b = std::clamp(first + litLength, a, sEnd);
+        const glm::dvec3 l1C = r.single(0.0); // the first look-up is at C
+        const glm::dvec3 l1a = a > 0.0 ? r.single(a) : l1C;
+        const glm::dvec3 lit = r.segmentTransmittance(a) * l1a - r.segmentTransmittance(b) * r.single(b);
+        part += glm::max(lit, glm::dvec3(0.0));
+      }
+      if (sky) part += r.segmentTransmittance(sEnd) * r.single(sEnd);
+    } else if (options.shafts == AtmosphereShafts::PrefilteredVisibility) {
+      const glm::dvec3 l1C = r.single(0.0);
+      const glm::dvec3 beyond = r.segmentTransmittance(sEnd) * r.single(sEnd);
+      part += shadowing.visibility * (l1C - beyond);
+      if (sky) part += beyond;
+    }
+    return part;
+  }
+
+  /// tablePart() of `ray`; near the horizon the blend of a ray just below and one just above it
+  /// (horizonBlendWidth).
+  glm::dvec3 blendedTablePart(RayEvaluator& ray, const glm::dvec3& v, const glm::dvec3& l) const {
+    const AtmosphereParameters& p = tables.parameters;
+    const double R = p.earthRadius;
+    const double r = glm::length(g.C), c = glm::dot(g.C, v) / r;
+    const double ch = cosHorizon(p, r - R), eps = horizonBlendWidth(p, tables.options.size, r - R);
+    const glm::dvec3 n = g.C / r, across = v - c * n;
+    if (std::abs(c - ch) < eps && glm::length(across) > 1e-9) {
+      const glm::dvec3 u = glm::normalize(across);
+      const auto tilted = [&](double cz) { return cz * n + std::sqrt(std::max(0.0, 1.0 - cz * cz)) * u; };
+      RayEvaluator below(tables, g.C, tilted(ch - eps), l), above(tables, g.C, tilted(ch + eps), l);
+      const double w = (c - ch + eps) / (2.0 * eps);
+      return (1.0 - w) * tablePart(below) + w * tablePart(above);
+    }
+    return tablePart(ray);
+  }
+
+  /// L1 from the view tables: the volume in front of the far plane, the sky-view table's whole ray beyond it.
+  void addViewTables(glm::dvec3& radiance, const AtmosphereViewTables& view, const glm::dvec3& v,
+                     const glm::dvec3& l) const {
+    const AtmosphereParameters& p = tables.parameters;
+    const double sEnd = g.sEnd;
+    const double cosSunView = glm::dot(v, l);
+    const auto L1 = [&](double t) {
+      return t > 0.0 ? sampleAerialPerspective(view, p, v, t / mpu, cosSunView) : glm::dvec3(0.0);
+    };
+    const glm::dvec3 toEnd = L1(sEnd);
+    if (options.shafts == AtmosphereShafts::None) {
+      radiance += toEnd;
+    } else if (options.shafts == AtmosphereShafts::LitLengthTable) {
+      const double litLength = std::max(0.0, shadowing.litLength) * mpu;
+      if (litLength > 0.0) {
+        const double a = std::clamp(shadowing.firstLit * mpu, 0.0, sEnd);
+        const double b = std::clamp(shadowing.firstLit * mpu + litLength, a, sEnd);
+        radiance += glm::max(L1(b) - L1(a), glm::dvec3(0.0));
+      }
+    } else {
+      radiance += shadowing.visibility * toEnd;
+    }
+    if (sky) radiance += glm::max(sampleSkyView(view, p, v, cosSunView) - toEnd, glm::dvec3(0.0));
+  }
+
+  /// SS-Int: the lit sections, then (sky) the unshadowed rest to the end of the ray.
+  glm::dvec3 integratedSingle(RayEvaluator& ray) const {
+    glm::dvec3 single(0.0);
+    for (const glm::dvec2& section : shadowing.litSections) {
+      const double ta = std::clamp(section.x * mpu - g.enter, 0.0, g.sEnd);
+      const double tb = std::clamp(section.y * mpu - g.enter, 0.0, g.sEnd);
+      if (!(tb > ta)) continue;
+      const double share = std::ceil(options.integrationSteps * (tb - ta) / g.sm);
+      const int steps =
+          static_cast<int>(std::clamp(share, 1.0, static_cast<double>(options.integrationSteps)));
+      single += ray.trapezoid(ta, tb, steps);
+    }
+    if (sky && g.tX > g.sEnd) single += ray.skyQuadrature(g.sEnd, g.tX, options.skySteps);
+    return single;
+  }
+};
+
 } // namespace
 
 // The view tables' fields (atmosphere.h), named after `owner`.
@@ -319,136 +448,45 @@ AtmosphereRay atmosphereRay(const AtmosphereTables& tables, const AtmospherePlac
                             const AtmosphereViewTables* view) {
   validate(placement, tables.parameters);
   validateRayOptions(options);
-  requireFiniteVector("origin", origin);
-  requireFiniteVector("direction", direction);
+  requireFinite("origin", origin);
+  requireFinite("direction", direction);
   const double dirLength = glm::length(direction);
   if (!(dirLength > 0.0)) throw InvalidArgument("direction", "zero length", "must be a non-zero direction");
-  if (!(surface >= 0.0) || !std::isfinite(surface))
-    throw InvalidArgument("surface", detail::formatValue(surface), "must be finite and >= 0");
+  requireNonNegative("surface", surface);
 
   const AtmosphereParameters& p = tables.parameters;
-  const double R = p.earthRadius, top = R + p.atmosphereHeight, mpu = placement.metersPerUnit;
+  const double mpu = placement.metersPerUnit;
   const glm::dvec3 v = direction / dirLength;
   const glm::dvec3 l = -sun.direction();
-  glm::dvec3 C = atmospherePosition(placement, p, origin);
-
   AtmosphereRay out;
-  // Yusov's restrained camera: a camera above the atmosphere starts where its ray enters it.
-  double enter = 0.0;
-  double t0 = 0.0, t1 = 0.0;
-  if (glm::length(C) > top) {
-    if (!sphereRoots(C, v, top, t0, t1) || !(t1 > 0.0)) return out; // misses the atmosphere
-    enter = std::max(0.0, t0);
-    C += v * enter;
-  }
-  double tTop = 0.0;
-  if (sphereRoots(C, v, top, t0, t1)) tTop = std::max(0.0, t1);
-  bool hitsGround = false;
-  double tX = tTop;
-  if (sphereRoots(C, v, R, t0, t1) && t0 > 0.0) {
-    hitsGround = true;
-    tX = std::min(t0, tTop);
-  }
-  const double sm = std::max(0.0, surface * mpu - enter);
-  const double sEnd = sky ? std::min(sm, tX) : std::min(sm, tTop); // s_F or s_E
-
-  RayEvaluator ray(tables, C, v, l);
-  // The view tables: None, (b), (c) with a camera in the atmosphere.
-  const bool fromView = view && options.shafts != AtmosphereShafts::Integrated && enter == 0.0;
-  // The table-based part of the radiance (all but (a)'s integrated single scattering and the view tables'
-  // part) of the ray of `r`.
-  const auto tablePart = [&](RayEvaluator& r) {
-    const auto multiple = [&](double t) { return r.multiple(t); };
-    const auto higher = [&](double t) { return r.lookUp(tables.higherOrders, t); };
-    if (fromView) return sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd); // L_H only
-    if (options.shafts == AtmosphereShafts::None) return sky ? r.multiple(0.0) : r.eq8(multiple, sEnd);
-    // Unoccluded higher orders (MS-UnO).
-    glm::dvec3 part = sky ? r.lookUp(tables.higherOrders, 0.0) : r.eq8(higher, sEnd);
-    if (options.shafts == AtmosphereShafts::LitLengthTable) {
-      // SS-LUT: Eq. 8 with L1 between the first lit point and the end of the lit length.
-      const double litLength = std::max(0.0, shadowing.litLength) * mpu;
-      if (litLength > 0.0) {
-        const double first = shadowing.firstLit * mpu - enter;
-        const double a = std::clamp(first, 0.0, sEnd);
-        const double b = std::clamp(first + litLength, a, sEnd);
-        const glm::dvec3 l1C = r.single(0.0); // the first look-up is at C
-        const glm::dvec3 l1a = a > 0.0 ? r.single(a) : l1C;
-        const glm::dvec3 lit = r.segmentTransmittance(a) * l1a - r.segmentTransmittance(b) * r.single(b);
-        part += glm::max(lit, glm::dvec3(0.0));
-      }
-      if (sky) part += r.segmentTransmittance(sEnd) * r.single(sEnd);
-    } else if (options.shafts == AtmosphereShafts::PrefilteredVisibility) {
-      const glm::dvec3 l1C = r.single(0.0);
-      const glm::dvec3 beyond = r.segmentTransmittance(sEnd) * r.single(sEnd);
-      part += shadowing.visibility * (l1C - beyond);
-      if (sky) part += beyond;
-    }
-    return part;
-  };
-  // Near the horizon: the blend of a ray just below and one just above it (horizonBlendWidth).
-  glm::dvec3 radiance(0.0);
-  {
-    const double r = glm::length(C), c = glm::dot(C, v) / r;
-    const double ch = cosHorizon(p, r - R), eps = horizonBlendWidth(p, tables.options.size, r - R);
-    const glm::dvec3 n = C / r, across = v - c * n;
-    if (std::abs(c - ch) < eps && glm::length(across) > 1e-9) {
-      const glm::dvec3 u = glm::normalize(across);
-      const auto tilted = [&](double cz) { return cz * n + std::sqrt(std::max(0.0, 1.0 - cz * cz)) * u; };
-      RayEvaluator below(tables, C, tilted(ch - eps), l), above(tables, C, tilted(ch + eps), l);
-      const double w = (c - ch + eps) / (2.0 * eps);
-      radiance = (1.0 - w) * tablePart(below) + w * tablePart(above);
-    } else {
-      radiance = tablePart(ray);
-    }
-  }
-  if (fromView) { // L1: the volume in front of the far plane, the sky-view table's whole ray beyond it
-    const double cosSunView = glm::dot(v, l);
-    const auto L1 = [&](double t) {
-      return t > 0.0 ? sampleAerialPerspective(*view, p, v, t / mpu, cosSunView) : glm::dvec3(0.0);
-    };
-    const glm::dvec3 toEnd = L1(sEnd);
-    if (options.shafts == AtmosphereShafts::None) {
-      radiance += toEnd;
-    } else if (options.shafts == AtmosphereShafts::LitLengthTable) {
-      const double litLength = std::max(0.0, shadowing.litLength) * mpu;
-      if (litLength > 0.0) {
-        const double a = std::clamp(shadowing.firstLit * mpu, 0.0, sEnd);
-        const double b = std::clamp(shadowing.firstLit * mpu + litLength, a, sEnd);
-        radiance += glm::max(L1(b) - L1(a), glm::dvec3(0.0));
-      }
-    } else {
-      radiance += shadowing.visibility * toEnd;
-    }
-    if (sky) radiance += glm::max(sampleSkyView(*view, p, v, cosSunView) - toEnd, glm::dvec3(0.0));
-  }
-  if (options.shafts == AtmosphereShafts::Integrated) {
-    // SS-Int: the lit sections, then (sky) the unshadowed rest to the end of the ray.
-    glm::dvec3 single(0.0);
-    for (const glm::dvec2& section : shadowing.litSections) {
-      const double ta = std::clamp(section.x * mpu - enter, 0.0, sEnd);
-      const double tb = std::clamp(section.y * mpu - enter, 0.0, sEnd);
-      if (!(tb > ta)) continue;
-      const double share = std::ceil(options.integrationSteps * (tb - ta) / sm);
-      const int steps =
-          static_cast<int>(std::clamp(share, 1.0, static_cast<double>(options.integrationSteps)));
-      single += ray.trapezoid(ta, tb, steps);
-    }
-    if (sky && tX > sEnd) single += ray.skyQuadrature(sEnd, tX, options.skySteps);
-    radiance += single;
-  }
+  const std::optional<RayGeometry> geometry =
+      rayGeometry(p, atmospherePosition(placement, p, origin), v, surface * mpu, sky);
+  if (!geometry) return out; // misses the atmosphere
+  const RayGeometry& g = *geometry;
+  RayEvaluator ray(tables, g.C, v, l);
+  const RayTerms terms{tables,
+                       shadowing,
+                       options,
+                       g,
+                       mpu,
+                       sky,
+                       view && options.shafts != AtmosphereShafts::Integrated && g.enter == 0.0};
+  glm::dvec3 radiance = terms.blendedTablePart(ray, v, l);
+  if (terms.fromView) terms.addViewTables(radiance, *view, v, l);
+  if (options.shafts == AtmosphereShafts::Integrated) radiance += terms.integratedSingle(ray);
   // A sky pixel whose ray ends on the ground beyond the scene: the ground's reflected light.
-  if (sky && hitsGround && p.groundAlbedo > 0.0) {
-    const glm::dvec3 X = ray.at(tX);
+  if (sky && g.hitsGround && p.groundAlbedo > 0.0) {
+    const glm::dvec3 X = ray.at(g.tX);
     const double cosSun = glm::dot(X / glm::length(X), l);
     const glm::dvec3 direct = cosSun > 0.0 ? sunTransmittance(tables, X, l) * cosSun : glm::dvec3(0.0);
-    radiance += ray.segmentTransmittance(tX) * (p.groundAlbedo / std::numbers::pi) *
+    radiance += ray.segmentTransmittance(g.tX) * (p.groundAlbedo / std::numbers::pi) *
                 (direct + lookUpAmbientSkyLight(tables, cosSun));
   }
   out.inscattering = sun.irradiance() * radiance;
   if (sky)
-    out.transmittance = hitsGround ? glm::dvec3(0.0) : ray.transmittance(tX);
+    out.transmittance = g.hitsGround ? glm::dvec3(0.0) : ray.transmittance(g.tX);
   else
-    out.transmittance = ray.segmentTransmittance(sEnd);
+    out.transmittance = ray.segmentTransmittance(g.sEnd);
   return out;
 }
 

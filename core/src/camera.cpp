@@ -16,7 +16,7 @@ namespace crep {
 Camera::Camera(const glm::dvec3& position, const glm::dquat& orientation, double fovY, double aspect,
                double near, double far)
     : position_(position), fovY_(fovY), aspect_(aspect), near_(near), far_(far) {
-  detail::requireFiniteVec3("Camera.position", position);
+  requireFinite("Camera.position", position);
   const double qlen = std::sqrt(orientation.w * orientation.w + orientation.x * orientation.x +
                                 orientation.y * orientation.y + orientation.z * orientation.z);
   if (!std::isfinite(qlen) || qlen < 1e-12)
@@ -38,13 +38,8 @@ Camera::Camera(const glm::dvec3& position, const glm::dquat& orientation, double
 
 Camera Camera::fromMatrices(const glm::dmat4& v, const glm::dmat4& p, ClipDepth clipDepth,
                             double maxDistance) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r) {
-      if (!std::isfinite(v[c][r]))
-        throw InvalidArgument("Camera.viewFromWorld", detail::formatValue(v[c][r]), "must be finite");
-      if (!std::isfinite(p[c][r]))
-        throw InvalidArgument("Camera.clipFromView", detail::formatValue(p[c][r]), "must be finite");
-    }
+  requireFinite("Camera.viewFromWorld", v);
+  requireFinite("Camera.clipFromView", p);
   if (clipDepth != ClipDepth::NegativeOneToOne && clipDepth != ClipDepth::ZeroToOne)
     throw InvalidArgument("Camera.clipDepth", std::to_string(static_cast<int>(clipDepth)),
                           "must be NegativeOneToOne or ZeroToOne");
@@ -126,9 +121,9 @@ Camera Camera::fromMatrices(const glm::dmat4& v, const glm::dmat4& p, ClipDepth 
 
 Camera Camera::lookAt(const glm::dvec3& position, const glm::dvec3& target, const glm::dvec3& up, double fovY,
                       double aspect, double near, double far) {
-  detail::requireFiniteVec3("Camera.position", position);
-  detail::requireFiniteVec3("Camera.target", target);
-  detail::requireFiniteVec3("Camera.up", up);
+  requireFinite("Camera.position", position);
+  requireFinite("Camera.target", target);
+  requireFinite("Camera.up", up);
   const glm::dvec3 toTarget = target - position;
   const double dist = glm::length(toTarget);
   if (!(dist > 0.0) || !std::isfinite(dist))

@@ -325,6 +325,13 @@ void requireTexture2D(const char* parameter, std::uint32_t texture, int width, i
                                                     : ""));
 }
 
+long long requireBuffer(const char* parameter, std::uint32_t buffer, const std::string& requirement) {
+  if (buffer == 0 || glIsBuffer(buffer) != GL_TRUE) invalid(parameter, std::to_string(buffer), requirement);
+  GLint64 size = 0;
+  glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &size);
+  return static_cast<long long>(size);
+}
+
 void unbindPassState(int units) {
   glUseProgram(0);
   for (GLuint unit = 0; unit < static_cast<GLuint>(units); ++unit) {

@@ -14,13 +14,12 @@
 namespace crep {
 
 namespace {
-using detail::formatVec3;
 /// v / |v| for any finite non-zero v: scaled by its largest component first, so neither tiny (1e-300)
 /// nor huge (1e300) vectors under- or overflow in the length.
 glm::dvec3 unitDirection(const char* parameter, const glm::dvec3& v) {
   const double largest = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
   if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) || !(largest > 0.0))
-    throw InvalidArgument(parameter, formatVec3(v), "must be a finite, non-zero vector");
+    throw InvalidArgument(parameter, detail::formatValue(v), "must be a finite, non-zero vector");
   const glm::dvec3 scaled = v / largest;
   return scaled / glm::length(scaled);
 }
@@ -46,7 +45,7 @@ SpotLight::SpotLight(const SpotLightParams& p)
     : position_(p.position), direction_(unitDirection("SpotLight.direction", p.direction)),
       inner_(p.innerConeAngle), outer_(p.outerConeAngle), range_(p.range), near_(p.nearPlane),
       intensity_(p.color * p.intensity) {
-  detail::requireFiniteVec3("SpotLight.position", p.position);
+  requireFinite("SpotLight.position", p.position);
   const double quarter = 0.5 * std::numbers::pi;
   if (!std::isfinite(outer_) || !(outer_ > 0.0) || !(outer_ < quarter))
     throw InvalidArgument("SpotLight.outerConeAngle", detail::formatValue(outer_),
@@ -60,8 +59,7 @@ SpotLight::SpotLight(const SpotLightParams& p)
   if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range_))
     throw InvalidArgument("SpotLight.nearPlane", detail::formatValue(p.nearPlane), "must be in (0, range)");
   requireColor("SpotLight.color", p.color);
-  if (!std::isfinite(p.intensity) || !(p.intensity > 0.0))
-    throw InvalidArgument("SpotLight.intensity", detail::formatValue(p.intensity), "must be finite and > 0");
+  requirePositive("SpotLight.intensity", p.intensity);
   if (!(std::max({p.color.x, p.color.y, p.color.z}) > 0.0))
     throw InvalidArgument("SpotLight.color", "(0, 0, 0)", "at least one channel must be > 0");
   cosInner_ = std::cos(inner_);
@@ -88,7 +86,7 @@ glm::dmat4 SpotLight::lightClipFromLightView() const {
 
 PointLight::PointLight(const PointLightParams& p)
     : position_(p.position), range_(p.range), near_(p.nearPlane), intensity_(p.color * p.intensity) {
-  detail::requireFiniteVec3("PointLight.position", p.position);
+  requireFinite("PointLight.position", p.position);
   requirePositive("PointLight.range", range_);
   if (near_ == -1.0) near_ = range_ * 1e-3;
   if (!std::isfinite(near_) || !(near_ > 0.0) || !(near_ < range_))
@@ -96,8 +94,7 @@ PointLight::PointLight(const PointLightParams& p)
   requireColor("PointLight.color", p.color);
   if (!(std::max({p.color.x, p.color.y, p.color.z}) > 0.0))
     throw InvalidArgument("PointLight.color", "(0, 0, 0)", "at least one channel must be > 0");
-  if (!std::isfinite(p.intensity) || !(p.intensity > 0.0))
-    throw InvalidArgument("PointLight.intensity", detail::formatValue(p.intensity), "must be finite and > 0");
+  requirePositive("PointLight.intensity", p.intensity);
 }
 
 glm::dvec3 PointLight::faceAxis(int face) {

@@ -42,22 +42,16 @@ void validate(const EpipolarOptions& o) {
   if (o.slices < 0 || o.slices > kMaxEpipolarSlices)
     throw InvalidArgument("EpipolarOptions.slices", detail::formatValue(o.slices),
                           "must be 0 (automatic) or in [1, " + std::to_string(kMaxEpipolarSlices) + "]");
-  if (!(o.slicesPerBorderPixel > 0.0) || !std::isfinite(o.slicesPerBorderPixel))
-    throw InvalidArgument("EpipolarOptions.slicesPerBorderPixel", detail::formatValue(o.slicesPerBorderPixel),
-                          "must be finite and > 0");
+  requirePositive("EpipolarOptions.slicesPerBorderPixel", o.slicesPerBorderPixel);
   if (o.regions < 1 || o.regions > RectifyOptions::kMaxSplits)
     throw InvalidArgument("EpipolarOptions.regions", detail::formatValue(o.regions),
                           "must be in [1, " + std::to_string(RectifyOptions::kMaxSplits) + "]");
   if (o.regionScheme == SplitScheme::Blend)
     throw InvalidArgument("EpipolarOptions.regionScheme", "Blend", "must be Uniform or Logarithmic");
-  if (!(o.epipoleBlockRadius >= 0.0) || !std::isfinite(o.epipoleBlockRadius))
-    throw InvalidArgument("EpipolarOptions.epipoleBlockRadius", detail::formatValue(o.epipoleBlockRadius),
-                          "must be finite and >= 0");
+  requireNonNegative("EpipolarOptions.epipoleBlockRadius", o.epipoleBlockRadius);
   if (o.maxBlockPixels < 0)
     throw InvalidArgument("EpipolarOptions.maxBlockPixels", std::to_string(o.maxBlockPixels), "must be >= 0");
-  if (!(o.depthWarp >= 0.0) || !std::isfinite(o.depthWarp))
-    throw InvalidArgument("EpipolarOptions.depthWarp", detail::formatValue(o.depthWarp),
-                          "must be finite and >= 0");
+  requireNonNegative("EpipolarOptions.depthWarp", o.depthWarp);
 }
 
 // Sec. 4.1 (Baran-style epipolar coordinates) with Yusov Sec. 6.1: epipole, exit sides, border arc, slice

@@ -68,15 +68,9 @@ void validate(const EpipolarSamplingOptions& o, const std::string& owner) {
   if (o.initialStep < 1 || o.initialStep > o.samples || (o.initialStep & (o.initialStep - 1)) != 0)
     throw InvalidArgument(owner + ".initialStep", detail::formatValue(o.initialStep),
                           "must be a power of two in [1, samples]");
-  if (!(o.depthThreshold > 0.0) || !std::isfinite(o.depthThreshold))
-    throw InvalidArgument(owner + ".depthThreshold", detail::formatValue(o.depthThreshold),
-                          "must be finite and > 0");
-  if (!(o.scatteringThreshold > 0.0) || !std::isfinite(o.scatteringThreshold))
-    throw InvalidArgument(owner + ".scatteringThreshold", detail::formatValue(o.scatteringThreshold),
-                          "must be finite and > 0");
-  if (!(o.bilateralThreshold >= 0.0) || !std::isfinite(o.bilateralThreshold))
-    throw InvalidArgument(owner + ".bilateralThreshold", detail::formatValue(o.bilateralThreshold),
-                          "must be finite and >= 0");
+  requirePositive(owner + ".depthThreshold", o.depthThreshold);
+  requirePositive(owner + ".scatteringThreshold", o.scatteringThreshold);
+  requireNonNegative(owner + ".bilateralThreshold", o.bilateralThreshold);
   if (o.epipoleDensity < 1 || o.epipoleDensity > 64 || (o.epipoleDensity & (o.epipoleDensity - 1)) != 0)
     throw InvalidArgument(owner + ".epipoleDensity", detail::formatValue(o.epipoleDensity),
                           "must be a power of two in [1, 64] (1 = off)");

@@ -73,7 +73,7 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
     throw InvalidArgument(std::string(kCreate) + ".width", std::to_string(info.width), "must be > 0");
   if (info.height <= 0)
     throw InvalidArgument(std::string(kCreate) + ".height", std::to_string(info.height), "must be > 0");
-  validate(info.options, std::string(kCreate) + ".options");
+  crep::validate(info.options, std::string(kCreate) + ".options");
   const EpipolarSamplingOptions& o = info.options;
   gl::checkTextureSize("EpipolarSamplingPass::CreateInfo.width/height", info.width, info.height);
   if (info.width % o.downscale != 0)
@@ -132,15 +132,14 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
   gl::checkError("EpipolarSamplingPass");
 }
 
-void EpipolarSamplingPass::checkFrame(const FrameAttribs& f) const {
-  if (!f.camera) throw InvalidArgument("EpipolarSamplingPass::FrameAttribs.camera", "null", "must be set");
-  if (!f.light) throw InvalidArgument("EpipolarSamplingPass::FrameAttribs.light", "null", "must be set");
-  if (!f.medium) throw InvalidArgument("EpipolarSamplingPass::FrameAttribs.medium", "null", "must be set");
-  gl::requireTexture2D("EpipolarSamplingPass::FrameAttribs.cameraDepth", f.cameraDepth, info_.width,
-                       info_.height);
-  gl::requireDepthFormat("EpipolarSamplingPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  gl::requireTexture2D("EpipolarSamplingPass::FrameAttribs.output", f.output, info_.width, info_.height,
-                       GL_RGBA32F);
+void EpipolarSamplingPass::validate(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.camera) invalid(p + "camera", "null", "must be set");
+  if (!f.light) invalid(p + "light", "null", "must be set");
+  if (!f.medium) invalid(p + "medium", "null", "must be set");
+  gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth, info_.width, info_.height);
+  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+  gl::requireTexture2D((p + "output").c_str(), f.output, info_.width, info_.height, GL_RGBA32F);
 }
 
 void EpipolarSamplingPass::bindCommon(std::uint32_t program) const {
@@ -151,7 +150,7 @@ void EpipolarSamplingPass::bindCommon(std::uint32_t program) const {
 }
 
 void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
-  checkFrame(f);
+  validate(f);
   const EpipolarSamplingOptions& o = info_.options;
   lines_ = epipolarLines(*f.camera, *f.light, info_.width, info_.height, o);
   const gpu::MarchParams march =
@@ -213,7 +212,7 @@ void EpipolarSamplingPass::interpolate() {
 }
 
 void EpipolarSamplingPass::unwarp(const FrameAttribs& f) {
-  checkFrame(f);
+  validate(f);
   const GLuint out = info_.options.downscale > 1 ? target_.get() : f.output;
   correctionList_.output = out;
   evaluatorBarrier();
@@ -237,7 +236,7 @@ void EpipolarSamplingPass::unwarp(const FrameAttribs& f) {
 
 void EpipolarSamplingPass::upscale(const FrameAttribs& f) {
   if (info_.options.downscale == 1) return;
-  checkFrame(f);
+  validate(f);
   upscaleList_.output = f.output;
   evaluatorBarrier();
   gpu::clearSampleList(upscaleBuffer_.get());

@@ -29,12 +29,27 @@ LayoutKind layoutKind(const RectifiedLayout& layout) {
 // ---------------------------------------------------------------------------------------------------
 // MinMaxTreePass
 
+void requireTreeLevels(const char* parameter, int mapWidth) {
+  if (MinMaxTrees::levelCount(mapWidth) > 16)
+    throw GlError("crep: " + std::string(parameter) + " " + std::to_string(mapWidth) +
+                  " needs more than 16 tree levels");
+}
+
+void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
+                         const std::string& use) {
+  const long long size = gl::requireBuffer(
+      parameter, buffer, "must be the MinMaxTreePass::treeBuffer() of the map (" + use + ")");
+  const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(mapWidth)) * mapHeight * 8;
+  if (size < needed)
+    invalid(parameter, std::to_string(size) + " bytes",
+            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(mapWidth) + " x " +
+                std::to_string(mapHeight) + " map (" + std::to_string(needed) + " bytes)");
+}
+
 MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("MinMaxTreePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
+  requireTreeLevels("MinMaxTreePass::CreateInfo.mapWidth", info.mapWidth);
   levels_ = MinMaxTrees::levelCount(info.mapWidth);
-  if (levels_ > 16)
-    throw GlError("crep: MinMaxTreePass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
-                  " needs more than 16 tree levels");
   rowStride_ = MinMaxTrees::rowStrideFor(info.mapWidth);
   program_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/minmax_build.comp", {}}});
   buffer_ = gl::createBuffer();
@@ -105,9 +120,7 @@ constexpr GLuint kListBinding = 2;
 
 RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
-  if (MinMaxTrees::levelCount(info.mapWidth) > 16)
-    throw GlError("crep: RectifiedMarchPass::CreateInfo.mapWidth " + std::to_string(info.mapWidth) +
-                  " needs more than 16 tree levels");
+  requireTreeLevels("RectifiedMarchPass::CreateInfo.mapWidth", info.mapWidth);
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("RectifiedMarchPass");
@@ -134,56 +147,66 @@ void RectifiedMarchPass::prepare(gpu::LayoutKind kind, bool textured, bool list)
   program(kind, textured, list);
 }
 
-void RectifiedMarchPass::run(const FrameAttribs& f) {
-  if (!f.layout) throw InvalidArgument("RectifiedMarchPass::FrameAttribs.layout", "null", "must be set");
-  if (!f.camera || !f.medium)
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.camera/medium", "null", "must be set");
+/// A validated frame of the march (RectifiedMarchPass::validate) and what run() derives from it.
+struct RectifiedMarchPass::Plan {
+  GpuLayoutData layoutData;        ///< the map's layout block, serialized once per run
+  int width = 0, height = 0;       ///< the camera image
+  int outWidth = 0, outHeight = 0; ///< the textures written: the image's, or the list's
+};
+
+void RectifiedMarchPass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.layout) invalid(p + "layout", "null", "must be set");
+  if (!f.camera || !f.medium) invalid(p + "camera/medium", "null", "must be set");
   if ((f.light == nullptr) == (f.localLight == nullptr))
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.light/localLight",
-                          f.light ? "both set" : "both null", "exactly one must be set");
-  const GpuLayoutData layoutData = gpu::requireGpuLayout(*f.layout); // serialized once per run
-  const gpu::LayoutKind kind = layoutData.kind;
+    invalid(p + "light/localLight", f.light ? "both set" : "both null", "exactly one must be set");
+  Plan plan;
+  plan.layoutData = gpu::requireGpuLayout(*f.layout);
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "RectifiedMarchPass::CreateInfo.mapWidth/mapHeight");
   // The image size is the camera depth texture's own (gl::textureLevel); with a work list, imageWidth x
   // imageHeight when given, and the outputs are the list's.
   const gpu::SampleList* list = f.list;
   const gl::TextureLevel image =
-      list
-          ? gpu::listImageSize(f.imageWidth, f.imageHeight, f.cameraDepth, "RectifiedMarchPass::FrameAttribs")
-          : gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  const int width = image.width, height = image.height;
-  gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth, W, H);
-  gl::requireDepthFormat("RectifiedMarchPass::FrameAttribs.rectifiedDepth", f.rectifiedDepth);
-  if (!list) gl::requireDepthFormat("RectifiedMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  // The textures written: the image's, or the list's (its output and coordinates).
-  int outWidth = width, outHeight = height;
+      list ? gpu::listImageSize(f.imageWidth, f.imageHeight, f.cameraDepth, std::string(owner))
+           : gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
+  plan.width = plan.outWidth = image.width;
+  plan.height = plan.outHeight = image.height;
+  gl::requireTexture2D((p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
+  gl::requireDepthFormat((p + "rectifiedDepth").c_str(), f.rectifiedDepth);
+  if (!list) gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
   if (list) {
-    gpu::validateSampleList(*list, "RectifiedMarchPass::FrameAttribs.list");
-    outWidth = list->width;
-    outHeight = list->height;
+    gpu::validateSampleList(*list, p + "list");
+    plan.outWidth = list->width;
+    plan.outHeight = list->height;
   } else {
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
+    gl::requireTexture2D((p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
   }
   if (f.stepsOutput != 0)
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, outWidth, outHeight,
-                         GL_R32F);
-  if (f.lightColors != 0)
-    gl::requireTexture2D("RectifiedMarchPass::FrameAttribs.lightColors", f.lightColors, W, H);
-  const bool tree = info_.mode == Mode::MinMaxTree;
-  if (tree && (f.minMaxBuffer == 0 || !glIsBuffer(f.minMaxBuffer)))
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
-                          "must be the MinMaxTreePass::treeBuffer() of the map (MinMaxTree mode)");
-  if (tree) {
-    GLint64 size = 0;
-    glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
-    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
-    if (size < needed)
-      throw InvalidArgument("RectifiedMarchPass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
-                            "must hold the trees of a " + std::to_string(W) + " x " + std::to_string(H) +
-                                " map (" + std::to_string(needed) + " bytes)");
-  }
+    gl::requireTexture2D((p + "stepsOutput").c_str(), f.stepsOutput, plan.outWidth, plan.outHeight, GL_R32F);
+  if (f.lightColors != 0) gl::requireTexture2D((p + "lightColors").c_str(), f.lightColors, W, H);
+  if (info_.mode == Mode::MinMaxTree)
+    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "MinMaxTree mode");
+  if (list && f.blockRadius >= 0.0)
+    invalid(p + "blockRadius", detail::formatValue(f.blockRadius),
+            "must be -1 with a work list (the list says which texels to march)");
+  if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
+    invalid(p + "blockCenter/blockRadius", detail::formatValue(f.blockRadius), "must be finite");
+  gpu::LayoutBuffers::requireUploadable(plan.layoutData, H);
+  return plan;
+}
 
+void RectifiedMarchPass::run(const FrameAttribs& f) {
+  const Plan p = plan(f, "RectifiedMarchPass::FrameAttribs");
+  const gpu::LayoutKind kind = p.layoutData.kind;
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  const int width = p.width, height = p.height;
+  const gpu::SampleList* list = f.list;
+  const bool tree = info_.mode == Mode::MinMaxTree;
   const bool textured = f.lightColors != 0;
   const GLuint program = this->program(kind, textured, list != nullptr);
 
@@ -191,18 +214,15 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
       f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
                    : gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
-  if (list && f.blockRadius >= 0.0)
-    throw InvalidArgument("RectifiedMarchPass::FrameAttribs.blockRadius", detail::formatValue(f.blockRadius),
-                          "must be -1 with a work list (the list says which texels to march)");
   if (!gpu::setMarchRegion(params, width, height, f.blockCenter, list ? -1.0 : f.blockRadius,
                            "RectifiedMarchPass::FrameAttribs"))
     return; // the block misses the image
   glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-  layoutBuffers_.upload(layoutData, H);
+  layoutBuffers_.upload(p.layoutData, H);
 
   const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
                                           : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, outWidth, outHeight);
+                                                                 GL_R32F, p.outWidth, p.outHeight);
   // A work list reads its coordinates at the camera depth's unit and writes its own output.
   gpu::bindMarchResources(program, params_.get(), list ? list->coordinates : f.cameraDepth, f.rectifiedDepth,
                           sampler_.get(), list ? list->output : f.output, steps);

@@ -23,10 +23,7 @@
 namespace crep {
 
 void validateLightMatrix(const glm::dmat4& M, const glm::dvec3& lightDirection) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(M[c][r]))
-        throw InvalidArgument("lightClipFromWorld", detail::formatValue(M[c][r]), "must be finite");
+  requireFinite("lightClipFromWorld", M);
   if (M[0][3] != 0.0 || M[1][3] != 0.0 || M[2][3] != 0.0 || M[3][3] == 0.0)
     throw InvalidArgument("lightClipFromWorld", "a perspective matrix",
                           "must be affine (an orthographic shadow matrix: last row 0 0 0 w)");
@@ -48,12 +45,8 @@ void validateLightMatrix(const glm::dmat4& M, const glm::dvec3& lightDirection) 
 // A perspective projection centred at the light (Klehm et al. 2014, Sec. 3.2 "Local Lights": the light's
 // own shadow frustum): clip x = y = w = 0 at the light position.
 void validateLocalLightMatrix(const glm::dmat4& M, const glm::dvec3& lightPosition) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(M[c][r]))
-        throw InvalidArgument("lightClipFromWorld", detail::formatValue(M[c][r]), "must be finite");
-  if (!std::isfinite(lightPosition.x) || !std::isfinite(lightPosition.y) || !std::isfinite(lightPosition.z))
-    throw InvalidArgument("lightPosition", "not finite", "must be finite");
+  requireFinite("lightClipFromWorld", M);
+  requireFinite("lightPosition", lightPosition);
   if (std::abs(glm::determinant(M)) < 1e-300)
     throw InvalidArgument("lightClipFromWorld", "a singular matrix", "must be invertible");
   // Each of rows x, y, w must vanish at the light: the light is the centre of projection, every light ray
@@ -162,31 +155,45 @@ ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
   gl::checkError("ShadowResamplePass");
 }
 
-void ShadowResamplePass::run(const FrameAttribs& f) {
-  if (!f.layout) throw InvalidArgument("ShadowResamplePass::FrameAttribs.layout", "null", "must be set");
+/// A validated frame of the pass (ShadowResamplePass::validate) and what run() derives from it.
+struct ShadowResamplePass::Plan {
+  gl::TextureLevel shadow;  ///< the standard shadow map's level 0
+  GpuLayoutData layoutData; ///< the map's layout block
+};
+
+void ShadowResamplePass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+ShadowResamplePass::Plan ShadowResamplePass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.layout) invalid(p + "layout", "null", "must be set");
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
-  const gl::TextureLevel shadow =
-      gl::requireTexture2D("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
-  gl::requireDepthFormat("ShadowResamplePass::FrameAttribs.shadowMap", f.shadowMap);
-  gl::requireTexture2D("ShadowResamplePass::FrameAttribs.output", f.output, W, H, GL_R32F);
+  Plan plan;
+  plan.shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
+  gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
+  gl::requireTexture2D((p + "output").c_str(), f.output, W, H, GL_R32F);
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
+  if (f.minMaxBuffer != 0) {
+    if (MinMaxTreePass::lowLevels(W) < 1)
+      invalid(p + "minMaxBuffer", std::to_string(f.minMaxBuffer),
+              "needs a map wider than 64 texels (no low tree levels below the top 6)");
+    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H,
+                        "its low levels are written here");
+  }
+  plan.layoutData = gpu::requireGpuLayout(*f.layout);
+  gpu::LayoutBuffers::requireUploadable(plan.layoutData, H);
+  return plan;
+}
 
+void ShadowResamplePass::run(const FrameAttribs& f) {
+  const Plan checked = plan(f, "ShadowResamplePass::FrameAttribs");
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  const gl::TextureLevel& shadow = checked.shadow;
   const bool trees = f.minMaxBuffer != 0;
   const int lowLevels = MinMaxTreePass::lowLevels(W);
-  if (trees) {
-    if (lowLevels < 1)
-      throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(f.minMaxBuffer),
-                            "needs a map wider than 64 texels (no low tree levels below the top 6)");
-    GLint64 size = 0;
-    if (glIsBuffer(f.minMaxBuffer)) glGetNamedBufferParameteri64v(f.minMaxBuffer, GL_BUFFER_SIZE, &size);
-    const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(W)) * H * 8;
-    if (size < needed)
-      throw InvalidArgument("ShadowResamplePass::FrameAttribs.minMaxBuffer", std::to_string(size) + " bytes",
-                            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(W) + " x " +
-                                std::to_string(H) + " map (" + std::to_string(needed) + " bytes)");
-  }
-  const gpu::LayoutKind kind = layoutBuffers_.upload(*f.layout, H);
+  const gpu::LayoutKind kind = layoutBuffers_.upload(checked.layoutData, H);
   gl::Handle& program = programs_[static_cast<int>(kind)][trees ? 1 : 0];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,

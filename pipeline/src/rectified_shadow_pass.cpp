@@ -8,13 +8,6 @@
 
 namespace crep {
 
-namespace {
-[[noreturn]] void invalid(const std::string& parameter, const std::string& value,
-                          const std::string& requirement) {
-  throw InvalidArgument(parameter, value, requirement);
-}
-} // namespace
-
 RectifiedShadowPass::RectifiedShadowPass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("RectifiedShadowPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   framebuffer_ = gl::createFramebuffer();
@@ -32,24 +25,29 @@ std::size_t RectifiedShadowPass::memoryBytes() const noexcept {
                   : 0;
 }
 
-void RectifiedShadowPass::run(const FrameAttribs& frame) {
-  gl::requireNotMovedFrom(framebuffer_, "RectifiedShadowPass");
+void RectifiedShadowPass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
   const Rectification* r = frame.rectification;
-  if (r == nullptr) invalid("RectifiedShadowPass::FrameAttribs.rectification", "null", "must be set");
+  if (r == nullptr) invalid(p + "rectification", "null", "must be set");
   if (!r->projective())
-    invalid("RectifiedShadowPass::FrameAttribs.rectification", r->message,
-            "must be projective (else use the epipolar fallback)");
+    invalid(p + "rectification", r->message, "must be projective (else use the epipolar fallback)");
   if (r->layout != SplitLayout::Regions)
-    invalid("RectifiedShadowPass::FrameAttribs.rectification", "SplitLayout::Layers",
+    invalid(p + "rectification", "SplitLayout::Layers",
             "must use SplitLayout::Regions (the splits side by side in one map)");
-  if (!frame.drawCasters) invalid("RectifiedShadowPass::FrameAttribs.drawCasters", "empty", "must be set");
+  if (!frame.drawCasters) invalid(p + "drawCasters", "empty", "must be set");
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (W % r->splitCount() != 0)
     invalid("RectifiedShadowPass::CreateInfo.mapWidth", std::to_string(W),
             "must be a multiple of the split count " + std::to_string(r->splitCount()));
-  if (frame.depthTexture != 0)
-    gl::requireTexture2D("RectifiedShadowPass::FrameAttribs.depthTexture", frame.depthTexture, W, H);
-  else if (!texture_)
+  if (frame.depthTexture != 0) gl::requireTexture2D((p + "depthTexture").c_str(), frame.depthTexture, W, H);
+}
+
+void RectifiedShadowPass::run(const FrameAttribs& frame) {
+  gl::requireNotMovedFrom(framebuffer_, "RectifiedShadowPass");
+  validate(frame);
+  const Rectification* r = frame.rectification;
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  if (frame.depthTexture == 0 && !texture_)
     texture_ = gl::createTexture2D(GL_DEPTH_COMPONENT32F, W, H,
                                    "RectifiedShadowPass::CreateInfo.mapWidth/mapHeight");
   const std::uint32_t target = frame.depthTexture != 0 ? frame.depthTexture : texture_.get();

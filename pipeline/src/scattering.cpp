@@ -44,10 +44,6 @@ const char* layoutToken(Scattering::Layout layout) {
 
 namespace {
 
-void invalid(const std::string& parameter, const std::string& value, const std::string& requirement) {
-  throw InvalidArgument(parameter, value, requirement);
-}
-
 const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   gl::checkTextureSize("Scattering::CreateInfo.width/height", info.width, info.height);
   gl::checkTextureSize("Scattering::CreateInfo.mapSize", info.mapSize, info.mapSize);
@@ -86,15 +82,11 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.mapSize", std::to_string(info.mapSize),
             "must be a multiple of epipolarRegions * prefilter.regionsPerSplit = " +
                 std::to_string(epipolarRegions));
-  if (!(info.localLightDepthWarp >= 0.0 && std::isfinite(info.localLightDepthWarp)))
-    invalid("Scattering::CreateInfo.localLightDepthWarp", detail::formatValue(info.localLightDepthWarp),
-            "must be finite and >= 0");
+  requireNonNegative("Scattering::CreateInfo.localLightDepthWarp", info.localLightDepthWarp);
   if (!(info.epipolarDepthWarp >= 0.0 && std::isfinite(info.epipolarDepthWarp)))
     invalid("Scattering::CreateInfo.epipolarDepthWarp", detail::formatValue(info.epipolarDepthWarp),
             "must be finite and >= 0 (radians; 0 = linear depth)");
-  if (!(info.ownShadowMapBias >= 0.0 && std::isfinite(info.ownShadowMapBias)))
-    invalid("Scattering::CreateInfo.ownShadowMapBias", detail::formatValue(info.ownShadowMapBias),
-            "must be finite and >= 0");
+  requireNonNegative("Scattering::CreateInfo.ownShadowMapBias", info.ownShadowMapBias);
   if (info.evaluationScale != 1.0 && info.evaluationScale != 0.5 && info.evaluationScale != 0.25)
     invalid("Scattering::CreateInfo.evaluationScale", detail::formatValue(info.evaluationScale),
             "must be 1, 0.5 or 0.25");
@@ -159,7 +151,7 @@ void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map
                       std::span<const glm::dvec3> directions, const std::string& what) {
   gl::requireTexture2D((field + ".texture").c_str(), map.texture);
   gl::requireDepthFormat((field + ".texture").c_str(), map.texture);
-  if (!std::isfinite(map.bias)) invalid(field + ".bias", detail::formatValue(map.bias), "must be finite");
+  requireFinite(field + ".bias", map.bias);
   try {
     validateLocalLightMatrix(map.lightClipFromWorld, position);
   } catch (const InvalidArgument& e) {
@@ -171,8 +163,7 @@ void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map
 
 /// The local lights' shadow inputs (Klehm et al. 2014, Sec. 3.2 "Local Lights"; scattering.h): span sizes,
 /// each given map, drawCasters for the lights without maps.
-void validateLocalShadowMaps(const Scattering::FrameAttribs& f) {
-  const std::string prefix = "Scattering::FrameAttribs.";
+void validateLocalShadowMaps(const Scattering::FrameAttribs& f, const std::string& prefix) {
   if (!f.spotShadowMaps.empty() && f.spotShadowMaps.size() != f.spotLights.size())
     invalid(prefix + "spotShadowMaps", "size " + std::to_string(f.spotShadowMaps.size()),
             "must be 0 or spotLights.size() = " + std::to_string(f.spotLights.size()));
@@ -211,8 +202,8 @@ void validateLocalShadowMaps(const Scattering::FrameAttribs& f) {
 
 /// The light textures (scattering.h "Light textures"): the directional light's and the spots' (span size,
 /// each texture and projection), and the evaluation options without a textured variant.
-void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOptions& evaluate) {
-  const std::string prefix = "Scattering::FrameAttribs.";
+void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOptions& evaluate,
+                           const std::string& prefix) {
   if (!f.spotLightTextures.empty() && f.spotLightTextures.size() != f.spotLights.size())
     invalid(prefix + "spotLightTextures", "size " + std::to_string(f.spotLightTextures.size()),
             "must be 0 or spotLights.size() = " + std::to_string(f.spotLights.size()));
@@ -243,27 +234,26 @@ void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOpti
 }
 
 /// FrameAttribs::froxels (scattering.h "Froxel volumes"): grid, jitter, the volume's target, format, size.
-void validateFroxelTarget(const Scattering::FroxelTarget& t, const Camera& camera) {
-  const char* owner = "Scattering::FrameAttribs.froxels";
-  validate(t.grid, owner);
-  froxelDepthRange(t.grid, camera, owner);
-  validateFroxelJitter(t.jitter, "Scattering::FrameAttribs.froxels.jitter");
-  const gl::TextureLevel v = gl::textureLevel("Scattering::FrameAttribs.froxels.volume", t.volume);
+void validateFroxelTarget(const Scattering::FroxelTarget& t, const Camera& camera, const std::string& owner) {
+  validate(t.grid, owner.c_str());
+  froxelDepthRange(t.grid, camera, owner.c_str());
+  validateFroxelJitter(t.jitter, owner + ".jitter");
+  const gl::TextureLevel v = gl::textureLevel((owner + ".volume").c_str(), t.volume);
   if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
-    invalid("Scattering::FrameAttribs.froxels.volume", "texture " + std::to_string(t.volume),
+    invalid(owner + ".volume", "texture " + std::to_string(t.volume),
             "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
   if (v.width != t.grid.width || v.height != t.grid.height || v.depth != t.grid.depth)
-    invalid("Scattering::FrameAttribs.froxels.volume",
+    invalid(owner + ".volume",
             std::to_string(v.width) + " x " + std::to_string(v.height) + " x " + std::to_string(v.depth),
             "must have the grid's size " + std::to_string(t.grid.width) + " x " +
                 std::to_string(t.grid.height) + " x " + std::to_string(t.grid.depth));
 }
 
 /// FrameAttribs::output is written while the inputs are read: it must be none of them.
-void requireOutputNotAnInput(const Scattering::FrameAttribs& f) {
+void requireOutputNotAnInput(const Scattering::FrameAttribs& f, const std::string& prefix) {
   const auto check = [&](std::uint32_t input, const std::string& name) {
     if (input != 0 && input == f.output)
-      invalid("Scattering::FrameAttribs.output", "texture " + std::to_string(f.output) + ", also " + name,
+      invalid(prefix + "output", "texture " + std::to_string(f.output) + ", also " + name,
               "must not be one of the frame's inputs");
   };
   check(f.cameraDepth, "FrameAttribs.cameraDepth");
@@ -452,6 +442,35 @@ struct Scattering::Impl {
     const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
     return {name, timer.milliseconds(), wall.count()};
   }
+  /// timedStage() appended to the frame's stages.
+  template <class Work>
+  void stage(FrameResult& r, const char* name, const Work& work) {
+    r.stages.push_back(timedStage(name, work));
+  }
+
+  /// The directional light's map of a frame: its layout and texture, the standard shadow map of an
+  /// epipolar frame (the engine's, or `own` rendered with drawCasters), the light colours.
+  struct DirectionalMap {
+    std::shared_ptr<const RectifiedLayout> layout;
+    std::uint32_t map = 0, colors = 0;
+    ShadowMap own;
+    const ShadowMap* shadow = nullptr;
+    bool treesFromResample = false; ///< the resampling wrote the trees' low levels
+  };
+  bool marching() const { return info.method == Method::MinMaxMarch; }
+  void projectiveMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d);
+  void epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d);
+  void evaluateRays(const FrameAttribs& f, const DirectionalMap& d, std::uint32_t depth, std::uint32_t output,
+                    const gpu::SampleList* list, bool reuseTable);
+  void evaluatePixels(const FrameAttribs& f, FrameResult& r, const DirectionalMap& d);
+  void epipoleBlock(const FrameAttribs& f, FrameResult& r, const DirectionalMap& d);
+
+  struct LocalLightRun;
+  void runLocalLight(const FrameAttribs& f, FrameResult& r, const LocalLight& light,
+                     const Rectification& rect, const glm::dmat4& lightClipFromWorld, const ShadowMap* given,
+                     const GpuLightTexture* texture, LightResult result);
+  /// Adds the local light's scattering to the output.
+  void addLocalScattering(const FrameAttribs& f);
 };
 
 Scattering::Scattering(const CreateInfo& info) : impl_(std::make_unique<Impl>(info)) {}
@@ -527,282 +546,453 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   }
 }
 
-Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
-  Impl& m = *impl_;
-  const CreateInfo& info = m.info;
+void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
+  if (!impl_)
+    invalid("Scattering", "a moved-from object",
+            "owns no GPU resources: assign a constructed Scattering first");
+  const CreateInfo& info = impl_->info;
+  const std::string p = std::string(owner) + ".";
   const bool local = !f.spotLights.empty() || !f.pointLights.empty();
-  if (!f.camera) invalid("Scattering::FrameAttribs.camera", "null", "must be set");
-  if (!f.light && !local)
-    invalid("Scattering::FrameAttribs.light", "null", "must be set unless local lights are given");
-  if (!f.medium) invalid("Scattering::FrameAttribs.medium", "null", "must be set");
+  if (!f.camera) invalid(p + "camera", "null", "must be set");
+  if (!f.light && !local) invalid(p + "light", "null", "must be set unless local lights are given");
+  if (!f.medium) invalid(p + "medium", "null", "must be set");
   if (f.output != 0 || !f.froxels) { // a froxel volume alone reads no camera depth
-    gl::requireTexture2D("Scattering::FrameAttribs.cameraDepth", f.cameraDepth, info.width, info.height);
-    gl::requireTexture2D("Scattering::FrameAttribs.output", f.output, info.width, info.height, GL_RGBA32F);
-    requireOutputNotAnInput(f);
-    gl::requireDepthFormat("Scattering::FrameAttribs.cameraDepth", f.cameraDepth);
+    gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth, info.width, info.height);
+    gl::requireTexture2D((p + "output").c_str(), f.output, info.width, info.height, GL_RGBA32F);
+    requireOutputNotAnInput(f, p);
+    gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
   }
   if (f.froxels) {
     if (!f.light)
-      invalid("Scattering::FrameAttribs.froxels", "set without a directional light",
+      invalid(p + "froxels", "set without a directional light",
               "needs FrameAttribs::light (local lights are not added to froxel volumes)");
     if (f.output == 0 && local)
-      invalid("Scattering::FrameAttribs.output", "0",
+      invalid(p + "output", "0",
               "must be set with local lights (they are added to the per-pixel output only)");
-    validateFroxelTarget(*f.froxels, *f.camera);
+    validateFroxelTarget(*f.froxels, *f.camera, p + "froxels");
     if (info.method != Method::Prefiltered)
-      invalid("Scattering::FrameAttribs.froxels", "set with CreateInfo.method = Method::MinMaxMarch",
+      invalid(p + "froxels", "set with CreateInfo.method = Method::MinMaxMarch",
               "needs Method::Prefiltered (the fill evaluates the prefiltered basis)");
   }
   if (f.light && !f.drawCasters && !f.shadowMap)
-    invalid("Scattering::FrameAttribs.drawCasters/shadowMap", "both empty", "one shadow input must be given");
-  validateLocalShadowMaps(f);
-  validateLightTextures(f, info.evaluate);
+    invalid(p + "drawCasters/shadowMap", "both empty", "one shadow input must be given");
+  validateLocalShadowMaps(f, p);
+  validateLightTextures(f, info.evaluate, p);
+  if (f.light && f.shadowMap) {
+    gl::requireTexture2D((p + "shadowMap.texture").c_str(), f.shadowMap->texture);
+    gl::requireDepthFormat((p + "shadowMap.texture").c_str(), f.shadowMap->texture);
+    requireFinite(p + "shadowMap.bias", f.shadowMap->bias);
+    try {
+      validateLightMatrix(f.shadowMap->lightClipFromWorld, f.light->direction());
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(p + "shadowMap.lightClipFromWorld", e.what(),
+                            "an orthographic shadow matrix looking along the light");
+    }
+  }
+}
+
+Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
+  Impl& m = *impl_;
+  validate(f);
+  FrameResult r;
   if (!f.light) {
     // A night frame: the transmittance, then the local lights added.
-    FrameResult r;
-    r.stages.push_back(m.timedStage("transmittance", [&] { m.writeTransmittance(f); }));
+    m.stage(r, "transmittance", [&] { m.writeTransmittance(f); });
     runLocalLights(f, r);
     gl::checkError("Scattering::run");
     return r;
   }
-  // The epipole block of an epipolar layout is tree-marched this frame (Fig. 8's block on screen).
-  const auto treeMarchedBlock = [&](const EpipolarLayout& epipolar) {
-    return info.method == Method::Prefiltered && info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch &&
-           epipolar.epipolePixel().has_value() && epipolar.epipoleBlockRadiusPixels() > 0.0;
-  };
-  bool treesFromResample = false; // the resampling wrote the trees' low levels
-  if (f.shadowMap) {
-    gl::requireTexture2D("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
-    gl::requireDepthFormat("Scattering::FrameAttribs.shadowMap.texture", f.shadowMap->texture);
-    if (!std::isfinite(f.shadowMap->bias))
-      invalid("Scattering::FrameAttribs.shadowMap.bias", detail::formatValue(f.shadowMap->bias),
-              "must be finite");
-    try {
-      validateLightMatrix(f.shadowMap->lightClipFromWorld, f.light->direction());
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument("Scattering::FrameAttribs.shadowMap.lightClipFromWorld", e.what(),
-                            "an orthographic shadow matrix looking along the light");
-    }
-  }
-
-  FrameResult r;
-  const auto stage = [&](const char* name, const auto& work) {
-    r.stages.push_back(m.timedStage(name, work));
-  };
-  r.rectification = rectify(*f.camera, *f.light, info.rectify);
-  std::shared_ptr<const RectifiedLayout> layout;
-  std::uint32_t map = 0;
-  ShadowMap own;
-  const ShadowMap* shadow = f.shadowMap;
-  if (r.rectification.projective()) {
-    // Klehm et al. 2014, Sec. 4.2: the casters rendered once per split with its matrix.
-    r.layout = Layout::Projective;
-    auto projective = std::make_shared<const ProjectiveLayout>(r.rectification);
-    layout = projective;
-    if (f.drawCasters) {
-      stage("shadow pass (rectified)", [&] {
-        m.rectified.run(
-            {&r.rectification, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
-      });
-      map = m.rectified.depthTexture();
-    } else {
-      stage("resample (projective)", [&] {
-        m.resample.run({projective.get(), shadow->texture, shadow->lightClipFromWorld, m.resampled.get()});
-      });
-      map = m.resampled.get();
-    }
-  } else {
-    // Sec. 4.1: the standard shadow map resampled into epipolar slices (mapSize of them, so the cost of the
-    // frame stays that of a projective one).
-    r.layout = Layout::Epipolar;
-    EpipolarOptions options;
-    options.slices = info.mapSize;
-    options.referenceRay = info.rectify.referenceRay;
-    options.regions = info.epipolarRegions;
-    options.depthWarp = info.epipolarDepthWarp;
-    options.epipoleBlockRadius = info.epipoleBlockRadius;
-    options.maxBlockPixels = info.epipoleBlockMaxPixels;
-    auto epipolar =
-        std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
-    layout = epipolar;
-    if (!shadow) {
-      if (!m.ownShadowMap) m.ownShadowMap.emplace(info.ownShadowMapSize);
-      own.texture = m.ownShadowMap->texture.get();
-      // A standard map covering the frustum (casters between the light and it are kept by GL_DEPTH_CLAMP).
-      own.lightClipFromWorld = orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners());
-      own.bias = info.ownShadowMapBias;
-      stage("shadow pass (standard)", [&] {
-        m.ownShadowMap->render("Scattering::FrameAttribs.drawCasters",
-                               [&] { f.drawCasters(own.lightClipFromWorld); });
-      });
-      shadow = &own;
-    }
-    r.shadowMap = *shadow;
-    // A tree-marched epipole block needs the map's min/max trees: their low levels are written by the
-    // resampling itself (the map read once), the rest after it (the block's stage below).
-    treesFromResample =
-        treeMarchedBlock(*epipolar) && f.output != 0 && MinMaxTreePass::lowLevels(info.mapSize) >= 1;
-    stage("resample (epipolar)", [&] {
-      m.resample.run({epipolar.get(), shadow->texture, shadow->lightClipFromWorld, m.resampled.get(),
-                      treesFromResample ? m.trees->treeBuffer() : 0u});
-    });
-    map = m.resampled.get();
-  }
-  r.rectifiedMap = {layout, map, info.mapSize, info.mapSize};
+  r.rectification = rectify(*f.camera, *f.light, m.info.rectify);
+  Impl::DirectionalMap d;
+  d.shadow = f.shadowMap;
+  if (r.rectification.projective())
+    m.projectiveMap(f, r, d);
+  else
+    m.epipolarMap(f, r, d);
+  r.rectifiedMap = {d.layout, d.map, m.info.mapSize, m.info.mapSize};
   // Light textures (Klehm et al. 2014, Sec. 3.2): the colour of every texel's light ray on this frame's
   // layout (projective or epipolar), prefiltered per colour channel.
-  std::uint32_t colors = 0;
   if (f.lightTexture)
-    stage("light colours", [&] { colors = m.lightColors(*layout, *f.lightTexture, f.light, nullptr); });
-  const bool marching = info.method == Method::MinMaxMarch;
-  if (marching)
-    stage("min/max trees", [&] { m.trees->run(map); });
+    m.stage(r, "light colours",
+            [&] { d.colors = m.lightColors(*d.layout, *f.lightTexture, f.light, nullptr); });
+  if (m.marching())
+    m.stage(r, "min/max trees", [&] { m.trees->run(d.map); });
   else
-    stage("prefilter", [&] {
+    m.stage(r, "prefilter", [&] {
       m.prefilter.run(
-          {.rectifiedDepth = map, .layout = layout.get(), .medium = f.medium, .lightColors = colors});
+          {.rectifiedDepth = d.map, .layout = d.layout.get(), .medium = f.medium, .lightColors = d.colors});
     });
-  // The method on a camera depth image into `output`, or on a GPU work list (epipolar sampling's samples
-  // and corrections: EvaluatePass / RectifiedMarchPass FrameAttribs::list).
-  const auto evaluateRays = [&](std::uint32_t depth, std::uint32_t output, const gpu::SampleList* list,
-                                bool reuseTable) {
-    if (marching) {
-      RectifiedMarchPass::FrameAttribs a;
-      a.layout = layout.get();
-      a.camera = f.camera;
-      a.light = f.light;
-      a.medium = f.medium;
-      a.cameraDepth = depth;
-      a.rectifiedDepth = map;
-      a.minMaxBuffer = m.trees->treeBuffer();
-      a.output = output;
-      a.lightColors = colors;
-      a.list = list;
-      if (list) {
-        a.imageWidth = info.width;
-        a.imageHeight = info.height;
-      }
-      m.march->run(a);
-    } else {
-      EvaluatePass::FrameAttribs e;
-      e.cameraDepth = depth;
-      e.output = output;
-      e.camera = f.camera;
-      e.light = f.light;
-      e.medium = f.medium;
-      e.layout = layout.get();
-      e.basis = m.prefilter.filteredBasis();
-      e.list = list;
-      if (list) {
-        e.imageWidth = info.width;
-        e.imageHeight = info.height;
-      }
-      e.reuseTable = reuseTable;
-      m.evaluate.run(e);
-    }
-  };
   const bool pixels = f.output != 0;
-  if (m.reduced && pixels)
-    stage("downsample depth", [&] { m.reduced->downsample(f.cameraDepth, m.lowDepth.get()); });
-  if (pixels && !m.sampling)
-    stage(marching ? "march" : "evaluate", [&] {
-      evaluateRays(m.reduced ? m.lowDepth.get() : f.cameraDepth, m.reduced ? m.lowOutput.get() : f.output,
-                   nullptr, false);
-    });
-  if (pixels && m.sampling) {
-    // Yusov 2012, Sec. 6: samples along epipolar lines, refined at breaks; the method evaluates the
-    // selected ones and the pixels the unwarp cannot serve (the lists, no read-back).
-    const EpipolarSamplingPass::FrameAttribs s{f.camera, f.light, f.medium, f.cameraDepth, f.output};
-    EpipolarSamplingPass& pass = *m.sampling;
-    stage("epipolar samples", [&] { pass.placeSamples(s); });
-    stage("refine samples", [&] { pass.refine(); });
-    stage(marching ? "march samples" : "evaluate samples",
-          [&] { evaluateRays(0, 0, &pass.sampleList(), false); });
-    stage("interpolate", [&] { pass.interpolate(); });
-    stage("unwarp", [&] { pass.unwarp(s); });
-    stage("correct", [&] { evaluateRays(0, 0, &pass.correctionList(), true); });
-    if (info.epipolarSampling.downscale > 1) {
-      stage("upscale", [&] { pass.upscale(s); });
-      stage("correct (full)", [&] { evaluateRays(0, 0, &pass.upscaleCorrectionList(), true); });
-    }
-    if (info.stageTimings) {
-      const EpipolarSamplingPass::Statistics st = pass.statistics();
-      r.sampling = {st.validSamples, st.marchedSamples, st.correctedPixels, st.correctedFullPixels};
-    }
-  }
-  if (m.reduced && pixels)
-    stage("upsample", [&] {
-      m.reduced->upsample(m.lowOutput.get(), m.lowDepth.get(), f.cameraDepth, f.output, *f.camera);
-    });
+  if (pixels) m.evaluatePixels(f, r, d);
   if (f.froxels)
-    stage("froxels", [&] {
+    m.stage(r, "froxels", [&] {
       // The same basis evaluated at the volume's cells (EvaluatePass::FrameAttribs::froxels), from the
       // scattering prefix table the per-pixel evaluation built (reuseTable), so the stage times the fill.
       EvaluatePass::FrameAttribs e;
       e.camera = f.camera;
       e.light = f.light;
       e.medium = f.medium;
-      e.layout = layout.get();
+      e.layout = d.layout.get();
       e.basis = m.prefilter.filteredBasis();
       e.froxels = {f.froxels->volume, f.froxels->grid, f.froxels->jitter};
       e.reuseTable = pixels;
       m.evaluate.run(e);
     });
-  if (r.layout == Layout::Epipolar && pixels && !marching) {
-    const auto& epipolar = static_cast<const EpipolarLayout&>(*layout);
-    const auto centre = epipolar.epipolePixel();
-    const double radius = epipolar.epipoleBlockRadiusPixels();
-    if (centre && radius > 0.0) {
-      // Fig. 8: the pixels next to the epipole, where the slices converge and the prefilter's weights, exact
-      // for one reference ray per region, fit the rays nearly parallel to the light worst.
-      r.epipoleBlockRadius = radius;
-      if (info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch) {
-        // The min/max tree march over the same epipolar map (Chen et al. 2011; Yusov 2012, Algorithm 2):
-        // exact visibility on the map, the walk skipping lit and shadowed runs of texels whole, so the cost
-        // is the block's pixels (at most epipoleBlockMaxPixels) times a short walk.
-        stage("min/max trees (epipole block)", [&] {
-          if (treesFromResample)
-            m.trees->completeUpperLevels();
-          else
-            m.trees->run(map);
-        });
-        stage("epipole block (tree march)", [&] {
-          RectifiedMarchPass::FrameAttribs a;
-          a.layout = layout.get();
-          a.camera = f.camera;
-          a.light = f.light;
-          a.medium = f.medium;
-          a.cameraDepth = f.cameraDepth;
-          a.rectifiedDepth = map;
-          a.minMaxBuffer = m.trees->treeBuffer();
-          a.output = f.output;
-          a.lightColors = colors;
-          a.blockCenter = *centre;
-          a.blockRadius = radius;
-          m.march->run(a);
-        });
-      } else {
-        stage("epipole block (world march)", [&] {
-          WorldMarchPass::FrameAttribs b;
-          b.camera = f.camera;
-          b.light = f.light;
-          b.medium = f.medium;
-          b.cameraDepth = f.cameraDepth;
-          b.shadowMap = shadow->texture;
-          b.lightClipFromWorld = shadow->lightClipFromWorld;
-          b.bias = shadow->bias;
-          b.output = f.output;
-          b.blockCenter = *centre;
-          b.blockRadius = radius;
-          if (f.lightTexture) b.lightTexture = *f.lightTexture;
-          m.block.run(b);
-        });
-      }
-    }
-  }
+  if (r.layout == Layout::Epipolar && pixels && !m.marching()) m.epipoleBlock(f, r, d);
   runLocalLights(f, r);
   gl::checkError("Scattering::run");
   return r;
+}
+
+// Klehm et al. 2014, Sec. 4.2: the casters rendered once per split with its matrix, or the engine's map
+// resampled.
+void Scattering::Impl::projectiveMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d) {
+  r.layout = Layout::Projective;
+  auto projective = std::make_shared<const ProjectiveLayout>(r.rectification);
+  d.layout = projective;
+  if (f.drawCasters) {
+    stage(r, "shadow pass (rectified)", [&] {
+      rectified.run(
+          {&r.rectification, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
+    });
+    d.map = rectified.depthTexture();
+  } else {
+    stage(r, "resample (projective)", [&] {
+      resample.run({projective.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.get()});
+    });
+    d.map = resampled.get();
+  }
+}
+
+// Sec. 4.1: the standard shadow map resampled into epipolar slices (mapSize of them, so the cost of the frame
+// stays that of a projective one).
+void Scattering::Impl::epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d) {
+  r.layout = Layout::Epipolar;
+  EpipolarOptions options;
+  options.slices = info.mapSize;
+  options.referenceRay = info.rectify.referenceRay;
+  options.regions = info.epipolarRegions;
+  options.depthWarp = info.epipolarDepthWarp;
+  options.epipoleBlockRadius = info.epipoleBlockRadius;
+  options.maxBlockPixels = info.epipoleBlockMaxPixels;
+  auto epipolar =
+      std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
+  d.layout = epipolar;
+  if (!d.shadow) {
+    if (!ownShadowMap) ownShadowMap.emplace(info.ownShadowMapSize);
+    d.own.texture = ownShadowMap->texture.get();
+    // A standard map covering the frustum (casters between the light and it are kept by GL_DEPTH_CLAMP).
+    d.own.lightClipFromWorld = orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners());
+    d.own.bias = info.ownShadowMapBias;
+    stage(r, "shadow pass (standard)", [&] {
+      ownShadowMap->render("Scattering::FrameAttribs.drawCasters",
+                           [&] { f.drawCasters(d.own.lightClipFromWorld); });
+    });
+    d.shadow = &d.own;
+  }
+  r.shadowMap = *d.shadow;
+  // A tree-marched epipole block (Fig. 8's block on screen) needs the map's min/max trees: their low levels
+  // are written by the resampling itself (the map read once), the rest after it (the block's stage).
+  const bool treeMarchedBlock =
+      info.method == Method::Prefiltered && info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch &&
+      epipolar->epipolePixel().has_value() && epipolar->epipoleBlockRadiusPixels() > 0.0;
+  d.treesFromResample = treeMarchedBlock && f.output != 0 && MinMaxTreePass::lowLevels(info.mapSize) >= 1;
+  stage(r, "resample (epipolar)", [&] {
+    resample.run({epipolar.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.get(),
+                  d.treesFromResample ? trees->treeBuffer() : 0u});
+  });
+  d.map = resampled.get();
+}
+
+// The method on a camera depth image into `output`, or on a GPU work list (epipolar sampling's samples and
+// corrections: EvaluatePass / RectifiedMarchPass FrameAttribs::list).
+void Scattering::Impl::evaluateRays(const FrameAttribs& f, const DirectionalMap& d, std::uint32_t depth,
+                                    std::uint32_t output, const gpu::SampleList* list, bool reuseTable) {
+  if (marching()) {
+    RectifiedMarchPass::FrameAttribs a;
+    a.layout = d.layout.get();
+    a.camera = f.camera;
+    a.light = f.light;
+    a.medium = f.medium;
+    a.cameraDepth = depth;
+    a.rectifiedDepth = d.map;
+    a.minMaxBuffer = trees->treeBuffer();
+    a.output = output;
+    a.lightColors = d.colors;
+    a.list = list;
+    if (list) {
+      a.imageWidth = info.width;
+      a.imageHeight = info.height;
+    }
+    march->run(a);
+  } else {
+    EvaluatePass::FrameAttribs e;
+    e.cameraDepth = depth;
+    e.output = output;
+    e.camera = f.camera;
+    e.light = f.light;
+    e.medium = f.medium;
+    e.layout = d.layout.get();
+    e.basis = prefilter.filteredBasis();
+    e.list = list;
+    if (list) {
+      e.imageWidth = info.width;
+      e.imageHeight = info.height;
+    }
+    e.reuseTable = reuseTable;
+    evaluate.run(e);
+  }
+}
+
+// The per-pixel output: every pixel (at evaluationScale), or epipolar sampling's samples and corrections.
+void Scattering::Impl::evaluatePixels(const FrameAttribs& f, FrameResult& r, const DirectionalMap& d) {
+  if (reduced) stage(r, "downsample depth", [&] { reduced->downsample(f.cameraDepth, lowDepth.get()); });
+  if (!sampling)
+    stage(r, marching() ? "march" : "evaluate", [&] {
+      evaluateRays(f, d, reduced ? lowDepth.get() : f.cameraDepth, reduced ? lowOutput.get() : f.output,
+                   nullptr, false);
+    });
+  if (sampling) {
+    // Yusov 2012, Sec. 6: samples along epipolar lines, refined at breaks; the method evaluates the
+    // selected ones and the pixels the unwarp cannot serve (the lists, no read-back).
+    const EpipolarSamplingPass::FrameAttribs s{f.camera, f.light, f.medium, f.cameraDepth, f.output};
+    EpipolarSamplingPass& pass = *sampling;
+    stage(r, "epipolar samples", [&] { pass.placeSamples(s); });
+    stage(r, "refine samples", [&] { pass.refine(); });
+    stage(r, marching() ? "march samples" : "evaluate samples",
+          [&] { evaluateRays(f, d, 0, 0, &pass.sampleList(), false); });
+    stage(r, "interpolate", [&] { pass.interpolate(); });
+    stage(r, "unwarp", [&] { pass.unwarp(s); });
+    stage(r, "correct", [&] { evaluateRays(f, d, 0, 0, &pass.correctionList(), true); });
+    if (info.epipolarSampling.downscale > 1) {
+      stage(r, "upscale", [&] { pass.upscale(s); });
+      stage(r, "correct (full)", [&] { evaluateRays(f, d, 0, 0, &pass.upscaleCorrectionList(), true); });
+    }
+    if (info.stageTimings) {
+      const EpipolarSamplingPass::Statistics st = pass.statistics();
+      r.sampling = {st.validSamples, st.marchedSamples, st.correctedPixels, st.correctedFullPixels};
+    }
+  }
+  if (reduced)
+    stage(r, "upsample",
+          [&] { reduced->upsample(lowOutput.get(), lowDepth.get(), f.cameraDepth, f.output, *f.camera); });
+}
+
+// Fig. 8: the pixels next to the epipole, where the slices converge and the prefilter's weights, exact for
+// one reference ray per region, fit the rays nearly parallel to the light worst.
+void Scattering::Impl::epipoleBlock(const FrameAttribs& f, FrameResult& r, const DirectionalMap& d) {
+  const auto& epipolar = static_cast<const EpipolarLayout&>(*d.layout);
+  const auto centre = epipolar.epipolePixel();
+  const double radius = epipolar.epipoleBlockRadiusPixels();
+  if (!centre || !(radius > 0.0)) return;
+  r.epipoleBlockRadius = radius;
+  if (info.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch) {
+    // The min/max tree march over the same epipolar map (Chen et al. 2011; Yusov 2012, Algorithm 2): exact
+    // visibility on the map, the walk skipping lit and shadowed runs of texels whole, so the cost is the
+    // block's pixels (at most epipoleBlockMaxPixels) times a short walk.
+    stage(r, "min/max trees (epipole block)", [&] {
+      if (d.treesFromResample)
+        trees->completeUpperLevels();
+      else
+        trees->run(d.map);
+    });
+    stage(r, "epipole block (tree march)", [&] {
+      RectifiedMarchPass::FrameAttribs a;
+      a.layout = d.layout.get();
+      a.camera = f.camera;
+      a.light = f.light;
+      a.medium = f.medium;
+      a.cameraDepth = f.cameraDepth;
+      a.rectifiedDepth = d.map;
+      a.minMaxBuffer = trees->treeBuffer();
+      a.output = f.output;
+      a.lightColors = d.colors;
+      a.blockCenter = *centre;
+      a.blockRadius = radius;
+      march->run(a);
+    });
+  } else {
+    stage(r, "epipole block (world march)", [&] {
+      WorldMarchPass::FrameAttribs b;
+      b.camera = f.camera;
+      b.light = f.light;
+      b.medium = f.medium;
+      b.cameraDepth = f.cameraDepth;
+      b.shadowMap = d.shadow->texture;
+      b.lightClipFromWorld = d.shadow->lightClipFromWorld;
+      b.bias = d.shadow->bias;
+      b.output = f.output;
+      b.blockCenter = *centre;
+      b.blockRadius = radius;
+      if (f.lightTexture) b.lightTexture = *f.lightTexture;
+      block.run(b);
+    });
+  }
+}
+
+/// One local light of a frame (a spot, or one point-light face) and its stages, timed into `result` and
+/// the frame's stages.
+struct Scattering::Impl::LocalLightRun {
+  Impl& m;
+  const FrameAttribs& f;
+  FrameResult& r;
+  const LocalLight& light;
+  const glm::dmat4& lightClipFromWorld;
+  const ShadowMap* given;
+  const GpuLightTexture* texture;
+  LightResult& result;
+
+  template <class Work>
+  void timed(const char* name, const Work& work) {
+    const Stage s = m.timedStage(name, work);
+    r.stages.push_back(s);
+    result.wallMilliseconds += s.wallMilliseconds;
+    result.gpuMilliseconds += s.gpuMilliseconds;
+  }
+
+  // The light's perspective map (the given one, else its own matrix's rendered with drawCasters).
+  ShadowMap perspectiveMap() {
+    if (given) return *given;
+    if (!m.localShadowMap) m.localShadowMap.emplace(m.info.ownShadowMapSize);
+    timed("local light: shadow pass (perspective)", [&] {
+      m.localShadowMap->render("Scattering::FrameAttribs.drawCasters",
+                               [&] { f.drawCasters(lightClipFromWorld); });
+    });
+    return ShadowMap{m.localShadowMap->texture.get(), lightClipFromWorld, m.info.ownShadowMapBias};
+  }
+
+  // Sec. 4.1's point resampling of a perspective map into `layout` (no casters drawn).
+  std::uint32_t resampled(const RectifiedLayout& layout, const ShadowMap& shadow, const char* name) {
+    if (!m.localResampled)
+      m.localResampled =
+          gl::createTexture2D(GL_R32F, m.info.mapSize, m.info.mapSize, "Scattering: local map");
+    timed(name, [&] {
+      m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, m.localResampled.get()});
+    });
+    return m.localResampled.get();
+  }
+
+  // The light's map on `layout` prefiltered with its light-side factor and evaluated into its image.
+  void prefiltered(const RectifiedLayout& layout, std::uint32_t map) {
+    std::uint32_t colors = 0;
+    if (texture)
+      timed("local light: light colours", [&] { colors = m.lightColors(layout, *texture, nullptr, &light); });
+    const int M = light.cone ? m.spotBases() : m.localBases();
+    const int Z = light.cone && dynamic_cast<const ProjectiveLayout*>(&layout) != nullptr
+                      ? m.spotTableSamples()
+                      : m.localTableSamples();
+    timed("local light: prefilter", [&] {
+      m.localLightPrefilter(M).run({.rectifiedDepth = map,
+                                    .layout = &layout,
+                                    .medium = f.medium,
+                                    .localLight = &light,
+                                    .lightColors = colors});
+    });
+    timed("local light: evaluate", [&] {
+      EvaluatePass::FrameAttribs e;
+      e.cameraDepth = f.cameraDepth;
+      e.output = m.localScattering.get();
+      e.camera = f.camera;
+      e.medium = f.medium;
+      e.layout = &layout;
+      e.basis = m.localLightPrefilter(M).filteredBasis();
+      e.localLight = &light;
+      m.localLightEvaluate(M, Z).run(e);
+    });
+  }
+
+  // The world-space march of the light against a perspective map, into the light's image: every pixel, or
+  // those within `radius` pixels of `centre` (radius >= 0).
+  void worldMarch(const ShadowMap& shadow, glm::dvec2 centre, double radius, const char* name) {
+    timed(name, [&] {
+      WorldMarchPass::FrameAttribs b;
+      b.camera = f.camera;
+      b.localLight = &light;
+      b.medium = f.medium;
+      b.cameraDepth = f.cameraDepth;
+      b.shadowMap = shadow.texture;
+      b.lightClipFromWorld = shadow.lightClipFromWorld;
+      b.bias = shadow.bias;
+      b.output = m.localScattering.get();
+      b.blockCenter = centre;
+      b.blockRadius = radius;
+      if (texture) b.lightTexture = *texture;
+      m.block.run(b);
+    });
+  }
+
+  // The projective rectification: the given map resampled, or the casters rendered per split.
+  void projective(const Rectification& rect) {
+    const ProjectiveLayout layout(rect);
+    std::uint32_t map = 0;
+    if (given) {
+      map = resampled(layout, *given, "local light: resample (projective)");
+    } else {
+      if (!m.localRectified)
+        m.localRectified.emplace(RectifiedShadowPass::CreateInfo{m.info.mapSize, m.info.mapSize});
+      timed("local light: shadow pass (rectified)", [&] {
+        m.localRectified->run(
+            {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
+      });
+      map = m.localRectified->depthTexture();
+    }
+    prefiltered(layout, map);
+  }
+
+  // In or near the view: Sec. 4.1's epipolar layout around the camera-light axis (the light's image is the
+  // epipole), mapSize slices, the light's perspective map resampled into it.
+  void epipolar() {
+    const CreateInfo& info = m.info;
+    EpipolarOptions options;
+    options.slices = info.mapSize;
+    options.referenceRay = info.rectify.referenceRay;
+    options.regions = info.epipolarRegions;
+    options.depthWarp = info.localLightDepthWarp;
+    options.epipoleBlockRadius = info.localLightBlockRadius;
+    options.maxBlockPixels = info.epipoleBlockMaxPixels;
+    const EpipolarLayout layout(*f.camera, light.position, info.width, info.height, options);
+    result.epipolar = true;
+    const ShadowMap shadow = perspectiveMap();
+    prefiltered(layout, resampled(layout, shadow, "local light: resample (epipolar)"));
+    // Fig. 8's epipole block around the light's image: there every slice meets and a pixel's rays cross
+    // every light ray within a short distance of the light.
+    const std::optional<glm::dvec2> centre = layout.epipolePixel();
+    const double radius = layout.epipoleBlockRadiusPixels();
+    if (centre && radius > 0.0)
+      worldMarch(shadow, *centre, radius, "local light: epipole block (world march)");
+  }
+};
+
+void Scattering::Impl::addLocalScattering(const FrameAttribs& f) {
+  glUseProgram(accumulate.get());
+  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(1, localScattering.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glDispatchCompute(static_cast<GLuint>((info.width + 7) / 8), static_cast<GLuint>((info.height + 7) / 8), 1);
+  gl::passOutputBarrier();
+  gl::unbindPassState(2);
+}
+
+void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, const LocalLight& light,
+                                     const Rectification& rect, const glm::dmat4& lightClipFromWorld,
+                                     const ShadowMap* given, const GpuLightTexture* texture,
+                                     LightResult result) {
+  result.status = rect.status;
+  result.message = rect.message;
+  result.preRenderedMap = given != nullptr;
+  if (rect.status == RectifyStatus::Empty) {
+    r.localLights.push_back(result);
+    return;
+  }
+  LocalLightRun run{*this, f, r, light, lightClipFromWorld, given, texture, result};
+  if (rect.projective())
+    run.projective(rect);
+  else if (info.localLightFallback == LocalLightFallback::Epipolar && info.epipolarRegions >= 2 &&
+           glm::length(light.position - f.camera->position()) > f.camera->near())
+    run.epipolar();
+  else // the world-space march against the light's perspective map (the reference)
+    run.worldMarch(run.perspectiveMap(), glm::dvec2(0.0), -1.0, "local light: world-space march");
+  addLocalScattering(f);
+  r.localLights.push_back(result);
 }
 
 // Klehm et al. 2014, Sec. 3.2 "Local Lights": every spot light and point-light face rectified for the camera,
@@ -816,143 +1006,6 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     m.localScattering = gl::createTexture2D(GL_RGBA32F, info.width, info.height, "Scattering: local light");
     m.accumulate = buildProgram({{ShaderStage::Compute, "passes/pipeline/accumulate.comp", {}}});
   }
-  const auto timed = [&](LightResult& result, const char* name, const auto& work) {
-    const Stage s = m.timedStage(name, work);
-    r.stages.push_back(s);
-    result.wallMilliseconds += s.wallMilliseconds;
-    result.gpuMilliseconds += s.gpuMilliseconds;
-  };
-  const auto addToOutput = [&] {
-    glUseProgram(m.accumulate.get());
-    glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, m.localScattering.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-    glDispatchCompute(static_cast<GLuint>((info.width + 7) / 8), static_cast<GLuint>((info.height + 7) / 8),
-                      1);
-    gl::passOutputBarrier();
-    gl::unbindPassState(2);
-  };
-  const auto one = [&](const LocalLight& light, const Rectification& rect,
-                       const glm::dmat4& lightClipFromWorld, const ShadowMap* given,
-                       const GpuLightTexture* texture, LightResult result) {
-    result.status = rect.status;
-    result.message = rect.message;
-    result.preRenderedMap = given != nullptr;
-    if (rect.status == RectifyStatus::Empty) {
-      r.localLights.push_back(result);
-      return;
-    }
-    // The light's perspective map (the given one, else its own matrix's rendered with drawCasters).
-    const auto perspectiveMap = [&] {
-      if (given) return *given;
-      if (!m.localShadowMap) m.localShadowMap.emplace(info.ownShadowMapSize);
-      timed(result, "local light: shadow pass (perspective)", [&] {
-        m.localShadowMap->render("Scattering::FrameAttribs.drawCasters",
-                                 [&] { f.drawCasters(lightClipFromWorld); });
-      });
-      return ShadowMap{m.localShadowMap->texture.get(), lightClipFromWorld, info.ownShadowMapBias};
-    };
-    // Sec. 4.1's point resampling of a perspective map into `layout` (no casters drawn).
-    const auto resampled = [&](const RectifiedLayout& layout, const ShadowMap& shadow, const char* name) {
-      if (!m.localResampled)
-        m.localResampled = gl::createTexture2D(GL_R32F, info.mapSize, info.mapSize, "Scattering: local map");
-      timed(result, name, [&] {
-        m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, m.localResampled.get()});
-      });
-      return m.localResampled.get();
-    };
-    // The light's map on `layout` prefiltered with its light-side factor and evaluated into the output.
-    const auto prefiltered = [&](const RectifiedLayout& layout, std::uint32_t map) {
-      std::uint32_t colors = 0;
-      if (texture)
-        timed(result, "local light: light colours",
-              [&] { colors = m.lightColors(layout, *texture, nullptr, &light); });
-      const int M = light.cone ? m.spotBases() : m.localBases();
-      const int Z = light.cone && dynamic_cast<const ProjectiveLayout*>(&layout) != nullptr
-                        ? m.spotTableSamples()
-                        : m.localTableSamples();
-      timed(result, "local light: prefilter", [&] {
-        m.localLightPrefilter(M).run({.rectifiedDepth = map,
-                                      .layout = &layout,
-                                      .medium = f.medium,
-                                      .localLight = &light,
-                                      .lightColors = colors});
-      });
-      timed(result, "local light: evaluate", [&] {
-        EvaluatePass::FrameAttribs e;
-        e.cameraDepth = f.cameraDepth;
-        e.output = m.localScattering.get();
-        e.camera = f.camera;
-        e.medium = f.medium;
-        e.layout = &layout;
-        e.basis = m.localLightPrefilter(M).filteredBasis();
-        e.localLight = &light;
-        m.localLightEvaluate(M, Z).run(e);
-      });
-    };
-    // The world-space march of the light against a perspective map, into the light's image: every pixel, or
-    // those within `radius` pixels of `centre` (radius >= 0).
-    const auto worldMarch = [&](const ShadowMap& shadow, glm::dvec2 centre, double radius, const char* name) {
-      timed(result, name, [&] {
-        WorldMarchPass::FrameAttribs b;
-        b.camera = f.camera;
-        b.localLight = &light;
-        b.medium = f.medium;
-        b.cameraDepth = f.cameraDepth;
-        b.shadowMap = shadow.texture;
-        b.lightClipFromWorld = shadow.lightClipFromWorld;
-        b.bias = shadow.bias;
-        b.output = m.localScattering.get();
-        b.blockCenter = centre;
-        b.blockRadius = radius;
-        if (texture) b.lightTexture = *texture;
-        m.block.run(b);
-      });
-    };
-    if (rect.projective()) {
-      const ProjectiveLayout layout(rect);
-      std::uint32_t map = 0;
-      if (given) {
-        map = resampled(layout, *given, "local light: resample (projective)");
-      } else {
-        if (!m.localRectified)
-          m.localRectified.emplace(RectifiedShadowPass::CreateInfo{info.mapSize, info.mapSize});
-        timed(result, "local light: shadow pass (rectified)", [&] {
-          m.localRectified->run(
-              {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
-        });
-        map = m.localRectified->depthTexture();
-      }
-      prefiltered(layout, map);
-      addToOutput();
-    } else if (info.localLightFallback == LocalLightFallback::Epipolar && info.epipolarRegions >= 2 &&
-               glm::length(light.position - f.camera->position()) > f.camera->near()) {
-      // In or near the view: Sec. 4.1's epipolar layout around the camera-light axis (the light's image is
-      // the epipole), mapSize slices, the light's perspective map resampled into it.
-      EpipolarOptions options;
-      options.slices = info.mapSize;
-      options.referenceRay = info.rectify.referenceRay;
-      options.regions = info.epipolarRegions;
-      options.depthWarp = info.localLightDepthWarp;
-      options.epipoleBlockRadius = info.localLightBlockRadius;
-      options.maxBlockPixels = info.epipoleBlockMaxPixels;
-      const EpipolarLayout layout(*f.camera, light.position, info.width, info.height, options);
-      result.epipolar = true;
-      const ShadowMap shadow = perspectiveMap();
-      prefiltered(layout, resampled(layout, shadow, "local light: resample (epipolar)"));
-      // Fig. 8's epipole block around the light's image: there every slice meets and a pixel's rays cross
-      // every light ray within a short distance of the light.
-      const std::optional<glm::dvec2> centre = layout.epipolePixel();
-      const double radius = layout.epipoleBlockRadiusPixels();
-      if (centre && radius > 0.0)
-        worldMarch(shadow, *centre, radius, "local light: epipole block (world march)");
-      addToOutput();
-    } else {
-      // The world-space march against the light's perspective map (the reference).
-      worldMarch(perspectiveMap(), glm::dvec2(0.0), -1.0, "local light: world-space march");
-      addToOutput();
-    }
-    r.localLights.push_back(result);
-  };
   for (std::size_t i = 0; i < f.spotLights.size(); ++i) {
     const SpotLight& spot = f.spotLights[i];
     LightResult result;
@@ -961,8 +1014,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     const GpuLightTexture* texture = i < f.spotLightTextures.size() && f.spotLightTextures[i].texture != 0
                                          ? &f.spotLightTextures[i]
                                          : nullptr;
-    one(LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify), spot.lightClipFromWorld(),
-        f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i], texture, result);
+    m.runLocalLight(f, r, LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify),
+                    spot.lightClipFromWorld(), f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i],
+                    texture, result);
   }
   for (std::size_t i = 0; i < f.pointLights.size(); ++i) {
     const PointLight& point = f.pointLights[i];
@@ -972,10 +1026,11 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
       result.kind = LightResult::Kind::PointFace;
       result.index = static_cast<int>(i);
       result.face = face;
-      one(LocalLight::pointFace(point, face), faces[static_cast<std::size_t>(face)],
-          point.faceClipFromWorld(face),
-          f.pointShadowMaps.empty() ? nullptr : &f.pointShadowMaps[6 * i + static_cast<std::size_t>(face)],
-          nullptr, result);
+      m.runLocalLight(f, r, LocalLight::pointFace(point, face), faces[static_cast<std::size_t>(face)],
+                      point.faceClipFromWorld(face),
+                      f.pointShadowMaps.empty() ? nullptr
+                                                : &f.pointShadowMaps[6 * i + static_cast<std::size_t>(face)],
+                      nullptr, result);
     }
   }
 }

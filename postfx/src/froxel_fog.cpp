@@ -178,8 +178,7 @@ double esmVisibility(const Image& esm, const glm::dmat4& lightClipFromWorld, con
 }
 
 void validate(const FroxelDensity& d, const char* owner) {
-  if (!std::isfinite(d.heightBase))
-    throw InvalidArgument(field(owner, "heightBase"), detail::formatValue(d.heightBase), "must be finite");
+  requireFinite(field(owner, "heightBase"), d.heightBase);
   if (!(d.heightFalloff >= 0.0) || !std::isfinite(d.heightFalloff))
     throw InvalidArgument(field(owner, "heightFalloff"), detail::formatValue(d.heightFalloff),
                           "world units, must be finite and >= 0 (0 = no height fog)");

@@ -41,22 +41,10 @@ gl::Handle buildFroxelProgram(const char* path, std::uint32_t format) {
   return buildProgram({{ShaderStage::Compute, path, {{"CREP_FROXEL_FORMAT", formatQualifier(format)}}}});
 }
 
-void requireFinite3(const glm::dvec3& v, const std::string& parameter) {
-  for (int c = 0; c < 3; ++c)
-    if (!std::isfinite(v[c])) throw InvalidArgument(parameter, detail::formatValue(v[c]), "must be finite");
-}
-
 void requireJitter(const glm::dvec3& j, const std::string& parameter) {
   for (int c = 0; c < 3; ++c)
     if (!(j[c] >= -0.5 && j[c] <= 0.5))
       throw InvalidArgument(parameter, detail::formatValue(j[c]), "cells, each component in [-0.5, 0.5]");
-}
-
-void requireMatrix(const glm::dmat4& m, const std::string& parameter) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r]))
-        throw InvalidArgument(parameter, detail::formatValue(m[c][r]), "must be finite");
 }
 
 /// A caller's volume: an existing GL_TEXTURE_3D of the grid's size (and `format` when not 0).
@@ -155,7 +143,7 @@ gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, cons
 // ---- EsmPass: Annen et al. 2008 downsampled and box-blurred as Wronski 2014 (rule 1) ----
 
 EsmPass::EsmPass(const CreateInfo& info) : info_(info) {
-  validate(info.options, "EsmPass::CreateInfo.options");
+  crep::validate(info.options, "EsmPass::CreateInfo.options");
   downsample_ = buildProgram({{ShaderStage::Compute, "passes/postfx/esm_downsample.comp", {}}});
   blur_ = buildProgram({{ShaderStage::Compute, "passes/postfx/esm_blur.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
@@ -167,10 +155,16 @@ std::size_t EsmPass::memoryBytes() const noexcept {
   return 2 * sizeof(float) * static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
 }
 
+void EsmPass::validate(const FrameAttribs& f, std::string_view owner) const {
+  const std::string o(owner);
+  gl::requireTexture2D(name(o.c_str(), "shadowMap").c_str(), f.shadowMap);
+  gl::requireDepthFormat(name(o.c_str(), "shadowMap").c_str(), f.shadowMap);
+  requireFinite(name(o.c_str(), "lightClipFromWorld"), f.lightClipFromWorld);
+}
+
 void EsmPass::run(const FrameAttribs& f) {
-  const gl::TextureLevel map = gl::requireTexture2D("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
-  gl::requireDepthFormat("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
-  requireMatrix(f.lightClipFromWorld, "EsmPass::FrameAttribs.lightClipFromWorld");
+  validate(f);
+  const gl::TextureLevel map = gl::textureLevel("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
   const double c = esmDepthExponent(info_.options, f.lightClipFromWorld);
   const int factor = info_.options.downsample;
   const int w = (map.width + factor - 1) / factor, h = (map.height + factor - 1) / factor;
@@ -213,8 +207,8 @@ void EsmPass::run(const FrameAttribs& f) {
 FroxelLightingPass::FroxelLightingPass(const CreateInfo& info) : info_(info) {
   const char* owner = "FroxelLightingPass::CreateInfo";
   requireGrid(info.grid, owner);
-  validate(info.density, "FroxelLightingPass::CreateInfo.density");
-  validate(info.esm, "FroxelLightingPass::CreateInfo.esm");
+  crep::validate(info.density, "FroxelLightingPass::CreateInfo.density");
+  crep::validate(info.esm, "FroxelLightingPass::CreateInfo.esm");
   validateFroxelFormat(info.format, owner);
   for (int c = 0; c < 3; ++c)
     if (!(info.ambient[c] >= 0.0) || !std::isfinite(info.ambient[c]))
@@ -226,21 +220,26 @@ FroxelLightingPass::FroxelLightingPass(const CreateInfo& info) : info_(info) {
   gl::checkError("FroxelLightingPass");
 }
 
-void FroxelLightingPass::run(const FrameAttribs& f) {
-  const char* owner = "FroxelLightingPass::FrameAttribs";
-  if (!f.camera || !f.light || !f.medium)
-    throw InvalidArgument(name(owner, "camera/light/medium"), "null", "must be set");
+void FroxelLightingPass::validate(const FrameAttribs& f, std::string_view ownerName) const {
+  const std::string o(ownerName);
+  const char* owner = o.c_str();
+  if (!f.camera || !f.light || !f.medium) invalid(name(owner, "camera/light/medium"), "null", "must be set");
   requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
   requireJitter(f.jitter, name(owner, "jitter"));
-  requireFinite3(f.noiseOffset, name(owner, "noiseOffset"));
-  gl::TextureLevel esm;
+  requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   if (f.esm != 0) {
-    esm = gl::requireTexture2D(name(owner, "esm").c_str(), f.esm);
+    const gl::TextureLevel esm = gl::requireTexture2D(name(owner, "esm").c_str(), f.esm);
     if (esm.internalFormat != GL_R32F)
-      throw InvalidArgument(name(owner, "esm"), "internal format " + std::to_string(esm.internalFormat),
-                            "must be GL_R32F (EsmPass::esm())");
-    requireMatrix(f.lightClipFromWorld, name(owner, "lightClipFromWorld"));
+      invalid(name(owner, "esm"), "internal format " + std::to_string(esm.internalFormat),
+              "must be GL_R32F (EsmPass::esm())");
+    requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
+}
+
+void FroxelLightingPass::run(const FrameAttribs& f) {
+  validate(f);
+  const gl::TextureLevel esm =
+      f.esm != 0 ? gl::textureLevel("FroxelLightingPass::FrameAttribs.esm", f.esm) : gl::TextureLevel{};
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   assignMedium(p, *f.medium);
@@ -275,11 +274,16 @@ FroxelAccumulatePass::FroxelAccumulatePass(const CreateInfo& info) : info_(info)
   gl::checkError("FroxelAccumulatePass");
 }
 
-void FroxelAccumulatePass::run(const FrameAttribs& f) {
-  const char* owner = "FroxelAccumulatePass::FrameAttribs";
-  if (!f.camera || !f.medium) throw InvalidArgument(name(owner, "camera/medium"), "null", "must be set");
+void FroxelAccumulatePass::validate(const FrameAttribs& f, std::string_view ownerName) const {
+  const std::string o(ownerName);
+  const char* owner = o.c_str();
+  if (!f.camera || !f.medium) invalid(name(owner, "camera/medium"), "null", "must be set");
   requireVolume(name(owner, "volume"), f.volume, info_.grid, info_.format);
   requireJitter(f.jitter, name(owner, "jitter"));
+}
+
+void FroxelAccumulatePass::run(const FrameAttribs& f) {
+  validate(f);
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   assignMedium(p, *f.medium);
@@ -303,19 +307,23 @@ FroxelTemporalPass::FroxelTemporalPass(const CreateInfo& info) : info_(info) {
   gl::checkError("FroxelTemporalPass");
 }
 
-void FroxelTemporalPass::run(const FrameAttribs& f) {
-  const char* owner = "FroxelTemporalPass::FrameAttribs";
-  if (!f.camera) throw InvalidArgument(name(owner, "camera"), "null", "must be set");
+void FroxelTemporalPass::validate(const FrameAttribs& f, std::string_view ownerName) const {
+  const std::string o(ownerName);
+  const char* owner = o.c_str();
+  if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   if (!(f.historyWeight >= 0.0 && f.historyWeight < 1.0))
-    throw InvalidArgument(name(owner, "historyWeight"), detail::formatValue(f.historyWeight),
-                          "must be in [0, 1)");
+    invalid(name(owner, "historyWeight"), detail::formatValue(f.historyWeight), "must be in [0, 1)");
   requireVolume(name(owner, "current"), f.current, info_.grid, 0);
   requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
   const bool useHistory = f.previousCamera != nullptr && f.historyWeight > 0.0;
   if (useHistory) requireVolume(name(owner, "history"), f.history, info_.grid, 0);
   if (f.output == f.current || (useHistory && f.output == f.history))
-    throw InvalidArgument(name(owner, "output"), std::to_string(f.output),
-                          "must differ from current and history");
+    invalid(name(owner, "output"), std::to_string(f.output), "must differ from current and history");
+}
+
+void FroxelTemporalPass::run(const FrameAttribs& f) {
+  validate(f);
+  const bool useHistory = f.previousCamera != nullptr && f.historyWeight > 0.0;
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   if (useHistory) {
@@ -350,13 +358,19 @@ FroxelApplyPass::FroxelApplyPass(const CreateInfo& info) : info_(info) {
   gl::checkError("FroxelApplyPass");
 }
 
-void FroxelApplyPass::run(const FrameAttribs& f) {
-  const char* owner = "FroxelApplyPass::FrameAttribs";
-  if (!f.camera) throw InvalidArgument(name(owner, "camera"), "null", "must be set");
+void FroxelApplyPass::validate(const FrameAttribs& f, std::string_view ownerName) const {
+  const std::string o(ownerName);
+  const char* owner = o.c_str();
+  if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   const gl::TextureLevel depth = gl::requireTexture2D(name(owner, "cameraDepth").c_str(), f.cameraDepth);
   gl::requireTexture2D(name(owner, "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
   requireVolume(name(owner, "volume"), f.volume, info_.grid, 0);
   requireJitter(f.offset, name(owner, "offset"));
+}
+
+void FroxelApplyPass::run(const FrameAttribs& f) {
+  validate(f);
+  const gl::TextureLevel depth = gl::textureLevel("FroxelApplyPass::FrameAttribs.cameraDepth", f.cameraDepth);
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   p.jitter = glm::vec4(glm::vec3(f.offset), 0.0f);
@@ -427,24 +441,29 @@ std::size_t FroxelFog::memoryBytes() const noexcept {
   return volumes * cells * perCell + esm_.memoryBytes();
 }
 
-void FroxelFog::run(const FrameAttribs& f) {
-  const char* owner = "FroxelFog::FrameAttribs";
-  if (!f.camera) throw InvalidArgument(name(owner, "camera"), "null", "must be set");
+void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) const {
+  const std::string o(ownerName);
+  const char* owner = o.c_str();
+  if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   if (f.mode == Mode::Esm && (!f.light || !f.medium))
-    throw InvalidArgument(name(owner, "light/medium"), "null", "must be set in Mode::Esm");
+    invalid(name(owner, "light/medium"), "null", "must be set in Mode::Esm");
   if (f.output != 0) {
     const gl::TextureLevel depth = gl::requireTexture2D(name(owner, "cameraDepth").c_str(), f.cameraDepth);
     gl::requireTexture2D(name(owner, "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
   }
   if (f.mode == Mode::Esm && f.shadowMap != 0) {
     gl::requireTexture2D(name(owner, "shadowMap").c_str(), f.shadowMap);
-    requireMatrix(f.lightClipFromWorld, name(owner, "lightClipFromWorld"));
+    requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
   if (f.mode == Mode::Prefiltered)
     requireVolume(name(owner, "mode"), current_.get(), info_.grid, info_.format);
-  requireFinite3(f.noiseOffset, name(owner, "noiseOffset"));
+  requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   froxelDepthRange(info_.grid, *f.camera, "FroxelFog::CreateInfo");
   if (f.previousCamera) froxelDepthRange(info_.grid, *f.previousCamera, "FroxelFog::CreateInfo");
+}
+
+void FroxelFog::run(const FrameAttribs& f) {
+  validate(f);
   timings_ = Timings{};
   const auto stage = [&](double& ms, const auto& body) {
     if (info_.timings) timer_.begin();

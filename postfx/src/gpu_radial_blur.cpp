@@ -34,7 +34,7 @@ RadialBlurParams makeRadialBlurParams(const RadialBlurOptions& o, const RadialLi
 } // namespace gpu
 
 RadialBlurPass::RadialBlurPass(const CreateInfo& info) : info_(info) {
-  validate(info.options, "RadialBlurPass::CreateInfo.options");
+  crep::validate(info.options, "RadialBlurPass::CreateInfo.options");
   // 32 x 32 = 1024 invocations: the smallest GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS GL 4.5 guarantees.
   if (info.workgroupSize < 1 || info.workgroupSize > 32)
     throw InvalidArgument("RadialBlurPass::CreateInfo.workgroupSize", detail::formatValue(info.workgroupSize),
@@ -52,15 +52,20 @@ RadialBlurPass::RadialBlurPass(const CreateInfo& info) : info_(info) {
   gl::checkError("RadialBlurPass");
 }
 
+void RadialBlurPass::validate(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.camera) invalid(p + "camera", "null", "must be set");
+  if (!f.light) invalid(p + "light", "null", "must be set");
+  if (!f.medium) invalid(p + "medium", "null", "must be set");
+  const gl::TextureLevel depth = gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
+  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+  gl::requireTexture2D((p + "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
+}
+
 void RadialBlurPass::run(const FrameAttribs& f) {
-  if (!f.camera) throw InvalidArgument("RadialBlurPass::FrameAttribs.camera", "null", "must be set");
-  if (!f.light) throw InvalidArgument("RadialBlurPass::FrameAttribs.light", "null", "must be set");
-  if (!f.medium) throw InvalidArgument("RadialBlurPass::FrameAttribs.medium", "null", "must be set");
-  const gl::TextureLevel depth =
-      gl::requireTexture2D("RadialBlurPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  gl::requireDepthFormat("RadialBlurPass::FrameAttribs.cameraDepth", f.cameraDepth);
+  validate(f);
+  const gl::TextureLevel depth = gl::textureLevel("RadialBlurPass::FrameAttribs.cameraDepth", f.cameraDepth);
   const int width = depth.width, height = depth.height;
-  gl::requireTexture2D("RadialBlurPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
   const RadialBlurOptions& o = info_.options;
   const glm::ivec2 size = radialSourceSize(width, height, o.sourceScale);
   if (!source_ || size.x != sourceWidth_ || size.y != sourceHeight_) {

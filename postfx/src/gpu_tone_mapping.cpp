@@ -22,7 +22,7 @@ constexpr const char* kOwner = "ToneMapPass::CreateInfo.options";
 } // namespace
 
 ToneMapPass::ToneMapPass(const CreateInfo& info) : info_(info) {
-  validate(info.options, kOwner);
+  crep::validate(info.options, kOwner);
   reduceProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_reduce.comp", {}}});
   adaptProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_adapt.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::ToneMapParams));
@@ -38,7 +38,7 @@ ToneMapPass::ToneMapPass(const CreateInfo& info) : info_(info) {
 }
 
 void ToneMapPass::setOptions(const ToneMapOptions& options) {
-  validate(options, "ToneMapPass::options");
+  crep::validate(options, "ToneMapPass::options");
   info_.options = options;
 }
 
@@ -55,25 +55,27 @@ std::uint32_t ToneMapPass::toneMapProgram(std::uint32_t outputFormat) {
   return program.get();
 }
 
-void ToneMapPass::run(const FrameAttribs& f) {
-  const gl::TextureLevel in = gl::requireTexture2D("ToneMapPass::FrameAttribs.input", f.input);
+void ToneMapPass::validate(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  const gl::TextureLevel in = gl::requireTexture2D((p + "input").c_str(), f.input);
   if (in.internalFormat != GL_RGBA32F && in.internalFormat != GL_RGBA16F)
-    throw InvalidArgument("ToneMapPass::FrameAttribs.input",
-                          "internal format " + std::to_string(in.internalFormat),
-                          "must be GL_RGBA32F or GL_RGBA16F");
-  if (f.output == f.input)
-    throw InvalidArgument("ToneMapPass::FrameAttribs.output", std::to_string(f.output),
-                          "must not be the input texture");
-  const gl::TextureLevel out = gl::requireTexture2D("ToneMapPass::FrameAttribs.output", f.output);
+    invalid(p + "input", "internal format " + std::to_string(in.internalFormat),
+            "must be GL_RGBA32F or GL_RGBA16F");
+  if (f.output == f.input) invalid(p + "output", std::to_string(f.output), "must not be the input texture");
+  const gl::TextureLevel out = gl::requireTexture2D((p + "output").c_str(), f.output);
   if (out.internalFormat != GL_RGBA8 && out.internalFormat != GL_RGBA32F)
-    throw InvalidArgument("ToneMapPass::FrameAttribs.output",
-                          "internal format " + std::to_string(out.internalFormat),
-                          "must be GL_RGBA8 or GL_RGBA32F");
+    invalid(p + "output", "internal format " + std::to_string(out.internalFormat),
+            "must be GL_RGBA8 or GL_RGBA32F");
   if (out.width != in.width || out.height != in.height)
-    throw InvalidArgument(
-        "ToneMapPass::FrameAttribs.output", std::to_string(out.width) + "x" + std::to_string(out.height),
-        "must be the input's size " + std::to_string(in.width) + "x" + std::to_string(in.height));
-  requireNonNegative("ToneMapPass::FrameAttribs.dt", f.dt);
+    invalid(p + "output", std::to_string(out.width) + "x" + std::to_string(out.height),
+            "must be the input's size " + std::to_string(in.width) + "x" + std::to_string(in.height));
+  requireNonNegative(p + "dt", f.dt);
+}
+
+void ToneMapPass::run(const FrameAttribs& f) {
+  validate(f);
+  const gl::TextureLevel in = gl::textureLevel("ToneMapPass::FrameAttribs.input", f.input);
+  const gl::TextureLevel out = gl::textureLevel("ToneMapPass::FrameAttribs.output", f.output);
 
   const ToneMapOptions& o = info_.options;
   const int groupsX = (in.width + kReductionTile - 1) / kReductionTile;

@@ -26,23 +26,17 @@ bool isSky(const Camera& camera, double d) {
 } // namespace
 
 void validate(const RadialBlurOptions& o, const char* owner) {
-  if (!(std::isfinite(o.exposure) && o.exposure >= 0.0))
-    throw InvalidArgument(field(owner, "exposure"), detail::formatValue(o.exposure),
-                          "must be finite and >= 0");
+  requireNonNegative(field(owner, "exposure"), o.exposure);
   if (!(std::isfinite(o.decay) && o.decay > 0.0 && o.decay <= 1.0))
     throw InvalidArgument(field(owner, "decay"), detail::formatValue(o.decay), "must be in (0, 1]");
-  if (!(std::isfinite(o.weight) && o.weight >= 0.0))
-    throw InvalidArgument(field(owner, "weight"), detail::formatValue(o.weight), "must be finite and >= 0");
-  if (!(std::isfinite(o.density) && o.density > 0.0))
-    throw InvalidArgument(field(owner, "density"), detail::formatValue(o.density), "must be finite and > 0");
+  requireNonNegative(field(owner, "weight"), o.weight);
+  requirePositive(field(owner, "density"), o.density);
   if (o.samples < 1 || o.samples > 1024)
     throw InvalidArgument(field(owner, "samples"), detail::formatValue(o.samples), "must be in [1, 1024]");
   if (o.sourceScale < 1 || o.sourceScale > 16)
     throw InvalidArgument(field(owner, "sourceScale"), detail::formatValue(o.sourceScale),
                           "must be in [1, 16]");
-  if (!(std::isfinite(o.fadeMargin) && o.fadeMargin > 0.0))
-    throw InvalidArgument(field(owner, "fadeMargin"), detail::formatValue(o.fadeMargin),
-                          "must be finite and > 0");
+  requirePositive(field(owner, "fadeMargin"), o.fadeMargin);
   if (o.threads < 0)
     throw InvalidArgument(field(owner, "threads"), detail::formatValue(o.threads), "must be >= 0");
   if (o.mode != RadialBlurMode::SourceRadiance && o.mode != RadialBlurMode::OcclusionFraction)
@@ -52,9 +46,7 @@ void validate(const RadialBlurOptions& o, const char* owner) {
 
 // Mitchell 2007, Sec. 13.4 (the light's screen position) and Sec. 13.6 (fade toward the perpendicular).
 RadialLight radialLight(const Camera& camera, const DirectionalLight& light, double fadeMargin) {
-  if (!(std::isfinite(fadeMargin) && fadeMargin > 0.0))
-    throw InvalidArgument("RadialBlurOptions.fadeMargin", detail::formatValue(fadeMargin),
-                          "must be finite and > 0");
+  requirePositive("RadialBlurOptions.fadeMargin", fadeMargin);
   RadialLight r;
   const glm::dvec4 q = camera.clipFromWorld() * glm::dvec4(-light.direction(), 0.0);
   if (!(q.w > 0.0)) return r; // behind the camera or in its image plane: fade 0

@@ -59,11 +59,6 @@ std::string str(long long v) {
   return std::to_string(v);
 }
 
-[[noreturn]] void invalid(const std::string& parameter, const std::string& value,
-                          const std::string& requirement) {
-  throw InvalidArgument(parameter, value, requirement);
-}
-
 int getInteger(GLenum pname) {
   GLint v = 0;
   glGetIntegerv(pname, &v);
@@ -295,7 +290,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.mapWidth", info.mapWidth, 1);
   requireAtLeast("PrefilterPass::CreateInfo.mapHeight", info.mapHeight, 1);
   const PrefilterOptions& o = info.options;
-  validate(o, "PrefilterPass::CreateInfo.options");
+  crep::validate(o, "PrefilterPass::CreateInfo.options");
   if (o.regionsPerSplit > info.mapWidth)
     invalid("PrefilterPass::CreateInfo.options.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
             "must be in [1, width = " + str(info.mapWidth) + "]");
@@ -346,105 +341,146 @@ PrefilterPass::~PrefilterPass() = default;
 PrefilterPass::PrefilterPass(PrefilterPass&&) noexcept = default;
 PrefilterPass& PrefilterPass::operator=(PrefilterPass&&) noexcept = default;
 
-void PrefilterPass::run(const FrameAttribs& frame) {
-  gl::requireNotMovedFrom(sampler_, "PrefilterPass");
-  if (frame.layout == nullptr)
-    invalid("PrefilterPass::FrameAttribs.layout", "null", "must point to the map's layout");
-  const gl::TextureLevel depth =
-      gl::textureLevel("PrefilterPass::FrameAttribs.rectifiedDepth", frame.rectifiedDepth);
-  if (depth.target != GL_TEXTURE_2D)
-    invalid("PrefilterPass::FrameAttribs.rectifiedDepth", "texture " + str(frame.rectifiedDepth),
-            "must be a GL_TEXTURE_2D");
-  gl::requireDepthFormat("PrefilterPass::FrameAttribs.rectifiedDepth", frame.rectifiedDepth);
-  if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
-    invalid("PrefilterPass::FrameAttribs.rectifiedDepth", sizeString(depth.width, depth.height),
-            "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
-  double s = frame.extinctionOverride;
-  if (s < 0.0) {
-    if (frame.medium == nullptr)
-      invalid("PrefilterPass::FrameAttribs.medium", "null", "must be set unless extinctionOverride >= 0");
-    s = weightExtinction(*frame.medium);
-  }
-  if (!std::isfinite(s))
-    invalid("PrefilterPass::FrameAttribs.extinctionOverride", detail::formatValue(s), "must be finite");
+/// A validated frame of the prefilter pass (PrefilterPass::validate) and what run() derives from it.
+struct PrefilterPass::Plan {
+  double extinction = 0.0; ///< the weight extinction s
+  int K = 1, R = 1, n = 1; ///< layout regions, prefilter regions R = K P, texels per region
+  bool local = false, textured = false;
+};
 
-  const int K = frame.layout->regionCount(), P = info_.options.regionsPerSplit, R = K * P;
-  const int W = info_.mapWidth, H = info_.mapHeight;
-  if (K < 1 || W % R != 0)
-    invalid("PrefilterPass::FrameAttribs.layout", "regionCount() " + str(K),
-            "regionCount() x regionsPerSplit (" + str(K) + " x " + str(P) + ") must divide the map width " +
+void PrefilterPass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_view owner) const {
+  const std::string f = std::string(owner) + ".";
+  if (frame.layout == nullptr) invalid(f + "layout", "null", "must point to the map's layout");
+  const gl::TextureLevel depth = gl::textureLevel((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
+  if (depth.target != GL_TEXTURE_2D)
+    invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a GL_TEXTURE_2D");
+  gl::requireDepthFormat((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
+  if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
+    invalid(f + "rectifiedDepth", sizeString(depth.width, depth.height),
+            "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
+  Plan p;
+  p.extinction = frame.extinctionOverride;
+  if (p.extinction < 0.0) {
+    if (frame.medium == nullptr) invalid(f + "medium", "null", "must be set unless extinctionOverride >= 0");
+    p.extinction = weightExtinction(*frame.medium);
+  }
+  requireFinite(f + "extinctionOverride", p.extinction);
+
+  const int P = info_.options.regionsPerSplit, W = info_.mapWidth, H = info_.mapHeight;
+  p.K = frame.layout->regionCount();
+  p.R = p.K * P;
+  if (p.K < 1 || W % p.R != 0)
+    invalid(f + "layout", "regionCount() " + str(p.K),
+            "regionCount() x regionsPerSplit (" + str(p.K) + " x " + str(P) + ") must divide the map width " +
                 str(W));
-  const int n = W / R;
-  const bool local = frame.localLight != nullptr;
-  const bool textured = frame.lightColors != 0;
-  if (textured) {
-    gl::requireTexture2D("PrefilterPass::FrameAttribs.lightColors", frame.lightColors, W, H);
+  p.n = W / p.R;
+  p.local = frame.localLight != nullptr;
+  p.textured = frame.lightColors != 0;
+  if (p.textured) {
+    gl::requireTexture2D((f + "lightColors").c_str(), frame.lightColors, W, H);
     if (info_.memoryLimit)
-      invalid("PrefilterPass::FrameAttribs.lightColors", str(frame.lightColors),
+      invalid(f + "lightColors", str(frame.lightColors),
               "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
+    // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
     if (!texturedTexture_) {
-      // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
       const int maxLayers = gl::maxArrayTextureLayers();
       if (3 * layers() > maxLayers)
         throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(info_.options.bases) + " needs " +
                       str(3 * layers()) +
                       " layers with a light texture, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
-      texturedTexture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-      glTextureStorage3D(texturedTexture_.get(), 1, internalFormat(info_.options.format), W, H, 3 * layers());
-      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-      // RGBA32F: a light texture's HDR texels (projector images in physical units) are kept whole; half
-      // floats clipped them at 65504. GPU: one fetch per region per pixel, so the extra bytes are cheap.
-      meanColor_ = gl::createTexture2D(GL_RGBA32F, W, H, "PrefilterPass: mean colour (light textures)");
-      glTextureParameteri(meanColor_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-      glTextureParameteri(meanColor_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-      gl::checkError("PrefilterPass: light-texture basis array and mean colour");
     }
-    gl::Handle& variant = programTextured_[local ? 1 : 0];
-    if (!variant) variant = buildProgram(prefilterStages(info_, local, true));
   }
-  if (local && frame.medium == nullptr)
-    invalid("PrefilterPass::FrameAttribs.medium", "null", "must be set with a localLight");
-  if (local && info_.options.weights != WeightMode::Exact)
+  if (p.local && frame.medium == nullptr) invalid(f + "medium", "null", "must be set with a localLight");
+  if (p.local && info_.options.weights != WeightMode::Exact)
     invalid("PrefilterPass::CreateInfo.options.weights", weightModeToken(info_.options.weights),
             "must be exact with a localLight");
+  return p;
+}
 
-  const std::vector<DistanceProfile> profiles = referenceProfiles(*frame.layout, H, P);
-  const std::vector<gpu::RegionWeights> weights = gpuRegionWeights(profiles, info_.options.weights, n);
-  if (local) {
-    // Sec. 3.2: the reference rays the light-side factor is sampled along (direction, start distance).
-    std::vector<gpu::RegionRay> rays(profiles.size());
-    for (int j = 0; j < H; ++j) {
-      const double row = (j + 0.5) / H;
-      for (int r = 0; r < R; ++r) {
-        const glm::vec3 direction(
-            frame.layout->viewRayDirection(row, frame.layout->regionReferenceDepth(row, r / P)));
-        const std::size_t k =
-            static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r);
-        const double t0 = profiles[k](0.0);
-        rays[k] = gpu::RegionRay(direction, std::isfinite(t0) ? static_cast<float>(t0) : -1.0f);
-      }
-    }
-    gl::uploadGrowingBuffer(raysBuffer_, raysCapacity_, rays.data(), rays.size() * sizeof(gpu::RegionRay));
-    if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
-    gpu::LocalLightParams lp = localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), s);
-    lp.cone.w = static_cast<float>(static_cast<int>(info_.options.localLightWeights));
-    glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
-    if (!programLocal_) programLocal_ = buildProgram(prefilterStages(info_, true));
+void PrefilterPass::run(const FrameAttribs& frame) {
+  gl::requireNotMovedFrom(sampler_, "PrefilterPass");
+  const Plan p = plan(frame, "PrefilterPass::FrameAttribs");
+  if (p.textured) prepareTextured(p.local);
+  const std::size_t weightBytes = upload(frame, p);
+  dispatch(frame, p, weightBytes);
+  ran_ = true;
+  lastTextured_ = p.textured;
+  lastLayoutRegions_ = p.K;
+  lastExtinction_ = p.extinction;
+  lastLocal_ = p.local;
+}
+
+void PrefilterPass::prepareTextured(bool local) {
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  if (!texturedTexture_) {
+    // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
+    texturedTexture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
+    glTextureStorage3D(texturedTexture_.get(), 1, internalFormat(info_.options.format), W, H, 3 * layers());
+    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    // RGBA32F: a light texture's HDR texels (projector images in physical units) are kept whole; half
+    // floats clipped them at 65504. GPU: one fetch per region per pixel, so the extra bytes are cheap.
+    meanColor_ = gl::createTexture2D(GL_RGBA32F, W, H, "PrefilterPass: mean colour (light textures)");
+    glTextureParameteri(meanColor_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(meanColor_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl::checkError("PrefilterPass: light-texture basis array and mean colour");
   }
+  gl::Handle& variant = programTextured_[local ? 1 : 0];
+  if (!variant) variant = buildProgram(prefilterStages(info_, local, true));
+}
+
+std::size_t PrefilterPass::upload(const FrameAttribs& frame, const Plan& p) {
+  const int W = info_.mapWidth, H = info_.mapHeight;
+  const std::vector<DistanceProfile> profiles =
+      referenceProfiles(*frame.layout, H, info_.options.regionsPerSplit);
+  const std::vector<gpu::RegionWeights> weights = gpuRegionWeights(profiles, info_.options.weights, p.n);
+  if (p.local) uploadLocalLight(frame, p, profiles);
   const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
   gl::uploadGrowingBuffer(weightsBuffer_, weightsCapacity_, weights.data(), bytes);
 
   gpu::PrefilterParams params;
-  params.mapSize = glm::ivec4(W, H, R, n);
-  params.basisInfo = glm::ivec4(info_.options.bases, basesPerInvocation(info_, local),
+  params.mapSize = glm::ivec4(W, H, p.R, p.n);
+  params.basisInfo = glm::ivec4(info_.options.bases, basesPerInvocation(info_, p.local),
                                 static_cast<int>(info_.options.weights), 0);
   params.weights =
-      glm::vec4(static_cast<float>(s), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
+      glm::vec4(static_cast<float>(p.extinction), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
   glNamedBufferSubData(paramsBuffer_.get(), 0, sizeof params, &params);
+  return bytes;
+}
 
+void PrefilterPass::uploadLocalLight(const FrameAttribs& frame, const Plan& p,
+                                     const std::vector<DistanceProfile>& profiles) {
+  const int H = info_.mapHeight, P = info_.options.regionsPerSplit, R = p.R;
+  // Sec. 3.2: the reference rays the light-side factor is sampled along (direction, start distance).
+  std::vector<gpu::RegionRay> rays(profiles.size());
+  for (int j = 0; j < H; ++j) {
+    const double row = (j + 0.5) / H;
+    for (int r = 0; r < R; ++r) {
+      const glm::vec3 direction(
+          frame.layout->viewRayDirection(row, frame.layout->regionReferenceDepth(row, r / P)));
+      const std::size_t k =
+          static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r);
+      const double t0 = profiles[k](0.0);
+      rays[k] = gpu::RegionRay(direction, std::isfinite(t0) ? static_cast<float>(t0) : -1.0f);
+    }
+  }
+  gl::uploadGrowingBuffer(raysBuffer_, raysCapacity_, rays.data(), rays.size() * sizeof(gpu::RegionRay));
+  if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
+  gpu::LocalLightParams lp =
+      localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), p.extinction);
+  lp.cone.w = static_cast<float>(static_cast<int>(info_.options.localLightWeights));
+  glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
+  if (!programLocal_) programLocal_ = buildProgram(prefilterStages(info_, true));
+}
+
+void PrefilterPass::dispatch(const FrameAttribs& frame, const Plan& p, std::size_t weightBytes) {
+  const bool local = p.local, textured = p.textured;
   glUseProgram(textured ? programTextured_[local ? 1 : 0].get()
                : local  ? programLocal_.get()
                         : program_.get());
@@ -462,10 +498,11 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   glBindImageTexture(0, textured ? texturedTexture_.get() : texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
                      internalFormat(info_.options.format));
   glBindBufferBase(GL_UNIFORM_BUFFER, 0, paramsBuffer_.get());
-  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0, static_cast<GLsizeiptr>(bytes));
-  glDispatchCompute(static_cast<GLuint>(ceilDiv(H, info_.workgroupRows)),
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0,
+                    static_cast<GLsizeiptr>(weightBytes));
+  glDispatchCompute(static_cast<GLuint>(ceilDiv(info_.mapHeight, info_.workgroupRows)),
                     static_cast<GLuint>(ceilDiv(baseGroups(info_, local), info_.workgroupBaseGroups)),
-                    static_cast<GLuint>(ceilDiv(R, info_.workgroupRegions)));
+                    static_cast<GLuint>(ceilDiv(p.R, info_.workgroupRegions)));
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
@@ -482,12 +519,6 @@ void PrefilterPass::run(const FrameAttribs& frame) {
   }
   glUseProgram(0);
   gl::checkError("PrefilterPass::run");
-
-  ran_ = true;
-  lastTextured_ = textured;
-  lastLayoutRegions_ = K;
-  lastExtinction_ = s;
-  lastLocal_ = local;
 }
 
 FilteredBasisView PrefilterPass::filteredBasis() const {
@@ -593,7 +624,7 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
 
 EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   validateBases(info.bases, "EvaluatePass::CreateInfo.bases");
-  validate(info.options, "EvaluatePass::CreateInfo.options");
+  crep::validate(info.options, "EvaluatePass::CreateInfo.options");
   if (info.outputFormat != StorageFormat::RGBA32F && info.outputFormat != StorageFormat::RGBA16F)
     invalid("EvaluatePass::CreateInfo.outputFormat", storageFormatToken(info.outputFormat),
             "must be RGBA32F or RGBA16F");
@@ -657,281 +688,342 @@ std::size_t PrefilterPass::memoryBytes() const noexcept {
          (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }
 
-void EvaluatePass::run(const FrameAttribs& frame) {
-  gl::requireNotMovedFrom(basisSampler_, "EvaluatePass");
-  if (frame.camera == nullptr) invalid("EvaluatePass::FrameAttribs.camera", "null", "must be set");
-  const bool local = frame.localLight != nullptr;
-  if ((frame.light == nullptr) == !local)
-    invalid("EvaluatePass::FrameAttribs.light/localLight", local ? "both set" : "both null",
-            "exactly one must be set");
-  if (frame.medium == nullptr) invalid("EvaluatePass::FrameAttribs.medium", "null", "must be set");
-  if (frame.layout == nullptr) invalid("EvaluatePass::FrameAttribs.layout", "null", "must be set");
-  const FilteredBasisView& basis = frame.basis;
-  if (basis.bases != info_.bases)
-    invalid("EvaluatePass::FrameAttribs.basis.bases", detail::formatValue(basis.bases),
-            "must equal EvaluatePass::CreateInfo.bases = " + str(info_.bases));
-  const bool textured = basis.textured;
-  const int basisLayers = (textured ? 3 : 1) * layerCount(basis.bases);
-  const gl::TextureLevel b = gl::textureLevel("EvaluatePass::FrameAttribs.basis.texture", basis.texture);
-  if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
-      b.depth < basisLayers)
-    invalid("EvaluatePass::FrameAttribs.basis.texture", "texture " + str(basis.texture),
-            "must be a GL_TEXTURE_2D_ARRAY of " + sizeString(basis.width, basis.height) + " x " +
-                str(basisLayers) + " layers");
-  if (textured) {
-    // Light textures (prefilter.h): the textured variants exist for the scattering prefix table (the
-    // default) and the direct path without a table.
-    gl::requireTexture2D("EvaluatePass::FrameAttribs.basis.meanColor", basis.meanColor, basis.width,
-                         basis.height);
-    if (info_.options.nearPlaneCorrection)
-      invalid("EvaluatePass::FrameAttribs.basis.textured", "true",
-              "a light texture is not supported with CreateInfo.options.nearPlaneCorrection");
-    if (usesVisibilityTable(info_.options) && !usesScatteringPrefix(info_.options))
-      invalid("EvaluatePass::FrameAttribs.basis.textured", "true",
-              "a light texture needs CreateInfo.options.scatteringPrefix or visibilityTableSamples = 0 (no "
-              "textured variant of the visibility table alone)");
-    if (info_.memoryLimit)
-      invalid("EvaluatePass::FrameAttribs.basis.textured", "true",
-              "not with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
-  }
-  if (info_.options.nearPlaneCorrection &&
-      (basis.regionWeights == 0 || glIsBuffer(basis.regionWeights) != GL_TRUE))
-    invalid("EvaluatePass::FrameAttribs.basis.regionWeights", str(basis.regionWeights),
-            "must name the region-weights buffer (near-plane correction)");
-  // Froxel volumes (prefilter.h, "Froxel volumes"): the directional light's evaluation at the cells.
-  const bool froxels = frame.froxels.volume != 0;
-  // Work lists (Yusov 2012, Sec. 6.4 and 6.7): the list's entries instead of every pixel.
-  const gpu::SampleList* list = frame.list;
-  const bool pixels = !list && (frame.output != 0 || !froxels);
+/// A validated frame of the evaluation (EvaluatePass::validate) and what run() derives from it.
+struct EvaluatePass::Plan {
+  bool local = false, textured = false, froxels = false, pixels = false, projective = true;
+  bool table = false, prefix = false, reuse = false;
+  const gpu::SampleList* list = nullptr;
   FroxelDepthRange froxelRange;
   GLenum volumeFormat = GL_RGBA32F;
-  if (froxels) {
-    const char* owner = "EvaluatePass::FrameAttribs.froxels";
-    validate(frame.froxels.grid, owner);
-    validateFroxelJitter(frame.froxels.jitter, "EvaluatePass::FrameAttribs.froxels.jitter");
-    froxelRange = froxelDepthRange(frame.froxels.grid, *frame.camera, owner);
-    if (local)
-      invalid("EvaluatePass::FrameAttribs.froxels", "with localLight",
-              "froxel volumes are filled for the directional light only");
-    if (info_.memoryLimit)
-      invalid("EvaluatePass::FrameAttribs.froxels", "a volume",
-              "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the per-pixel pass)");
-    const gl::TextureLevel v =
-        gl::textureLevel("EvaluatePass::FrameAttribs.froxels.volume", frame.froxels.volume);
-    const FroxelGrid& g = frame.froxels.grid;
-    if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
-      invalid("EvaluatePass::FrameAttribs.froxels.volume", "texture " + str(frame.froxels.volume),
-              "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
-    if (v.width != g.width || v.height != g.height || v.depth != g.depth)
-      invalid("EvaluatePass::FrameAttribs.froxels.volume",
-              sizeString(v.width, v.height) + " x " + str(v.depth),
-              "must have the grid's size " + sizeString(g.width, g.height) + " x " + str(g.depth));
-    volumeFormat = v.internalFormat;
-    const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
-                            "EvaluatePass::CreateInfo.workgroupHeight",
-                            "EvaluatePass::FrameAttribs.froxels.grid.depth"};
-    const int localSize[3] = {info_.workgroupWidth, info_.workgroupHeight, 1};
-    const int groups[3] = {ceilDiv(g.width, info_.workgroupWidth), ceilDiv(g.height, info_.workgroupHeight),
-                           g.depth};
-    checkWorkgroup(names, localSize, groups);
+  /// The pixels' camera depth size, or with a work list the camera image's size (0 for froxels alone).
+  int imageWidth = 0, imageHeight = 0;
+  std::optional<GpuLayoutData> layoutData; ///< a non-projective layout's block
+  int layoutKind = -1;  ///< CREP_EVAL_LAYOUT: -1 the projective frame, else gpu::LayoutKind
+  int layoutSlot = 0;   ///< program variants: 0 projective frame, 1 + layoutKind
+  int variantIndex = 0; ///< (local ? 3 : 0) + layoutSlot
+  gpu::ScatteringParams scattering;
+};
+
+namespace {
+
+/// EvaluatePass::FrameAttribs::basis against the pass (`f`: the FrameAttribs' name and a dot).
+void validateBasisView(const EvaluatePass::CreateInfo& info, const FilteredBasisView& basis,
+                       const std::string& f) {
+  if (basis.bases != info.bases)
+    invalid(f + "basis.bases", detail::formatValue(basis.bases),
+            "must equal EvaluatePass::CreateInfo.bases = " + str(info.bases));
+  const int basisLayers = (basis.textured ? 3 : 1) * layerCount(basis.bases);
+  const gl::TextureLevel b = gl::textureLevel((f + "basis.texture").c_str(), basis.texture);
+  if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
+      b.depth < basisLayers)
+    invalid(f + "basis.texture", "texture " + str(basis.texture),
+            "must be a GL_TEXTURE_2D_ARRAY of " + sizeString(basis.width, basis.height) + " x " +
+                str(basisLayers) + " layers");
+  if (basis.textured) {
+    // Light textures (prefilter.h): the textured variants exist for the scattering prefix table (the
+    // default) and the direct path without a table.
+    gl::requireTexture2D((f + "basis.meanColor").c_str(), basis.meanColor, basis.width, basis.height);
+    if (info.options.nearPlaneCorrection)
+      invalid(f + "basis.textured", "true",
+              "a light texture is not supported with CreateInfo.options.nearPlaneCorrection");
+    if (usesVisibilityTable(info.options) && !usesScatteringPrefix(info.options))
+      invalid(f + "basis.textured", "true",
+              "a light texture needs CreateInfo.options.scatteringPrefix or visibilityTableSamples = 0 (no "
+              "textured variant of the visibility table alone)");
+    if (info.memoryLimit)
+      invalid(f + "basis.textured", "true",
+              "not with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
   }
-  gl::TextureLevel depth, out;
-  const GLenum outFormat = internalFormat(info_.outputFormat);
-  int listWidth = 0, listHeight = 0; // the camera image's size for a list
-  if (list) {
-    const gl::TextureLevel image = gpu::listImageSize(frame.imageWidth, frame.imageHeight, frame.cameraDepth,
-                                                      "EvaluatePass::FrameAttribs");
-    listWidth = image.width;
-    listHeight = image.height;
-    gpu::validateSampleList(*list, "EvaluatePass::FrameAttribs.list");
+  if (info.options.nearPlaneCorrection)
+    gl::requireBuffer((f + "basis.regionWeights").c_str(), basis.regionWeights,
+                      "must name the region-weights buffer (near-plane correction)");
+}
+
+/// Froxel volumes (prefilter.h, "Froxel volumes"): the directional light's evaluation at the cells.
+void validateFroxels(const EvaluatePass::CreateInfo& info, const EvaluatePass::FroxelTarget& froxels,
+                     const Camera& camera, bool local, const std::string& f, FroxelDepthRange& range,
+                     GLenum& volumeFormat) {
+  const std::string owner = f + "froxels";
+  validate(froxels.grid, owner.c_str());
+  validateFroxelJitter(froxels.jitter, owner + ".jitter");
+  range = froxelDepthRange(froxels.grid, camera, owner.c_str());
+  if (local) invalid(owner, "with localLight", "froxel volumes are filled for the directional light only");
+  if (info.memoryLimit)
+    invalid(owner, "a volume",
+            "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the per-pixel pass)");
+  const gl::TextureLevel v = gl::textureLevel((owner + ".volume").c_str(), froxels.volume);
+  const FroxelGrid& g = froxels.grid;
+  if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
+    invalid(owner + ".volume", "texture " + str(froxels.volume),
+            "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
+  if (v.width != g.width || v.height != g.height || v.depth != g.depth)
+    invalid(owner + ".volume", sizeString(v.width, v.height) + " x " + str(v.depth),
+            "must have the grid's size " + sizeString(g.width, g.height) + " x " + str(g.depth));
+  volumeFormat = v.internalFormat;
+  const std::string depthName = owner + ".grid.depth";
+  const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
+                          "EvaluatePass::CreateInfo.workgroupHeight", depthName.c_str()};
+  const int localSize[3] = {info.workgroupWidth, info.workgroupHeight, 1};
+  const int groups[3] = {ceilDiv(g.width, info.workgroupWidth), ceilDiv(g.height, info.workgroupHeight),
+                         g.depth};
+  checkWorkgroup(names, localSize, groups);
+}
+
+/// The camera depth and output textures of the per-pixel evaluation; returns the depth's level.
+gl::TextureLevel validatePixelTextures(const EvaluatePass::CreateInfo& info,
+                                       const EvaluatePass::FrameAttribs& frame, const std::string& f) {
+  const gl::TextureLevel depth = gl::textureLevel((f + "cameraDepth").c_str(), frame.cameraDepth);
+  if (depth.target != GL_TEXTURE_2D)
+    invalid(f + "cameraDepth", "texture " + str(frame.cameraDepth), "must be a GL_TEXTURE_2D");
+  gl::requireDepthFormat((f + "cameraDepth").c_str(), frame.cameraDepth);
+  const gl::TextureLevel out = gl::textureLevel((f + "output").c_str(), frame.output);
+  if (out.target != GL_TEXTURE_2D || out.internalFormat != internalFormat(info.outputFormat))
+    invalid(f + "output", "texture " + str(frame.output),
+            std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info.outputFormat));
+  if (out.width != depth.width || out.height != depth.height)
+    invalid(f + "output", sizeString(out.width, out.height),
+            "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
+  return depth;
+}
+
+} // namespace
+
+void EvaluatePass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+EvaluatePass::Plan EvaluatePass::plan(const FrameAttribs& frame, std::string_view owner) const {
+  const std::string f = std::string(owner) + ".";
+  if (frame.camera == nullptr) invalid(f + "camera", "null", "must be set");
+  Plan p;
+  p.local = frame.localLight != nullptr;
+  if ((frame.light == nullptr) == !p.local)
+    invalid(f + "light/localLight", p.local ? "both set" : "both null", "exactly one must be set");
+  if (frame.medium == nullptr) invalid(f + "medium", "null", "must be set");
+  if (frame.layout == nullptr) invalid(f + "layout", "null", "must be set");
+  const FilteredBasisView& basis = frame.basis;
+  validateBasisView(info_, basis, f);
+  p.textured = basis.textured;
+  p.froxels = frame.froxels.volume != 0;
+  // Work lists (Yusov 2012, Sec. 6.4 and 6.7): the list's entries instead of every pixel.
+  p.list = frame.list;
+  p.pixels = !p.list && (frame.output != 0 || !p.froxels);
+  if (p.froxels)
+    validateFroxels(info_, frame.froxels, *frame.camera, p.local, f, p.froxelRange, p.volumeFormat);
+  if (p.list) {
+    const gl::TextureLevel image =
+        gpu::listImageSize(frame.imageWidth, frame.imageHeight, frame.cameraDepth, std::string(owner));
+    p.imageWidth = image.width;
+    p.imageHeight = image.height;
+    gpu::validateSampleList(*p.list, f + "list");
   }
-  if (pixels) {
-    depth = gl::textureLevel("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
-    if (depth.target != GL_TEXTURE_2D)
-      invalid("EvaluatePass::FrameAttribs.cameraDepth", "texture " + str(frame.cameraDepth),
-              "must be a GL_TEXTURE_2D");
-    gl::requireDepthFormat("EvaluatePass::FrameAttribs.cameraDepth", frame.cameraDepth);
-    out = gl::textureLevel("EvaluatePass::FrameAttribs.output", frame.output);
-    if (out.target != GL_TEXTURE_2D || out.internalFormat != outFormat)
-      invalid("EvaluatePass::FrameAttribs.output", "texture " + str(frame.output),
-              std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info_.outputFormat));
-    if (out.width != depth.width || out.height != depth.height)
-      invalid("EvaluatePass::FrameAttribs.output", sizeString(out.width, out.height),
-              "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
+  if (p.pixels) {
+    const gl::TextureLevel depth = validatePixelTextures(info_, frame, f);
+    p.imageWidth = depth.width;
+    p.imageHeight = depth.height;
   }
 
   // A projective layout is evaluated from the scattering block's frame (the default program); any other
   // layout with a GPU mapping through its own block (Klehm et al. 2014, Sec. 4.1 for the epipolar one),
   // serialized once here.
-  const bool projective = dynamic_cast<const ProjectiveLayout*>(frame.layout) != nullptr;
-  if (local != basis.localLight)
+  p.projective = dynamic_cast<const ProjectiveLayout*>(frame.layout) != nullptr;
+  if (p.local != basis.localLight)
     invalid(
-        "EvaluatePass::FrameAttribs.basis.localLight", basis.localLight ? "true" : "false",
-        local ? "the basis must be prefiltered with the local light (PrefilterPass::FrameAttribs::localLight)"
-              : "a basis prefiltered for a local light needs FrameAttribs::localLight");
-  if (local && info_.options.nearPlaneCorrection)
+        f + "basis.localLight", basis.localLight ? "true" : "false",
+        p.local
+            ? "the basis must be prefiltered with the local light (PrefilterPass::FrameAttribs::localLight)"
+            : "a basis prefiltered for a local light needs FrameAttribs::localLight");
+  if (p.local && info_.options.nearPlaneCorrection)
     invalid("EvaluatePass::CreateInfo.options.nearPlaneCorrection", "true", "not supported for local lights");
-  std::optional<GpuLayoutData> layoutData;
-  if (!projective) layoutData = gpu::requireGpuLayout(*frame.layout);
+  if (!p.projective) {
+    p.layoutData = gpu::requireGpuLayout(*frame.layout);
+    p.layoutKind = static_cast<int>(p.layoutData->kind);
+  }
   // The program variants' slot: the projective frame (0) or the layout block of a kind (1 + kind).
-  const int layoutSlot = projective ? 0 : 1 + static_cast<int>(layoutData->kind);
+  p.layoutSlot = p.projective ? 0 : 1 + p.layoutKind;
+  p.variantIndex = (p.local ? 3 : 0) + p.layoutSlot;
   // A local light has no constant C: the block's directional light is unused (zero irradiance).
   const DirectionalLight unusedLight(glm::dvec3(0.0, 0.0, -1.0), glm::dvec3(0.0));
-  const gpu::ScatteringParams scattering =
-      scatteringParamsOf(basis, *frame.layout, local ? unusedLight : *frame.light, *frame.medium);
-  GLuint program = program_.get();
-  if (local) {
-    gl::Handle& localProgram = localPrograms_[layoutSlot];
-    if (!localProgram && !textured)
-      localProgram = buildProgram(evaluateStages(info_, projective ? -1 : layoutSlot - 1, true));
-    program = localProgram.get();
-    if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
-    const gpu::LocalLightParams lp = localLightParams(
-        *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
-    glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
-    glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, localBuffer_.get());
-    // The airlight table of the medium's g (made on the CPU in double, a few ms, when g changes).
-    if (info_.localClosedForm && (!airlightTable_ || airlightG_ != frame.medium->hgG())) {
-      const AirlightTable t = makeAirlightTable(frame.medium->hgG());
-      airlightTable_ = gl::createTexture2D(GL_RG32F, t.xiSamples, t.uSamples, "EvaluatePass: airlight table");
-      glTextureSubImage2D(airlightTable_.get(), 0, 0, 0, t.xiSamples, t.uSamples, GL_RG, GL_FLOAT,
-                          t.values.data());
-      if (!airlightSampler_) airlightSampler_ = gl::createClampSampler(GL_LINEAR);
-      airlightG_ = frame.medium->hgG();
-    }
-    if (info_.localClosedForm) {
-      glBindTextureUnit(kAirlightUnit, airlightTable_.get());
-      glBindSampler(kAirlightUnit, airlightSampler_.get());
-    }
-  }
-  gpu::LayoutKind layoutKind{};
-  if (!projective) {
-    const gpu::LayoutKind kind =
-        layoutBuffers_.upload(*layoutData, basis.height, "EvaluatePass::FrameAttribs.layout");
-    layoutKind = kind;
-    if (!textured && pixels && !local) {
-      gl::Handle& variant = layoutPrograms_[static_cast<int>(kind)];
-      if (!variant) variant = buildProgram(evaluateStages(info_, static_cast<int>(kind)));
-      program = variant.get();
-    }
-  }
-  // Light textures: the CREP_LIGHT_TEXTURE variants (projective frame, layouts, local light), on first use.
-  const int variantIndex = (local ? 3 : 0) + layoutSlot;
-  if (textured && pixels) {
-    gl::Handle& variant = texturedPrograms_[variantIndex];
-    if (!variant)
-      variant =
-          buildProgram(evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), local, true));
-    program = variant.get();
-  }
-  if (list) { // the CREP_SAMPLE_LIST variant of the program chosen above
-    gl::Handle& variant = listPrograms_[textured ? 1 : 0][variantIndex];
-    if (!variant)
-      variant = buildProgram(evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), local,
-                                            textured, false, true));
-    program = variant.get();
-  }
+  p.scattering =
+      scatteringParamsOf(basis, *frame.layout, p.local ? unusedLight : *frame.light, *frame.medium);
+  if (!p.projective)
+    gpu::LayoutBuffers::requireUploadable(*p.layoutData, basis.height, (f + "layout").c_str());
+
+  p.table = usesVisibilityTable(info_.options);
+  p.prefix = usesScatteringPrefix(info_.options);
+  p.reuse = p.table && frame.reuseTable;
+  if (p.reuse &&
+      (tableBasis_ != basis.texture || tableVariant_ != p.variantIndex + 6 * int(p.textured) ||
+       tableWidth_ != basis.regions() * info_.options.visibilityTableSamples || tableHeight_ != basis.height))
+    invalid(f + "reuseTable", "true",
+            "the previous run() built no table for this basis (texture, size, regions, layout kind)");
+  return p;
+}
+
+void EvaluatePass::run(const FrameAttribs& frame) {
+  gl::requireNotMovedFrom(basisSampler_, "EvaluatePass");
+  const Plan p = plan(frame, "EvaluatePass::FrameAttribs");
+  if (p.local) uploadLocalLight(frame);
+  if (!p.projective)
+    layoutBuffers_.upload(*p.layoutData, frame.basis.height, "EvaluatePass::FrameAttribs.layout");
+  const GLuint program = evaluationProgram(p);
   gpu::EvaluateParams params;
   gpu::assignCamera(params, *frame.camera);
-  params.imageSize = list ? glm::ivec4(listWidth, listHeight, 0, 0)
-                          : glm::ivec4(pixels ? depth.width : 0, pixels ? depth.height : 0, 0, 0);
-  glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof scattering, &scattering);
+  params.imageSize = glm::ivec4(p.imageWidth, p.imageHeight, 0, 0);
+  glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof p.scattering, &p.scattering);
   glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
-
-  const bool table = usesVisibilityTable(info_.options);
-  const bool prefix = usesScatteringPrefix(info_.options);
-  const bool reuse = table && frame.reuseTable;
-  if (reuse &&
-      (tableBasis_ != basis.texture || tableVariant_ != variantIndex + 6 * int(textured) ||
-       tableWidth_ != basis.regions() * info_.options.visibilityTableSamples || tableHeight_ != basis.height))
-    invalid("EvaluatePass::FrameAttribs.reuseTable", "true",
-            "the previous run() built no table for this basis (texture, size, regions, layout kind)");
-  if (table && !reuse) {
-    // The per-frame table of this basis (EvaluateOptions::visibilityTableSamples / scatteringPrefix): the
-    // scattering prefix table (RGBA32F, the default) or the region visibility table (R32F), rebuilt every
-    // run; both R Z x H texels.
-    const int Z = info_.options.visibilityTableSamples, R = basis.regions();
-    const bool sections = local && usesLocalSectionTable(info_.options);
-    if (sections && (!sectionTexture_ || tableWidth_ != R * Z || tableHeight_ != basis.height))
-      sectionTexture_ = gl::createTexture2D(GL_RGBA32F, R * Z, basis.height,
-                                            "EvaluatePass: local section table (regions x samples, rows)");
-    if (tableWidth_ != R * Z || tableHeight_ != basis.height) {
-      tableTexture_ =
-          gl::createTexture2D(prefix ? GL_RGBA32F : GL_R32F, R * Z, basis.height,
-                              prefix ? "EvaluatePass: scattering prefix table (regions x samples, rows)"
-                                     : "EvaluatePass: visibility table (regions x samples, rows)");
-      tableWidth_ = R * Z;
-      tableHeight_ = basis.height;
-    }
-    if (!tableCoefficients_ || tableMargin_ != basis.depthMargin) {
-      // a(z_s) of every sample (the CPU reference's values), as M / 4 vec4 per sample (zero beyond M).
-      const int M = info_.bases, layers = layerCount(M);
-      const std::vector<double> as =
-          visibilityTableCoefficients(Z, M, basis.depthMargin, info_.options.ringing);
-      std::vector<float> a(static_cast<std::size_t>(Z) * static_cast<std::size_t>(layers) * 4, 0.0f);
-      for (int k = 0; k < Z; ++k)
-        for (int m = 0; m < M; ++m)
-          a[static_cast<std::size_t>(k) * static_cast<std::size_t>(layers) * 4 +
-            static_cast<std::size_t>(m)] =
-              static_cast<float>(as[static_cast<std::size_t>(k) * static_cast<std::size_t>(M) +
-                                    static_cast<std::size_t>(m)]);
-      tableCoefficients_ = gl::createBuffer();
-      glNamedBufferStorage(tableCoefficients_.get(), static_cast<GLsizeiptr>(a.size() * sizeof(float)),
-                           a.data(), 0);
-      tableMargin_ = basis.depthMargin;
-    }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, tableCoefficients_.get());
-    glBindTextureUnit(kTableBasisUnit, basis.texture);
-    if (textured)
-      glBindTextureUnit(kMeanColorUnit, basis.meanColor); // texelFetch at the regions' last texels
-    glBindSampler(kTableBasisUnit, depthSampler_.get());  // nearest, clamped: texelFetch ignores it anyway
-    if (prefix) {
-      // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
-      gl::Handle& prefixProgram = textured ? texturedPrefixPrograms_[variantIndex]
-                                  : local
-                                      ? localPrefixPrograms_[layoutSlot]
-                                      : prefixPrograms_[projective ? 0 : 1 + static_cast<int>(layoutKind)];
-      if (!prefixProgram)
-        prefixProgram = buildProgram(
-            prefixStages(info_, projective ? -1 : static_cast<int>(layoutKind), local, textured));
-      glUseProgram(prefixProgram.get());
-      if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
-      glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
-      glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-      if (sections)
-        glBindImageTexture(kLocalSectionImage, sectionTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                           GL_RGBA32F);
-      glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height), 1);
-      if (sections) glBindImageTexture(kLocalSectionImage, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    } else {
-      glUseProgram(tableProgram_.get());
-      glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
-      glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-      glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
-    }
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, 0);
-    glBindSampler(kTableBasisUnit, 0);
-    glBindTextureUnit(kTableBasisUnit, 0);
-    tableBasis_ = basis.texture;
-    tableVariant_ = variantIndex + 6 * int(textured);
+  if (p.table && !p.reuse) buildTable(frame.basis, p);
+  bindEvaluation(frame, p, program);
+  if (p.pixels) {
+    glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, internalFormat(info_.outputFormat));
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(p.imageWidth, info_.workgroupWidth)),
+                      static_cast<GLuint>(ceilDiv(p.imageHeight, info_.workgroupHeight)), 1);
   }
-  if (table) {
-    const GLuint unit = prefix ? kPrefixUnit : kTableUnit;
+  if (p.list) { // one invocation per entry, groups of 64 (gpu::kSampleListGroupSize)
+    glBindImageTexture(0, p.list->output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, p.list->buffer);
+    gpu::dispatchSampleList(p.list->buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, 0);
+  }
+  if (p.froxels) dispatchFroxels(frame, p, params);
+  unbindEvaluation(p);
+  gl::checkError("EvaluatePass::run");
+}
+
+void EvaluatePass::uploadLocalLight(const FrameAttribs& frame) {
+  if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
+  const gpu::LocalLightParams lp = localLightParams(
+      *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
+  glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
+  glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, localBuffer_.get());
+  // The airlight table of the medium's g (made on the CPU in double, a few ms, when g changes).
+  if (info_.localClosedForm && (!airlightTable_ || airlightG_ != frame.medium->hgG())) {
+    const AirlightTable t = makeAirlightTable(frame.medium->hgG());
+    airlightTable_ = gl::createTexture2D(GL_RG32F, t.xiSamples, t.uSamples, "EvaluatePass: airlight table");
+    glTextureSubImage2D(airlightTable_.get(), 0, 0, 0, t.xiSamples, t.uSamples, GL_RG, GL_FLOAT,
+                        t.values.data());
+    if (!airlightSampler_) airlightSampler_ = gl::createClampSampler(GL_LINEAR);
+    airlightG_ = frame.medium->hgG();
+  }
+  if (info_.localClosedForm) {
+    glBindTextureUnit(kAirlightUnit, airlightTable_.get());
+    glBindSampler(kAirlightUnit, airlightSampler_.get());
+  }
+}
+
+GLuint EvaluatePass::evaluationProgram(const Plan& p) {
+  GLuint program = program_.get();
+  if (p.local) {
+    gl::Handle& localProgram = localPrograms_[p.layoutSlot];
+    if (!localProgram && !p.textured) localProgram = buildProgram(evaluateStages(info_, p.layoutKind, true));
+    program = localProgram.get();
+  }
+  if (!p.projective && !p.textured && p.pixels && !p.local) {
+    gl::Handle& variant = layoutPrograms_[p.layoutKind];
+    if (!variant) variant = buildProgram(evaluateStages(info_, p.layoutKind));
+    program = variant.get();
+  }
+  // Light textures: the CREP_LIGHT_TEXTURE variants (projective frame, layouts, local light), on first use.
+  if (p.textured && p.pixels) {
+    gl::Handle& variant = texturedPrograms_[p.variantIndex];
+    if (!variant) variant = buildProgram(evaluateStages(info_, p.layoutKind, p.local, true));
+    program = variant.get();
+  }
+  if (p.list) { // the CREP_SAMPLE_LIST variant of the program chosen above
+    gl::Handle& variant = listPrograms_[p.textured ? 1 : 0][p.variantIndex];
+    if (!variant)
+      variant = buildProgram(evaluateStages(info_, p.layoutKind, p.local, p.textured, false, true));
+    program = variant.get();
+  }
+  return program;
+}
+
+void EvaluatePass::uploadTableCoefficients(double depthMargin) {
+  // a(z_s) of every sample (the CPU reference's values), as M / 4 vec4 per sample (zero beyond M).
+  const int Z = info_.options.visibilityTableSamples, M = info_.bases, layers = layerCount(M);
+  const std::vector<double> as = visibilityTableCoefficients(Z, M, depthMargin, info_.options.ringing);
+  std::vector<float> a(static_cast<std::size_t>(Z) * static_cast<std::size_t>(layers) * 4, 0.0f);
+  for (int k = 0; k < Z; ++k)
+    for (int m = 0; m < M; ++m)
+      a[static_cast<std::size_t>(k) * static_cast<std::size_t>(layers) * 4 + static_cast<std::size_t>(m)] =
+          static_cast<float>(
+              as[static_cast<std::size_t>(k) * static_cast<std::size_t>(M) + static_cast<std::size_t>(m)]);
+  tableCoefficients_ = gl::createBuffer();
+  glNamedBufferStorage(tableCoefficients_.get(), static_cast<GLsizeiptr>(a.size() * sizeof(float)), a.data(),
+                       0);
+  tableMargin_ = depthMargin;
+}
+
+void EvaluatePass::buildTable(const FilteredBasisView& basis, const Plan& p) {
+  // The per-frame table of this basis (EvaluateOptions::visibilityTableSamples / scatteringPrefix): the
+  // scattering prefix table (RGBA32F, the default) or the region visibility table (R32F), rebuilt every
+  // run; both R Z x H texels.
+  const int Z = info_.options.visibilityTableSamples, R = basis.regions();
+  const bool sections = p.local && usesLocalSectionTable(info_.options);
+  if (sections && (!sectionTexture_ || tableWidth_ != R * Z || tableHeight_ != basis.height))
+    sectionTexture_ = gl::createTexture2D(GL_RGBA32F, R * Z, basis.height,
+                                          "EvaluatePass: local section table (regions x samples, rows)");
+  if (tableWidth_ != R * Z || tableHeight_ != basis.height) {
+    tableTexture_ =
+        gl::createTexture2D(p.prefix ? GL_RGBA32F : GL_R32F, R * Z, basis.height,
+                            p.prefix ? "EvaluatePass: scattering prefix table (regions x samples, rows)"
+                                     : "EvaluatePass: visibility table (regions x samples, rows)");
+    tableWidth_ = R * Z;
+    tableHeight_ = basis.height;
+  }
+  if (!tableCoefficients_ || tableMargin_ != basis.depthMargin) uploadTableCoefficients(basis.depthMargin);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, tableCoefficients_.get());
+  glBindTextureUnit(kTableBasisUnit, basis.texture);
+  if (p.textured)
+    glBindTextureUnit(kMeanColorUnit, basis.meanColor); // texelFetch at the regions' last texels
+  glBindSampler(kTableBasisUnit, depthSampler_.get());  // nearest, clamped: texelFetch ignores it anyway
+  if (p.prefix) {
+    // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
+    gl::Handle& prefixProgram = p.textured ? texturedPrefixPrograms_[p.variantIndex]
+                                : p.local  ? localPrefixPrograms_[p.layoutSlot]
+                                           : prefixPrograms_[p.layoutSlot];
+    if (!prefixProgram) prefixProgram = buildProgram(prefixStages(info_, p.layoutKind, p.local, p.textured));
+    glUseProgram(prefixProgram.get());
+    if (!p.projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
+    glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
+    glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    if (sections)
+      glBindImageTexture(kLocalSectionImage, sectionTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                         GL_RGBA32F);
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height), 1);
+    if (sections) glBindImageTexture(kLocalSectionImage, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  } else {
+    glUseProgram(tableProgram_.get());
+    glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
+    glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
+  }
+  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, 0);
+  glBindSampler(kTableBasisUnit, 0);
+  glBindTextureUnit(kTableBasisUnit, 0);
+  tableBasis_ = basis.texture;
+  tableVariant_ = p.variantIndex + 6 * int(p.textured);
+}
+
+void EvaluatePass::bindEvaluation(const FrameAttribs& frame, const Plan& p, GLuint program) {
+  const FilteredBasisView& basis = frame.basis;
+  if (p.table) {
+    const GLuint unit = p.prefix ? kPrefixUnit : kTableUnit;
     glBindTextureUnit(unit, tableTexture_.get());
     glBindSampler(unit, tableSampler_.get());
-    if (local && usesLocalSectionTable(info_.options)) {
+    if (p.local && usesLocalSectionTable(info_.options)) {
       glBindTextureUnit(kLocalSectionUnit, sectionTexture_.get());
       glBindSampler(kLocalSectionUnit, tableSampler_.get());
     }
   }
   glUseProgram(program);
-  if (!projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
+  if (!p.projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
   glBindTextureUnit(kBasisUnit, basis.texture);
   glBindSampler(kBasisUnit, basisSampler_.get());
-  glBindTextureUnit(kCameraDepthUnit, list ? list->coordinates : frame.cameraDepth);
+  glBindTextureUnit(kCameraDepthUnit, p.list ? p.list->coordinates : frame.cameraDepth);
   glBindSampler(kCameraDepthUnit, depthSampler_.get());
-  if (textured) {
+  if (p.textured) {
     glBindTextureUnit(kMeanColorUnit, basis.meanColor);
     glBindSampler(kMeanColorUnit, basisSampler_.get()); // sampled as the basis is (EvaluateOptions::sampling)
   }
@@ -939,53 +1031,43 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, evaluateBuffer_.get());
   if (info_.options.nearPlaneCorrection)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, basis.regionWeights);
-  if (pixels) {
-    glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, outFormat);
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(depth.width, info_.workgroupWidth)),
-                      static_cast<GLuint>(ceilDiv(depth.height, info_.workgroupHeight)), 1);
-  }
-  if (list) { // one invocation per entry, groups of 64 (gpu::kSampleListGroupSize)
-    glBindImageTexture(0, list->output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, list->buffer);
-    gpu::dispatchSampleList(list->buffer);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, 0);
-  }
-  if (froxels) {
-    // The froxel variant of the same program (CREP_FROXELS) on the same bindings; the evaluate block's
-    // imageSize holds the grid's size.
-    const FroxelGrid& g = frame.froxels.grid;
-    gl::Handle& variant =
-        froxelPrograms_[textured ? 1 : 0][projective ? 0 : 1 + static_cast<int>(layoutKind)];
-    if (!variant)
-      variant = buildProgram(
-          evaluateStages(info_, projective ? -1 : static_cast<int>(layoutKind), false, textured, true));
-    params.imageSize = glm::ivec4(g.width, g.height, g.depth, 0);
-    glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
-    glProgramUniform4f(variant.get(), 0, static_cast<float>(frame.froxels.jitter.x),
-                       static_cast<float>(frame.froxels.jitter.y), static_cast<float>(frame.froxels.jitter.z),
-                       0.0f);
-    glProgramUniform2f(variant.get(), 1, static_cast<float>(froxelRange.near),
-                       static_cast<float>(froxelRange.far));
-    glUseProgram(variant.get());
-    glBindImageTexture(0, frame.froxels.volume, 0, GL_TRUE, 0, GL_WRITE_ONLY, volumeFormat);
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(g.width, info_.workgroupWidth)),
-                      static_cast<GLuint>(ceilDiv(g.height, info_.workgroupHeight)),
-                      static_cast<GLuint>(g.depth));
-  }
+}
+
+void EvaluatePass::dispatchFroxels(const FrameAttribs& frame, const Plan& p, gpu::EvaluateParams params) {
+  // The froxel variant of the same program (CREP_FROXELS) on the same bindings; the evaluate block's
+  // imageSize holds the grid's size.
+  const FroxelGrid& g = frame.froxels.grid;
+  gl::Handle& variant = froxelPrograms_[p.textured ? 1 : 0][p.layoutSlot];
+  if (!variant) variant = buildProgram(evaluateStages(info_, p.layoutKind, false, p.textured, true));
+  params.imageSize = glm::ivec4(g.width, g.height, g.depth, 0);
+  glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
+  glProgramUniform4f(variant.get(), 0, static_cast<float>(frame.froxels.jitter.x),
+                     static_cast<float>(frame.froxels.jitter.y), static_cast<float>(frame.froxels.jitter.z),
+                     0.0f);
+  glProgramUniform2f(variant.get(), 1, static_cast<float>(p.froxelRange.near),
+                     static_cast<float>(p.froxelRange.far));
+  glUseProgram(variant.get());
+  glBindImageTexture(0, frame.froxels.volume, 0, GL_TRUE, 0, GL_WRITE_ONLY, p.volumeFormat);
+  glDispatchCompute(static_cast<GLuint>(ceilDiv(g.width, info_.workgroupWidth)),
+                    static_cast<GLuint>(ceilDiv(g.height, info_.workgroupHeight)),
+                    static_cast<GLuint>(g.depth));
+}
+
+void EvaluatePass::unbindEvaluation(const Plan& p) {
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   if (info_.options.nearPlaneCorrection)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
   glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
-  if (local) {
+  if (p.local) {
     glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, 0);
     glBindSampler(kAirlightUnit, 0);
     glBindTextureUnit(kAirlightUnit, 0);
     glBindSampler(kLocalSectionUnit, 0);
     glBindTextureUnit(kLocalSectionUnit, 0);
   }
-  if (!projective) {
+  if (!p.projective) {
     glBindBufferBase(GL_UNIFORM_BUFFER, kLayoutBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLayoutRowsBinding, 0);
   }
@@ -994,18 +1076,17 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   glBindTextureUnit(kCameraDepthUnit, 0);
   glBindSampler(kBasisUnit, 0);
   glBindTextureUnit(kBasisUnit, 0);
-  if (textured) {
+  if (p.textured) {
     glBindSampler(kMeanColorUnit, 0);
     glBindTextureUnit(kMeanColorUnit, 0);
   }
-  if (table) {
+  if (p.table) {
     glBindSampler(kTableUnit, 0);
     glBindTextureUnit(kTableUnit, 0);
     glBindSampler(kPrefixUnit, 0);
     glBindTextureUnit(kPrefixUnit, 0);
   }
   glUseProgram(0);
-  gl::checkError("EvaluatePass::run");
 }
 
 } // namespace crep

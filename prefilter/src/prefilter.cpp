@@ -290,8 +290,7 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
   validate(map);
   validate(options);
   if (colors) validateLightColors(*colors, map.width(), map.height(), "lightColors");
-  if (!(extinction >= 0.0) || !std::isfinite(extinction))
-    throw InvalidArgument("extinction", detail::formatValue(extinction), "must be finite and >= 0");
+  requireNonNegative("extinction", extinction);
   const int W = map.width(), H = map.height(), M = options.bases;
   const int R = map.layout->regionCount() * options.regionsPerSplit;
   if (W % R != 0)
@@ -545,6 +544,78 @@ struct LocalSegments {
   glm::dvec3 prefix(const glm::dvec3& S) const { return S; }
 };
 
+/// GL_LINEAR of a table texture (width R Z, height H, `channels` values per texel) at depth d and normalized
+/// row: x = d (Z - 1) inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for the basis.
+struct TableLerp {
+  int Z = 2, R = 1, H = 1;
+  double operator()(const std::vector<double>& values, int channels, int channel, int r, double depth,
+                    double row) const {
+    const double xs = std::clamp(depth, 0.0, 1.0) * (Z - 1);
+    const double ys = std::clamp(row * H - 0.5, 0.0, static_cast<double>(H - 1));
+    const int x0 = static_cast<int>(std::floor(xs)), y0 = static_cast<int>(std::floor(ys));
+    const int x1 = std::min(x0 + 1, Z - 1), y1 = std::min(y0 + 1, H - 1);
+    const double fx = xs - x0, fy = ys - y0;
+    const auto at = [&](int xi, int yi) {
+      return values[((static_cast<std::size_t>(yi) * static_cast<std::size_t>(R) +
+                      static_cast<std::size_t>(r)) *
+                         static_cast<std::size_t>(Z) +
+                     static_cast<std::size_t>(xi)) *
+                        static_cast<std::size_t>(channels) +
+                    static_cast<std::size_t>(channel)];
+    };
+    return (1.0 - fy) * ((1.0 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+           fy * ((1.0 - fx) * at(x0, y1) + fx * at(x1, y1));
+  }
+};
+
+/// The visibility of region r's segment [ua, ub] of a mapped ray from the filtered basis, one value per
+/// colour basis: the prefix at ub, or with the near-plane correction (ua > 0, Sec. 3.1) the corrected
+/// difference. `a` holds the ray's M coefficients; Fa and Fb are scratch.
+glm::dvec3 regionVisibility(const FilteredBasis& basis, const EvaluateOptions& options, const MappedRay& m,
+                            int nearestRow, int r, double ua, double ub,
+                            const std::array<double, kMaxBases>& a, std::array<double, kMaxBases>& Fa,
+                            std::array<double, kMaxBases>& Fb) {
+  const int M = basis.bases, R = basis.regions, C = basis.colorBases();
+  glm::dvec3 V(0.0);
+  bool plain = ua <= 0.0;
+  double wa = 0.0, wb = 0.0;
+  if (!plain) {
+    // Near-plane correction: the prefix difference of one region, each prefix restored by its own
+    // weight total (Appendix A), then renormalized by the segment's total.
+    const DistanceProfile& p =
+        basis.profiles[static_cast<std::size_t>(nearestRow) * static_cast<std::size_t>(R) +
+                       static_cast<std::size_t>(r)];
+    wa = regionWeightTotal(basis.weights, basis.extinction, p, basis.regionWidth(), ua);
+    wb = regionWeightTotal(basis.weights, basis.extinction, p, basis.regionWidth(), ub);
+    plain = !(wb - wa > 1e-12 * wb);
+  }
+  // Light textures (prefilter.h): each channel's basis, its prefix weighted by W cbar.
+  const glm::dvec3 cb =
+      basis.textured ? sampleMeanColor(basis, options.sampling, r, ub, m.row) : glm::dvec3(1.0);
+  const glm::dvec3 ca =
+      basis.textured && !plain ? sampleMeanColor(basis, options.sampling, r, ua, m.row) : glm::dvec3(1.0);
+  for (int c = 0; c < C; ++c) {
+    sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data(), c);
+    double dot = 0.0;
+    if (plain) {
+      for (int k = 0; k < M; ++k)
+        dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
+      V[c] = std::clamp(0.5 + dot, 0.0, 1.0) * cb[c];
+      continue;
+    }
+    const double wbc = wb * cb[c], wac = wa * ca[c];
+    if (!(wbc - wac > 0.0)) continue; // no weighted light in the segment: V = 0
+    sampleFiltered(basis, options.sampling, r, ua, m.row, Fa.data(), c);
+    for (int k = 0; k < M; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      dot += a[kk] * (wbc * Fb[kk] - wac * Fa[kk]);
+    }
+    dot /= wbc - wac;
+    V[c] = (wbc - wac) / (wb - wa) * std::clamp(0.5 + dot, 0.0, 1.0);
+  }
+  return V;
+}
+
 /// The evaluation (see prefilter.h) with `segmentsFor(direction)` giving the light's segment rule and
 /// `prefixTable(visibility)` the scattering prefix table.
 /// `rayAt(x, y)` gives the PixelRay of output pixel (x, y) of a w x h image (the camera image's pixel rays,
@@ -558,7 +629,6 @@ Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt,
   validate(options);
   const RectifiedLayout& layout = *basis.layout;
   const int M = basis.bases, R = basis.regions;
-  const int n = basis.regionWidth();
   const double greySigma = weightExtinction(medium);
   const glm::dvec3 origin = camera.position();
   const bool table = usesVisibilityTable(options);
@@ -568,27 +638,7 @@ Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt,
       table ? visibilityTable(basis, Z, options.ringing) : std::vector<double>();
   const std::vector<double> prefixValues = prefix ? prefixTable(tableValues) : std::vector<double>();
   const std::vector<double> sectionValues = prefix ? sectionTable() : std::vector<double>();
-  // GL_LINEAR of a table texture (width R Z, height H, `channels` values per texel) at depth d and
-  // normalized row: x = d (Z - 1) inside the region's samples, y = clamp(row H - 0.5, 0, H - 1) as for
-  // the basis.
-  const auto lerpTable = [&](const std::vector<double>& values, int channels, int channel, int r,
-                             double depth, double row) {
-    const double xs = std::clamp(depth, 0.0, 1.0) * (Z - 1);
-    const double ys = std::clamp(row * basis.height - 0.5, 0.0, static_cast<double>(basis.height - 1));
-    const int x0 = static_cast<int>(std::floor(xs)), y0 = static_cast<int>(std::floor(ys));
-    const int x1 = std::min(x0 + 1, Z - 1), y1 = std::min(y0 + 1, basis.height - 1);
-    const double fx = xs - x0, fy = ys - y0;
-    const auto at = [&](int xi, int yi) {
-      return values[((static_cast<std::size_t>(yi) * static_cast<std::size_t>(R) +
-                      static_cast<std::size_t>(r)) *
-                         static_cast<std::size_t>(Z) +
-                     static_cast<std::size_t>(xi)) *
-                        static_cast<std::size_t>(channels) +
-                    static_cast<std::size_t>(channel)];
-    };
-    return (1.0 - fy) * ((1.0 - fx) * at(x0, y0) + fx * at(x1, y0)) +
-           fy * ((1.0 - fx) * at(x0, y1) + fx * at(x1, y1));
-  };
+  const TableLerp lerpTable{Z, R, basis.height};
   const int C = basis.colorBases(); // light textures: one basis per colour channel
   Image out(w, h, 4);
   parallelRows(h, options.threads, [&](int y) {
@@ -628,43 +678,7 @@ Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt,
             L += segment.weighted(C == 1 ? glm::dvec3(V[0]) : V, ta, tb);
             return;
           }
-          bool plain = ua <= 0.0;
-          double wa = 0.0, wb = 0.0;
-          if (!plain) {
-            // Near-plane correction: the prefix difference of one region, each prefix restored by its own
-            // weight total (Appendix A), then renormalized by the segment's total.
-            const DistanceProfile& p =
-                basis.profiles[static_cast<std::size_t>(nearestRow) * static_cast<std::size_t>(R) +
-                               static_cast<std::size_t>(r)];
-            wa = regionWeightTotal(basis.weights, basis.extinction, p, n, ua);
-            wb = regionWeightTotal(basis.weights, basis.extinction, p, n, ub);
-            plain = !(wb - wa > 1e-12 * wb);
-          }
-          // Light textures (prefilter.h): each channel's basis, its prefix weighted by W cbar.
-          const glm::dvec3 cb =
-              basis.textured ? sampleMeanColor(basis, options.sampling, r, ub, m.row) : glm::dvec3(1.0);
-          const glm::dvec3 ca = basis.textured && !plain
-                                    ? sampleMeanColor(basis, options.sampling, r, ua, m.row)
-                                    : glm::dvec3(1.0);
-          for (int c = 0; c < C; ++c) {
-            sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data(), c);
-            double dot = 0.0;
-            if (plain) {
-              for (int k = 0; k < M; ++k)
-                dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
-              V[c] = std::clamp(0.5 + dot, 0.0, 1.0) * cb[c];
-              continue;
-            }
-            const double wbc = wb * cb[c], wac = wa * ca[c];
-            if (!(wbc - wac > 0.0)) continue; // no weighted light in the segment: V = 0
-            sampleFiltered(basis, options.sampling, r, ua, m.row, Fa.data(), c);
-            for (int k = 0; k < M; ++k) {
-              const auto kk = static_cast<std::size_t>(k);
-              dot += a[kk] * (wbc * Fb[kk] - wac * Fa[kk]);
-            }
-            dot /= wbc - wac;
-            V[c] = (wbc - wac) / (wb - wa) * std::clamp(0.5 + dot, 0.0, 1.0);
-          }
+          V = regionVisibility(basis, options, m, nearestRow, r, ua, ub, a, Fa, Fb);
           if constexpr (requires { segment.ray.partialShare(ta, tb, tb); }) {
             if (!sectionValues.empty() && r == m.last.region) {
               // The last region of a local light from the section table (EvaluateOptions::localSectionTable):

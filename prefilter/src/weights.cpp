@@ -23,8 +23,7 @@ void requireTexels(int texels, std::size_t size, std::size_t expected) {
 }
 
 void requireExtinction(double s) {
-  if (!(s >= 0.0) || !std::isfinite(s))
-    throw InvalidArgument("extinction", detail::formatValue(s), "must be finite and >= 0");
+  requireNonNegative("extinction", s);
 }
 
 /// Eq. 12 parameters of a region: first texel length D0 and log of the step ratio r (texel centres).

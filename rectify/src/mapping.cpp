@@ -23,10 +23,6 @@ void requireProjective(const Rectification& r) {
                           "the mapping helpers need a projective rectification");
 }
 
-void requireFiniteArg(const char* name, double v) {
-  if (!std::isfinite(v)) throw InvalidArgument(name, detail::formatValue(v), "must be finite");
-}
-
 double rowSlope(const RectifiedFrame& f, double row) {
   return f.rowSlopeMin + row * (f.rowSlopeMax - f.rowSlopeMin);
 }
@@ -80,9 +76,9 @@ RectPoint Rectification::toRectified(const glm::dvec3& world) const {
 
 glm::dvec3 Rectification::toWorld(double column, double row, double depth) const {
   requireProjective(*this);
-  requireFiniteArg("Rectification.toWorld.column", column);
-  requireFiniteArg("Rectification.toWorld.row", row);
-  requireFiniteArg("Rectification.toWorld.depth", depth);
+  requireFinite("Rectification.toWorld.column", column);
+  requireFinite("Rectification.toWorld.row", row);
+  requireFinite("Rectification.toWorld.depth", depth);
   const RectifiedFrame& f = frame;
   const double y = rowSlope(f, row), z = depthSlope(f, depth);
   const double den = inverseX(f, zetaOfColumn(*this, column), z);
@@ -96,8 +92,8 @@ glm::dvec3 Rectification::toWorld(double column, double row, double depth) const
 
 LightRay Rectification::lightRay(double column, double row) const {
   requireProjective(*this);
-  requireFiniteArg("Rectification.lightRay.column", column);
-  requireFiniteArg("Rectification.lightRay.row", row);
+  requireFinite("Rectification.lightRay.column", column);
+  requireFinite("Rectification.lightRay.row", row);
   const RectifiedFrame& f = frame;
   const double y = rowSlope(f, row), zeta = zetaOfColumn(*this, column);
   const double rho = f.inverseLightDistance;
@@ -134,7 +130,7 @@ RowReference Rectification::rowReference(double row) const {
 
 RowReference Rectification::rowReference(double row, ReferenceRay choice) const {
   requireProjective(*this);
-  requireFiniteArg("Rectification.rowReference.row", row);
+  requireFinite("Rectification.rowReference.row", row);
   const RectifiedFrame& f = frame;
   // The row's view rays: the slope hull cut by the line y = const (clamped onto the hull).
   double hy0 = std::numeric_limits<double>::infinity(), hy1 = -hy0;

@@ -91,8 +91,7 @@ void validate(const RectifyOptions& o) {
 }
 
 std::vector<double> splitPositions(double xmin, double xmax, int splits, SplitScheme scheme, double blend) {
-  if (!std::isfinite(xmin) || !(xmin > 0.0))
-    throw InvalidArgument("splitPositions.xmin", detail::formatValue(xmin), "must be finite and > 0");
+  requirePositive("splitPositions.xmin", xmin);
   if (!std::isfinite(xmax) || !(xmax > xmin))
     throw InvalidArgument("splitPositions.xmax", detail::formatValue(xmax), "must be finite and > xmin");
   RectifyOptions o;
@@ -514,12 +513,7 @@ Rectification rectify(const Camera& camera, const SpotLight& light, const Rectif
 std::array<Rectification, 6> rectifyPointLight(const Camera& camera, const glm::dvec3& position, double range,
                                                const RectifyOptions& options, double nearPlane) {
   validate(options);
-  for (int i = 0; i < 3; ++i)
-    if (!std::isfinite(position[i]))
-      throw InvalidArgument("PointLight.position",
-                            "(" + detail::formatValue(position.x) + ", " + detail::formatValue(position.y) +
-                                ", " + detail::formatValue(position.z) + ")",
-                            "components must be finite");
+  requireFinite("PointLight.position", position);
   requirePositive("PointLight.range", range);
   const double near = nearPlane <= 0.0 ? range * 1e-3 : nearPlane;
   if (!std::isfinite(near) || !(near < range))

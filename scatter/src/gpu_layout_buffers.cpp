@@ -27,25 +27,28 @@ LayoutKind LayoutBuffers::upload(const RectifiedLayout& layout, int mapHeight, c
   return upload(requireGpuLayout(layout, parameter), mapHeight, parameter);
 }
 
-LayoutKind LayoutBuffers::upload(const GpuLayoutData& d, int mapHeight, const char* parameter) {
-  const GpuLayoutData* data = &d;
-  if (data->regionCount > kMaxLayoutRegions)
-    throw InvalidArgument(parameter, "regionCount() " + std::to_string(data->regionCount),
+void LayoutBuffers::requireUploadable(const GpuLayoutData& d, int mapHeight, const char* parameter) {
+  if (d.regionCount > kMaxLayoutRegions)
+    throw InvalidArgument(parameter, "regionCount() " + std::to_string(d.regionCount),
                           "must be <= " + std::to_string(kMaxLayoutRegions) + " on the GPU");
-  if (data->rowCount != 0 && data->rowCount != mapHeight)
+  if (d.rowCount != 0 && d.rowCount != mapHeight)
     throw InvalidArgument("mapHeight", std::to_string(mapHeight),
-                          "must be the layout's row count " + std::to_string(data->rowCount) +
+                          "must be the layout's row count " + std::to_string(d.rowCount) +
                               " (an EpipolarLayout's slice count)");
-  if (data->block.size() > kMaxBlockBytes)
-    throw InvalidArgument(parameter, std::to_string(data->block.size()) + " bytes of layout block",
+  if (d.block.size() > kMaxBlockBytes)
+    throw InvalidArgument(parameter, std::to_string(d.block.size()) + " bytes of layout block",
                           "must be <= " + std::to_string(kMaxBlockBytes));
+}
+
+LayoutKind LayoutBuffers::upload(const GpuLayoutData& d, int mapHeight, const char* parameter) {
+  requireUploadable(d, mapHeight, parameter);
   if (!block_) block_ = gl::createDynamicBuffer(kMaxBlockBytes);
-  glNamedBufferSubData(block_.get(), 0, static_cast<GLsizeiptr>(data->block.size()), data->block.data());
-  hasRows_ = !data->rows.empty();
+  glNamedBufferSubData(block_.get(), 0, static_cast<GLsizeiptr>(d.block.size()), d.block.data());
+  hasRows_ = !d.rows.empty();
   if (hasRows_) {
-    gl::uploadGrowingBuffer(rows_, rowsCapacity_, data->rows.data(), data->rows.size());
+    gl::uploadGrowingBuffer(rows_, rowsCapacity_, d.rows.data(), d.rows.size());
   }
-  kind_ = data->kind;
+  kind_ = d.kind;
   return kind_;
 }
 

@@ -63,27 +63,42 @@ std::size_t LightColorMapPass::memoryBytes() const noexcept {
 
 // The colour of each map texel's light ray (Klehm et al. 2014, Sec. 3.2: the light-side factor per colour
 // component), crep::lightColorMap in float.
-void LightColorMapPass::run(const FrameAttribs& f) {
-  if (f.layout == nullptr)
-    throw InvalidArgument("LightColorMapPass::FrameAttribs.layout", "null", "must be set");
+/// A validated frame of the pass (LightColorMapPass::validate) and what run() derives from it.
+struct LightColorMapPass::Plan {
+  gl::TextureLevel level;   ///< the light texture's level 0
+  GpuLayoutData layoutData; ///< the map's layout block
+};
+
+void LightColorMapPass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+LightColorMapPass::Plan LightColorMapPass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (f.layout == nullptr) invalid(p + "layout", "null", "must be set");
   if ((f.light != nullptr) == (f.localLight != nullptr))
-    throw InvalidArgument("LightColorMapPass::FrameAttribs.light/localLight",
-                          f.light ? "both set" : "both null", "exactly one must be set");
+    invalid(p + "light/localLight", f.light ? "both set" : "both null", "exactly one must be set");
   if (f.localLight && !f.layout->localLightPosition())
-    throw InvalidArgument(
-        "LightColorMapPass::FrameAttribs.layout", "a directional light's",
-        "a local light's map has its layout (ProjectiveLayout or EpipolarLayout of the light)");
-  const gl::TextureLevel level = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight,
-                                                              "LightColorMapPass::FrameAttribs.lightTexture");
+    invalid(p + "layout", "a directional light's",
+            "a local light's map has its layout (ProjectiveLayout or EpipolarLayout of the light)");
+  Plan plan;
+  plan.level = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight, p + "lightTexture");
+  plan.layoutData = gpu::requireGpuLayout(*f.layout, (p + "layout").c_str());
+  gpu::LayoutBuffers::requireUploadable(plan.layoutData, info_.mapHeight, (p + "layout").c_str());
+  return plan;
+}
+
+void LightColorMapPass::run(const FrameAttribs& f) {
+  const Plan p = plan(f, "LightColorMapPass::FrameAttribs");
   const gpu::LayoutKind kind =
-      layout_.upload(*f.layout, info_.mapHeight, "LightColorMapPass::FrameAttribs.layout");
+      layout_.upload(p.layoutData, info_.mapHeight, "LightColorMapPass::FrameAttribs.layout");
   gl::Handle& program = programs_[static_cast<int>(kind)];
   if (!program)
     program = buildProgram({{ShaderStage::Compute,
                              "passes/scatter/light_colors.comp",
                              {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
   const gpu::LightTextureParams params =
-      gpu::makeLightTextureParams(f.lightTexture, level, info_.mapWidth, info_.mapHeight, f.localLight);
+      gpu::makeLightTextureParams(f.lightTexture, p.level, info_.mapWidth, info_.mapHeight, f.localLight);
   glNamedBufferSubData(params_.get(), 0, sizeof params, &params);
 
   glUseProgram(program.get());

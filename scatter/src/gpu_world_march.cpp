@@ -116,34 +116,38 @@ void dispatchMarch(int width, int height, const char* what) {
 } // namespace gpu
 
 WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
-  validate(info.options);
+  crep::validate(info.options);
   program_ = buildProgram({{ShaderStage::Compute, "passes/scatter/march_reference.comp", {}}});
   params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
   sampler_ = gl::createClampSampler(GL_NEAREST);
   gl::checkError("WorldMarchPass");
 }
 
-void WorldMarchPass::run(const FrameAttribs& f) {
-  if (!f.camera || !f.medium)
-    throw InvalidArgument("WorldMarchPass::FrameAttribs.camera/medium", "null", "must be set");
+/// A validated frame of the pass (WorldMarchPass::validate) and what run() derives from it.
+struct WorldMarchPass::Plan {
+  gl::TextureLevel depth, shadow, lightTexture; ///< level 0 of the camera depth, the map, the light texture
+};
+
+void WorldMarchPass::validate(const FrameAttribs& frame, std::string_view owner) const {
+  plan(frame, owner);
+}
+
+WorldMarchPass::Plan WorldMarchPass::plan(const FrameAttribs& f, std::string_view owner) const {
+  const std::string p = std::string(owner) + ".";
+  if (!f.camera || !f.medium) invalid(p + "camera/medium", "null", "must be set");
   if ((f.light != nullptr) == (f.localLight != nullptr))
-    throw InvalidArgument("WorldMarchPass::FrameAttribs.light/localLight", f.light ? "both set" : "both null",
-                          "exactly one must be set");
+    invalid(p + "light/localLight", f.light ? "both set" : "both null", "exactly one must be set");
   // The image and map sizes are the textures' own (gl::textureLevel).
-  const gl::TextureLevel depth =
-      gl::requireTexture2D("WorldMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  const gl::TextureLevel shadow = gl::requireTexture2D("WorldMarchPass::FrameAttribs.shadowMap", f.shadowMap);
-  gl::requireDepthFormat("WorldMarchPass::FrameAttribs.cameraDepth", f.cameraDepth);
-  gl::requireDepthFormat("WorldMarchPass::FrameAttribs.shadowMap", f.shadowMap);
-  const int width = depth.width, height = depth.height;
-  gl::requireTexture2D("WorldMarchPass::FrameAttribs.output", f.output, width, height, GL_RGBA32F);
+  Plan plan;
+  plan.depth = gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
+  plan.shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
+  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+  gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
+  const int width = plan.depth.width, height = plan.depth.height;
+  gl::requireTexture2D((p + "output").c_str(), f.output, width, height, GL_RGBA32F);
   if (f.stepsOutput != 0)
-    gl::requireTexture2D("WorldMarchPass::FrameAttribs.stepsOutput", f.stepsOutput, width, height, GL_R32F);
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(f.lightClipFromWorld[c][r]))
-        throw InvalidArgument("WorldMarchPass::FrameAttribs.lightClipFromWorld",
-                              detail::formatValue(f.lightClipFromWorld[c][r]), "must be finite");
+    gl::requireTexture2D((p + "stepsOutput").c_str(), f.stepsOutput, width, height, GL_R32F);
+  requireFinite(p + "lightClipFromWorld", f.lightClipFromWorld);
   if (const LocalLight* l = f.localLight) {
     const auto finite3 = [](const glm::dvec3& v) {
       return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -151,20 +155,25 @@ void WorldMarchPass::run(const FrameAttribs& f) {
     const bool finite = finite3(l->position) && finite3(l->intensity) && finite3(l->axis) &&
                         std::isfinite(l->nearPlane) && std::isfinite(l->cosInner) &&
                         std::isfinite(l->cosOuter);
-    if (!finite)
-      throw InvalidArgument("WorldMarchPass::FrameAttribs.localLight", "a non-finite member",
-                            "must be finite");
+    if (!finite) invalid(p + "localLight", "a non-finite member", "must be finite");
     if (l->face < -1 || l->face > 5)
-      throw InvalidArgument("WorldMarchPass::FrameAttribs.localLight->face", detail::formatValue(l->face),
-                            "must be -1 or a point light face in [0, 5]");
+      invalid(p + "localLight->face", detail::formatValue(l->face),
+              "must be -1 or a point light face in [0, 5]");
   }
-  if (!std::isfinite(f.bias))
-    throw InvalidArgument("WorldMarchPass::FrameAttribs.bias", detail::formatValue(f.bias), "must be finite");
+  requireFinite(p + "bias", f.bias);
+  if (f.lightTexture.texture != 0)
+    plan.lightTexture =
+        gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight, p + "lightTexture");
+  if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
+    invalid(p + "blockCenter/blockRadius", detail::formatValue(f.blockRadius), "must be finite");
+  return plan;
+}
+
+void WorldMarchPass::run(const FrameAttribs& f) {
+  const Plan p = plan(f, "WorldMarchPass::FrameAttribs");
+  const int width = p.depth.width, height = p.depth.height;
+  const gl::TextureLevel& shadow = p.shadow;
   const bool textured = f.lightTexture.texture != 0;
-  gl::TextureLevel textureLevel;
-  if (textured)
-    textureLevel = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight,
-                                                "WorldMarchPass::FrameAttribs.lightTexture");
   gpu::MarchParams params = f.light ? gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height,
                                                            shadow.width, shadow.height)
                                     : gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height,
@@ -191,7 +200,7 @@ void WorldMarchPass::run(const FrameAttribs& f) {
     }
     program = texturedProgram_.get();
     const gpu::LightTextureParams tp =
-        gpu::makeLightTextureParams(f.lightTexture, textureLevel, 0, 0, f.localLight);
+        gpu::makeLightTextureParams(f.lightTexture, p.lightTexture, 0, 0, f.localLight);
     glNamedBufferSubData(textureParams_.get(), 0, sizeof tp, &tp);
   }
   gpu::bindMarchResources(program, params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,

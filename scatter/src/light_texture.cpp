@@ -47,11 +47,7 @@ void validate(const LightTexture& t, std::string_view owner) {
   const std::string o(owner);
   if (t.rgb == nullptr) throw InvalidArgument(o + ".rgb", "null", "must point to an RGB image");
   validateLightColors(*t.rgb, 0, 0, o + ".rgb");
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(t.textureClipFromWorld[c][r]))
-        throw InvalidArgument(o + ".textureClipFromWorld", detail::formatValue(t.textureClipFromWorld[c][r]),
-                              "must be finite");
+  requireFinite(o + ".textureClipFromWorld", t.textureClipFromWorld);
 }
 
 namespace {
@@ -60,10 +56,7 @@ namespace {
 /// one texture point.
 void requireAlongRays(const glm::dmat4& m, const glm::dvec3& v, double h, std::string_view field,
                       const char* what) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r]))
-        throw InvalidArgument(std::string(field), detail::formatValue(m[c][r]), "must be finite");
+  requireFinite(field, m);
   for (const int k : {0, 1, 3}) {
     const glm::dvec4 r = row(m, k);
     const double value = glm::dot(glm::dvec3(r), v) + r.w * h;

@@ -16,8 +16,7 @@ void validate(const WorldMarchOptions& o) {
   if (o.refinements < 0 || o.refinements > 60)
     throw InvalidArgument("WorldMarchOptions.refinements", detail::formatValue(o.refinements),
                           "must be in [0, 60]");
-  if (!std::isfinite(o.bias))
-    throw InvalidArgument("WorldMarchOptions.bias", detail::formatValue(o.bias), "must be finite");
+  requireFinite("WorldMarchOptions.bias", o.bias);
   if (o.threads < 0)
     throw InvalidArgument("WorldMarchOptions.threads", detail::formatValue(o.threads), "must be >= 0");
 }
@@ -49,10 +48,7 @@ void validateShadowMap(const Image& shadowDepth, const glm::dmat4& m) {
         throw InvalidArgument("shadowDepth",
                               "texel (" + std::to_string(i) + ", " + std::to_string(j) + ") = NaN",
                               "depth-buffer values must not be NaN");
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r]))
-        throw InvalidArgument("lightClipFromWorld", detail::formatValue(m[c][r]), "must be finite");
+  requireFinite("lightClipFromWorld", m);
 }
 
 /// One pixel of the world-space march; `segment(ta, tb)` integrates a lit section (per channel); returns

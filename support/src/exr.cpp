@@ -618,6 +618,107 @@ struct CheckedPart {
   std::uint64_t chunkHeaderBytes = 0; // bytes before the pixel data of each chunk
 };
 
+// Pass 1 of validateLayout for one part: its data window against the size limits (`selected`: the part
+// readExr decodes, also against maxPixels), its channel list and tile description; returns its chunk count.
+long long checkedChunkCount(const FileLayout& layout, const PartLayout& part, bool selected,
+                            long long maxPixels, const std::string& which, const fs::path& path) {
+  const bool multiPart = (layout.flags & kFlagMultiPart) != 0;
+  if (!part.hasDataWindow) throwFormat(path, which + "missing or invalid dataWindow attribute");
+  const long long w = part.width(), h = part.height();
+  if (w <= 0 || h <= 0)
+    throwFormat(path, which + "empty or inverted data window (" + std::to_string(part.minX) + ", " +
+                          std::to_string(part.minY) + ") - (" + std::to_string(part.maxX) + ", " +
+                          std::to_string(part.maxY) + ")");
+  const long long pixelLimit = selected ? std::min(maxPixels, Image::kMaxPixels) : Image::kMaxPixels;
+  if (w > Image::kMaxDimension || h > Image::kMaxDimension || w * h > pixelLimit)
+    throwFormat(path, which + "data window " + std::to_string(w) + "x" + std::to_string(h) +
+                          " is too large (limits: " + std::to_string(Image::kMaxDimension) + " per side, " +
+                          std::to_string(pixelLimit) + " pixels)");
+  const bool deep = part.deep(layout.flags);
+  if (selected && deep) throwFormat(path, which + "deep images are not supported");
+  if (!deep && !part.hasChannels) throwFormat(path, which + "missing channels attribute");
+  long long count = 0;
+  if (part.tiled(layout.flags)) {
+    if (!part.hasTiles) throwFormat(path, which + "tiled part without a valid tiles attribute");
+    if (part.tileWidth == 0 || part.tileHeight == 0 || part.tileWidth > Image::kMaxDimension ||
+        part.tileHeight > Image::kMaxDimension ||
+        static_cast<long long>(part.tileWidth) * part.tileHeight > std::max(w * h, 1LL << 20))
+      throwFormat(path, which + "invalid tile size " + std::to_string(part.tileWidth) + "x" +
+                            std::to_string(part.tileHeight));
+    if (part.roundingMode > 1) throwFormat(path, which + "invalid tile rounding mode");
+    count = tiledChunkCount(part, w, h);
+    if (count < 0) throwFormat(path, which + "invalid tile level mode " + std::to_string(part.levelMode));
+    for (const ChannelLayout& channel : part.channels)
+      if (!deep && (channel.xSampling != 1 || channel.ySampling != 1))
+        throwFormat(path, which + "channel '" + channel.name + "' of a tiled part is subsampled");
+  } else {
+    const int lines = linesPerChunk(part.compression);
+    if (lines == 0)
+      throwFormat(path, which + "missing or unknown compression " + std::to_string(part.compression));
+    count = (h + lines - 1) / lines;
+  }
+  if (multiPart && (!part.hasChunkCount || part.chunkCount != count))
+    throwFormat(path, which + "missing or inconsistent chunkCount attribute (expected " +
+                          std::to_string(count) + ")");
+  return count;
+}
+
+// Pass 2 of validateLayout for part p: every chunk of its offset table `table` (read from the file) starts
+// after the tables (tablesEnd) and, with its size field, ends inside the file; a flat part's chunk headers
+// name the line or tile of their entry and a data size possible for the compression (validDataSize).
+void checkChunks(FileReader& reader, const FileLayout& layout, std::size_t p,
+                 const std::vector<std::uint8_t>& table, std::uint64_t tablesEnd, const std::string& which,
+                 const fs::path& path) {
+  const PartLayout& part = layout.parts[p];
+  const bool multiPart = (layout.flags & kFlagMultiPart) != 0;
+  const long long count = static_cast<long long>(table.size() / 8);
+  // Deep chunks have a different header; only their position and part number are checked.
+  const bool deep = part.deep(layout.flags);
+  const bool tiled = part.tiled(layout.flags);
+  const std::uint64_t headerBytes = (multiPart ? 4u : 0u) + (deep ? 0u : (tiled ? 20u : 8u));
+  // Reads the header of chunk i after checking its position and part number; returns its offset.
+  std::array<std::uint8_t, 24> chunkHeader{};
+  const auto locate = [&](long long i) {
+    const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
+    if (offset == 0)
+      throwFormat(path, which + "incomplete file (chunk " + std::to_string(i) + " is missing)");
+    if (offset < tablesEnd || offset >= reader.size() ||
+        !reader.readAt(offset, chunkHeader.data(), headerBytes))
+      throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " at offset " +
+                            std::to_string(offset) + " lies outside the pixel data of the " +
+                            std::to_string(reader.size()) + "-byte file)");
+    if (multiPart && FileReader::decode32(chunkHeader.data()) != static_cast<std::uint32_t>(p))
+      throwFormat(path, which + "corrupt chunk " + std::to_string(i) + " (wrong part number)");
+    return offset;
+  };
+  if (deep) {
+    for (long long i = 0; i < count; ++i)
+      locate(i);
+    return;
+  }
+  forEachChunk(part, tiled, [&](long long i, const ExpectedChunk& expected) {
+    const std::uint64_t offset = locate(i);
+    const std::uint8_t* fields = chunkHeader.data() + (multiPart ? 4 : 0);
+    const auto field = [&](int k) { return FileReader::toSigned(FileReader::decode32(fields + 4 * k)); };
+    const std::string chunk = which + "corrupt chunk " + std::to_string(i) + " (" + describe(expected) + ")";
+    if (tiled && (field(0) != expected.dx || field(1) != expected.dy || field(2) != expected.lx ||
+                  field(3) != expected.ly))
+      throwFormat(path, chunk + ": its header names tile (" + std::to_string(field(0)) + ", " +
+                            std::to_string(field(1)) + ") of level (" + std::to_string(field(2)) + ", " +
+                            std::to_string(field(3)) + ")");
+    if (!tiled && field(0) != expected.y0)
+      throwFormat(path, chunk + ": its header names scanline " + std::to_string(field(0)));
+    const std::int32_t dataSize = field(tiled ? 4 : 1);
+    if (!validDataSize(part.compression, dataSize, expected.rawBytes))
+      throwFormat(path, chunk + ": data size " + std::to_string(dataSize) + " bytes, expected " +
+                            expectedDataSize(part.compression, expected));
+    if (static_cast<std::uint64_t>(dataSize) > reader.size() - offset - headerBytes)
+      throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " of " +
+                            std::to_string(dataSize) + " bytes at offset " + std::to_string(offset) +
+                            " ends beyond the " + std::to_string(reader.size()) + "-byte file)");
+  });
+}
+
 // Checks, before OpenEXR sees the file:
 // - every part's data window against the size limits (OpenEXR sets up every part),
 // - every flat part's channel list (pixel types, sampling; no subsampling in tiled parts),
@@ -637,54 +738,19 @@ CheckedPart validateLayout(FileReader& reader, const FileLayout& layout, int par
   if (partIndex >= static_cast<int>(layout.parts.size()))
     throwFormat(path, "part " + std::to_string(partIndex) + " requested but the file has " +
                           std::to_string(layout.parts.size()) + " part(s)");
+  const auto which = [&](std::size_t p) {
+    return multiPart ? "part " + std::to_string(p) + ": " : std::string();
+  };
 
   // Pass 1: sizes and chunk counts.
   std::vector<long long> counts;
   std::uint64_t tablesEnd = layout.tablesStart;
   for (std::size_t p = 0; p < layout.parts.size(); ++p) {
-    const PartLayout& part = layout.parts[p];
-    const bool selected = static_cast<int>(p) == partIndex;
-    const std::string which = multiPart ? "part " + std::to_string(p) + ": " : std::string();
-    if (!part.hasDataWindow) throwFormat(path, which + "missing or invalid dataWindow attribute");
-    const long long w = part.width(), h = part.height();
-    if (w <= 0 || h <= 0)
-      throwFormat(path, which + "empty or inverted data window (" + std::to_string(part.minX) + ", " +
-                            std::to_string(part.minY) + ") - (" + std::to_string(part.maxX) + ", " +
-                            std::to_string(part.maxY) + ")");
-    const long long pixelLimit = selected ? std::min(maxPixels, Image::kMaxPixels) : Image::kMaxPixels;
-    if (w > Image::kMaxDimension || h > Image::kMaxDimension || w * h > pixelLimit)
-      throwFormat(path, which + "data window " + std::to_string(w) + "x" + std::to_string(h) +
-                            " is too large (limits: " + std::to_string(Image::kMaxDimension) + " per side, " +
-                            std::to_string(pixelLimit) + " pixels)");
-    const bool deep = part.deep(layout.flags);
-    if (selected && deep) throwFormat(path, which + "deep images are not supported");
-    if (!deep && !part.hasChannels) throwFormat(path, which + "missing channels attribute");
-    long long count = 0;
-    if (part.tiled(layout.flags)) {
-      if (!part.hasTiles) throwFormat(path, which + "tiled part without a valid tiles attribute");
-      if (part.tileWidth == 0 || part.tileHeight == 0 || part.tileWidth > Image::kMaxDimension ||
-          part.tileHeight > Image::kMaxDimension ||
-          static_cast<long long>(part.tileWidth) * part.tileHeight > std::max(w * h, 1LL << 20))
-        throwFormat(path, which + "invalid tile size " + std::to_string(part.tileWidth) + "x" +
-                              std::to_string(part.tileHeight));
-      if (part.roundingMode > 1) throwFormat(path, which + "invalid tile rounding mode");
-      count = tiledChunkCount(part, w, h);
-      if (count < 0) throwFormat(path, which + "invalid tile level mode " + std::to_string(part.levelMode));
-      for (const ChannelLayout& channel : part.channels)
-        if (!deep && (channel.xSampling != 1 || channel.ySampling != 1))
-          throwFormat(path, which + "channel '" + channel.name + "' of a tiled part is subsampled");
-    } else {
-      const int lines = linesPerChunk(part.compression);
-      if (lines == 0)
-        throwFormat(path, which + "missing or unknown compression " + std::to_string(part.compression));
-      count = (h + lines - 1) / lines;
-    }
-    if (multiPart && (!part.hasChunkCount || part.chunkCount != count))
-      throwFormat(path, which + "missing or inconsistent chunkCount attribute (expected " +
-                            std::to_string(count) + ")");
+    const long long count = checkedChunkCount(layout, layout.parts[p], static_cast<int>(p) == partIndex,
+                                              maxPixels, which(p), path);
     if (static_cast<std::uint64_t>(count) > (reader.size() - tablesEnd) / 8)
       throwFormat(path,
-                  which + "truncated file (chunk offset table of " + std::to_string(count) + " entries)");
+                  which(p) + "truncated file (chunk offset table of " + std::to_string(count) + " entries)");
     tablesEnd += static_cast<std::uint64_t>(count) * 8;
     counts.push_back(count);
   }
@@ -695,60 +761,17 @@ CheckedPart validateLayout(FileReader& reader, const FileLayout& layout, int par
   std::vector<std::uint8_t> table;
   for (std::size_t p = 0; p < layout.parts.size(); ++p) {
     const PartLayout& part = layout.parts[p];
-    const std::string which = multiPart ? "part " + std::to_string(p) + ": " : std::string();
-    const long long count = counts[p];
-    // Deep chunks have a different header; only their position and part number are checked.
-    const bool deep = part.deep(layout.flags);
     const bool tiled = part.tiled(layout.flags);
-    const std::uint64_t headerBytes = (multiPart ? 4u : 0u) + (deep ? 0u : (tiled ? 20u : 8u));
-    table.resize(static_cast<std::size_t>(count) * 8);
+    table.resize(static_cast<std::size_t>(counts[p]) * 8);
     if (!reader.readAt(tableOffset, table.data(), table.size()))
-      throwFormat(path, which + "truncated file (chunk offset table)");
-    if (static_cast<int>(p) == partIndex) checked = {&part, tiled, tableOffset, count, headerBytes};
-    tableOffset += table.size();
-
-    // Reads the header of chunk i after checking its position and part number; returns its offset.
-    std::array<std::uint8_t, 24> chunkHeader{};
-    const auto locate = [&](long long i) {
-      const std::uint64_t offset = FileReader::decode64(table.data() + i * 8);
-      if (offset == 0)
-        throwFormat(path, which + "incomplete file (chunk " + std::to_string(i) + " is missing)");
-      if (offset < tablesEnd || offset >= reader.size() ||
-          !reader.readAt(offset, chunkHeader.data(), headerBytes))
-        throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " at offset " +
-                              std::to_string(offset) + " lies outside the pixel data of the " +
-                              std::to_string(reader.size()) + "-byte file)");
-      if (multiPart && FileReader::decode32(chunkHeader.data()) != static_cast<std::uint32_t>(p))
-        throwFormat(path, which + "corrupt chunk " + std::to_string(i) + " (wrong part number)");
-      return offset;
-    };
-    if (deep) {
-      for (long long i = 0; i < count; ++i)
-        locate(i);
-      continue;
+      throwFormat(path, which(p) + "truncated file (chunk offset table)");
+    if (static_cast<int>(p) == partIndex) {
+      const std::uint64_t headerBytes =
+          (multiPart ? 4u : 0u) + (part.deep(layout.flags) ? 0u : (tiled ? 20u : 8u));
+      checked = {&part, tiled, tableOffset, counts[p], headerBytes};
     }
-    forEachChunk(part, tiled, [&](long long i, const ExpectedChunk& expected) {
-      const std::uint64_t offset = locate(i);
-      const std::uint8_t* fields = chunkHeader.data() + (multiPart ? 4 : 0);
-      const auto field = [&](int k) { return FileReader::toSigned(FileReader::decode32(fields + 4 * k)); };
-      const std::string chunk =
-          which + "corrupt chunk " + std::to_string(i) + " (" + describe(expected) + ")";
-      if (tiled && (field(0) != expected.dx || field(1) != expected.dy || field(2) != expected.lx ||
-                    field(3) != expected.ly))
-        throwFormat(path, chunk + ": its header names tile (" + std::to_string(field(0)) + ", " +
-                              std::to_string(field(1)) + ") of level (" + std::to_string(field(2)) + ", " +
-                              std::to_string(field(3)) + ")");
-      if (!tiled && field(0) != expected.y0)
-        throwFormat(path, chunk + ": its header names scanline " + std::to_string(field(0)));
-      const std::int32_t dataSize = field(tiled ? 4 : 1);
-      if (!validDataSize(part.compression, dataSize, expected.rawBytes))
-        throwFormat(path, chunk + ": data size " + std::to_string(dataSize) + " bytes, expected " +
-                              expectedDataSize(part.compression, expected));
-      if (static_cast<std::uint64_t>(dataSize) > reader.size() - offset - headerBytes)
-        throwFormat(path, which + "truncated or corrupt file (chunk " + std::to_string(i) + " of " +
-                              std::to_string(dataSize) + " bytes at offset " + std::to_string(offset) +
-                              " ends beyond the " + std::to_string(reader.size()) + "-byte file)");
-    });
+    tableOffset += table.size();
+    checkChunks(reader, layout, p, table, tablesEnd, which(p), path);
   }
   return checked;
 }

@@ -57,9 +57,7 @@ std::string shortNum(double v) {
 ImageMetrics compareImages(const Image& actual, const Image& reference, const CompareOptions& options) {
   const int channels = checkComparable(actual, reference, options.channels);
   requireNonNegative("CompareOptions.overThreshold", options.overThreshold);
-  if (!std::isfinite(options.peak) || options.peak < 0.0)
-    throw InvalidArgument("CompareOptions.peak", detail::formatValue(options.peak),
-                          "must be finite and >= 0");
+  requireNonNegative("CompareOptions.peak", options.peak);
 
   ImageMetrics m;
   m.overThreshold = options.overThreshold;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>
@@ -48,6 +49,8 @@ public:
     /// GL_RGBA32F of cameraDepth's size: RGB AtmosphereImage::transmittance, A 1; or 0 (not written).
     std::uint32_t transmittanceOutput = 0;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "AtmospherePass::FrameAttribs") const;
 
   /// One-time: validates (InvalidArgument naming the field; GlError beyond GL limits), builds the program.
   explicit AtmospherePass(const CreateInfo& info);
@@ -62,6 +65,12 @@ public:
   std::uint32_t skyMieTexture() const noexcept { return skyMie_.get(); }
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+  void uploadBlocks(const FrameAttribs& frame, const Plan& plan);
+  void computeViewTables(const AtmosphereTablesPass& tables);
+  void dispatchImage(const FrameAttribs& frame, const Plan& plan, std::uint32_t program);
+
   CreateInfo info_;
   bool view_ = false;
   gl::Handle volumeProgram_, skyViewProgram_, volumeRayleigh_, volumeMie_, skyRayleigh_, skyMie_;

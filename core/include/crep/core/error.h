@@ -5,6 +5,9 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
+
+#include <glm/fwd.hpp>
 
 namespace crep {
 
@@ -59,15 +62,27 @@ namespace detail {
 /// Formats a value for error messages (full precision for floating point).
 std::string formatValue(double v);
 std::string formatValue(long long v);
-inline std::string formatValue(int v) { return formatValue(static_cast<long long>(v)); }
-inline std::string formatValue(float v) { return formatValue(static_cast<double>(v)); }
+inline std::string formatValue(int v) {
+  return formatValue(static_cast<long long>(v));
+}
+inline std::string formatValue(float v) {
+  return formatValue(static_cast<double>(v));
+}
+std::string formatValue(const glm::dvec3& v); ///< "(x, y, z)"
 } // namespace detail
 
+/// Throws InvalidArgument(parameter, value, requirement): the one way the library reports a bad parameter.
+[[noreturn]] void invalid(std::string parameter, const std::string& value, const std::string& requirement);
+
 /// Throws InvalidArgument unless `value` is finite.
-void requireFinite(const char* parameter, double value);
+void requireFinite(std::string_view parameter, double value);
+/// Throws InvalidArgument unless every component of `value` is finite.
+void requireFinite(std::string_view parameter, const glm::dvec3& value);
+/// Throws InvalidArgument unless every element of `value` is finite (the message gives the first other one).
+void requireFinite(std::string_view parameter, const glm::dmat4& value);
 /// Throws InvalidArgument unless `value` is finite and > 0.
-void requirePositive(const char* parameter, double value);
+void requirePositive(std::string_view parameter, double value);
 /// Throws InvalidArgument unless `value` is finite and >= 0.
-void requireNonNegative(const char* parameter, double value);
+void requireNonNegative(std::string_view parameter, double value);
 
 } // namespace crep

@@ -92,6 +92,9 @@ TextureLevel requireTexture2D(const char* parameter, std::uint32_t texture);
 void requireTexture2D(const char* parameter, std::uint32_t texture, int width, int height,
                       std::uint32_t internalFormat = 0);
 
+/// GL_BUFFER_SIZE of `buffer` in bytes; InvalidArgument naming `parameter` if it is 0 or not a buffer.
+long long requireBuffer(const char* parameter, std::uint32_t buffer, const std::string& requirement);
+
 /// Throws InvalidArgument naming `parameter` unless `texture` reads as depth: a depth format sampled as
 /// depth, or GL_R32F (camera depth, shadow and rectified maps).
 void requireDepthFormat(const char* parameter, std::uint32_t texture);

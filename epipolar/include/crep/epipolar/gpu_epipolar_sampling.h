@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -64,6 +65,9 @@ public:
     std::uint32_t cameraDepth = 0;
     std::uint32_t output = 0; ///< GL_RGBA32F W x H: the in-scattering (RGB) and transmittance (A)
   };
+  /// Throws what placeSamples, unwarp and upscale would for `frame` (InvalidArgument naming the field).
+  void validate(const FrameAttribs& frame,
+                std::string_view owner = "EpipolarSamplingPass::FrameAttribs") const;
   /// Throws InvalidArgument naming the field ("EpipolarSamplingPass::CreateInfo.width", ...), GlError
   /// beyond the GL limits (README) or ShaderError. One-time: builds five programs, O(Ns N + W H) memory.
   explicit EpipolarSamplingPass(const CreateInfo& info);
@@ -116,7 +120,6 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
-  void checkFrame(const FrameAttribs& frame) const;
   void bindCommon(std::uint32_t program) const;
 
   CreateInfo info_;

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -57,6 +59,12 @@ private:
   gl::Handle program_, upperProgram_, buffer_, sampler_;
 };
 
+/// GlError naming `parameter` when a map of `mapWidth` columns needs more than the GPU walk's 16 levels.
+void requireTreeLevels(const char* parameter, int mapWidth);
+/// InvalidArgument naming `parameter` unless `buffer` holds the trees of a mapWidth x mapHeight map.
+void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
+                         const std::string& use);
+
 /// The march of every camera pixel's view ray along its row of a rectified map, with the map's min/max
 /// trees (MinMaxTree) or texel by texel (BruteForce). Per frame, O(pixels x steps).
 class RectifiedMarchPass {
@@ -95,6 +103,8 @@ public:
     glm::dvec2 blockCenter{0.0};
     double blockRadius = -1.0;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "RectifiedMarchPass::FrameAttribs") const;
   /// Throws InvalidArgument ("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight") / GlError like
   /// MinMaxTreePass.
   explicit RectifiedMarchPass(const CreateInfo& info);
@@ -104,6 +114,8 @@ public:
   void prepare(gpu::LayoutKind kind, bool textured = false, bool list = false);
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
   std::uint32_t program(gpu::LayoutKind kind, bool textured, bool list);
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;

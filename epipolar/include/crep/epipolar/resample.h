@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -59,6 +60,8 @@ public:
     /// (Yusov 2012, Sec. 6.3; README).
     std::uint32_t minMaxBuffer = 0;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "ShadowResamplePass::FrameAttribs") const;
   /// Throws InvalidArgument ("ShadowResamplePass::CreateInfo.mapWidth/mapHeight") for sizes <= 0, GlError
   /// beyond GL_MAX_TEXTURE_SIZE.
   explicit ShadowResamplePass(const CreateInfo& info);
@@ -66,6 +69,9 @@ public:
   void run(const FrameAttribs& frame);
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+
   CreateInfo info_;
   gpu::LayoutBuffers layoutBuffers_;
   gl::Handle programs_[2][2], params_, sampler_; ///< [layout kind][with the trees' low levels]

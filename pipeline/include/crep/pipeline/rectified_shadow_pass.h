@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -28,6 +29,10 @@ public:
     /// GL_TEXTURE_2D depth texture of mapWidth x mapHeight (D32F, or D24) to render into; 0 = its own D32F.
     std::uint32_t depthTexture = 0;
   };
+  /// Throws what run(frame) would before drawing: InvalidArgument naming the field after `owner` (a
+  /// depthTexture of a colour format is found when run() attaches it).
+  void validate(const FrameAttribs& frame,
+                std::string_view owner = "RectifiedShadowPass::FrameAttribs") const;
 
   /// Throws InvalidArgument naming the field for sizes < 1 or beyond GL_MAX_TEXTURE_SIZE.
   explicit RectifiedShadowPass(const CreateInfo& info);

@@ -9,6 +9,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -153,6 +154,9 @@ public:
     /// A volume to fill with this frame's basis, or null; needs `light`. At least one of output and froxels.
     const FroxelTarget* froxels = nullptr;
   };
+  /// Throws what run(frame) would for its inputs before any GL work: InvalidArgument naming the field after
+  /// `owner` (e.g. "Scattering::FrameAttribs.camera"), or naming "Scattering" for a moved-from object.
+  void validate(const FrameAttribs& frame, std::string_view owner = "Scattering::FrameAttribs") const;
 
   /// What a local light (or one point-light face) cost and how it was computed.
   struct LightResult {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -73,6 +74,8 @@ public:
     std::uint32_t shadowMap = 0;
     glm::dmat4 lightClipFromWorld{1.0}; ///< its matrix (turns the exponent into depth units)
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "EsmPass::FrameAttribs") const;
   /// Throws InvalidArgument naming "EsmPass::CreateInfo.options.<field>".
   explicit EsmPass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
@@ -108,6 +111,8 @@ public:
     glm::dvec3 noiseOffset{0.0};
     std::uint32_t output = 0; ///< GL_TEXTURE_3D, grid size, CreateInfo::format
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "FroxelLightingPass::FrameAttribs") const;
   explicit FroxelLightingPass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
 
@@ -129,6 +134,9 @@ public:
     glm::dvec3 jitter{0.0};         ///< the jitter the volume was lit with
     std::uint32_t volume = 0;       ///< GL_TEXTURE_3D, grid size, CreateInfo::format: read and written
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame,
+                std::string_view owner = "FroxelAccumulatePass::FrameAttribs") const;
   explicit FroxelAccumulatePass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
 
@@ -154,6 +162,8 @@ public:
     std::uint32_t history = 0;  ///< last frame's output (grid size), or 0 with previousCamera nullptr
     std::uint32_t output = 0;   ///< GL_TEXTURE_3D, grid size, CreateInfo::format; not current or history
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "FroxelTemporalPass::FrameAttribs") const;
   explicit FroxelTemporalPass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
 
@@ -175,6 +185,8 @@ public:
     glm::dvec3 offset{0.0};        ///< the volume's sample offset (its jitter; 0 after the temporal pass)
     std::uint32_t output = 0;      ///< GL_RGBA32F, cameraDepth's size
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "FroxelApplyPass::FrameAttribs") const;
   explicit FroxelApplyPass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
 
@@ -219,6 +231,8 @@ public:
     const Camera* previousCamera = nullptr;
     glm::dvec3 noiseOffset{0.0}; ///< Esm mode, world units (wind)
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "FroxelFog::FrameAttribs") const;
   /// Throws InvalidArgument naming "FroxelFog::CreateInfo.<field>" (grid, esm, density, ambient,
   /// temporal.historyWeight, format; a grid beyond GL_MAX_3D_TEXTURE_SIZE).
   explicit FroxelFog(const CreateInfo& info);

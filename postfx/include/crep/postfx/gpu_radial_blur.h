@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -48,6 +49,8 @@ public:
     std::uint32_t cameraDepth = 0;
     std::uint32_t output = 0; ///< GL_RGBA32F, the size of cameraDepth: RGB radial sum, A transmittance
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "RadialBlurPass::FrameAttribs") const;
   /// Throws InvalidArgument naming "RadialBlurPass::CreateInfo.options.<field>" or
   /// "RadialBlurPass::CreateInfo.workgroupSize".
   explicit RadialBlurPass(const CreateInfo& info);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <map>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -63,6 +64,8 @@ public:
     /// Forget the adaptation state: jump to this frame's log-average (e.g. a camera cut).
     bool resetAdaptation = false;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "ToneMapPass::FrameAttribs") const;
 
   explicit ToneMapPass(const CreateInfo& info);
   /// Tone-maps one frame. Throws InvalidArgument naming the FrameAttribs field. Per frame, O(pixels).

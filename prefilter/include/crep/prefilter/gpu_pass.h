@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include <crep/core/camera.h>
@@ -75,6 +76,9 @@ public:
     /// basis memory and filter work, + 8 bytes per texel, allocated on first use.
     std::uint32_t lightColors = 0;
   };
+  /// Throws what run(frame) would before its first GL change: InvalidArgument naming the field after
+  /// `owner`, GlError when a light texture's basis exceeds GL_MAX_ARRAY_TEXTURE_LAYERS.
+  void validate(const FrameAttribs& frame, std::string_view owner = "PrefilterPass::FrameAttribs") const;
 
   /// One-time: validates (InvalidArgument naming the field; GlError beyond GL limits), builds, allocates.
   explicit PrefilterPass(const CreateInfo& info);
@@ -105,6 +109,14 @@ public:
   FilteredBasisView filteredBasis() const;
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+  void prepareTextured(bool local);
+  std::size_t upload(const FrameAttribs& frame, const Plan& plan);
+  void uploadLocalLight(const FrameAttribs& frame, const Plan& plan,
+                        const std::vector<DistanceProfile>& profiles);
+  void dispatch(const FrameAttribs& frame, const Plan& plan, std::size_t weightBytes);
+
   CreateInfo info_;
   gl::Handle program_, programLocal_, texture_, sampler_, paramsBuffer_, weightsBuffer_, localBuffer_,
       raysBuffer_;
@@ -164,6 +176,9 @@ public:
     const gpu::SampleList* list = nullptr;
     int imageWidth = 0, imageHeight = 0; ///< with `list`: the camera image's W x H (0, 0: cameraDepth's)
   };
+  /// Throws what run(frame) would before its first GL change: InvalidArgument naming the field after
+  /// `owner` (GlError beyond the froxel dispatch's workgroup limits).
+  void validate(const FrameAttribs& frame, std::string_view owner = "EvaluatePass::FrameAttribs") const;
 
   /// One-time: validates (InvalidArgument naming the field, GlError beyond the workgroup limits), compiles.
   explicit EvaluatePass(const CreateInfo& info);
@@ -183,6 +198,16 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+  void uploadLocalLight(const FrameAttribs& frame);
+  std::uint32_t evaluationProgram(const Plan& plan);
+  void uploadTableCoefficients(double depthMargin);
+  void buildTable(const FilteredBasisView& basis, const Plan& plan);
+  void bindEvaluation(const FrameAttribs& frame, const Plan& plan, std::uint32_t program);
+  void dispatchFroxels(const FrameAttribs& frame, const Plan& plan, gpu::EvaluateParams params);
+  void unbindEvaluation(const Plan& plan);
+
   CreateInfo info_;
   gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
   /// Local-light programs and prefix programs: [projective frame, then per gpu::LayoutKind]; light block.

@@ -19,6 +19,8 @@ public:
   LayoutKind upload(const RectifiedLayout& layout, int mapHeight, const char* parameter = "layout");
   /// The same for a description already made with requireGpuLayout() (a layout is serialized once per run).
   LayoutKind upload(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
+  /// Throws InvalidArgument as upload() does for `data` and `mapHeight`, without uploading.
+  static void requireUploadable(const GpuLayoutData& data, int mapHeight, const char* parameter = "layout");
   /// Binds the block at uniform buffer `blockBinding` and any row table at storage buffer `rowsBinding`.
   void bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const;
   LayoutKind kind() const noexcept { return kind_; }

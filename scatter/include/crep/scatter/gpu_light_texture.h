@@ -61,6 +61,8 @@ public:
     const DirectionalLight* light = nullptr;
     const LocalLight* localLight = nullptr;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "LightColorMapPass::FrameAttribs") const;
 
   /// Throws InvalidArgument ("LightColorMapPass::CreateInfo.mapWidth" / ".mapHeight") for sizes <= 0,
   /// GlError beyond GL_MAX_TEXTURE_SIZE. One-time: 16 bytes per texel.
@@ -75,6 +77,9 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+
   CreateInfo info_;
   gl::Handle colors_, params_, sampler_;
   gl::Handle programs_[2]; ///< per gpu::LayoutKind, built on first use

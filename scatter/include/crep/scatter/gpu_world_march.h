@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include <glm/glm.hpp>
 
@@ -125,12 +126,17 @@ public:
     /// A light texture (texture 0 = none): each lit part times its colour at the part's midpoint.
     GpuLightTexture lightTexture;
   };
+  /// Throws what run(frame) would before any GL work: InvalidArgument naming the field after `owner`.
+  void validate(const FrameAttribs& frame, std::string_view owner = "WorldMarchPass::FrameAttribs") const;
   /// Throws InvalidArgument ("WorldMarchOptions.steps" / ".refinements") for bad values.
   explicit WorldMarchPass(const CreateInfo& info);
   /// Throws InvalidArgument naming the FrameAttribs field (e.g. ".light/localLight": both or neither).
   void run(const FrameAttribs& frame);
 
 private:
+  struct Plan;
+  Plan plan(const FrameAttribs& frame, std::string_view owner) const;
+
   CreateInfo info_;
   gl::Handle program_, params_, sampler_, dummySteps_;
   gl::Handle texturedProgram_, textureParams_; ///< light textures, on first use
