@@ -292,6 +292,19 @@ struct DepthTarget {
   }
 };
 
+// Sec. 4.1's layout options of the front door: mapSize slices and the shared settings; the sun and the local
+// lights differ in the depth warp and the epipole block's radius.
+EpipolarOptions epipolarOptions(const Scattering::CreateInfo& info, double depthWarp, double blockRadius) {
+  EpipolarOptions options;
+  options.slices = info.mapSize;
+  options.referenceRay = info.rectify.referenceRay;
+  options.regions = info.epipolarRegions;
+  options.depthWarp = depthWarp;
+  options.epipoleBlockRadius = blockRadius;
+  options.maxBlockPixels = info.epipoleBlockMaxPixels;
+  return options;
+}
+
 } // namespace
 
 struct Scattering::Impl {
@@ -668,13 +681,7 @@ void Scattering::Impl::projectiveMap(const FrameAttribs& f, FrameResult& r, Dire
 // stays that of a projective one).
 void Scattering::Impl::epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d) {
   r.layout = Layout::Epipolar;
-  EpipolarOptions options;
-  options.slices = info.mapSize;
-  options.referenceRay = info.rectify.referenceRay;
-  options.regions = info.epipolarRegions;
-  options.depthWarp = info.epipolarDepthWarp;
-  options.epipoleBlockRadius = info.epipoleBlockRadius;
-  options.maxBlockPixels = info.epipoleBlockMaxPixels;
+  const EpipolarOptions options = epipolarOptions(info, info.epipolarDepthWarp, info.epipoleBlockRadius);
   auto epipolar =
       std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
   d.layout = epipolar;
@@ -943,13 +950,8 @@ struct Scattering::Impl::LocalLightRun {
   // epipole), mapSize slices, the light's perspective map resampled into it.
   void epipolar() {
     const CreateInfo& info = m.info;
-    EpipolarOptions options;
-    options.slices = info.mapSize;
-    options.referenceRay = info.rectify.referenceRay;
-    options.regions = info.epipolarRegions;
-    options.depthWarp = info.localLightDepthWarp;
-    options.epipoleBlockRadius = info.localLightBlockRadius;
-    options.maxBlockPixels = info.epipoleBlockMaxPixels;
+    const EpipolarOptions options =
+        epipolarOptions(info, info.localLightDepthWarp, info.localLightBlockRadius);
     const EpipolarLayout layout(*f.camera, light.position, info.width, info.height, options);
     result.epipolar = true;
     const ShadowMap shadow = perspectiveMap();

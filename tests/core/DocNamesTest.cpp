@@ -7,6 +7,8 @@
 // of other APIs (gl* / GL_* of OpenGL, std::, glm::, Eigen::) are not checked.
 #include <doctest/doctest.h>
 
+#include "common/source_tree.h"
+
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -19,15 +21,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kModules = {"core",      "rectify",  "scatter",    "epipolar",
-                                           "prefilter", "pipeline", "atmosphere", "postfx"};
-
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using crep::test::kLibraryModules;
+using crep::test::readSourceFile;
 
 /// Splits C++ / GLSL text into code (comments and string literals blanked) and comment text.
 void splitComments(const std::string& text, std::string& code, std::string& comments) {
@@ -112,7 +107,7 @@ bool foreign(const std::string& qualified) {
 } // namespace
 
 TEST_CASE("every function and type a public header's comments cite exists in the library") {
-  const fs::path root = CREP_SOURCE_DIR;
+  const fs::path root = crep::test::kSourceRoot;
   std::set<std::string> known;
   std::vector<fs::path> headers;
   const auto scan = [&](const fs::path& dir, bool isHeaderDir) {
@@ -124,13 +119,13 @@ TEST_CASE("every function and type a public header's comments cite exists in the
           ext != ".frag")
         continue;
       std::string code, comments;
-      splitComments(readAll(e.path()), code, comments);
+      splitComments(readSourceFile(e.path()), code, comments);
       const std::set<std::string> ids = identifiers(code);
       known.insert(ids.begin(), ids.end());
       if (isHeaderDir && ext == ".h") headers.push_back(e.path());
     }
   };
-  for (const std::string& m : kModules) {
+  for (const std::string& m : kLibraryModules) {
     scan(root / m / "include", true);
     scan(root / m / "src", false);
   }
@@ -152,7 +147,7 @@ TEST_CASE("every function and type a public header's comments cite exists in the
   std::vector<std::string> missing;
   for (const fs::path& h : headers) {
     std::string code, comments;
-    splitComments(readAll(h), code, comments);
+    splitComments(readSourceFile(h), code, comments);
     comments = withoutQuotes(comments);
     for (std::sregex_iterator it(comments.begin(), comments.end(), cited), end; it != end; ++it) {
       std::string name = it->str();

@@ -5,6 +5,8 @@
 // rather than written as numbers in the shaders.
 #include <doctest/doctest.h>
 
+#include "common/source_tree.h"
+
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -16,16 +18,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kRoot = CREP_SOURCE_DIR;
-const std::vector<std::string> kLibraryModules = {"core",      "rectify",  "scatter",    "epipolar",
-                                                  "prefilter", "pipeline", "atmosphere", "postfx"};
-
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+const fs::path kRoot = crep::test::kSourceRoot;
+using crep::test::kLibraryModules;
+using crep::test::readSourceFile;
 
 std::vector<std::string> lines(const std::string& text) {
   std::vector<std::string> out;
@@ -136,7 +131,7 @@ struct LongFunction {
 /// Bodies of functions (outermost braces whose header ends like a function's: `) {`, `) const {`,
 /// `) noexcept {`, `) override {`, `-> T {`, or a constructor's initializer list) longer than `limit` lines.
 std::vector<LongFunction> longFunctions(const fs::path& file, int limit) {
-  const std::string code = codeOnly(readAll(file));
+  const std::string code = codeOnly(readSourceFile(file));
   std::vector<LongFunction> out;
   static const std::regex functionHeader(
       R"(\)\s*(const|noexcept|override|final|mutable|\s)*(->\s*[\w:<>,\s\*&]+)?\s*$|\)\s*:\s*[\w:]+[\(\{][^;]*[\)\}]\s*$)");
@@ -188,7 +183,7 @@ std::vector<LongFunction> longFunctions(const fs::path& file, int limit) {
 } // namespace
 
 TEST_CASE("README.md is a front page of at most 300 lines") {
-  const auto readme = lines(readAll(kRoot / "README.md"));
+  const auto readme = lines(readSourceFile(kRoot / "README.md"));
   CAPTURE(readme.size());
   CHECK(readme.size() > 20); // read the right file
   CHECK(readme.size() <= 300);
@@ -200,7 +195,7 @@ TEST_CASE("public headers are contracts: comment lines at most half the code lin
   // A measurement quoted in a header goes stale with the next change: "Measured", timings, error figures.
   static const std::regex figure(R"(([Mm]easured|\b\d+(\.\d+)?\s?ms\b|RMSE|PSNR|llvmpipe))");
   for (const auto& h : publicHeaders()) {
-    const std::string text = readAll(h);
+    const std::string text = readSourceFile(h);
     const CommentCount c = countComments(text);
     total.comment += c.comment;
     total.code += c.code;
@@ -269,7 +264,7 @@ TEST_CASE("binding points are named once: no literal binding numbers in the shad
     for (const auto& f : filesUnder(dir, {".glsl", ".comp", ".vert", ".frag", ".h"})) {
       if (dir == kRoot / "examples" && f.extension() == ".h") continue;
       int n = 0;
-      for (const auto& l : lines(readAll(f))) {
+      for (const auto& l : lines(readSourceFile(f))) {
         ++n;
         if (trim(l).rfind("//", 0) == 0) continue;
         if (std::regex_search(l, literal)) {
