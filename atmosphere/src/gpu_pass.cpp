@@ -11,6 +11,8 @@
 #include <crep/epipolar/march.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <string>
@@ -20,11 +22,10 @@ namespace crep {
 
 namespace {
 
-/// Texture units, uniform and storage bindings of passes/atmosphere/atmosphere.comp (its header comment).
-constexpr GLuint kUnitCameraDepth = 0, kUnitRectifiedDepth = 1, kUnitOpticalDepth = 2, kUnitSingle = 3,
-                 kUnitHigherOrders = 4, kUnitSingleMie = 5, kUnitPrefiltered = 6, kUnitAmbient = 7,
-                 kUnitVolumeRayleigh = 8, kUnitVolumeMie = 9, kUnitSkyRayleigh = 10, kUnitSkyMie = 11;
-constexpr int kUnits = 12; ///< units and bindings unbound afterwards (gl::unbindPassState)
+// Texture units, uniform and storage bindings of passes/atmosphere/atmosphere.comp: CREP_ATMOSPHERE_* of
+// crep/bindings.h.
+constexpr int kUnits = CREP_ATMOSPHERE_SKY_MIE_UNIT + 1; ///< units and bindings unbound afterwards
+                                                         ///< (gl::unbindPassState)
 
 bool walksTrees(AtmosphereShafts shafts) {
   return shafts == AtmosphereShafts::Integrated || shafts == AtmosphereShafts::LitLengthTable;
@@ -182,16 +183,20 @@ void AtmospherePass::uploadBlocks(const FrameAttribs& f, const Plan& p) {
 void AtmospherePass::computeViewTables(const AtmosphereTablesPass& tables) {
   const glm::ivec3 vs = info_.options.volumeSize;
   const glm::ivec2 ss = info_.options.skyViewSize;
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
-  glBindTextureUnit(kUnitOpticalDepth, tables.opticalDepthTexture());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_MARCH_BINDING, marchParams_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_PARAMS_BINDING, atmosphereParams_.get());
+  glBindTextureUnit(CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT, tables.opticalDepthTexture());
   glUseProgram(volumeProgram_.get());
-  glBindImageTexture(0, volumeRayleigh_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_ATMOSPHERE_VOLUME_RAYLEIGH_OUT_IMAGE, volumeRayleigh_.get(), 0, GL_TRUE, 0,
+                     GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_ATMOSPHERE_VOLUME_MIE_OUT_IMAGE, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
   glDispatchCompute(static_cast<GLuint>((vs.x + 7) / 8), static_cast<GLuint>((vs.y + 7) / 8), 1);
   glUseProgram(skyViewProgram_.get());
-  glBindImageTexture(0, skyRayleigh_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_ATMOSPHERE_SKY_RAYLEIGH_OUT_IMAGE, skyRayleigh_.get(), 0, GL_FALSE, 0,
+                     GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_ATMOSPHERE_SKY_MIE_OUT_IMAGE, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
   glDispatchCompute(static_cast<GLuint>((ss.x + 7) / 8), static_cast<GLuint>((ss.y + 7) / 8), 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }
@@ -202,41 +207,44 @@ void AtmospherePass::dispatchImage(const FrameAttribs& f, const Plan& p, std::ui
                                    : gl::scratchTexture2D(dummyTransmittance_, dummyWidth_, dummyHeight_,
                                                           GL_RGBA32F, p.width, p.height);
   glUseProgram(program);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, marchParams_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, 2, atmosphereParams_.get());
-  glBindTextureUnit(kUnitCameraDepth, f.cameraDepth);
-  glBindSampler(kUnitCameraDepth, nearest_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_MARCH_BINDING, marchParams_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_PARAMS_BINDING, atmosphereParams_.get());
+  glBindTextureUnit(CREP_ATMOSPHERE_CAMERA_DEPTH_UNIT, f.cameraDepth);
+  glBindSampler(CREP_ATMOSPHERE_CAMERA_DEPTH_UNIT, nearest_.get());
   // The tables keep their own sampling state (linear, clamp to edge: AtmosphereTablesPass).
-  glBindTextureUnit(kUnitOpticalDepth, f.tables->opticalDepthTexture());
-  glBindTextureUnit(kUnitSingle, f.tables->singleTexture());
-  glBindTextureUnit(kUnitHigherOrders, f.tables->higherOrdersTexture());
-  glBindTextureUnit(kUnitAmbient, f.tables->ambientTexture());
+  glBindTextureUnit(CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT, f.tables->opticalDepthTexture());
+  glBindTextureUnit(CREP_ATMOSPHERE_SINGLE_TABLE_UNIT, f.tables->singleTexture());
+  glBindTextureUnit(CREP_ATMOSPHERE_HIGHER_ORDERS_TABLE_UNIT, f.tables->higherOrdersTexture());
+  glBindTextureUnit(CREP_ATMOSPHERE_AMBIENT_TABLE_UNIT, f.tables->ambientTexture());
   // With combinedMie there is no single Mie table (the shader does not read the unit).
   const bool combined = f.tables->info().options.combinedMie;
-  glBindTextureUnit(kUnitSingleMie, combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
+  glBindTextureUnit(CREP_ATMOSPHERE_SINGLE_MIE_TABLE_UNIT,
+                    combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
   if (p.walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees
     layoutBuffers_.upload(p.layoutData, info_.mapHeight);
-    layoutBuffers_.bind(1, 1);
-    glBindTextureUnit(kUnitRectifiedDepth, f.rectifiedDepth);
-    glBindSampler(kUnitRectifiedDepth, nearest_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
+    layoutBuffers_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+    glBindTextureUnit(CREP_ATMOSPHERE_RECTIFIED_DEPTH_UNIT, f.rectifiedDepth);
+    glBindSampler(CREP_ATMOSPHERE_RECTIFIED_DEPTH_UNIT, nearest_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_ATMOSPHERE_MIN_MAX_BINDING, f.minMaxBuffer);
   }
   if (p.prefiltered) {
-    glBindTextureUnit(kUnitPrefiltered, f.prefiltered);
-    glBindSampler(kUnitPrefiltered, nearest_.get());
+    glBindTextureUnit(CREP_ATMOSPHERE_PREFILTERED_UNIT, f.prefiltered);
+    glBindSampler(CREP_ATMOSPHERE_PREFILTERED_UNIT, nearest_.get());
   }
   if (view_) {
-    const std::pair<GLuint, GLuint> views[] = {{kUnitVolumeRayleigh, volumeRayleigh_.get()},
-                                               {kUnitVolumeMie, volumeMie_.get()},
-                                               {kUnitSkyRayleigh, skyRayleigh_.get()},
-                                               {kUnitSkyMie, skyMie_.get()}};
+    const std::pair<GLuint, GLuint> views[] = {{CREP_ATMOSPHERE_VOLUME_RAYLEIGH_UNIT, volumeRayleigh_.get()},
+                                               {CREP_ATMOSPHERE_VOLUME_MIE_UNIT, volumeMie_.get()},
+                                               {CREP_ATMOSPHERE_SKY_RAYLEIGH_UNIT, skyRayleigh_.get()},
+                                               {CREP_ATMOSPHERE_SKY_MIE_UNIT, skyMie_.get()}};
     for (const auto& [unit, texture] : views) {
       glBindTextureUnit(unit, texture);
       glBindSampler(unit, linear_.get());
     }
   }
-  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(1, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_ATMOSPHERE_INSCATTERING_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
+  glBindImageTexture(CREP_ATMOSPHERE_TRANSMITTANCE_OUT_IMAGE, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
   glDispatchCompute(static_cast<GLuint>((p.width + 7) / 8), static_cast<GLuint>((p.height + 7) / 8), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(kUnits);

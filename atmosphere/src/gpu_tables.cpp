@@ -9,6 +9,8 @@
 #include <crep/core/gl_state.h>
 #include <crep/core/shader_library.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <chrono>
@@ -192,8 +194,10 @@ struct TableDispatch {
   /// accumulator += addend with the sum program.
   void sum(GLuint program, GLuint accumulator, GLuint addend) const {
     glUseProgram(program);
-    glBindImageTexture(0, accumulator, 0, GL_TRUE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, addend, 0, GL_TRUE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_SUM_ACCUMULATOR_IMAGE, accumulator, 0, GL_TRUE, 0,
+                       GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_SUM_ADDEND_IMAGE, addend, 0, GL_TRUE, 0, GL_READ_ONLY,
+                       GL_RGBA32F);
     dispatch();
   }
   void copy(GLuint from, GLuint to) const {
@@ -215,7 +219,8 @@ void computeSingle(const AtmospherePrecomputeOptions& o, const TableTextures& t,
   const bool lut = usesMultipleScatteringLut(o);
   // Optical depth.
   glUseProgram(programs.optical.get());
-  glBindImageTexture(0, t.opticalDepth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+  glBindImageTexture(CREP_ATMOSPHERE_TABLES_OPTICAL_DEPTH_OUTPUT_IMAGE, t.opticalDepth, 0, GL_FALSE, 0,
+                     GL_WRITE_ONLY, GL_RG32F);
   glDispatchCompute(groups(o.opticalDepthHeight, 8), groups(o.opticalDepthZenith, 8), 1);
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   clock.end("optical depth");
@@ -223,8 +228,9 @@ void computeSingle(const AtmospherePrecomputeOptions& o, const TableTextures& t,
   // Psi_ms (Hillaire 2020, the Lut method).
   if (lut) {
     glUseProgram(programs.ms.get());
-    glBindTextureUnit(0, t.opticalDepth);
-    glBindImageTexture(0, t.msLut, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(CREP_ATMOSPHERE_TABLES_MS_OPTICAL_DEPTH_UNIT, t.opticalDepth);
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_MS_OUTPUT_IMAGE, t.msLut, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                       GL_RGBA32F);
     glDispatchCompute(groups(o.multipleScatteringSize, 8), groups(o.multipleScatteringSize, 8), 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     clock.end("multiple scattering LUT");
@@ -232,12 +238,16 @@ void computeSingle(const AtmospherePrecomputeOptions& o, const TableTextures& t,
 
   // L1 without its phase functions (S_R, S_M); Lut: L_H in the same march.
   glUseProgram(programs.single.get());
-  glBindTextureUnit(0, t.opticalDepth);
-  glBindImageTexture(0, t.single, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  if (!o.combinedMie) glBindImageTexture(1, t.singleMie, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindTextureUnit(CREP_ATMOSPHERE_TABLES_SINGLE_OPTICAL_DEPTH_UNIT, t.opticalDepth);
+  glBindImageTexture(CREP_ATMOSPHERE_TABLES_SINGLE_OUTPUT_IMAGE, t.single, 0, GL_TRUE, 0, GL_WRITE_ONLY,
+                     GL_RGBA32F);
+  if (!o.combinedMie)
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_SINGLE_OUTPUT_MIE_IMAGE, t.singleMie, 0, GL_TRUE, 0,
+                       GL_WRITE_ONLY, GL_RGBA32F);
   if (lut) {
-    glBindTextureUnit(1, t.msLut);
-    glBindImageTexture(2, t.higher, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(CREP_ATMOSPHERE_TABLES_SINGLE_MS_LUT_UNIT, t.msLut);
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_SINGLE_OUTPUT_HIGHER_IMAGE, t.higher, 0, GL_TRUE, 0,
+                       GL_WRITE_ONLY, GL_RGBA32F);
   }
   TableDispatch{o.size}.dispatch();
   if (o.orders == 1) {
@@ -261,17 +271,19 @@ void computeOrders(const AtmospherePrecomputeOptions& o, const TableTextures& t,
   for (int n = 2; n <= o.orders; ++n) {
     const std::string name = "order " + std::to_string(n) + ": ";
     glUseProgram(n == 2 ? programs.firstScattered.get() : programs.scattered.get());
-    glBindTextureUnit(0, n == 2 ? t.single : order.get());
+    glBindTextureUnit(CREP_ATMOSPHERE_TABLES_SCATTERED_PREVIOUS_ORDER_UNIT, n == 2 ? t.single : order.get());
     if (n == 2) { // L1's Mie part and, for the ground's bounce, the optical depth table
-      glBindTextureUnit(1, mieTable);
-      glBindTextureUnit(2, t.opticalDepth);
+      glBindTextureUnit(CREP_ATMOSPHERE_TABLES_SCATTERED_SINGLE_MIE_UNIT, mieTable);
+      glBindTextureUnit(CREP_ATMOSPHERE_TABLES_SCATTERED_OPTICAL_DEPTH_UNIT, t.opticalDepth);
     }
-    glBindImageTexture(0, scattered.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_SCATTERED_OUTPUT_IMAGE, scattered.get(), 0, GL_TRUE, 0,
+                       GL_WRITE_ONLY, GL_RGBA32F);
     table.dispatch();
     clock.end(name + "J");
     glUseProgram(programs.order.get());
-    glBindTextureUnit(0, scattered.get());
-    glBindImageTexture(0, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(CREP_ATMOSPHERE_TABLES_ORDER_SCATTERED_UNIT, scattered.get());
+    glBindImageTexture(CREP_ATMOSPHERE_TABLES_ORDER_OUTPUT_IMAGE, order.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
+                       GL_RGBA32F);
     table.dispatch();
     // L_H += L_n (timed with this L stage).
     if (n == 2)
@@ -317,19 +329,22 @@ void AtmosphereTablesPass::compute() {
   const TablePrograms programs = buildTablePrograms(o);
 
   StageClock clock(times_);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, block.get());
-  // Samplers of the texture units: none (each texture's own linear, clamp-to-edge state).
-  glBindSampler(0, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_TABLES_PARAMS_BINDING, block.get());
+  // Samplers of the texture units the stages read (CREP_ATMOSPHERE_TABLES_*_UNIT, 0-2): none, whatever the
+  // engine left there (each texture's own linear, clamp-to-edge state).
+  glBindSamplers(0, 3, nullptr);
   const TableTextures t{opticalDepth_.get(), msLut_.get(), single_.get(), singleMie_.get(), higher_.get()};
   computeSingle(o, t, programs, clock);
   if (o.orders > 1 && !usesMultipleScatteringLut(o)) computeOrders(o, t, programs, clock);
 
   // E_sky.
   glUseProgram(programs.ambient.get());
-  glBindTextureUnit(0, single_.get());
-  glBindTextureUnit(1, o.combinedMie ? single_.get() : singleMie_.get());
-  glBindTextureUnit(2, higher_.get());
-  glBindImageTexture(0, ambient_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+  glBindTextureUnit(CREP_ATMOSPHERE_TABLES_AMBIENT_SINGLE_UNIT, single_.get());
+  glBindTextureUnit(CREP_ATMOSPHERE_TABLES_AMBIENT_SINGLE_MIE_UNIT,
+                    o.combinedMie ? single_.get() : singleMie_.get());
+  glBindTextureUnit(CREP_ATMOSPHERE_TABLES_AMBIENT_HIGHER_ORDERS_UNIT, higher_.get());
+  glBindImageTexture(CREP_ATMOSPHERE_TABLES_AMBIENT_OUTPUT_IMAGE, ambient_.get(), 0, GL_FALSE, 0,
+                     GL_WRITE_ONLY, GL_RGBA32F);
   glDispatchCompute(groups(o.ambientSize, 64), 1, 1);
   gl::passOutputBarrier();
   clock.end("ambient");

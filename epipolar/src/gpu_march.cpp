@@ -10,6 +10,8 @@
 
 #include <crep/scatter/gpu_layout_buffers.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -65,14 +67,14 @@ void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
   const GLuint p = program_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
-  glBindTextureUnit(0, rectifiedDepth);
-  glBindSampler(0, sampler_.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer_.get());
+  glBindTextureUnit(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, rectifiedDepth);
+  glBindSampler(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, sampler_.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, buffer_.get());
   if (levels_ > 0) glDispatchCompute(static_cast<GLuint>(info_.mapHeight), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
-  glBindSampler(0, 0);
-  glBindTextureUnit(0, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, 0);
+  glBindSampler(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, 0);
+  glBindTextureUnit(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, 0);
   glUseProgram(0);
   gl::checkError("MinMaxTreePass::run");
 }
@@ -91,10 +93,10 @@ void MinMaxTreePass::completeUpperLevels() {
   const GLuint p = upperProgram_.get();
   glUseProgram(p);
   glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer_.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, buffer_.get());
   if (levels_ > 0) glDispatchCompute(static_cast<GLuint>(info_.mapHeight), 1, 1);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, 0);
   glUseProgram(0);
   gl::checkError("MinMaxTreePass::completeUpperLevels");
 }
@@ -112,12 +114,6 @@ std::vector<float> MinMaxTreePass::readNodes() const {
 // ---------------------------------------------------------------------------------------------------
 // RectifiedMarchPass
 
-namespace {
-/// Storage buffer binding of a work list (CREP_SAMPLE_LIST_BINDING): 0 holds the trees, 1 the layout's
-/// per-slice table.
-constexpr GLuint kListBinding = 2;
-} // namespace
-
 RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
   gl::checkTextureSize("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
   requireTreeLevels("RectifiedMarchPass::CreateInfo.mapWidth", info.mapWidth);
@@ -133,13 +129,13 @@ std::uint32_t RectifiedMarchPass::program(gpu::LayoutKind kind, bool textured, b
                           "must be projective or epipolar");
   gl::Handle& program = programs_[list ? 1 : 0][textured ? 1 : 0][k];
   if (!program)
-    program = buildProgram({{ShaderStage::Compute,
-                             "passes/epipolar/march_rectified.comp",
-                             {{"CREP_MARCH_TREE", info_.mode == Mode::MinMaxTree ? "1" : "0"},
-                              {"CREP_LAYOUT", std::to_string(k)},
-                              {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
-                              {"CREP_SAMPLE_LIST", list ? "1" : "0"},
-                              {"CREP_SAMPLE_LIST_BINDING", std::to_string(kListBinding)}}}});
+    program =
+        buildProgram({{ShaderStage::Compute,
+                       "passes/epipolar/march_rectified.comp",
+                       {{"CREP_MARCH_TREE", info_.mode == Mode::MinMaxTree ? "1" : "0"},
+                        {"CREP_LAYOUT", std::to_string(k)},
+                        {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
+                        {"CREP_SAMPLE_LIST", list ? "1" : "0"}}}}); // at CREP_SAMPLE_LIST_DEFAULT_BINDING
   return program.get();
 }
 
@@ -226,25 +222,25 @@ void RectifiedMarchPass::run(const FrameAttribs& f) {
   // A work list reads its coordinates at the camera depth's unit and writes its own output.
   gpu::bindMarchResources(program, params_.get(), list ? list->coordinates : f.cameraDepth, f.rectifiedDepth,
                           sampler_.get(), list ? list->output : f.output, steps);
-  layoutBuffers_.bind(1, 1);
-  if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, f.minMaxBuffer);
+  layoutBuffers_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+  if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MARCH_MIN_MAX_BINDING, f.minMaxBuffer);
   if (textured) { // Klehm et al. 2014, Sec. 3.2: the light texture's colour per texel
-    glBindTextureUnit(2, f.lightColors);
-    glBindSampler(2, sampler_.get());
+    glBindTextureUnit(CREP_MARCH_LIGHT_COLORS_UNIT, f.lightColors);
+    glBindSampler(CREP_MARCH_LIGHT_COLORS_UNIT, sampler_.get());
   }
   if (list) { // Yusov 2012, Sec. 6.4: the selected samples only, one invocation per entry
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kListBinding, list->buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, list->buffer);
     gpu::dispatchSampleList(list->buffer);
     gl::passOutputBarrier();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kListBinding, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, 0);
     gl::unbindPassState(2);
     gl::checkError("RectifiedMarchPass::run (list)");
   } else {
     gpu::dispatchMarch(params.region.z, params.region.w, "RectifiedMarchPass::run");
   }
   if (textured) {
-    glBindSampler(2, 0);
-    glBindTextureUnit(2, 0);
+    glBindSampler(CREP_MARCH_LIGHT_COLORS_UNIT, 0);
+    glBindTextureUnit(CREP_MARCH_LIGHT_COLORS_UNIT, 0);
   }
 }
 

@@ -15,12 +15,13 @@
 #ifndef CREP_AIRLIGHT_GLSL
 #define CREP_AIRLIGHT_GLSL
 
+#include "bindings.h"
 #include "common.glsl"
 #include "local_light.glsl"
 #include "phase.glsl"
 
 #ifndef CREP_AIRLIGHT_UNIT
-#define CREP_AIRLIGHT_UNIT 4
+#define CREP_AIRLIGHT_UNIT CREP_AIRLIGHT_DEFAULT_UNIT
 #endif
 layout(binding = CREP_AIRLIGHT_UNIT) uniform sampler2D crep_airlightTable;
 

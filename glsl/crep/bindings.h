@@ -15,6 +15,25 @@
 // crep/sample_list.glsl: the work list, unless a pass sets CREP_SAMPLE_LIST_BINDING
 #define CREP_SAMPLE_LIST_DEFAULT_BINDING  2 // CrepSampleListBlock (storage)
 
+// crep/scattering.glsl, crep/airlight.glsl, passes/prefilter/evaluate.comp, scattering_prefix.comp: the
+// bindings of the evaluation, unless a pass sets the name without _DEFAULT (CREP_SCATTERING_BINDING, ...)
+#define CREP_SCATTERING_DEFAULT_BINDING          0 // CrepScatteringBlock (uniform)
+#define CREP_FILTERED_BASIS_DEFAULT_UNIT         0 // crep_filteredBasis
+#define CREP_REGION_WEIGHTS_DEFAULT_BINDING      1 // CrepRegionWeightsBlock (storage; near-plane correction)
+#define CREP_MEAN_COLOR_DEFAULT_UNIT             2 // crep_meanColor (light textures)
+#define CREP_LOCAL_LIGHT_DEFAULT_BINDING         3 // CrepLocalLightBlock (uniform)
+#define CREP_AIRLIGHT_DEFAULT_UNIT               4 // crep_airlightTable
+#define CREP_LOCAL_SECTION_DEFAULT_UNIT          5 // crep_localSections
+#define CREP_VISIBILITY_TABLE_DEFAULT_UNIT       6 // crep_visibilityTable
+#define CREP_SCATTERING_PREFIX_DEFAULT_UNIT      7 // crep_scatteringPrefix
+#define CREP_EVALUATE_DEFAULT_BINDING            1 // CrepEvaluateBlock (uniform; evaluate.comp)
+#define CREP_CAMERA_DEPTH_DEFAULT_UNIT           1 // cameraDepth (evaluate.comp)
+#define CREP_TABLE_COEFFICIENTS_DEFAULT_BINDING  0 // CrepTableCoefficients (storage; scattering_prefix.comp)
+// crep::EvaluatePass's layouts and work lists (the defaults above take 1 of both kinds): set as
+// CREP_LAYOUT_BINDING, CREP_SLICES_BINDING and CREP_SAMPLE_LIST_BINDING
+#define CREP_EVALUATE_LAYOUT_BINDING       2 // CrepProjectiveLayoutBlock or CrepEpipolarLayoutBlock (uniform)
+#define CREP_EVALUATE_SLICES_BINDING       2 // the epipolar slice table (storage)
+#define CREP_EVALUATE_SAMPLE_LIST_BINDING  3 // CrepSampleListBlock (storage)
 // passes/pipeline/accumulate.comp
 #define CREP_ACCUMULATE_ACCUMULATED_IMAGE  0 // crep_accumulated
 #define CREP_ACCUMULATE_ADDEND_IMAGE       1 // crep_addend

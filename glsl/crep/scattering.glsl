@@ -74,6 +74,7 @@
 #ifndef CREP_SCATTERING_GLSL
 #define CREP_SCATTERING_GLSL
 
+#include "bindings.h"
 #include "common.glsl"
 #include "local_light.glsl"
 #include "phase.glsl"
@@ -87,7 +88,7 @@
 #define CREP_LOCAL_LIGHT 0
 #endif
 #ifndef CREP_LOCAL_LIGHT_BINDING
-#define CREP_LOCAL_LIGHT_BINDING 3
+#define CREP_LOCAL_LIGHT_BINDING CREP_LOCAL_LIGHT_DEFAULT_BINDING
 #endif
 #ifndef CREP_LOCAL_SECTIONS
 #define CREP_LOCAL_SECTIONS 0
@@ -340,13 +341,13 @@ float crep_regionWeightTotal(CrepRegionWeights w, int mode, float s, int n, floa
 // Evaluation (Listing 4 + Appendix A, regions as in crep::evaluate).
 
 #ifndef CREP_SCATTERING_BINDING
-#define CREP_SCATTERING_BINDING 0
+#define CREP_SCATTERING_BINDING CREP_SCATTERING_DEFAULT_BINDING
 #endif
 #ifndef CREP_FILTERED_BASIS_UNIT
-#define CREP_FILTERED_BASIS_UNIT 0
+#define CREP_FILTERED_BASIS_UNIT CREP_FILTERED_BASIS_DEFAULT_UNIT
 #endif
 #ifndef CREP_REGION_WEIGHTS_BINDING
-#define CREP_REGION_WEIGHTS_BINDING 1
+#define CREP_REGION_WEIGHTS_BINDING CREP_REGION_WEIGHTS_DEFAULT_BINDING
 #endif
 
 layout(std140, binding = CREP_SCATTERING_BINDING) uniform CrepScatteringBlock { CrepScatteringParams crep_scattering; };
@@ -356,7 +357,7 @@ layout(binding = CREP_FILTERED_BASIS_UNIT) uniform sampler2DArray crep_filteredB
 #endif
 #if CREP_LIGHT_TEXTURE
 #ifndef CREP_MEAN_COLOR_UNIT
-#define CREP_MEAN_COLOR_UNIT 2
+#define CREP_MEAN_COLOR_UNIT CREP_MEAN_COLOR_DEFAULT_UNIT
 #endif
 layout(binding = CREP_MEAN_COLOR_UNIT) uniform sampler2D crep_meanColor; // cbar, rgb
 #if CREP_NEAR_PLANE_CORRECTION
@@ -368,7 +369,7 @@ layout(binding = CREP_MEAN_COLOR_UNIT) uniform sampler2D crep_meanColor; // cbar
 #endif
 #ifdef CREP_VISIBILITY_TABLE_SAMPLES
 #ifndef CREP_VISIBILITY_TABLE_UNIT
-#define CREP_VISIBILITY_TABLE_UNIT 6
+#define CREP_VISIBILITY_TABLE_UNIT CREP_VISIBILITY_TABLE_DEFAULT_UNIT
 #endif
 layout(binding = CREP_VISIBILITY_TABLE_UNIT) uniform sampler2D crep_visibilityTable;
 #ifndef CREP_SCATTERING_PREFIX
@@ -376,12 +377,12 @@ layout(binding = CREP_VISIBILITY_TABLE_UNIT) uniform sampler2D crep_visibilityTa
 #endif
 #if CREP_SCATTERING_PREFIX
 #ifndef CREP_SCATTERING_PREFIX_UNIT
-#define CREP_SCATTERING_PREFIX_UNIT 7
+#define CREP_SCATTERING_PREFIX_UNIT CREP_SCATTERING_PREFIX_DEFAULT_UNIT
 #endif
 layout(binding = CREP_SCATTERING_PREFIX_UNIT) uniform sampler2D crep_scatteringPrefix;
 #if CREP_LOCAL_LIGHT && CREP_LOCAL_SECTIONS
 #ifndef CREP_LOCAL_SECTION_UNIT
-#define CREP_LOCAL_SECTION_UNIT 5
+#define CREP_LOCAL_SECTION_UNIT CREP_LOCAL_SECTION_DEFAULT_UNIT
 #endif
 layout(binding = CREP_LOCAL_SECTION_UNIT) uniform sampler2D crep_localSections;
 #endif

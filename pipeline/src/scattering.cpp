@@ -18,6 +18,8 @@
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -967,8 +969,9 @@ struct Scattering::Impl::LocalLightRun {
 
 void Scattering::Impl::addLocalScattering(const FrameAttribs& f) {
   glUseProgram(accumulate.get());
-  glBindImageTexture(0, f.output, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-  glBindImageTexture(1, localScattering.get(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+  glBindImageTexture(CREP_ACCUMULATE_ACCUMULATED_IMAGE, f.output, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+  glBindImageTexture(CREP_ACCUMULATE_ADDEND_IMAGE, localScattering.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
+                     GL_RGBA32F);
   glDispatchCompute(static_cast<GLuint>((info.width + 7) / 8), static_cast<GLuint>((info.height + 7) / 8), 1);
   gl::passOutputBarrier();
   gl::unbindPassState(2);

@@ -11,6 +11,8 @@
 #include <crep/scatter/airlight.h>
 #include <crep/scatter/gpu_world_march.h>
 
+#include "crep/bindings.h"
+
 #include <epoxy/gl.h>
 
 #include <algorithm>
@@ -31,29 +33,9 @@ static_assert(gpu::kMaxSplits == RectifyOptions::kMaxSplits, "CREP_MAX_SPLITS");
 
 namespace {
 
-// Binding points (see gpu_pass.h and the shaders' defaults).
-constexpr GLuint kScatteringBinding = 0, kEvaluateBinding = 1, kRegionWeightsEvalBinding = 1;
-constexpr GLuint kBasisUnit = 0, kCameraDepthUnit = 1;
-/// The region visibility table: its texture unit in the evaluation (CREP_VISIBILITY_TABLE_UNIT's default)
-/// and the basis's unit in the table pass.
-constexpr GLuint kTableUnit = 6, kTableBasisUnit = 0, kTableCoefficientsBinding = 0;
-/// The scattering prefix table's unit in the evaluation (CREP_SCATTERING_PREFIX_UNIT's default).
-constexpr GLuint kPrefixUnit = 7;
-// Layouts other than projective: their block (gpu::LayoutBuffers) next to the scattering and evaluate blocks.
-constexpr GLuint kLayoutBinding = 2, kLayoutRowsBinding = 2;
-// The local-light block (CREP_LOCAL_LIGHT) of the evaluation and scattering prefix programs.
-constexpr GLuint kLocalLightBinding = 3;
-// The airlight table of the local-light programs (crep/airlight.glsl, crep::makeAirlightTable).
-constexpr GLuint kAirlightUnit = 4;
-// The local section table (EvaluateOptions::localSectionTable): image 1 of the prefix pass, unit 5 of the
-// evaluation.
-constexpr GLuint kLocalSectionUnit = 5, kLocalSectionImage = 1;
-// Work lists (EvaluatePass::FrameAttribs::list): the list's storage buffer binding (0 table coefficients,
-// 1 region weights, 2 layout rows).
-constexpr GLuint kSampleListBinding = 3;
-// Light textures (CREP_LIGHT_TEXTURE): the prefix mean colour in the evaluation and scattering prefix
-// programs.
-constexpr GLuint kMeanColorUnit = 2;
+// Binding points: the names of crep/bindings.h (the evaluation's defaults; layouts and work lists at
+// CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING and CREP_EVALUATE_SAMPLE_LIST_BINDING, injected
+// as defines).
 
 std::string str(long long v) {
   return std::to_string(v);
@@ -485,37 +467,39 @@ void PrefilterPass::dispatch(const FrameAttribs& frame, const Plan& p, std::size
                : local  ? programLocal_.get()
                         : program_.get());
   if (textured) {
-    glBindTextureUnit(1, frame.lightColors);
-    glBindSampler(1, sampler_.get());
-    glBindImageTexture(1, meanColor_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindTextureUnit(CREP_PREFILTER_LIGHT_COLORS_UNIT, frame.lightColors);
+    glBindSampler(CREP_PREFILTER_LIGHT_COLORS_UNIT, sampler_.get());
+    glBindImageTexture(CREP_PREFILTER_MEAN_COLOR_OUT_IMAGE, meanColor_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                       GL_RGBA32F);
   }
   if (local) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, 1, localBuffer_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, raysBuffer_.get());
+    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_LOCAL_LIGHT_BINDING, localBuffer_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_RAYS_BINDING, raysBuffer_.get());
   }
-  glBindTextureUnit(0, frame.rectifiedDepth);
-  glBindSampler(0, sampler_.get());
-  glBindImageTexture(0, textured ? texturedTexture_.get() : texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
+  glBindTextureUnit(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, frame.rectifiedDepth);
+  glBindSampler(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, sampler_.get());
+  glBindImageTexture(CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE,
+                     textured ? texturedTexture_.get() : texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
                      internalFormat(info_.options.format));
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, paramsBuffer_.get());
-  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, weightsBuffer_.get(), 0,
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_PARAMS_BINDING, paramsBuffer_.get());
+  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_WEIGHTS_BINDING, weightsBuffer_.get(), 0,
                     static_cast<GLsizeiptr>(weightBytes));
   glDispatchCompute(static_cast<GLuint>(ceilDiv(info_.mapHeight, info_.workgroupRows)),
                     static_cast<GLuint>(ceilDiv(baseGroups(info_, local), info_.workgroupBaseGroups)),
                     static_cast<GLuint>(ceilDiv(p.R, info_.workgroupRegions)));
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 0, 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, 1, 0);
-  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-  glBindSampler(0, 0);
-  glBindTextureUnit(0, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_WEIGHTS_BINDING, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_PARAMS_BINDING, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_RAYS_BINDING, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_LOCAL_LIGHT_BINDING, 0);
+  glBindImageTexture(CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+  glBindSampler(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, 0);
+  glBindTextureUnit(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, 0);
   if (textured) {
-    glBindImageTexture(1, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    glBindSampler(1, 0);
-    glBindTextureUnit(1, 0);
+    glBindImageTexture(CREP_PREFILTER_MEAN_COLOR_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    glBindSampler(CREP_PREFILTER_LIGHT_COLORS_UNIT, 0);
+    glBindTextureUnit(CREP_PREFILTER_LIGHT_COLORS_UNIT, 0);
   }
   glUseProgram(0);
   gl::checkError("PrefilterPass::run");
@@ -549,12 +533,13 @@ namespace {
 void addLayoutDefines(std::vector<ShaderDefine>& defines, int layoutKind) {
   if (layoutKind < 0) return;
   defines.push_back({"CREP_EVAL_LAYOUT", str(layoutKind)});
-  defines.push_back({"CREP_LAYOUT_BINDING", str(kLayoutBinding)});
-  defines.push_back({"CREP_SLICES_BINDING", str(kLayoutRowsBinding)});
+  defines.push_back({"CREP_LAYOUT_BINDING", str(CREP_EVALUATE_LAYOUT_BINDING)});
+  defines.push_back({"CREP_SLICES_BINDING", str(CREP_EVALUATE_SLICES_BINDING)});
 }
 
 /// The evaluation program's stages: projective frame of the scattering block (layoutKind < 0), or the
-/// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at kLayoutBinding / kLayoutRowsBinding.
+/// layout block of kind `layoutKind` (CREP_EVAL_LAYOUT) at CREP_EVALUATE_LAYOUT_BINDING /
+/// CREP_EVALUATE_SLICES_BINDING.
 std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& info, int layoutKind,
                                               bool local = false, bool textured = false, bool froxels = false,
                                               bool list = false) {
@@ -575,20 +560,16 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
   addLayoutDefines(stages[0].defines, layoutKind);
   if (local) {
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
-    stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
     stages[0].defines.push_back({"CREP_AIRLIGHT", info.localClosedForm ? "1" : "0"});
-    stages[0].defines.push_back({"CREP_AIRLIGHT_UNIT", str(kAirlightUnit)});
     stages[0].defines.push_back({"CREP_LOCAL_SECTIONS", usesLocalSectionTable(info.options) ? "1" : "0"});
-    stages[0].defines.push_back({"CREP_LOCAL_SECTION_UNIT", str(kLocalSectionUnit)});
   }
   if (textured) {
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
-    stages[0].defines.push_back({"CREP_MEAN_COLOR_UNIT", str(kMeanColorUnit)});
   }
   if (froxels) stages[0].defines.push_back({"CREP_FROXELS", "1"});
   if (list) {
     stages[0].defines.push_back({"CREP_SAMPLE_LIST", "1"});
-    stages[0].defines.push_back({"CREP_SAMPLE_LIST_BINDING", str(kSampleListBinding)});
+    stages[0].defines.push_back({"CREP_SAMPLE_LIST_BINDING", str(CREP_EVALUATE_SAMPLE_LIST_BINDING)});
   }
   return stages;
 }
@@ -602,21 +583,16 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
        "passes/prefilter/scattering_prefix.comp",
        {{"CREP_BASES", str(info.bases)},
         {"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
-        {"CREP_TABLE_COEFFICIENTS_BINDING", str(kTableCoefficientsBinding)},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   addLayoutDefines(stages[0].defines, layoutKind);
   if (local) {
     stages[0].defines.push_back({"CREP_LOCAL_LIGHT", "1"});
-    stages[0].defines.push_back({"CREP_LOCAL_LIGHT_BINDING", str(kLocalLightBinding)});
     stages[0].defines.push_back({"CREP_AIRLIGHT", info.localClosedForm ? "1" : "0"});
-    stages[0].defines.push_back({"CREP_AIRLIGHT_UNIT", str(kAirlightUnit)});
     stages[0].defines.push_back({"CREP_LOCAL_SECTIONS", usesLocalSectionTable(info.options) ? "1" : "0"});
-    stages[0].defines.push_back({"CREP_LOCAL_SECTION_UNIT", str(kLocalSectionUnit)});
   }
   if (textured) {
     stages[0].defines.push_back({"CREP_LIGHT_TEXTURE", "1"});
     stages[0].defines.push_back({"CREP_SCATTERING_PREFIX", "1"}); // the table this program builds
-    stages[0].defines.push_back({"CREP_MEAN_COLOR_UNIT", str(kMeanColorUnit)});
   }
   return stages;
 }
@@ -875,15 +851,17 @@ void EvaluatePass::run(const FrameAttribs& frame) {
   if (p.table && !p.reuse) buildTable(frame.basis, p);
   bindEvaluation(frame, p, program);
   if (p.pixels) {
-    glBindImageTexture(0, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, internalFormat(info_.outputFormat));
+    glBindImageTexture(CREP_EVALUATE_SCATTERING_OUT_IMAGE, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                       internalFormat(info_.outputFormat));
     glDispatchCompute(static_cast<GLuint>(ceilDiv(p.imageWidth, info_.workgroupWidth)),
                       static_cast<GLuint>(ceilDiv(p.imageHeight, info_.workgroupHeight)), 1);
   }
   if (p.list) { // one invocation per entry, groups of 64 (gpu::kSampleListGroupSize)
-    glBindImageTexture(0, p.list->output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, p.list->buffer);
+    glBindImageTexture(CREP_EVALUATE_SCATTERING_OUT_IMAGE, p.list->output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                       GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EVALUATE_SAMPLE_LIST_BINDING, p.list->buffer);
     gpu::dispatchSampleList(p.list->buffer);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kSampleListBinding, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EVALUATE_SAMPLE_LIST_BINDING, 0);
   }
   if (p.froxels) dispatchFroxels(frame, p, params);
   unbindEvaluation(p);
@@ -895,7 +873,7 @@ void EvaluatePass::uploadLocalLight(const FrameAttribs& frame) {
   const gpu::LocalLightParams lp = localLightParams(
       *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
   glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
-  glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, localBuffer_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_LOCAL_LIGHT_DEFAULT_BINDING, localBuffer_.get());
   // The airlight table of the medium's g (made on the CPU in double, a few ms, when g changes).
   if (info_.localClosedForm && (!airlightTable_ || airlightG_ != frame.medium->hgG())) {
     const AirlightTable t = makeAirlightTable(frame.medium->hgG());
@@ -906,8 +884,8 @@ void EvaluatePass::uploadLocalLight(const FrameAttribs& frame) {
     airlightG_ = frame.medium->hgG();
   }
   if (info_.localClosedForm) {
-    glBindTextureUnit(kAirlightUnit, airlightTable_.get());
-    glBindSampler(kAirlightUnit, airlightSampler_.get());
+    glBindTextureUnit(CREP_AIRLIGHT_DEFAULT_UNIT, airlightTable_.get());
+    glBindSampler(CREP_AIRLIGHT_DEFAULT_UNIT, airlightSampler_.get());
   }
 }
 
@@ -972,11 +950,17 @@ void EvaluatePass::buildTable(const FilteredBasisView& basis, const Plan& p) {
     tableHeight_ = basis.height;
   }
   if (!tableCoefficients_ || tableMargin_ != basis.depthMargin) uploadTableCoefficients(basis.depthMargin);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, tableCoefficients_.get());
-  glBindTextureUnit(kTableBasisUnit, basis.texture);
+  // The prefix program reads the basis and coefficients through crep/scattering.glsl's names, the table
+  // program through its own (the same numbers).
+  const GLuint coefficients =
+      p.prefix ? CREP_TABLE_COEFFICIENTS_DEFAULT_BINDING : CREP_VISIBILITY_TABLE_TABLE_COEFFICIENTS_BINDING;
+  const GLuint basisUnit = p.prefix ? CREP_FILTERED_BASIS_DEFAULT_UNIT : CREP_VISIBILITY_TABLE_BASIS_UNIT;
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, coefficients, tableCoefficients_.get());
+  glBindTextureUnit(basisUnit, basis.texture);
   if (p.textured)
-    glBindTextureUnit(kMeanColorUnit, basis.meanColor); // texelFetch at the regions' last texels
-  glBindSampler(kTableBasisUnit, depthSampler_.get());  // nearest, clamped: texelFetch ignores it anyway
+    glBindTextureUnit(CREP_MEAN_COLOR_DEFAULT_UNIT,
+                      basis.meanColor);          // texelFetch at the regions' last texels
+  glBindSampler(basisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
   if (p.prefix) {
     // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
     gl::Handle& prefixProgram = p.textured ? texturedPrefixPrograms_[p.variantIndex]
@@ -984,24 +968,28 @@ void EvaluatePass::buildTable(const FilteredBasisView& basis, const Plan& p) {
                                            : prefixPrograms_[p.layoutSlot];
     if (!prefixProgram) prefixProgram = buildProgram(prefixStages(info_, p.layoutKind, p.local, p.textured));
     glUseProgram(prefixProgram.get());
-    if (!p.projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
-    glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
-    glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    if (!p.projective) layoutBuffers_.bind(CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
+    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_SCATTERING_DEFAULT_BINDING, scatteringBuffer_.get());
+    glBindImageTexture(CREP_SCATTERING_PREFIX_PREFIX_OUT_IMAGE, tableTexture_.get(), 0, GL_FALSE, 0,
+                       GL_WRITE_ONLY, GL_RGBA32F);
     if (sections)
-      glBindImageTexture(kLocalSectionImage, sectionTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                         GL_RGBA32F);
+      glBindImageTexture(CREP_SCATTERING_PREFIX_SECTION_OUT_IMAGE, sectionTexture_.get(), 0, GL_FALSE, 0,
+                         GL_WRITE_ONLY, GL_RGBA32F);
     glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height), 1);
-    if (sections) glBindImageTexture(kLocalSectionImage, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    if (sections)
+      glBindImageTexture(CREP_SCATTERING_PREFIX_SECTION_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                         GL_RGBA32F);
   } else {
     glUseProgram(tableProgram_.get());
     glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
-    glBindImageTexture(0, tableTexture_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindImageTexture(CREP_VISIBILITY_TABLE_TABLE_OUT_IMAGE, tableTexture_.get(), 0, GL_FALSE, 0,
+                       GL_WRITE_ONLY, GL_R32F);
     glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
   }
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTableCoefficientsBinding, 0);
-  glBindSampler(kTableBasisUnit, 0);
-  glBindTextureUnit(kTableBasisUnit, 0);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, coefficients, 0);
+  glBindSampler(basisUnit, 0);
+  glBindTextureUnit(basisUnit, 0);
   tableBasis_ = basis.texture;
   tableVariant_ = p.variantIndex + 6 * int(p.textured);
 }
@@ -1009,28 +997,29 @@ void EvaluatePass::buildTable(const FilteredBasisView& basis, const Plan& p) {
 void EvaluatePass::bindEvaluation(const FrameAttribs& frame, const Plan& p, GLuint program) {
   const FilteredBasisView& basis = frame.basis;
   if (p.table) {
-    const GLuint unit = p.prefix ? kPrefixUnit : kTableUnit;
+    const GLuint unit = p.prefix ? CREP_SCATTERING_PREFIX_DEFAULT_UNIT : CREP_VISIBILITY_TABLE_DEFAULT_UNIT;
     glBindTextureUnit(unit, tableTexture_.get());
     glBindSampler(unit, tableSampler_.get());
     if (p.local && usesLocalSectionTable(info_.options)) {
-      glBindTextureUnit(kLocalSectionUnit, sectionTexture_.get());
-      glBindSampler(kLocalSectionUnit, tableSampler_.get());
+      glBindTextureUnit(CREP_LOCAL_SECTION_DEFAULT_UNIT, sectionTexture_.get());
+      glBindSampler(CREP_LOCAL_SECTION_DEFAULT_UNIT, tableSampler_.get());
     }
   }
   glUseProgram(program);
-  if (!p.projective) layoutBuffers_.bind(kLayoutBinding, kLayoutRowsBinding);
-  glBindTextureUnit(kBasisUnit, basis.texture);
-  glBindSampler(kBasisUnit, basisSampler_.get());
-  glBindTextureUnit(kCameraDepthUnit, p.list ? p.list->coordinates : frame.cameraDepth);
-  glBindSampler(kCameraDepthUnit, depthSampler_.get());
+  if (!p.projective) layoutBuffers_.bind(CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
+  glBindTextureUnit(CREP_FILTERED_BASIS_DEFAULT_UNIT, basis.texture);
+  glBindSampler(CREP_FILTERED_BASIS_DEFAULT_UNIT, basisSampler_.get());
+  glBindTextureUnit(CREP_CAMERA_DEPTH_DEFAULT_UNIT, p.list ? p.list->coordinates : frame.cameraDepth);
+  glBindSampler(CREP_CAMERA_DEPTH_DEFAULT_UNIT, depthSampler_.get());
   if (p.textured) {
-    glBindTextureUnit(kMeanColorUnit, basis.meanColor);
-    glBindSampler(kMeanColorUnit, basisSampler_.get()); // sampled as the basis is (EvaluateOptions::sampling)
+    glBindTextureUnit(CREP_MEAN_COLOR_DEFAULT_UNIT, basis.meanColor);
+    glBindSampler(CREP_MEAN_COLOR_DEFAULT_UNIT,
+                  basisSampler_.get()); // sampled as the basis is (EvaluateOptions::sampling)
   }
-  glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, scatteringBuffer_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, evaluateBuffer_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_SCATTERING_DEFAULT_BINDING, scatteringBuffer_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EVALUATE_DEFAULT_BINDING, evaluateBuffer_.get());
   if (info_.options.nearPlaneCorrection)
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, basis.regionWeights);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_REGION_WEIGHTS_DEFAULT_BINDING, basis.regionWeights);
 }
 
 void EvaluatePass::dispatchFroxels(const FrameAttribs& frame, const Plan& p, gpu::EvaluateParams params) {
@@ -1047,7 +1036,8 @@ void EvaluatePass::dispatchFroxels(const FrameAttribs& frame, const Plan& p, gpu
   glProgramUniform2f(variant.get(), 1, static_cast<float>(p.froxelRange.near),
                      static_cast<float>(p.froxelRange.far));
   glUseProgram(variant.get());
-  glBindImageTexture(0, frame.froxels.volume, 0, GL_TRUE, 0, GL_WRITE_ONLY, p.volumeFormat);
+  glBindImageTexture(CREP_EVALUATE_FROXELS_OUT_IMAGE, frame.froxels.volume, 0, GL_TRUE, 0, GL_WRITE_ONLY,
+                     p.volumeFormat);
   glDispatchCompute(static_cast<GLuint>(ceilDiv(g.width, info_.workgroupWidth)),
                     static_cast<GLuint>(ceilDiv(g.height, info_.workgroupHeight)),
                     static_cast<GLuint>(g.depth));
@@ -1057,34 +1047,34 @@ void EvaluatePass::unbindEvaluation(const Plan& p) {
   glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                   GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
   if (info_.options.nearPlaneCorrection)
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kRegionWeightsEvalBinding, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, kEvaluateBinding, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, kScatteringBinding, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_REGION_WEIGHTS_DEFAULT_BINDING, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EVALUATE_DEFAULT_BINDING, 0);
+  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_SCATTERING_DEFAULT_BINDING, 0);
   if (p.local) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, kLocalLightBinding, 0);
-    glBindSampler(kAirlightUnit, 0);
-    glBindTextureUnit(kAirlightUnit, 0);
-    glBindSampler(kLocalSectionUnit, 0);
-    glBindTextureUnit(kLocalSectionUnit, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_LOCAL_LIGHT_DEFAULT_BINDING, 0);
+    glBindSampler(CREP_AIRLIGHT_DEFAULT_UNIT, 0);
+    glBindTextureUnit(CREP_AIRLIGHT_DEFAULT_UNIT, 0);
+    glBindSampler(CREP_LOCAL_SECTION_DEFAULT_UNIT, 0);
+    glBindTextureUnit(CREP_LOCAL_SECTION_DEFAULT_UNIT, 0);
   }
   if (!p.projective) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, kLayoutBinding, 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kLayoutRowsBinding, 0);
+    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EVALUATE_LAYOUT_BINDING, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EVALUATE_SLICES_BINDING, 0);
   }
-  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-  glBindSampler(kCameraDepthUnit, 0);
-  glBindTextureUnit(kCameraDepthUnit, 0);
-  glBindSampler(kBasisUnit, 0);
-  glBindTextureUnit(kBasisUnit, 0);
+  glBindImageTexture(CREP_EVALUATE_SCATTERING_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+  glBindSampler(CREP_CAMERA_DEPTH_DEFAULT_UNIT, 0);
+  glBindTextureUnit(CREP_CAMERA_DEPTH_DEFAULT_UNIT, 0);
+  glBindSampler(CREP_FILTERED_BASIS_DEFAULT_UNIT, 0);
+  glBindTextureUnit(CREP_FILTERED_BASIS_DEFAULT_UNIT, 0);
   if (p.textured) {
-    glBindSampler(kMeanColorUnit, 0);
-    glBindTextureUnit(kMeanColorUnit, 0);
+    glBindSampler(CREP_MEAN_COLOR_DEFAULT_UNIT, 0);
+    glBindTextureUnit(CREP_MEAN_COLOR_DEFAULT_UNIT, 0);
   }
   if (p.table) {
-    glBindSampler(kTableUnit, 0);
-    glBindTextureUnit(kTableUnit, 0);
-    glBindSampler(kPrefixUnit, 0);
-    glBindTextureUnit(kPrefixUnit, 0);
+    glBindSampler(CREP_VISIBILITY_TABLE_DEFAULT_UNIT, 0);
+    glBindTextureUnit(CREP_VISIBILITY_TABLE_DEFAULT_UNIT, 0);
+    glBindSampler(CREP_SCATTERING_PREFIX_DEFAULT_UNIT, 0);
+    glBindTextureUnit(CREP_SCATTERING_PREFIX_DEFAULT_UNIT, 0);
   }
   glUseProgram(0);
 }

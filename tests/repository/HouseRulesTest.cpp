@@ -2,7 +2,7 @@
 // that is a front page, public headers that are contracts (comment lines at most half the code lines, no
 // measured figures: those live in docs/ and the module READMEs beside their commands), no function of the
 // library, the tool or the benchmarks longer than 120 lines, and binding points named (crep/bindings.h)
-// rather than written as numbers in the shaders.
+// rather than written as numbers in the shaders or in the library's host code that binds them.
 #include <doctest/doctest.h>
 
 #include "common/source_tree.h"
@@ -276,4 +276,29 @@ TEST_CASE("binding points are named once: no literal binding numbers in the shad
   CAPTURE(where);
   CHECK(library == 0);
   CHECK(library + tool <= 20);
+}
+
+TEST_CASE("binding points are named once: the library's host code binds by the names of crep/bindings.h") {
+  // glBind{BufferBase,BufferRange,TextureUnit,ImageTexture,Sampler} and LayoutBuffers::bind with a literal
+  // binding point repeat a number the shader names; the probe line shows the pattern matches one.
+  static const std::regex literal(
+      R"((glBind(BufferBase|BufferRange|TextureUnit|ImageTexture|Sampler)\((GL_[A-Z_]+,\s*)?|\.bind\()[0-9]+\s*[,)])");
+  REQUIRE(std::regex_search(std::string("  glBindBufferBase(GL_UNIFORM_BUFFER, 2, buffer);"), literal));
+  REQUIRE(std::regex_search(std::string("  glBindTextureUnit(0, texture);"), literal));
+  REQUIRE_FALSE(
+      std::regex_search(std::string("  glBindTextureUnit(CREP_MARCH_MAP_UNIT, texture);"), literal));
+  int count = 0;
+  std::string where;
+  for (const auto& m : kLibraryModules)
+    for (const auto& f : filesUnder(kRoot / m / "src", {".cpp", ".h"})) {
+      int n = 0;
+      for (const auto& l : lines(readSourceFile(f))) {
+        ++n;
+        if (trim(l).rfind("//", 0) == 0 || !std::regex_search(l, literal)) continue;
+        ++count;
+        where += "\n  " + fs::relative(f, kRoot).string() + ":" + std::to_string(n);
+      }
+    }
+  CAPTURE(where);
+  CHECK(count == 0);
 }

@@ -17,10 +17,10 @@
 #define CREP_LOCAL_SIZE_Y 8
 #endif
 #ifndef CREP_EVALUATE_BINDING
-#define CREP_EVALUATE_BINDING 1 // uniform buffer binding of CrepEvaluateBlock
+#define CREP_EVALUATE_BINDING CREP_EVALUATE_DEFAULT_BINDING // uniform buffer binding of CrepEvaluateBlock
 #endif
 #ifndef CREP_CAMERA_DEPTH_UNIT
-#define CREP_CAMERA_DEPTH_UNIT 1
+#define CREP_CAMERA_DEPTH_UNIT CREP_CAMERA_DEPTH_DEFAULT_UNIT
 #endif
 #ifndef CREP_MEMORY_LIMIT
 #define CREP_MEMORY_LIMIT 0 // 1: benchmark variant, the same fetches and store without the math

@@ -33,7 +33,7 @@
 #define CREP_MEMORY_LIMIT 0 // 1: benchmark variant, the same fetches and stores without the math
 #endif
 #ifndef CREP_TABLE_COEFFICIENTS_BINDING
-#define CREP_TABLE_COEFFICIENTS_BINDING 0
+#define CREP_TABLE_COEFFICIENTS_BINDING CREP_TABLE_COEFFICIENTS_DEFAULT_BINDING
 #endif
 #include "crep/scattering.glsl"
 #if CREP_LIGHT_TEXTURE && CREP_MEMORY_LIMIT
