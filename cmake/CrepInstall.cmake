@@ -13,8 +13,10 @@ endforeach()
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/support/include/crep DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/generated/include/crep/core/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/crep/core)
-# Public GLSL includes an engine can #include in its own shaders.
-install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/glsl/crep DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/glsl)
+# Public GLSL includes an engine can #include in its own shaders, and the passes' GLSL for an engine that
+# runs them with its own host code (the portable SPIR-V, HLSL and MSL: CrepPortableShaders.cmake).
+install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/glsl/crep ${CMAKE_CURRENT_SOURCE_DIR}/glsl/passes
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/glsl)
 
 set(CREP_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular)
 foreach(component runtime support)

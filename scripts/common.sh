@@ -10,6 +10,7 @@ CREP_PACKAGES=(
   libglm-dev libeigen3-dev libopenexr-dev doctest-dev libstb-dev
   libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   glslang-tools nlohmann-json3-dev zlib1g-dev
+  glslc spirv-tools spirv-cross
 )
 
 crep_install_packages() {

@@ -457,6 +457,37 @@ std::string ExpandedShader::translateLog(std::string_view log) const {
   return out;
 }
 
+namespace {
+struct VariantLog {
+  std::mutex mutex;
+  std::vector<ShaderStageSource> variants;
+};
+VariantLog& variantLog() {
+  static VariantLog log;
+  return log;
+}
+bool sameVariant(const ShaderStageSource& a, const ShaderStageSource& b) {
+  return a.stage == b.stage && a.path == b.path &&
+         std::equal(a.defines.begin(), a.defines.end(), b.defines.begin(), b.defines.end(),
+                    [](const ShaderDefine& x, const ShaderDefine& y) {
+                      return x.name == y.name && x.value == y.value;
+                    });
+}
+void recordVariant(const ShaderStageSource& stage) {
+  VariantLog& log = variantLog();
+  const std::lock_guard lock(log.mutex);
+  for (const ShaderStageSource& v : log.variants)
+    if (sameVariant(v, stage)) return;
+  log.variants.push_back(stage);
+}
+} // namespace
+
+std::vector<ShaderStageSource> programVariantsBuilt() {
+  VariantLog& log = variantLog();
+  const std::lock_guard lock(log.mutex);
+  return log.variants;
+}
+
 gl::Handle buildProgram(std::initializer_list<ShaderStageSource> stages) {
   return buildProgram(std::span<const ShaderStageSource>(stages.begin(), stages.size()));
 }
@@ -487,6 +518,7 @@ gl::Handle buildProgram(std::span<const ShaderStageSource> stages) {
     }
     paths += (paths.empty() ? "" : ", ") + quoted(stage.path);
     shaders.push_back(std::move(shader));
+    recordVariant(stage);
   }
 
   gl::Handle program(gl::ObjectType::Program, glCreateProgram());

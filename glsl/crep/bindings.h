@@ -7,6 +7,13 @@
 // kinds may share a number (GL has separate binding spaces per kind).
 #ifndef CREP_BINDINGS_H
 #define CREP_BINDINGS_H
+// Vulkan, and the HLSL and MSL made from its SPIR-V (share/crepuscular/shaders, docs/PORTABLE_SHADERS.md):
+// one descriptor set (0); a resource's binding is its number below plus the base of its kind, so GL's
+// separate binding spaces stay apart. The numbers below stay under the next base.
+#define CREP_VULKAN_UNIT_BASE     0  // combined image samplers (GL texture units)
+#define CREP_VULKAN_IMAGE_BASE    16 // storage images (GL image units)
+#define CREP_VULKAN_UNIFORM_BASE  24 // uniform blocks
+#define CREP_VULKAN_STORAGE_BASE  32 // storage blocks
 
 // crep/layout.glsl: the layout block and the epipolar slice table, unless a pass sets CREP_LAYOUT_BINDING /
 // CREP_SLICES_BINDING (crep::LayoutBuffers::bind takes the same two numbers)

@@ -1,22 +1,20 @@
 // The shader library without GL: embedded files, include expansion, #line bookkeeping, log
 // translation, and every shader of the library through glslangValidator (the Khronos reference
 // front end), which catches what one driver would accept and another reject.
+#include "common/shader_tools.h"
+
 #include <crep/core/error.h>
 #include <crep/core/shader_library.h>
 
 #include <doctest/doctest.h>
 
 #include <algorithm>
-#include <array>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 using crep::ExpandedShader;
@@ -44,36 +42,8 @@ bool isLibraryFile(std::string_view path) {
   return !path.starts_with("test/");
 }
 
-std::optional<std::filesystem::path> findInPath(const char* program) {
-  const char* pathEnv = std::getenv("PATH");
-  std::string_view rest = pathEnv != nullptr ? pathEnv : "";
-  while (!rest.empty()) {
-    const std::size_t colon = rest.find(':');
-    const std::filesystem::path candidate = std::filesystem::path(rest.substr(0, colon)) / program;
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
-    if (colon == std::string_view::npos) break;
-    rest.remove_prefix(colon + 1);
-  }
-  return std::nullopt;
-}
-
-struct RunResult {
-  int exitCode = -1;
-  std::string output;
-};
-
-RunResult run(const std::string& command) {
-  RunResult result;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  REQUIRE_MESSAGE(pipe != nullptr, "cannot run " << command);
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    result.output.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using crep::test::findInPath;
+using crep::test::RunResult;
 
 /// Writes `text` to the test output folder with the stage's extension and runs glslangValidator on
 /// it (plain validation: OpenGL GLSL semantics, no SPIR-V written).
@@ -96,7 +66,8 @@ RunResult glslang(const std::string& name, const std::string& extension, const s
                                      flags.find("-H") != std::string::npos
                                  ? " -o '" + file.string() + ".spv'"
                                  : "";
-  return run("'" + validator->string() + "' " + flags + output + " '" + file.string() + "'");
+  return crep::test::runCommand("'" + validator->string() + "' " + flags + output + " '" + file.string() +
+                                "'");
 }
 
 } // namespace

@@ -24,7 +24,12 @@ layout(local_size_x = 64) in;
 
 layout(binding = CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT) uniform sampler2D rectifiedDepth;
 layout(std430, binding = CREP_MIN_MAX_TREE_MIN_MAX_BINDING) buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepMinMaxBuildPush { ivec4 sizes; };
+#else
 layout(location = 0) uniform ivec4 sizes;
+#endif
 
 // Node m of level l from level l - 1 (size `below`, at offset offBelow) or, for l = 1, from the texels.
 vec2 crep_buildNode(int l, int m, int j, int base, int below, int offBelow) {

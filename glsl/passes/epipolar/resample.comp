@@ -28,7 +28,9 @@
 #if CREP_RESAMPLE_TREES
 layout(local_size_x = 64) in;
 layout(std430, binding = CREP_RESAMPLE_MIN_MAX_BINDING) buffer CrepMinMaxBlock { vec2 crep_minMax[]; };
+#ifndef VULKAN
 layout(location = 2) uniform ivec4 treeInfo; // L, row stride, C, 0
+#endif
 #else
 layout(local_size_x = 8, local_size_y = 8) in;
 #endif
@@ -36,8 +38,19 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, binding = CREP_RESAMPLE_MARCH_BINDING) uniform CrepMarchBlock { CrepMarchParams crep_march; };
 layout(binding = CREP_RESAMPLE_SHADOW_MAP_UNIT) uniform sampler2D shadowMap;
 layout(binding = CREP_RESAMPLE_RECTIFIED_OUT_IMAGE, r32f) uniform writeonly image2D rectifiedOut;
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepResamplePush {
+  mat4 worldFromLightClip;
+  float projectedDistance;
+#if CREP_RESAMPLE_TREES
+  layout(offset = 80) ivec4 treeInfo; // L, row stride, C, 0
+#endif
+};
+#else
 layout(location = 0) uniform mat4 worldFromLightClip;
 layout(location = 1) uniform float projectedDistance;
+#endif
 
 // The resampled depth of one texel of the rectified map (written to the output by the caller).
 float crep_resampleTexel(ivec2 texel, ivec2 mapSize) {

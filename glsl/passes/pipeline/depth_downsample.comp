@@ -9,7 +9,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT) uniform sampler2D crep_fullDepth;
 layout(binding = CREP_DEPTH_DOWNSAMPLE_LOW_DEPTH_IMAGE, r32f) uniform writeonly restrict image2D crep_lowDepth;
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepDepthDownsamplePush { ivec2 crep_lowSize; };
+#else
 layout(location = 0) uniform ivec2 crep_lowSize;
+#endif
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);

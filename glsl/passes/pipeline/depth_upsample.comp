@@ -15,8 +15,16 @@ layout(binding = CREP_DEPTH_UPSAMPLE_LOW_UNIT) uniform sampler2D crep_low;      
 layout(binding = CREP_DEPTH_UPSAMPLE_LOW_DEPTH_UNIT) uniform sampler2D crep_lowDepth;  // R32F, low size
 layout(binding = CREP_DEPTH_UPSAMPLE_FULL_DEPTH_UNIT) uniform sampler2D crep_fullDepth; // full size
 layout(binding = CREP_DEPTH_UPSAMPLE_OUTPUT_IMAGE, rgba32f) uniform writeonly restrict image2D crep_output;
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepDepthUpsamplePush {
+  ivec4 crep_sizes;
+  vec4 crep_cameraDepthMap;
+};
+#else
 layout(location = 0) uniform ivec4 crep_sizes;        // full width, height, low width, height
 layout(location = 1) uniform vec4 crep_cameraDepthMap; // crep_cameraViewDepth's map of the camera
+#endif
 
 
 void main() {

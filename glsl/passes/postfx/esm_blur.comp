@@ -10,7 +10,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std140, binding = CREP_ESM_FROXEL_BINDING) uniform CrepFroxelBlock { CrepFroxelParams crep_froxel; };
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepEsmBlurPush { int crep_direction; };
+#else
 layout(location = 0) uniform int crep_direction;
+#endif
 layout(binding = CREP_ESM_IN_UNIT) uniform sampler2D esmIn;
 layout(binding = CREP_ESM_OUT_IMAGE, r32f) uniform writeonly image2D esmOut;
 

@@ -48,8 +48,16 @@ layout(std140, binding = CREP_EVALUATE_BINDING) uniform CrepEvaluateBlock { Crep
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y, local_size_z = 1) in;
 // RGBA16F or RGBA32F: a writeonly image needs no format qualifier (GLSL 4.50), so one program serves both.
 layout(binding = CREP_EVALUATE_FROXELS_OUT_IMAGE) uniform writeonly restrict image3D crep_froxelsOut;
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepEvaluateFroxelsPush {
+  vec4 crep_froxelJitter;
+  vec2 crep_froxelRange;
+};
+#else
 layout(location = 0) uniform vec4 crep_froxelJitter; // xyz: the sample's offset in cells
 layout(location = 1) uniform vec2 crep_froxelRange;  // the volume's (near, far) view depth (FroxelDepthRange)
+#endif
 #elif CREP_SAMPLE_LIST
 #include "crep/sample_list.glsl"
 layout(local_size_x = CREP_SAMPLE_LIST_GROUP_SIZE) in;

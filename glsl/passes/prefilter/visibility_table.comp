@@ -28,7 +28,12 @@ layout(binding = CREP_VISIBILITY_TABLE_BASIS_UNIT) uniform sampler2DArray crep_b
 layout(binding = CREP_VISIBILITY_TABLE_TABLE_OUT_IMAGE, r32f) uniform writeonly restrict image2D crep_tableOut; // width R Z, height H
 // a(z_s) of sample s, layer l at index s * layers + l (Eq. 8 order, zero beyond M).
 layout(std430, binding = CREP_VISIBILITY_TABLE_TABLE_COEFFICIENTS_BINDING) readonly restrict buffer CrepTableCoefficients { vec4 crep_tableA[]; };
+// Vulkan (and so HLSL root constants, an MSL buffer): push constants; GL: uniform locations.
+#ifdef VULKAN
+layout(push_constant) uniform CrepVisibilityTablePush { ivec4 crep_tableSize; };
+#else
 layout(location = 0) uniform ivec4 crep_tableSize; // x H, y R, z n (texels per region)
+#endif
 
 void main() {
   int j = int(gl_GlobalInvocationID.x), r = int(gl_GlobalInvocationID.y);

@@ -64,4 +64,8 @@ struct ShaderStageSource {
 gl::Handle buildProgram(std::initializer_list<ShaderStageSource> stages);
 gl::Handle buildProgram(std::span<const ShaderStageSource> stages);
 
+/// Every distinct stage (path and defines) buildProgram compiled in this process, in first-use order: the
+/// variants an engine's frames use, to precompile for another API (docs/PORTABLE_SHADERS.md). Thread-safe.
+std::vector<ShaderStageSource> programVariantsBuilt();
+
 } // namespace crep

@@ -1,0 +1,102 @@
+# Portable shaders: every pass of the library (glsl/passes/<module>/<name>.comp, its default variant) is
+# compiled to Vulkan SPIR-V (glslc), validated (spirv-val), cross-compiled to HLSL Shader Model 6.0 and to
+# MSL 2.1 (spirv-cross), the HLSL is compiled back by glslang's HLSL front end as a check, and the
+# resources of all passes are described in one resources.json (spirv-cross --reflect, merged by
+# CrepShaderManifest.cmake). Output in ${CMAKE_BINARY_DIR}/shaders, installed to
+# share/crepuscular/shaders/{spirv,hlsl,msl,resources.json}. docs/PORTABLE_SHADERS.md has the rules.
+#
+# Bindings: one descriptor set (0); a resource's Vulkan binding is its GL binding number (glsl/crep/
+# bindings.h) plus the base of its kind, CREP_VULKAN_*_BASE of the same header, read from it here.
+
+option(CREP_PORTABLE_SHADERS "Compile the library's shaders to SPIR-V, HLSL and MSL (glslc, spirv-tools, spirv-cross)" ON)
+if(NOT CREP_PORTABLE_SHADERS)
+  return()
+endif()
+
+foreach(tool_package IN ITEMS "glslc:glslc" "spirv-val:spirv-tools" "spirv-cross:spirv-cross"
+                               "glslangValidator:glslang-tools")
+  string(REPLACE ":" ";" pair "${tool_package}")
+  list(GET pair 0 tool)
+  list(GET pair 1 package)
+  string(TOUPPER "CREP_${tool}" variable)
+  string(REPLACE "-" "_" variable "${variable}")
+  find_program(${variable} ${tool})
+  if(NOT ${variable})
+    message(FATAL_ERROR "CREP_PORTABLE_SHADERS: ${tool} not found; install the Debian package ${package} "
+                        "(the README's install step does) or configure with -DCREP_PORTABLE_SHADERS=OFF")
+  endif()
+endforeach()
+
+set(CREP_SHADER_SOURCE_DIR ${CMAKE_CURRENT_SOURCE_DIR}/glsl)
+set(CREP_SHADER_OUTPUT_DIR ${CMAKE_BINARY_DIR}/shaders)
+
+# The binding bases, named once in bindings.h.
+file(STRINGS ${CREP_SHADER_SOURCE_DIR}/crep/bindings.h base_lines REGEX "^#define CREP_VULKAN_[A-Z]+_BASE")
+foreach(kind IN ITEMS UNIT IMAGE UNIFORM STORAGE)
+  set(CREP_VULKAN_${kind}_BASE "")
+  foreach(line IN LISTS base_lines)
+    if(line MATCHES "^#define CREP_VULKAN_${kind}_BASE +([0-9]+)")
+      set(CREP_VULKAN_${kind}_BASE ${CMAKE_MATCH_1})
+    endif()
+  endforeach()
+  if(CREP_VULKAN_${kind}_BASE STREQUAL "")
+    message(FATAL_ERROR "glsl/crep/bindings.h: no #define CREP_VULKAN_${kind}_BASE")
+  endif()
+endforeach()
+
+file(GLOB_RECURSE crep_shader_includes CONFIGURE_DEPENDS ${CREP_SHADER_SOURCE_DIR}/crep/*.glsl
+     ${CREP_SHADER_SOURCE_DIR}/crep/*.h)
+file(GLOB_RECURSE crep_shader_passes CONFIGURE_DEPENDS RELATIVE ${CREP_SHADER_SOURCE_DIR}/passes
+     ${CREP_SHADER_SOURCE_DIR}/passes/*.comp)
+list(SORT crep_shader_passes)
+
+set(crep_portable_outputs)
+set(crep_reflections)
+set(crep_pass_names)
+foreach(pass IN LISTS crep_shader_passes) # <module>/<name>.comp
+  string(REGEX REPLACE "\\.comp$" "" stem "${pass}")
+  set(source ${CREP_SHADER_SOURCE_DIR}/passes/${pass})
+  set(spv ${CREP_SHADER_OUTPUT_DIR}/spirv/${stem}.spv)
+  set(hlsl ${CREP_SHADER_OUTPUT_DIR}/hlsl/${stem}.hlsl)
+  set(msl ${CREP_SHADER_OUTPUT_DIR}/msl/${stem}.metal)
+  set(reflection ${CREP_SHADER_OUTPUT_DIR}/reflect/${stem}.json)
+  set(hlsl_check ${CREP_SHADER_OUTPUT_DIR}/hlsl_check/${stem}.spv)
+  get_filename_component(module_dir ${stem} DIRECTORY)
+  add_custom_command(
+    OUTPUT ${spv} ${hlsl} ${msl} ${reflection} ${hlsl_check}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${CREP_SHADER_OUTPUT_DIR}/spirv/${module_dir}
+            ${CREP_SHADER_OUTPUT_DIR}/hlsl/${module_dir} ${CREP_SHADER_OUTPUT_DIR}/msl/${module_dir}
+            ${CREP_SHADER_OUTPUT_DIR}/reflect/${module_dir} ${CREP_SHADER_OUTPUT_DIR}/hlsl_check/${module_dir}
+    COMMAND ${CREP_GLSLC} --target-env=vulkan1.1 -Werror -I ${CREP_SHADER_SOURCE_DIR}
+            -ftexture-binding-base ${CREP_VULKAN_UNIT_BASE} -fsampler-binding-base ${CREP_VULKAN_UNIT_BASE}
+            -fimage-binding-base ${CREP_VULKAN_IMAGE_BASE} -fubo-binding-base ${CREP_VULKAN_UNIFORM_BASE}
+            -fssbo-binding-base ${CREP_VULKAN_STORAGE_BASE} -o ${spv} ${source}
+    COMMAND ${CREP_SPIRV_VAL} --target-env vulkan1.1 ${spv}
+    COMMAND ${CREP_SPIRV_CROSS} ${spv} --hlsl --shader-model 60 --output ${hlsl}
+    COMMAND ${CREP_GLSLANGVALIDATOR} -D -S comp -e main -V --target-env vulkan1.1 -o ${hlsl_check} ${hlsl}
+    COMMAND ${CREP_SPIRV_CROSS} ${spv} --msl --msl-version 20100 --msl-decoration-binding --output ${msl}
+    COMMAND ${CREP_SPIRV_CROSS} ${spv} --reflect --output ${reflection}
+    DEPENDS ${source} ${crep_shader_includes}
+    COMMENT "Portable shader passes/${pass}: SPIR-V, HLSL, MSL"
+    VERBATIM)
+  list(APPEND crep_portable_outputs ${spv} ${hlsl} ${msl} ${hlsl_check})
+  list(APPEND crep_reflections ${reflection})
+  list(APPEND crep_pass_names ${stem})
+endforeach()
+
+set(CREP_SHADER_RESOURCES ${CREP_SHADER_OUTPUT_DIR}/resources.json)
+string(REPLACE ";" "," crep_pass_list "${crep_pass_names}")
+add_custom_command(
+  OUTPUT ${CREP_SHADER_RESOURCES}
+  COMMAND ${CMAKE_COMMAND} -DOUTPUT=${CREP_SHADER_RESOURCES} -DSHADER_DIR=${CREP_SHADER_OUTPUT_DIR}
+          -DPASSES=${crep_pass_list} -DUNIT_BASE=${CREP_VULKAN_UNIT_BASE} -DIMAGE_BASE=${CREP_VULKAN_IMAGE_BASE}
+          -DUNIFORM_BASE=${CREP_VULKAN_UNIFORM_BASE} -DSTORAGE_BASE=${CREP_VULKAN_STORAGE_BASE}
+          -DVERSION=${PROJECT_VERSION} -P ${CMAKE_CURRENT_SOURCE_DIR}/cmake/CrepShaderManifest.cmake
+  DEPENDS ${crep_reflections} ${CMAKE_CURRENT_SOURCE_DIR}/cmake/CrepShaderManifest.cmake
+  COMMENT "Portable shaders: resources.json"
+  VERBATIM)
+add_custom_target(crep_portable_shaders ALL DEPENDS ${crep_portable_outputs} ${CREP_SHADER_RESOURCES})
+
+install(DIRECTORY ${CREP_SHADER_OUTPUT_DIR}/spirv ${CREP_SHADER_OUTPUT_DIR}/hlsl ${CREP_SHADER_OUTPUT_DIR}/msl
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/shaders)
+install(FILES ${CREP_SHADER_RESOURCES} DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/shaders)
