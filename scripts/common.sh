@@ -11,6 +11,7 @@ CREP_PACKAGES=(
   libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   glslang-tools nlohmann-json3-dev zlib1g-dev
   glslc spirv-tools spirv-cross
+  mesa-vulkan-drivers libvulkan-dev vulkan-validationlayers libshaderc-dev glslang-dev
 )
 
 crep_install_packages() {

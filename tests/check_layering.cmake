@@ -14,7 +14,7 @@ cmake_minimum_required(VERSION 3.25)
 # 3. Shaders: every file of glsl/ (embedded into the runtime library) is used by the library: its name
 #    appears in a library module's source or in another glsl/ file. Tool shaders live in examples/glsl/,
 #    test fixtures in tests/glsl/.
-set(library_modules core rectify scatter epipolar prefilter pipeline atmosphere postfx)
+set(library_modules core rectify scatter epipolar prefilter pipeline atmosphere postfx vulkan)
 set(allowed_core "core")
 set(allowed_rectify "core;rectify")
 set(allowed_scatter "core;rectify;scatter")
@@ -23,6 +23,7 @@ set(allowed_prefilter "core;rectify;scatter;prefilter") # never its sibling epip
 set(allowed_pipeline "core;rectify;scatter;epipolar;prefilter;pipeline") # the front door: uses both siblings
 set(allowed_atmosphere "core;rectify;scatter;epipolar;atmosphere") # the sky: no post effect, no front door
 set(allowed_postfx "core;rectify;scatter;epipolar;prefilter;pipeline;postfx")
+set(allowed_vulkan "core;vulkan") # a backend of core's gpu::Backend seam: no pass includes it
 set(allowed_support "core;support")
 set(failures "")
 

@@ -3,6 +3,7 @@
 // world-space reference march is WorldMarchPass in scatter/ (crep/scatter/gpu_world_march.h). Shaders:
 // passes/epipolar/minmax_build.comp, passes/epipolar/march_rectified.comp, crep/layout.glsl.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace crep {
@@ -49,34 +51,44 @@ void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWid
 }
 
 MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("MinMaxTreePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
+  if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
+  backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();
+  gpu::checkTextureSize(*backend_, "MinMaxTreePass::CreateInfo.mapWidth/mapHeight", info.mapWidth,
+                        info.mapHeight);
   requireTreeLevels("MinMaxTreePass::CreateInfo.mapWidth", info.mapWidth);
   levels_ = MinMaxTrees::levelCount(info.mapWidth);
   rowStride_ = MinMaxTrees::rowStrideFor(info.mapWidth);
-  program_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/minmax_build.comp", {}}});
-  buffer_ = gl::createBuffer();
-  const long long bytes = static_cast<long long>(std::max(rowStride_, 1)) * info.mapHeight * 8;
-  glNamedBufferStorage(buffer_.get(), static_cast<GLsizeiptr>(bytes), nullptr, GL_DYNAMIC_STORAGE_BIT);
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("MinMaxTreePass");
+  backend_->prepareProgram("passes/epipolar/minmax_build.comp", {});
+  const std::size_t bytes =
+      static_cast<std::size_t>(std::max(rowStride_, 1)) * static_cast<std::size_t>(info.mapHeight) * 8;
+  buffer_ = gpu::Buffer(*backend_, bytes, "MinMaxTreePass: trees");
+}
+
+/// One workgroup per row (passes/epipolar/minmax_build.comp); the upper-only variant reads no texture.
+gpu::Dispatch MinMaxTreePass::dispatch(bool upperOnly, std::uint32_t rectifiedDepth) const {
+  gpu::Dispatch d;
+  d.label = upperOnly ? "MinMaxTreePass::completeUpperLevels" : "MinMaxTreePass::run";
+  d.program = "passes/epipolar/minmax_build.comp";
+  if (upperOnly)
+    d.defines = {{"CREP_TREE_UPPER_ONLY", "1"}};
+  else
+    d.resources.push_back(gpu::Resource::sampled(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, rectifiedDepth));
+  d.resources.push_back(gpu::Resource::storage(CREP_MIN_MAX_TREE_MIN_MAX_BINDING, buffer_.id()));
+  d.push = {gpu::PushValue::of(0, glm::ivec4(info_.mapWidth, info_.mapHeight, levels_, rowStride_))};
+  d.groups = glm::uvec3(levels_ > 0 ? static_cast<unsigned>(info_.mapHeight) : 0u, 1u, 1u);
+  return d;
 }
 
 void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
-  gl::requireTexture2D("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth, info_.mapHeight);
-  gl::requireDepthFormat("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth);
-  const GLuint p = program_.get();
-  glUseProgram(p);
-  glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
-  glBindTextureUnit(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, rectifiedDepth);
-  glBindSampler(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, sampler_.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, buffer_.get());
-  if (levels_ > 0) glDispatchCompute(static_cast<GLuint>(info_.mapHeight), 1, 1);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, 0);
-  glBindSampler(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, 0);
-  glBindTextureUnit(CREP_MIN_MAX_TREE_RECTIFIED_DEPTH_UNIT, 0);
-  glUseProgram(0);
-  gl::checkError("MinMaxTreePass::run");
+  if (backend_->name() == "OpenGL") {
+    gl::requireTexture2D("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth,
+                         info_.mapHeight);
+    gl::requireDepthFormat("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth);
+  } else {
+    gpu::requireTexture(*backend_, "MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth,
+                        info_.mapHeight, {gpu::Format::Depth32F, gpu::Format::R32F});
+  }
+  backend_->dispatch(dispatch(false, rectifiedDepth));
 }
 
 int MinMaxTreePass::lowLevels(int mapWidth) {
@@ -87,27 +99,15 @@ void MinMaxTreePass::completeUpperLevels() {
   if (lowLevels(info_.mapWidth) < 1)
     throw InvalidArgument("MinMaxTreePass::CreateInfo.mapWidth", std::to_string(info_.mapWidth),
                           "must exceed 64 texels for completeUpperLevels (no low levels to start from)");
-  if (!upperProgram_)
-    upperProgram_ = buildProgram(
-        {{ShaderStage::Compute, "passes/epipolar/minmax_build.comp", {{"CREP_TREE_UPPER_ONLY", "1"}}}});
-  const GLuint p = upperProgram_.get();
-  glUseProgram(p);
-  glProgramUniform4i(p, 0, info_.mapWidth, info_.mapHeight, levels_, rowStride_);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, buffer_.get());
-  if (levels_ > 0) glDispatchCompute(static_cast<GLuint>(info_.mapHeight), 1, 1);
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MIN_MAX_TREE_MIN_MAX_BINDING, 0);
-  glUseProgram(0);
-  gl::checkError("MinMaxTreePass::completeUpperLevels");
+  backend_->dispatch(dispatch(true, 0));
 }
 
 std::vector<float> MinMaxTreePass::readNodes() const {
   std::vector<float> out(static_cast<std::size_t>(rowStride_) * static_cast<std::size_t>(info_.mapHeight) *
                          2);
-  if (!out.empty())
-    glGetNamedBufferSubData(buffer_.get(), 0, static_cast<GLsizeiptr>(out.size() * sizeof(float)),
-                            out.data());
-  gl::checkError("MinMaxTreePass::readNodes");
+  if (out.empty()) return out;
+  const std::vector<std::byte> bytes = backend_->readBuffer(buffer_.id(), 0, out.size() * sizeof(float));
+  std::memcpy(out.data(), bytes.data(), bytes.size());
   return out;
 }
 

@@ -35,8 +35,12 @@ layout(location = 0) uniform ivec4 sizes;
 vec2 crep_buildNode(int l, int m, int j, int base, int below, int offBelow) {
   int a = 2 * m, b = min(2 * m + 1, below - 1);
   if (l == 1) {
+#if CREP_TREE_UPPER_ONLY
+    return vec2(0.0); // not reached (levels 1..C, C >= 1, are in the buffer): the variant reads no texture
+#else
     float da = texelFetch(rectifiedDepth, ivec2(a, j), 0).r, db = texelFetch(rectifiedDepth, ivec2(b, j), 0).r;
     return vec2(min(da, db), max(da, db));
+#endif
   }
   vec2 na = crep_minMax[base + offBelow + a], nb = crep_minMax[base + offBelow + b];
   return vec2(min(na.x, nb.x), max(na.y, nb.y));

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -13,6 +14,7 @@
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/gpu_layout.h>
@@ -24,25 +26,29 @@
 namespace crep {
 
 /// The 1D min/max trees of every row of a W x H rectified map (Yusov 2012, Sec. 6.3) in a storage buffer
-/// it owns, in MinMaxTrees' layout (bit-identical values).
+/// it owns, in MinMaxTrees' layout (bit-identical values). Runs on any gpu::Backend.
 class MinMaxTreePass {
 public:
   struct CreateInfo {
-    int mapWidth = 0;  ///< W texels (> 0, <= GL_MAX_TEXTURE_SIZE)
-    int mapHeight = 0; ///< H texels (> 0, <= GL_MAX_TEXTURE_SIZE)
+    int mapWidth = 0;  ///< W texels (> 0, <= the backend's maximum texture size)
+    int mapHeight = 0; ///< H texels (> 0, <= the backend's maximum texture size)
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   /// Throws InvalidArgument ("MinMaxTreePass::CreateInfo.mapWidth/mapHeight") for sizes <= 0, GlError
   /// beyond GL_MAX_TEXTURE_SIZE or 2^16 columns, ShaderError. One-time.
   explicit MinMaxTreePass(const CreateInfo& info);
 
-  /// Builds the trees of `rectifiedDepth` (the caller's W x H depth texture). Per frame, O(W H).
+  /// Builds the trees of `rectifiedDepth` (the caller's W x H depth texture: a GL name, or a texture id of
+  /// the backend). Per frame, O(W H).
   void run(std::uint32_t rectifiedDepth);
   /// max(0, levelCount(W) - 6): the levels the map's producer may write (README, split build).
   static int lowLevels(int mapWidth);
   /// Builds levels lowLevels(W) + 1..L from the low levels in treeBuffer(); same nodes as run().
   void completeUpperLevels();
 
-  std::uint32_t treeBuffer() const noexcept { return buffer_.get(); } ///< GL_SHADER_STORAGE_BUFFER
+  /// The trees: a GL_SHADER_STORAGE_BUFFER name, or a buffer id of the backend.
+  std::uint32_t treeBuffer() const noexcept { return buffer_.id(); }
   int levels() const noexcept { return levels_; }
   int rowStride() const noexcept { return rowStride_; }
   /// Reads the buffer back: 2 floats per node, MinMaxTrees::data()'s layout.
@@ -55,8 +61,11 @@ public:
 
 private:
   CreateInfo info_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
   int levels_ = 0, rowStride_ = 0;
-  gl::Handle program_, upperProgram_, buffer_, sampler_;
+  gpu::Buffer buffer_;
+  gpu::Dispatch dispatch(bool upperOnly, std::uint32_t rectifiedDepth) const;
 };
 
 /// GlError naming `parameter` when a map of `mapWidth` columns needs more than the GPU walk's 16 levels.

@@ -1,0 +1,178 @@
+// The backend-independent parts of the seam (crep/core/gpu_backend.h): resource and push-constant
+// helpers, and the owning handles.
+#include <crep/core/error.h>
+#include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+namespace crep::gpu {
+
+int componentCount(Format format) {
+  switch (format) {
+  case Format::R32F:
+  case Format::Depth32F:
+    return 1;
+  case Format::RG32F:
+    return 2;
+  case Format::RGBA32F:
+  case Format::RGBA16F:
+    return 4;
+  }
+  return 4;
+}
+
+Resource Resource::sampled(std::uint32_t binding, TextureId t, Filter f) {
+  Resource r;
+  r.kind = ResourceKind::SampledTexture;
+  r.binding = binding;
+  r.texture = t;
+  r.filter = f;
+  return r;
+}
+
+Resource Resource::image(std::uint32_t binding, TextureId t, Access a) {
+  Resource r;
+  r.kind = ResourceKind::StorageImage;
+  r.binding = binding;
+  r.texture = t;
+  r.access = a;
+  return r;
+}
+
+Resource Resource::uniform(std::uint32_t binding, BufferId b, std::size_t offset, std::size_t size) {
+  Resource r;
+  r.kind = ResourceKind::UniformBuffer;
+  r.binding = binding;
+  r.buffer = b;
+  r.offset = offset;
+  r.size = size;
+  return r;
+}
+
+Resource Resource::storage(std::uint32_t binding, BufferId b, std::size_t offset, std::size_t size) {
+  Resource r = uniform(binding, b, offset, size);
+  r.kind = ResourceKind::StorageBuffer;
+  return r;
+}
+
+namespace {
+template <class T>
+PushValue make(std::uint32_t location, PushValue::Type type, const T* components, int n) {
+  static_assert(sizeof(T) == 4);
+  PushValue p;
+  p.location = location;
+  p.type = type;
+  std::memcpy(p.bits.data(), components, static_cast<std::size_t>(n) * 4);
+  return p;
+}
+
+/// std430 size and alignment of a push value's type, bytes.
+std::pair<std::size_t, std::size_t> sizeAndAlignment(PushValue::Type type) {
+  switch (type) {
+  case PushValue::Type::Int:
+  case PushValue::Type::Float:
+    return {4, 4};
+  case PushValue::Type::IVec2:
+  case PushValue::Type::Vec2:
+    return {8, 8};
+  case PushValue::Type::IVec4:
+  case PushValue::Type::Vec4:
+    return {16, 16};
+  case PushValue::Type::Mat4:
+    return {64, 16};
+  }
+  return {4, 4};
+}
+} // namespace
+
+PushValue PushValue::of(std::uint32_t location, int v) {
+  return make(location, Type::Int, &v, 1);
+}
+PushValue PushValue::of(std::uint32_t location, const glm::ivec2& v) {
+  return make(location, Type::IVec2, &v.x, 2);
+}
+PushValue PushValue::of(std::uint32_t location, const glm::ivec4& v) {
+  return make(location, Type::IVec4, &v.x, 4);
+}
+PushValue PushValue::of(std::uint32_t location, float v) {
+  return make(location, Type::Float, &v, 1);
+}
+PushValue PushValue::of(std::uint32_t location, const glm::vec2& v) {
+  return make(location, Type::Vec2, &v.x, 2);
+}
+PushValue PushValue::of(std::uint32_t location, const glm::vec4& v) {
+  return make(location, Type::Vec4, &v.x, 4);
+}
+PushValue PushValue::of(std::uint32_t location, const glm::mat4& v) {
+  return make(location, Type::Mat4, &v[0][0], 16);
+}
+
+std::vector<std::byte> packPushConstants(std::span<const PushValue> values) {
+  std::vector<std::byte> out;
+  for (const PushValue& v : values) {
+    const auto [size, alignment] = sizeAndAlignment(v.type);
+    const std::size_t offset = (out.size() + alignment - 1) / alignment * alignment;
+    out.resize(offset + size);
+    std::memcpy(out.data() + offset, v.bits.data(), size);
+  }
+  if (out.size() > 128)
+    throw InvalidArgument("gpu::Dispatch.push", std::to_string(out.size()) + " bytes",
+                          "must pack into at most 128 bytes");
+  return out;
+}
+
+void checkTextureSize(const Backend& backend, const char* parameter, int width, int height) {
+  if (backend.name() == "OpenGL") return gl::checkTextureSize(parameter, width, height);
+  const std::string value = std::to_string(width) + " x " + std::to_string(height);
+  if (width <= 0 || height <= 0) throw InvalidArgument(parameter, value, "width and height must be > 0");
+  const int limit = backend.maxTextureSize();
+  if (width > limit || height > limit)
+    throw InvalidArgument(parameter, value,
+                          "must not exceed the " + std::string(backend.name()) +
+                              " device's maximum texture size " + std::to_string(limit));
+}
+
+void requireTexture(const Backend& backend, const char* parameter, TextureId texture, int width, int height,
+                    std::initializer_list<Format> formats) {
+  if (texture == 0) throw InvalidArgument(parameter, "0", "must be a texture");
+  const TextureDesc d = backend.describe(texture);
+  if (d.type != TextureType::Texture2D || d.width != width || d.height != height)
+    throw InvalidArgument(parameter, std::to_string(d.width) + " x " + std::to_string(d.height),
+                          "must be a 2D texture of " + std::to_string(width) + " x " +
+                              std::to_string(height));
+  if (std::find(formats.begin(), formats.end(), d.format) == formats.end())
+    throw InvalidArgument(parameter, "format " + std::to_string(static_cast<int>(d.format)),
+                          "has a format the pass cannot read");
+}
+
+Texture& Texture::operator=(Texture&& o) noexcept {
+  if (this != &o) {
+    if (backend_ != nullptr && id_ != 0) backend_->destroyTexture(id_);
+    backend_ = o.backend_;
+    id_ = std::exchange(o.id_, 0);
+  }
+  return *this;
+}
+
+Texture::~Texture() {
+  if (backend_ != nullptr && id_ != 0) backend_->destroyTexture(id_);
+}
+
+Buffer& Buffer::operator=(Buffer&& o) noexcept {
+  if (this != &o) {
+    if (backend_ != nullptr && id_ != 0) backend_->destroyBuffer(id_);
+    backend_ = o.backend_;
+    id_ = std::exchange(o.id_, 0);
+    bytes_ = o.bytes_;
+  }
+  return *this;
+}
+
+Buffer::~Buffer() {
+  if (backend_ != nullptr && id_ != 0) backend_->destroyBuffer(id_);
+}
+
+} // namespace crep::gpu

@@ -1,0 +1,799 @@
+// gpu::Backend on Vulkan 1.1 (crep/vulkan/vulkan_backend.h). One command buffer records the calls in
+// order; a read or finish() submits it and waits. Choices made for a real GPU are marked "GPU:".
+#include "crep/bindings.h"
+
+#include <crep/vulkan/vulkan_backend.h>
+
+#include <shaderc/shaderc.hpp>
+#include <vulkan/vulkan.h>
+
+#include <glm/gtc/packing.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <mutex>
+
+namespace crep::gpu {
+
+namespace {
+
+void check(VkResult r, const char* what) {
+  if (r != VK_SUCCESS)
+    throw VulkanError("crep: " + std::string(what) + " failed (VkResult " + std::to_string(r) + ")");
+}
+
+VkFormat vkFormat(Format f) {
+  switch (f) {
+  case Format::R32F:
+    return VK_FORMAT_R32_SFLOAT;
+  case Format::RG32F:
+    return VK_FORMAT_R32G32_SFLOAT;
+  case Format::RGBA32F:
+    return VK_FORMAT_R32G32B32A32_SFLOAT;
+  case Format::RGBA16F:
+    return VK_FORMAT_R16G16B16A16_SFLOAT;
+  case Format::Depth32F:
+    return VK_FORMAT_D32_SFLOAT;
+  }
+  return VK_FORMAT_R32G32B32A32_SFLOAT;
+}
+
+/// Bytes per texel as stored.
+std::size_t texelBytes(Format f) {
+  return f == Format::RGBA16F ? 8 : static_cast<std::size_t>(componentCount(f)) * 4;
+}
+
+std::uint32_t vulkanBinding(const Resource& r) {
+  switch (r.kind) {
+  case ResourceKind::SampledTexture:
+    return CREP_VULKAN_UNIT_BASE + r.binding;
+  case ResourceKind::StorageImage:
+    return CREP_VULKAN_IMAGE_BASE + r.binding;
+  case ResourceKind::UniformBuffer:
+    return CREP_VULKAN_UNIFORM_BASE + r.binding;
+  case ResourceKind::StorageBuffer:
+    return CREP_VULKAN_STORAGE_BASE + r.binding;
+  }
+  return r.binding;
+}
+
+VkDescriptorType descriptorType(ResourceKind k) {
+  switch (k) {
+  case ResourceKind::SampledTexture:
+    return VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  case ResourceKind::StorageImage:
+    return VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+  case ResourceKind::UniformBuffer:
+    return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  case ResourceKind::StorageBuffer:
+    return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  }
+  return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+}
+
+std::string programKey(const std::string& path, std::span<const ShaderDefine> defines) {
+  std::string key = path;
+  for (const ShaderDefine& d : defines)
+    key += "\n" + d.name + "=" + d.value;
+  return key;
+}
+
+/// The validation layer's warnings and errors (its callback may run on any thread).
+struct MessageLog {
+  std::mutex mutex;
+  std::vector<std::string> messages;
+};
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                         VkDebugUtilsMessageTypeFlagsEXT,
+                                         const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  auto* log = static_cast<MessageLog*>(user);
+  const char* level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning";
+  const std::lock_guard lock(log->mutex);
+  log->messages.push_back(std::string(level) + ": " + (data->pMessage != nullptr ? data->pMessage : ""));
+  return VK_FALSE;
+}
+
+struct ImageEntry {
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  TextureDesc desc;
+};
+
+struct BufferEntry {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  void* mapped = nullptr;
+  std::size_t bytes = 0;
+};
+
+struct Pipeline {
+  VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+};
+
+} // namespace
+
+struct VulkanBackend::Impl {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties properties{};
+  VkPhysicalDeviceMemoryProperties memory{};
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  std::uint32_t family = 0;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  bool recording = false;
+  VkSampler nearest = VK_NULL_HANDLE, linear = VK_NULL_HANDLE;
+  PFN_vkCmdPushDescriptorSetKHR pushDescriptorSet = nullptr;
+
+  std::map<TextureId, ImageEntry> images;
+  std::map<BufferId, BufferEntry> buffers;
+  std::uint32_t nextId = 1;
+  std::map<std::string, VkShaderModule> modules;
+  std::map<std::string, Pipeline> pipelines;
+  std::vector<BufferEntry> staging; ///< freed after the submission that used them
+
+  MessageLog log;
+
+  void createInstance(bool validation);
+  void pickDevice(const std::string& name);
+  void createDevice();
+  std::uint32_t memoryType(std::uint32_t bits, VkMemoryPropertyFlags required,
+                           VkMemoryPropertyFlags preferred) const;
+  BufferEntry makeBuffer(std::size_t bytes, VkBufferUsageFlags usage);
+  void freeBuffer(BufferEntry& b);
+  void begin();
+  void barrier();
+  void transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to);
+  void submit();
+  VkShaderModule module(const std::string& program, std::span<const ShaderDefine> defines);
+  Pipeline& pipeline(const Dispatch& d);
+  ImageEntry& image(TextureId id, const char* what);
+  BufferEntry& buffer(BufferId id, const char* what);
+  ~Impl();
+};
+
+void VulkanBackend::Impl::createInstance(bool validation) {
+  VkApplicationInfo app{};
+  app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+  app.pApplicationName = "crepuscular";
+  app.pEngineName = "crepuscular";
+  app.apiVersion = VK_API_VERSION_1_1;
+  const char* layers[] = {"VK_LAYER_KHRONOS_validation"};
+  const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+  if (validation) {
+    std::uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    std::vector<VkLayerProperties> available(count);
+    vkEnumerateInstanceLayerProperties(&count, available.data());
+    if (std::none_of(available.begin(), available.end(),
+                     [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, layers[0]) == 0; }))
+      throw VulkanError(
+          "crep: VulkanBackend::CreateInfo.validation: VK_LAYER_KHRONOS_validation is not installed "
+          "(Debian package vulkan-validationlayers)");
+  }
+  VkDebugUtilsMessengerCreateInfoEXT debug{};
+  debug.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  debug.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  debug.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  debug.pfnUserCallback = onMessage;
+  debug.pUserData = &log;
+  VkInstanceCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+  ci.pApplicationInfo = &app;
+  if (validation) {
+    ci.enabledLayerCount = 1;
+    ci.ppEnabledLayerNames = layers;
+    ci.enabledExtensionCount = 1;
+    ci.ppEnabledExtensionNames = extensions;
+    ci.pNext = &debug; // messages of instance creation too
+  }
+  check(vkCreateInstance(&ci, nullptr, &instance), "vkCreateInstance (is a Vulkan driver installed? Debian: "
+                                                   "mesa-vulkan-drivers)");
+  if (validation) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (create == nullptr) throw VulkanError("crep: vkCreateDebugUtilsMessengerEXT is not available");
+    check(create(instance, &debug, nullptr, &messenger), "vkCreateDebugUtilsMessengerEXT");
+  }
+}
+
+void VulkanBackend::Impl::pickDevice(const std::string& name) {
+  std::uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance, &count, nullptr);
+  std::vector<VkPhysicalDevice> devices(count);
+  vkEnumeratePhysicalDevices(instance, &count, devices.data());
+  std::string seen;
+  for (VkPhysicalDevice d : devices) {
+    VkPhysicalDeviceProperties p;
+    vkGetPhysicalDeviceProperties(d, &p);
+    seen += std::string(seen.empty() ? "" : ", ") + p.deviceName;
+    if (!name.empty() && std::string(p.deviceName).find(name) == std::string::npos) continue;
+    std::uint32_t families = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> props(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &families, props.data());
+    for (std::uint32_t i = 0; i < families; ++i)
+      if ((props[i].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0) {
+        physical = d;
+        family = i;
+        properties = p;
+        vkGetPhysicalDeviceMemoryProperties(d, &memory);
+        return;
+      }
+  }
+  throw VulkanError("crep: VulkanBackend: no Vulkan device with a compute queue" +
+                    (name.empty() ? std::string() : " named like \"" + name + "\"") +
+                    " (devices: " + (seen.empty() ? "none" : seen) + ")");
+}
+
+void VulkanBackend::Impl::createDevice() {
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo q{};
+  q.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+  q.queueFamilyIndex = family;
+  q.queueCount = 1;
+  q.pQueuePriorities = &priority;
+  VkPhysicalDeviceFeatures supported{};
+  vkGetPhysicalDeviceFeatures(physical, &supported);
+  VkPhysicalDeviceFeatures features{};
+  // The froxel variant of the evaluation writes its volume without a format qualifier.
+  features.shaderStorageImageWriteWithoutFormat = supported.shaderStorageImageWriteWithoutFormat;
+  features.shaderStorageImageExtendedFormats = supported.shaderStorageImageExtendedFormats;
+  const char* extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+  VkDeviceCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  ci.queueCreateInfoCount = 1;
+  ci.pQueueCreateInfos = &q;
+  ci.enabledExtensionCount = 1;
+  ci.ppEnabledExtensionNames = extensions;
+  ci.pEnabledFeatures = &features;
+  check(vkCreateDevice(physical, &ci, nullptr, &device), "vkCreateDevice (with VK_KHR_push_descriptor)");
+  vkGetDeviceQueue(device, family, 0, &queue);
+  pushDescriptorSet = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
+      vkGetDeviceProcAddr(device, "vkCmdPushDescriptorSetKHR"));
+  if (pushDescriptorSet == nullptr) throw VulkanError("crep: vkCmdPushDescriptorSetKHR is not available");
+
+  VkCommandPoolCreateInfo pci{};
+
+  pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = family;
+  check(vkCreateCommandPool(device, &pci, nullptr, &pool), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  ai.commandPool = pool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  check(vkAllocateCommandBuffers(device, &ai, &cmd), "vkAllocateCommandBuffers");
+  VkFenceCreateInfo fi{};
+  fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  check(vkCreateFence(device, &fi, nullptr, &fence), "vkCreateFence");
+  for (auto [filter, sampler] :
+       {std::pair{VK_FILTER_NEAREST, &nearest}, std::pair{VK_FILTER_LINEAR, &linear}}) {
+    VkSamplerCreateInfo si{};
+    si.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+    si.magFilter = si.minFilter = filter;
+    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    si.maxLod = 0.0f;
+    check(vkCreateSampler(device, &si, nullptr, sampler), "vkCreateSampler");
+  }
+}
+
+std::uint32_t VulkanBackend::Impl::memoryType(std::uint32_t bits, VkMemoryPropertyFlags required,
+                                              VkMemoryPropertyFlags preferred) const {
+  for (VkMemoryPropertyFlags want : {required | preferred, required})
+    for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) != 0 && (memory.memoryTypes[i].propertyFlags & want) == want) return i;
+  throw VulkanError("crep: VulkanBackend: no memory type with the properties needed");
+}
+
+BufferEntry VulkanBackend::Impl::makeBuffer(std::size_t bytes, VkBufferUsageFlags usage) {
+  BufferEntry b;
+  b.bytes = bytes;
+  VkBufferCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+  ci.size = bytes;
+  ci.usage = usage;
+  ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  check(vkCreateBuffer(device, &ci, nullptr, &b.buffer), "vkCreateBuffer");
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, b.buffer, &req);
+  VkMemoryAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  ai.allocationSize = req.size;
+  // GPU: host-visible memory, device-local where the device has such (resizable BAR, integrated and CPU
+  // devices); the writes are recorded in the command stream either way (writeBuffer), so a discrete GPU
+  // without it only reads its buffers over the bus.
+  ai.memoryTypeIndex = memoryType(req.memoryTypeBits,
+                                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                  VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  check(vkAllocateMemory(device, &ai, nullptr, &b.memory), "vkAllocateMemory (buffer)");
+  check(vkBindBufferMemory(device, b.buffer, b.memory, 0), "vkBindBufferMemory");
+  check(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+  return b;
+}
+
+void VulkanBackend::Impl::freeBuffer(BufferEntry& b) {
+  if (b.memory != VK_NULL_HANDLE) vkUnmapMemory(device, b.memory);
+  vkDestroyBuffer(device, b.buffer, nullptr);
+  vkFreeMemory(device, b.memory, nullptr);
+  b = {};
+}
+
+void VulkanBackend::Impl::begin() {
+  if (recording) return;
+  VkCommandBufferBeginInfo bi{};
+  bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  check(vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
+  recording = true;
+}
+
+void VulkanBackend::Impl::barrier() {
+  // Every call sees the writes of the calls before it (the Backend's contract). GPU: one global barrier
+  // per call; an engine's render graph would place narrower ones.
+  VkMemoryBarrier m{};
+  m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  m.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_UNIFORM_READ_BIT |
+                    VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &m, 0,
+                       nullptr, 0, nullptr);
+}
+
+namespace {
+VkImageSubresourceRange wholeImage(const TextureDesc& d) {
+  return {static_cast<VkImageAspectFlags>(d.format == Format::Depth32F ? VK_IMAGE_ASPECT_DEPTH_BIT
+                                                                       : VK_IMAGE_ASPECT_COLOR_BIT),
+          0, 1, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
+}
+} // namespace
+
+void VulkanBackend::Impl::transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to) {
+  VkImageMemoryBarrier b{};
+  b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+  b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                    VK_ACCESS_TRANSFER_WRITE_BIT;
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = e.image;
+  b.subresourceRange = wholeImage(e.desc);
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &b);
+}
+
+void VulkanBackend::Impl::submit() {
+  if (!recording) return;
+  VkMemoryBarrier m{};
+  m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  m.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &m, 0, nullptr, 0, nullptr);
+  check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  recording = false;
+  VkSubmitInfo si{};
+  si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  check(vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
+  check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  check(vkResetFences(device, 1, &fence), "vkResetFences");
+  check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  for (BufferEntry& b : staging)
+    freeBuffer(b);
+  staging.clear();
+}
+
+VkShaderModule VulkanBackend::Impl::module(const std::string& program,
+                                           std::span<const ShaderDefine> defines) {
+  const std::string key = programKey(program, defines);
+  if (auto it = modules.find(key); it != modules.end()) return it->second;
+  const ExpandedShader expanded = ShaderLibrary::expand(program, defines);
+  shaderc::CompileOptions options;
+  options.SetTargetEnvironment(shaderc_target_env_vulkan, shaderc_env_version_vulkan_1_1);
+  options.SetBindingBase(shaderc_uniform_kind_texture, CREP_VULKAN_UNIT_BASE);
+  options.SetBindingBase(shaderc_uniform_kind_sampler, CREP_VULKAN_UNIT_BASE);
+  options.SetBindingBase(shaderc_uniform_kind_image, CREP_VULKAN_IMAGE_BASE);
+  options.SetBindingBase(shaderc_uniform_kind_buffer, CREP_VULKAN_UNIFORM_BASE);
+  options.SetBindingBase(shaderc_uniform_kind_storage_buffer, CREP_VULKAN_STORAGE_BASE);
+  options.SetOptimizationLevel(shaderc_optimization_level_performance);
+  const shaderc::Compiler compiler;
+  const shaderc::SpvCompilationResult result =
+      compiler.CompileGlslToSpv(expanded.text, shaderc_compute_shader, program.c_str(), options);
+  if (result.GetCompilationStatus() != shaderc_compilation_status_success) {
+    std::string variant;
+    for (const ShaderDefine& d : defines)
+      variant += " " + d.name + "=" + d.value;
+    throw ShaderError("crep: cannot compile compute shader \"" + program + "\"" +
+                      (variant.empty() ? "" : " (" + variant.substr(1) + ")") + " for Vulkan:\n" +
+                      expanded.translateLog(result.GetErrorMessage()));
+  }
+  const std::vector<std::uint32_t> words(result.cbegin(), result.cend());
+  VkShaderModuleCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+  ci.codeSize = words.size() * 4;
+  ci.pCode = words.data();
+  VkShaderModule m = VK_NULL_HANDLE;
+  check(vkCreateShaderModule(device, &ci, nullptr, &m), "vkCreateShaderModule");
+  modules[key] = m;
+  return m;
+}
+
+Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d) {
+  // One pipeline per variant and resource signature (the descriptor layout follows the dispatch).
+  std::string key = programKey(d.program, d.defines) + "\n#";
+  std::vector<VkDescriptorSetLayoutBinding> bindings;
+  for (const Resource& r : d.resources) {
+    VkDescriptorSetLayoutBinding b{};
+    b.binding = vulkanBinding(r);
+    b.descriptorType = descriptorType(r.kind);
+    b.descriptorCount = 1;
+    b.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    bindings.push_back(b);
+    key += " " + std::to_string(b.binding) + ":" + std::to_string(b.descriptorType);
+  }
+  const std::vector<std::byte> push = packPushConstants(d.push);
+  key += " push " + std::to_string(push.size());
+  if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
+
+  Pipeline p;
+  VkDescriptorSetLayoutCreateInfo li{};
+  li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+  li.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+  li.bindingCount = static_cast<std::uint32_t>(bindings.size());
+  li.pBindings = bindings.data();
+  check(vkCreateDescriptorSetLayout(device, &li, nullptr, &p.setLayout), "vkCreateDescriptorSetLayout");
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, static_cast<std::uint32_t>(push.size())};
+  VkPipelineLayoutCreateInfo pl{};
+  pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &p.setLayout;
+  pl.pushConstantRangeCount = push.empty() ? 0 : 1;
+  pl.pPushConstantRanges = &range;
+  check(vkCreatePipelineLayout(device, &pl, nullptr, &p.layout), "vkCreatePipelineLayout");
+  VkComputePipelineCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+  ci.stage = {};
+  ci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  ci.stage.module = module(d.program, d.defines);
+  ci.stage.pName = "main";
+  ci.layout = p.layout;
+  check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline),
+        "vkCreateComputePipelines");
+  return pipelines[key] = p;
+}
+
+ImageEntry& VulkanBackend::Impl::image(TextureId id, const char* what) {
+  const auto it = images.find(id);
+  if (it == images.end())
+    throw InvalidArgument(what, std::to_string(id), "must be a texture of this VulkanBackend");
+  return it->second;
+}
+
+BufferEntry& VulkanBackend::Impl::buffer(BufferId id, const char* what) {
+  const auto it = buffers.find(id);
+  if (it == buffers.end())
+    throw InvalidArgument(what, std::to_string(id), "must be a buffer of this VulkanBackend");
+  return it->second;
+}
+
+VulkanBackend::Impl::~Impl() {
+  if (device != VK_NULL_HANDLE) {
+    vkDeviceWaitIdle(device);
+    for (BufferEntry& b : staging)
+      freeBuffer(b);
+    for (auto& [id, b] : buffers)
+      freeBuffer(b);
+    for (auto& [id, i] : images) {
+      vkDestroyImageView(device, i.view, nullptr);
+      vkDestroyImage(device, i.image, nullptr);
+      vkFreeMemory(device, i.memory, nullptr);
+    }
+    for (auto& [key, p] : pipelines) {
+      vkDestroyPipeline(device, p.pipeline, nullptr);
+      vkDestroyPipelineLayout(device, p.layout, nullptr);
+      vkDestroyDescriptorSetLayout(device, p.setLayout, nullptr);
+    }
+    for (auto& [key, m] : modules)
+      vkDestroyShaderModule(device, m, nullptr);
+    vkDestroySampler(device, nearest, nullptr);
+    vkDestroySampler(device, linear, nullptr);
+    vkDestroyFence(device, fence, nullptr);
+    vkDestroyCommandPool(device, pool, nullptr);
+    vkDestroyDevice(device, nullptr);
+  }
+  if (messenger != VK_NULL_HANDLE) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy != nullptr) destroy(instance, messenger, nullptr);
+  }
+  if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+}
+
+// ---------------------------------------------------------------------------------------------------
+
+VulkanBackend::VulkanBackend() : VulkanBackend(CreateInfo{}) {}
+
+VulkanBackend::VulkanBackend(const CreateInfo& info) : impl_(std::make_unique<Impl>()) {
+  impl_->createInstance(info.validation);
+  impl_->pickDevice(info.deviceName);
+  impl_->createDevice();
+}
+
+VulkanBackend::~VulkanBackend() = default;
+
+int VulkanBackend::maxTextureSize() const {
+  return static_cast<int>(impl_->properties.limits.maxImageDimension2D);
+}
+
+std::string VulkanBackend::deviceName() const {
+  return impl_->properties.deviceName;
+}
+
+std::vector<std::string> VulkanBackend::validationMessages() const {
+  const std::lock_guard lock(impl_->log.mutex);
+  return impl_->log.messages;
+}
+
+TextureDesc VulkanBackend::describe(TextureId texture) const {
+  TextureDesc d = impl_->image(texture, "gpu::VulkanBackend texture").desc;
+  d.label.clear();
+  return d;
+}
+
+void VulkanBackend::prepareProgram(const std::string& program, std::span<const ShaderDefine> defines) {
+  impl_->module(program, defines);
+}
+
+TextureId VulkanBackend::createTexture(const TextureDesc& desc) {
+  checkTextureSize(*this, "gpu::TextureDesc.width/height", desc.width, desc.height);
+  if (desc.depth < 1 || (desc.type == TextureType::Texture2D && desc.depth != 1))
+    throw InvalidArgument("gpu::TextureDesc.depth", std::to_string(desc.depth),
+                          "must be >= 1 (1 for a Texture2D)");
+  Impl& v = *impl_;
+  ImageEntry e;
+  e.desc = desc;
+  const bool depth = desc.format == Format::Depth32F;
+  VkImageCreateInfo ci{};
+  ci.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+  ci.imageType = desc.type == TextureType::Texture3D ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
+  ci.format = vkFormat(desc.format);
+  ci.extent = {static_cast<std::uint32_t>(desc.width), static_cast<std::uint32_t>(desc.height),
+               desc.type == TextureType::Texture3D ? static_cast<std::uint32_t>(desc.depth) : 1u};
+  ci.mipLevels = 1;
+  ci.arrayLayers = desc.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(desc.depth) : 1u;
+  ci.samples = VK_SAMPLE_COUNT_1_BIT;
+  ci.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ci.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+             (depth ? 0u : static_cast<VkImageUsageFlags>(VK_IMAGE_USAGE_STORAGE_BIT));
+  ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  ci.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  check(vkCreateImage(v.device, &ci, nullptr, &e.image), "vkCreateImage");
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(v.device, e.image, &req);
+  VkMemoryAllocateInfo ai{};
+  ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+  ai.allocationSize = req.size;
+  ai.memoryTypeIndex = v.memoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  check(vkAllocateMemory(v.device, &ai, nullptr, &e.memory), "vkAllocateMemory (image)");
+  check(vkBindImageMemory(v.device, e.image, e.memory, 0), "vkBindImageMemory");
+  VkImageViewCreateInfo vi{};
+  vi.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+  vi.image = e.image;
+  vi.viewType = desc.type == TextureType::Texture3D        ? VK_IMAGE_VIEW_TYPE_3D
+                : desc.type == TextureType::Texture2DArray ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                           : VK_IMAGE_VIEW_TYPE_2D;
+  vi.format = ci.format;
+  vi.subresourceRange = {
+      static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0,
+      ci.arrayLayers};
+  check(vkCreateImageView(v.device, &vi, nullptr, &e.view), "vkCreateImageView");
+  // GPU: every image lives in VK_IMAGE_LAYOUT_GENERAL (sampled, stored and copied without transitions); some
+  // GPUs sample faster from SHADER_READ_ONLY_OPTIMAL.
+  v.begin();
+  VkImageMemoryBarrier b{};
+  b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+  b.srcAccessMask = 0;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = e.image;
+  b.subresourceRange = vi.subresourceRange;
+  vkCmdPipelineBarrier(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &b);
+  const TextureId id = v.nextId++;
+  v.images[id] = e;
+  return id;
+}
+
+void VulkanBackend::destroyTexture(TextureId texture) {
+  Impl& v = *impl_;
+  const auto it = v.images.find(texture);
+  if (it == v.images.end()) return;
+  v.submit(); // the recorded calls may use it
+  vkDestroyImageView(v.device, it->second.view, nullptr);
+  vkDestroyImage(v.device, it->second.image, nullptr);
+  vkFreeMemory(v.device, it->second.memory, nullptr);
+  v.images.erase(it);
+}
+
+BufferId VulkanBackend::createBuffer(std::size_t bytes, std::string_view) {
+  if (bytes == 0) throw InvalidArgument("gpu::Backend::createBuffer bytes", "0", "must be > 0");
+  Impl& v = *impl_;
+  const BufferId id = v.nextId++;
+  v.buffers[id] =
+      v.makeBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
+                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  return id;
+}
+
+void VulkanBackend::destroyBuffer(BufferId buffer) {
+  Impl& v = *impl_;
+  const auto it = v.buffers.find(buffer);
+  if (it == v.buffers.end()) return;
+  v.submit();
+  v.freeBuffer(it->second);
+  v.buffers.erase(it);
+}
+
+void VulkanBackend::writeBuffer(BufferId buffer, std::size_t offset, std::span<const std::byte> bytes) {
+  Impl& v = *impl_;
+  BufferEntry& b = v.buffer(buffer, "gpu::VulkanBackend::writeBuffer buffer");
+  if (offset + bytes.size() > b.bytes)
+    throw InvalidArgument("gpu::VulkanBackend::writeBuffer bytes", std::to_string(offset + bytes.size()),
+                          "must fit in the buffer's " + std::to_string(b.bytes) + " bytes");
+  if (bytes.empty()) return;
+  // In the command stream, after the calls recorded before it (a host write would overtake them).
+  v.begin();
+  v.barrier();
+  BufferEntry s = v.makeBuffer(bytes.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::memcpy(s.mapped, bytes.data(), bytes.size());
+  const VkBufferCopy region{0, offset, bytes.size()};
+  vkCmdCopyBuffer(v.cmd, s.buffer, b.buffer, 1, &region);
+  v.staging.push_back(s);
+}
+
+void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texels) {
+  Impl& v = *impl_;
+  const ImageEntry& e = v.image(texture, "gpu::VulkanBackend::writeTexture texture");
+  const TextureDesc& d = e.desc;
+  const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
+                            static_cast<std::size_t>(d.depth);
+  const std::size_t components = static_cast<std::size_t>(componentCount(d.format));
+  if (texels.size() != count * components)
+    throw InvalidArgument("gpu::Backend::writeTexture texels", std::to_string(texels.size()),
+                          "must hold " + std::to_string(count * components) + " floats (the whole texture)");
+  BufferEntry s = v.makeBuffer(count * texelBytes(d.format), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  if (d.format == Format::RGBA16F) {
+    auto* out = static_cast<std::uint16_t*>(s.mapped);
+    for (std::size_t i = 0; i < texels.size(); ++i)
+      out[i] = glm::packHalf1x16(texels[i]);
+  } else {
+    std::memcpy(s.mapped, texels.data(), texels.size_bytes());
+  }
+  v.begin();
+  v.barrier();
+  VkBufferImageCopy region{};
+  region.imageSubresource = {
+      static_cast<VkImageAspectFlags>(d.format == Format::Depth32F ? VK_IMAGE_ASPECT_DEPTH_BIT
+                                                                   : VK_IMAGE_ASPECT_COLOR_BIT),
+      0, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
+  region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
+                        d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
+  // Copies in the transfer layouts (GPU: the fast path of a copy engine), then back to GENERAL.
+  v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+  vkCmdCopyBufferToImage(v.cmd, s.buffer, e.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+  v.staging.push_back(s);
+}
+
+std::vector<std::byte> VulkanBackend::readBuffer(BufferId buffer, std::size_t offset, std::size_t bytes) {
+  Impl& v = *impl_;
+  BufferEntry& b = v.buffer(buffer, "gpu::VulkanBackend::readBuffer buffer");
+  if (offset + bytes > b.bytes)
+    throw InvalidArgument("gpu::VulkanBackend::readBuffer bytes", std::to_string(offset + bytes),
+                          "must fit in the buffer's " + std::to_string(b.bytes) + " bytes");
+  v.submit();
+  std::vector<std::byte> out(bytes);
+  std::memcpy(out.data(), static_cast<const std::byte*>(b.mapped) + offset, bytes);
+  return out;
+}
+
+std::vector<float> VulkanBackend::readTexture(TextureId texture) {
+  Impl& v = *impl_;
+  const ImageEntry& e = v.image(texture, "gpu::VulkanBackend::readTexture texture");
+  const TextureDesc& d = e.desc;
+  const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
+                            static_cast<std::size_t>(d.depth);
+  BufferEntry s = v.makeBuffer(count * texelBytes(d.format), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  v.begin();
+  v.barrier();
+  VkBufferImageCopy region{};
+  region.imageSubresource = {
+      static_cast<VkImageAspectFlags>(d.format == Format::Depth32F ? VK_IMAGE_ASPECT_DEPTH_BIT
+                                                                   : VK_IMAGE_ASPECT_COLOR_BIT),
+      0, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
+  region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
+                        d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
+  v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  vkCmdCopyImageToBuffer(v.cmd, e.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.buffer, 1, &region);
+  v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+  v.submit();
+  std::vector<float> out(count * static_cast<std::size_t>(componentCount(d.format)));
+  if (d.format == Format::RGBA16F) {
+    const auto* in = static_cast<const std::uint16_t*>(s.mapped);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = glm::unpackHalf1x16(in[i]);
+  } else {
+    std::memcpy(out.data(), s.mapped, out.size() * sizeof(float));
+  }
+  v.freeBuffer(s);
+  return out;
+}
+
+void VulkanBackend::dispatch(const Dispatch& d) {
+  Impl& v = *impl_;
+  const Pipeline& p = v.pipeline(d);
+  const std::vector<std::byte> push = packPushConstants(d.push);
+  std::vector<VkDescriptorImageInfo> imageInfos(d.resources.size());
+  std::vector<VkDescriptorBufferInfo> bufferInfos(d.resources.size());
+  std::vector<VkWriteDescriptorSet> writes;
+  for (std::size_t i = 0; i < d.resources.size(); ++i) {
+    const Resource& r = d.resources[i];
+    VkWriteDescriptorSet w{};
+    w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    w.dstBinding = vulkanBinding(r);
+    w.descriptorCount = 1;
+    w.descriptorType = descriptorType(r.kind);
+    if (r.kind == ResourceKind::SampledTexture || r.kind == ResourceKind::StorageImage) {
+      const ImageEntry& e = v.image(r.texture, (d.label + " texture").c_str());
+      imageInfos[i] = {r.kind == ResourceKind::SampledTexture
+                           ? (r.filter == Filter::Linear ? v.linear : v.nearest)
+                           : VK_NULL_HANDLE,
+                       e.view, VK_IMAGE_LAYOUT_GENERAL};
+      w.pImageInfo = &imageInfos[i];
+    } else {
+      const BufferEntry& b = v.buffer(r.buffer, (d.label + " buffer").c_str());
+      bufferInfos[i] = {b.buffer, r.offset, r.size != 0 ? r.size : VK_WHOLE_SIZE};
+      w.pBufferInfo = &bufferInfos[i];
+    }
+    writes.push_back(w);
+  }
+  v.begin();
+  v.barrier();
+  vkCmdBindPipeline(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+  if (!writes.empty())
+    v.pushDescriptorSet(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0,
+                        static_cast<std::uint32_t>(writes.size()), writes.data());
+  if (!push.empty())
+    vkCmdPushConstants(v.cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       static_cast<std::uint32_t>(push.size()), push.data());
+  if (d.groups.x > 0 && d.groups.y > 0 && d.groups.z > 0)
+    vkCmdDispatch(v.cmd, d.groups.x, d.groups.y, d.groups.z);
+}
+
+void VulkanBackend::finish() {
+  impl_->submit();
+}
+
+} // namespace crep::gpu
