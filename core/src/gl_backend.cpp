@@ -134,6 +134,11 @@ TextureDesc GlBackend::describe(TextureId texture) const {
   return d;
 }
 
+std::size_t GlBackend::bufferBytes(BufferId buffer) const {
+  return static_cast<std::size_t>(
+      gl::requireBuffer("gpu::GlBackend buffer", buffer, "must be a GL buffer name"));
+}
+
 gl::Handle& GlBackend::program(const std::string& path, std::span<const ShaderDefine> defines) {
   gl::Handle& p = programs_[programKey(path, defines)];
   if (!p)

@@ -50,6 +50,25 @@ void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWid
                 std::to_string(mapHeight) + " map (" + std::to_string(needed) + " bytes)");
 }
 
+void requireMinMaxBuffer(const gpu::Backend& backend, const char* parameter, std::uint32_t buffer,
+                         int mapWidth, int mapHeight, const std::string& use) {
+  if (backend.name() == "OpenGL") return requireMinMaxBuffer(parameter, buffer, mapWidth, mapHeight, use);
+  const std::string requirement = "must be the MinMaxTreePass::treeBuffer() of the map (" + use + ")";
+  if (buffer == 0) invalid(parameter, "0", requirement);
+  std::size_t size = 0;
+  try {
+    size = backend.bufferBytes(buffer);
+  } catch (const InvalidArgument&) {
+    invalid(parameter, std::to_string(buffer), requirement);
+  }
+  const std::size_t needed =
+      static_cast<std::size_t>(MinMaxTrees::rowStrideFor(mapWidth)) * static_cast<std::size_t>(mapHeight) * 8;
+  if (size < needed)
+    invalid(parameter, std::to_string(size) + " bytes",
+            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(mapWidth) + " x " +
+                std::to_string(mapHeight) + " map (" + std::to_string(needed) + " bytes)");
+}
+
 MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
   if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
   backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();

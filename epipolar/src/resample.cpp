@@ -1,6 +1,7 @@
 // Point resampling of a standard shadow map into a rectified map with blocker clamping (Klehm et al. 2014,
 // Sec. 4.1); rules in crep/epipolar/resample.h. Shader: passes/epipolar_resample.comp.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/parallel.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
@@ -149,16 +150,18 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
 // ShadowResamplePass
 
 ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("ShadowResamplePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
-  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("ShadowResamplePass");
+  if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
+  backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();
+  gpu::checkTextureSize(*backend_, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight", info.mapWidth,
+                        info.mapHeight);
+  layoutBuffers_ = gpu::LayoutBuffers(backend_);
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::MarchParams), "ShadowResamplePass: march block");
 }
 
 /// A validated frame of the pass (ShadowResamplePass::validate) and what run() derives from it.
 struct ShadowResamplePass::Plan {
-  gl::TextureLevel shadow;  ///< the standard shadow map's level 0
-  GpuLayoutData layoutData; ///< the map's layout block
+  int shadowWidth = 0, shadowHeight = 0; ///< the standard shadow map's level 0
+  GpuLayoutData layoutData;              ///< the map's layout block
 };
 
 void ShadowResamplePass::validate(const FrameAttribs& frame, std::string_view owner) const {
@@ -171,15 +174,27 @@ ShadowResamplePass::Plan ShadowResamplePass::plan(const FrameAttribs& f, std::st
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
   Plan plan;
-  plan.shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
-  gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
-  gl::requireTexture2D((p + "output").c_str(), f.output, W, H, GL_R32F);
+  if (backend_->name() == "OpenGL") {
+    const gl::TextureLevel shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
+    plan.shadowWidth = shadow.width;
+    plan.shadowHeight = shadow.height;
+    gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
+    gl::requireTexture2D((p + "output").c_str(), f.output, W, H, GL_R32F);
+  } else {
+    if (f.shadowMap == 0) invalid(p + "shadowMap", "0", "must be a texture");
+    const gpu::TextureDesc shadow = backend_->describe(f.shadowMap);
+    gpu::requireTexture(*backend_, (p + "shadowMap").c_str(), f.shadowMap, shadow.width, shadow.height,
+                        {gpu::Format::Depth32F, gpu::Format::R32F});
+    plan.shadowWidth = shadow.width;
+    plan.shadowHeight = shadow.height;
+    gpu::requireTexture(*backend_, (p + "output").c_str(), f.output, W, H, {gpu::Format::R32F});
+  }
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
   if (f.minMaxBuffer != 0) {
     if (MinMaxTreePass::lowLevels(W) < 1)
       invalid(p + "minMaxBuffer", std::to_string(f.minMaxBuffer),
               "needs a map wider than 64 texels (no low tree levels below the top 6)");
-    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H,
+    requireMinMaxBuffer(*backend_, (p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H,
                         "its low levels are written here");
   }
   plan.layoutData = gpu::requireGpuLayout(*f.layout);
@@ -190,43 +205,34 @@ ShadowResamplePass::Plan ShadowResamplePass::plan(const FrameAttribs& f, std::st
 void ShadowResamplePass::run(const FrameAttribs& f) {
   const Plan checked = plan(f, "ShadowResamplePass::FrameAttribs");
   const int W = info_.mapWidth, H = info_.mapHeight;
-  const gl::TextureLevel& shadow = checked.shadow;
   const bool trees = f.minMaxBuffer != 0;
-  const int lowLevels = MinMaxTreePass::lowLevels(W);
   const gpu::LayoutKind kind = layoutBuffers_.upload(checked.layoutData, H);
-  gl::Handle& program = programs_[static_cast<int>(kind)][trees ? 1 : 0];
-  if (!program)
-    program = buildProgram({{ShaderStage::Compute,
-                             "passes/epipolar/resample.comp",
-                             {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
-                              {"CREP_RESAMPLE_TREES", trees ? "1" : "0"}}}});
   gpu::MarchParams params;
-  params.sizes = glm::ivec4(shadow.width, shadow.height, W, H);
+  params.sizes = glm::ivec4(checked.shadowWidth, checked.shadowHeight, W, H);
   params.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
-  glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-  const glm::mat4 worldFromClip(glm::inverse(f.lightClipFromWorld));
+  backend_->writeBuffer(params_.id(), 0, std::as_bytes(std::span(&params, 1)));
 
-  const GLuint p = program.get();
-  glUseProgram(p);
-  glProgramUniformMatrix4fv(p, 0, 1, GL_FALSE, &worldFromClip[0][0]);
-  glProgramUniform1f(p, 1, static_cast<float>(projectedPointDistance(*f.layout)));
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_RESAMPLE_MARCH_BINDING, params_.get());
-  layoutBuffers_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
-  glBindTextureUnit(CREP_RESAMPLE_SHADOW_MAP_UNIT, f.shadowMap);
-  glBindSampler(CREP_RESAMPLE_SHADOW_MAP_UNIT, sampler_.get());
-  glBindImageTexture(CREP_RESAMPLE_RECTIFIED_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+  gpu::Dispatch d;
+  d.label = "ShadowResamplePass::run";
+  d.program = "passes/epipolar/resample.comp";
+  d.defines = {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))},
+               {"CREP_RESAMPLE_TREES", trees ? "1" : "0"}};
+  d.resources = {gpu::Resource::uniform(CREP_RESAMPLE_MARCH_BINDING, params_.id()),
+                 gpu::Resource::sampled(CREP_RESAMPLE_SHADOW_MAP_UNIT, f.shadowMap),
+                 gpu::Resource::image(CREP_RESAMPLE_RECTIFIED_OUT_IMAGE, f.output, gpu::Access::WriteOnly)};
+  layoutBuffers_.appendResources(d.resources, CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+  d.push = {gpu::PushValue::of(0, glm::mat4(glm::inverse(f.lightClipFromWorld))),
+            gpu::PushValue::of(1, static_cast<float>(projectedPointDistance(*f.layout)))};
   if (trees) { // one work group of 64 per row, 2^lowLevels texels per invocation
-    glProgramUniform4i(p, 2, MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), lowLevels, 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_RESAMPLE_MIN_MAX_BINDING, f.minMaxBuffer);
-    glDispatchCompute(static_cast<GLuint>(H), 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_RESAMPLE_MIN_MAX_BINDING, 0);
+    d.push.push_back(
+        gpu::PushValue::of(2, glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W),
+                                         MinMaxTreePass::lowLevels(W), 0)));
+    d.resources.push_back(gpu::Resource::storage(CREP_RESAMPLE_MIN_MAX_BINDING, f.minMaxBuffer));
+    d.groups = glm::uvec3(static_cast<unsigned>(H), 1u, 1u);
   } else {
-    glDispatchCompute(static_cast<GLuint>((W + 7) / 8), static_cast<GLuint>((H + 7) / 8), 1);
+    d.groups = glm::uvec3(static_cast<unsigned>((W + 7) / 8), static_cast<unsigned>((H + 7) / 8), 1u);
   }
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError("ShadowResamplePass::run");
+  backend_->dispatch(d);
 }
 
 } // namespace crep

@@ -1,5 +1,6 @@
 // Upload of a layout's GPU description (crep/scatter/gpu_layout_buffers.h).
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 
 #include <epoxy/gl.h>
@@ -42,19 +43,36 @@ void LayoutBuffers::requireUploadable(const GpuLayoutData& d, int mapHeight, con
 
 LayoutKind LayoutBuffers::upload(const GpuLayoutData& d, int mapHeight, const char* parameter) {
   requireUploadable(d, mapHeight, parameter);
-  if (!block_) block_ = gl::createDynamicBuffer(kMaxBlockBytes);
-  glNamedBufferSubData(block_.get(), 0, static_cast<GLsizeiptr>(d.block.size()), d.block.data());
+  if (backend_ == nullptr) {
+    ownBackend_ = std::make_unique<GlBackend>();
+    backend_ = ownBackend_.get();
+  }
+  if (!block_) block_ = Buffer(*backend_, kMaxBlockBytes, "LayoutBuffers: layout block");
+  backend_->writeBuffer(block_.id(), 0, std::as_bytes(std::span(d.block)));
   hasRows_ = !d.rows.empty();
   if (hasRows_) {
-    gl::uploadGrowingBuffer(rows_, rowsCapacity_, d.rows.data(), d.rows.size());
+    // Grown to the next power of two when too small (an epipolar layout's slice count changes per frame).
+    if (rows_.bytes() < d.rows.size()) {
+      std::size_t capacity = 256;
+      while (capacity < d.rows.size())
+        capacity *= 2;
+      rows_ = Buffer(*backend_, capacity, "LayoutBuffers: row table");
+    }
+    backend_->writeBuffer(rows_.id(), 0, std::as_bytes(std::span(d.rows)));
   }
   kind_ = d.kind;
   return kind_;
 }
 
 void LayoutBuffers::bind(std::uint32_t blockBinding, std::uint32_t rowsBinding) const {
-  glBindBufferBase(GL_UNIFORM_BUFFER, blockBinding, block_.get());
-  if (hasRows_) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, rowsBinding, rows_.get());
+  glBindBufferBase(GL_UNIFORM_BUFFER, blockBinding, block_.id());
+  if (hasRows_) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, rowsBinding, rows_.id());
+}
+
+void LayoutBuffers::appendResources(std::vector<Resource>& out, std::uint32_t blockBinding,
+                                    std::uint32_t rowsBinding) const {
+  out.push_back(Resource::uniform(blockBinding, block_.id()));
+  if (hasRows_) out.push_back(Resource::storage(rowsBinding, rows_.id())); // the whole buffer, as bind()
 }
 
 } // namespace crep::gpu

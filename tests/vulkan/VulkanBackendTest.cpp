@@ -1,18 +1,25 @@
-// gpu::VulkanBackend on Mesa's lavapipe with the validation layer on: transfers round-trip exactly, a
-// pass written once against gpu::Backend (MinMaxTreePass) gives the CPU reference's nodes bit for bit as
-// it does on GL, bad input is named, and the validation layer reports nothing.
+// gpu::VulkanBackend on Mesa's lavapipe with the validation layer on: transfers round-trip exactly, the
+// passes written once against gpu::Backend (MinMaxTreePass, ShadowResamplePass) agree with their CPU
+// references as they do on GL, bad input is named, and the validation layer reports nothing.
 #include <crep/core/error.h>
 #include <crep/core/gpu_backend.h>
 #include <crep/core/image.h>
+#include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/epipolar/resample.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scenes/scene.h>
 #include <crep/vulkan/vulkan_backend.h>
 
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 using namespace crep;
@@ -140,5 +147,82 @@ TEST_CASE("Vulkan backend: bad input is named") {
   CHECK_THROWS_WITH_AS(MinMaxTreePass({.mapWidth = -1, .mapHeight = 4, .backend = &vk}),
                        doctest::Contains("MinMaxTreePass::CreateInfo.mapWidth/mapHeight"), InvalidArgument);
   CHECK_THROWS_AS(vk.prepareProgram("passes/does/not_exist.comp", {}), ShaderError);
+  checkNoValidationMessages(vk);
+}
+
+TEST_CASE("Vulkan backend: ShadowResamplePass matches the CPU resampling, and its fused tree levels "
+          "MinMaxTreePass") {
+  gpu::VulkanBackend vk(validated());
+  const scenes::Scene scene = scenes::makeScene("colonnade", 16.0 / 9.0);
+  const glm::dmat4 lightMatrix =
+      scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
+  // A standard shadow map with smooth slopes and steps (silhouettes), in [0, 1].
+  const int S = 512;
+  Image shadow(S, S, 1);
+  for (int j = 0; j < S; ++j)
+    for (int i = 0; i < S; ++i) {
+      const double u = (i + 0.5) / S, v = (j + 0.5) / S;
+      const bool box = (i / 64 + j / 48) % 3 == 0;
+      shadow.at(i, j) =
+          static_cast<float>(0.55 + 0.25 * std::sin(6.0 * u) * std::cos(4.0 * v) - (box ? 0.2 : 0.0));
+    }
+  gpu::Texture shadowTexture(vk, {gpu::TextureType::Texture2D, gpu::Format::Depth32F, S, S, 1, "shadow map"});
+  vk.writeTexture(shadowTexture.id(), shadow.data());
+
+  const auto epipolar = std::make_shared<const EpipolarLayout>(scene.camera, scene.sun, 160, 90);
+  RectifyOptions ro;
+  ro.splits = 4;
+  const auto projective = std::make_shared<const ProjectiveLayout>(rectify(scene.camera, scene.sun, ro));
+  for (const auto& [name, layout, H] : {std::tuple<std::string, std::shared_ptr<const RectifiedLayout>, int>{
+                                            "epipolar", epipolar, epipolar->sliceCount()},
+                                        {"projective", projective, 128}}) {
+    CAPTURE(name);
+    const int W = 256;
+    const RectifiedMap cpu = resampleShadowMap(layout, W, H, shadow, lightMatrix);
+    gpu::Texture map(vk, {gpu::TextureType::Texture2D, gpu::Format::R32F, W, H, 1, "rectified map"});
+    ShadowResamplePass pass({.mapWidth = W, .mapHeight = H, .backend = &vk});
+    ShadowResamplePass::FrameAttribs f;
+    f.layout = layout.get();
+    f.shadowMap = shadowTexture.id();
+    f.lightClipFromWorld = lightMatrix;
+    f.output = map.id();
+    pass.run(f);
+    const std::vector<float> gpu = vk.readTexture(map.id());
+    // The bounds of the GL pass's test (tests/epipolar/EpipolarGLTest.cpp): float light rays pick a
+    // neighbouring standard texel now and then.
+    int differ = 0;
+    double mean = 0.0;
+    for (int j = 0; j < H; ++j)
+      for (int i = 0; i < W; ++i) {
+        const double d = std::abs(gpu[static_cast<std::size_t>(j * W + i)] - cpu.depth.at(i, j));
+        if (d > 1e-3)
+          ++differ;
+        else
+          mean += d / (W * H);
+      }
+    MESSAGE(name << ": " << differ << " of " << W * H << " texels differ by > 1e-3, the others by " << mean
+                 << " on average");
+    CHECK(differ < W * H / 100);
+    CHECK(mean < 5e-5);
+    // With a tree buffer: the same map bit for bit, and after completeUpperLevels() the trees of the map.
+    MinMaxTreePass fromMap({.mapWidth = W, .mapHeight = H, .backend = &vk}),
+        fused({.mapWidth = W, .mapHeight = H, .backend = &vk});
+    fromMap.run(map.id());
+    gpu::Texture fusedMap(vk, {gpu::TextureType::Texture2D, gpu::Format::R32F, W, H, 1, "rectified map"});
+    f.output = fusedMap.id();
+    f.minMaxBuffer = fused.treeBuffer();
+    pass.run(f);
+    CHECK(vk.readTexture(fusedMap.id()) == gpu);
+    fused.completeUpperLevels();
+    CHECK(fused.readNodes() == fromMap.readNodes());
+  }
+  ShadowResamplePass pass({.mapWidth = 64, .mapHeight = 32, .backend = &vk});
+  ShadowResamplePass::FrameAttribs bad;
+  bad.layout = projective.get();
+  bad.shadowMap = shadowTexture.id();
+  bad.lightClipFromWorld = lightMatrix;
+  bad.output = shadowTexture.id(); // a depth texture of another size
+  CHECK_THROWS_WITH_AS(pass.run(bad), doctest::Contains("ShadowResamplePass::FrameAttribs.output"),
+                       InvalidArgument);
   checkNoValidationMessages(vk);
 }

@@ -559,6 +559,10 @@ TextureDesc VulkanBackend::describe(TextureId texture) const {
   return d;
 }
 
+std::size_t VulkanBackend::bufferBytes(BufferId buffer) const {
+  return impl_->buffer(buffer, "gpu::VulkanBackend buffer").bytes;
+}
+
 void VulkanBackend::prepareProgram(const std::string& program, std::span<const ShaderDefine> defines) {
   impl_->module(program, defines);
 }

@@ -17,6 +17,7 @@ public:
   std::string_view name() const override { return "OpenGL"; }
   int maxTextureSize() const override;
   TextureDesc describe(TextureId texture) const override;
+  std::size_t bufferBytes(BufferId buffer) const override;
   void prepareProgram(const std::string& program, std::span<const ShaderDefine> defines) override;
 
   TextureId createTexture(const TextureDesc& desc) override;

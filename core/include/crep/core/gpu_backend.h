@@ -107,6 +107,8 @@ public:
   /// What `texture` is (size, format, type; label empty). InvalidArgument if it is no texture of this
   /// backend.
   virtual TextureDesc describe(TextureId texture) const = 0;
+  /// The size of `buffer` in bytes. InvalidArgument if it is no buffer of this backend.
+  virtual std::size_t bufferBytes(BufferId buffer) const = 0;
   /// Compiles a program ahead of its first dispatch, so that a ShaderError comes at a pass's creation.
   virtual void prepareProgram(const std::string& program, std::span<const ShaderDefine> defines) = 0;
 

@@ -73,6 +73,9 @@ void requireTreeLevels(const char* parameter, int mapWidth);
 /// InvalidArgument naming `parameter` unless `buffer` holds the trees of a mapWidth x mapHeight map.
 void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
                          const std::string& use);
+/// The same for a buffer of `backend`.
+void requireMinMaxBuffer(const gpu::Backend& backend, const char* parameter, std::uint32_t buffer,
+                         int mapWidth, int mapHeight, const std::string& use);
 
 /// The march of every camera pixel's view ray along its row of a rectified map, with the map's min/max
 /// trees (MinMaxTree) or texel by texel (BruteForce). Per frame, O(pixels x steps).

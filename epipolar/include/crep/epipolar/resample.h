@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/image.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
@@ -46,16 +47,18 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
 class ShadowResamplePass {
 public:
   struct CreateInfo {
-    int mapWidth = 0;  ///< W texels of the rectified maps it writes (> 0, <= GL_MAX_TEXTURE_SIZE)
+    int mapWidth = 0;  ///< W texels of the rectified maps it writes (> 0, <= the backend's maximum)
     int mapHeight = 0; ///< H texels (for an EpipolarLayout: its sliceCount())
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   struct FrameAttribs {
     const RectifiedLayout* layout = nullptr; ///< ProjectiveLayout or EpipolarLayout (not stored)
-    /// standard shadow map: GL_TEXTURE_2D depth (or GL_R32F) texture, any size
+    /// standard shadow map: 2D depth (or R32F) texture, any size (a GL name, or a texture id of the backend)
     std::uint32_t shadowMap = 0;
     /// the matrix it was rendered with (validateLayoutLightMatrix)
     glm::dmat4 lightClipFromWorld{1.0};
-    std::uint32_t output = 0; ///< GL_R32F mapWidth x mapHeight texture (written)
+    std::uint32_t output = 0; ///< R32F mapWidth x mapHeight texture (written)
     /// 0, or a MinMaxTreePass::treeBuffer() (mapWidth > 64) whose low tree levels the pass also writes
     /// (Yusov 2012, Sec. 6.3; README).
     std::uint32_t minMaxBuffer = 0;
@@ -73,8 +76,10 @@ private:
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
 
   CreateInfo info_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2][2], params_, sampler_; ///< [layout kind][with the trees' low levels]
+  gpu::Buffer params_;
 };
 
 } // namespace crep
