@@ -19,11 +19,19 @@ install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/glsl/crep ${CMAKE_CURRENT_SOURCE_D
         DESTINATION ${CMAKE_INSTALL_DATADIR}/crepuscular/glsl)
 
 set(CREP_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/crepuscular)
-foreach(component runtime support)
+set(CREP_COMPONENTS runtime support)
+set(CREP_VULKAN_INSTALLED OFF)
+set(CREP_VULKAN_STATIC OFF)
+if(TARGET crepuscular_vulkan)
+  list(APPEND CREP_COMPONENTS vulkan)
+  set(CREP_VULKAN_INSTALLED ON)
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/vulkan/include/crep DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endif()
+foreach(component IN LISTS CREP_COMPONENTS)
   if(component STREQUAL "runtime")
     set(target crepuscular)
   else()
-    set(target crepuscular_support)
+    set(target crepuscular_${component})
   endif()
   install(TARGETS ${target} EXPORT crepuscular-${component}-targets
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -1,4 +1,5 @@
 #include "bench_suite.h"
+#include "backends.h"
 #include "plot.h"
 
 #include "args.h"
@@ -1469,6 +1470,8 @@ const std::vector<BenchSection>& benchSections() {
       {"scaling", "Table 2: the GPU passes vs map width, map height and M", scalingSection},
       {"parallelization", "Table 1: prefilter regions per split x bases per invocation",
        parallelizationSection},
+      {"backends", "the passes on the gpu::Backend seam: OpenGL vs Vulkan, the same frame",
+       [](BenchRun& r) { backendsBench(r.options); }},
   };
   return sections;
 }

@@ -5,6 +5,8 @@ cmake_minimum_required(VERSION 3.25)
 #             and evaluation passes on it, then a crep::Scattering frame from its own reversed-Z camera
 #             matrices and shadow map; its link line must not mention OpenEXR or stb
 #   support/  a tool: find_package(crepuscular COMPONENTS support), an EXR round trip
+#   vulkan/   an engine on Vulkan: find_package(crepuscular COMPONENTS vulkan), MinMaxTreePass on
+#             gpu::VulkanBackend against the CPU trees, validation layer on (when built with CREP_VULKAN)
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -48,7 +50,11 @@ if(NOT installed_count EQUAL count)
 endif()
 message(STATUS "portable shaders: ${count} passes with SPIR-V, HLSL and MSL in ${shaders}")
 
-foreach(consumer runtime support)
+set(consumers runtime support)
+if(EXISTS ${WORK_DIR}/prefix/include/crep/vulkan/vulkan_backend.h) # built with CREP_VULKAN
+  list(APPEND consumers vulkan)
+endif()
+foreach(consumer IN LISTS consumers)
   set(build ${WORK_DIR}/${consumer})
   run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE}/${consumer} -B ${build} -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
       -DCMAKE_BUILD_TYPE=Release)
