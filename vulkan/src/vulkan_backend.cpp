@@ -670,6 +670,11 @@ void VulkanBackend::writeBuffer(BufferId buffer, std::size_t offset, std::span<c
   // In the command stream, after the calls recorded before it (a host write would overtake them).
   v.begin();
   v.barrier();
+  if (bytes.size() <= 65536 && offset % 4 == 0 && bytes.size() % 4 == 0) {
+    // Small writes (a pass's blocks) go into the command buffer itself: no allocation per write.
+    vkCmdUpdateBuffer(v.cmd, b.buffer, offset, bytes.size(), bytes.data());
+    return;
+  }
   BufferEntry s = v.makeBuffer(bytes.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   std::memcpy(s.mapped, bytes.data(), bytes.size());
   const VkBufferCopy region{0, offset, bytes.size()};
