@@ -68,13 +68,6 @@ GLenum access(Access a) {
   return a == Access::ReadOnly ? GL_READ_ONLY : a == Access::WriteOnly ? GL_WRITE_ONLY : GL_READ_WRITE;
 }
 
-std::string programKey(const std::string& path, std::span<const ShaderDefine> defines) {
-  std::string key = path;
-  for (const ShaderDefine& def : defines)
-    key += "\n" + def.name + "=" + def.value;
-  return key;
-}
-
 void setUniform(GLuint program, const PushValue& v) {
   const GLint l = static_cast<GLint>(v.location);
   const auto* i = reinterpret_cast<const GLint*>(v.bits.data());
@@ -140,7 +133,7 @@ std::size_t GlBackend::bufferBytes(BufferId buffer) const {
 }
 
 gl::Handle& GlBackend::program(const std::string& path, std::span<const ShaderDefine> defines) {
-  gl::Handle& p = programs_[programKey(path, defines)];
+  gl::Handle& p = programs_[variantKey(path, defines)];
   if (!p)
     p = buildProgram(
         std::vector<ShaderStageSource>{{ShaderStage::Compute, path, {defines.begin(), defines.end()}}});

@@ -110,6 +110,13 @@ PushValue PushValue::of(std::uint32_t location, const glm::mat4& v) {
   return make(location, Type::Mat4, &v[0][0], 16);
 }
 
+std::string variantKey(std::string_view program, std::span<const ShaderDefine> defines) {
+  std::string key(program);
+  for (const ShaderDefine& d : defines)
+    key += "\n" + d.name + "=" + d.value;
+  return key;
+}
+
 std::vector<std::byte> packPushConstants(std::span<const PushValue> values) {
   std::vector<std::byte> out;
   for (const PushValue& v : values) {

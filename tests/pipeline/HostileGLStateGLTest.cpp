@@ -371,20 +371,8 @@ TEST_CASE("GL state contract: crep::Scattering gives the clean context's frame b
     return f.read();
   });
 
-  const Image window = [] {
-    Image t(8, 8, 4, 1.0f);
-    for (int j = 0; j < 8; ++j)
-      for (int i = 0; i < 8; ++i)
-        t.at(i, j, i < 4 ? 0 : 2) = 0.1f;
-    return t;
-  }();
-  const gl::Handle texture = gl::createTexture2D(GL_RGBA32F, 8, 8);
-  glTextureSubImage2D(texture.get(), 0, 0, 0, 8, 8, GL_RGBA, GL_FLOAT, window.data().data());
-  const glm::dvec3 d = f.scene.sun.direction(),
-                   target = f.scene.camera.position() + 14.0 * f.scene.camera.forward();
-  const GpuLightTexture sunTexture{texture.get(),
-                                   glm::ortho(-30.0, 30.0, -30.0, 30.0, 1.0, 1000.0) *
-                                       glm::lookAt(target - 300.0 * d, target, {0.0, 1.0, 0.0})};
+  const SunWindow window = sunWindowTexture(f);
+  const GpuLightTexture& sunTexture = window.light;
   checkUnderHostileState("sun with a light texture, projective", [&] {
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.lightTexture = &sunTexture;

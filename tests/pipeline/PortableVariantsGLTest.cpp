@@ -46,19 +46,9 @@ TEST_CASE("portable shaders: every program variant of the front door's frames co
   };
   run("sun, projective", f.attribs(true, false));
   {
-    Image window(8, 8, 4, 1.0f);
-    for (int j = 0; j < 8; ++j)
-      for (int i = 0; i < 4; ++i)
-        window.at(i, j, 0) = 0.1f;
-    const gl::Handle texture = gl::createTexture2D(GL_RGBA32F, 8, 8);
-    glTextureSubImage2D(texture.get(), 0, 0, 0, 8, 8, GL_RGBA, GL_FLOAT, window.data().data());
-    const glm::dvec3 d = f.scene.sun.direction(),
-                     target = f.scene.camera.position() + 14.0 * f.scene.camera.forward();
-    const GpuLightTexture sunTexture{texture.get(),
-                                     glm::ortho(-30.0, 30.0, -30.0, 30.0, 1.0, 1000.0) *
-                                         glm::lookAt(target - 300.0 * d, target, {0.0, 1.0, 0.0})};
+    const SunWindow window = sunWindowTexture(f);
     Scattering::FrameAttribs a = f.attribs(true, false);
-    a.lightTexture = &sunTexture;
+    a.lightTexture = &window.light;
     run("sun with a light texture", a);
   }
   {

@@ -75,13 +75,6 @@ Image windowTexture(float scale) {
   return t;
 }
 
-glm::dmat4 sunWindow(const ScatteringFixture& f) {
-  const Camera& c = f.scene.camera;
-  const glm::dvec3 target = c.position() + 14.0 * c.forward(), d = f.scene.sun.direction();
-  return glm::ortho(-30.0, 30.0, -30.0, 30.0, 1.0, 1000.0) *
-         glm::lookAt(target - 300.0 * d, target, {0, 1, 0});
-}
-
 } // namespace
 
 TEST_CASE("Scattering failure guarantee: a callback that throws or raises a GL error, and a call from inside "
@@ -248,7 +241,7 @@ TEST_CASE("Scattering inputs at the door: target, format class and aliasing of e
   for (const GLenum format : {GLenum(GL_DEPTH_COMPONENT32F), GLenum(GL_RGBA32UI)}) {
     CAPTURE(format);
     const gl::Handle wrong = gl::createTexture2D(format, 8, 8);
-    const GpuLightTexture texture{wrong.get(), sunWindow(f)};
+    const GpuLightTexture texture{wrong.get(), sunWindowMatrix(f)};
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.lightTexture = &texture;
     CHECK(named(a) == "Scattering::FrameAttribs.lightTexture.texture");
@@ -270,7 +263,7 @@ TEST_CASE(
   Scattering scattering(info);
   const auto frame = [&](const Image& texels) {
     const gl::Handle texture = uploadRgba(texels);
-    const GpuLightTexture light{texture.get(), sunWindow(f)};
+    const GpuLightTexture light{texture.get(), sunWindowMatrix(f)};
     Scattering::FrameAttribs a = f.attribs(true, false);
     a.lightTexture = &light;
     scattering.run(a);

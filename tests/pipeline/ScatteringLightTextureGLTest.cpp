@@ -39,15 +39,6 @@ Scattering::CreateInfo textureInfo() {
   return info;
 }
 
-/// The sun's window: an orthographic projection along the sun, 60 world units wide, centred on the point 14
-/// units in front of the camera (the colour edge runs through the view).
-glm::dmat4 sunWindow(const ScatteringFixture& f) {
-  const Camera& c = f.scene.camera;
-  const glm::dvec3 target = c.position() + 14.0 * c.forward(), d = f.scene.sun.direction();
-  const glm::dvec3 up = std::abs(d.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
-  return glm::ortho(-30.0, 30.0, -30.0, 30.0, 1.0, 1000.0) * glm::lookAt(target - 300.0 * d, target, up);
-}
-
 /// The off-screen spot of ScatteringLocalGLTest (behind and above the camera, projective).
 SpotLight offScreenSpot(const Camera& c) {
   return spotToward(c, c.position() - 4.0 * c.forward() + 7.0 * c.up());
@@ -168,7 +159,7 @@ TEST_CASE("Scattering light textures: a constant white texture gives the untextu
     const std::string name = inView ? "sun in view (fallback)" : "sun (projective)";
     CAPTURE(name);
     if (inView) f.lightToward(1.0, 0.25, 0.2);
-    const GpuLightTexture texture{white.get(), sunWindow(f)};
+    const GpuLightTexture texture{white.get(), sunWindowMatrix(f)};
     Scattering::FrameAttribs a = f.attribs(!inView, inView);
     const Scattering::FrameResult plain = scattering.run(a);
     CHECK(plain.layout == (inView ? Scattering::Layout::Epipolar : Scattering::Layout::Projective));
@@ -230,7 +221,7 @@ TEST_CASE("Scattering light textures: a two-colour texture on the sun and a spot
     const std::string name = inView ? "colonnade, sun in view (fallback)" : "colonnade, sun (projective)";
     CAPTURE(name);
     if (inView) f.lightToward(1.0, 0.25, 0.2);
-    const GpuLightTexture window{texture.get(), sunWindow(f)};
+    const GpuLightTexture window{texture.get(), sunWindowMatrix(f)};
     Scattering::FrameAttribs a = f.attribs(!inView, inView);
     const Scattering::FrameResult plainResult = scattering.run(a);
     const Image plain = f.read();
@@ -291,7 +282,7 @@ TEST_CASE("Scattering light textures: reduced-resolution evaluation with a textu
         std::string(inView ? "sun in view (fallback)" : "sun (projective)") + ", evaluationScale 0.5";
     CAPTURE(name);
     if (inView) f.lightToward(1.0, 0.25, 0.2);
-    const GpuLightTexture window{texture.get(), sunWindow(f)};
+    const GpuLightTexture window{texture.get(), sunWindowMatrix(f)};
     Scattering::FrameAttribs a = f.attribs(!inView, inView);
     const Scattering::FrameResult plainResult = scattering.run(a);
     const Image plain = f.read();
@@ -334,7 +325,7 @@ TEST_CASE("Scattering light textures: LightColorMapPass on the epipolar layout e
   options.depthWarp = info.epipolarDepthWarp;
   options.epipoleBlockRadius = info.epipoleBlockRadius;
   const EpipolarLayout layout(f.scene.camera, f.scene.sun, kWidth, kHeight, options);
-  const glm::dmat4 window = sunWindow(f);
+  const glm::dmat4 window = sunWindowMatrix(f);
   const Image cpu = lightColorMap({&tex, window}, layout, info.mapSize, info.mapSize);
   LightColorMapPass pass({.mapWidth = info.mapSize, .mapHeight = info.mapSize});
   pass.run({.layout = &layout, .lightTexture = {texture.get(), window}, .light = &f.scene.sun});
@@ -369,7 +360,7 @@ TEST_CASE("Scattering light textures: bad input is named") {
   ScatteringFixture f("colonnade");
   Scattering scattering(textureInfo());
   const SpotLight spot = offScreenSpot(f.scene.camera);
-  const GpuLightTexture window{white.get(), sunWindow(f)}, gobo{white.get(), spot.lightClipFromWorld()};
+  const GpuLightTexture window{white.get(), sunWindowMatrix(f)}, gobo{white.get(), spot.lightClipFromWorld()};
   const auto throwsNaming = [&](const Scattering::FrameAttribs& a, const std::string& field) {
     CAPTURE(field);
     CHECK_THROWS_WITH_AS(scattering.run(a), doctest::Contains(field.c_str()), InvalidArgument);

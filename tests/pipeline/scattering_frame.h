@@ -10,10 +10,13 @@
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/pipeline/scattering.h>
+#include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>
@@ -182,6 +185,33 @@ inline SpotLight spotToward(const Camera& c, const glm::dvec3& position) {
                     .color = {1.0, 0.85, 0.6},
                     .intensity = 150.0,
                     .range = 80.0});
+}
+
+/// The sun's window: an orthographic projection along the sun, 60 world units wide, centred on the point 14
+/// units in front of the camera (the colour edge runs through the view).
+inline glm::dmat4 sunWindowMatrix(const ScatteringFixture& f) {
+  const Camera& c = f.scene.camera;
+  const glm::dvec3 target = c.position() + 14.0 * c.forward(), d = f.scene.sun.direction();
+  const glm::dvec3 up = std::abs(d.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
+  return glm::ortho(-30.0, 30.0, -30.0, 30.0, 1.0, 1000.0) * glm::lookAt(target - 300.0 * d, target, up);
+}
+
+/// The light texture of the pipeline tests on the sun: an 8 x 8 RGBA32F window (left half 0.1 red, right
+/// half 0.1 blue, the rest 1) through sunWindowMatrix().
+struct SunWindow {
+  gl::Handle texture;
+  GpuLightTexture light;
+};
+inline SunWindow sunWindowTexture(const ScatteringFixture& f) {
+  Image window(8, 8, 4, 1.0f);
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i)
+      window.at(i, j, i < 4 ? 0 : 2) = 0.1f;
+  SunWindow w;
+  w.texture = gl::createTexture2D(GL_RGBA32F, 8, 8);
+  glTextureSubImage2D(w.texture.get(), 0, 0, 0, 8, 8, GL_RGBA, GL_FLOAT, window.data().data());
+  w.light = GpuLightTexture{w.texture.get(), sunWindowMatrix(f)};
+  return w;
 }
 
 /// sum.rgb += add.rgb.

@@ -1,6 +1,8 @@
 // gpu::VulkanBackend on Mesa's lavapipe with the validation layer on: transfers round-trip exactly, the
 // passes written once against gpu::Backend (MinMaxTreePass, ShadowResamplePass) agree with their CPU
 // references as they do on GL, bad input is named, and the validation layer reports nothing.
+#include "common/map_agreement.h"
+
 #include <crep/core/error.h>
 #include <crep/core/gpu_backend.h>
 #include <crep/core/image.h>
@@ -23,6 +25,7 @@
 #include <vector>
 
 using namespace crep;
+using crep::test::checkResampledMap;
 
 namespace {
 
@@ -188,22 +191,7 @@ TEST_CASE("Vulkan backend: ShadowResamplePass matches the CPU resampling, and it
     f.output = map.id();
     pass.run(f);
     const std::vector<float> gpu = vk.readTexture(map.id());
-    // The bounds of the GL pass's test (tests/epipolar/EpipolarGLTest.cpp): float light rays pick a
-    // neighbouring standard texel now and then.
-    int differ = 0;
-    double mean = 0.0;
-    for (int j = 0; j < H; ++j)
-      for (int i = 0; i < W; ++i) {
-        const double d = std::abs(gpu[static_cast<std::size_t>(j * W + i)] - cpu.depth.at(i, j));
-        if (d > 1e-3)
-          ++differ;
-        else
-          mean += d / (W * H);
-      }
-    MESSAGE(name << ": " << differ << " of " << W * H << " texels differ by > 1e-3, the others by " << mean
-                 << " on average");
-    CHECK(differ < W * H / 100);
-    CHECK(mean < 5e-5);
+    checkResampledMap(name, gpu, cpu.depth); // the GL pass's bounds
     // With a tree buffer: the same map bit for bit, and after completeUpperLevels() the trees of the map.
     MinMaxTreePass fromMap({.mapWidth = W, .mapHeight = H, .backend = &vk}),
         fused({.mapWidth = W, .mapHeight = H, .backend = &vk});

@@ -72,13 +72,6 @@ VkDescriptorType descriptorType(ResourceKind k) {
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
 
-std::string programKey(const std::string& path, std::span<const ShaderDefine> defines) {
-  std::string key = path;
-  for (const ShaderDefine& d : defines)
-    key += "\n" + d.name + "=" + d.value;
-  return key;
-}
-
 /// The validation layer's warnings and errors (its callback may run on any thread).
 struct MessageLog {
   std::mutex mutex;
@@ -403,7 +396,7 @@ void VulkanBackend::Impl::submit() {
 
 VkShaderModule VulkanBackend::Impl::module(const std::string& program,
                                            std::span<const ShaderDefine> defines) {
-  const std::string key = programKey(program, defines);
+  const std::string key = variantKey(program, defines);
   if (auto it = modules.find(key); it != modules.end()) return it->second;
   const ExpandedShader expanded = ShaderLibrary::expand(program, defines);
   shaderc::CompileOptions options;
@@ -438,7 +431,7 @@ VkShaderModule VulkanBackend::Impl::module(const std::string& program,
 
 Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d) {
   // One pipeline per variant and resource signature (the descriptor layout follows the dispatch).
-  std::string key = programKey(d.program, d.defines) + "\n#";
+  std::string key = variantKey(d.program, d.defines) + "\n#";
   std::vector<VkDescriptorSetLayoutBinding> bindings;
   for (const Resource& r : d.resources) {
     VkDescriptorSetLayoutBinding b{};

@@ -96,6 +96,9 @@ struct Dispatch {
   glm::uvec3 groups{1, 1, 1};        ///< work groups; a zero count dispatches nothing
 };
 
+/// A program variant's key for a backend's caches: the path, then each define as "NAME=value".
+std::string variantKey(std::string_view program, std::span<const ShaderDefine> defines);
+
 /// What a pass needs of a graphics API. Every call is in order: a dispatch sees the writes of every call
 /// before it (writes, dispatches), a read sees every call before it. Not thread-safe.
 class Backend {
