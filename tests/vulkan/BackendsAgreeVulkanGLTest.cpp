@@ -1,0 +1,106 @@
+// The same frame on both backends: each built-in scene's standard shadow map, rendered by GL, resampled
+// into its rectified map with the map's min/max trees by the passes on the backend seam, once on
+// gpu::GlBackend (llvmpipe) and once on gpu::VulkanBackend (lavapipe, validation on). The two maps are
+// compared by relative RMSE and their largest difference; the trees of each backend are those of its map.
+#include "common/gl_fixture.h"
+
+#include <crep/core/gl.h>
+#include <crep/core/gl_backend.h>
+#include <crep/epipolar/epipolar.h>
+#include <crep/epipolar/gpu_march.h>
+#include <crep/epipolar/march.h>
+#include <crep/epipolar/resample.h>
+#include <crep/rectify/rectify.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+#include <crep/vulkan/vulkan_backend.h>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace crep;
+
+namespace {
+
+/// One backend's run of the frame: the rectified map and its trees.
+struct BackendRun {
+  std::vector<float> map, nodes, treesOfMap;
+};
+
+BackendRun runOn(gpu::Backend& backend, const Image& shadow, const RectifiedLayout& layout,
+                 const glm::dmat4& lightMatrix, int W, int H) {
+  gpu::Texture shadowMap(backend, {gpu::TextureType::Texture2D, gpu::Format::Depth32F, shadow.width(),
+                                   shadow.height(), 1, "shadow map"});
+  backend.writeTexture(shadowMap.id(), shadow.data());
+  gpu::Texture map(backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, W, H, 1, "rectified map"});
+  ShadowResamplePass resample({.mapWidth = W, .mapHeight = H, .backend = &backend});
+  MinMaxTreePass fused({.mapWidth = W, .mapHeight = H, .backend = &backend}),
+      fromMap({.mapWidth = W, .mapHeight = H, .backend = &backend});
+  ShadowResamplePass::FrameAttribs f;
+  f.layout = &layout;
+  f.shadowMap = shadowMap.id();
+  f.lightClipFromWorld = lightMatrix;
+  f.output = map.id();
+  f.minMaxBuffer = fused.treeBuffer();
+  resample.run(f);
+  fused.completeUpperLevels();
+  fromMap.run(map.id());
+  return {backend.readTexture(map.id()), fused.readNodes(), fromMap.readNodes()};
+}
+
+} // namespace
+
+TEST_CASE("backends agree: a scene's rectified map and trees on OpenGL and on Vulkan") {
+  CREP_REQUIRE_GL();
+  gpu::VulkanBackend::CreateInfo info;
+  info.validation = true;
+  gpu::VulkanBackend vk(info);
+  gpu::GlBackend gl;
+  const int width = 320, height = 180, S = 1024, W = 256;
+  for (const std::string name : {"forest", "sunset", "colonnade"}) {
+    CAPTURE(name);
+    const scenes::Scene scene = scenes::makeScene(name, static_cast<double>(width) / height);
+    const glm::dmat4 lightMatrix =
+        scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
+    scenes::SceneRenderer renderer(scene.mesh);
+    const Image shadow = renderer.renderDepthImage(lightMatrix, S, S, {.depthClamp = true});
+    // The frame's layout: projective when the rectification allows it, epipolar otherwise (the sun in view).
+    const Rectification rect = rectify(scene.camera, scene.sun, RectifyOptions{});
+    std::unique_ptr<RectifiedLayout> layout;
+    int H = 256;
+    if (rect.status == RectifyStatus::Projective) {
+      layout = std::make_unique<ProjectiveLayout>(rect);
+    } else {
+      auto epipolar = std::make_unique<EpipolarLayout>(scene.camera, scene.sun, width, height);
+      H = epipolar->sliceCount();
+      layout = std::move(epipolar);
+    }
+    const BackendRun a = runOn(gl, shadow, *layout, lightMatrix, W, H),
+                     b = runOn(vk, shadow, *layout, lightMatrix, W, H);
+    REQUIRE(a.map.size() == b.map.size());
+    double squared = 0.0, reference = 0.0, largest = 0.0;
+    int differ = 0;
+    for (std::size_t i = 0; i < a.map.size(); ++i) {
+      const double d = static_cast<double>(b.map[i]) - a.map[i];
+      squared += d * d;
+      reference += static_cast<double>(a.map[i]) * a.map[i];
+      largest = std::max(largest, std::abs(d));
+      differ += d != 0.0;
+    }
+    const double relativeRmse = std::sqrt(squared / reference);
+    MESSAGE(name << " (" << std::string(rect.status == RectifyStatus::Projective ? "projective" : "epipolar")
+                 << ", " << W << "x" << H << "): relative RMSE " << relativeRmse << ", max |difference| "
+                 << largest << ", " << differ << " of " << a.map.size() << " texels differ");
+    CHECK(relativeRmse <= 1e-4);
+    // Each backend's fused trees are the trees of its own map, bit for bit.
+    CHECK(a.nodes == a.treesOfMap);
+    CHECK(b.nodes == b.treesOfMap);
+  }
+  const std::vector<std::string> messages = vk.validationMessages();
+  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
+                                                  << (messages.empty() ? "" : messages.front()));
+}
