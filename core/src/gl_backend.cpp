@@ -24,6 +24,8 @@ GLenum internalFormat(Format f) {
     return GL_RGBA16F;
   case Format::Depth32F:
     return GL_DEPTH_COMPONENT32F;
+  case Format::RGBA8:
+    return GL_RGBA8;
   }
   return GL_RGBA32F;
 }
@@ -108,6 +110,20 @@ int GlBackend::maxTextureSize() const {
   return gl::maxTextureSize();
 }
 
+int GlBackend::maxArrayLayers() const {
+  return gl::maxArrayTextureLayers();
+}
+
+ComputeLimits GlBackend::computeLimits() const {
+  ComputeLimits l;
+  for (GLuint axis = 0; axis < 3; ++axis) {
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_SIZE, axis, &l.groupSize[axis]);
+    glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, axis, &l.groupCount[axis]);
+  }
+  glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &l.invocations);
+  return l;
+}
+
 TextureDesc GlBackend::describe(TextureId texture) const {
   if (texture == 0 || glIsTexture(texture) != GL_TRUE)
     throw InvalidArgument("gpu::GlBackend texture", std::to_string(texture), "must be a GL texture name");
@@ -119,6 +135,7 @@ TextureDesc GlBackend::describe(TextureId texture) const {
   d.format = t.internal == GL_R32F                           ? Format::R32F
              : t.internal == GL_RG32F                        ? Format::RG32F
              : t.internal == GL_RGBA16F                      ? Format::RGBA16F
+             : t.internal == GL_RGBA8                        ? Format::RGBA8
              : pixelFormat(t.internal) == GL_DEPTH_COMPONENT ? Format::Depth32F
                                                              : Format::RGBA32F;
   d.width = t.width;
@@ -157,6 +174,13 @@ TextureId GlBackend::createTexture(const TextureDesc& desc) {
     glTextureStorage2D(t.get(), 1, internalFormat(desc.format), desc.width, desc.height);
   else
     glTextureStorage3D(t.get(), 1, internalFormat(desc.format), desc.width, desc.height, desc.depth);
+  // Linear and clamped by the texture's own state too: an engine's shader may sample it without a sampler
+  // object (a pass binds its own).
+  glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(t.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
   if (!desc.label.empty())
     glObjectLabel(GL_TEXTURE, t.get(), static_cast<GLsizei>(desc.label.size()), desc.label.data());
   gl::checkError("gpu::GlBackend::createTexture");

@@ -19,6 +19,7 @@ int componentCount(Format format) {
     return 2;
   case Format::RGBA32F:
   case Format::RGBA16F:
+  case Format::RGBA8:
     return 4;
   }
   return 4;

@@ -6,6 +6,7 @@
 // (gpu::RegionWeights), fills the shared blocks (gpu_structs.h) and dispatches. Contract:
 // crep/prefilter/prefilter.h.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/airlight.h>
@@ -19,8 +20,10 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <new>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace crep {
 
@@ -75,25 +78,50 @@ void requireAtLeast(const char* parameter, int value, int minimum) {
   if (value < minimum) invalid(parameter, detail::formatValue(value), "must be >= " + str(minimum));
 }
 
-/// Local size and dispatch counts against GL_MAX_COMPUTE_WORK_GROUP_{SIZE,INVOCATIONS,COUNT}.
-void checkWorkgroup(const char* const names[3], const int local[3], const int groups[3]) {
+/// Local size and dispatch counts against GL_MAX_COMPUTE_WORK_GROUP_{SIZE,INVOCATIONS,COUNT} (the
+/// backend's compute limits).
+void checkWorkgroup(const gpu::ComputeLimits& limits, const char* const names[3], const int local[3],
+                    const int groups[3]) {
   long long invocations = 1;
-  for (GLuint axis = 0; axis < 3; ++axis) {
-    const int maxSize = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_SIZE, axis);
+  for (int axis = 0; axis < 3; ++axis) {
+    const int maxSize = limits.groupSize[axis];
     if (local[axis] > maxSize)
       throw GlError(std::string(names[axis]) + " = " + str(local[axis]) +
                     " exceeds GL_MAX_COMPUTE_WORK_GROUP_SIZE[" + str(axis) + "] = " + str(maxSize));
-    const int maxCount = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_COUNT, axis);
+    const int maxCount = limits.groupCount[axis];
     if (groups[axis] > maxCount)
       throw GlError(std::string(names[axis]) + " = " + str(local[axis]) + " needs " + str(groups[axis]) +
                     " workgroups, beyond GL_MAX_COMPUTE_WORK_GROUP_COUNT[" + str(axis) +
                     "] = " + str(maxCount));
     invocations *= local[axis];
   }
-  const int maxInvocations = getInteger(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS);
+  const int maxInvocations = limits.invocations;
   if (invocations > maxInvocations)
     throw GlError(std::string(names[0]) + " x " + names[1] + " x " + names[2] + " = " + str(invocations) +
                   " exceeds GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS = " + str(maxInvocations));
+}
+
+/// The same against the current GL context's limits (EvaluatePass, still on GL).
+void checkWorkgroup(const char* const names[3], const int local[3], const int groups[3]) {
+  gpu::ComputeLimits limits;
+  for (GLuint axis = 0; axis < 3; ++axis) {
+    limits.groupSize[axis] = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_SIZE, axis);
+    limits.groupCount[axis] = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_COUNT, axis);
+  }
+  limits.invocations = getInteger(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS);
+  checkWorkgroup(limits, names, local, groups);
+}
+
+gpu::Format basisFormat(StorageFormat format) {
+  switch (format) {
+  case StorageFormat::RGBA8:
+    return gpu::Format::RGBA8;
+  case StorageFormat::RGBA16F:
+    return gpu::Format::RGBA16F;
+  case StorageFormat::RGBA32F:
+    break;
+  }
+  return gpu::Format::RGBA32F;
 }
 
 GLenum internalFormat(StorageFormat format) {
@@ -280,14 +308,19 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.workgroupBaseGroups", info.workgroupBaseGroups, 1);
   requireAtLeast("PrefilterPass::CreateInfo.workgroupRegions", info.workgroupRegions, 1);
 
-  const int maxSize = gl::maxTextureSize();
+  if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
+  backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();
+  gpu::Backend& b = *backend_;
+  const int maxSize = b.maxTextureSize();
+  const std::string limitName =
+      b.name() == "OpenGL" ? "GL_MAX_TEXTURE_SIZE" : "the device's maximum texture size";
   if (info.mapWidth > maxSize)
-    throw GlError("PrefilterPass::CreateInfo.mapWidth = " + str(info.mapWidth) +
-                  " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
+    throw GlError("PrefilterPass::CreateInfo.mapWidth = " + str(info.mapWidth) + " exceeds " + limitName +
+                  " = " + str(maxSize));
   if (info.mapHeight > maxSize)
-    throw GlError("PrefilterPass::CreateInfo.mapHeight = " + str(info.mapHeight) +
-                  " exceeds GL_MAX_TEXTURE_SIZE = " + str(maxSize));
-  const int maxLayers = gl::maxArrayTextureLayers();
+    throw GlError("PrefilterPass::CreateInfo.mapHeight = " + str(info.mapHeight) + " exceeds " + limitName +
+                  " = " + str(maxSize));
+  const int maxLayers = b.maxArrayLayers();
   if (layers() > maxLayers)
     throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(o.bases) + " needs " + str(layers()) +
                   " layers, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
@@ -300,28 +333,34 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
     const int groups[3] = {ceilDiv(info.mapHeight, info.workgroupRows),
                            ceilDiv(baseGroups(info), info.workgroupBaseGroups),
                            ceilDiv(info.mapWidth, info.workgroupRegions)};
-    checkWorkgroup(names, local, groups);
+    checkWorkgroup(b.computeLimits(), names, local, groups);
   }
 
-  program_ = buildProgram(prefilterStages(info, false));
-
-  texture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-  glTextureStorage3D(texture_.get(), 1, internalFormat(o.format), info.mapWidth, info.mapHeight, layers());
-  glTextureParameteri(texture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(texture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(texture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(texture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  gl::checkError(
-      "PrefilterPass: filtered-basis texture array (PrefilterPass::CreateInfo width x height x bases)");
-
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  paramsBuffer_ = gl::createDynamicBuffer(sizeof(gpu::PrefilterParams));
-  gl::checkError("PrefilterPass: buffers");
+  const ShaderStageSource stage = prefilterStages(info, false)[0];
+  b.prepareProgram(stage.path, stage.defines);
+  texture_ = gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(o.format), info.mapWidth,
+                              info.mapHeight, layers(), "PrefilterPass: filtered basis"});
+  paramsBuffer_ = gpu::Buffer(b, sizeof(gpu::PrefilterParams), "PrefilterPass: parameters");
 }
 
 PrefilterPass::~PrefilterPass() = default;
-PrefilterPass::PrefilterPass(PrefilterPass&&) noexcept = default;
-PrefilterPass& PrefilterPass::operator=(PrefilterPass&&) noexcept = default;
+
+PrefilterPass::PrefilterPass(PrefilterPass&& o) noexcept
+    : info_(o.info_), ownBackend_(std::move(o.ownBackend_)), backend_(std::exchange(o.backend_, nullptr)),
+      texture_(std::move(o.texture_)), paramsBuffer_(std::move(o.paramsBuffer_)),
+      weightsBuffer_(std::move(o.weightsBuffer_)), localBuffer_(std::move(o.localBuffer_)),
+      raysBuffer_(std::move(o.raysBuffer_)), texturedTexture_(std::move(o.texturedTexture_)),
+      meanColor_(std::move(o.meanColor_)), ran_(o.ran_), lastLocal_(o.lastLocal_),
+      lastTextured_(o.lastTextured_), lastLayoutRegions_(o.lastLayoutRegions_),
+      lastExtinction_(o.lastExtinction_) {}
+
+PrefilterPass& PrefilterPass::operator=(PrefilterPass&& o) noexcept {
+  if (this != &o) {
+    this->~PrefilterPass(); // the textures and buffers go before the backend that made them
+    new (this) PrefilterPass(std::move(o));
+  }
+  return *this;
+}
 
 /// A validated frame of the prefilter pass (PrefilterPass::validate) and what run() derives from it.
 struct PrefilterPass::Plan {
@@ -337,13 +376,18 @@ void PrefilterPass::validate(const FrameAttribs& frame, std::string_view owner) 
 PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_view owner) const {
   const std::string f = std::string(owner) + ".";
   if (frame.layout == nullptr) invalid(f + "layout", "null", "must point to the map's layout");
-  const gl::TextureLevel depth = gl::textureLevel((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
-  if (depth.target != GL_TEXTURE_2D)
-    invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a GL_TEXTURE_2D");
-  gl::requireDepthFormat((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
-  if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
-    invalid(f + "rectifiedDepth", sizeString(depth.width, depth.height),
-            "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
+  if (backend_->name() == "OpenGL") {
+    const gl::TextureLevel depth = gl::textureLevel((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
+    if (depth.target != GL_TEXTURE_2D)
+      invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a GL_TEXTURE_2D");
+    gl::requireDepthFormat((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
+    if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
+      invalid(f + "rectifiedDepth", sizeString(depth.width, depth.height),
+              "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
+  } else {
+    gpu::requireTexture(*backend_, (f + "rectifiedDepth").c_str(), frame.rectifiedDepth, info_.mapWidth,
+                        info_.mapHeight, {gpu::Format::Depth32F, gpu::Format::R32F});
+  }
   Plan p;
   p.extinction = frame.extinctionOverride;
   if (p.extinction < 0.0) {
@@ -363,13 +407,17 @@ PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_v
   p.local = frame.localLight != nullptr;
   p.textured = frame.lightColors != 0;
   if (p.textured) {
-    gl::requireTexture2D((f + "lightColors").c_str(), frame.lightColors, W, H);
+    if (backend_->name() == "OpenGL")
+      gl::requireTexture2D((f + "lightColors").c_str(), frame.lightColors, W, H);
+    else
+      gpu::requireTexture(*backend_, (f + "lightColors").c_str(), frame.lightColors, W, H,
+                          {gpu::Format::RGBA32F, gpu::Format::RGBA16F, gpu::Format::RGBA8});
     if (info_.memoryLimit)
       invalid(f + "lightColors", str(frame.lightColors),
               "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
     // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
     if (!texturedTexture_) {
-      const int maxLayers = gl::maxArrayTextureLayers();
+      const int maxLayers = backend_->maxArrayLayers();
       if (3 * layers() > maxLayers)
         throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(info_.options.bases) + " needs " +
                       str(3 * layers()) +
@@ -384,7 +432,8 @@ PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_v
 }
 
 void PrefilterPass::run(const FrameAttribs& frame) {
-  gl::requireNotMovedFrom(sampler_, "PrefilterPass");
+  if (backend_ == nullptr)
+    invalid("PrefilterPass", "a moved-from object", "owns no GL objects: assign a constructed one first");
   const Plan p = plan(frame, "PrefilterPass::FrameAttribs");
   if (p.textured) prepareTextured(p.local);
   const std::size_t weightBytes = upload(frame, p);
@@ -398,24 +447,34 @@ void PrefilterPass::run(const FrameAttribs& frame) {
 
 void PrefilterPass::prepareTextured(bool local) {
   const int W = info_.mapWidth, H = info_.mapHeight;
+  gpu::Backend& b = *backend_;
   if (!texturedTexture_) {
     // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
-    texturedTexture_ = gl::createTexture(GL_TEXTURE_2D_ARRAY);
-    glTextureStorage3D(texturedTexture_.get(), 1, internalFormat(info_.options.format), W, H, 3 * layers());
-    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(texturedTexture_.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    texturedTexture_ =
+        gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(info_.options.format), W, H,
+                         3 * layers(), "PrefilterPass: filtered basis (light textures)"});
     // RGBA32F: a light texture's HDR texels (projector images in physical units) are kept whole; half
     // floats clipped them at 65504. GPU: one fetch per region per pixel, so the extra bytes are cheap.
-    meanColor_ = gl::createTexture2D(GL_RGBA32F, W, H, "PrefilterPass: mean colour (light textures)");
-    glTextureParameteri(meanColor_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(meanColor_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    gl::checkError("PrefilterPass: light-texture basis array and mean colour");
+    meanColor_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, W, H, 1,
+                                  "PrefilterPass: mean colour (light textures)"});
   }
-  gl::Handle& variant = programTextured_[local ? 1 : 0];
-  if (!variant) variant = buildProgram(prefilterStages(info_, local, true));
+  const ShaderStageSource stage = prefilterStages(info_, local, true)[0];
+  b.prepareProgram(stage.path, stage.defines);
 }
+
+namespace {
+/// `buffer` holding at least `bytes` (grown to the next power of two), then `bytes` of `data` written at 0.
+void writeGrowing(gpu::Backend& backend, gpu::Buffer& buffer, const void* data, std::size_t bytes,
+                  const char* label) {
+  if (buffer.bytes() < bytes) {
+    std::size_t capacity = 256;
+    while (capacity < bytes)
+      capacity *= 2;
+    buffer = gpu::Buffer(backend, capacity, label);
+  }
+  backend.writeBuffer(buffer.id(), 0, {static_cast<const std::byte*>(data), bytes});
+}
+} // namespace
 
 std::size_t PrefilterPass::upload(const FrameAttribs& frame, const Plan& p) {
   const int W = info_.mapWidth, H = info_.mapHeight;
@@ -424,7 +483,7 @@ std::size_t PrefilterPass::upload(const FrameAttribs& frame, const Plan& p) {
   const std::vector<gpu::RegionWeights> weights = gpuRegionWeights(profiles, info_.options.weights, p.n);
   if (p.local) uploadLocalLight(frame, p, profiles);
   const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
-  gl::uploadGrowingBuffer(weightsBuffer_, weightsCapacity_, weights.data(), bytes);
+  writeGrowing(*backend_, weightsBuffer_, weights.data(), bytes, "PrefilterPass: region weights");
 
   gpu::PrefilterParams params;
   params.mapSize = glm::ivec4(W, H, p.R, p.n);
@@ -432,7 +491,7 @@ std::size_t PrefilterPass::upload(const FrameAttribs& frame, const Plan& p) {
                                 static_cast<int>(info_.options.weights), 0);
   params.weights =
       glm::vec4(static_cast<float>(p.extinction), static_cast<float>(info_.options.depthMargin), 0.0f, 0.0f);
-  glNamedBufferSubData(paramsBuffer_.get(), 0, sizeof params, &params);
+  backend_->writeBuffer(paramsBuffer_.id(), 0, std::as_bytes(std::span(&params, 1)));
   return bytes;
 }
 
@@ -452,57 +511,44 @@ void PrefilterPass::uploadLocalLight(const FrameAttribs& frame, const Plan& p,
       rays[k] = gpu::RegionRay(direction, std::isfinite(t0) ? static_cast<float>(t0) : -1.0f);
     }
   }
-  gl::uploadGrowingBuffer(raysBuffer_, raysCapacity_, rays.data(), rays.size() * sizeof(gpu::RegionRay));
-  if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
+  writeGrowing(*backend_, raysBuffer_, rays.data(), rays.size() * sizeof(gpu::RegionRay),
+               "PrefilterPass: region rays");
+  if (!localBuffer_)
+    localBuffer_ = gpu::Buffer(*backend_, sizeof(gpu::LocalLightParams), "PrefilterPass: light");
   gpu::LocalLightParams lp =
       localLightParams(*frame.localLight, *frame.medium, frame.layout->origin(), p.extinction);
   lp.cone.w = static_cast<float>(static_cast<int>(info_.options.localLightWeights));
-  glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
-  if (!programLocal_) programLocal_ = buildProgram(prefilterStages(info_, true));
+  backend_->writeBuffer(localBuffer_.id(), 0, std::as_bytes(std::span(&lp, 1)));
+  const ShaderStageSource stage = prefilterStages(info_, true)[0];
+  backend_->prepareProgram(stage.path, stage.defines);
 }
 
 void PrefilterPass::dispatch(const FrameAttribs& frame, const Plan& p, std::size_t weightBytes) {
   const bool local = p.local, textured = p.textured;
-  glUseProgram(textured ? programTextured_[local ? 1 : 0].get()
-               : local  ? programLocal_.get()
-                        : program_.get());
+  const ShaderStageSource stage = prefilterStages(info_, local, textured)[0];
+  gpu::Dispatch d;
+  d.label = "PrefilterPass::run";
+  d.program = stage.path;
+  d.defines = stage.defines;
+  d.resources = {
+      gpu::Resource::sampled(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, frame.rectifiedDepth),
+      gpu::Resource::image(CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE,
+                           textured ? texturedTexture_.id() : texture_.id(), gpu::Access::WriteOnly),
+      gpu::Resource::uniform(CREP_PREFILTER_PARAMS_BINDING, paramsBuffer_.id()),
+      gpu::Resource::storage(CREP_PREFILTER_REGION_WEIGHTS_BINDING, weightsBuffer_.id(), 0, weightBytes)};
   if (textured) {
-    glBindTextureUnit(CREP_PREFILTER_LIGHT_COLORS_UNIT, frame.lightColors);
-    glBindSampler(CREP_PREFILTER_LIGHT_COLORS_UNIT, sampler_.get());
-    glBindImageTexture(CREP_PREFILTER_MEAN_COLOR_OUT_IMAGE, meanColor_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                       GL_RGBA32F);
+    d.resources.push_back(gpu::Resource::sampled(CREP_PREFILTER_LIGHT_COLORS_UNIT, frame.lightColors));
+    d.resources.push_back(
+        gpu::Resource::image(CREP_PREFILTER_MEAN_COLOR_OUT_IMAGE, meanColor_.id(), gpu::Access::WriteOnly));
   }
   if (local) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_LOCAL_LIGHT_BINDING, localBuffer_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_RAYS_BINDING, raysBuffer_.get());
+    d.resources.push_back(gpu::Resource::uniform(CREP_PREFILTER_LOCAL_LIGHT_BINDING, localBuffer_.id()));
+    d.resources.push_back(gpu::Resource::storage(CREP_PREFILTER_REGION_RAYS_BINDING, raysBuffer_.id()));
   }
-  glBindTextureUnit(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, frame.rectifiedDepth);
-  glBindSampler(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, sampler_.get());
-  glBindImageTexture(CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE,
-                     textured ? texturedTexture_.get() : texture_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
-                     internalFormat(info_.options.format));
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_PARAMS_BINDING, paramsBuffer_.get());
-  glBindBufferRange(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_WEIGHTS_BINDING, weightsBuffer_.get(), 0,
-                    static_cast<GLsizeiptr>(weightBytes));
-  glDispatchCompute(static_cast<GLuint>(ceilDiv(info_.mapHeight, info_.workgroupRows)),
-                    static_cast<GLuint>(ceilDiv(baseGroups(info_, local), info_.workgroupBaseGroups)),
-                    static_cast<GLuint>(ceilDiv(p.R, info_.workgroupRegions)));
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                  GL_TEXTURE_UPDATE_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_WEIGHTS_BINDING, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_PARAMS_BINDING, 0);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_PREFILTER_REGION_RAYS_BINDING, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_PREFILTER_LOCAL_LIGHT_BINDING, 0);
-  glBindImageTexture(CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-  glBindSampler(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, 0);
-  glBindTextureUnit(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, 0);
-  if (textured) {
-    glBindImageTexture(CREP_PREFILTER_MEAN_COLOR_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    glBindSampler(CREP_PREFILTER_LIGHT_COLORS_UNIT, 0);
-    glBindTextureUnit(CREP_PREFILTER_LIGHT_COLORS_UNIT, 0);
-  }
-  glUseProgram(0);
-  gl::checkError("PrefilterPass::run");
+  d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(info_.mapHeight, info_.workgroupRows)),
+                        static_cast<unsigned>(ceilDiv(baseGroups(info_, local), info_.workgroupBaseGroups)),
+                        static_cast<unsigned>(ceilDiv(p.R, info_.workgroupRegions)));
+  backend_->dispatch(d);
 }
 
 FilteredBasisView PrefilterPass::filteredBasis() const {
@@ -510,8 +556,8 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
   FilteredBasisView v;
   v.texture = filteredBasisTexture();
   v.textured = lastTextured_;
-  v.meanColor = lastTextured_ ? meanColor_.get() : 0;
-  v.regionWeights = weightsBuffer_.get();
+  v.meanColor = lastTextured_ ? meanColor_.id() : 0;
+  v.regionWeights = weightsBuffer_.id();
   v.width = info_.mapWidth;
   v.height = info_.mapHeight;
   v.bases = info_.options.bases;
@@ -651,7 +697,7 @@ EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
 EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
 
 std::size_t PrefilterPass::memoryBytes() const noexcept {
-  if (!sampler_) return 0; // moved from
+  if (backend_ == nullptr) return 0; // moved from
   const std::size_t textured =
       texturedTexture_
           ? 3 * filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases,
@@ -660,7 +706,7 @@ std::size_t PrefilterPass::memoryBytes() const noexcept {
           : 0;
   return textured +
          filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
-         weightsCapacity_ + sizeof(gpu::PrefilterParams) + raysCapacity_ +
+         weightsBuffer_.bytes() + sizeof(gpu::PrefilterParams) + raysBuffer_.bytes() +
          (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }
 

@@ -10,6 +10,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -35,13 +36,15 @@ VkFormat vkFormat(Format f) {
     return VK_FORMAT_R16G16B16A16_SFLOAT;
   case Format::Depth32F:
     return VK_FORMAT_D32_SFLOAT;
+  case Format::RGBA8:
+    return VK_FORMAT_R8G8B8A8_UNORM;
   }
   return VK_FORMAT_R32G32B32A32_SFLOAT;
 }
 
 /// Bytes per texel as stored.
 std::size_t texelBytes(Format f) {
-  return f == Format::RGBA16F ? 8 : static_cast<std::size_t>(componentCount(f)) * 4;
+  return f == Format::RGBA16F ? 8 : f == Format::RGBA8 ? 4 : static_cast<std::size_t>(componentCount(f)) * 4;
 }
 
 std::uint32_t vulkanBinding(const Resource& r) {
@@ -537,6 +540,22 @@ int VulkanBackend::maxTextureSize() const {
   return static_cast<int>(impl_->properties.limits.maxImageDimension2D);
 }
 
+int VulkanBackend::maxArrayLayers() const {
+  return static_cast<int>(impl_->properties.limits.maxImageArrayLayers);
+}
+
+ComputeLimits VulkanBackend::computeLimits() const {
+  const VkPhysicalDeviceLimits& v = impl_->properties.limits;
+  ComputeLimits l;
+  for (int axis = 0; axis < 3; ++axis) {
+    l.groupSize[axis] = static_cast<int>(v.maxComputeWorkGroupSize[axis]);
+    l.groupCount[axis] =
+        static_cast<int>(std::min<std::uint32_t>(v.maxComputeWorkGroupCount[axis], 0x7fffffffu));
+  }
+  l.invocations = static_cast<int>(v.maxComputeWorkGroupInvocations);
+  return l;
+}
+
 std::string VulkanBackend::deviceName() const {
   return impl_->properties.deviceName;
 }
@@ -690,6 +709,10 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
     auto* out = static_cast<std::uint16_t*>(s.mapped);
     for (std::size_t i = 0; i < texels.size(); ++i)
       out[i] = glm::packHalf1x16(texels[i]);
+  } else if (d.format == Format::RGBA8) {
+    auto* out = static_cast<std::uint8_t*>(s.mapped);
+    for (std::size_t i = 0; i < texels.size(); ++i)
+      out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(texels[i], 0.0f, 1.0f) * 255.0f));
   } else {
     std::memcpy(s.mapped, texels.data(), texels.size_bytes());
   }
@@ -746,6 +769,10 @@ std::vector<float> VulkanBackend::readTexture(TextureId texture) {
     const auto* in = static_cast<const std::uint16_t*>(s.mapped);
     for (std::size_t i = 0; i < out.size(); ++i)
       out[i] = glm::unpackHalf1x16(in[i]);
+  } else if (d.format == Format::RGBA8) {
+    const auto* in = static_cast<const std::uint8_t*>(s.mapped);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = static_cast<float>(in[i]) / 255.0f;
   } else {
     std::memcpy(out.data(), s.mapped, out.size() * sizeof(float));
   }

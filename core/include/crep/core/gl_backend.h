@@ -16,6 +16,8 @@ public:
   GlBackend();
   std::string_view name() const override { return "OpenGL"; }
   int maxTextureSize() const override;
+  int maxArrayLayers() const override;
+  ComputeLimits computeLimits() const override;
   TextureDesc describe(TextureId texture) const override;
   std::size_t bufferBytes(BufferId buffer) const override;
   void prepareProgram(const std::string& program, std::span<const ShaderDefine> defines) override;

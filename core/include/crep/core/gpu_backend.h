@@ -22,8 +22,9 @@ namespace crep::gpu {
 
 enum class TextureType : std::uint8_t { Texture2D, Texture2DArray, Texture3D };
 
-/// Texel formats of the passes' textures. Depth32F is sampled only (a depth map's red channel).
-enum class Format : std::uint8_t { R32F, RG32F, RGBA32F, RGBA16F, Depth32F };
+/// Texel formats of the passes' textures. Depth32F is sampled only (a depth map's red channel); RGBA8 is
+/// unsigned normalized (floats in [0, 1] through the Backend).
+enum class Format : std::uint8_t { R32F, RG32F, RGBA32F, RGBA16F, Depth32F, RGBA8 };
 
 /// Components per texel of `format` (1, 2 or 4) as read and written through the Backend (floats).
 int componentCount(Format format);
@@ -35,6 +36,12 @@ struct TextureDesc {
   int height = 0;    ///< texels, > 0
   int depth = 1;     ///< layers (Texture2DArray) or slices (Texture3D), > 0; 1 for Texture2D
   std::string label; ///< debug name shown by the API's tools
+};
+
+struct ComputeLimits {
+  int groupSize[3] = {0, 0, 0};  ///< GL_MAX_COMPUTE_WORK_GROUP_SIZE, maxComputeWorkGroupSize
+  int groupCount[3] = {0, 0, 0}; ///< GL_MAX_COMPUTE_WORK_GROUP_COUNT, maxComputeWorkGroupCount
+  int invocations = 0;           ///< GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, maxComputeWorkGroupInvocations
 };
 
 /// A backend's texture or buffer: an id it issued (create*) or imported (GlBackend: the GL object's
@@ -107,6 +114,10 @@ public:
   virtual std::string_view name() const = 0; ///< "OpenGL", "Vulkan", ...
   /// The largest width or height of a 2D texture (GL_MAX_TEXTURE_SIZE, maxImageDimension2D).
   virtual int maxTextureSize() const = 0;
+  /// The most layers of a 2D array texture (GL_MAX_ARRAY_TEXTURE_LAYERS, maxImageArrayLayers).
+  virtual int maxArrayLayers() const = 0;
+  /// Compute limits: work-group size per axis, work groups per dispatch per axis, invocations per group.
+  virtual ComputeLimits computeLimits() const = 0;
   /// What `texture` is (size, format, type; label empty). InvalidArgument if it is no texture of this
   /// backend.
   virtual TextureDesc describe(TextureId texture) const = 0;

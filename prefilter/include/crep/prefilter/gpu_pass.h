@@ -5,11 +5,13 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string_view>
 #include <vector>
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/prefilter/gpu_structs.h>
@@ -62,10 +64,13 @@ public:
     int workgroupBaseGroups = 1; ///< local_size_y: groups of bases per workgroup, >= 1
     int workgroupRegions = 1;    ///< local_size_z: regions per workgroup, >= 1
     bool memoryLimit = false;    ///< benchmarks only: the memory traffic alone, output meaningless
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
 
   struct FrameAttribs {
-    /// The rectified map: GL_TEXTURE_2D of mapWidth x mapHeight, any depth or float format (r = depth value).
+    /// The rectified map: 2D texture of mapWidth x mapHeight, any depth or float format (r = depth value); a
+    /// GL name, or a texture id of the backend.
     std::uint32_t rectifiedDepth = 0;
     const RectifiedLayout* layout = nullptr; ///< the map's layout (reference-ray profiles); not owned
     const Medium* medium = nullptr;   ///< weight extinction = weightExtinction(*medium), unless overridden
@@ -97,14 +102,14 @@ public:
   int layers() const noexcept { return layerCount(info_.options.bases); }
   /// GPU memory it owns, bytes: the filtered basis (filteredBasisBytes) and its buffers.
   std::size_t memoryBytes() const noexcept;
-  /// GL_TEXTURE_2D_ARRAY of the last run's basis (GL_LINEAR, clamp to edge; 3 bases when textured).
+  /// 2D array texture of the last run's basis (linear, clamp to edge; 3 bases when textured).
   std::uint32_t filteredBasisTexture() const noexcept {
-    return lastTextured_ ? texturedTexture_.get() : texture_.get();
+    return lastTextured_ ? texturedTexture_.id() : texture_.id();
   }
-  /// GL_TEXTURE_2D of the last textured run's prefix mean colour (GL_RGBA16F, GL_LINEAR), or 0.
-  std::uint32_t meanColorTexture() const noexcept { return meanColor_.get(); }
-  /// GL buffer of gpu::RegionWeights of the last run (for the near-plane correction).
-  std::uint32_t regionWeightsBuffer() const noexcept { return weightsBuffer_.get(); }
+  /// 2D texture of the last textured run's prefix mean colour (RGBA32F, linear), or 0.
+  std::uint32_t meanColorTexture() const noexcept { return meanColor_.id(); }
+  /// Buffer of gpu::RegionWeights of the last run (for the near-plane correction).
+  std::uint32_t regionWeightsBuffer() const noexcept { return weightsBuffer_.id(); }
   /// The filtered basis of the last run. Throws Error before the first run().
   FilteredBasisView filteredBasis() const;
 
@@ -118,11 +123,12 @@ private:
   void dispatch(const FrameAttribs& frame, const Plan& plan, std::size_t weightBytes);
 
   CreateInfo info_;
-  gl::Handle program_, programLocal_, texture_, sampler_, paramsBuffer_, weightsBuffer_, localBuffer_,
-      raysBuffer_;
-  /// Light textures: programs (directional, local), 3-basis array, mean colour; built on first use.
-  gl::Handle programTextured_[2], texturedTexture_, meanColor_;
-  std::size_t weightsCapacity_ = 0, raysCapacity_ = 0;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr; ///< null when moved from
+  gpu::Texture texture_;
+  gpu::Buffer paramsBuffer_, weightsBuffer_, localBuffer_, raysBuffer_;
+  /// Light textures: 3-basis array, mean colour; allocated on first use.
+  gpu::Texture texturedTexture_, meanColor_;
   bool ran_ = false, lastLocal_ = false, lastTextured_ = false;
   int lastLayoutRegions_ = 1;
   double lastExtinction_ = 0.0;

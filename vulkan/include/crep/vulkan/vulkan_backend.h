@@ -37,6 +37,8 @@ public:
 
   std::string_view name() const override { return "Vulkan"; }
   int maxTextureSize() const override;
+  int maxArrayLayers() const override;
+  ComputeLimits computeLimits() const override;
   TextureDesc describe(TextureId texture) const override;
   std::size_t bufferBytes(BufferId buffer) const override;
   void prepareProgram(const std::string& program, std::span<const ShaderDefine> defines) override;
