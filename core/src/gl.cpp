@@ -256,14 +256,6 @@ Handle createDynamicBuffer(std::size_t bytes) {
   return b;
 }
 
-void uploadGrowingBuffer(Handle& buffer, std::size_t& capacity, const void* data, std::size_t bytes) {
-  if (!buffer || capacity < bytes) {
-    buffer = createDynamicBuffer(bytes);
-    capacity = bytes;
-  }
-  glNamedBufferSubData(buffer.get(), 0, static_cast<GLsizeiptr>(bytes), data);
-}
-
 std::uint32_t scratchTexture2D(Handle& texture, int& w, int& h, std::uint32_t internalFormat, int width,
                                int height) {
   if (!texture || w < width || h < height) {

@@ -312,6 +312,12 @@ void GlBackend::dispatch(const Dispatch& d) {
   gl::checkError(d.label.c_str());
 }
 
+Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own) {
+  if (given != nullptr) return *given;
+  if (!own) own = std::make_unique<GlBackend>();
+  return *own;
+}
+
 void GlBackend::finish() {
   glFinish();
 }

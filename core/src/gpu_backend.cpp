@@ -156,6 +156,17 @@ void requireTexture(const Backend& backend, const char* parameter, TextureId tex
                           "has a format the pass cannot read");
 }
 
+void writeGrowing(Backend& backend, Buffer& buffer, std::span<const std::byte> bytes,
+                  std::string_view label) {
+  if (buffer.bytes() < bytes.size()) {
+    std::size_t capacity = 256;
+    while (capacity < bytes.size())
+      capacity *= 2;
+    buffer = Buffer(backend, capacity, label);
+  }
+  backend.writeBuffer(buffer.id(), 0, bytes);
+}
+
 Texture& Texture::operator=(Texture&& o) noexcept {
   if (this != &o) {
     if (backend_ != nullptr && id_ != 0) backend_->destroyTexture(id_);

@@ -39,39 +39,43 @@ void requireTreeLevels(const char* parameter, int mapWidth) {
                   " needs more than 16 tree levels");
 }
 
-void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
-                         const std::string& use) {
-  const long long size = gl::requireBuffer(
-      parameter, buffer, "must be the MinMaxTreePass::treeBuffer() of the map (" + use + ")");
-  const long long needed = static_cast<long long>(MinMaxTrees::rowStrideFor(mapWidth)) * mapHeight * 8;
-  if (size < needed)
-    invalid(parameter, std::to_string(size) + " bytes",
+namespace {
+/// InvalidArgument naming `parameter` unless `bytes` hold the trees of a mapWidth x mapHeight map.
+void requireTreeBytes(const char* parameter, std::size_t bytes, int mapWidth, int mapHeight) {
+  const std::size_t needed =
+      static_cast<std::size_t>(MinMaxTrees::rowStrideFor(mapWidth)) * static_cast<std::size_t>(mapHeight) * 8;
+  if (bytes < needed)
+    invalid(parameter, std::to_string(bytes) + " bytes",
             "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(mapWidth) + " x " +
                 std::to_string(mapHeight) + " map (" + std::to_string(needed) + " bytes)");
+}
+
+std::string treeBufferRequirement(const std::string& use) {
+  return "must be the MinMaxTreePass::treeBuffer() of the map (" + use + ")";
+}
+} // namespace
+
+void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,
+                         const std::string& use) {
+  const long long size = gl::requireBuffer(parameter, buffer, treeBufferRequirement(use));
+  requireTreeBytes(parameter, static_cast<std::size_t>(size), mapWidth, mapHeight);
 }
 
 void requireMinMaxBuffer(const gpu::Backend& backend, const char* parameter, std::uint32_t buffer,
                          int mapWidth, int mapHeight, const std::string& use) {
   if (backend.name() == "OpenGL") return requireMinMaxBuffer(parameter, buffer, mapWidth, mapHeight, use);
-  const std::string requirement = "must be the MinMaxTreePass::treeBuffer() of the map (" + use + ")";
-  if (buffer == 0) invalid(parameter, "0", requirement);
+  if (buffer == 0) invalid(parameter, "0", treeBufferRequirement(use));
   std::size_t size = 0;
   try {
     size = backend.bufferBytes(buffer);
   } catch (const InvalidArgument&) {
-    invalid(parameter, std::to_string(buffer), requirement);
+    invalid(parameter, std::to_string(buffer), treeBufferRequirement(use));
   }
-  const std::size_t needed =
-      static_cast<std::size_t>(MinMaxTrees::rowStrideFor(mapWidth)) * static_cast<std::size_t>(mapHeight) * 8;
-  if (size < needed)
-    invalid(parameter, std::to_string(size) + " bytes",
-            "must be a MinMaxTreePass::treeBuffer() of a " + std::to_string(mapWidth) + " x " +
-                std::to_string(mapHeight) + " map (" + std::to_string(needed) + " bytes)");
+  requireTreeBytes(parameter, size, mapWidth, mapHeight);
 }
 
 MinMaxTreePass::MinMaxTreePass(const CreateInfo& info) : info_(info) {
-  if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
-  backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
   gpu::checkTextureSize(*backend_, "MinMaxTreePass::CreateInfo.mapWidth/mapHeight", info.mapWidth,
                         info.mapHeight);
   requireTreeLevels("MinMaxTreePass::CreateInfo.mapWidth", info.mapWidth);

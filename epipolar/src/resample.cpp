@@ -150,8 +150,7 @@ RectifiedMap resampleShadowMap(std::shared_ptr<const RectifiedLayout> layout, in
 // ShadowResamplePass
 
 ShadowResamplePass::ShadowResamplePass(const CreateInfo& info) : info_(info) {
-  if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
-  backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
   gpu::checkTextureSize(*backend_, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight", info.mapWidth,
                         info.mapHeight);
   layoutBuffers_ = gpu::LayoutBuffers(backend_);

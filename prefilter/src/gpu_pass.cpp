@@ -308,8 +308,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.workgroupBaseGroups", info.workgroupBaseGroups, 1);
   requireAtLeast("PrefilterPass::CreateInfo.workgroupRegions", info.workgroupRegions, 1);
 
-  if (info.backend == nullptr) ownBackend_ = std::make_unique<gpu::GlBackend>();
-  backend_ = info.backend != nullptr ? info.backend : ownBackend_.get();
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
   gpu::Backend& b = *backend_;
   const int maxSize = b.maxTextureSize();
   const std::string limitName =
@@ -462,20 +461,6 @@ void PrefilterPass::prepareTextured(bool local) {
   b.prepareProgram(stage.path, stage.defines);
 }
 
-namespace {
-/// `buffer` holding at least `bytes` (grown to the next power of two), then `bytes` of `data` written at 0.
-void writeGrowing(gpu::Backend& backend, gpu::Buffer& buffer, const void* data, std::size_t bytes,
-                  const char* label) {
-  if (buffer.bytes() < bytes) {
-    std::size_t capacity = 256;
-    while (capacity < bytes)
-      capacity *= 2;
-    buffer = gpu::Buffer(backend, capacity, label);
-  }
-  backend.writeBuffer(buffer.id(), 0, {static_cast<const std::byte*>(data), bytes});
-}
-} // namespace
-
 std::size_t PrefilterPass::upload(const FrameAttribs& frame, const Plan& p) {
   const int W = info_.mapWidth, H = info_.mapHeight;
   const std::vector<DistanceProfile> profiles =
@@ -483,7 +468,8 @@ std::size_t PrefilterPass::upload(const FrameAttribs& frame, const Plan& p) {
   const std::vector<gpu::RegionWeights> weights = gpuRegionWeights(profiles, info_.options.weights, p.n);
   if (p.local) uploadLocalLight(frame, p, profiles);
   const std::size_t bytes = weights.size() * sizeof(gpu::RegionWeights);
-  writeGrowing(*backend_, weightsBuffer_, weights.data(), bytes, "PrefilterPass: region weights");
+  gpu::writeGrowing(*backend_, weightsBuffer_, std::as_bytes(std::span(weights)),
+                    "PrefilterPass: region weights");
 
   gpu::PrefilterParams params;
   params.mapSize = glm::ivec4(W, H, p.R, p.n);
@@ -511,8 +497,7 @@ void PrefilterPass::uploadLocalLight(const FrameAttribs& frame, const Plan& p,
       rays[k] = gpu::RegionRay(direction, std::isfinite(t0) ? static_cast<float>(t0) : -1.0f);
     }
   }
-  writeGrowing(*backend_, raysBuffer_, rays.data(), rays.size() * sizeof(gpu::RegionRay),
-               "PrefilterPass: region rays");
+  gpu::writeGrowing(*backend_, raysBuffer_, std::as_bytes(std::span(rays)), "PrefilterPass: region rays");
   if (!localBuffer_)
     localBuffer_ = gpu::Buffer(*backend_, sizeof(gpu::LocalLightParams), "PrefilterPass: light");
   gpu::LocalLightParams lp =

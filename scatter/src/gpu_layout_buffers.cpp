@@ -43,22 +43,13 @@ void LayoutBuffers::requireUploadable(const GpuLayoutData& d, int mapHeight, con
 
 LayoutKind LayoutBuffers::upload(const GpuLayoutData& d, int mapHeight, const char* parameter) {
   requireUploadable(d, mapHeight, parameter);
-  if (backend_ == nullptr) {
-    ownBackend_ = std::make_unique<GlBackend>();
-    backend_ = ownBackend_.get();
-  }
+  if (backend_ == nullptr) backend_ = &givenOrGl(nullptr, ownBackend_); // at the first upload: GL is current
   if (!block_) block_ = Buffer(*backend_, kMaxBlockBytes, "LayoutBuffers: layout block");
   backend_->writeBuffer(block_.id(), 0, std::as_bytes(std::span(d.block)));
   hasRows_ = !d.rows.empty();
   if (hasRows_) {
-    // Grown to the next power of two when too small (an epipolar layout's slice count changes per frame).
-    if (rows_.bytes() < d.rows.size()) {
-      std::size_t capacity = 256;
-      while (capacity < d.rows.size())
-        capacity *= 2;
-      rows_ = Buffer(*backend_, capacity, "LayoutBuffers: row table");
-    }
-    backend_->writeBuffer(rows_.id(), 0, std::as_bytes(std::span(d.rows)));
+    // An epipolar layout's slice count changes per frame.
+    writeGrowing(*backend_, rows_, d.rows, "LayoutBuffers: row table");
   }
   kind_ = d.kind;
   return kind_;

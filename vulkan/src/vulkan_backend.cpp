@@ -150,7 +150,7 @@ struct VulkanBackend::Impl {
   void transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to);
   void submit();
   VkShaderModule module(const std::string& program, std::span<const ShaderDefine> defines);
-  Pipeline& pipeline(const Dispatch& d);
+  Pipeline& pipeline(const Dispatch& d, std::size_t pushBytes);
   ImageEntry& image(TextureId id, const char* what);
   BufferEntry& buffer(BufferId id, const char* what);
   ~Impl();
@@ -432,7 +432,7 @@ VkShaderModule VulkanBackend::Impl::module(const std::string& program,
   return m;
 }
 
-Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d) {
+Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d, std::size_t pushBytes) {
   // One pipeline per variant and resource signature (the descriptor layout follows the dispatch).
   std::string key = variantKey(d.program, d.defines) + "\n#";
   std::vector<VkDescriptorSetLayoutBinding> bindings;
@@ -445,8 +445,7 @@ Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d) {
     bindings.push_back(b);
     key += " " + std::to_string(b.binding) + ":" + std::to_string(b.descriptorType);
   }
-  const std::vector<std::byte> push = packPushConstants(d.push);
-  key += " push " + std::to_string(push.size());
+  key += " push " + std::to_string(pushBytes);
   if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
 
   Pipeline p;
@@ -456,12 +455,12 @@ Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d) {
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
   check(vkCreateDescriptorSetLayout(device, &li, nullptr, &p.setLayout), "vkCreateDescriptorSetLayout");
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, static_cast<std::uint32_t>(push.size())};
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, static_cast<std::uint32_t>(pushBytes)};
   VkPipelineLayoutCreateInfo pl{};
   pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   pl.setLayoutCount = 1;
   pl.pSetLayouts = &p.setLayout;
-  pl.pushConstantRangeCount = push.empty() ? 0 : 1;
+  pl.pushConstantRangeCount = pushBytes == 0 ? 0 : 1;
   pl.pPushConstantRanges = &range;
   check(vkCreatePipelineLayout(device, &pl, nullptr, &p.layout), "vkCreatePipelineLayout");
   VkComputePipelineCreateInfo ci{};
@@ -782,8 +781,8 @@ std::vector<float> VulkanBackend::readTexture(TextureId texture) {
 
 void VulkanBackend::dispatch(const Dispatch& d) {
   Impl& v = *impl_;
-  const Pipeline& p = v.pipeline(d);
   const std::vector<std::byte> push = packPushConstants(d.push);
+  const Pipeline& p = v.pipeline(d, push.size());
   std::vector<VkDescriptorImageInfo> imageInfos(d.resources.size());
   std::vector<VkDescriptorBufferInfo> bufferInfos(d.resources.size());
   std::vector<VkWriteDescriptorSet> writes;

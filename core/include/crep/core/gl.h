@@ -67,9 +67,6 @@ Handle createTexture2D(std::uint32_t internalFormat, int width, int height,
 Handle createClampSampler(std::uint32_t filter);
 /// A buffer of `bytes` bytes with GL_DYNAMIC_STORAGE_BIT (filled with glNamedBufferSubData).
 Handle createDynamicBuffer(std::size_t bytes);
-/// Uploads `bytes` bytes to `buffer`, first (re)creating it with createDynamicBuffer when it is empty or
-/// smaller than that; `capacity` tracks its size. The per-frame storage buffers of the passes.
-void uploadGrowingBuffer(Handle& buffer, std::size_t& capacity, const void* data, std::size_t bytes);
 /// An owned texture of at least width x height in `internalFormat`, (re)allocated when smaller: scratch
 /// output for a pass whose caller does not want that output. `capacityWidth/Height` track its size.
 std::uint32_t scratchTexture2D(Handle& texture, int& capacityWidth, int& capacityHeight,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <memory>
 #include <string>
 
 #include <crep/core/gl.h>
@@ -40,5 +41,8 @@ private:
   std::map<std::string, gl::Handle> programs_; ///< by program and defines
   gl::Handle& program(const std::string& path, std::span<const ShaderDefine> defines);
 };
+
+/// `given`, or else a GlBackend made into `own` on the current GL context: the default backend of a pass.
+Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own);
 
 } // namespace crep::gpu

@@ -154,6 +154,11 @@ void checkTextureSize(const Backend& backend, const char* parameter, int width, 
 void requireTexture(const Backend& backend, const char* parameter, TextureId texture, int width, int height,
                     std::initializer_list<Format> formats);
 
+class Buffer;
+/// Writes `bytes` at offset 0 of `buffer`, first replacing it by a buffer of `backend` of the next power of
+/// two >= bytes.size() (at least 256) when it is smaller: per-frame tables whose size changes.
+void writeGrowing(Backend& backend, Buffer& buffer, std::span<const std::byte> bytes, std::string_view label);
+
 /// A texture or buffer of a Backend, destroyed with it. Move-only.
 class Texture {
 public:
