@@ -51,6 +51,17 @@ int vulkanBindingBase(const std::string& kind) {
 }
 
 namespace {
+/// Writes `text` to <dir>/<flat>.<pid>.comp: tests of one binary run as parallel processes (ctest -j)
+/// and may take the same pass, so each process writes its own file.
+std::filesystem::path writeScratch(const std::filesystem::path& dir, const std::string& flat,
+                                   const std::string& text) {
+  const std::filesystem::path source = dir / (flat + "." + std::to_string(::getpid()) + ".comp");
+  std::ofstream out(source, std::ios::binary);
+  out << text;
+  out.close();
+  REQUIRE_MESSAGE(out.good(), "cannot write " << source.string());
+  return source;
+}
 std::filesystem::path requireTool(const char* program, const char* package) {
   const std::optional<std::filesystem::path> path = findInPath(program);
   REQUIRE_MESSAGE(path.has_value(), program << " not found in PATH: install " << package
@@ -66,8 +77,8 @@ RunResult compileComputeForVulkan(const std::string& name, const std::string& te
   std::filesystem::create_directories(dir);
   std::string flat = name;
   std::replace(flat.begin(), flat.end(), '/', '_');
-  const std::filesystem::path source = dir / (flat + ".comp"), spirv = dir / (flat + ".spv");
-  std::ofstream(source, std::ios::binary) << text;
+  const std::filesystem::path source = writeScratch(dir, flat, text),
+                              spirv = dir / (flat + "." + std::to_string(::getpid()) + ".spv");
   const std::string unit = std::to_string(vulkanBindingBase("UNIT"));
   RunResult r = runCommand("'" + glslc.string() + "' --target-env=vulkan1.1 -Werror -ftexture-binding-base " +
                            unit + " -fsampler-binding-base " + unit + " -fimage-binding-base " +
@@ -85,9 +96,11 @@ RunResult preprocessCompute(const std::string& name, const std::string& text) {
   std::filesystem::create_directories(dir);
   std::string flat = name;
   std::replace(flat.begin(), flat.end(), '/', '_');
-  const std::filesystem::path source = dir / (flat + ".comp");
-  std::ofstream(source, std::ios::binary) << text;
-  return runCommand("'" + validator.string() + "' -E '" + source.string() + "'");
+  const std::filesystem::path source = writeScratch(dir, flat, text);
+  RunResult r = runCommand("'" + validator.string() + "' -E '" + source.string() + "'");
+  std::error_code ignored;
+  std::filesystem::remove(source, ignored);
+  return r;
 }
 
 bool isLibraryPass(std::string_view path) {

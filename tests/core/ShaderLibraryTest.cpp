@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unistd.h>
 #include <vector>
 
 using crep::ExpandedShader;
@@ -54,7 +55,9 @@ RunResult glslang(const std::string& name, const std::string& extension, const s
       validator.has_value(),
       "glslangValidator not found in PATH: install glslang-tools (apt-get install glslang-tools, part "
       "of the README's set-up command)");
-  const std::filesystem::path dir = std::filesystem::path(CREP_TEST_OUTPUT_DIR) / "glslang";
+  // One folder per process: the test cases run as parallel processes (ctest -j) on the same files.
+  const std::filesystem::path dir =
+      std::filesystem::path(CREP_TEST_OUTPUT_DIR) / "glslang" / std::to_string(::getpid());
   std::filesystem::create_directories(dir);
   std::string flat = name;
   std::replace(flat.begin(), flat.end(), '/', '_');
