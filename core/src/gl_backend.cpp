@@ -285,7 +285,11 @@ void GlBackend::dispatch(const Dispatch& d) {
     }
     }
   }
-  if (d.groups.x > 0 && d.groups.y > 0 && d.groups.z > 0)
+  if (d.indirect != 0) {
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, d.indirect);
+    glDispatchComputeIndirect(static_cast<GLintptr>(d.indirectOffset));
+    glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+  } else if (d.groups.x > 0 && d.groups.y > 0 && d.groups.z > 0)
     glDispatchCompute(d.groups.x, d.groups.y, d.groups.z);
   // Every later use of what the dispatch wrote (a choice for simplicity: a GPU driver may stall on a full
   // barrier where the passes' own narrower bits would not; the next dispatch's reads decide on real

@@ -44,18 +44,6 @@ std::string str(long long v) {
   return std::to_string(v);
 }
 
-int getInteger(GLenum pname) {
-  GLint v = 0;
-  glGetIntegerv(pname, &v);
-  return v;
-}
-
-int getIndexed(GLenum pname, GLuint index) {
-  GLint v = 0;
-  glGetIntegeri_v(pname, index, &v);
-  return v;
-}
-
 int ceilDiv(int a, int b) {
   return (a + b - 1) / b;
 }
@@ -99,17 +87,6 @@ void checkWorkgroup(const gpu::ComputeLimits& limits, const char* const names[3]
   if (invocations > maxInvocations)
     throw GlError(std::string(names[0]) + " x " + names[1] + " x " + names[2] + " = " + str(invocations) +
                   " exceeds GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS = " + str(maxInvocations));
-}
-
-/// The same against the current GL context's limits (EvaluatePass, still on GL).
-void checkWorkgroup(const char* const names[3], const int local[3], const int groups[3]) {
-  gpu::ComputeLimits limits;
-  for (GLuint axis = 0; axis < 3; ++axis) {
-    limits.groupSize[axis] = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_SIZE, axis);
-    limits.groupCount[axis] = getIndexed(GL_MAX_COMPUTE_WORK_GROUP_COUNT, axis);
-  }
-  limits.invocations = getInteger(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS);
-  checkWorkgroup(limits, names, local, groups);
 }
 
 gpu::Format basisFormat(StorageFormat format) {
@@ -629,58 +606,6 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
 }
 } // namespace
 
-EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
-  validateBases(info.bases, "EvaluatePass::CreateInfo.bases");
-  crep::validate(info.options, "EvaluatePass::CreateInfo.options");
-  if (info.outputFormat != StorageFormat::RGBA32F && info.outputFormat != StorageFormat::RGBA16F)
-    invalid("EvaluatePass::CreateInfo.outputFormat", storageFormatToken(info.outputFormat),
-            "must be RGBA32F or RGBA16F");
-  requireAtLeast("EvaluatePass::CreateInfo.workgroupWidth", info.workgroupWidth, 1);
-  requireAtLeast("EvaluatePass::CreateInfo.workgroupHeight", info.workgroupHeight, 1);
-  {
-    const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
-                            "EvaluatePass::CreateInfo.workgroupHeight", "(none)"};
-    const int local[3] = {info.workgroupWidth, info.workgroupHeight, 1};
-    const int groups[3] = {1, 1, 1};
-    checkWorkgroup(names, local, groups);
-  }
-  program_ = buildProgram(evaluateStages(info, -1));
-  basisSampler_ =
-      gl::createClampSampler(info.options.sampling == Sampling::Bilinear ? GL_LINEAR : GL_NEAREST);
-  depthSampler_ = gl::createClampSampler(GL_NEAREST);
-  if (usesVisibilityTable(info.options)) tableSampler_ = gl::createClampSampler(GL_LINEAR);
-  if (usesScatteringPrefix(info.options))
-    prefixPrograms_[0] = buildProgram(prefixStages(info, -1));
-  else if (usesVisibilityTable(info.options))
-    tableProgram_ = buildProgram({{ShaderStage::Compute,
-                                   "passes/prefilter/visibility_table.comp",
-                                   {{"CREP_BASES", str(info.bases)},
-                                    {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
-                                    {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}});
-  scatteringBuffer_ = gl::createDynamicBuffer(sizeof(gpu::ScatteringParams));
-  evaluateBuffer_ = gl::createDynamicBuffer(sizeof(gpu::EvaluateParams));
-  gl::checkError("EvaluatePass: samplers and buffers");
-}
-
-std::size_t EvaluatePass::memoryBytes() const noexcept {
-  if (!basisSampler_) return 0; // moved from
-  const std::size_t coefficients = tableCoefficients_
-                                       ? static_cast<std::size_t>(info_.options.visibilityTableSamples) *
-                                             static_cast<std::size_t>(layerCount(info_.bases)) * 16
-                                       : 0;
-  const std::size_t texels = static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_);
-  const std::size_t airlight =
-      airlightTable_ ? std::size_t(AirlightTable::kDefaultUSamples) * AirlightTable::kDefaultXiSamples * 8
-                     : 0;
-  const std::size_t sections = sectionTexture_ ? texels * 16 : 0;
-  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + coefficients + airlight + sections +
-         sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
-}
-
-EvaluatePass::~EvaluatePass() = default;
-EvaluatePass::EvaluatePass(EvaluatePass&&) noexcept = default;
-EvaluatePass& EvaluatePass::operator=(EvaluatePass&&) noexcept = default;
-
 std::size_t PrefilterPass::memoryBytes() const noexcept {
   if (backend_ == nullptr) return 0; // moved from
   const std::size_t textured =
@@ -695,13 +620,139 @@ std::size_t PrefilterPass::memoryBytes() const noexcept {
          (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }
 
+namespace {
+/// The region visibility table's program (EvaluateOptions::visibilityTableSamples without the prefix table).
+ShaderStageSource tableStage(const EvaluatePass::CreateInfo& info) {
+  return {ShaderStage::Compute,
+          "passes/prefilter/visibility_table.comp",
+          {{"CREP_BASES", str(info.bases)},
+           {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
+           {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}};
+}
+
+/// A dispatch of the first stage of `stages` (the passes' programs have one).
+gpu::Dispatch dispatchOf(const char* label, const std::vector<ShaderStageSource>& stages) {
+  gpu::Dispatch d;
+  d.label = label;
+  d.program = stages[0].path;
+  d.defines = stages[0].defines;
+  return d;
+}
+
+/// Level 0 of `texture` in GL's terms on any backend: the GL query on OpenGL, else the backend's description
+/// (target and internal format as the GL enums of its type and format). InvalidArgument naming `parameter`.
+gl::TextureLevel textureLevelOf(const gpu::Backend& backend, const char* parameter, std::uint32_t texture) {
+  if (backend.name() == "OpenGL") return gl::textureLevel(parameter, texture);
+  if (texture == 0) invalid(parameter, "0", "must be a texture");
+  gpu::TextureDesc d;
+  try {
+    d = backend.describe(texture);
+  } catch (const InvalidArgument&) {
+    invalid(parameter, str(texture),
+            "must be a texture of the pass's " + std::string(backend.name()) + " backend");
+  }
+  static constexpr GLenum formats[] = {GL_R32F, GL_RG32F, GL_RGBA32F, GL_RGBA16F, GL_DEPTH_COMPONENT32F,
+                                       GL_RGBA8};
+  gl::TextureLevel level;
+  level.target = d.type == gpu::TextureType::Texture2D        ? GL_TEXTURE_2D
+                 : d.type == gpu::TextureType::Texture2DArray ? GL_TEXTURE_2D_ARRAY
+                                                              : GL_TEXTURE_3D;
+  level.width = d.width;
+  level.height = d.height;
+  level.depth = d.depth;
+  level.internalFormat = formats[static_cast<int>(d.format)];
+  return level;
+}
+
+/// gl::requireDepthFormat on any backend (other backends: Depth32F or R32F).
+void requireDepthFormatOf(const gpu::Backend& backend, const char* parameter, std::uint32_t texture) {
+  if (backend.name() == "OpenGL") return gl::requireDepthFormat(parameter, texture);
+  const GLenum format = textureLevelOf(backend, parameter, texture).internalFormat;
+  if (format != GL_DEPTH_COMPONENT32F && format != GL_R32F)
+    invalid(parameter, "texture " + str(texture), "must be a depth (Depth32F) or R32F texture");
+}
+
+/// gl::requireBuffer on any backend.
+void requireBufferOf(const gpu::Backend& backend, const char* parameter, std::uint32_t buffer,
+                     const std::string& requirement) {
+  if (backend.name() == "OpenGL") {
+    gl::requireBuffer(parameter, buffer, requirement);
+    return;
+  }
+  if (buffer == 0) invalid(parameter, "0", requirement);
+  try {
+    backend.bufferBytes(buffer);
+  } catch (const InvalidArgument&) {
+    invalid(parameter, str(buffer),
+            requirement + " of the pass's " + std::string(backend.name()) + " backend");
+  }
+}
+} // namespace
+
+EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
+  validateBases(info.bases, "EvaluatePass::CreateInfo.bases");
+  crep::validate(info.options, "EvaluatePass::CreateInfo.options");
+  if (info.outputFormat != StorageFormat::RGBA32F && info.outputFormat != StorageFormat::RGBA16F)
+    invalid("EvaluatePass::CreateInfo.outputFormat", storageFormatToken(info.outputFormat),
+            "must be RGBA32F or RGBA16F");
+  requireAtLeast("EvaluatePass::CreateInfo.workgroupWidth", info.workgroupWidth, 1);
+  requireAtLeast("EvaluatePass::CreateInfo.workgroupHeight", info.workgroupHeight, 1);
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::Backend& b = *backend_;
+  layoutBuffers_ = gpu::LayoutBuffers(backend_);
+  {
+    const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
+                            "EvaluatePass::CreateInfo.workgroupHeight", "(none)"};
+    const int local[3] = {info.workgroupWidth, info.workgroupHeight, 1};
+    const int groups[3] = {1, 1, 1};
+    checkWorkgroup(b.computeLimits(), names, local, groups);
+  }
+  const auto prepare = [&b](const ShaderStageSource& s) { b.prepareProgram(s.path, s.defines); };
+  prepare(evaluateStages(info, -1)[0]);
+  if (usesScatteringPrefix(info.options))
+    prepare(prefixStages(info, -1)[0]);
+  else if (usesVisibilityTable(info.options))
+    prepare(tableStage(info));
+  scatteringBuffer_ = gpu::Buffer(b, sizeof(gpu::ScatteringParams), "EvaluatePass: scattering block");
+  evaluateBuffer_ = gpu::Buffer(b, sizeof(gpu::EvaluateParams), "EvaluatePass: evaluate block");
+}
+
+std::size_t EvaluatePass::memoryBytes() const noexcept {
+  if (backend_ == nullptr) return 0; // moved from
+  const std::size_t texels = static_cast<std::size_t>(tableWidth_) * static_cast<std::size_t>(tableHeight_);
+  const std::size_t airlight =
+      airlightTable_ ? std::size_t(AirlightTable::kDefaultUSamples) * AirlightTable::kDefaultXiSamples * 8
+                     : 0;
+  const std::size_t sections = sectionTexture_ ? texels * 16 : 0;
+  return texels * (usesScatteringPrefix(info_.options) ? 16 : 4) + tableCoefficients_.bytes() + airlight +
+         sections + sizeof(gpu::ScatteringParams) + sizeof(gpu::EvaluateParams);
+}
+
+EvaluatePass::~EvaluatePass() = default;
+
+EvaluatePass::EvaluatePass(EvaluatePass&& o) noexcept
+    : info_(o.info_), ownBackend_(std::move(o.ownBackend_)), backend_(std::exchange(o.backend_, nullptr)),
+      scatteringBuffer_(std::move(o.scatteringBuffer_)), evaluateBuffer_(std::move(o.evaluateBuffer_)),
+      localBuffer_(std::move(o.localBuffer_)), tableCoefficients_(std::move(o.tableCoefficients_)),
+      airlightTable_(std::move(o.airlightTable_)), sectionTexture_(std::move(o.sectionTexture_)),
+      tableTexture_(std::move(o.tableTexture_)), airlightG_(o.airlightG_), tableBasis_(o.tableBasis_),
+      tableVariant_(o.tableVariant_), tableMargin_(o.tableMargin_), tableWidth_(o.tableWidth_),
+      tableHeight_(o.tableHeight_), layoutBuffers_(std::move(o.layoutBuffers_)) {}
+
+EvaluatePass& EvaluatePass::operator=(EvaluatePass&& o) noexcept {
+  if (this != &o) {
+    this->~EvaluatePass(); // the textures and buffers go before the backend that made them
+    new (this) EvaluatePass(std::move(o));
+  }
+  return *this;
+}
+
 /// A validated frame of the evaluation (EvaluatePass::validate) and what run() derives from it.
 struct EvaluatePass::Plan {
   bool local = false, textured = false, froxels = false, pixels = false, projective = true;
   bool table = false, prefix = false, reuse = false;
   const gpu::SampleList* list = nullptr;
   FroxelDepthRange froxelRange;
-  GLenum volumeFormat = GL_RGBA32F;
   /// The pixels' camera depth size, or with a work list the camera image's size (0 for froxels alone).
   int imageWidth = 0, imageHeight = 0;
   std::optional<GpuLayoutData> layoutData; ///< a non-projective layout's block
@@ -714,13 +765,13 @@ struct EvaluatePass::Plan {
 namespace {
 
 /// EvaluatePass::FrameAttribs::basis against the pass (`f`: the FrameAttribs' name and a dot).
-void validateBasisView(const EvaluatePass::CreateInfo& info, const FilteredBasisView& basis,
-                       const std::string& f) {
+void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateInfo& info,
+                       const FilteredBasisView& basis, const std::string& f) {
   if (basis.bases != info.bases)
     invalid(f + "basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info.bases));
   const int basisLayers = (basis.textured ? 3 : 1) * layerCount(basis.bases);
-  const gl::TextureLevel b = gl::textureLevel((f + "basis.texture").c_str(), basis.texture);
+  const gl::TextureLevel b = textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
   if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
       b.depth < basisLayers)
     invalid(f + "basis.texture", "texture " + str(basis.texture),
@@ -729,7 +780,10 @@ void validateBasisView(const EvaluatePass::CreateInfo& info, const FilteredBasis
   if (basis.textured) {
     // Light textures (prefilter.h): the textured variants exist for the scattering prefix table (the
     // default) and the direct path without a table.
-    gl::requireTexture2D((f + "basis.meanColor").c_str(), basis.meanColor, basis.width, basis.height);
+    const gl::TextureLevel mean = textureLevelOf(backend, (f + "basis.meanColor").c_str(), basis.meanColor);
+    if (mean.target != GL_TEXTURE_2D || mean.width != basis.width || mean.height != basis.height)
+      invalid(f + "basis.meanColor", "texture " + str(basis.meanColor),
+              "must be a GL_TEXTURE_2D of " + sizeString(basis.width, basis.height));
     if (info.options.nearPlaneCorrection)
       invalid(f + "basis.textured", "true",
               "a light texture is not supported with CreateInfo.options.nearPlaneCorrection");
@@ -742,23 +796,23 @@ void validateBasisView(const EvaluatePass::CreateInfo& info, const FilteredBasis
               "not with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
   }
   if (info.options.nearPlaneCorrection)
-    gl::requireBuffer((f + "basis.regionWeights").c_str(), basis.regionWeights,
-                      "must name the region-weights buffer (near-plane correction)");
+    requireBufferOf(backend, (f + "basis.regionWeights").c_str(), basis.regionWeights,
+                    "must name the region-weights buffer (near-plane correction)");
 }
 
 /// Froxel volumes (prefilter.h, "Froxel volumes"): the directional light's evaluation at the cells.
-void validateFroxels(const EvaluatePass::CreateInfo& info, const EvaluatePass::FroxelTarget& froxels,
-                     const Camera& camera, bool local, const std::string& f, FroxelDepthRange& range,
-                     GLenum& volumeFormat) {
+FroxelDepthRange validateFroxels(const gpu::Backend& backend, const EvaluatePass::CreateInfo& info,
+                                 const EvaluatePass::FroxelTarget& froxels, const Camera& camera, bool local,
+                                 const std::string& f) {
   const std::string owner = f + "froxels";
   validate(froxels.grid, owner.c_str());
   validateFroxelJitter(froxels.jitter, owner + ".jitter");
-  range = froxelDepthRange(froxels.grid, camera, owner.c_str());
+  const FroxelDepthRange range = froxelDepthRange(froxels.grid, camera, owner.c_str());
   if (local) invalid(owner, "with localLight", "froxel volumes are filled for the directional light only");
   if (info.memoryLimit)
     invalid(owner, "a volume",
             "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the per-pixel pass)");
-  const gl::TextureLevel v = gl::textureLevel((owner + ".volume").c_str(), froxels.volume);
+  const gl::TextureLevel v = textureLevelOf(backend, (owner + ".volume").c_str(), froxels.volume);
   const FroxelGrid& g = froxels.grid;
   if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
     invalid(owner + ".volume", "texture " + str(froxels.volume),
@@ -766,24 +820,24 @@ void validateFroxels(const EvaluatePass::CreateInfo& info, const EvaluatePass::F
   if (v.width != g.width || v.height != g.height || v.depth != g.depth)
     invalid(owner + ".volume", sizeString(v.width, v.height) + " x " + str(v.depth),
             "must have the grid's size " + sizeString(g.width, g.height) + " x " + str(g.depth));
-  volumeFormat = v.internalFormat;
   const std::string depthName = owner + ".grid.depth";
   const char* names[3] = {"EvaluatePass::CreateInfo.workgroupWidth",
                           "EvaluatePass::CreateInfo.workgroupHeight", depthName.c_str()};
   const int localSize[3] = {info.workgroupWidth, info.workgroupHeight, 1};
   const int groups[3] = {ceilDiv(g.width, info.workgroupWidth), ceilDiv(g.height, info.workgroupHeight),
                          g.depth};
-  checkWorkgroup(names, localSize, groups);
+  checkWorkgroup(backend.computeLimits(), names, localSize, groups);
+  return range;
 }
 
 /// The camera depth and output textures of the per-pixel evaluation; returns the depth's level.
-gl::TextureLevel validatePixelTextures(const EvaluatePass::CreateInfo& info,
+gl::TextureLevel validatePixelTextures(const gpu::Backend& backend, const EvaluatePass::CreateInfo& info,
                                        const EvaluatePass::FrameAttribs& frame, const std::string& f) {
-  const gl::TextureLevel depth = gl::textureLevel((f + "cameraDepth").c_str(), frame.cameraDepth);
+  const gl::TextureLevel depth = textureLevelOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
   if (depth.target != GL_TEXTURE_2D)
     invalid(f + "cameraDepth", "texture " + str(frame.cameraDepth), "must be a GL_TEXTURE_2D");
-  gl::requireDepthFormat((f + "cameraDepth").c_str(), frame.cameraDepth);
-  const gl::TextureLevel out = gl::textureLevel((f + "output").c_str(), frame.output);
+  requireDepthFormatOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
+  const gl::TextureLevel out = textureLevelOf(backend, (f + "output").c_str(), frame.output);
   if (out.target != GL_TEXTURE_2D || out.internalFormat != internalFormat(info.outputFormat))
     invalid(f + "output", "texture " + str(frame.output),
             std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info.outputFormat));
@@ -791,6 +845,43 @@ gl::TextureLevel validatePixelTextures(const EvaluatePass::CreateInfo& info,
     invalid(f + "output", sizeString(out.width, out.height),
             "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
   return depth;
+}
+
+/// A work list on any backend (gpu::validateSampleList and gpu::listImageSize on OpenGL); returns the camera
+/// image's size.
+gl::TextureLevel validateList(const gpu::Backend& backend, const EvaluatePass::FrameAttribs& frame,
+                              const std::string& owner) {
+  if (backend.name() == "OpenGL") {
+    const gl::TextureLevel image =
+        gpu::listImageSize(frame.imageWidth, frame.imageHeight, frame.cameraDepth, owner);
+    gpu::validateSampleList(*frame.list, owner + ".list");
+    return image;
+  }
+  const gpu::SampleList& list = *frame.list;
+  const std::string l = owner + ".list";
+  requireBufferOf(backend, (l + ".buffer").c_str(), list.buffer, "must be a work-list buffer");
+  const std::size_t needed = static_cast<std::size_t>(gpu::kSampleListHeaderBytes) +
+                             static_cast<std::size_t>(std::max(list.capacity, 0)) * 4;
+  if (list.capacity < 1 || backend.bufferBytes(list.buffer) < needed)
+    invalid(l + ".buffer", str(list.buffer),
+            "must hold the header and capacity = " + str(list.capacity) + " entries (capacity >= 1)");
+  for (const auto& [name, texture] :
+       {std::pair{".coordinates", list.coordinates}, std::pair{".output", list.output}}) {
+    const gl::TextureLevel t = textureLevelOf(backend, (l + name).c_str(), texture);
+    if (t.target != GL_TEXTURE_2D || t.internalFormat != GL_RGBA32F || t.width != list.width ||
+        t.height != list.height)
+      invalid(l + name, "texture " + str(texture),
+              "must be a GL_TEXTURE_2D of format GL_RGBA32F, " + sizeString(list.width, list.height));
+  }
+  if (frame.imageWidth == 0 && frame.imageHeight == 0)
+    return textureLevelOf(backend, (owner + ".cameraDepth").c_str(), frame.cameraDepth);
+  if (frame.imageWidth <= 0 || frame.imageHeight <= 0)
+    invalid(owner + ".imageWidth/imageHeight", sizeString(frame.imageWidth, frame.imageHeight),
+            "must both be > 0 (or both 0: cameraDepth's size)");
+  gl::TextureLevel image;
+  image.width = frame.imageWidth;
+  image.height = frame.imageHeight;
+  return image;
 }
 
 } // namespace
@@ -809,23 +900,20 @@ EvaluatePass::Plan EvaluatePass::plan(const FrameAttribs& frame, std::string_vie
   if (frame.medium == nullptr) invalid(f + "medium", "null", "must be set");
   if (frame.layout == nullptr) invalid(f + "layout", "null", "must be set");
   const FilteredBasisView& basis = frame.basis;
-  validateBasisView(info_, basis, f);
+  validateBasisView(*backend_, info_, basis, f);
   p.textured = basis.textured;
   p.froxels = frame.froxels.volume != 0;
   // Work lists (Yusov 2012, Sec. 6.4 and 6.7): the list's entries instead of every pixel.
   p.list = frame.list;
   p.pixels = !p.list && (frame.output != 0 || !p.froxels);
-  if (p.froxels)
-    validateFroxels(info_, frame.froxels, *frame.camera, p.local, f, p.froxelRange, p.volumeFormat);
+  if (p.froxels) p.froxelRange = validateFroxels(*backend_, info_, frame.froxels, *frame.camera, p.local, f);
   if (p.list) {
-    const gl::TextureLevel image =
-        gpu::listImageSize(frame.imageWidth, frame.imageHeight, frame.cameraDepth, std::string(owner));
+    const gl::TextureLevel image = validateList(*backend_, frame, std::string(owner));
     p.imageWidth = image.width;
     p.imageHeight = image.height;
-    gpu::validateSampleList(*p.list, f + "list");
   }
   if (p.pixels) {
-    const gl::TextureLevel depth = validatePixelTextures(info_, frame, f);
+    const gl::TextureLevel depth = validatePixelTextures(*backend_, info_, frame, f);
     p.imageWidth = depth.width;
     p.imageHeight = depth.height;
   }
@@ -868,83 +956,92 @@ EvaluatePass::Plan EvaluatePass::plan(const FrameAttribs& frame, std::string_vie
 }
 
 void EvaluatePass::run(const FrameAttribs& frame) {
-  gl::requireNotMovedFrom(basisSampler_, "EvaluatePass");
+  if (backend_ == nullptr)
+    invalid("EvaluatePass", "a moved-from object", "owns no GPU objects: assign a constructed one first");
   const Plan p = plan(frame, "EvaluatePass::FrameAttribs");
   if (p.local) uploadLocalLight(frame);
   if (!p.projective)
     layoutBuffers_.upload(*p.layoutData, frame.basis.height, "EvaluatePass::FrameAttribs.layout");
-  const GLuint program = evaluationProgram(p);
   gpu::EvaluateParams params;
   gpu::assignCamera(params, *frame.camera);
   params.imageSize = glm::ivec4(p.imageWidth, p.imageHeight, 0, 0);
-  glNamedBufferSubData(scatteringBuffer_.get(), 0, sizeof p.scattering, &p.scattering);
-  glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
+  backend_->writeBuffer(scatteringBuffer_.id(), 0, std::as_bytes(std::span(&p.scattering, 1)));
+  backend_->writeBuffer(evaluateBuffer_.id(), 0, std::as_bytes(std::span(&params, 1)));
   if (p.table && !p.reuse) buildTable(frame.basis, p);
-  bindEvaluation(frame, p, program);
   if (p.pixels) {
-    glBindImageTexture(CREP_EVALUATE_SCATTERING_OUT_IMAGE, frame.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                       internalFormat(info_.outputFormat));
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(p.imageWidth, info_.workgroupWidth)),
-                      static_cast<GLuint>(ceilDiv(p.imageHeight, info_.workgroupHeight)), 1);
+    gpu::Dispatch d = evaluation(frame, p, false, false);
+    d.resources.push_back(gpu::Resource::sampled(CREP_CAMERA_DEPTH_DEFAULT_UNIT, frame.cameraDepth));
+    d.resources.push_back(
+        gpu::Resource::image(CREP_EVALUATE_SCATTERING_OUT_IMAGE, frame.output, gpu::Access::WriteOnly));
+    d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(p.imageWidth, info_.workgroupWidth)),
+                          static_cast<unsigned>(ceilDiv(p.imageHeight, info_.workgroupHeight)), 1u);
+    backend_->dispatch(d);
   }
-  if (p.list) { // one invocation per entry, groups of 64 (gpu::kSampleListGroupSize)
-    glBindImageTexture(CREP_EVALUATE_SCATTERING_OUT_IMAGE, p.list->output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                       GL_RGBA32F);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EVALUATE_SAMPLE_LIST_BINDING, p.list->buffer);
-    gpu::dispatchSampleList(p.list->buffer);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EVALUATE_SAMPLE_LIST_BINDING, 0);
+  if (p.list) { // one invocation per entry, groups of 64 (gpu::kSampleListGroupSize), counts from the list
+    gpu::Dispatch d = evaluation(frame, p, false, true);
+    d.resources.push_back(gpu::Resource::sampled(CREP_CAMERA_DEPTH_DEFAULT_UNIT, p.list->coordinates));
+    d.resources.push_back(
+        gpu::Resource::image(CREP_EVALUATE_SCATTERING_OUT_IMAGE, p.list->output, gpu::Access::WriteOnly));
+    d.resources.push_back(gpu::Resource::storage(CREP_EVALUATE_SAMPLE_LIST_BINDING, p.list->buffer));
+    d.indirect = p.list->buffer;
+    backend_->dispatch(d);
   }
   if (p.froxels) dispatchFroxels(frame, p, params);
-  unbindEvaluation(p);
-  gl::checkError("EvaluatePass::run");
 }
 
 void EvaluatePass::uploadLocalLight(const FrameAttribs& frame) {
-  if (!localBuffer_) localBuffer_ = gl::createDynamicBuffer(sizeof(gpu::LocalLightParams));
+  gpu::Backend& b = *backend_;
+  if (!localBuffer_) localBuffer_ = gpu::Buffer(b, sizeof(gpu::LocalLightParams), "EvaluatePass: light");
   const gpu::LocalLightParams lp = localLightParams(
       *frame.localLight, *frame.medium, frame.camera->position(), weightExtinction(*frame.medium));
-  glNamedBufferSubData(localBuffer_.get(), 0, sizeof lp, &lp);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_LOCAL_LIGHT_DEFAULT_BINDING, localBuffer_.get());
+  b.writeBuffer(localBuffer_.id(), 0, std::as_bytes(std::span(&lp, 1)));
   // The airlight table of the medium's g (made on the CPU in double, a few ms, when g changes).
   if (info_.localClosedForm && (!airlightTable_ || airlightG_ != frame.medium->hgG())) {
     const AirlightTable t = makeAirlightTable(frame.medium->hgG());
-    airlightTable_ = gl::createTexture2D(GL_RG32F, t.xiSamples, t.uSamples, "EvaluatePass: airlight table");
-    glTextureSubImage2D(airlightTable_.get(), 0, 0, 0, t.xiSamples, t.uSamples, GL_RG, GL_FLOAT,
-                        t.values.data());
-    if (!airlightSampler_) airlightSampler_ = gl::createClampSampler(GL_LINEAR);
+    airlightTable_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RG32F, t.xiSamples,
+                                      t.uSamples, 1, "EvaluatePass: airlight table"});
+    std::vector<float> texels(t.values.begin(), t.values.end());
+    b.writeTexture(airlightTable_.id(), texels);
     airlightG_ = frame.medium->hgG();
-  }
-  if (info_.localClosedForm) {
-    glBindTextureUnit(CREP_AIRLIGHT_DEFAULT_UNIT, airlightTable_.get());
-    glBindSampler(CREP_AIRLIGHT_DEFAULT_UNIT, airlightSampler_.get());
   }
 }
 
-GLuint EvaluatePass::evaluationProgram(const Plan& p) {
-  GLuint program = program_.get();
-  if (p.local) {
-    gl::Handle& localProgram = localPrograms_[p.layoutSlot];
-    if (!localProgram && !p.textured) localProgram = buildProgram(evaluateStages(info_, p.layoutKind, true));
-    program = localProgram.get();
+/// The local light's block and, in closed form, its airlight table (filtered linearly), for the evaluation
+/// and the prefix programs.
+void EvaluatePass::appendLocalResources(std::vector<gpu::Resource>& out) const {
+  out.push_back(gpu::Resource::uniform(CREP_LOCAL_LIGHT_DEFAULT_BINDING, localBuffer_.id()));
+  if (info_.localClosedForm)
+    out.push_back(
+        gpu::Resource::sampled(CREP_AIRLIGHT_DEFAULT_UNIT, airlightTable_.id(), gpu::Filter::Linear));
+}
+
+gpu::Dispatch EvaluatePass::evaluation(const FrameAttribs& frame, const Plan& p, bool froxels,
+                                       bool list) const {
+  gpu::Dispatch d = dispatchOf(froxels ? "EvaluatePass::run (froxels)" : "EvaluatePass::run",
+                               evaluateStages(info_, p.layoutKind, p.local, p.textured, froxels, list));
+  const FilteredBasisView& basis = frame.basis;
+  // The basis and the light textures' mean colour are filtered as EvaluateOptions::sampling says.
+  const gpu::Filter basisFilter =
+      info_.options.sampling == Sampling::Bilinear ? gpu::Filter::Linear : gpu::Filter::Nearest;
+  d.resources = {gpu::Resource::sampled(CREP_FILTERED_BASIS_DEFAULT_UNIT, basis.texture, basisFilter),
+                 gpu::Resource::uniform(CREP_SCATTERING_DEFAULT_BINDING, scatteringBuffer_.id()),
+                 gpu::Resource::uniform(CREP_EVALUATE_DEFAULT_BINDING, evaluateBuffer_.id())};
+  if (p.textured)
+    d.resources.push_back(gpu::Resource::sampled(CREP_MEAN_COLOR_DEFAULT_UNIT, basis.meanColor, basisFilter));
+  if (p.table) {
+    const std::uint32_t unit =
+        p.prefix ? CREP_SCATTERING_PREFIX_DEFAULT_UNIT : CREP_VISIBILITY_TABLE_DEFAULT_UNIT;
+    d.resources.push_back(gpu::Resource::sampled(unit, tableTexture_.id(), gpu::Filter::Linear));
+    if (p.local && usesLocalSectionTable(info_.options))
+      d.resources.push_back(
+          gpu::Resource::sampled(CREP_LOCAL_SECTION_DEFAULT_UNIT, sectionTexture_.id(), gpu::Filter::Linear));
   }
-  if (!p.projective && !p.textured && p.pixels && !p.local) {
-    gl::Handle& variant = layoutPrograms_[p.layoutKind];
-    if (!variant) variant = buildProgram(evaluateStages(info_, p.layoutKind));
-    program = variant.get();
-  }
-  // Light textures: the CREP_LIGHT_TEXTURE variants (projective frame, layouts, local light), on first use.
-  if (p.textured && p.pixels) {
-    gl::Handle& variant = texturedPrograms_[p.variantIndex];
-    if (!variant) variant = buildProgram(evaluateStages(info_, p.layoutKind, p.local, true));
-    program = variant.get();
-  }
-  if (p.list) { // the CREP_SAMPLE_LIST variant of the program chosen above
-    gl::Handle& variant = listPrograms_[p.textured ? 1 : 0][p.variantIndex];
-    if (!variant)
-      variant = buildProgram(evaluateStages(info_, p.layoutKind, p.local, p.textured, false, true));
-    program = variant.get();
-  }
-  return program;
+  if (p.local) appendLocalResources(d.resources);
+  if (!p.projective)
+    layoutBuffers_.appendResources(d.resources, CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
+  if (info_.options.nearPlaneCorrection)
+    d.resources.push_back(gpu::Resource::storage(CREP_REGION_WEIGHTS_DEFAULT_BINDING, basis.regionWeights));
+  return d;
 }
 
 void EvaluatePass::uploadTableCoefficients(double depthMargin) {
@@ -957,9 +1054,8 @@ void EvaluatePass::uploadTableCoefficients(double depthMargin) {
       a[static_cast<std::size_t>(k) * static_cast<std::size_t>(layers) * 4 + static_cast<std::size_t>(m)] =
           static_cast<float>(
               as[static_cast<std::size_t>(k) * static_cast<std::size_t>(M) + static_cast<std::size_t>(m)]);
-  tableCoefficients_ = gl::createBuffer();
-  glNamedBufferStorage(tableCoefficients_.get(), static_cast<GLsizeiptr>(a.size() * sizeof(float)), a.data(),
-                       0);
+  tableCoefficients_ = gpu::Buffer(*backend_, a.size() * sizeof(float), "EvaluatePass: table coefficients");
+  backend_->writeBuffer(tableCoefficients_.id(), 0, std::as_bytes(std::span(a)));
   tableMargin_ = depthMargin;
 }
 
@@ -967,147 +1063,73 @@ void EvaluatePass::buildTable(const FilteredBasisView& basis, const Plan& p) {
   // The per-frame table of this basis (EvaluateOptions::visibilityTableSamples / scatteringPrefix): the
   // scattering prefix table (RGBA32F, the default) or the region visibility table (R32F), rebuilt every
   // run; both R Z x H texels.
+  gpu::Backend& b = *backend_;
   const int Z = info_.options.visibilityTableSamples, R = basis.regions();
   const bool sections = p.local && usesLocalSectionTable(info_.options);
   if (sections && (!sectionTexture_ || tableWidth_ != R * Z || tableHeight_ != basis.height))
-    sectionTexture_ = gl::createTexture2D(GL_RGBA32F, R * Z, basis.height,
-                                          "EvaluatePass: local section table (regions x samples, rows)");
+    sectionTexture_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, R * Z, basis.height,
+                                       1, "EvaluatePass: local section table (regions x samples, rows)"});
   if (tableWidth_ != R * Z || tableHeight_ != basis.height) {
     tableTexture_ =
-        gl::createTexture2D(p.prefix ? GL_RGBA32F : GL_R32F, R * Z, basis.height,
-                            p.prefix ? "EvaluatePass: scattering prefix table (regions x samples, rows)"
-                                     : "EvaluatePass: visibility table (regions x samples, rows)");
+        gpu::Texture(b, {gpu::TextureType::Texture2D, p.prefix ? gpu::Format::RGBA32F : gpu::Format::R32F,
+                         R * Z, basis.height, 1,
+                         p.prefix ? "EvaluatePass: scattering prefix table (regions x samples, rows)"
+                                  : "EvaluatePass: visibility table (regions x samples, rows)"});
     tableWidth_ = R * Z;
     tableHeight_ = basis.height;
   }
   if (!tableCoefficients_ || tableMargin_ != basis.depthMargin) uploadTableCoefficients(basis.depthMargin);
-  // The prefix program reads the basis and coefficients through crep/scattering.glsl's names, the table
-  // program through its own (the same numbers).
-  const GLuint coefficients =
-      p.prefix ? CREP_TABLE_COEFFICIENTS_DEFAULT_BINDING : CREP_VISIBILITY_TABLE_TABLE_COEFFICIENTS_BINDING;
-  const GLuint basisUnit = p.prefix ? CREP_FILTERED_BASIS_DEFAULT_UNIT : CREP_VISIBILITY_TABLE_BASIS_UNIT;
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, coefficients, tableCoefficients_.get());
-  glBindTextureUnit(basisUnit, basis.texture);
-  if (p.textured)
-    glBindTextureUnit(CREP_MEAN_COLOR_DEFAULT_UNIT,
-                      basis.meanColor);          // texelFetch at the regions' last texels
-  glBindSampler(basisUnit, depthSampler_.get()); // nearest, clamped: texelFetch ignores it anyway
   if (p.prefix) {
-    // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp).
-    gl::Handle& prefixProgram = p.textured ? texturedPrefixPrograms_[p.variantIndex]
-                                : p.local  ? localPrefixPrograms_[p.layoutSlot]
-                                           : prefixPrograms_[p.layoutSlot];
-    if (!prefixProgram) prefixProgram = buildProgram(prefixStages(info_, p.layoutKind, p.local, p.textured));
-    glUseProgram(prefixProgram.get());
-    if (!p.projective) layoutBuffers_.bind(CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
-    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_SCATTERING_DEFAULT_BINDING, scatteringBuffer_.get());
-    glBindImageTexture(CREP_SCATTERING_PREFIX_PREFIX_OUT_IMAGE, tableTexture_.get(), 0, GL_FALSE, 0,
-                       GL_WRITE_ONLY, GL_RGBA32F);
+    // One workgroup per (64 samples, row), on the layout of the evaluation (scattering_prefix.comp); the
+    // basis and coefficients through crep/scattering.glsl's names, read with texelFetch.
+    gpu::Dispatch d = dispatchOf("EvaluatePass: scattering prefix table",
+                                 prefixStages(info_, p.layoutKind, p.local, p.textured));
+    d.resources = {gpu::Resource::storage(CREP_TABLE_COEFFICIENTS_DEFAULT_BINDING, tableCoefficients_.id()),
+                   gpu::Resource::sampled(CREP_FILTERED_BASIS_DEFAULT_UNIT, basis.texture),
+                   gpu::Resource::uniform(CREP_SCATTERING_DEFAULT_BINDING, scatteringBuffer_.id()),
+                   gpu::Resource::image(CREP_SCATTERING_PREFIX_PREFIX_OUT_IMAGE, tableTexture_.id(),
+                                        gpu::Access::WriteOnly)};
+    if (p.textured) // texelFetch at the regions' last texels
+      d.resources.push_back(gpu::Resource::sampled(CREP_MEAN_COLOR_DEFAULT_UNIT, basis.meanColor));
     if (sections)
-      glBindImageTexture(CREP_SCATTERING_PREFIX_SECTION_OUT_IMAGE, sectionTexture_.get(), 0, GL_FALSE, 0,
-                         GL_WRITE_ONLY, GL_RGBA32F);
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(Z, 64)), static_cast<GLuint>(basis.height), 1);
-    if (sections)
-      glBindImageTexture(CREP_SCATTERING_PREFIX_SECTION_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                         GL_RGBA32F);
+      d.resources.push_back(gpu::Resource::image(CREP_SCATTERING_PREFIX_SECTION_OUT_IMAGE,
+                                                 sectionTexture_.id(), gpu::Access::WriteOnly));
+    if (p.local) appendLocalResources(d.resources);
+    if (!p.projective)
+      layoutBuffers_.appendResources(d.resources, CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
+    d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(Z, 64)), static_cast<unsigned>(basis.height), 1u);
+    b.dispatch(d);
   } else {
-    glUseProgram(tableProgram_.get());
-    glProgramUniform4i(tableProgram_.get(), 0, basis.height, R, basis.width / R, 0);
-    glBindImageTexture(CREP_VISIBILITY_TABLE_TABLE_OUT_IMAGE, tableTexture_.get(), 0, GL_FALSE, 0,
-                       GL_WRITE_ONLY, GL_R32F);
-    glDispatchCompute(static_cast<GLuint>(ceilDiv(basis.height, 64)), static_cast<GLuint>(R), 1);
+    gpu::Dispatch d = dispatchOf("EvaluatePass: visibility table", {tableStage(info_)});
+    d.resources = {
+        gpu::Resource::storage(CREP_VISIBILITY_TABLE_TABLE_COEFFICIENTS_BINDING, tableCoefficients_.id()),
+        gpu::Resource::sampled(CREP_VISIBILITY_TABLE_BASIS_UNIT, basis.texture),
+        gpu::Resource::image(CREP_VISIBILITY_TABLE_TABLE_OUT_IMAGE, tableTexture_.id(),
+                             gpu::Access::WriteOnly)};
+    d.push = {gpu::PushValue::of(0, glm::ivec4(basis.height, R, basis.width / R, 0))};
+    d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(basis.height, 64)), static_cast<unsigned>(R), 1u);
+    b.dispatch(d);
   }
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, coefficients, 0);
-  glBindSampler(basisUnit, 0);
-  glBindTextureUnit(basisUnit, 0);
   tableBasis_ = basis.texture;
   tableVariant_ = p.variantIndex + 6 * int(p.textured);
 }
 
-void EvaluatePass::bindEvaluation(const FrameAttribs& frame, const Plan& p, GLuint program) {
-  const FilteredBasisView& basis = frame.basis;
-  if (p.table) {
-    const GLuint unit = p.prefix ? CREP_SCATTERING_PREFIX_DEFAULT_UNIT : CREP_VISIBILITY_TABLE_DEFAULT_UNIT;
-    glBindTextureUnit(unit, tableTexture_.get());
-    glBindSampler(unit, tableSampler_.get());
-    if (p.local && usesLocalSectionTable(info_.options)) {
-      glBindTextureUnit(CREP_LOCAL_SECTION_DEFAULT_UNIT, sectionTexture_.get());
-      glBindSampler(CREP_LOCAL_SECTION_DEFAULT_UNIT, tableSampler_.get());
-    }
-  }
-  glUseProgram(program);
-  if (!p.projective) layoutBuffers_.bind(CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
-  glBindTextureUnit(CREP_FILTERED_BASIS_DEFAULT_UNIT, basis.texture);
-  glBindSampler(CREP_FILTERED_BASIS_DEFAULT_UNIT, basisSampler_.get());
-  glBindTextureUnit(CREP_CAMERA_DEPTH_DEFAULT_UNIT, p.list ? p.list->coordinates : frame.cameraDepth);
-  glBindSampler(CREP_CAMERA_DEPTH_DEFAULT_UNIT, depthSampler_.get());
-  if (p.textured) {
-    glBindTextureUnit(CREP_MEAN_COLOR_DEFAULT_UNIT, basis.meanColor);
-    glBindSampler(CREP_MEAN_COLOR_DEFAULT_UNIT,
-                  basisSampler_.get()); // sampled as the basis is (EvaluateOptions::sampling)
-  }
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_SCATTERING_DEFAULT_BINDING, scatteringBuffer_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EVALUATE_DEFAULT_BINDING, evaluateBuffer_.get());
-  if (info_.options.nearPlaneCorrection)
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_REGION_WEIGHTS_DEFAULT_BINDING, basis.regionWeights);
-}
-
 void EvaluatePass::dispatchFroxels(const FrameAttribs& frame, const Plan& p, gpu::EvaluateParams params) {
-  // The froxel variant of the same program (CREP_FROXELS) on the same bindings; the evaluate block's
+  // The froxel variant of the same program (CREP_FROXELS) on the same resources; the evaluate block's
   // imageSize holds the grid's size.
   const FroxelGrid& g = frame.froxels.grid;
-  gl::Handle& variant = froxelPrograms_[p.textured ? 1 : 0][p.layoutSlot];
-  if (!variant) variant = buildProgram(evaluateStages(info_, p.layoutKind, false, p.textured, true));
   params.imageSize = glm::ivec4(g.width, g.height, g.depth, 0);
-  glNamedBufferSubData(evaluateBuffer_.get(), 0, sizeof params, &params);
-  glProgramUniform4f(variant.get(), 0, static_cast<float>(frame.froxels.jitter.x),
-                     static_cast<float>(frame.froxels.jitter.y), static_cast<float>(frame.froxels.jitter.z),
-                     0.0f);
-  glProgramUniform2f(variant.get(), 1, static_cast<float>(p.froxelRange.near),
-                     static_cast<float>(p.froxelRange.far));
-  glUseProgram(variant.get());
-  glBindImageTexture(CREP_EVALUATE_FROXELS_OUT_IMAGE, frame.froxels.volume, 0, GL_TRUE, 0, GL_WRITE_ONLY,
-                     p.volumeFormat);
-  glDispatchCompute(static_cast<GLuint>(ceilDiv(g.width, info_.workgroupWidth)),
-                    static_cast<GLuint>(ceilDiv(g.height, info_.workgroupHeight)),
-                    static_cast<GLuint>(g.depth));
-}
-
-void EvaluatePass::unbindEvaluation(const Plan& p) {
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                  GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
-  if (info_.options.nearPlaneCorrection)
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_REGION_WEIGHTS_DEFAULT_BINDING, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EVALUATE_DEFAULT_BINDING, 0);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_SCATTERING_DEFAULT_BINDING, 0);
-  if (p.local) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_LOCAL_LIGHT_DEFAULT_BINDING, 0);
-    glBindSampler(CREP_AIRLIGHT_DEFAULT_UNIT, 0);
-    glBindTextureUnit(CREP_AIRLIGHT_DEFAULT_UNIT, 0);
-    glBindSampler(CREP_LOCAL_SECTION_DEFAULT_UNIT, 0);
-    glBindTextureUnit(CREP_LOCAL_SECTION_DEFAULT_UNIT, 0);
-  }
-  if (!p.projective) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EVALUATE_LAYOUT_BINDING, 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EVALUATE_SLICES_BINDING, 0);
-  }
-  glBindImageTexture(CREP_EVALUATE_SCATTERING_OUT_IMAGE, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-  glBindSampler(CREP_CAMERA_DEPTH_DEFAULT_UNIT, 0);
-  glBindTextureUnit(CREP_CAMERA_DEPTH_DEFAULT_UNIT, 0);
-  glBindSampler(CREP_FILTERED_BASIS_DEFAULT_UNIT, 0);
-  glBindTextureUnit(CREP_FILTERED_BASIS_DEFAULT_UNIT, 0);
-  if (p.textured) {
-    glBindSampler(CREP_MEAN_COLOR_DEFAULT_UNIT, 0);
-    glBindTextureUnit(CREP_MEAN_COLOR_DEFAULT_UNIT, 0);
-  }
-  if (p.table) {
-    glBindSampler(CREP_VISIBILITY_TABLE_DEFAULT_UNIT, 0);
-    glBindTextureUnit(CREP_VISIBILITY_TABLE_DEFAULT_UNIT, 0);
-    glBindSampler(CREP_SCATTERING_PREFIX_DEFAULT_UNIT, 0);
-    glBindTextureUnit(CREP_SCATTERING_PREFIX_DEFAULT_UNIT, 0);
-  }
-  glUseProgram(0);
+  backend_->writeBuffer(evaluateBuffer_.id(), 0, std::as_bytes(std::span(&params, 1)));
+  gpu::Dispatch d = evaluation(frame, p, true, false);
+  d.resources.push_back(
+      gpu::Resource::image(CREP_EVALUATE_FROXELS_OUT_IMAGE, frame.froxels.volume, gpu::Access::WriteOnly));
+  d.push = {gpu::PushValue::of(0, glm::vec4(glm::vec3(frame.froxels.jitter), 0.0f)),
+            gpu::PushValue::of(
+                1, glm::vec2(static_cast<float>(p.froxelRange.near), static_cast<float>(p.froxelRange.far)))};
+  d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(g.width, info_.workgroupWidth)),
+                        static_cast<unsigned>(ceilDiv(g.height, info_.workgroupHeight)),
+                        static_cast<unsigned>(g.depth));
+  backend_->dispatch(d);
 }
 
 } // namespace crep

@@ -344,10 +344,12 @@ void VulkanBackend::Impl::barrier() {
   m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   m.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_UNIFORM_READ_BIT |
-                    VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+                    VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT; // work lists' group counts (Dispatch::indirect)
   vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &m, 0,
-                       nullptr, 0, nullptr);
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
+                           VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                       0, 1, &m, 0, nullptr, 0, nullptr);
 }
 
 namespace {
@@ -658,7 +660,8 @@ BufferId VulkanBackend::createBuffer(std::size_t bytes, std::string_view) {
   const BufferId id = v.nextId++;
   v.buffers[id] =
       v.makeBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
-                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+                              VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                              VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   return id;
 }
 
@@ -816,7 +819,10 @@ void VulkanBackend::dispatch(const Dispatch& d) {
   if (!push.empty())
     vkCmdPushConstants(v.cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
                        static_cast<std::uint32_t>(push.size()), push.data());
-  if (d.groups.x > 0 && d.groups.y > 0 && d.groups.z > 0)
+  if (d.indirect != 0)
+    vkCmdDispatchIndirect(v.cmd, v.buffer(d.indirect, (d.label + " indirect").c_str()).buffer,
+                          d.indirectOffset);
+  else if (d.groups.x > 0 && d.groups.y > 0 && d.groups.z > 0)
     vkCmdDispatch(v.cmd, d.groups.x, d.groups.y, d.groups.z);
 }
 

@@ -101,6 +101,10 @@ struct Dispatch {
   std::vector<Resource> resources;   ///< every resource the variant reads or writes
   std::vector<PushValue> push;       ///< the push-constant block (at most 128 bytes packed)
   glm::uvec3 groups{1, 1, 1};        ///< work groups; a zero count dispatches nothing
+  /// Non-zero: an indirect dispatch, the three uint32 group counts read from this buffer at
+  /// indirectOffset (written by an earlier dispatch; a GPU work list), `groups` unused.
+  BufferId indirect = 0;
+  std::size_t indirectOffset = 0; ///< bytes, a multiple of 4
 };
 
 /// A program variant's key for a backend's caches: the path, then each define as "NAME=value".

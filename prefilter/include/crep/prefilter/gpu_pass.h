@@ -1,7 +1,8 @@
 // GPU passes of prefiltered single scattering (Klehm, Seidel, Eisemann 2014, Sec. 3.3, Listings 2-4,
 // Appendix A): PrefilterPass (rectified depth -> filtered basis), EvaluatePass (camera depth -> scattering),
-// prefilter.h's rules in float. Conventions, bindings: prefilter/README.md, "gpu_pass.h". Each needs a
-// current OpenGL 4.5 core context for its whole lifetime and never creates, owns or changes one.
+// prefilter.h's rules in float. Conventions, bindings: prefilter/README.md, "gpu_pass.h". Each runs on the
+// gpu::Backend of its CreateInfo; by default a GL backend on the current OpenGL 4.5 core context, which it
+// needs for its whole lifetime and never creates, owns or changes.
 #pragma once
 
 #include <cstdint>
@@ -24,7 +25,7 @@
 namespace crep {
 
 /// A filtered basis on the GPU: the texture array and the parameters it was prefiltered with
-/// (everything evaluation needs besides the layout). Non-owning GL names.
+/// (everything evaluation needs besides the layout). Non-owning ids of the passes' backend (GL names).
 struct FilteredBasisView {
   std::uint32_t texture = 0;       ///< GL_TEXTURE_2D_ARRAY, width x height x ceil(bases / 4) layers, RGBA
   std::uint32_t regionWeights = 0; ///< buffer of height * R gpu::RegionWeights (near-plane correction)
@@ -147,11 +148,13 @@ public:
     /// crep/scatter/airlight.h) instead of the quadrature (crep_localSegment, default).
     bool localClosedForm = false;
     bool memoryLimit = false; ///< benchmarks only: the memory traffic alone, output meaningless
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
 
   /// A froxel volume to fill (Wronski 2014; crep::evaluateFroxels is its CPU reference).
   struct FroxelTarget {
-    /// GL_TEXTURE_3D of grid.width x grid.height x grid.depth, GL_RGBA16F or GL_RGBA32F, or 0 (no volume):
+    /// 3D texture (GL_TEXTURE_3D) of grid.width x grid.height x grid.depth, RGBA16F or RGBA32F, or 0 (none):
     /// RGB in-scattered radiance to the cell's sample point, A grey transmittance to it.
     std::uint32_t volume = 0;
     FroxelGrid grid;        ///< cells and depth range (crep/scatter/froxel_grid.h)
@@ -159,7 +162,8 @@ public:
   };
 
   struct FrameAttribs {
-    /// GL_TEXTURE_2D, depth-buffer values of `camera` in [0, 1]; may be 0 when output is 0.
+    /// 2D texture (a GL name or the backend's id), depth-buffer values of `camera` in [0, 1]; may be 0 when
+    /// output is 0.
     std::uint32_t cameraDepth = 0;
     /// GL_TEXTURE_2D of cameraDepth's size in outputFormat: RGB L, A T; may be 0 with a froxel volume.
     std::uint32_t output = 0;
@@ -207,35 +211,25 @@ private:
   struct Plan;
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
   void uploadLocalLight(const FrameAttribs& frame);
-  std::uint32_t evaluationProgram(const Plan& plan);
+  void appendLocalResources(std::vector<gpu::Resource>& out) const;
+  gpu::Dispatch evaluation(const FrameAttribs& frame, const Plan& plan, bool froxels, bool list) const;
   void uploadTableCoefficients(double depthMargin);
   void buildTable(const FilteredBasisView& basis, const Plan& plan);
-  void bindEvaluation(const FrameAttribs& frame, const Plan& plan, std::uint32_t program);
   void dispatchFroxels(const FrameAttribs& frame, const Plan& plan, gpu::EvaluateParams params);
-  void unbindEvaluation(const Plan& plan);
 
   CreateInfo info_;
-  gl::Handle program_, basisSampler_, depthSampler_, scatteringBuffer_, evaluateBuffer_;
-  /// Local-light programs and prefix programs: [projective frame, then per gpu::LayoutKind]; light block.
-  gl::Handle localPrograms_[3], localPrefixPrograms_[3], localBuffer_;
-  /// Local lights: the airlight table (RG32F) of the medium's g, and its sampler.
-  gl::Handle airlightTable_, airlightSampler_;
-  gl::Handle sectionTexture_; ///< local lights: the local section table (the prefix table's size)
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr; ///< null when moved from
+  gpu::Buffer scatteringBuffer_, evaluateBuffer_, localBuffer_;
+  gpu::Buffer tableCoefficients_; ///< a(z_s) of the table's samples (storage buffer), for tableMargin_
+  /// Local lights: the airlight table (RG32F) of the medium's g; the local section table (the table's size).
+  gpu::Texture airlightTable_, sectionTexture_;
+  /// The per-frame table: R32F visibility or RGBA32F prefix, R Z x H.
+  gpu::Texture tableTexture_;
   double airlightG_ = 0.0;
-  gl::Handle layoutPrograms_[2]; ///< per gpu::LayoutKind, built on first use (non-projective layouts)
-  /// The table's pass, texture (R32F visibility or RGBA32F prefix, R Z x H) and sampler; prefix programs.
-  gl::Handle tableProgram_, tableTexture_, tableSampler_;
-  gl::Handle prefixPrograms_[3];
-  /// Textured programs: [0 projective, 1 + gpu::LayoutKind, 3 + the same for a local light].
-  gl::Handle texturedPrograms_[6], texturedPrefixPrograms_[6];
-  /// Froxel programs: [textured][0 projective, 1 + gpu::LayoutKind].
-  gl::Handle froxelPrograms_[2][3];
-  /// Work-list programs: [textured][as the textured programs].
-  gl::Handle listPrograms_[2][6];
   /// What the table was last built for (FrameAttribs::reuseTable).
   std::uint32_t tableBasis_ = 0;
   int tableVariant_ = -1;
-  gl::Handle tableCoefficients_; ///< a(z_s) of the table's samples (storage buffer), for tableMargin_
   double tableMargin_ = -1.0;
   int tableWidth_ = 0, tableHeight_ = 0;
   gpu::LayoutBuffers layoutBuffers_;
