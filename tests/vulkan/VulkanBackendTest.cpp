@@ -1,6 +1,7 @@
 // gpu::VulkanBackend on Mesa's lavapipe with the validation layer on: transfers round-trip exactly, the
 // passes written once against gpu::Backend (MinMaxTreePass, ShadowResamplePass) agree with their CPU
-// references as they do on GL, bad input is named, and the validation layer reports nothing.
+// references as they do on GL, bad input is named (the backend's and EvaluatePass's), and the validation
+// layer reports nothing.
 #include "common/map_agreement.h"
 
 #include <crep/core/error.h>
@@ -10,6 +11,7 @@
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/prefilter/gpu_pass.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
 #include <crep/vulkan/vulkan_backend.h>
@@ -212,5 +214,70 @@ TEST_CASE("Vulkan backend: ShadowResamplePass matches the CPU resampling, and it
   bad.output = shadowTexture.id(); // a depth texture of another size
   CHECK_THROWS_WITH_AS(pass.run(bad), doctest::Contains("ShadowResamplePass::FrameAttribs.output"),
                        InvalidArgument);
+  checkNoValidationMessages(vk);
+}
+
+TEST_CASE("Vulkan backend: EvaluatePass names the field of a texture or buffer it cannot use") {
+  gpu::VulkanBackend vk(validated());
+  const scenes::Scene scene = scenes::makeScene("boxes", 16.0 / 9.0);
+  RectifyOptions ro;
+  ro.splits = 2;
+  Rectification r = rectify(scene.camera, scene.sun, ro);
+  REQUIRE(r.projective());
+  const ProjectiveLayout layout(std::move(r));
+  constexpr int W = 64, H = 16, w = 16, h = 9;
+  gpu::Texture map(vk, {gpu::TextureType::Texture2D, gpu::Format::R32F, W, H, 1, "map"});
+  vk.writeTexture(map.id(), std::vector<float>(W * H, 0.5f));
+  PrefilterPass::CreateInfo prefilterInfo;
+  prefilterInfo.mapWidth = W;
+  prefilterInfo.mapHeight = H;
+  prefilterInfo.backend = &vk;
+  PrefilterPass prefilterPass(prefilterInfo);
+  prefilterPass.run({.rectifiedDepth = map.id(), .layout = &layout, .medium = &scene.medium});
+  EvaluatePass::CreateInfo evaluateInfo;
+  evaluateInfo.backend = &vk;
+  EvaluatePass pass(evaluateInfo);
+  gpu::Texture depth(vk, {gpu::TextureType::Texture2D, gpu::Format::R32F, w, h, 1, "depth"});
+  gpu::Texture out(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, w, h, 1, "out"});
+  gpu::Texture wrongFormat(vk, {gpu::TextureType::Texture2D, gpu::Format::R32F, w, h, 1, "R32F"});
+  gpu::Texture wrongSize(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, w + 1, h, 1, "size"});
+  gpu::Texture colour(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, w, h, 1, "colour"});
+  EvaluatePass::FrameAttribs f;
+  f.cameraDepth = depth.id();
+  f.output = out.id();
+  f.camera = &scene.camera;
+  f.light = &scene.sun;
+  f.medium = &scene.medium;
+  f.layout = &layout;
+  f.basis = prefilterPass.filteredBasis();
+  pass.run(f); // the frame as given works
+  const auto rejects = [&](EvaluatePass::FrameAttribs bad, const char* field) {
+    CAPTURE(std::string(field));
+    CHECK_THROWS_WITH_AS(pass.run(bad), doctest::Contains(field), InvalidArgument);
+  };
+  EvaluatePass::FrameAttribs bad = f;
+  bad.output = wrongFormat.id();
+  rejects(bad, "EvaluatePass::FrameAttribs.output");
+  bad.output = wrongSize.id();
+  rejects(bad, "EvaluatePass::FrameAttribs.output");
+  bad = f;
+  bad.cameraDepth = colour.id(); // a colour texture is no depth
+  rejects(bad, "EvaluatePass::FrameAttribs.cameraDepth");
+  bad.cameraDepth = 9999; // no texture of this backend (a GL name, say)
+  rejects(bad, "EvaluatePass::FrameAttribs.cameraDepth");
+  bad = f;
+  bad.basis.texture = map.id(); // a 2D texture, not the basis array
+  rejects(bad, "EvaluatePass::FrameAttribs.basis.texture");
+  bad = f;
+  bad.froxels.volume = out.id(); // 2D, not a volume
+  rejects(bad, "EvaluatePass::FrameAttribs.froxels.volume");
+  gpu::Buffer small(vk, 16, "list");
+  const gpu::SampleList list{small.id(), colour.id(), out.id(), w, h, w * h};
+  bad = f;
+  bad.list = &list;
+  rejects(bad, "EvaluatePass::FrameAttribs.list.buffer");
+  EvaluatePass moved = std::move(pass);
+  CHECK_THROWS_WITH_AS(pass.run(f), doctest::Contains("EvaluatePass"), InvalidArgument);
+  moved.run(f);
   checkNoValidationMessages(vk);
 }
