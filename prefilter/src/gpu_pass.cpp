@@ -639,54 +639,6 @@ gpu::Dispatch dispatchOf(const char* label, const std::vector<ShaderStageSource>
   return d;
 }
 
-/// Level 0 of `texture` in GL's terms on any backend: the GL query on OpenGL, else the backend's description
-/// (target and internal format as the GL enums of its type and format). InvalidArgument naming `parameter`.
-gl::TextureLevel textureLevelOf(const gpu::Backend& backend, const char* parameter, std::uint32_t texture) {
-  if (backend.name() == "OpenGL") return gl::textureLevel(parameter, texture);
-  if (texture == 0) invalid(parameter, "0", "must be a texture");
-  gpu::TextureDesc d;
-  try {
-    d = backend.describe(texture);
-  } catch (const InvalidArgument&) {
-    invalid(parameter, str(texture),
-            "must be a texture of the pass's " + std::string(backend.name()) + " backend");
-  }
-  static constexpr GLenum formats[] = {GL_R32F, GL_RG32F, GL_RGBA32F, GL_RGBA16F, GL_DEPTH_COMPONENT32F,
-                                       GL_RGBA8};
-  gl::TextureLevel level;
-  level.target = d.type == gpu::TextureType::Texture2D        ? GL_TEXTURE_2D
-                 : d.type == gpu::TextureType::Texture2DArray ? GL_TEXTURE_2D_ARRAY
-                                                              : GL_TEXTURE_3D;
-  level.width = d.width;
-  level.height = d.height;
-  level.depth = d.depth;
-  level.internalFormat = formats[static_cast<int>(d.format)];
-  return level;
-}
-
-/// gl::requireDepthFormat on any backend (other backends: Depth32F or R32F).
-void requireDepthFormatOf(const gpu::Backend& backend, const char* parameter, std::uint32_t texture) {
-  if (backend.name() == "OpenGL") return gl::requireDepthFormat(parameter, texture);
-  const GLenum format = textureLevelOf(backend, parameter, texture).internalFormat;
-  if (format != GL_DEPTH_COMPONENT32F && format != GL_R32F)
-    invalid(parameter, "texture " + str(texture), "must be a depth (Depth32F) or R32F texture");
-}
-
-/// gl::requireBuffer on any backend.
-void requireBufferOf(const gpu::Backend& backend, const char* parameter, std::uint32_t buffer,
-                     const std::string& requirement) {
-  if (backend.name() == "OpenGL") {
-    gl::requireBuffer(parameter, buffer, requirement);
-    return;
-  }
-  if (buffer == 0) invalid(parameter, "0", requirement);
-  try {
-    backend.bufferBytes(buffer);
-  } catch (const InvalidArgument&) {
-    invalid(parameter, str(buffer),
-            requirement + " of the pass's " + std::string(backend.name()) + " backend");
-  }
-}
 } // namespace
 
 EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
@@ -771,7 +723,7 @@ void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateIn
     invalid(f + "basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info.bases));
   const int basisLayers = (basis.textured ? 3 : 1) * layerCount(basis.bases);
-  const gl::TextureLevel b = textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
+  const gl::TextureLevel b = gpu::textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
   if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
       b.depth < basisLayers)
     invalid(f + "basis.texture", "texture " + str(basis.texture),
@@ -780,7 +732,8 @@ void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateIn
   if (basis.textured) {
     // Light textures (prefilter.h): the textured variants exist for the scattering prefix table (the
     // default) and the direct path without a table.
-    const gl::TextureLevel mean = textureLevelOf(backend, (f + "basis.meanColor").c_str(), basis.meanColor);
+    const gl::TextureLevel mean =
+        gpu::textureLevelOf(backend, (f + "basis.meanColor").c_str(), basis.meanColor);
     if (mean.target != GL_TEXTURE_2D || mean.width != basis.width || mean.height != basis.height)
       invalid(f + "basis.meanColor", "texture " + str(basis.meanColor),
               "must be a GL_TEXTURE_2D of " + sizeString(basis.width, basis.height));
@@ -796,8 +749,8 @@ void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateIn
               "not with CreateInfo.memoryLimit (a benchmark variant of the untextured pass)");
   }
   if (info.options.nearPlaneCorrection)
-    requireBufferOf(backend, (f + "basis.regionWeights").c_str(), basis.regionWeights,
-                    "must name the region-weights buffer (near-plane correction)");
+    gpu::requireBufferOf(backend, (f + "basis.regionWeights").c_str(), basis.regionWeights,
+                         "must name the region-weights buffer (near-plane correction)");
 }
 
 /// Froxel volumes (prefilter.h, "Froxel volumes"): the directional light's evaluation at the cells.
@@ -812,7 +765,7 @@ FroxelDepthRange validateFroxels(const gpu::Backend& backend, const EvaluatePass
   if (info.memoryLimit)
     invalid(owner, "a volume",
             "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the per-pixel pass)");
-  const gl::TextureLevel v = textureLevelOf(backend, (owner + ".volume").c_str(), froxels.volume);
+  const gl::TextureLevel v = gpu::textureLevelOf(backend, (owner + ".volume").c_str(), froxels.volume);
   const FroxelGrid& g = froxels.grid;
   if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
     invalid(owner + ".volume", "texture " + str(froxels.volume),
@@ -833,11 +786,11 @@ FroxelDepthRange validateFroxels(const gpu::Backend& backend, const EvaluatePass
 /// The camera depth and output textures of the per-pixel evaluation; returns the depth's level.
 gl::TextureLevel validatePixelTextures(const gpu::Backend& backend, const EvaluatePass::CreateInfo& info,
                                        const EvaluatePass::FrameAttribs& frame, const std::string& f) {
-  const gl::TextureLevel depth = textureLevelOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
+  const gl::TextureLevel depth = gpu::textureLevelOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
   if (depth.target != GL_TEXTURE_2D)
     invalid(f + "cameraDepth", "texture " + str(frame.cameraDepth), "must be a GL_TEXTURE_2D");
-  requireDepthFormatOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
-  const gl::TextureLevel out = textureLevelOf(backend, (f + "output").c_str(), frame.output);
+  gpu::requireDepthFormatOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
+  const gl::TextureLevel out = gpu::textureLevelOf(backend, (f + "output").c_str(), frame.output);
   if (out.target != GL_TEXTURE_2D || out.internalFormat != internalFormat(info.outputFormat))
     invalid(f + "output", "texture " + str(frame.output),
             std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info.outputFormat));
@@ -845,43 +798,6 @@ gl::TextureLevel validatePixelTextures(const gpu::Backend& backend, const Evalua
     invalid(f + "output", sizeString(out.width, out.height),
             "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
   return depth;
-}
-
-/// A work list on any backend (gpu::validateSampleList and gpu::listImageSize on OpenGL); returns the camera
-/// image's size.
-gl::TextureLevel validateList(const gpu::Backend& backend, const EvaluatePass::FrameAttribs& frame,
-                              const std::string& owner) {
-  if (backend.name() == "OpenGL") {
-    const gl::TextureLevel image =
-        gpu::listImageSize(frame.imageWidth, frame.imageHeight, frame.cameraDepth, owner);
-    gpu::validateSampleList(*frame.list, owner + ".list");
-    return image;
-  }
-  const gpu::SampleList& list = *frame.list;
-  const std::string l = owner + ".list";
-  requireBufferOf(backend, (l + ".buffer").c_str(), list.buffer, "must be a work-list buffer");
-  const std::size_t needed = static_cast<std::size_t>(gpu::kSampleListHeaderBytes) +
-                             static_cast<std::size_t>(std::max(list.capacity, 0)) * 4;
-  if (list.capacity < 1 || backend.bufferBytes(list.buffer) < needed)
-    invalid(l + ".buffer", str(list.buffer),
-            "must hold the header and capacity = " + str(list.capacity) + " entries (capacity >= 1)");
-  for (const auto& [name, texture] :
-       {std::pair{".coordinates", list.coordinates}, std::pair{".output", list.output}}) {
-    const gl::TextureLevel t = textureLevelOf(backend, (l + name).c_str(), texture);
-    if (t.target != GL_TEXTURE_2D || t.internalFormat != GL_RGBA32F || t.width != list.width ||
-        t.height != list.height)
-      invalid(l + name, "texture " + str(texture),
-              "must be a GL_TEXTURE_2D of format GL_RGBA32F, " + sizeString(list.width, list.height));
-  }
-  if (frame.imageWidth == 0 && frame.imageHeight == 0)
-    return textureLevelOf(backend, (owner + ".cameraDepth").c_str(), frame.cameraDepth);
-  if (frame.imageWidth <= 0 || frame.imageHeight <= 0)
-    invalid(owner + ".imageWidth/imageHeight", sizeString(frame.imageWidth, frame.imageHeight),
-            "must both be > 0 (or both 0: cameraDepth's size)");
-  gl::TextureLevel image;
-  image.width = frame.imageWidth;
-  image.height = frame.imageHeight;
-  return image;
 }
 
 } // namespace
@@ -908,7 +824,9 @@ EvaluatePass::Plan EvaluatePass::plan(const FrameAttribs& frame, std::string_vie
   p.pixels = !p.list && (frame.output != 0 || !p.froxels);
   if (p.froxels) p.froxelRange = validateFroxels(*backend_, info_, frame.froxels, *frame.camera, p.local, f);
   if (p.list) {
-    const gl::TextureLevel image = validateList(*backend_, frame, std::string(owner));
+    const gl::TextureLevel image = gpu::listImageSize(*backend_, frame.imageWidth, frame.imageHeight,
+                                                      frame.cameraDepth, std::string(owner));
+    gpu::validateSampleList(*backend_, *p.list, f + "list");
     p.imageWidth = image.width;
     p.imageHeight = image.height;
   }

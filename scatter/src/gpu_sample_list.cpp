@@ -2,8 +2,11 @@
 #include <crep/core/error.h>
 #include <crep/scatter/gpu_sample_list.h>
 
+#include <crep/core/gl_backend.h>
+
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <array>
 #include <string>
 
@@ -57,6 +60,31 @@ gl::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t ca
   size.width = imageWidth;
   size.height = imageHeight;
   return size;
+}
+
+void validateSampleList(const Backend& backend, const SampleList& list, const std::string& owner) {
+  if (backend.name() == "OpenGL") return validateSampleList(list, owner);
+  const std::size_t bytes =
+      requireBufferOf(backend, (owner + ".buffer").c_str(), list.buffer, "must name the list's buffer");
+  const std::size_t needed = static_cast<std::size_t>(kSampleListHeaderBytes) +
+                             static_cast<std::size_t>(std::max(list.capacity, 0)) * 4;
+  if (list.capacity < 1 || bytes < needed)
+    throw InvalidArgument(owner + ".buffer", std::to_string(list.buffer),
+                          "must hold the header and capacity = " + std::to_string(list.capacity) +
+                              " entries (capacity >= 1)");
+  requireTexture2DOf(backend, (owner + ".coordinates").c_str(), list.coordinates, list.width, list.height,
+                     GL_RGBA32F);
+  requireTexture2DOf(backend, (owner + ".output").c_str(), list.output, list.width, list.height, GL_RGBA32F);
+}
+
+gl::TextureLevel listImageSize(const Backend& backend, int imageWidth, int imageHeight,
+                               std::uint32_t cameraDepth, const std::string& owner) {
+  if (backend.name() == "OpenGL" || imageWidth != 0 || imageHeight != 0)
+    return listImageSize(imageWidth, imageHeight, cameraDepth, owner);
+  const gl::TextureLevel level = textureLevelOf(backend, (owner + ".cameraDepth").c_str(), cameraDepth);
+  if (level.target != GL_TEXTURE_2D)
+    throw InvalidArgument(owner + ".cameraDepth", std::to_string(cameraDepth), "must be a 2D texture");
+  return level;
 }
 
 } // namespace crep::gpu

@@ -45,4 +45,19 @@ private:
 /// `given`, or else a GlBackend made into `own` on the current GL context: the default backend of a pass.
 Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own);
 
+// A pass's checks of its inputs on any backend, in GL's terms: the GL query on a GlBackend (any GL format
+// an engine may pass), else Backend::describe() / bufferBytes() with the type and format as their GL enums.
+// Each throws InvalidArgument naming `parameter`.
+
+/// Level 0 of `texture` (gl::textureLevel).
+gl::TextureLevel textureLevelOf(const Backend& backend, const char* parameter, TextureId texture);
+/// gl::requireTexture2D(parameter, texture, width, height, internalFormat) on any backend.
+void requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture, int width,
+                        int height, std::uint32_t internalFormat = 0);
+/// gl::requireDepthFormat: other backends accept Depth32F and R32F.
+void requireDepthFormatOf(const Backend& backend, const char* parameter, TextureId texture);
+/// gl::requireBuffer: a buffer of the backend; returns its size in bytes.
+std::size_t requireBufferOf(const Backend& backend, const char* parameter, BufferId buffer,
+                            const std::string& requirement);
+
 } // namespace crep::gpu

@@ -7,6 +7,7 @@
 #include <string>
 
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 
 namespace crep::gpu {
 
@@ -39,5 +40,10 @@ void validateSampleList(const SampleList& list, const std::string& owner);
 /// else cameraDepth's size. InvalidArgument naming owner + ".imageWidth/imageHeight" or ".cameraDepth".
 gl::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
                                const std::string& owner);
+/// The two checks above for a list of `backend`'s objects (on a GlBackend, the same checks); the buffer
+/// must also hold the header and `capacity` entries.
+void validateSampleList(const Backend& backend, const SampleList& list, const std::string& owner);
+gl::TextureLevel listImageSize(const Backend& backend, int imageWidth, int imageHeight,
+                               std::uint32_t cameraDepth, const std::string& owner);
 
 } // namespace crep::gpu
