@@ -138,32 +138,30 @@ std::vector<float> MinMaxTreePass::readNodes() const {
 // RectifiedMarchPass
 
 RectifiedMarchPass::RectifiedMarchPass(const CreateInfo& info) : info_(info) {
-  gl::checkTextureSize("RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::checkTextureSize(*backend_, "RectifiedMarchPass::CreateInfo.mapWidth/mapHeight", info.mapWidth,
+                        info.mapHeight);
   requireTreeLevels("RectifiedMarchPass::CreateInfo.mapWidth", info.mapWidth);
-  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("RectifiedMarchPass");
+  layoutBuffers_ = gpu::LayoutBuffers(backend_);
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::MarchParams), "RectifiedMarchPass: parameters");
 }
 
-std::uint32_t RectifiedMarchPass::program(gpu::LayoutKind kind, bool textured, bool list) {
+ShaderStageSource RectifiedMarchPass::program(gpu::LayoutKind kind, bool textured, bool list) const {
   const int k = static_cast<int>(kind);
   if (k < 0 || k > 1)
     throw InvalidArgument("RectifiedMarchPass layout kind", std::to_string(k),
                           "must be projective or epipolar");
-  gl::Handle& program = programs_[list ? 1 : 0][textured ? 1 : 0][k];
-  if (!program)
-    program =
-        buildProgram({{ShaderStage::Compute,
-                       "passes/epipolar/march_rectified.comp",
-                       {{"CREP_MARCH_TREE", info_.mode == Mode::MinMaxTree ? "1" : "0"},
-                        {"CREP_LAYOUT", std::to_string(k)},
-                        {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
-                        {"CREP_SAMPLE_LIST", list ? "1" : "0"}}}}); // at CREP_SAMPLE_LIST_DEFAULT_BINDING
-  return program.get();
+  return {ShaderStage::Compute,
+          "passes/epipolar/march_rectified.comp",
+          {{"CREP_MARCH_TREE", info_.mode == Mode::MinMaxTree ? "1" : "0"},
+           {"CREP_LAYOUT", std::to_string(k)},
+           {"CREP_LIGHT_TEXTURE", textured ? "1" : "0"},
+           {"CREP_SAMPLE_LIST", list ? "1" : "0"}}}; // at CREP_SAMPLE_LIST_DEFAULT_BINDING
 }
 
 void RectifiedMarchPass::prepare(gpu::LayoutKind kind, bool textured, bool list) {
-  program(kind, textured, list);
+  const ShaderStageSource stage = program(kind, textured, list);
+  backend_->prepareProgram(stage.path, stage.defines);
 }
 
 /// A validated frame of the march (RectifiedMarchPass::validate) and what run() derives from it.
@@ -187,29 +185,35 @@ RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::st
   plan.layoutData = gpu::requireGpuLayout(*f.layout);
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "RectifiedMarchPass::CreateInfo.mapWidth/mapHeight");
-  // The image size is the camera depth texture's own (gl::textureLevel); with a work list, imageWidth x
-  // imageHeight when given, and the outputs are the list's.
+  // The image size is the camera depth texture's own; with a work list, imageWidth x imageHeight when
+  // given, and the outputs are the list's.
+  const gpu::Backend& b = *backend_;
   const gpu::SampleList* list = f.list;
-  const gl::TextureLevel image =
-      list ? gpu::listImageSize(f.imageWidth, f.imageHeight, f.cameraDepth, std::string(owner))
-           : gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
+  gl::TextureLevel image;
+  if (list) {
+    image = gpu::listImageSize(b, f.imageWidth, f.imageHeight, f.cameraDepth, std::string(owner));
+  } else {
+    image = gpu::textureLevelOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+    gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, image.width, image.height);
+  }
   plan.width = plan.outWidth = image.width;
   plan.height = plan.outHeight = image.height;
-  gl::requireTexture2D((p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
-  gl::requireDepthFormat((p + "rectifiedDepth").c_str(), f.rectifiedDepth);
-  if (!list) gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+  gpu::requireTexture2DOf(b, (p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
+  gpu::requireDepthFormatOf(b, (p + "rectifiedDepth").c_str(), f.rectifiedDepth);
+  if (!list) gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   if (list) {
-    gpu::validateSampleList(*list, p + "list");
+    gpu::validateSampleList(b, *list, p + "list");
     plan.outWidth = list->width;
     plan.outHeight = list->height;
   } else {
-    gl::requireTexture2D((p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
+    gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
   }
   if (f.stepsOutput != 0)
-    gl::requireTexture2D((p + "stepsOutput").c_str(), f.stepsOutput, plan.outWidth, plan.outHeight, GL_R32F);
-  if (f.lightColors != 0) gl::requireTexture2D((p + "lightColors").c_str(), f.lightColors, W, H);
+    gpu::requireTexture2DOf(b, (p + "stepsOutput").c_str(), f.stepsOutput, plan.outWidth, plan.outHeight,
+                            GL_R32F);
+  if (f.lightColors != 0) gpu::requireTexture2DOf(b, (p + "lightColors").c_str(), f.lightColors, W, H);
   if (info_.mode == Mode::MinMaxTree)
-    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "MinMaxTree mode");
+    requireMinMaxBuffer(b, (p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "MinMaxTree mode");
   if (list && f.blockRadius >= 0.0)
     invalid(p + "blockRadius", detail::formatValue(f.blockRadius),
             "must be -1 with a work list (the list says which texels to march)");
@@ -221,50 +225,56 @@ RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::st
 
 void RectifiedMarchPass::run(const FrameAttribs& f) {
   const Plan p = plan(f, "RectifiedMarchPass::FrameAttribs");
-  const gpu::LayoutKind kind = p.layoutData.kind;
+  gpu::Backend& b = *backend_;
   const int W = info_.mapWidth, H = info_.mapHeight;
-  const int width = p.width, height = p.height;
   const gpu::SampleList* list = f.list;
-  const bool tree = info_.mode == Mode::MinMaxTree;
   const bool textured = f.lightColors != 0;
-  const GLuint program = this->program(kind, textured, list != nullptr);
-
   gpu::MarchParams params =
-      f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, width, height, W, H)
-                   : gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height, W, H);
+      f.localLight ? gpu::makeMarchParams(*f.camera, *f.localLight, *f.medium, p.width, p.height, W, H)
+                   : gpu::makeMarchParams(*f.camera, *f.light, *f.medium, p.width, p.height, W, H);
   params.info = glm::ivec4(MinMaxTrees::levelCount(W), MinMaxTrees::rowStrideFor(W), 0, 0);
-  if (!gpu::setMarchRegion(params, width, height, f.blockCenter, list ? -1.0 : f.blockRadius,
+  if (!gpu::setMarchRegion(params, p.width, p.height, f.blockCenter, list ? -1.0 : f.blockRadius,
                            "RectifiedMarchPass::FrameAttribs"))
     return; // the block misses the image
-  glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
+  b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&params, 1)));
   layoutBuffers_.upload(p.layoutData, H);
-
-  const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
-                                          : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, p.outWidth, p.outHeight);
+  std::uint32_t steps = f.stepsOutput;
+  if (steps == 0) { // the program always writes its step counts: a scratch target of the output's size
+    if (!dummySteps_ || dummyWidth_ != p.outWidth || dummyHeight_ != p.outHeight) {
+      dummySteps_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::R32F, p.outWidth, p.outHeight,
+                                     1, "RectifiedMarchPass: step counts (unused)"});
+      dummyWidth_ = p.outWidth;
+      dummyHeight_ = p.outHeight;
+    }
+    steps = dummySteps_.id();
+  }
+  const ShaderStageSource stage = program(p.layoutData.kind, textured, list != nullptr);
+  gpu::Dispatch d;
+  d.label = list ? "RectifiedMarchPass::run (list)" : "RectifiedMarchPass::run";
+  d.program = stage.path;
+  d.defines = stage.defines;
   // A work list reads its coordinates at the camera depth's unit and writes its own output.
-  gpu::bindMarchResources(program, params_.get(), list ? list->coordinates : f.cameraDepth, f.rectifiedDepth,
-                          sampler_.get(), list ? list->output : f.output, steps);
-  layoutBuffers_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
-  if (tree) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_MARCH_MIN_MAX_BINDING, f.minMaxBuffer);
-  if (textured) { // Klehm et al. 2014, Sec. 3.2: the light texture's colour per texel
-    glBindTextureUnit(CREP_MARCH_LIGHT_COLORS_UNIT, f.lightColors);
-    glBindSampler(CREP_MARCH_LIGHT_COLORS_UNIT, sampler_.get());
-  }
+  d.resources = {
+      gpu::Resource::uniform(CREP_MARCH_PARAMS_BINDING, params_.id()),
+      gpu::Resource::sampled(CREP_MARCH_CAMERA_DEPTH_UNIT, list ? list->coordinates : f.cameraDepth),
+      gpu::Resource::sampled(CREP_MARCH_MAP_UNIT, f.rectifiedDepth),
+      gpu::Resource::image(CREP_MARCH_SCATTERING_OUT_IMAGE, list ? list->output : f.output,
+                           gpu::Access::WriteOnly),
+      gpu::Resource::image(CREP_MARCH_STEPS_OUT_IMAGE, steps, gpu::Access::WriteOnly)};
+  layoutBuffers_.appendResources(d.resources, CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+  if (info_.mode == Mode::MinMaxTree)
+    d.resources.push_back(gpu::Resource::storage(CREP_MARCH_MIN_MAX_BINDING, f.minMaxBuffer));
+  if (textured) // Klehm et al. 2014, Sec. 3.2: the light texture's colour per texel
+    d.resources.push_back(gpu::Resource::sampled(CREP_MARCH_LIGHT_COLORS_UNIT, f.lightColors));
   if (list) { // Yusov 2012, Sec. 6.4: the selected samples only, one invocation per entry
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, list->buffer);
-    gpu::dispatchSampleList(list->buffer);
-    gl::passOutputBarrier();
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, 0);
-    gl::unbindPassState(2);
-    gl::checkError("RectifiedMarchPass::run (list)");
+    d.resources.push_back(gpu::Resource::storage(CREP_SAMPLE_LIST_DEFAULT_BINDING, list->buffer));
+    d.indirect = list->buffer;
   } else {
-    gpu::dispatchMarch(params.region.z, params.region.w, "RectifiedMarchPass::run");
+    // 8 x 8 pixels per workgroup (gpu::dispatchMarch's choice): the block's bounding box or the image.
+    d.groups = glm::uvec3(static_cast<unsigned>((params.region.z + 7) / 8),
+                          static_cast<unsigned>((params.region.w + 7) / 8), 1u);
   }
-  if (textured) {
-    glBindSampler(CREP_MARCH_LIGHT_COLORS_UNIT, 0);
-    glBindTextureUnit(CREP_MARCH_LIGHT_COLORS_UNIT, 0);
-  }
+  b.dispatch(d);
 }
 
 } // namespace crep

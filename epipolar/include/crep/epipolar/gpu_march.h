@@ -86,6 +86,8 @@ public:
     int mapWidth = 0;  ///< W texels of the maps it will march (> 0, <= GL_MAX_TEXTURE_SIZE)
     int mapHeight = 0; ///< H texels
     Mode mode = Mode::MinMaxTree;
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   /// Per-frame inputs: non-owning.
   struct FrameAttribs {
@@ -128,10 +130,13 @@ public:
 private:
   struct Plan;
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
-  std::uint32_t program(gpu::LayoutKind kind, bool textured, bool list);
+  ShaderStageSource program(gpu::LayoutKind kind, bool textured, bool list) const;
   CreateInfo info_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2][2][2], params_, sampler_, dummySteps_; ///< [list][textured][layout kind]
+  gpu::Buffer params_;
+  gpu::Texture dummySteps_; ///< R32F: the step counts when FrameAttribs::stepsOutput is 0
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 
