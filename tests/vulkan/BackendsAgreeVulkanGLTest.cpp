@@ -2,6 +2,7 @@
 // into its rectified map with the map's min/max trees by the passes on the backend seam, once on
 // gpu::GlBackend (llvmpipe) and once on gpu::VulkanBackend (lavapipe, validation on). The two maps are
 // compared by relative RMSE and their largest difference; the trees of each backend are those of its map.
+// RectifiedMarchPass (min/max tree march with a block, brute force) then marches the same map on both.
 #include "common/gl_fixture.h"
 
 #include <crep/core/gl.h>
@@ -17,9 +18,11 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 using namespace crep;
@@ -50,6 +53,55 @@ BackendRun runOn(gpu::Backend& backend, const Image& shadow, const RectifiedLayo
   fused.completeUpperLevels();
   fromMap.run(map.id());
   return {backend.readTexture(map.id()), fused.readNodes(), fromMap.readNodes()};
+}
+
+/// The tree march (the whole image, then an epipole-block-like disc over it) and the brute-force march of
+/// `map` (W x H, R32F, the same values on both backends) on `backend`: RGBA floats of both images.
+std::pair<std::vector<float>, std::vector<float>> marchOn(gpu::Backend& backend, const scenes::Scene& scene,
+                                                          const RectifiedLayout& layout, const Image& map,
+                                                          const Image& cameraDepth) {
+  const int W = map.width(), H = map.height(), w = cameraDepth.width(), h = cameraDepth.height();
+  gpu::Texture mapTexture(backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, W, H, 1, "map"});
+  backend.writeTexture(mapTexture.id(), map.data());
+  gpu::Texture depth(backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, w, h, 1, "camera depth"});
+  backend.writeTexture(depth.id(), cameraDepth.data());
+  MinMaxTreePass trees({.mapWidth = W, .mapHeight = H, .backend = &backend});
+  trees.run(mapTexture.id());
+  std::vector<float> images[2];
+  for (const RectifiedMarchPass::Mode mode :
+       {RectifiedMarchPass::Mode::MinMaxTree, RectifiedMarchPass::Mode::BruteForce}) {
+    RectifiedMarchPass march({.mapWidth = W, .mapHeight = H, .mode = mode, .backend = &backend});
+    gpu::Texture out(backend, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, w, h, 1, "march"});
+    RectifiedMarchPass::FrameAttribs a;
+    a.layout = &layout;
+    a.camera = &scene.camera;
+    a.light = &scene.sun;
+    a.medium = &scene.medium;
+    a.cameraDepth = depth.id();
+    a.rectifiedDepth = mapTexture.id();
+    a.minMaxBuffer = trees.treeBuffer();
+    a.output = out.id();
+    march.run(a);
+    if (mode == RectifiedMarchPass::Mode::MinMaxTree) { // a disc over the image's centre, marched again
+      a.blockCenter = glm::dvec2(w / 2.0, h / 2.0);
+      a.blockRadius = h / 4.0;
+      march.run(a);
+    }
+    images[mode == RectifiedMarchPass::Mode::MinMaxTree ? 0 : 1] = backend.readTexture(out.id());
+  }
+  return {images[0], images[1]};
+}
+
+/// Relative RMSE of b against a (RGB of RGBA floats).
+double relativeRmseRgb(const std::vector<float>& a, const std::vector<float>& b) {
+  double squared = 0.0, reference = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (i % 4 != 3) {
+      const double d = static_cast<double>(b[i]) - a[i];
+      squared += d * d;
+      reference += static_cast<double>(a[i]) * a[i];
+    }
+  return std::sqrt(squared / reference);
 }
 
 } // namespace
@@ -99,6 +151,17 @@ TEST_CASE("backends agree: a scene's rectified map and trees on OpenGL and on Vu
     // Each backend's fused trees are the trees of its own map, bit for bit.
     CHECK(a.nodes == a.treesOfMap);
     CHECK(b.nodes == b.treesOfMap);
+    // RectifiedMarchPass on both backends over the same map (GL's): tree march with a block, brute force.
+    Image map(W, H, 1);
+    std::copy(a.map.begin(), a.map.end(), map.data().begin());
+    const Image cameraDepth = renderer.renderDepthImage(scene.camera.clipFromWorld(), width, height);
+    const auto [glTree, glBrute] = marchOn(gl, scene, *layout, map, cameraDepth);
+    const auto [vkTree, vkBrute] = marchOn(vk, scene, *layout, map, cameraDepth);
+    const double tree = relativeRmseRgb(glTree, vkTree), brute = relativeRmseRgb(glBrute, vkBrute);
+    MESSAGE(name << ": RectifiedMarchPass Vulkan vs GL, relative RMSE: min/max tree march " << tree
+                 << ", brute force " << brute);
+    CHECK(tree <= 1e-4);
+    CHECK(brute <= 1e-4);
   }
   const std::vector<std::string> messages = vk.validationMessages();
   CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
