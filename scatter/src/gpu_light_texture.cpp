@@ -2,6 +2,7 @@
 // caller's texture and projection, and the colour map pass (glsl/passes/scatter/light_colors.comp). Rules in
 // crep/scatter/light_texture.h.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/light_texture.h>
@@ -32,6 +33,25 @@ gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const D
   return level;
 }
 
+gl::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightTexture& texture,
+                                         const DirectionalLight* light, const LocalLight* localLight,
+                                         std::string_view field) {
+  if (backend.name() == "OpenGL") return validateGpuLightTexture(texture, light, localLight, field);
+  const std::string f(field);
+  const std::string textureField = f + ".texture";
+  const gl::TextureLevel level = textureLevelOf(backend, textureField.c_str(), texture.texture);
+  if (level.target != GL_TEXTURE_2D)
+    throw InvalidArgument(textureField, std::to_string(texture.texture), "must be a 2D texture");
+  if (level.internalFormat == GL_DEPTH_COMPONENT32F)
+    throw InvalidArgument(textureField, std::to_string(texture.texture),
+                          "must have a colour format (not depth)");
+  if (localLight)
+    validateLightProjection(texture.textureClipFromWorld, *localLight, f + ".textureClipFromWorld");
+  else if (light)
+    validateLightProjection(texture.textureClipFromWorld, *light, f + ".textureClipFromWorld");
+  return level;
+}
+
 LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gl::TextureLevel& level,
                                           int mapWidth, int mapHeight, const LocalLight* localLight) {
   LightTextureParams p;
@@ -50,10 +70,12 @@ LightColorMapPass::LightColorMapPass(const CreateInfo& info) : info_(info) {
   if (info.mapHeight <= 0)
     throw InvalidArgument("LightColorMapPass::CreateInfo.mapHeight", detail::formatValue(info.mapHeight),
                           "must be > 0");
-  colors_ = gl::createTexture2D(GL_RGBA32F, info.mapWidth, info.mapHeight, "LightColorMapPass::CreateInfo");
-  params_ = gl::createDynamicBuffer(sizeof(gpu::LightTextureParams));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("LightColorMapPass");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::checkTextureSize(*backend_, "LightColorMapPass::CreateInfo", info.mapWidth, info.mapHeight);
+  layout_ = gpu::LayoutBuffers(backend_);
+  colors_ = gpu::Texture(*backend_, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, info.mapWidth,
+                                     info.mapHeight, 1, "LightColorMapPass: colour map"});
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::LightTextureParams), "LightColorMapPass: light texture");
 }
 
 std::size_t LightColorMapPass::memoryBytes() const noexcept {
@@ -82,7 +104,8 @@ LightColorMapPass::Plan LightColorMapPass::plan(const FrameAttribs& f, std::stri
     invalid(p + "layout", "a directional light's",
             "a local light's map has its layout (ProjectiveLayout or EpipolarLayout of the light)");
   Plan plan;
-  plan.level = gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight, p + "lightTexture");
+  plan.level =
+      gpu::validateGpuLightTexture(*backend_, f.lightTexture, f.light, f.localLight, p + "lightTexture");
   plan.layoutData = gpu::requireGpuLayout(*f.layout, (p + "layout").c_str());
   gpu::LayoutBuffers::requireUploadable(plan.layoutData, info_.mapHeight, (p + "layout").c_str());
   return plan;
@@ -92,27 +115,21 @@ void LightColorMapPass::run(const FrameAttribs& f) {
   const Plan p = plan(f, "LightColorMapPass::FrameAttribs");
   const gpu::LayoutKind kind =
       layout_.upload(p.layoutData, info_.mapHeight, "LightColorMapPass::FrameAttribs.layout");
-  gl::Handle& program = programs_[static_cast<int>(kind)];
-  if (!program)
-    program = buildProgram({{ShaderStage::Compute,
-                             "passes/scatter/light_colors.comp",
-                             {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}}}});
   const gpu::LightTextureParams params =
       gpu::makeLightTextureParams(f.lightTexture, p.level, info_.mapWidth, info_.mapHeight, f.localLight);
-  glNamedBufferSubData(params_.get(), 0, sizeof params, &params);
-
-  glUseProgram(program.get());
-  layout_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_LIGHT_COLORS_LIGHT_TEXTURE_BINDING, params_.get());
-  glBindTextureUnit(CREP_LIGHT_COLORS_LIGHT_TEXTURE_UNIT, f.lightTexture.texture);
-  glBindSampler(CREP_LIGHT_COLORS_LIGHT_TEXTURE_UNIT, sampler_.get());
-  glBindImageTexture(CREP_LIGHT_COLORS_COLORS_OUT_IMAGE, colors_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((info_.mapWidth + 7) / 8),
-                    static_cast<GLuint>((info_.mapHeight + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError("LightColorMapPass::run");
+  backend_->writeBuffer(params_.id(), 0, std::as_bytes(std::span(&params, 1)));
+  gpu::Dispatch d;
+  d.label = "LightColorMapPass::run";
+  d.program = "passes/scatter/light_colors.comp";
+  d.defines = {{"CREP_LAYOUT", std::to_string(static_cast<int>(kind))}};
+  d.resources = {
+      gpu::Resource::uniform(CREP_LIGHT_COLORS_LIGHT_TEXTURE_BINDING, params_.id()),
+      gpu::Resource::sampled(CREP_LIGHT_COLORS_LIGHT_TEXTURE_UNIT, f.lightTexture.texture),
+      gpu::Resource::image(CREP_LIGHT_COLORS_COLORS_OUT_IMAGE, colors_.id(), gpu::Access::WriteOnly)};
+  layout_.appendResources(d.resources, CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+  d.groups = glm::uvec3(static_cast<unsigned>((info_.mapWidth + 7) / 8),
+                        static_cast<unsigned>((info_.mapHeight + 7) / 8), 1u);
+  backend_->dispatch(d);
 }
 
 } // namespace crep

@@ -2,6 +2,7 @@
 // Eq. 1 and 3) and the shared march block. Shader: passes/scatter/march_reference.comp, crep/march.glsl,
 // crep/local_light.glsl.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -117,10 +118,9 @@ void dispatchMarch(int width, int height, const char* what) {
 
 WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
   crep::validate(info.options);
-  program_ = buildProgram({{ShaderStage::Compute, "passes/scatter/march_reference.comp", {}}});
-  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("WorldMarchPass");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  backend_->prepareProgram("passes/scatter/march_reference.comp", {});
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::MarchParams), "WorldMarchPass: parameters");
 }
 
 /// A validated frame of the pass (WorldMarchPass::validate) and what run() derives from it.
@@ -137,16 +137,19 @@ WorldMarchPass::Plan WorldMarchPass::plan(const FrameAttribs& f, std::string_vie
   if (!f.camera || !f.medium) invalid(p + "camera/medium", "null", "must be set");
   if ((f.light != nullptr) == (f.localLight != nullptr))
     invalid(p + "light/localLight", f.light ? "both set" : "both null", "exactly one must be set");
-  // The image and map sizes are the textures' own (gl::textureLevel).
+  // The image and map sizes are the textures' own.
+  const gpu::Backend& b = *backend_;
   Plan plan;
-  plan.depth = gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
-  plan.shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
-  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
-  gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
+  plan.depth = gpu::textureLevelOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  plan.shadow = gpu::textureLevelOf(b, (p + "shadowMap").c_str(), f.shadowMap);
+  gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, plan.depth.width, plan.depth.height);
+  gpu::requireTexture2DOf(b, (p + "shadowMap").c_str(), f.shadowMap, plan.shadow.width, plan.shadow.height);
+  gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  gpu::requireDepthFormatOf(b, (p + "shadowMap").c_str(), f.shadowMap);
   const int width = plan.depth.width, height = plan.depth.height;
-  gl::requireTexture2D((p + "output").c_str(), f.output, width, height, GL_RGBA32F);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, width, height, GL_RGBA32F);
   if (f.stepsOutput != 0)
-    gl::requireTexture2D((p + "stepsOutput").c_str(), f.stepsOutput, width, height, GL_R32F);
+    gpu::requireTexture2DOf(b, (p + "stepsOutput").c_str(), f.stepsOutput, width, height, GL_R32F);
   requireFinite(p + "lightClipFromWorld", f.lightClipFromWorld);
   if (const LocalLight* l = f.localLight) {
     const auto finite3 = [](const glm::dvec3& v) {
@@ -163,7 +166,7 @@ WorldMarchPass::Plan WorldMarchPass::plan(const FrameAttribs& f, std::string_vie
   requireFinite(p + "bias", f.bias);
   if (f.lightTexture.texture != 0)
     plan.lightTexture =
-        gpu::validateGpuLightTexture(f.lightTexture, f.light, f.localLight, p + "lightTexture");
+        gpu::validateGpuLightTexture(b, f.lightTexture, f.light, f.localLight, p + "lightTexture");
   if (!std::isfinite(f.blockRadius) || !std::isfinite(f.blockCenter.x) || !std::isfinite(f.blockCenter.y))
     invalid(p + "blockCenter/blockRadius", detail::formatValue(f.blockRadius), "must be finite");
   return plan;
@@ -184,37 +187,41 @@ void WorldMarchPass::run(const FrameAttribs& f) {
   if (!gpu::setMarchRegion(params, width, height, f.blockCenter, f.blockRadius,
                            "WorldMarchPass::FrameAttribs"))
     return; // the block misses the image
-  const glm::ivec4 region = params.region;
-  glNamedBufferSubData(params_.get(), 0, sizeof(params), &params);
-
-  const GLuint steps = f.stepsOutput != 0 ? f.stepsOutput
-                                          : gl::scratchTexture2D(dummySteps_, dummyWidth_, dummyHeight_,
-                                                                 GL_R32F, width, height);
-  GLuint program = program_.get();
+  gpu::Backend& b = *backend_;
+  b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&params, 1)));
+  std::uint32_t steps = f.stepsOutput;
+  if (steps == 0) { // the program always writes its step counts: a scratch target of the image's size
+    if (!dummySteps_ || dummyWidth_ != width || dummyHeight_ != height) {
+      dummySteps_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::R32F, width, height, 1,
+                                     "WorldMarchPass: step counts (unused)"});
+      dummyWidth_ = width;
+      dummyHeight_ = height;
+    }
+    steps = dummySteps_.id();
+  }
+  gpu::Dispatch d;
+  d.label = "WorldMarchPass::run";
+  d.program = "passes/scatter/march_reference.comp";
+  d.resources = {gpu::Resource::uniform(CREP_MARCH_PARAMS_BINDING, params_.id()),
+                 gpu::Resource::sampled(CREP_MARCH_CAMERA_DEPTH_UNIT, f.cameraDepth),
+                 gpu::Resource::sampled(CREP_MARCH_MAP_UNIT, f.shadowMap),
+                 gpu::Resource::image(CREP_MARCH_SCATTERING_OUT_IMAGE, f.output, gpu::Access::WriteOnly),
+                 gpu::Resource::image(CREP_MARCH_STEPS_OUT_IMAGE, steps, gpu::Access::WriteOnly)};
   if (textured) {
     // Light textures (Klehm et al. 2014, Sec. 3.2): the CREP_LIGHT_TEXTURE variant and its block.
-    if (!texturedProgram_) {
-      texturedProgram_ = buildProgram(
-          {{ShaderStage::Compute, "passes/scatter/march_reference.comp", {{"CREP_LIGHT_TEXTURE", "1"}}}});
-      textureParams_ = gl::createDynamicBuffer(sizeof(gpu::LightTextureParams));
-    }
-    program = texturedProgram_.get();
+    if (!textureParams_)
+      textureParams_ = gpu::Buffer(b, sizeof(gpu::LightTextureParams), "WorldMarchPass: light texture");
     const gpu::LightTextureParams tp =
         gpu::makeLightTextureParams(f.lightTexture, p.lightTexture, 0, 0, f.localLight);
-    glNamedBufferSubData(textureParams_.get(), 0, sizeof tp, &tp);
+    b.writeBuffer(textureParams_.id(), 0, std::as_bytes(std::span(&tp, 1)));
+    d.defines = {{"CREP_LIGHT_TEXTURE", "1"}};
+    d.resources.push_back(gpu::Resource::uniform(CREP_MARCH_LIGHT_TEXTURE_BINDING, textureParams_.id()));
+    d.resources.push_back(gpu::Resource::sampled(CREP_MARCH_LIGHT_TEXTURE_UNIT, f.lightTexture.texture));
   }
-  gpu::bindMarchResources(program, params_.get(), f.cameraDepth, f.shadowMap, sampler_.get(), f.output,
-                          steps);
-  if (textured) {
-    glBindBufferBase(GL_UNIFORM_BUFFER, CREP_MARCH_LIGHT_TEXTURE_BINDING, textureParams_.get());
-    glBindTextureUnit(CREP_MARCH_LIGHT_TEXTURE_UNIT, f.lightTexture.texture);
-    glBindSampler(CREP_MARCH_LIGHT_TEXTURE_UNIT, sampler_.get());
-  }
-  gpu::dispatchMarch(region.z, region.w, "WorldMarchPass::run");
-  if (textured) {
-    glBindSampler(CREP_MARCH_LIGHT_TEXTURE_UNIT, 0);
-    glBindTextureUnit(CREP_MARCH_LIGHT_TEXTURE_UNIT, 0);
-  }
+  // 8 x 8 pixels per workgroup (gpu::dispatchMarch's choice): the block's bounding box or the image.
+  d.groups = glm::uvec3(static_cast<unsigned>((params.region.z + 7) / 8),
+                        static_cast<unsigned>((params.region.w + 7) / 8), 1u);
+  b.dispatch(d);
 }
 
 } // namespace crep

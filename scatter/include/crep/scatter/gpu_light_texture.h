@@ -5,11 +5,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string_view>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
@@ -41,6 +43,10 @@ namespace gpu {
 /// (validateLightProjection). Returns the texture's level 0.
 gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
                                          const LocalLight* localLight, std::string_view field);
+/// The same for a texture of `backend` (any colour format, not depth).
+gl::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightTexture& texture,
+                                         const DirectionalLight* light, const LocalLight* localLight,
+                                         std::string_view field);
 /// The block of `texture` (level 0 `level`) for a mapWidth x mapHeight colour map; w = 0 without localLight.
 LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gl::TextureLevel& level,
                                           int mapWidth, int mapHeight, const LocalLight* localLight);
@@ -52,6 +58,8 @@ public:
   struct CreateInfo {
     int mapWidth = 1024;  ///< W of the rectified maps it colours
     int mapHeight = 1024; ///< H
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   struct FrameAttribs {
     /// The map's layout: any layout with a GPU mapping. Not owned.
@@ -70,8 +78,8 @@ public:
   /// Writes colorMapTexture(). Throws InvalidArgument naming the FrameAttribs field. Per frame, O(W H).
   void run(const FrameAttribs& frame);
 
-  /// GL_TEXTURE_2D, GL_RGBA32F, mapWidth x mapHeight (nearest filtering, clamp to edge).
-  std::uint32_t colorMapTexture() const noexcept { return colors_.get(); }
+  /// 2D texture, RGBA32F, mapWidth x mapHeight (a GL name on OpenGL): read texel by texel by the passes.
+  std::uint32_t colorMapTexture() const noexcept { return colors_.id(); }
   const CreateInfo& createInfo() const noexcept { return info_; }
   /// GPU memory it owns, bytes: the colour map (16 per texel) and its block.
   std::size_t memoryBytes() const noexcept;
@@ -81,8 +89,10 @@ private:
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
 
   CreateInfo info_;
-  gl::Handle colors_, params_, sampler_;
-  gl::Handle programs_[2]; ///< per gpu::LayoutKind, built on first use
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Texture colors_;
+  gpu::Buffer params_;
   gpu::LayoutBuffers layout_;
 };
 

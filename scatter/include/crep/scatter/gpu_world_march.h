@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -104,6 +105,8 @@ public:
   struct CreateInfo {
     /// steps and refinements are compiled in; bias and threads are unused (FrameAttribs::bias).
     WorldMarchOptions options;
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
@@ -138,8 +141,10 @@ private:
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
 
   CreateInfo info_;
-  gl::Handle program_, params_, sampler_, dummySteps_;
-  gl::Handle texturedProgram_, textureParams_; ///< light textures, on first use
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_, textureParams_; ///< the march block; the light texture's, on first use
+  gpu::Texture dummySteps_;            ///< R32F: the step counts when FrameAttribs::stepsOutput is 0
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 
