@@ -3,6 +3,7 @@
 // (Fig. 8), from the passes of scatter/, epipolar/ and prefilter/.
 #include <crep/core/error.h>
 #include <crep/core/gl.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/gl_state.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
@@ -47,10 +48,16 @@ const char* layoutToken(Scattering::Layout layout) {
 namespace {
 
 const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
-  gl::checkTextureSize("Scattering::CreateInfo.width/height", info.width, info.height);
-  gl::checkTextureSize("Scattering::CreateInfo.mapSize", info.mapSize, info.mapSize);
-  gl::checkTextureSize("Scattering::CreateInfo.ownShadowMapSize", info.ownShadowMapSize,
-                       info.ownShadowMapSize);
+  // Against the limits of the backend (GL: the current context's, GlError beyond them).
+  const auto checkSize = [&](const char* parameter, int width, int height) {
+    if (info.backend != nullptr)
+      gpu::checkTextureSize(*info.backend, parameter, width, height);
+    else
+      gl::checkTextureSize(parameter, width, height);
+  };
+  checkSize("Scattering::CreateInfo.width/height", info.width, info.height);
+  checkSize("Scattering::CreateInfo.mapSize", info.mapSize, info.mapSize);
+  checkSize("Scattering::CreateInfo.ownShadowMapSize", info.ownShadowMapSize, info.ownShadowMapSize);
   validate(info.rectify);
   if (info.rectify.layout != SplitLayout::Regions)
     invalid("Scattering::CreateInfo.rectify.layout", "not SplitLayout::Regions",
@@ -117,6 +124,15 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (info.sampling != Scattering::Sampling::PerPixel && info.sampling != Scattering::Sampling::Epipolar)
     invalid("Scattering::CreateInfo.sampling", std::to_string(static_cast<int>(info.sampling)),
             "must be Sampling::PerPixel or Sampling::Epipolar");
+  if (info.backend != nullptr && info.backend->name() != "OpenGL") {
+    // The stages still written with GL calls (docs/BACKENDS.md, "What remains GL-only").
+    if (info.sampling != Scattering::Sampling::PerPixel)
+      invalid("Scattering::CreateInfo.sampling", "Sampling::Epipolar",
+              "needs the OpenGL backend (EpipolarSamplingPass is not on the backend seam yet)");
+    if (factor != 1)
+      invalid("Scattering::CreateInfo.evaluationScale", detail::formatValue(info.evaluationScale),
+              "must be 1 on a backend other than OpenGL (DepthAwareResamplePass is not on the seam yet)");
+  }
   if (info.sampling == Scattering::Sampling::Epipolar) {
     validate(info.epipolarSampling, "Scattering::CreateInfo.epipolarSampling");
     if (factor != 1)
@@ -129,6 +145,14 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
               "must be multiples of epipolarSampling.downscale = " + std::to_string(F));
   }
   return info;
+}
+
+/// gl::requireTexture2D(parameter, texture) (any size) on any backend.
+gl::TextureLevel requireTexture2D(const gpu::Backend& backend, const char* parameter, std::uint32_t texture) {
+  if (backend.name() == "OpenGL") return gl::requireTexture2D(parameter, texture);
+  const gl::TextureLevel level = gpu::textureLevelOf(backend, parameter, texture);
+  gpu::requireTexture2DOf(backend, parameter, texture, level.width, level.height);
+  return level;
 }
 
 /// Throws unless every direction of `directions` from `position` is inside the map of M (in front of it, NDC
@@ -149,10 +173,11 @@ void requireCovers(const std::string& field, const glm::dmat4& M, const glm::dve
 }
 
 /// One local light's given perspective map: texture, bias, matrix centred at `position`, coverage.
-void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map, const glm::dvec3& position,
-                      std::span<const glm::dvec3> directions, const std::string& what) {
-  gl::requireTexture2D((field + ".texture").c_str(), map.texture);
-  gl::requireDepthFormat((field + ".texture").c_str(), map.texture);
+void validateLocalMap(const gpu::Backend& backend, const std::string& field, const Scattering::ShadowMap& map,
+                      const glm::dvec3& position, std::span<const glm::dvec3> directions,
+                      const std::string& what) {
+  requireTexture2D(backend, (field + ".texture").c_str(), map.texture);
+  gpu::requireDepthFormatOf(backend, (field + ".texture").c_str(), map.texture);
   requireFinite(field + ".bias", map.bias);
   try {
     validateLocalLightMatrix(map.lightClipFromWorld, position);
@@ -165,7 +190,8 @@ void validateLocalMap(const std::string& field, const Scattering::ShadowMap& map
 
 /// The local lights' shadow inputs (Klehm et al. 2014, Sec. 3.2 "Local Lights"; scattering.h): span sizes,
 /// each given map, drawCasters for the lights without maps.
-void validateLocalShadowMaps(const Scattering::FrameAttribs& f, const std::string& prefix) {
+void validateLocalShadowMaps(const gpu::Backend& backend, const Scattering::FrameAttribs& f,
+                             const std::string& prefix) {
   if (!f.spotShadowMaps.empty() && f.spotShadowMaps.size() != f.spotLights.size())
     invalid(prefix + "spotShadowMaps", "size " + std::to_string(f.spotShadowMaps.size()),
             "must be 0 or spotLights.size() = " + std::to_string(f.spotLights.size()));
@@ -187,7 +213,7 @@ void validateLocalShadowMaps(const Scattering::FrameAttribs& f, const std::strin
       cone[std::size_t(k)] = std::cos(spot.outerConeAngle()) * a +
                              std::sin(spot.outerConeAngle()) * (std::cos(phi) * u + std::sin(phi) * v);
     }
-    validateLocalMap(prefix + "spotShadowMaps[" + std::to_string(i) + "]", f.spotShadowMaps[i],
+    validateLocalMap(backend, prefix + "spotShadowMaps[" + std::to_string(i) + "]", f.spotShadowMaps[i],
                      spot.position(), cone, "the spot's outer cone");
   }
   for (std::size_t j = 0; j < f.pointShadowMaps.size(); ++j) {
@@ -196,7 +222,7 @@ void validateLocalShadowMaps(const Scattering::FrameAttribs& f, const std::strin
     const glm::dvec3 A = PointLight::faceAxis(face), B = PointLight::faceAxis((face / 2 * 2 + 2) % 6),
                      C = PointLight::faceAxis((face / 2 * 2 + 4) % 6);
     const std::array<glm::dvec3, 4> corners{A + B + C, A + B - C, A - B + C, A - B - C};
-    validateLocalMap(prefix + "pointShadowMaps[" + std::to_string(j) + "]", f.pointShadowMaps[j],
+    validateLocalMap(backend, prefix + "pointShadowMaps[" + std::to_string(j) + "]", f.pointShadowMaps[j],
                      f.pointLights[j / 6].position(), corners,
                      "face " + std::to_string(face) + "'s sector of directions (PointLight::faceOf)");
   }
@@ -204,8 +230,8 @@ void validateLocalShadowMaps(const Scattering::FrameAttribs& f, const std::strin
 
 /// The light textures (scattering.h "Light textures"): the directional light's and the spots' (span size,
 /// each texture and projection), and the evaluation options without a textured variant.
-void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOptions& evaluate,
-                           const std::string& prefix) {
+void validateLightTextures(const gpu::Backend& backend, const Scattering::FrameAttribs& f,
+                           const EvaluateOptions& evaluate, const std::string& prefix) {
   if (!f.spotLightTextures.empty() && f.spotLightTextures.size() != f.spotLights.size())
     invalid(prefix + "spotLightTextures", "size " + std::to_string(f.spotLightTextures.size()),
             "must be 0 or spotLights.size() = " + std::to_string(f.spotLights.size()));
@@ -213,13 +239,13 @@ void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOpti
   if (f.lightTexture) {
     if (!f.light)
       invalid(prefix + "lightTexture", "set without a directional light", "must be null when light is null");
-    gpu::validateGpuLightTexture(*f.lightTexture, f.light, nullptr, prefix + "lightTexture");
+    gpu::validateGpuLightTexture(backend, *f.lightTexture, f.light, nullptr, prefix + "lightTexture");
     any = true;
   }
   for (std::size_t i = 0; i < f.spotLightTextures.size(); ++i) {
     if (f.spotLightTextures[i].texture == 0) continue; // untextured entry
     const LocalLight light = LocalLight::spot(f.spotLights[i]);
-    gpu::validateGpuLightTexture(f.spotLightTextures[i], nullptr, &light,
+    gpu::validateGpuLightTexture(backend, f.spotLightTextures[i], nullptr, &light,
                                  prefix + "spotLightTextures[" + std::to_string(i) + "]");
     any = true;
   }
@@ -236,11 +262,12 @@ void validateLightTextures(const Scattering::FrameAttribs& f, const EvaluateOpti
 }
 
 /// FrameAttribs::froxels (scattering.h "Froxel volumes"): grid, jitter, the volume's target, format, size.
-void validateFroxelTarget(const Scattering::FroxelTarget& t, const Camera& camera, const std::string& owner) {
+void validateFroxelTarget(const gpu::Backend& backend, const Scattering::FroxelTarget& t,
+                          const Camera& camera, const std::string& owner) {
   validate(t.grid, owner.c_str());
   froxelDepthRange(t.grid, camera, owner.c_str());
   validateFroxelJitter(t.jitter, owner + ".jitter");
-  const gl::TextureLevel v = gl::textureLevel((owner + ".volume").c_str(), t.volume);
+  const gl::TextureLevel v = gpu::textureLevelOf(backend, (owner + ".volume").c_str(), t.volume);
   if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
     invalid(owner + ".volume", "texture " + std::to_string(t.volume),
             "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
@@ -309,13 +336,38 @@ EpipolarOptions epipolarOptions(const Scattering::CreateInfo& info, double depth
 
 } // namespace
 
+/// The passes' CreateInfos on the object's backend.
+PrefilterPass::CreateInfo prefilterInfo(int mapSize, const PrefilterOptions& options, gpu::Backend* backend) {
+  PrefilterPass::CreateInfo c;
+  c.mapWidth = c.mapHeight = mapSize;
+  c.options = options;
+  c.backend = backend;
+  return c;
+}
+
+EvaluatePass::CreateInfo evaluateInfo(int bases, const EvaluateOptions& options, bool closedForm,
+                                      gpu::Backend* backend) {
+  EvaluatePass::CreateInfo c;
+  c.bases = bases;
+  c.options = options;
+  c.localClosedForm = closedForm;
+  c.backend = backend;
+  return c;
+}
+
 struct Scattering::Impl {
   explicit Impl(const CreateInfo& i)
-      : info(validated(i)), prefilter({i.mapSize, i.mapSize, i.prefilter}),
-        evaluate(
-            {.bases = i.prefilter.bases, .options = i.evaluate, .localClosedForm = i.localLightClosedForm}),
-        resample({i.mapSize, i.mapSize}), block({i.epipoleBlock}), rectified({i.mapSize, i.mapSize}) {
-    resampled = gl::createTexture2D(GL_R32F, i.mapSize, i.mapSize, "Scattering::CreateInfo.mapSize");
+      : info(validated(i)), backend(&gpu::givenOrGl(i.backend, ownBackend)), gl(backend->name() == "OpenGL"),
+        prefilter(prefilterInfo(i.mapSize, i.prefilter, backend)),
+        evaluate(evaluateInfo(i.prefilter.bases, i.evaluate, i.localLightClosedForm, backend)),
+        resample({.mapWidth = i.mapSize, .mapHeight = i.mapSize, .backend = backend}),
+        block({.options = i.epipoleBlock, .backend = backend}) {
+    if (gl) {
+      rectified.emplace(RectifiedShadowPass::CreateInfo{i.mapSize, i.mapSize});
+      timer.emplace();
+    }
+    resampled = gpu::Texture(*backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, i.mapSize, i.mapSize,
+                                        1, "Scattering: resampled map"});
     // The min/max trees and their march: Method::MinMaxMarch's, or the prefiltered method's epipole block.
     // Made (and the block's program built) with the object, so the first frame with the sun in view
     // compiles nothing.
@@ -323,9 +375,10 @@ struct Scattering::Impl {
                            i.epipoleBlockMethod == EpipoleBlockMethod::TreeMarch &&
                            i.epipoleBlockRadius > 0.0;
     if (i.method == Method::MinMaxMarch || treeBlock) {
-      trees.emplace(MinMaxTreePass::CreateInfo{i.mapSize, i.mapSize});
-      march.emplace(
-          RectifiedMarchPass::CreateInfo{i.mapSize, i.mapSize, RectifiedMarchPass::Mode::MinMaxTree});
+      trees.emplace(
+          MinMaxTreePass::CreateInfo{.mapWidth = i.mapSize, .mapHeight = i.mapSize, .backend = backend});
+      march.emplace(RectifiedMarchPass::CreateInfo{i.mapSize, i.mapSize, RectifiedMarchPass::Mode::MinMaxTree,
+                                                   backend});
     }
     if (treeBlock) march->prepare(gpu::LayoutKind::Epipolar);
     if (i.sampling == Sampling::Epipolar)
@@ -340,12 +393,15 @@ struct Scattering::Impl {
   }
 
   CreateInfo info;
+  std::unique_ptr<gpu::Backend> ownBackend; ///< CreateInfo::backend null: a GlBackend of its own
+  gpu::Backend* backend;                    ///< runs every pass (CreateInfo::backend or ownBackend)
+  bool gl;                                  ///< the backend is OpenGL: the GL-only stages are available
   PrefilterPass prefilter;
   EvaluatePass evaluate;
   ShadowResamplePass resample;
   WorldMarchPass block;
-  RectifiedShadowPass rectified;                 ///< the projective map rasterized with drawCasters
-  gl::Handle resampled;                          ///< R32F: a map resampled from a standard shadow map
+  std::optional<RectifiedShadowPass> rectified;  ///< GL: the projective map rasterized with drawCasters
+  gpu::Texture resampled;                        ///< R32F: a map resampled from a standard shadow map
   std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
   gl::Handle lowDepth, lowOutput;                ///< its camera depth (R32F) and scattering (RGBA32F)
@@ -353,14 +409,14 @@ struct Scattering::Impl {
   std::optional<MinMaxTreePass> trees;
   std::optional<RectifiedMarchPass> march;      ///< ... and the tree march
   std::optional<EpipolarSamplingPass> sampling; ///< Sampling::Epipolar
-  gl::GpuTimer timer;
-  bool running = false; ///< inside run(): a call from drawCasters is refused
+  std::optional<gl::GpuTimer> timer;            ///< GL: the stages' GL_TIME_ELAPSED
+  bool running = false;                         ///< inside run(): a call from drawCasters is refused
   /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
   /// made on the first frame with local lights; their fallback's perspective shadow map.
-  gl::Handle localScattering, accumulate;
+  gpu::Texture localScattering;
   std::optional<DepthTarget> localShadowMap;
   std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
-  gl::Handle localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
+  gpu::Texture localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
   /// The local lights' own passes for an M (CreateInfo::spotLightBases, localLightBases) or table samples
   /// (spotLightTableSamples, localLightTableSamples) that differ from the directional light's, made on
   /// first use; the evaluations keyed by (M, Z).
@@ -389,7 +445,7 @@ struct Scattering::Impl {
     if (it == localPrefilters.end()) {
       PrefilterOptions options = info.prefilter;
       options.bases = M;
-      it = localPrefilters.emplace(M, PrefilterPass::CreateInfo{info.mapSize, info.mapSize, options}).first;
+      it = localPrefilters.emplace(M, prefilterInfo(info.mapSize, options, backend)).first;
     }
     return it->second;
   }
@@ -400,9 +456,7 @@ struct Scattering::Impl {
       EvaluateOptions options = info.evaluate;
       options.visibilityTableSamples = Z;
       it = localEvaluates
-               .emplace(std::pair(M, Z),
-                        EvaluatePass::CreateInfo{
-                            .bases = M, .options = options, .localClosedForm = info.localLightClosedForm})
+               .emplace(std::pair(M, Z), evaluateInfo(M, options, info.localLightClosedForm, backend))
                .first;
     }
     return it->second;
@@ -412,29 +466,33 @@ struct Scattering::Impl {
   /// Runs the colour map pass for `layout` and returns its texture.
   std::uint32_t lightColors(const RectifiedLayout& layout, const GpuLightTexture& texture,
                             const DirectionalLight* light, const LocalLight* localLight) {
-    if (!colorMap) colorMap.emplace(LightColorMapPass::CreateInfo{info.mapSize, info.mapSize});
+    if (!colorMap) colorMap.emplace(LightColorMapPass::CreateInfo{info.mapSize, info.mapSize, backend});
     colorMap->run({.layout = &layout, .lightTexture = texture, .light = light, .localLight = localLight});
     return colorMap->colorMapTexture();
   }
-  /// Night frames (no directional light): the transmittance pass, its parameters and sampler.
-  gl::Handle transmittance, transmittanceParams, transmittanceSampler;
+  /// Night frames (no directional light): the transmittance pass's parameters.
+  gpu::Buffer transmittanceParams;
 
   /// A night frame's output before the local lights are added: RGB 0, A the transmittance to the surface
   /// (the surface radiance's factor in Klehm et al. 2014, Eq. 1).
   void writeTransmittance(const FrameAttribs& f) {
-    if (!transmittance) {
-      transmittance = buildProgram({{ShaderStage::Compute, "passes/pipeline/transmittance.comp", {}}});
-      transmittanceParams = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-      transmittanceSampler = gl::createClampSampler(GL_NEAREST);
-    }
+    if (!transmittanceParams)
+      transmittanceParams = gpu::Buffer(*backend, sizeof(gpu::MarchParams), "Scattering: transmittance");
     // The pass reads the camera and the medium's extinction only: any light fills the rest.
     const gpu::MarchParams params =
         gpu::makeMarchParams(*f.camera, DirectionalLight(glm::dvec3(0.0, -1.0, 0.0), glm::dvec3(0.0)),
                              *f.medium, info.width, info.height, 1, 1);
-    glNamedBufferSubData(transmittanceParams.get(), 0, sizeof(params), &params);
-    gpu::bindMarchResources(transmittance.get(), transmittanceParams.get(), f.cameraDepth, f.cameraDepth,
-                            transmittanceSampler.get(), f.output, 0);
-    gpu::dispatchMarch(info.width, info.height, "Scattering::run (transmittance)");
+    backend->writeBuffer(transmittanceParams.id(), 0, std::as_bytes(std::span(&params, 1)));
+    gpu::Dispatch d;
+    d.label = "Scattering::run (transmittance)";
+    d.program = "passes/pipeline/transmittance.comp";
+    d.resources = {gpu::Resource::uniform(CREP_MARCH_PARAMS_BINDING, transmittanceParams.id()),
+                   gpu::Resource::sampled(CREP_MARCH_CAMERA_DEPTH_UNIT, f.cameraDepth),
+                   gpu::Resource::image(CREP_MARCH_SCATTERING_OUT_IMAGE, f.output, gpu::Access::WriteOnly)};
+    d.groups =
+        glm::uvec3(static_cast<unsigned>((info.width + 7) / 8), static_cast<unsigned>((info.height + 7) / 8),
+                   1u); // gpu::dispatchMarch's 8 x 8 groups
+    backend->dispatch(d);
   }
 
   /// Runs `work` as one stage: with stageTimings, its GL_TIME_ELAPSED and wall clock (ended by glFinish).
@@ -445,17 +503,23 @@ struct Scattering::Impl {
       return {name, 0.0, 0.0};
     }
     const auto start = std::chrono::steady_clock::now();
-    timer.begin();
+    if (!timer) { // other backends: the wall clock to the end of the stage's work (gpuMilliseconds 0)
+      work();
+      backend->finish();
+      const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
+      return {name, 0.0, wall.count()};
+    }
+    timer->begin();
     try {
       work();
     } catch (...) {
-      timer.cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
+      timer->cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
       throw;
     }
-    timer.end();
+    timer->end();
     glFinish();
     const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
-    return {name, timer.milliseconds(), wall.count()};
+    return {name, timer->milliseconds(), wall.count()};
   }
   /// timedStage() appended to the frame's stages.
   template <class Work>
@@ -504,7 +568,8 @@ std::size_t Scattering::memoryBytes() const noexcept {
   const std::size_t map =
       static_cast<std::size_t>(m.info.mapSize) * static_cast<std::size_t>(m.info.mapSize) * 4;
   // The R32F resampled map, and the D32F rasterized one once a frame has drawn casters into it.
-  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() + m.rectified.memoryBytes() + map;
+  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() +
+                      (m.rectified ? m.rectified->memoryBytes() : 0) + map;
   if (m.reduced)
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
@@ -538,9 +603,11 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
             "called while a frame of the same object runs (from FrameAttribs.drawCasters?)",
             "must not be re-entered");
   // What the caller's state must not be, since the library cannot set it aside (docs/GL_STATE.md).
-  gl::requireNoPendingError("Scattering::run");
-  gl::requireNoActiveTransformFeedback("Scattering::run");
-  if (m.info.stageTimings) gl::requireNoActiveTimerQuery("Scattering::run (CreateInfo.stageTimings)");
+  if (m.gl) {
+    gl::requireNoPendingError("Scattering::run");
+    gl::requireNoActiveTransformFeedback("Scattering::run");
+    if (m.info.stageTimings) gl::requireNoActiveTimerQuery("Scattering::run (CreateInfo.stageTimings)");
+  }
   // However the frame ends: no query of ours active, program 0 and units / binding points 0-7 unbound
   // (docs/GL_STATE.md), and the object ready for the next frame. The raster state is restored by the
   // depth passes' own scopes.
@@ -548,15 +615,18 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   struct OnExit {
     Impl& m;
     ~OnExit() {
-      m.timer.cancel();
-      gl::unbindPassState(8);
+      if (m.gl) {
+        m.timer->cancel();
+        gl::unbindPassState(8);
+      }
       m.running = false;
     }
   } onExit{m};
   try {
     return runFrame(f);
   } catch (...) {
-    gl::drainErrors(); // raised during this call (by a pass or the caller's callback): not left to the caller
+    // Raised during this call (by a pass or the caller's callback): not left to the caller.
+    if (m.gl) gl::drainErrors();
     throw;
   }
 }
@@ -566,16 +636,17 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
     invalid("Scattering", "a moved-from object",
             "owns no GPU resources: assign a constructed Scattering first");
   const CreateInfo& info = impl_->info;
+  const gpu::Backend& b = *impl_->backend;
   const std::string p = std::string(owner) + ".";
   const bool local = !f.spotLights.empty() || !f.pointLights.empty();
   if (!f.camera) invalid(p + "camera", "null", "must be set");
   if (!f.light && !local) invalid(p + "light", "null", "must be set unless local lights are given");
   if (!f.medium) invalid(p + "medium", "null", "must be set");
   if (f.output != 0 || !f.froxels) { // a froxel volume alone reads no camera depth
-    gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth, info.width, info.height);
-    gl::requireTexture2D((p + "output").c_str(), f.output, info.width, info.height, GL_RGBA32F);
+    gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, info.width, info.height);
+    gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, info.width, info.height, GL_RGBA32F);
     requireOutputNotAnInput(f, p);
-    gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+    gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   }
   if (f.froxels) {
     if (!f.light)
@@ -584,18 +655,21 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
     if (f.output == 0 && local)
       invalid(p + "output", "0",
               "must be set with local lights (they are added to the per-pixel output only)");
-    validateFroxelTarget(*f.froxels, *f.camera, p + "froxels");
+    validateFroxelTarget(b, *f.froxels, *f.camera, p + "froxels");
     if (info.method != Method::Prefiltered)
       invalid(p + "froxels", "set with CreateInfo.method = Method::MinMaxMarch",
               "needs Method::Prefiltered (the fill evaluates the prefiltered basis)");
   }
   if (f.light && !f.drawCasters && !f.shadowMap)
     invalid(p + "drawCasters/shadowMap", "both empty", "one shadow input must be given");
-  validateLocalShadowMaps(f, p);
-  validateLightTextures(f, info.evaluate, p);
+  if (f.drawCasters && !impl_->gl)
+    invalid(p + "drawCasters", "set on the " + std::string(b.name()) + " backend",
+            "draws with GL, on the OpenGL backend only: give shadowMap, spotShadowMaps and pointShadowMaps");
+  validateLocalShadowMaps(b, f, p);
+  validateLightTextures(b, f, info.evaluate, p);
   if (f.light && f.shadowMap) {
-    gl::requireTexture2D((p + "shadowMap.texture").c_str(), f.shadowMap->texture);
-    gl::requireDepthFormat((p + "shadowMap.texture").c_str(), f.shadowMap->texture);
+    requireTexture2D(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
+    gpu::requireDepthFormatOf(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
     requireFinite(p + "shadowMap.bias", f.shadowMap->bias);
     try {
       validateLightMatrix(f.shadowMap->lightClipFromWorld, f.light->direction());
@@ -614,7 +688,7 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
     // A night frame: the transmittance, then the local lights added.
     m.stage(r, "transmittance", [&] { m.writeTransmittance(f); });
     runLocalLights(f, r);
-    gl::checkError("Scattering::run");
+    if (m.gl) gl::checkError("Scattering::run");
     return r;
   }
   r.rectification = rectify(*f.camera, *f.light, m.info.rectify);
@@ -655,7 +729,7 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
     });
   if (r.layout == Layout::Epipolar && pixels && !m.marching()) m.epipoleBlock(f, r, d);
   runLocalLights(f, r);
-  gl::checkError("Scattering::run");
+  if (m.gl) gl::checkError("Scattering::run");
   return r;
 }
 
@@ -667,15 +741,15 @@ void Scattering::Impl::projectiveMap(const FrameAttribs& f, FrameResult& r, Dire
   d.layout = projective;
   if (f.drawCasters) {
     stage(r, "shadow pass (rectified)", [&] {
-      rectified.run(
+      rectified->run(
           {&r.rectification, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
     });
-    d.map = rectified.depthTexture();
+    d.map = rectified->depthTexture();
   } else {
     stage(r, "resample (projective)", [&] {
-      resample.run({projective.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.get()});
+      resample.run({projective.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.id()});
     });
-    d.map = resampled.get();
+    d.map = resampled.id();
   }
 }
 
@@ -707,10 +781,10 @@ void Scattering::Impl::epipolarMap(const FrameAttribs& f, FrameResult& r, Direct
       epipolar->epipolePixel().has_value() && epipolar->epipoleBlockRadiusPixels() > 0.0;
   d.treesFromResample = treeMarchedBlock && f.output != 0 && MinMaxTreePass::lowLevels(info.mapSize) >= 1;
   stage(r, "resample (epipolar)", [&] {
-    resample.run({epipolar.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.get(),
+    resample.run({epipolar.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.id(),
                   d.treesFromResample ? trees->treeBuffer() : 0u});
   });
-  d.map = resampled.get();
+  d.map = resampled.id();
 }
 
 // The method on a camera depth image into `output`, or on a GPU work list (epipolar sampling's samples and
@@ -874,11 +948,12 @@ struct Scattering::Impl::LocalLightRun {
   std::uint32_t resampled(const RectifiedLayout& layout, const ShadowMap& shadow, const char* name) {
     if (!m.localResampled)
       m.localResampled =
-          gl::createTexture2D(GL_R32F, m.info.mapSize, m.info.mapSize, "Scattering: local map");
+          gpu::Texture(*m.backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, m.info.mapSize,
+                                    m.info.mapSize, 1, "Scattering: local map"});
     timed(name, [&] {
-      m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, m.localResampled.get()});
+      m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, m.localResampled.id()});
     });
-    return m.localResampled.get();
+    return m.localResampled.id();
   }
 
   // The light's map on `layout` prefiltered with its light-side factor and evaluated into its image.
@@ -900,7 +975,7 @@ struct Scattering::Impl::LocalLightRun {
     timed("local light: evaluate", [&] {
       EvaluatePass::FrameAttribs e;
       e.cameraDepth = f.cameraDepth;
-      e.output = m.localScattering.get();
+      e.output = m.localScattering.id();
       e.camera = f.camera;
       e.medium = f.medium;
       e.layout = &layout;
@@ -922,7 +997,7 @@ struct Scattering::Impl::LocalLightRun {
       b.shadowMap = shadow.texture;
       b.lightClipFromWorld = shadow.lightClipFromWorld;
       b.bias = shadow.bias;
-      b.output = m.localScattering.get();
+      b.output = m.localScattering.id();
       b.blockCenter = centre;
       b.blockRadius = radius;
       if (texture) b.lightTexture = *texture;
@@ -968,13 +1043,15 @@ struct Scattering::Impl::LocalLightRun {
 };
 
 void Scattering::Impl::addLocalScattering(const FrameAttribs& f) {
-  glUseProgram(accumulate.get());
-  glBindImageTexture(CREP_ACCUMULATE_ACCUMULATED_IMAGE, f.output, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-  glBindImageTexture(CREP_ACCUMULATE_ADDEND_IMAGE, localScattering.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
-                     GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((info.width + 7) / 8), static_cast<GLuint>((info.height + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
+  gpu::Dispatch d;
+  d.label = "Scattering::run (add a local light)";
+  d.program = "passes/pipeline/accumulate.comp";
+  d.resources = {
+      gpu::Resource::image(CREP_ACCUMULATE_ACCUMULATED_IMAGE, f.output, gpu::Access::ReadWrite),
+      gpu::Resource::image(CREP_ACCUMULATE_ADDEND_IMAGE, localScattering.id(), gpu::Access::ReadOnly)};
+  d.groups = glm::uvec3(static_cast<unsigned>((info.width + 7) / 8),
+                        static_cast<unsigned>((info.height + 7) / 8), 1u);
+  backend->dispatch(d);
 }
 
 void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, const LocalLight& light,
@@ -1007,10 +1084,9 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
   Impl& m = *impl_;
   const CreateInfo& info = m.info;
   if (f.spotLights.empty() && f.pointLights.empty()) return;
-  if (!m.localScattering) {
-    m.localScattering = gl::createTexture2D(GL_RGBA32F, info.width, info.height, "Scattering: local light");
-    m.accumulate = buildProgram({{ShaderStage::Compute, "passes/pipeline/accumulate.comp", {}}});
-  }
+  if (!m.localScattering)
+    m.localScattering = gpu::Texture(*m.backend, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F,
+                                                  info.width, info.height, 1, "Scattering: local light"});
   for (std::size_t i = 0; i < f.spotLights.size(); ++i) {
     const SpotLight& spot = f.spotLights[i];
     LightResult result;

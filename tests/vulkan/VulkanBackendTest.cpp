@@ -11,6 +11,7 @@
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
@@ -280,4 +281,48 @@ TEST_CASE("Vulkan backend: EvaluatePass names the field of a texture or buffer i
   CHECK_THROWS_WITH_AS(pass.run(f), doctest::Contains("EvaluatePass"), InvalidArgument);
   moved.run(f);
   checkNoValidationMessages(vk);
+}
+
+TEST_CASE("Vulkan backend: crep::Scattering names what needs the OpenGL backend") {
+  gpu::VulkanBackend vk(validated());
+  Scattering::CreateInfo info;
+  info.width = 64;
+  info.height = 32;
+  info.mapSize = 256;
+  info.backend = &vk;
+  {
+    Scattering::CreateInfo epipolar = info;
+    epipolar.sampling = Scattering::Sampling::Epipolar;
+    CHECK_THROWS_WITH_AS(Scattering{epipolar}, doctest::Contains("Scattering::CreateInfo.sampling"),
+                         InvalidArgument);
+    Scattering::CreateInfo reduced = info;
+    reduced.evaluationScale = 0.5;
+    CHECK_THROWS_WITH_AS(Scattering{reduced}, doctest::Contains("Scattering::CreateInfo.evaluationScale"),
+                         InvalidArgument);
+  }
+  Scattering scattering(info);
+  const scenes::Scene scene = scenes::makeScene("forest", 2.0);
+  gpu::Texture depth(vk, {gpu::TextureType::Texture2D, gpu::Format::Depth32F, 64, 32, 1, "depth"});
+  gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, 64, 32, 1, "output"});
+  Scattering::FrameAttribs f;
+  f.camera = &scene.camera;
+  f.light = &scene.sun;
+  f.medium = &scene.medium;
+  f.cameraDepth = depth.id();
+  f.output = output.id();
+  f.drawCasters = [](const glm::dmat4&) {};
+  CHECK_THROWS_WITH_AS(scattering.run(f), doctest::Contains("Scattering::FrameAttribs.drawCasters"),
+                       InvalidArgument);
+  f.drawCasters = nullptr;
+  gpu::Texture colour(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, 64, 64, 1, "colour"});
+  const Scattering::ShadowMap notDepth{colour.id(), glm::dmat4(1.0), 0.0};
+  f.shadowMap = &notDepth;
+  CHECK_THROWS_WITH_AS(scattering.run(f), doctest::Contains("Scattering::FrameAttribs.shadowMap.texture"),
+                       InvalidArgument);
+  f.shadowMap = nullptr;
+  f.output = 12345; // no texture of this backend (say, a GL name)
+  CHECK_THROWS_WITH_AS(scattering.run(f), doctest::Contains("Scattering::FrameAttribs.output"),
+                       InvalidArgument);
+  const std::vector<std::string> messages = vk.validationMessages();
+  CHECK(messages.empty());
 }

@@ -1,7 +1,8 @@
 // The front door (Klehm, Seidel, Eisemann 2014): one object per view, one run() per frame, every frame
 // prefiltered, on the projective layout (Sec. 4.2) or the epipolar fallback (Sec. 4.1). Shadow inputs, local
 // lights, light textures, froxels, epipolar sampling, GL state: pipeline/README.md, "scattering.h".
-// Needs a current OpenGL 4.5 core context for its whole lifetime; never creates or owns one.
+// On the default GL backend it needs a current OpenGL 4.5 core context for its whole lifetime and never
+// creates or owns one; CreateInfo::backend runs it on another (docs/BACKENDS.md).
 #pragma once
 
 #include <cstdint>
@@ -15,6 +16,7 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>
@@ -108,6 +110,10 @@ public:
     int mapSizeMultiple() const;
     /// Depth bias of that map in the world-space marches (depth-buffer units), finite and >= 0.
     double ownShadowMapBias = 1e-4;
+    /// Runs the frame (must outlive the object); null: a gpu::GlBackend of its own on the current GL
+    /// context. Other backends take the engine's shadow maps (no drawCasters), Sampling::PerPixel and
+    /// evaluationScale 1; their stages are timed by the wall clock (gpuMilliseconds 0).
+    gpu::Backend* backend = nullptr;
   };
 
   /// An engine's shadow map: depth-buffer values of lightClipFromWorld, GL conventions, cleared to 1.

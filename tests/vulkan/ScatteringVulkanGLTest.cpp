@@ -1,0 +1,210 @@
+// The front door on both backends: crep::Scattering with CreateInfo::backend on gpu::VulkanBackend
+// (lavapipe, validation on) and on gpu::GlBackend (llvmpipe), fed the same engine inputs: the camera depth
+// and the shadow maps of a built-in scene, rendered once by GL and uploaded to each backend (a Vulkan
+// engine renders its own). The frames of the port's goal: forest (projective) and sunset (the sun in view:
+// epipolar layout and its tree-marched epipole block) at 320x180, colonnade-night (spot and point lights
+// from their perspective maps, no sun), and stained-glass (a light texture on the sun); froxel volumes filled
+// on the sunlit ones. Bar: relative RMSE <= 1e-4 between the backends' outputs.
+#include "common/gl_fixture.h"
+
+#include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
+#include <crep/pipeline/scattering.h>
+#include <crep/scatter/gpu_light_texture.h>
+#include <crep/scenes/scene.h>
+#include <crep/scenes/scene_renderer.h>
+#include <crep/vulkan/vulkan_backend.h>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace crep;
+
+namespace {
+
+constexpr int kWidth = 320, kHeight = 180, kSunMap = 1024, kLocalMap = 512;
+
+/// A scene's engine inputs on the CPU: camera depth, the sun's standard map, the local lights' maps.
+struct EngineInputs {
+  scenes::Scene scene;
+  Image cameraDepth, sunMap;
+  glm::dmat4 sunMatrix{1.0};
+  std::vector<Image> spotMaps,
+      pointMaps; ///< one per spot; six per point light (face k of light i at 6 i + k)
+};
+
+EngineInputs renderInputs(const std::string& name) {
+  EngineInputs in{scenes::makeScene(name, static_cast<double>(kWidth) / kHeight), {}, {}, {}, {}, {}};
+  const scenes::Scene& s = in.scene;
+  scenes::SceneRenderer renderer(s.mesh);
+  in.cameraDepth = renderer.renderDepthImage(s.camera.clipFromWorld(), kWidth, kHeight);
+  if (s.hasSun) {
+    in.sunMatrix = scenes::standardLightClipFromWorld(s.sun, s.boundsMin, s.boundsMax);
+    in.sunMap = renderer.renderDepthImage(in.sunMatrix, kSunMap, kSunMap, {.depthClamp = true});
+  }
+  for (const SpotLight& spot : s.spotLights)
+    in.spotMaps.push_back(renderer.renderDepthImage(spot.lightClipFromWorld(), kLocalMap, kLocalMap));
+  for (const PointLight& point : s.pointLights)
+    for (int face = 0; face < 6; ++face)
+      in.pointMaps.push_back(renderer.renderDepthImage(point.faceClipFromWorld(face), kLocalMap, kLocalMap));
+  return in;
+}
+
+gpu::Texture depthTexture(gpu::Backend& b, const Image& image, const char* label) {
+  gpu::Texture t(
+      b, {gpu::TextureType::Texture2D, gpu::Format::Depth32F, image.width(), image.height(), 1, label});
+  b.writeTexture(t.id(), image.data());
+  return t;
+}
+
+struct FrameOutput {
+  std::vector<float> rgba, volume; ///< the output; the froxel volume (with a grid)
+  Scattering::FrameResult result;
+};
+
+/// RGBA floats of a 3- or 4-channel image (alpha 1 when it has none).
+std::vector<float> rgbaOf(const Image& image) {
+  std::vector<float> out;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x)
+      out.insert(out.end(), {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2),
+                             image.channels() == 4 ? image.at(x, y, 3) : 1.0f});
+  return out;
+}
+
+/// One frame of `in` through crep::Scattering on `b` (the engine's maps given, no drawCasters).
+FrameOutput frameOn(gpu::Backend& b, const EngineInputs& in, Scattering::CreateInfo info,
+                    const FroxelGrid* grid = nullptr) {
+  const scenes::Scene& s = in.scene;
+  const gpu::Texture depth = depthTexture(b, in.cameraDepth, "camera depth");
+  gpu::Texture sun;
+  if (s.hasSun) sun = depthTexture(b, in.sunMap, "sun map");
+  std::vector<gpu::Texture> locals;
+  std::vector<Scattering::ShadowMap> spotMaps, pointMaps;
+  for (std::size_t i = 0; i < in.spotMaps.size(); ++i) {
+    locals.push_back(depthTexture(b, in.spotMaps[i], "spot map"));
+    spotMaps.push_back({locals.back().id(), s.spotLights[i].lightClipFromWorld(), 1e-4});
+  }
+  for (std::size_t i = 0; i < in.pointMaps.size(); ++i) {
+    locals.push_back(depthTexture(b, in.pointMaps[i], "point face map"));
+    pointMaps.push_back(
+        {locals.back().id(), s.pointLights[i / 6].faceClipFromWorld(static_cast<int>(i % 6)), 1e-4});
+  }
+  gpu::Texture output(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, kWidth, kHeight, 1, "output"});
+  info.width = kWidth;
+  info.height = kHeight;
+  info.backend = &b;
+  Scattering scattering(info);
+  const Scattering::ShadowMap sunMap{sun.id(), in.sunMatrix, 1e-4};
+  Scattering::FrameAttribs f;
+  f.camera = &s.camera;
+  f.light = s.hasSun ? &s.sun : nullptr;
+  f.medium = &s.medium;
+  f.cameraDepth = depth.id();
+  f.output = output.id();
+  f.shadowMap = s.hasSun ? &sunMap : nullptr;
+  f.spotLights = s.spotLights;
+  f.pointLights = s.pointLights;
+  f.spotShadowMaps = spotMaps;
+  f.pointShadowMaps = pointMaps;
+  // The scene's light texture (stained-glass), and a froxel volume filled from the same basis.
+  gpu::Texture window, volume;
+  GpuLightTexture lightTexture;
+  if (s.sunTexture) {
+    window = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, s.sunTexture->rgb.width(),
+                              s.sunTexture->rgb.height(), 1, "light texture"});
+    b.writeTexture(window.id(), rgbaOf(s.sunTexture->rgb));
+    lightTexture = {window.id(), s.sunTexture->textureClipFromWorld};
+    f.lightTexture = &lightTexture;
+  }
+  Scattering::FroxelTarget froxels;
+  if (grid != nullptr) {
+    volume = gpu::Texture(b, {gpu::TextureType::Texture3D, gpu::Format::RGBA16F, grid->width, grid->height,
+                              grid->depth, "froxels"});
+    froxels = {volume.id(), *grid, glm::dvec3(0.25, -0.25, 0.5)};
+    f.froxels = &froxels;
+  }
+  FrameOutput out;
+  out.result = scattering.run(f);
+  out.rgba = b.readTexture(output.id());
+  if (grid != nullptr) out.volume = b.readTexture(volume.id());
+  return out;
+}
+
+/// Relative RMSE of `a` against `b` over all four channels; `nonFinite` counts a's NaN and Inf.
+double relativeRmse(const std::vector<float>& a, const std::vector<float>& b, long long& nonFinite) {
+  REQUIRE(a.size() == b.size());
+  double squared = 0.0, reference = 0.0;
+  nonFinite = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (!std::isfinite(a[i])) {
+      ++nonFinite;
+      continue;
+    }
+    const double d = static_cast<double>(a[i]) - b[i];
+    squared += d * d;
+    reference += static_cast<double>(b[i]) * b[i];
+  }
+  return std::sqrt(squared / reference);
+}
+
+gpu::VulkanBackend::CreateInfo withValidation() {
+  gpu::VulkanBackend::CreateInfo info;
+  info.validation = true;
+  return info;
+}
+
+} // namespace
+
+TEST_CASE("Vulkan backend: crep::Scattering gives GL's frame on forest, sunset (sun in view) and "
+          "colonnade-night (local lights)") {
+  CREP_REQUIRE_GL();
+  gpu::VulkanBackend vk(withValidation());
+  gpu::GlBackend gl;
+  FroxelGrid grid;
+  grid.width = 40;
+  grid.height = 24;
+  grid.depth = 32;
+  for (const std::string name : {"forest", "sunset", "colonnade-night", "stained-glass"}) {
+    CAPTURE(name);
+    const EngineInputs in = renderInputs(name);
+    for (const Scattering::Method method :
+         {Scattering::Method::Prefiltered, Scattering::Method::MinMaxMarch}) {
+      if (method == Scattering::Method::MinMaxMarch && !in.scene.hasSun) continue; // a method of the sun
+      Scattering::CreateInfo info;
+      info.mapSize = 512;
+      info.method = method;
+      // Froxels with the sun's prefiltered basis (a stage of the front door's Prefiltered method).
+      const FroxelGrid* volume =
+          in.scene.hasSun && method == Scattering::Method::Prefiltered ? &grid : nullptr;
+      const FrameOutput a = frameOn(vk, in, info, volume), b = frameOn(gl, in, info, volume);
+      long long nonFinite = 0;
+      const double e = relativeRmse(a.rgba, b.rgba, nonFinite);
+      int epipolarLights = 0;
+      for (const Scattering::LightResult& l : a.result.localLights)
+        epipolarLights += l.epipolar;
+      MESSAGE(name << std::string(method == Scattering::Method::MinMaxMarch ? " (min/max march)" : "") << ", "
+                   << std::string(in.scene.hasSun ? layoutToken(a.result.layout) : "no sun") << ", "
+                   << a.result.localLights.size() << " local lights (" << epipolarLights
+                   << " on their epipolar layout), " << a.result.stages.size()
+                   << " stages: Vulkan vs GL relative RMSE " << e << ", " << nonFinite << " non-finite");
+      CHECK(nonFinite == 0);
+      CHECK(e <= 1e-4);
+      CHECK(a.result.stages.size() == b.result.stages.size());
+      CHECK(a.result.layout == b.result.layout);
+      if (volume != nullptr) {
+        const double v = relativeRmse(a.volume, b.volume, nonFinite);
+        MESSAGE(name << ": froxel volume (RGBA16F), Vulkan vs GL relative RMSE " << v << ", " << nonFinite
+                     << " non-finite");
+        CHECK(nonFinite == 0);
+        CHECK(v <= 1e-4);
+      }
+    }
+  }
+  const std::vector<std::string> messages = vk.validationMessages();
+  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
+                                                  << (messages.empty() ? "" : messages.front()));
+}
