@@ -29,6 +29,7 @@
 #define CREP_REGION_WEIGHTS_DEFAULT_BINDING      1 // CrepRegionWeightsBlock (storage; near-plane correction)
 #define CREP_MEAN_COLOR_DEFAULT_UNIT             2 // crep_meanColor (light textures)
 #define CREP_LOCAL_LIGHT_DEFAULT_BINDING         3 // CrepLocalLightBlock (uniform)
+#define CREP_LOCAL_LIGHT_STORAGE_DEFAULT_BINDING 4 // CrepLocalLightBlock on Vulkan (storage)
 #define CREP_AIRLIGHT_DEFAULT_UNIT               4 // crep_airlightTable
 #define CREP_LOCAL_SECTION_DEFAULT_UNIT          5 // crep_localSections
 #define CREP_VISIBILITY_TABLE_DEFAULT_UNIT       6 // crep_visibilityTable

@@ -410,7 +410,17 @@ layout(std430, binding = CREP_REGION_WEIGHTS_BINDING) readonly buffer CrepRegion
 #endif
 
 #if CREP_LOCAL_LIGHT
+#ifdef VULKAN
+// Vulkan: the same block as a read-only storage buffer (std430 = std140 for its vec4 members). Mesa 22.3's
+// lavapipe faults when it inlines this block's values (used in branches) as a uniform block next to a
+// layout block (docs/BACKENDS.md, "Vulkan backend").
+#ifndef CREP_LOCAL_LIGHT_STORAGE_BINDING
+#define CREP_LOCAL_LIGHT_STORAGE_BINDING CREP_LOCAL_LIGHT_STORAGE_DEFAULT_BINDING
+#endif
+layout(std430, binding = CREP_LOCAL_LIGHT_STORAGE_BINDING) readonly buffer CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
+#else
 layout(std140, binding = CREP_LOCAL_LIGHT_BINDING) uniform CrepLocalLightBlock { CrepLocalLightParams crep_localParams; };
+#endif
 #ifndef CREP_AIRLIGHT
 #define CREP_AIRLIGHT 1
 #endif

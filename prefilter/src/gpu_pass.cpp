@@ -927,7 +927,10 @@ void EvaluatePass::uploadLocalLight(const FrameAttribs& frame) {
 /// The local light's block and, in closed form, its airlight table (filtered linearly), for the evaluation
 /// and the prefix programs.
 void EvaluatePass::appendLocalResources(std::vector<gpu::Resource>& out) const {
-  out.push_back(gpu::Resource::uniform(CREP_LOCAL_LIGHT_DEFAULT_BINDING, localBuffer_.id()));
+  // GL: a uniform block; the Vulkan form of the shader reads it as a storage buffer (crep/scattering.glsl).
+  out.push_back(backend_->name() == "OpenGL"
+                    ? gpu::Resource::uniform(CREP_LOCAL_LIGHT_DEFAULT_BINDING, localBuffer_.id())
+                    : gpu::Resource::storage(CREP_LOCAL_LIGHT_STORAGE_DEFAULT_BINDING, localBuffer_.id()));
   if (info_.localClosedForm)
     out.push_back(
         gpu::Resource::sampled(CREP_AIRLIGHT_DEFAULT_UNIT, airlightTable_.id(), gpu::Filter::Linear));

@@ -368,6 +368,24 @@ TEST_CASE("Vulkan backend: EvaluatePass with local lights (spot, point face, clo
       checkBackendsAgree(name, runOn(b.vk, in, p, e), runOn(b.gl, in, p, e));
     }
   }
+  // In view: a spot and a point-light face on their epipolar layouts (Sec. 4.1 around the light's image).
+  for (const LocalLight& light :
+       {LocalLight::spot(analyticViewSpot()), LocalLight::pointFace(analyticViewPoint(), 5)}) {
+    EpipolarOptions eo;
+    eo.slices = H;
+    eo.depthWarp = 0.03; // Scattering::CreateInfo::localLightDepthWarp
+    const auto layout = std::make_shared<const EpipolarLayout>(camera, light.position, w, h, eo);
+    REQUIRE(layout->epipoleOnScreen());
+    const RectifiedMap map = castRectifiedMap(layout, W, H, wallHitFromLight);
+    const Inputs in{layout.get(), &map.depth, &depth, &camera, &medium, nullptr, &light};
+    for (const int variant : {0, 1}) {
+      EvaluatePass::CreateInfo e;
+      e.options.scatteringPrefix = variant == 0;
+      checkBackendsAgree(std::string(light.cone ? "spot in view" : "point face -Z in view") +
+                             ", epipolar layout" + (variant == 0 ? ", prefix table" : ", per-region table"),
+                         runOn(b.vk, in, p, e), runOn(b.gl, in, p, e));
+    }
+  }
   // Light textures: the sun's window and a spot's gobo, their colour maps from the CPU.
   const Image texture = twoColourTexture();
   for (const bool isSpot : {false, true}) {

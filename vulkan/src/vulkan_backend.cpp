@@ -782,7 +782,16 @@ std::vector<float> VulkanBackend::readTexture(TextureId texture) {
   return out;
 }
 
-void VulkanBackend::dispatch(const Dispatch& d) {
+void VulkanBackend::dispatch(const Dispatch& given) {
+  // The resources in binding order, for the descriptor layout and the writes alike (one pipeline per
+  // signature whatever order a pass lists them in); a binding given twice is the pass's error.
+  Dispatch d = given;
+  std::stable_sort(d.resources.begin(), d.resources.end(),
+                   [](const Resource& a, const Resource& b) { return vulkanBinding(a) < vulkanBinding(b); });
+  for (std::size_t i = 1; i < d.resources.size(); ++i)
+    if (vulkanBinding(d.resources[i]) == vulkanBinding(d.resources[i - 1]))
+      throw InvalidArgument(d.label + " resources",
+                            "binding " + std::to_string(vulkanBinding(d.resources[i])), "is given twice");
   Impl& v = *impl_;
   const std::vector<std::byte> push = packPushConstants(d.push);
   const Pipeline& p = v.pipeline(d, push.size());
