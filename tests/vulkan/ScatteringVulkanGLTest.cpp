@@ -11,8 +11,8 @@
 #include <crep/core/gl_backend.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_light_texture.h>
+#include <crep/scenes/engine_frame.h>
 #include <crep/scenes/scene.h>
-#include <crep/scenes/scene_renderer.h>
 #include <crep/vulkan/vulkan_backend.h>
 
 #include <doctest/doctest.h>
@@ -27,17 +27,14 @@ namespace {
 
 constexpr int kWidth = 320, kHeight = 180, kSunMap = 1024, kLocalMap = 512;
 
-/// A scene's engine inputs on the CPU: camera depth, the sun's standard map, the local lights' maps.
+/// A built-in scene and its engine maps (rendered once by GL, uploaded to each backend).
 struct EngineInputs {
   scenes::Scene scene;
-  Image cameraDepth, sunMap;
-  glm::dmat4 sunMatrix{1.0};
-  std::vector<Image> spotMaps,
-      pointMaps; ///< one per spot; six per point light (face k of light i at 6 i + k)
+  scenes::EngineMaps maps;
 };
 
 EngineInputs renderInputs(const std::string& name) {
-  EngineInputs in{scenes::makeScene(name, static_cast<double>(kWidth) / kHeight), {}, {}, {}, {}, {}};
+  EngineInputs in{scenes::makeScene(name, static_cast<double>(kWidth) / kHeight), {}};
   if (name == "colonnade-night") {
     // And a spot in view, 6 units ahead of the camera and 1 up, aimed down and forward: its rectification
     // falls back to its epipolar layout (Klehm et al. 2014, Sec. 4.1) with a world-marched epipole block.
@@ -50,26 +47,8 @@ EngineInputs renderInputs(const std::string& name) {
                                              .intensity = 20.0,
                                              .range = 40.0}));
   }
-  const scenes::Scene& s = in.scene;
-  scenes::SceneRenderer renderer(s.mesh);
-  in.cameraDepth = renderer.renderDepthImage(s.camera.clipFromWorld(), kWidth, kHeight);
-  if (s.hasSun) {
-    in.sunMatrix = scenes::standardLightClipFromWorld(s.sun, s.boundsMin, s.boundsMax);
-    in.sunMap = renderer.renderDepthImage(in.sunMatrix, kSunMap, kSunMap, {.depthClamp = true});
-  }
-  for (const SpotLight& spot : s.spotLights)
-    in.spotMaps.push_back(renderer.renderDepthImage(spot.lightClipFromWorld(), kLocalMap, kLocalMap));
-  for (const PointLight& point : s.pointLights)
-    for (int face = 0; face < 6; ++face)
-      in.pointMaps.push_back(renderer.renderDepthImage(point.faceClipFromWorld(face), kLocalMap, kLocalMap));
+  in.maps = scenes::renderEngineMaps(in.scene, kWidth, kHeight, kSunMap, kLocalMap);
   return in;
-}
-
-gpu::Texture depthTexture(gpu::Backend& b, const Image& image, const char* label) {
-  gpu::Texture t(
-      b, {gpu::TextureType::Texture2D, gpu::Format::Depth32F, image.width(), image.height(), 1, label});
-  b.writeTexture(t.id(), image.data());
-  return t;
 }
 
 struct FrameOutput {
@@ -91,37 +70,13 @@ std::vector<float> rgbaOf(const Image& image) {
 FrameOutput frameOn(gpu::Backend& b, const EngineInputs& in, Scattering::CreateInfo info,
                     const FroxelGrid* grid = nullptr) {
   const scenes::Scene& s = in.scene;
-  const gpu::Texture depth = depthTexture(b, in.cameraDepth, "camera depth");
-  gpu::Texture sun;
-  if (s.hasSun) sun = depthTexture(b, in.sunMap, "sun map");
-  std::vector<gpu::Texture> locals;
-  std::vector<Scattering::ShadowMap> spotMaps, pointMaps;
-  for (std::size_t i = 0; i < in.spotMaps.size(); ++i) {
-    locals.push_back(depthTexture(b, in.spotMaps[i], "spot map"));
-    spotMaps.push_back({locals.back().id(), s.spotLights[i].lightClipFromWorld(), 1e-4});
-  }
-  for (std::size_t i = 0; i < in.pointMaps.size(); ++i) {
-    locals.push_back(depthTexture(b, in.pointMaps[i], "point face map"));
-    pointMaps.push_back(
-        {locals.back().id(), s.pointLights[i / 6].faceClipFromWorld(static_cast<int>(i % 6)), 1e-4});
-  }
+  const scenes::EngineFrame engine(b, s, in.maps);
   gpu::Texture output(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, kWidth, kHeight, 1, "output"});
   info.width = kWidth;
   info.height = kHeight;
   info.backend = &b;
   Scattering scattering(info);
-  const Scattering::ShadowMap sunMap{sun.id(), in.sunMatrix, 1e-4};
-  Scattering::FrameAttribs f;
-  f.camera = &s.camera;
-  f.light = s.hasSun ? &s.sun : nullptr;
-  f.medium = &s.medium;
-  f.cameraDepth = depth.id();
-  f.output = output.id();
-  f.shadowMap = s.hasSun ? &sunMap : nullptr;
-  f.spotLights = s.spotLights;
-  f.pointLights = s.pointLights;
-  f.spotShadowMaps = spotMaps;
-  f.pointShadowMaps = pointMaps;
+  Scattering::FrameAttribs f = engine.attribs(output.id());
   // The scene's light texture (stained-glass), and a froxel volume filled from the same basis.
   gpu::Texture window, volume;
   GpuLightTexture lightTexture;

@@ -1,0 +1,46 @@
+// A built-in scene's frame as an engine hands it to crep::Scattering on any gpu::Backend: the camera depth
+// and the shadow maps rendered once by GL and read back (renderEngineMaps), then uploaded to a backend as
+// its depth textures (EngineFrame). How the backends are compared side by side: tests/vulkan/ and the
+// bench's "backends" section.
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include <crep/core/gpu_backend.h>
+#include <crep/core/image.h>
+#include <crep/pipeline/scattering.h>
+#include <crep/scenes/scene.h>
+
+namespace crep::scenes {
+
+/// The engine's inputs of a frame, on the CPU (1 channel, depth-buffer values, row 0 at the bottom).
+struct EngineMaps {
+  Image cameraDepth;                ///< width x height, of scene.camera
+  Image sunMap;                     ///< sunMapSize^2 with depth clamp; empty without a sun
+  glm::dmat4 sunClipFromWorld{1.0}; ///< standardLightClipFromWorld of the scene's bounds
+  std::vector<Image> spotMaps;      ///< one per scene spot (its lightClipFromWorld), localMapSize^2
+  std::vector<Image> pointMaps;     ///< six per point light, face k of light i at 6 i + k
+};
+
+/// Renders the maps with GL (needs a current context). Sizes > 0.
+EngineMaps renderEngineMaps(const Scene& scene, int width, int height, int sunMapSize, int localMapSize);
+
+/// The maps as Depth32F textures of `backend` (kept for its lifetime), and the frame over them.
+class EngineFrame {
+public:
+  EngineFrame(gpu::Backend& backend, const Scene& scene, const EngineMaps& maps, double bias = 1e-4);
+  /// The frame's attributes writing `output` (RGBA32F, the camera depth's size, a texture of the backend):
+  /// camera, sun and medium of the scene, the maps as shadowMap / spotShadowMaps / pointShadowMaps.
+  Scattering::FrameAttribs attribs(std::uint32_t output) const;
+
+private:
+  const Scene& scene_;
+  gpu::Texture depth_, sun_;
+  std::vector<gpu::Texture> locals_;
+  Scattering::ShadowMap sunMap_;
+  std::vector<Scattering::ShadowMap> spotMaps_, pointMaps_;
+};
+
+} // namespace crep::scenes
