@@ -45,6 +45,8 @@ const char* const kRender =
             --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
                                 DIR/shadow.exr (float depth-buffer values), DIR/frame.json, and
                                 DIR/lightN.exr for a scene's local lights
+            --backend B         opengl (default) | vulkan: crep::Scattering (--method prefilter or
+                                minmax) on a Vulkan device, given the scene's maps rendered by GL
             --debug-gl          debug GL context; GL errors abort the command
 )";
 

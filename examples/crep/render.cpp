@@ -13,6 +13,7 @@
 #include "methods.h"
 #include "options.h"
 #include "paths.h"
+#include "render_backend.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -293,7 +294,7 @@ int renderAtmosphere(const Args& args, const std::string& sceneName, glm::ivec2 
 } // namespace
 
 int renderCommand(const std::vector<std::string>& argv) {
-  std::set<std::string> valued = {"scene", "size", "out", "exposure", "export-frame"};
+  std::set<std::string> valued = {"scene", "size", "out", "exposure", "export-frame", "backend"};
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
   valued.insert(kAtmosphereOptions.begin(), kAtmosphereOptions.end());
   valued.insert(kToneMapValuedOptions.begin(), kToneMapValuedOptions.end());
@@ -311,6 +312,8 @@ int renderCommand(const std::vector<std::string>& argv) {
   const MethodSettings settings = methodSettings(args);
   requireMethodImageSize(settings, {method}, size,
                          "--size " + std::to_string(size.x) + "x" + std::to_string(size.y), true);
+  const std::string backend = args.string("backend", "opengl");
+  requireBackend(backend, method, settings);
   const std::string out = args.string("out", "crep-" + sceneName);
   requireOutputPrefix({"--out", out});
   const std::string exportDir = args.string("export-frame", "");
@@ -342,7 +345,8 @@ int renderCommand(const std::vector<std::string>& argv) {
   SceneFrame s = makeSceneFrame(sceneName, size.x, size.y, settings.mapSize, timings);
   FrameInputs& frame = *s.frame;
 
-  MethodOutput result = runMethod(method, frame, settings);
+  MethodOutput result =
+      backend == "vulkan" ? runOnVulkan(s, method, settings) : runMethod(method, frame, settings);
   timings.append(result.timings.rows());
   gl::Handle composite = timings.time(
       "composite", [&] { return compositeImage(frame, s.color.get(), result.scattering.get()); });

@@ -9,7 +9,10 @@ EngineMaps renderEngineMaps(const Scene& s, int width, int height, int sunMapSiz
   SceneRenderer renderer(s.mesh);
   m.cameraDepth = renderer.renderDepthImage(s.camera.clipFromWorld(), width, height);
   if (s.hasSun) {
-    m.sunClipFromWorld = standardLightClipFromWorld(s.sun, s.boundsMin, s.boundsMax);
+    // Fitted to the view frustum, as an engine's (first) cascade is and as crep::Scattering fits its own map
+    // on a fallback frame; casters between the light and the frustum are kept by the depth clamp.
+    const auto corners = s.camera.frustumCorners();
+    m.sunClipFromWorld = orthographicLightClipFromWorld(s.sun, corners);
     m.sunMap = renderer.renderDepthImage(m.sunClipFromWorld, sunMapSize, sunMapSize, {.depthClamp = true});
   }
   for (const SpotLight& spot : s.spotLights)
@@ -30,21 +33,21 @@ gpu::Texture depthTexture(gpu::Backend& b, const Image& image, const char* label
 }
 } // namespace
 
-EngineFrame::EngineFrame(gpu::Backend& b, const Scene& scene, const EngineMaps& m, double bias)
+EngineFrame::EngineFrame(gpu::Backend& b, const Scene& scene, const EngineMaps& m)
     : scene_(scene), depth_(depthTexture(b, m.cameraDepth, "engine frame: camera depth")) {
   if (scene.hasSun) {
     sun_ = depthTexture(b, m.sunMap, "engine frame: sun map");
-    sunMap_ = {sun_.id(), m.sunClipFromWorld, bias};
+    sunMap_ = {sun_.id(), m.sunClipFromWorld, m.sunBias};
   }
   locals_.reserve(m.spotMaps.size() + m.pointMaps.size());
   for (std::size_t i = 0; i < m.spotMaps.size(); ++i) {
     locals_.push_back(depthTexture(b, m.spotMaps[i], "engine frame: spot map"));
-    spotMaps_.push_back({locals_.back().id(), scene.spotLights[i].lightClipFromWorld(), bias});
+    spotMaps_.push_back({locals_.back().id(), scene.spotLights[i].lightClipFromWorld(), m.localBias});
   }
   for (std::size_t i = 0; i < m.pointMaps.size(); ++i) {
     locals_.push_back(depthTexture(b, m.pointMaps[i], "engine frame: point face map"));
-    pointMaps_.push_back(
-        {locals_.back().id(), scene.pointLights[i / 6].faceClipFromWorld(static_cast<int>(i % 6)), bias});
+    pointMaps_.push_back({locals_.back().id(),
+                          scene.pointLights[i / 6].faceClipFromWorld(static_cast<int>(i % 6)), m.localBias});
   }
 }
 

@@ -19,9 +19,11 @@ namespace crep::scenes {
 struct EngineMaps {
   Image cameraDepth;                ///< width x height, of scene.camera
   Image sunMap;                     ///< sunMapSize^2 with depth clamp; empty without a sun
-  glm::dmat4 sunClipFromWorld{1.0}; ///< standardLightClipFromWorld of the scene's bounds
+  glm::dmat4 sunClipFromWorld{1.0}; ///< orthographicLightClipFromWorld of the camera's frustum
   std::vector<Image> spotMaps;      ///< one per scene spot (its lightClipFromWorld), localMapSize^2
   std::vector<Image> pointMaps;     ///< six per point light, face k of light i at 6 i + k
+  double sunBias = 1e-4;            ///< Scattering::ShadowMap::bias of the sun's map (depth-buffer units)
+  double localBias = 1e-4;          ///< the same for the local lights' maps
 };
 
 /// Renders the maps with GL (needs a current context). Sizes > 0.
@@ -30,7 +32,7 @@ EngineMaps renderEngineMaps(const Scene& scene, int width, int height, int sunMa
 /// The maps as Depth32F textures of `backend` (kept for its lifetime), and the frame over them.
 class EngineFrame {
 public:
-  EngineFrame(gpu::Backend& backend, const Scene& scene, const EngineMaps& maps, double bias = 1e-4);
+  EngineFrame(gpu::Backend& backend, const Scene& scene, const EngineMaps& maps);
   /// The frame's attributes writing `output` (RGBA32F, the camera depth's size, a texture of the backend):
   /// camera, sun and medium of the scene, the maps as shadowMap / spotShadowMaps / pointShadowMaps.
   Scattering::FrameAttribs attribs(std::uint32_t output) const;

@@ -1,0 +1,124 @@
+// `crep render --backend vulkan` (render_backend.h).
+#include "render_backend.h"
+
+#include "args.h"
+
+#include <crep/core/error.h>
+#include <crep/core/gl.h>
+#include <crep/pipeline/scattering.h>
+#include <crep/scatter/gpu_light_texture.h>
+#include <crep/scenes/engine_frame.h>
+#include <crep/scenes/scene_renderer.h>
+#if CREP_HAS_VULKAN
+#include <crep/vulkan/vulkan_backend.h>
+#endif
+
+#include <epoxy/gl.h>
+
+#include <vector>
+
+namespace crep::tool {
+
+std::string backendNames() {
+  return CREP_HAS_VULKAN ? "opengl | vulkan" : "opengl";
+}
+
+void requireBackend(const std::string& backend, const std::string& method, const MethodSettings& settings) {
+  if (backend == "opengl") return;
+  if (backend != "vulkan" || !CREP_HAS_VULKAN)
+    throw UsageError("option --backend: unknown backend '" + backend + "' (one of: " + backendNames() + ")");
+  if (method != "prefilter" && method != "minmax")
+    throw UsageError("option --backend vulkan: runs --method prefilter or minmax (crep::Scattering), not " +
+                     method);
+  if (settings.scale != 1.0)
+    throw UsageError("option --backend vulkan: needs --scale 1 (reduced resolution is an OpenGL stage)");
+}
+
+#if CREP_HAS_VULKAN
+namespace {
+
+/// RGBA floats of a 3- or 4-channel image (alpha 1 when it has none).
+std::vector<float> rgbaOf(const Image& image) {
+  std::vector<float> out;
+  out.reserve(static_cast<std::size_t>(image.width()) * static_cast<std::size_t>(image.height()) * 4);
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x)
+      out.insert(out.end(), {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2),
+                             image.channels() == 4 ? image.at(x, y, 3) : 1.0f});
+  return out;
+}
+
+} // namespace
+
+MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const MethodSettings& settings) {
+  const scenes::Scene& scene = *s.scene;
+  const FrameInputs& frame = *s.frame;
+  MethodOutput out;
+  out.used = method;
+  // The frame's own maps, read back, as an engine hands them over: the camera depth, the sun's standard map
+  // and each local light's perspective map (those the OpenGL methods and the reference use).
+  const scenes::EngineMaps maps = out.timings.time("engine maps (read back from GL)", [&] {
+    scenes::EngineMaps m;
+    m.cameraDepth = scenes::readDepthTexture(frame.cameraDepth.get(), frame.width, frame.height);
+    if (frame.directional) {
+      m.sunMap = scenes::readDepthTexture(frame.shadowMap.get(), frame.shadowWidth, frame.shadowHeight);
+      m.sunClipFromWorld = frame.lightClipFromWorld;
+      m.sunBias = frame.shadowBias;
+    }
+    for (const LocalShadowMap& l : frame.spotShadows)
+      m.spotMaps.push_back(scenes::readDepthTexture(l.texture.get(), l.width, l.height));
+    for (const LocalShadowMap& l : frame.pointShadows)
+      m.pointMaps.push_back(scenes::readDepthTexture(l.texture.get(), l.width, l.height));
+    m.localBias = kLocalShadowBias;
+    return m;
+  });
+  gpu::VulkanBackend vk;
+  const scenes::EngineFrame engine(vk, scene, maps);
+  gpu::Texture window; // the sun's light texture (stained-glass)
+  GpuLightTexture lightTexture;
+  if (scene.sunTexture) {
+    window =
+        gpu::Texture(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, scene.sunTexture->rgb.width(),
+                          scene.sunTexture->rgb.height(), 1, "crep render: light texture"});
+    vk.writeTexture(window.id(), rgbaOf(scene.sunTexture->rgb));
+    lightTexture = {window.id(), scene.sunTexture->textureClipFromWorld};
+  }
+  gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, frame.width, frame.height, 1,
+                           "crep render: scattering"});
+  Scattering::CreateInfo info;
+  info.method = method == "minmax" ? Scattering::Method::MinMaxMarch : Scattering::Method::Prefiltered;
+  info.width = frame.width;
+  info.height = frame.height;
+  info.mapSize = settings.mapSize;
+  info.rectify = settings.rectify;
+  info.prefilter = settings.prefilter;
+  info.epipoleBlock.steps = settings.steps;
+  info.epipoleBlockMethod = settings.epipoleBlock;
+  info.epipoleBlockRadius = settings.epipoleBlockRadius;
+  info.epipoleBlockMaxPixels = settings.epipoleBlockMaxPixels;
+  info.backend = &vk;
+  Scattering scattering = out.timings.time("setup", [&] { return Scattering(info); });
+  Scattering::FrameAttribs a = engine.attribs(output.id());
+  if (scene.sunTexture && scene.hasSun) a.lightTexture = &lightTexture;
+  const Scattering::FrameResult r = scattering.run(a);
+  for (const Scattering::Stage& stage : r.stages)
+    out.timings.append({{stage.name, stage.wallMilliseconds}});
+  // Back to GL for the composite (the tool's own passes).
+  const std::vector<float> texels =
+      out.timings.time("read back (Vulkan)", [&] { return vk.readTexture(output.id()); });
+  out.scattering = gl::createTexture2D(GL_RGBA32F, frame.width, frame.height, "crep render --backend vulkan");
+  glTextureSubImage2D(out.scattering.get(), 0, 0, 0, frame.width, frame.height, GL_RGBA, GL_FLOAT,
+                      texels.data());
+  out.detail = std::string(scene.hasSun ? layoutToken(r.layout) : "no directional light") + " layout, map " +
+               std::to_string(settings.mapSize) + "^2, " + std::to_string(r.localLights.size()) +
+               " local lights; on Vulkan (" + vk.deviceName() + ")";
+  return out;
+}
+#else
+MethodOutput runOnVulkan(const SceneFrame&, const std::string&, const MethodSettings&) {
+  throw UsageError(
+      "option --backend vulkan: this build has no Vulkan backend (configure with -DCREP_VULKAN=ON)");
+}
+#endif
+
+} // namespace crep::tool
