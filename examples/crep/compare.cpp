@@ -9,6 +9,7 @@
 #include "methods.h"
 #include "options.h"
 #include "paths.h"
+#include "render_backend.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -99,13 +100,21 @@ struct CompareArgs {
   int tileWidth = 0;
   std::vector<std::string> names; ///< the methods, the reference first
   std::string out, csvPath, pngPath;
+  std::string backend = "opengl"; ///< --backend: prefilter and minmax on Vulkan (render_backend.h)
   bool debugGl = false;
 };
+
+/// The methods --backend vulkan runs on Vulkan (crep::Scattering's); the others, the reference among them,
+/// stay on OpenGL.
+bool runsOnBackend(const std::string& method) {
+  return method == "prefilter" || method == "minmax";
+}
 
 /// Parses and checks the command line: the scene, the sizes (the contact sheet within the image limits),
 /// the methods and the output prefix.
 CompareArgs parseCompareArgs(const std::vector<std::string>& argv) {
-  std::set<std::string> valued = {"scene", "size", "out", "exposure", "amplify", "tile-width", "methods"};
+  std::set<std::string> valued = {"scene",   "size",    "out",     "exposure",
+                                  "amplify", "methods", "backend", "tile-width"};
   valued.insert(kMethodOptions.begin(), kMethodOptions.end());
   valued.erase("method");
   const Args args(argv, valued, {"debug-gl"});
@@ -124,6 +133,13 @@ CompareArgs parseCompareArgs(const std::vector<std::string>& argv) {
   o.tileWidth =
       args.integer("tile-width", std::clamp(o.size.x, kMinTileWidth, 400), kMinTileWidth, kMaxTileWidth);
   o.names = selectedMethods(args);
+  o.backend = args.string("backend", "opengl");
+  if (o.backend != "opengl") {
+    requireBackend(o.backend, "prefilter", o.settings);
+    if (std::none_of(o.names.begin(), o.names.end(), runsOnBackend))
+      throw UsageError("option --backend " + o.backend +
+                       ": runs prefilter and minmax; --methods has neither");
+  }
   const glm::ivec2 size = o.size;
   requireMethodImageSize(o.settings, o.names, size,
                          "--size " + std::to_string(size.x) + "x" + std::to_string(size.y), false);
@@ -151,7 +167,8 @@ std::vector<Result> runMethods(const CompareArgs& o, SceneFrame& s) {
   std::vector<Result> results;
   for (const std::string& name : o.names) {
     if (isatty(2)) std::fprintf(stderr, "crep compare: method %s ...\n", name.c_str());
-    MethodOutput m = runMethod(name, frame, o.settings);
+    MethodOutput m = o.backend == "vulkan" && runsOnBackend(name) ? runOnVulkan(s, name, o.settings)
+                                                                  : runMethod(name, frame, o.settings);
     gl::Handle composite = compositeImage(frame, s.color.get(), m.scattering.get());
     Result r{name,
              m.used,
@@ -184,8 +201,8 @@ std::string compareCsv(const CompareArgs& o, const std::vector<Result>& results)
     csv << "," << csvField("ms " + st);
   csv << ",ms total\n";
   for (const Result& r : results) {
-    csv << o.sceneName << "," << o.size.x << "," << o.size.y << "," << r.name << "," << csvField(r.used) << ","
-        << number(r.metrics.relativeRmse) << "," << number(r.metrics.psnr) << ","
+    csv << o.sceneName << "," << o.size.x << "," << o.size.y << "," << r.name << "," << csvField(r.used)
+        << "," << number(r.metrics.relativeRmse) << "," << number(r.metrics.psnr) << ","
         << number(r.metrics.maxAbsError) << "," << number(r.metrics.meanAbsError);
     for (const std::string& st : stages) {
       csv << ",";

@@ -80,6 +80,8 @@ const char* const kCompare =
             --tile-width N      width of each image on the sheet in [16, 4096] (default: the image
                                 width within [16, 400])
             --out PREFIX        writes PREFIX.png and PREFIX.csv (default crep-compare-<scene>)
+            --backend B         opengl (default) | vulkan: prefilter and minmax on a Vulkan device
+                                (the reference and the other methods on OpenGL)
             --debug-gl          debug GL context; GL errors abort the command
 )";
 

@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,23 @@ double relativeRmse(const crep::Image& a, const crep::Image& b) {
 } // namespace
 
 #if CREP_TOOL_HAS_VULKAN
+TEST_CASE("crep compare --backend vulkan: prefilter and minmax on Vulkan beside the OpenGL reference") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir{"crep-backend-compare"};
+  const std::string out = (dir.path() / "sheet").string();
+  const ArgvResult r =
+      runCrepArgv({"compare", "--scene", "sunset", "--size", "96x54", "--map-size", "128", "--steps", "64",
+                   "--methods", "prefilter,minmax", "--backend", "vulkan", "--out", out});
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  std::ifstream csv(out + ".csv");
+  const std::string text((std::istreambuf_iterator<char>(csv)), std::istreambuf_iterator<char>());
+  // The Vulkan rows carry the Vulkan frame's stages (its read-back), the reference its march.
+  CHECK(text.find("ms read back (Vulkan)") != std::string::npos);
+  CHECK(text.find("sunset,96,54,prefilter,prefilter,") != std::string::npos);
+  CHECK(text.find("sunset,96,54,minmax,minmax,") != std::string::npos);
+}
+
 TEST_CASE(
     "crep render --backend vulkan: the sun in view and local lights on a Vulkan device, as close to the "
     "world-space reference as the OpenGL backend's image") {
@@ -83,5 +102,8 @@ TEST_CASE("crep render --backend: an unknown backend and the methods Vulkan does
       runCrepArgv({"render", "--backend", "vulkan", "--scale", "0.5", "--out", "/tmp/crep-never"});
   CHECK(scale.status == 2);
   CHECK(scale.output.find("--scale") != std::string::npos);
+  const ArgvResult none = runCrepArgv({"compare", "--backend", "vulkan", "--methods", "radial"});
+  CHECK(none.status == 2);
+  CHECK(none.output.find("--backend vulkan: runs prefilter and minmax") != std::string::npos);
 #endif
 }
