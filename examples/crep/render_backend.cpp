@@ -85,17 +85,9 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
   }
   gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, frame.width, frame.height, 1,
                            "crep render: scattering"});
-  Scattering::CreateInfo info;
-  info.method = method == "minmax" ? Scattering::Method::MinMaxMarch : Scattering::Method::Prefiltered;
-  info.width = frame.width;
-  info.height = frame.height;
-  info.mapSize = settings.mapSize;
-  info.rectify = settings.rectify;
-  info.prefilter = settings.prefilter;
-  info.epipoleBlock.steps = settings.steps;
-  info.epipoleBlockMethod = settings.epipoleBlock;
-  info.epipoleBlockRadius = settings.epipoleBlockRadius;
-  info.epipoleBlockMaxPixels = settings.epipoleBlockMaxPixels;
+  Scattering::CreateInfo info = frontDoorCreateInfo(frame, settings,
+                                                    method == "minmax" ? Scattering::Method::MinMaxMarch
+                                                                       : Scattering::Method::Prefiltered);
   info.backend = &vk;
   Scattering scattering = out.timings.time("setup", [&] { return Scattering(info); });
   Scattering::FrameAttribs a = engine.attribs(output.id());

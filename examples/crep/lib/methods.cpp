@@ -393,21 +393,7 @@ MethodOutput runFrontDoor(FrameInputs& frame, const MethodSettings& settings, Sc
                           Scattering::Sampling sampling, const char* name) {
   MethodOutput out;
   out.used = name;
-  Scattering::CreateInfo info;
-  info.method = method;
-  info.sampling = sampling;
-  info.epipolarSampling = settings.sampling;
-  info.width = frame.width;
-  info.height = frame.height;
-  info.mapSize = settings.mapSize;
-  info.rectify = settings.rectify;
-  info.prefilter = settings.prefilter;
-  info.epipoleBlock.steps = settings.steps;
-  info.epipoleBlockMethod = settings.epipoleBlock;
-  info.epipoleBlockRadius = settings.epipoleBlockRadius;
-  info.epipoleBlockMaxPixels = settings.epipoleBlockMaxPixels;
-  // --scale is the per-pixel evaluation's (compare runs the epipolar methods beside it at full size).
-  info.evaluationScale = sampling == Scattering::Sampling::PerPixel ? settings.scale : 1.0;
+  const Scattering::CreateInfo info = frontDoorCreateInfo(frame, settings, method, sampling);
   auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });
   const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.lightClipFromWorld, frame.shadowBias};
   Scattering::FrameAttribs a;
@@ -696,6 +682,26 @@ MethodOutput runFroxelPrefilter(FrameInputs& frame, const MethodSettings& settin
 }
 
 } // namespace
+
+Scattering::CreateInfo frontDoorCreateInfo(const FrameInputs& frame, const MethodSettings& settings,
+                                           Scattering::Method method, Scattering::Sampling sampling) {
+  Scattering::CreateInfo info;
+  info.method = method;
+  info.sampling = sampling;
+  info.epipolarSampling = settings.sampling;
+  info.width = frame.width;
+  info.height = frame.height;
+  info.mapSize = settings.mapSize;
+  info.rectify = settings.rectify;
+  info.prefilter = settings.prefilter;
+  info.epipoleBlock.steps = settings.steps;
+  info.epipoleBlockMethod = settings.epipoleBlock;
+  info.epipoleBlockRadius = settings.epipoleBlockRadius;
+  info.epipoleBlockMaxPixels = settings.epipoleBlockMaxPixels;
+  // --scale is the per-pixel evaluation's (compare runs the epipolar methods beside it at full size).
+  info.evaluationScale = sampling == Scattering::Sampling::PerPixel ? settings.scale : 1.0;
+  return info;
+}
 
 const std::vector<Method>& methodRegistry() {
   static const std::vector<Method> registry = {

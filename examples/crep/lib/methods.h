@@ -51,5 +51,10 @@ EpipolarMap makeEpipolarMap(const FrameInputs& frame, const MethodSettings& sett
 /// Runs `name` and, when the rectification is not projective and the method needs it, the fallback
 /// (announced on stderr by the method).
 MethodOutput runMethod(const std::string& name, FrameInputs& frame, const MethodSettings& settings);
+/// The front door's CreateInfo of the tool's settings for `frame` (the prefilter, minmax and epipolar
+/// methods; `crep render --backend` adds its backend).
+Scattering::CreateInfo frontDoorCreateInfo(const FrameInputs& frame, const MethodSettings& settings,
+                                           Scattering::Method method,
+                                           Scattering::Sampling sampling = Scattering::Sampling::PerPixel);
 
 } // namespace crep::tool
