@@ -3,6 +3,7 @@
 // operators of glsl/crep/tone_mapping.glsl. Shaders: passes/postfx/luminance_reduce.comp,
 // passes/postfx/luminance_adapt.comp, passes/tone_map.comp.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/postfx/gpu_tone_mapping.h>
 
@@ -11,7 +12,9 @@
 #include <epoxy/gl.h>
 
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <vector>
 
 namespace crep {
 
@@ -23,18 +26,17 @@ constexpr const char* kOwner = "ToneMapPass::CreateInfo.options";
 
 ToneMapPass::ToneMapPass(const CreateInfo& info) : info_(info) {
   crep::validate(info.options, kOwner);
-  reduceProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_reduce.comp", {}}});
-  adaptProgram_ = buildProgram({{ShaderStage::Compute, "passes/postfx/luminance_adapt.comp", {}}});
-  params_ = gl::createDynamicBuffer(sizeof(gpu::ToneMapParams));
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::Backend& b = *backend_;
+  b.prepareProgram("passes/postfx/luminance_reduce.comp", {});
+  b.prepareProgram("passes/postfx/luminance_adapt.comp", {});
+  params_ = gpu::Buffer(b, sizeof(gpu::ToneMapParams), "ToneMapPass: parameters");
   // The state starts zeroed: valid = 0, so the first reduced frame sets the adapted luminance.
-  state_ = gl::createBuffer();
+  state_ = gpu::Buffer(b, sizeof(gpu::ToneMapState), "ToneMapPass: adaptation state");
   const gpu::ToneMapState zero{};
-  glNamedBufferStorage(state_.get(), sizeof zero, &zero, GL_DYNAMIC_STORAGE_BIT);
-  // texelFetch through a nearest sampler: a caller's texture with a mipmapping filter and one level would
-  // be incomplete (and read as zero) without it.
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  toneMapProgram(GL_RGBA32F); // compile errors surface at construction
-  gl::checkError("ToneMapPass");
+  b.writeBuffer(state_.id(), 0, std::as_bytes(std::span(&zero, 1)));
+  const ShaderStageSource stage = toneMapStage(false); // compile errors surface at construction
+  b.prepareProgram(stage.path, stage.defines);
 }
 
 void ToneMapPass::setOptions(const ToneMapOptions& options) {
@@ -42,27 +44,25 @@ void ToneMapPass::setOptions(const ToneMapOptions& options) {
   info_.options = options;
 }
 
-std::uint32_t ToneMapPass::toneMapProgram(std::uint32_t outputFormat) {
-  const bool rgba8 = outputFormat == GL_RGBA8;
-  const int key = static_cast<int>(info_.options.op) * 2 + (rgba8 ? 1 : 0);
-  gl::Handle& program = toneMapPrograms_[key];
-  if (!program)
-    program = buildProgram({{ShaderStage::Compute,
-                             "passes/postfx/tone_map.comp",
-                             {{"CREP_TONE_MAP_OPERATOR", std::to_string(static_cast<int>(info_.options.op))},
-                              {"CREP_TONE_MAP_FORMAT", rgba8 ? "rgba8" : "rgba32f"},
-                              {"CREP_TONE_MAP_SRGB", info_.encodeSrgb ? "1" : "0"}}}});
-  return program.get();
+ShaderStageSource ToneMapPass::toneMapStage(bool rgba8) const {
+  return {ShaderStage::Compute,
+          "passes/postfx/tone_map.comp",
+          {{"CREP_TONE_MAP_OPERATOR", std::to_string(static_cast<int>(info_.options.op))},
+           {"CREP_TONE_MAP_FORMAT", rgba8 ? "rgba8" : "rgba32f"},
+           {"CREP_TONE_MAP_SRGB", info_.encodeSrgb ? "1" : "0"}}};
 }
 
 void ToneMapPass::validate(const FrameAttribs& f, std::string_view owner) const {
   const std::string p = std::string(owner) + ".";
-  const gl::TextureLevel in = gl::requireTexture2D((p + "input").c_str(), f.input);
+  const gpu::Backend& b = *backend_;
+  const gl::TextureLevel in = gpu::textureLevelOf(b, (p + "input").c_str(), f.input);
+  gpu::requireTexture2DOf(b, (p + "input").c_str(), f.input, in.width, in.height);
   if (in.internalFormat != GL_RGBA32F && in.internalFormat != GL_RGBA16F)
     invalid(p + "input", "internal format " + std::to_string(in.internalFormat),
             "must be GL_RGBA32F or GL_RGBA16F");
   if (f.output == f.input) invalid(p + "output", std::to_string(f.output), "must not be the input texture");
-  const gl::TextureLevel out = gl::requireTexture2D((p + "output").c_str(), f.output);
+  const gl::TextureLevel out = gpu::textureLevelOf(b, (p + "output").c_str(), f.output);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, out.width, out.height);
   if (out.internalFormat != GL_RGBA8 && out.internalFormat != GL_RGBA32F)
     invalid(p + "output", "internal format " + std::to_string(out.internalFormat),
             "must be GL_RGBA8 or GL_RGBA32F");
@@ -74,8 +74,9 @@ void ToneMapPass::validate(const FrameAttribs& f, std::string_view owner) const 
 
 void ToneMapPass::run(const FrameAttribs& f) {
   validate(f);
-  const gl::TextureLevel in = gl::textureLevel("ToneMapPass::FrameAttribs.input", f.input);
-  const gl::TextureLevel out = gl::textureLevel("ToneMapPass::FrameAttribs.output", f.output);
+  gpu::Backend& b = *backend_;
+  const gl::TextureLevel in = gpu::textureLevelOf(b, "ToneMapPass::FrameAttribs.input", f.input);
+  const gl::TextureLevel out = gpu::textureLevelOf(b, "ToneMapPass::FrameAttribs.output", f.output);
 
   const ToneMapOptions& o = info_.options;
   const int groupsX = (in.width + kReductionTile - 1) / kReductionTile;
@@ -88,40 +89,45 @@ void ToneMapPass::run(const FrameAttribs& f) {
   params.adaptation = glm::vec4(static_cast<float>(factor), 0.0f, 0.0f, 0.0f);
   params.flags = glm::ivec4(o.autoExposure ? 1 : 0, f.resetAdaptation ? 1 : 0, groupsX * groupsY, 0);
   params.sizes = glm::ivec4(in.width, in.height, groupsX, groupsY);
-  glNamedBufferSubData(params_.get(), 0, sizeof params, &params);
+  b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&params, 1)));
 
-  const GLuint program = toneMapProgram(out.internalFormat);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_TONE_MAP_PARAMS_BINDING, params_.get());
-  glBindTextureUnit(CREP_TONE_MAP_HDR_UNIT, f.input);
-  glBindSampler(CREP_TONE_MAP_HDR_UNIT, sampler_.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_TONE_MAP_STATE_BINDING, state_.get());
+  const gpu::Resource block = gpu::Resource::uniform(CREP_TONE_MAP_PARAMS_BINDING, params_.id()),
+                      state = gpu::Resource::storage(CREP_TONE_MAP_STATE_BINDING, state_.id()),
+                      hdr = gpu::Resource::sampled(CREP_TONE_MAP_HDR_UNIT, f.input); // texelFetch, nearest
   if (o.autoExposure) {
+    // The log-average luminance by tiles, then the adaptation of the state (one invocation).
     const std::size_t bytes = sizeof(gpu::LuminancePartial) * static_cast<std::size_t>(groupsX * groupsY);
-    if (!partials_ || partialsCapacity_ < bytes) {
-      partials_ = gl::createDynamicBuffer(bytes);
-      partialsCapacity_ = bytes;
-    }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_TONE_MAP_LUMINANCE_PARTIALS_BINDING, partials_.get());
-    glUseProgram(reduceProgram_.get());
-    glDispatchCompute(static_cast<GLuint>(groupsX), static_cast<GLuint>(groupsY), 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(adaptProgram_.get());
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    if (partials_.bytes() < bytes) partials_ = gpu::Buffer(b, bytes, "ToneMapPass: luminance partials");
+    const gpu::Resource partials =
+        gpu::Resource::storage(CREP_TONE_MAP_LUMINANCE_PARTIALS_BINDING, partials_.id(), 0, bytes);
+    b.dispatch({"ToneMapPass::run (reduce)",
+                "passes/postfx/luminance_reduce.comp",
+                {},
+                {hdr, block, partials},
+                {},
+                glm::uvec3(static_cast<unsigned>(groupsX), static_cast<unsigned>(groupsY), 1u)});
+    b.dispatch({"ToneMapPass::run (adapt)",
+                "passes/postfx/luminance_adapt.comp",
+                {},
+                {block, partials, state},
+                {},
+                glm::uvec3(1u)});
   }
-  glUseProgram(program);
-  glBindImageTexture(CREP_TONE_MAP_DISPLAY_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     out.internalFormat);
-  glDispatchCompute(static_cast<GLuint>((in.width + 7) / 8), static_cast<GLuint>((in.height + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError("ToneMapPass::run");
+  const ShaderStageSource stage = toneMapStage(out.internalFormat == GL_RGBA8);
+  b.dispatch({"ToneMapPass::run",
+              stage.path,
+              stage.defines,
+              {hdr, block, state,
+               gpu::Resource::image(CREP_TONE_MAP_DISPLAY_IMAGE, f.output, gpu::Access::WriteOnly)},
+              {},
+              glm::uvec3(static_cast<unsigned>((in.width + 7) / 8),
+                         static_cast<unsigned>((in.height + 7) / 8), 1u)});
 }
 
 gpu::ToneMapState ToneMapPass::readState() const {
   gpu::ToneMapState s;
-  glGetNamedBufferSubData(state_.get(), 0, sizeof s, &s);
-  gl::checkError("ToneMapPass::readState");
+  const std::vector<std::byte> bytes = backend_->readBuffer(state_.id(), 0, sizeof s);
+  std::memcpy(&s, bytes.data(), sizeof s);
   return s;
 }
 

@@ -4,12 +4,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string_view>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/postfx/radial_blur.h>
@@ -40,6 +42,8 @@ public:
     RadialBlurOptions options;
     /// Invocations per workgroup: workgroupSize^2, in [1, 32]; 8 suits every GPU's SIMD width (README).
     int workgroupSize = 8;
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
@@ -60,13 +64,16 @@ public:
 
   const CreateInfo& createInfo() const noexcept { return info_; }
   /// The source texture of the last run (RGBA32F, radialSourceSize of that run's image), 0 before any.
-  std::uint32_t sourceTexture() const noexcept { return source_.get(); }
+  std::uint32_t sourceTexture() const noexcept { return source_.id(); }
   /// The sun of the last run (screen position and fade).
   const RadialLight& lastLight() const noexcept { return lastLight_; }
 
 private:
   CreateInfo info_;
-  gl::Handle sourceProgram_, blurProgram_, marchParams_, radialParams_, nearest_, linear_, source_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer marchParams_, radialParams_;
+  gpu::Texture source_; ///< the occlusion pre-pass (RGBA32F, cameraDepth / sourceScale)
   int sourceWidth_ = 0, sourceHeight_ = 0;
   RadialLight lastLight_;
 };

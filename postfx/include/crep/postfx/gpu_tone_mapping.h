@@ -4,12 +4,14 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
+#include <memory>
 #include <string_view>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
+#include <crep/core/shader_library.h>
 #include <crep/postfx/tone_mapping.h>
 
 namespace crep {
@@ -53,6 +55,8 @@ public:
     ToneMapOptions options;
     /// Write values encoded by crep_srgbEncode (IEC 61966-2-1) instead of linear.
     bool encodeSrgb = false;
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   struct FrameAttribs {
     /// GL_TEXTURE_2D, GL_RGBA32F or GL_RGBA16F: linear HDR RGB (A ignored); its size is the frame's.
@@ -75,18 +79,19 @@ public:
   void setOptions(const ToneMapOptions& options);
   const ToneMapOptions& options() const { return info_.options; }
 
-  /// The GL storage buffer holding gpu::ToneMapState (owned by the pass).
-  std::uint32_t stateBuffer() const { return state_.get(); }
+  /// The storage buffer holding gpu::ToneMapState (owned by the pass; a GL name on the GL backend).
+  std::uint32_t stateBuffer() const { return state_.id(); }
   /// Reads the state back (a pipeline stall; for tests and debugging).
   gpu::ToneMapState readState() const;
 
 private:
-  std::uint32_t toneMapProgram(std::uint32_t outputFormat);
+  ShaderStageSource toneMapStage(bool rgba8) const;
 
   CreateInfo info_;
-  gl::Handle reduceProgram_, adaptProgram_, params_, partials_, state_, sampler_;
-  std::size_t partialsCapacity_ = 0;
-  std::map<int, gl::Handle> toneMapPrograms_; ///< by operator x 2 + (output is RGBA8)
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_, partials_,
+      state_; ///< the block, the per-tile luminance partials, the adaptation state
 };
 
 } // namespace crep
