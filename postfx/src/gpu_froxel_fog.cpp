@@ -5,6 +5,7 @@
 #include <crep/postfx/gpu_froxel_fog.h>
 
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/ray.h>
@@ -13,8 +14,12 @@
 
 #include <epoxy/gl.h>
 
+#include <chrono>
 #include <cmath>
+#include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace crep {
 
@@ -37,8 +42,13 @@ const char* formatQualifier(std::uint32_t format) {
   return format == GL_RGBA32F ? "rgba32f" : "rgba16f";
 }
 
-gl::Handle buildFroxelProgram(const char* path, std::uint32_t format) {
-  return buildProgram({{ShaderStage::Compute, path, {{"CREP_FROXEL_FORMAT", formatQualifier(format)}}}});
+gpu::Format froxelFormat(std::uint32_t format) {
+  return format == GL_RGBA32F ? gpu::Format::RGBA32F : gpu::Format::RGBA16F;
+}
+
+/// A froxel program in the volume's format.
+std::vector<ShaderDefine> formatDefines(std::uint32_t format) {
+  return {{"CREP_FROXEL_FORMAT", formatQualifier(format)}};
 }
 
 void requireJitter(const glm::dvec3& j, const std::string& parameter) {
@@ -47,10 +57,10 @@ void requireJitter(const glm::dvec3& j, const std::string& parameter) {
       throw InvalidArgument(parameter, detail::formatValue(j[c]), "cells, each component in [-0.5, 0.5]");
 }
 
-/// A caller's volume: an existing GL_TEXTURE_3D of the grid's size (and `format` when not 0).
-void requireVolume(const std::string& parameter, std::uint32_t texture, const FroxelGrid& grid,
-                   std::uint32_t format) {
-  const gl::TextureLevel l = gl::textureLevel(parameter.c_str(), texture);
+/// A caller's volume: an existing 3D texture of the grid's size (and `format` when not 0) of `backend`.
+void requireVolume(const gpu::Backend& backend, const std::string& parameter, std::uint32_t texture,
+                   const FroxelGrid& grid, std::uint32_t format) {
+  const gl::TextureLevel l = gpu::textureLevelOf(backend, parameter.c_str(), texture);
   if (l.target != GL_TEXTURE_3D)
     throw InvalidArgument(parameter, std::to_string(texture), "must be a GL_TEXTURE_3D");
   if (l.width != grid.width || l.height != grid.height || l.depth != grid.depth)
@@ -66,9 +76,10 @@ void requireVolume(const std::string& parameter, std::uint32_t texture, const Fr
                           "must be GL_RGBA16F or GL_RGBA32F");
 }
 
-/// Checks the grid (validate) and the driver's 3D texture limit.
-void requireGrid(const FroxelGrid& grid, const char* owner) {
+/// Checks the grid (validate) and, on GL, the driver's 3D texture limit (other backends: at creation).
+void requireGrid(const FroxelGrid& grid, const char* owner, const gpu::Backend* backend = nullptr) {
   validate(grid, owner);
+  if (backend != nullptr && backend->name() != "OpenGL") return;
   GLint limit = 0;
   glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &limit);
   const int sizes[3] = {grid.width, grid.height, grid.depth};
@@ -96,26 +107,28 @@ void assignMedium(gpu::FroxelParams& p, const Medium& medium) {
   p.extinction = glm::vec4(glm::vec3(medium.extinction()), static_cast<float>(weightExtinction(medium)));
 }
 
-void dispatch3D(const FroxelGrid& g, const char* what) {
-  // 4 x 4 x 4 cells per workgroup: 64 invocations, a multiple of every GPU's SIMD width (32 / 64).
-  glDispatchCompute(static_cast<GLuint>((g.width + 3) / 4), static_cast<GLuint>((g.height + 3) / 4),
-                    static_cast<GLuint>((g.depth + 3) / 4));
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError(what);
+/// 4 x 4 x 4 cells per workgroup: 64 invocations, a multiple of every GPU's SIMD width (32 / 64).
+glm::uvec3 groups3D(const FroxelGrid& g) {
+  return {static_cast<unsigned>((g.width + 3) / 4), static_cast<unsigned>((g.height + 3) / 4),
+          static_cast<unsigned>((g.depth + 3) / 4)};
 }
 
-void dispatch2D(int width, int height, const char* what) {
-  glDispatchCompute(static_cast<GLuint>((width + 7) / 8), static_cast<GLuint>((height + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError(what);
+glm::uvec3 groups2D(int width, int height) {
+  return {static_cast<unsigned>((width + 7) / 8), static_cast<unsigned>((height + 7) / 8), 1u};
 }
 
-gl::Handle linearClampSampler() {
-  gl::Handle s = gl::createClampSampler(GL_LINEAR);
-  glSamplerParameteri(s.get(), GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
-  return s;
+/// A dispatch of `program` (in `defines`' variant) on the block `params` and `resources`.
+gpu::Dispatch froxelDispatch(const char* label, const char* program, std::vector<ShaderDefine> defines,
+                             std::uint32_t paramsBinding, const gpu::Buffer& params,
+                             std::vector<gpu::Resource> resources, glm::uvec3 groups) {
+  gpu::Dispatch d;
+  d.label = label;
+  d.program = program;
+  d.defines = std::move(defines);
+  d.resources = std::move(resources);
+  d.resources.push_back(gpu::Resource::uniform(paramsBinding, params.id()));
+  d.groups = groups;
+  return d;
 }
 
 } // namespace
@@ -140,15 +153,22 @@ gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, cons
   return t;
 }
 
+gpu::Texture createFroxelVolume(gpu::Backend& backend, const FroxelGrid& grid, std::uint32_t format,
+                                const char* owner) {
+  requireGrid(grid, owner, &backend);
+  validateFroxelFormat(format, owner);
+  return gpu::Texture(backend, {gpu::TextureType::Texture3D, froxelFormat(format), grid.width, grid.height,
+                                grid.depth, std::string(owner) + ": froxel volume"});
+}
+
 // ---- EsmPass: Annen et al. 2008 downsampled and box-blurred as Wronski 2014 (rule 1) ----
 
 EsmPass::EsmPass(const CreateInfo& info) : info_(info) {
   crep::validate(info.options, "EsmPass::CreateInfo.options");
-  downsample_ = buildProgram({{ShaderStage::Compute, "passes/postfx/esm_downsample.comp", {}}});
-  blur_ = buildProgram({{ShaderStage::Compute, "passes/postfx/esm_blur.comp", {}}});
-  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("EsmPass");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  backend_->prepareProgram("passes/postfx/esm_downsample.comp", {});
+  backend_->prepareProgram("passes/postfx/esm_blur.comp", {});
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::FroxelParams), "EsmPass: parameters");
 }
 
 std::size_t EsmPass::memoryBytes() const noexcept {
@@ -157,20 +177,23 @@ std::size_t EsmPass::memoryBytes() const noexcept {
 
 void EsmPass::validate(const FrameAttribs& f, std::string_view owner) const {
   const std::string o(owner);
-  gl::requireTexture2D(name(o.c_str(), "shadowMap").c_str(), f.shadowMap);
-  gl::requireDepthFormat(name(o.c_str(), "shadowMap").c_str(), f.shadowMap);
+  const std::string map = name(o.c_str(), "shadowMap");
+  const gl::TextureLevel level = gpu::textureLevelOf(*backend_, map.c_str(), f.shadowMap);
+  gpu::requireTexture2DOf(*backend_, map.c_str(), f.shadowMap, level.width, level.height);
+  gpu::requireDepthFormatOf(*backend_, map.c_str(), f.shadowMap);
   requireFinite(name(o.c_str(), "lightClipFromWorld"), f.lightClipFromWorld);
 }
 
 void EsmPass::run(const FrameAttribs& f) {
   validate(f);
-  const gl::TextureLevel map = gl::textureLevel("EsmPass::FrameAttribs.shadowMap", f.shadowMap);
+  gpu::Backend& b = *backend_;
+  const gl::TextureLevel map = gpu::textureLevelOf(b, "EsmPass::FrameAttribs.shadowMap", f.shadowMap);
   const double c = esmDepthExponent(info_.options, f.lightClipFromWorld);
   const int factor = info_.options.downsample;
   const int w = (map.width + factor - 1) / factor, h = (map.height + factor - 1) / factor;
   if (w != width_ || h != height_) {
-    esm_ = gl::createTexture2D(GL_R32F, w, h, "EsmPass::FrameAttribs.shadowMap");
-    scratch_ = gl::createTexture2D(GL_R32F, w, h, "EsmPass::FrameAttribs.shadowMap");
+    esm_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::R32F, w, h, 1, "EsmPass: ESM"});
+    scratch_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::R32F, w, h, 1, "EsmPass: blur"});
     width_ = w;
     height_ = h;
   }
@@ -178,35 +201,32 @@ void EsmPass::run(const FrameAttribs& f) {
   p.esm = glm::vec4(static_cast<float>(c), static_cast<float>(info_.options.bias), 1.0f, 0.0f);
   p.sizes = glm::ivec4(map.width, map.height, w, h);
   p.info = glm::ivec4(factor, info_.options.blurRadius, 0, 0);
-  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
+  b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&p, 1)));
   // Downsample into the ESM, blur x into the scratch texture, blur y back into the ESM.
-  glUseProgram(downsample_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ESM_FROXEL_BINDING, params_.get());
-  glBindTextureUnit(CREP_ESM_SHADOW_MAP_UNIT, f.shadowMap);
-  glBindSampler(CREP_ESM_SHADOW_MAP_UNIT, sampler_.get());
-  glBindImageTexture(CREP_ESM_OUT_IMAGE, esm_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(static_cast<GLuint>((w + 7) / 8), static_cast<GLuint>((h + 7) / 8), 1);
-  if (info_.options.blurRadius > 0) {
-    glUseProgram(blur_.get());
+  b.dispatch(froxelDispatch("EsmPass::run (downsample)", "passes/postfx/esm_downsample.comp", {},
+                            CREP_ESM_FROXEL_BINDING, params_,
+                            {gpu::Resource::sampled(CREP_ESM_SHADOW_MAP_UNIT, f.shadowMap),
+                             gpu::Resource::image(CREP_ESM_OUT_IMAGE, esm_.id(), gpu::Access::WriteOnly)},
+                            groups2D(w, h)));
+  if (info_.options.blurRadius > 0)
     for (int direction = 0; direction < 2; ++direction) {
-      glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-      glProgramUniform1i(blur_.get(), 0, direction);
-      glBindTextureUnit(CREP_ESM_IN_UNIT, direction == 0 ? esm_.get() : scratch_.get());
-      glBindImageTexture(CREP_ESM_OUT_IMAGE, direction == 0 ? scratch_.get() : esm_.get(), 0, GL_FALSE, 0,
-                         GL_WRITE_ONLY, GL_R32F);
-      glDispatchCompute(static_cast<GLuint>((w + 7) / 8), static_cast<GLuint>((h + 7) / 8), 1);
+      gpu::Dispatch d = froxelDispatch(
+          "EsmPass::run (blur)", "passes/postfx/esm_blur.comp", {}, CREP_ESM_FROXEL_BINDING, params_,
+          {gpu::Resource::sampled(CREP_ESM_IN_UNIT, direction == 0 ? esm_.id() : scratch_.id()),
+           gpu::Resource::image(CREP_ESM_OUT_IMAGE, direction == 0 ? scratch_.id() : esm_.id(),
+                                gpu::Access::WriteOnly)},
+          groups2D(w, h));
+      d.push = {gpu::PushValue::of(0, direction)};
+      b.dispatch(d);
     }
-  }
-  gl::passOutputBarrier();
-  gl::unbindPassState(2);
-  gl::checkError("EsmPass::run");
 }
 
 // ---- FroxelLightingPass: Wronski 2014, "Density estimation and volume lighting" (rule 2) ----
 
 FroxelLightingPass::FroxelLightingPass(const CreateInfo& info) : info_(info) {
   const char* owner = "FroxelLightingPass::CreateInfo";
-  requireGrid(info.grid, owner);
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  requireGrid(info.grid, owner, backend_);
   crep::validate(info.density, "FroxelLightingPass::CreateInfo.density");
   crep::validate(info.esm, "FroxelLightingPass::CreateInfo.esm");
   validateFroxelFormat(info.format, owner);
@@ -214,23 +234,23 @@ FroxelLightingPass::FroxelLightingPass(const CreateInfo& info) : info_(info) {
     if (!(info.ambient[c] >= 0.0) || !std::isfinite(info.ambient[c]))
       throw InvalidArgument(name(owner, "ambient"), detail::formatValue(info.ambient[c]),
                             "must be finite and >= 0");
-  program_ = buildFroxelProgram("passes/postfx/froxel_light.comp", info.format);
-  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-  gl::checkError("FroxelLightingPass");
+  backend_->prepareProgram("passes/postfx/froxel_light.comp", formatDefines(info.format));
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::FroxelParams), "FroxelLightingPass: parameters");
 }
 
 void FroxelLightingPass::validate(const FrameAttribs& f, std::string_view ownerName) const {
   const std::string o(ownerName);
   const char* owner = o.c_str();
   if (!f.camera || !f.light || !f.medium) invalid(name(owner, "camera/light/medium"), "null", "must be set");
-  requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
+  requireVolume(*backend_, name(owner, "output"), f.output, info_.grid, info_.format);
   requireJitter(f.jitter, name(owner, "jitter"));
   requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   if (f.esm != 0) {
-    const gl::TextureLevel esm = gl::requireTexture2D(name(owner, "esm").c_str(), f.esm);
+    const std::string esmName = name(owner, "esm");
+    const gl::TextureLevel esm = gpu::textureLevelOf(*backend_, esmName.c_str(), f.esm);
+    gpu::requireTexture2DOf(*backend_, esmName.c_str(), f.esm, esm.width, esm.height);
     if (esm.internalFormat != GL_R32F)
-      invalid(name(owner, "esm"), "internal format " + std::to_string(esm.internalFormat),
+      invalid(esmName, "internal format " + std::to_string(esm.internalFormat),
               "must be GL_R32F (EsmPass::esm())");
     requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
@@ -238,8 +258,9 @@ void FroxelLightingPass::validate(const FrameAttribs& f, std::string_view ownerN
 
 void FroxelLightingPass::run(const FrameAttribs& f) {
   validate(f);
+  gpu::Backend& b = *backend_;
   const gl::TextureLevel esm =
-      f.esm != 0 ? gl::textureLevel("FroxelLightingPass::FrameAttribs.esm", f.esm) : gl::TextureLevel{};
+      f.esm != 0 ? gpu::textureLevelOf(b, "FroxelLightingPass::FrameAttribs.esm", f.esm) : gl::TextureLevel{};
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   assignMedium(p, *f.medium);
@@ -255,30 +276,37 @@ void FroxelLightingPass::run(const FrameAttribs& f) {
                     static_cast<float>(info_.esm.bias), f.esm != 0 ? 1.0f : 0.0f, 0.0f);
   p.sizes = glm::ivec4(0, 0, esm.width, esm.height);
   p.lightClipFromWorld = glm::mat4(f.lightClipFromWorld);
-  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
-  glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
-  glBindTextureUnit(CREP_FROXEL_ESM_UNIT, f.esm);
-  glBindSampler(CREP_FROXEL_ESM_UNIT, sampler_.get());
-  glBindImageTexture(CREP_FROXEL_LIGHTING_OUT_IMAGE, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
-  dispatch3D(info_.grid, "FroxelLightingPass::run");
+  b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&p, 1)));
+  // Without an ESM (every point lit, p.esm.z = 0) the shader reads none; a 1-texel stand-in keeps the
+  // descriptor valid on every API.
+  if (f.esm == 0 && !unlit_) {
+    unlit_ = gpu::Texture(
+        b, {gpu::TextureType::Texture2D, gpu::Format::R32F, 1, 1, 1, "FroxelLightingPass: no ESM"});
+    b.writeTexture(unlit_.id(), std::vector<float>{1.0f});
+  }
+  b.dispatch(
+      froxelDispatch("FroxelLightingPass::run", "passes/postfx/froxel_light.comp",
+                     formatDefines(info_.format), CREP_FROXEL_PARAMS_BINDING, params_,
+                     {gpu::Resource::sampled(CREP_FROXEL_ESM_UNIT, f.esm != 0 ? f.esm : unlit_.id()),
+                      gpu::Resource::image(CREP_FROXEL_LIGHTING_OUT_IMAGE, f.output, gpu::Access::WriteOnly)},
+                     groups3D(info_.grid)));
 }
 
 // ---- FroxelAccumulatePass: Wronski 2014, "Solving scattering equation" (rule 3) ----
 
 FroxelAccumulatePass::FroxelAccumulatePass(const CreateInfo& info) : info_(info) {
-  requireGrid(info.grid, "FroxelAccumulatePass::CreateInfo");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  requireGrid(info.grid, "FroxelAccumulatePass::CreateInfo", backend_);
   validateFroxelFormat(info.format, "FroxelAccumulatePass::CreateInfo");
-  program_ = buildFroxelProgram("passes/postfx/froxel_accumulate.comp", info.format);
-  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
-  gl::checkError("FroxelAccumulatePass");
+  backend_->prepareProgram("passes/postfx/froxel_accumulate.comp", formatDefines(info.format));
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::FroxelParams), "FroxelAccumulatePass: parameters");
 }
 
 void FroxelAccumulatePass::validate(const FrameAttribs& f, std::string_view ownerName) const {
   const std::string o(ownerName);
   const char* owner = o.c_str();
   if (!f.camera || !f.medium) invalid(name(owner, "camera/medium"), "null", "must be set");
-  requireVolume(name(owner, "volume"), f.volume, info_.grid, info_.format);
+  requireVolume(*backend_, name(owner, "volume"), f.volume, info_.grid, info_.format);
   requireJitter(f.jitter, name(owner, "jitter"));
 }
 
@@ -288,23 +316,21 @@ void FroxelAccumulatePass::run(const FrameAttribs& f) {
   assignFrame(p, *f.camera, info_.grid);
   assignMedium(p, *f.medium);
   p.jitter = glm::vec4(glm::vec3(f.jitter), 0.0f);
-  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
-  glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
-  glBindImageTexture(CREP_FROXEL_VOLUME_IMAGE, f.volume, 0, GL_TRUE, 0, GL_READ_WRITE, info_.format);
-  dispatch2D(info_.grid.width, info_.grid.height, "FroxelAccumulatePass::run");
+  backend_->writeBuffer(params_.id(), 0, std::as_bytes(std::span(&p, 1)));
+  backend_->dispatch(froxelDispatch("FroxelAccumulatePass::run", "passes/postfx/froxel_accumulate.comp",
+                                    formatDefines(info_.format), CREP_FROXEL_PARAMS_BINDING, params_,
+                                    {gpu::Resource::image(CREP_FROXEL_VOLUME_IMAGE, f.volume)},
+                                    groups2D(info_.grid.width, info_.grid.height)));
 }
 
 // ---- FroxelTemporalPass: Wronski 2014, "Temporal reprojection" (rule 5) ----
 
 FroxelTemporalPass::FroxelTemporalPass(const CreateInfo& info) : info_(info) {
-  requireGrid(info.grid, "FroxelTemporalPass::CreateInfo");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  requireGrid(info.grid, "FroxelTemporalPass::CreateInfo", backend_);
   validateFroxelFormat(info.format, "FroxelTemporalPass::CreateInfo");
-  program_ = buildFroxelProgram("passes/postfx/froxel_temporal.comp", info.format);
-  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
-  nearest_ = gl::createClampSampler(GL_NEAREST);
-  linear_ = linearClampSampler();
-  gl::checkError("FroxelTemporalPass");
+  backend_->prepareProgram("passes/postfx/froxel_temporal.comp", formatDefines(info.format));
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::FroxelParams), "FroxelTemporalPass: parameters");
 }
 
 void FroxelTemporalPass::validate(const FrameAttribs& f, std::string_view ownerName) const {
@@ -313,10 +339,10 @@ void FroxelTemporalPass::validate(const FrameAttribs& f, std::string_view ownerN
   if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   if (!(f.historyWeight >= 0.0 && f.historyWeight < 1.0))
     invalid(name(owner, "historyWeight"), detail::formatValue(f.historyWeight), "must be in [0, 1)");
-  requireVolume(name(owner, "current"), f.current, info_.grid, 0);
-  requireVolume(name(owner, "output"), f.output, info_.grid, info_.format);
+  requireVolume(*backend_, name(owner, "current"), f.current, info_.grid, 0);
+  requireVolume(*backend_, name(owner, "output"), f.output, info_.grid, info_.format);
   const bool useHistory = f.previousCamera != nullptr && f.historyWeight > 0.0;
-  if (useHistory) requireVolume(name(owner, "history"), f.history, info_.grid, 0);
+  if (useHistory) requireVolume(*backend_, name(owner, "history"), f.history, info_.grid, 0);
   if (f.output == f.current || (useHistory && f.output == f.history))
     invalid(name(owner, "output"), std::to_string(f.output), "must differ from current and history");
 }
@@ -335,55 +361,55 @@ void FroxelTemporalPass::run(const FrameAttribs& f) {
     p.grid.w = 1;
   }
   p.jitter = glm::vec4(0.0f, 0.0f, 0.0f, static_cast<float>(useHistory ? f.historyWeight : 0.0));
-  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
-  glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
-  glBindTextureUnit(CREP_FROXEL_CURRENT_UNIT, f.current);
-  glBindSampler(CREP_FROXEL_CURRENT_UNIT, nearest_.get());
-  // unused without history (weight 0)
-  glBindTextureUnit(CREP_FROXEL_HISTORY_UNIT, useHistory ? f.history : f.current);
-  glBindSampler(CREP_FROXEL_HISTORY_UNIT, linear_.get());
-  glBindImageTexture(CREP_FROXEL_BLENDED_OUT_IMAGE, f.output, 0, GL_TRUE, 0, GL_WRITE_ONLY, info_.format);
-  dispatch3D(info_.grid, "FroxelTemporalPass::run");
+  backend_->writeBuffer(params_.id(), 0, std::as_bytes(std::span(&p, 1)));
+  backend_->dispatch(
+      froxelDispatch("FroxelTemporalPass::run", "passes/postfx/froxel_temporal.comp",
+                     formatDefines(info_.format), CREP_FROXEL_PARAMS_BINDING, params_,
+                     {gpu::Resource::sampled(CREP_FROXEL_CURRENT_UNIT, f.current),
+                      // unused without history (weight 0)
+                      gpu::Resource::sampled(CREP_FROXEL_HISTORY_UNIT, useHistory ? f.history : f.current,
+                                             gpu::Filter::Linear),
+                      gpu::Resource::image(CREP_FROXEL_BLENDED_OUT_IMAGE, f.output, gpu::Access::WriteOnly)},
+                     groups3D(info_.grid)));
 }
 
 // ---- FroxelApplyPass: Wronski 2014, "Applying effect" (rule 4) ----
 
 FroxelApplyPass::FroxelApplyPass(const CreateInfo& info) : info_(info) {
-  requireGrid(info.grid, "FroxelApplyPass::CreateInfo");
-  program_ = buildProgram({{ShaderStage::Compute, "passes/postfx/froxel_apply.comp", {}}});
-  params_ = gl::createDynamicBuffer(sizeof(gpu::FroxelParams));
-  nearest_ = gl::createClampSampler(GL_NEAREST);
-  linear_ = linearClampSampler();
-  gl::checkError("FroxelApplyPass");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  requireGrid(info.grid, "FroxelApplyPass::CreateInfo", backend_);
+  backend_->prepareProgram("passes/postfx/froxel_apply.comp", {});
+  params_ = gpu::Buffer(*backend_, sizeof(gpu::FroxelParams), "FroxelApplyPass: parameters");
 }
 
 void FroxelApplyPass::validate(const FrameAttribs& f, std::string_view ownerName) const {
   const std::string o(ownerName);
   const char* owner = o.c_str();
   if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
-  const gl::TextureLevel depth = gl::requireTexture2D(name(owner, "cameraDepth").c_str(), f.cameraDepth);
-  gl::requireTexture2D(name(owner, "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
-  requireVolume(name(owner, "volume"), f.volume, info_.grid, 0);
+  const std::string depthName = name(owner, "cameraDepth");
+  const gl::TextureLevel depth = gpu::textureLevelOf(*backend_, depthName.c_str(), f.cameraDepth);
+  gpu::requireTexture2DOf(*backend_, depthName.c_str(), f.cameraDepth, depth.width, depth.height);
+  gpu::requireTexture2DOf(*backend_, name(owner, "output").c_str(), f.output, depth.width, depth.height,
+                          GL_RGBA32F);
+  requireVolume(*backend_, name(owner, "volume"), f.volume, info_.grid, 0);
   requireJitter(f.offset, name(owner, "offset"));
 }
 
 void FroxelApplyPass::run(const FrameAttribs& f) {
   validate(f);
-  const gl::TextureLevel depth = gl::textureLevel("FroxelApplyPass::FrameAttribs.cameraDepth", f.cameraDepth);
+  const gl::TextureLevel depth =
+      gpu::textureLevelOf(*backend_, "FroxelApplyPass::FrameAttribs.cameraDepth", f.cameraDepth);
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   p.jitter = glm::vec4(glm::vec3(f.offset), 0.0f);
   p.sizes = glm::ivec4(depth.width, depth.height, 0, 0);
-  glNamedBufferSubData(params_.get(), 0, sizeof p, &p);
-  glUseProgram(program_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_FROXEL_PARAMS_BINDING, params_.get());
-  glBindTextureUnit(CREP_FROXEL_CAMERA_DEPTH_UNIT, f.cameraDepth);
-  glBindSampler(CREP_FROXEL_CAMERA_DEPTH_UNIT, nearest_.get());
-  glBindTextureUnit(CREP_FROXEL_INTEGRATED_UNIT, f.volume);
-  glBindSampler(CREP_FROXEL_INTEGRATED_UNIT, linear_.get());
-  glBindImageTexture(CREP_FROXEL_SCATTERING_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  dispatch2D(depth.width, depth.height, "FroxelApplyPass::run");
+  backend_->writeBuffer(params_.id(), 0, std::as_bytes(std::span(&p, 1)));
+  backend_->dispatch(froxelDispatch(
+      "FroxelApplyPass::run", "passes/postfx/froxel_apply.comp", {}, CREP_FROXEL_PARAMS_BINDING, params_,
+      {gpu::Resource::sampled(CREP_FROXEL_CAMERA_DEPTH_UNIT, f.cameraDepth),
+       gpu::Resource::sampled(CREP_FROXEL_INTEGRATED_UNIT, f.volume, gpu::Filter::Linear),
+       gpu::Resource::image(CREP_FROXEL_SCATTERING_OUT_IMAGE, f.output, gpu::Access::WriteOnly)},
+      groups2D(depth.width, depth.height)));
 }
 
 // ---- FroxelFog ----
@@ -392,7 +418,7 @@ namespace {
 
 const FroxelFog::CreateInfo& validated(const FroxelFog::CreateInfo& info) {
   const char* owner = "FroxelFog::CreateInfo";
-  requireGrid(info.grid, owner);
+  requireGrid(info.grid, owner, info.backend);
   validate(info.esm, "FroxelFog::CreateInfo.esm");
   validate(info.density, "FroxelFog::CreateInfo.density");
   validateFroxelFormat(info.format, owner);
@@ -409,14 +435,17 @@ const FroxelFog::CreateInfo& validated(const FroxelFog::CreateInfo& info) {
 } // namespace
 
 FroxelFog::FroxelFog(const CreateInfo& info)
-    : info_(validated(info)), esm_({info.esm}),
-      lighting_({info.grid, info.density, info.ambient, info.esm, info.format}),
-      accumulate_({info.grid, info.format}), temporal_({info.grid, info.format}), apply_({info.grid}) {
-  current_ = createFroxelVolume(info.grid, info.format, "FroxelFog::CreateInfo");
+    : info_(validated(info)), backend_(&gpu::givenOrGl(info.backend, ownBackend_)),
+      esm_({info.esm, backend_}),
+      lighting_({info.grid, info.density, info.ambient, info.esm, info.format, backend_}),
+      accumulate_({info.grid, info.format, backend_}), temporal_({info.grid, info.format, backend_}),
+      apply_({info.grid, backend_}) {
+  current_ = createFroxelVolume(*backend_, info.grid, info.format, "FroxelFog::CreateInfo");
   if (info.temporal.historyWeight > 0.0)
-    for (gl::Handle& h : history_)
-      h = createFroxelVolume(info.grid, info.format, "FroxelFog::CreateInfo");
-  volume_ = current_.get();
+    for (gpu::Texture& h : history_)
+      h = createFroxelVolume(*backend_, info.grid, info.format, "FroxelFog::CreateInfo");
+  volume_ = current_.id();
+  if (backend_->name() == "OpenGL") timer_.emplace();
 }
 
 glm::dvec3 FroxelFog::lightingJitter(int frameIndex) const {
@@ -444,19 +473,25 @@ std::size_t FroxelFog::memoryBytes() const noexcept {
 void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) const {
   const std::string o(ownerName);
   const char* owner = o.c_str();
+  const gpu::Backend& b = *backend_;
   if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   if (f.mode == Mode::Esm && (!f.light || !f.medium))
     invalid(name(owner, "light/medium"), "null", "must be set in Mode::Esm");
   if (f.output != 0) {
-    const gl::TextureLevel depth = gl::requireTexture2D(name(owner, "cameraDepth").c_str(), f.cameraDepth);
-    gl::requireTexture2D(name(owner, "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
+    const std::string depthName = name(owner, "cameraDepth");
+    const gl::TextureLevel depth = gpu::textureLevelOf(b, depthName.c_str(), f.cameraDepth);
+    gpu::requireTexture2DOf(b, depthName.c_str(), f.cameraDepth, depth.width, depth.height);
+    gpu::requireTexture2DOf(b, name(owner, "output").c_str(), f.output, depth.width, depth.height,
+                            GL_RGBA32F);
   }
   if (f.mode == Mode::Esm && f.shadowMap != 0) {
-    gl::requireTexture2D(name(owner, "shadowMap").c_str(), f.shadowMap);
+    const std::string mapName = name(owner, "shadowMap");
+    const gl::TextureLevel map = gpu::textureLevelOf(b, mapName.c_str(), f.shadowMap);
+    gpu::requireTexture2DOf(b, mapName.c_str(), f.shadowMap, map.width, map.height);
     requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
   if (f.mode == Mode::Prefiltered)
-    requireVolume(name(owner, "mode"), current_.get(), info_.grid, info_.format);
+    requireVolume(b, name(owner, "mode"), current_.id(), info_.grid, info_.format);
   requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   froxelDepthRange(info_.grid, *f.camera, "FroxelFog::CreateInfo");
   if (f.previousCamera) froxelDepthRange(info_.grid, *f.previousCamera, "FroxelFog::CreateInfo");
@@ -465,18 +500,25 @@ void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) cons
 void FroxelFog::run(const FrameAttribs& f) {
   validate(f);
   timings_ = Timings{};
+  // GL: GL_TIME_ELAPSED per stage; other backends: the wall clock to the stage's end (finish()).
   const auto stage = [&](double& ms, const auto& body) {
-    if (info_.timings) timer_.begin();
+    if (!info_.timings) return body();
+    if (!timer_) {
+      const auto start = std::chrono::steady_clock::now();
+      body();
+      backend_->finish();
+      ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      return;
+    }
+    timer_->begin();
     try {
       body();
     } catch (...) {
-      timer_.cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
+      timer_->cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
       throw;
     }
-    if (info_.timings) {
-      timer_.end();
-      ms = timer_.milliseconds();
-    }
+    timer_->end();
+    ms = timer_->milliseconds();
   };
   const glm::dvec3 j = jitter(f.frameIndex);
   if (f.mode == Mode::Esm) {
@@ -490,13 +532,13 @@ void FroxelFog::run(const FrameAttribs& f) {
       a.lightClipFromWorld = f.lightClipFromWorld;
       a.jitter = lightingJitter(f.frameIndex);
       a.noiseOffset = f.noiseOffset;
-      a.output = current_.get();
+      a.output = current_.id();
       lighting_.run(a);
     });
-    stage(timings_.accumulate, [&] { accumulate_.run({f.camera, f.medium, j, current_.get()}); });
+    stage(timings_.accumulate, [&] { accumulate_.run({f.camera, f.medium, j, current_.id()}); });
   }
   glm::dvec3 offset = j;
-  volume_ = current_.get();
+  volume_ = current_.id();
   if (info_.temporal.historyWeight > 0.0) {
     const int out = latest_ == 0 ? 1 : 0;
     stage(timings_.temporal, [&] {
@@ -504,13 +546,13 @@ void FroxelFog::run(const FrameAttribs& f) {
       a.camera = f.camera;
       a.previousCamera = latest_ >= 0 ? f.previousCamera : nullptr;
       a.historyWeight = info_.temporal.historyWeight;
-      a.current = current_.get();
-      a.history = latest_ >= 0 ? history_[static_cast<std::size_t>(latest_)].get() : 0;
-      a.output = history_[static_cast<std::size_t>(out)].get();
+      a.current = current_.id();
+      a.history = latest_ >= 0 ? history_[static_cast<std::size_t>(latest_)].id() : 0;
+      a.output = history_[static_cast<std::size_t>(out)].id();
       temporal_.run(a);
     });
     latest_ = out;
-    volume_ = history_[static_cast<std::size_t>(out)].get();
+    volume_ = history_[static_cast<std::size_t>(out)].id();
     offset = glm::dvec3(0.0); // the blended volume holds its values at the cell centres
   }
   if (f.output != 0)

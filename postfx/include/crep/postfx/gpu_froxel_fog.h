@@ -1,17 +1,20 @@
-// The froxel fog on the GPU (Wronski 2014, "Volumetric Fog"): the GL passes of froxel_fog.h's rules 1-5
-// and the front door FroxelFog. Every pass requires a current OpenGL 4.5 context (never owns one). Volume
-// format, GL state left, NaN inputs: postfx/README.md, "crep/postfx/gpu_froxel_fog.h".
+// The froxel fog on the GPU (Wronski 2014, "Volumetric Fog"): the passes of froxel_fog.h's rules 1-5 and the
+// front door FroxelFog, each on the gpu::Backend of its CreateInfo (default: GL on the current OpenGL 4.5
+// context, never owned). Volume format, GL state left, NaN inputs: postfx/README.md, "gpu_froxel_fog.h".
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string_view>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/postfx/froxel_fog.h>
@@ -62,12 +65,16 @@ FroxelCamera froxelCamera(const Camera& camera);
 void validateFroxelFormat(std::uint32_t format, const char* owner);
 /// A GL_TEXTURE_3D of the grid's size in `format` (InvalidArgument naming `owner`.grid.width / ...).
 gl::Handle createFroxelVolume(const FroxelGrid& grid, std::uint32_t format, const char* owner);
+/// The same as a 3D texture of `backend`.
+gpu::Texture createFroxelVolume(gpu::Backend& backend, const FroxelGrid& grid, std::uint32_t format,
+                                const char* owner);
 
 /// Rule 1 on the GPU: the ESM of a standard shadow map. Owns two R32F textures. Per frame, O(map texels).
 class EsmPass {
 public:
   struct CreateInfo {
     EsmOptions options;
+    gpu::Backend* backend = nullptr; ///< runs the pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
     /// GL_TEXTURE_2D of depth-buffer values in [0, 1] (a depth format or GL_R32F), read with texelFetch
@@ -80,14 +87,17 @@ public:
   explicit EsmPass(const CreateInfo& info);
   void run(const FrameAttribs& frame);
   /// R32F, ceil(W / f) x ceil(H / f): log-space depths (rule 1)
-  std::uint32_t esm() const noexcept { return esm_.get(); }
+  std::uint32_t esm() const noexcept { return esm_.id(); }
   int width() const noexcept { return width_; }
   int height() const noexcept { return height_; }
   std::size_t memoryBytes() const noexcept; ///< both R32F textures
 
 private:
   CreateInfo info_;
-  gl::Handle downsample_, blur_, params_, sampler_, esm_, scratch_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_;
+  gpu::Texture esm_, scratch_;
   int width_ = 0, height_ = 0;
 };
 
@@ -98,8 +108,9 @@ public:
     FroxelGrid grid;
     FroxelDensity density;
     glm::dvec3 ambient{0.0};
-    EsmOptions esm;                ///< exponent and bias of the test (the ESM's own build is EsmPass's)
-    std::uint32_t format = 0x881A; ///< GL_RGBA16F or GL_RGBA32F (0x8814)
+    EsmOptions esm;                  ///< exponent and bias of the test (the ESM's own build is EsmPass's)
+    std::uint32_t format = 0x881A;   ///< GL_RGBA16F or GL_RGBA32F (0x8814)
+    gpu::Backend* backend = nullptr; ///< runs the pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
@@ -118,7 +129,10 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle program_, params_, sampler_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_;
+  gpu::Texture unlit_; ///< a 1-texel stand-in bound when no ESM is given (never read)
 };
 
 /// Rule 3 on the GPU: the lighting volume integrated front to back, in place.
@@ -126,7 +140,8 @@ class FroxelAccumulatePass {
 public:
   struct CreateInfo {
     FroxelGrid grid;
-    std::uint32_t format = 0x881A; ///< GL_RGBA16F or GL_RGBA32F
+    std::uint32_t format = 0x881A;   ///< GL_RGBA16F or GL_RGBA32F
+    gpu::Backend* backend = nullptr; ///< runs the pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
@@ -142,7 +157,9 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle program_, params_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_;
 };
 
 /// Rule 5 on the GPU: the history reprojected, clamped and blended with the current volume.
@@ -150,7 +167,8 @@ class FroxelTemporalPass {
 public:
   struct CreateInfo {
     FroxelGrid grid;
-    std::uint32_t format = 0x881A; ///< of the output (GL_RGBA16F or GL_RGBA32F)
+    std::uint32_t format = 0x881A;   ///< of the output (GL_RGBA16F or GL_RGBA32F)
+    gpu::Backend* backend = nullptr; ///< runs the pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
@@ -169,7 +187,9 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle program_, params_, nearest_, linear_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_;
 };
 
 /// Rule 4 on the GPU: one trilinear fetch per pixel.
@@ -177,6 +197,7 @@ class FroxelApplyPass {
 public:
   struct CreateInfo {
     FroxelGrid grid;
+    gpu::Backend* backend = nullptr; ///< runs the pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
     const Camera* camera = nullptr;
@@ -192,7 +213,9 @@ public:
 
 private:
   CreateInfo info_;
-  gl::Handle program_, params_, nearest_, linear_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
+  gpu::Buffer params_;
 };
 
 /// The froxel fog of one view (Wronski 2014), one run() per frame: Esm mode (ESM, lighting, accumulation)
@@ -214,8 +237,10 @@ public:
     glm::dvec3 ambient{0.0}; ///< isotropic ambient radiance per channel, >= 0 (default 0)
     TemporalOptions temporal;
     std::uint32_t format = 0x881A; ///< GL_RGBA16F (default) or GL_RGBA32F
-    /// Per-stage GPU times with GL_TIME_ELAPSED queries (a stall per stage: tools only).
+    /// Per-stage GPU times with GL_TIME_ELAPSED queries (a stall per stage: tools only); other backends:
+    /// the wall clock to each stage's end.
     bool timings = false;
+    gpu::Backend* backend = nullptr; ///< runs every pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
     Mode mode = Mode::Esm;
@@ -245,7 +270,7 @@ public:
   /// Where Mode::Esm lights each cell: froxelJitter(frameIndex) in all three axes, or 0 (README).
   glm::dvec3 lightingJitter(int frameIndex) const;
   /// The volume the lighting and accumulation (or crep::Scattering's fill) write: GL_TEXTURE_3D.
-  std::uint32_t currentVolume() const noexcept { return current_.get(); }
+  std::uint32_t currentVolume() const noexcept { return current_.id(); }
   /// The integrated volume of the last run() (blended with temporal), sample offset 0, for the engine.
   std::uint32_t volume() const noexcept { return volume_; }
   std::size_t memoryBytes() const noexcept;
@@ -257,17 +282,19 @@ public:
 
 private:
   CreateInfo info_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr;
   EsmPass esm_;
   FroxelLightingPass lighting_;
   FroxelAccumulatePass accumulate_;
   FroxelTemporalPass temporal_;
   FroxelApplyPass apply_;
-  gl::Handle current_;
-  std::array<gl::Handle, 2> history_;
+  gpu::Texture current_;
+  std::array<gpu::Texture, 2> history_;
   int latest_ = -1; ///< index of history_ written last, -1 = none
   std::uint32_t volume_ = 0;
   Timings timings_;
-  gl::GpuTimer timer_;
+  std::optional<gl::GpuTimer> timer_; ///< GL: the stages' GL_TIME_ELAPSED
 };
 
 } // namespace crep
