@@ -343,6 +343,13 @@ gl::TextureLevel textureLevelOf(const Backend& backend, const char* parameter, T
   return level;
 }
 
+gl::TextureLevel requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture) {
+  if (backend.name() == "OpenGL") return gl::requireTexture2D(parameter, texture);
+  const gl::TextureLevel level = textureLevelOf(backend, parameter, texture);
+  requireTexture2DOf(backend, parameter, texture, level.width, level.height);
+  return level;
+}
+
 void requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture, int width,
                         int height, std::uint32_t format) {
   if (backend.name() == "OpenGL") return gl::requireTexture2D(parameter, texture, width, height, format);

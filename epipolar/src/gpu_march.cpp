@@ -63,14 +63,7 @@ void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWid
 
 void requireMinMaxBuffer(const gpu::Backend& backend, const char* parameter, std::uint32_t buffer,
                          int mapWidth, int mapHeight, const std::string& use) {
-  if (backend.name() == "OpenGL") return requireMinMaxBuffer(parameter, buffer, mapWidth, mapHeight, use);
-  if (buffer == 0) invalid(parameter, "0", treeBufferRequirement(use));
-  std::size_t size = 0;
-  try {
-    size = backend.bufferBytes(buffer);
-  } catch (const InvalidArgument&) {
-    invalid(parameter, std::to_string(buffer), treeBufferRequirement(use));
-  }
+  const std::size_t size = gpu::requireBufferOf(backend, parameter, buffer, treeBufferRequirement(use));
   requireTreeBytes(parameter, size, mapWidth, mapHeight);
 }
 
@@ -103,14 +96,9 @@ gpu::Dispatch MinMaxTreePass::dispatch(bool upperOnly, std::uint32_t rectifiedDe
 }
 
 void MinMaxTreePass::run(std::uint32_t rectifiedDepth) {
-  if (backend_->name() == "OpenGL") {
-    gl::requireTexture2D("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth,
-                         info_.mapHeight);
-    gl::requireDepthFormat("MinMaxTreePass::run.rectifiedDepth", rectifiedDepth);
-  } else {
-    gpu::requireTexture(*backend_, "MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth,
-                        info_.mapHeight, {gpu::Format::Depth32F, gpu::Format::R32F});
-  }
+  gpu::requireTexture2DOf(*backend_, "MinMaxTreePass::run.rectifiedDepth", rectifiedDepth, info_.mapWidth,
+                          info_.mapHeight);
+  gpu::requireDepthFormatOf(*backend_, "MinMaxTreePass::run.rectifiedDepth", rectifiedDepth);
   backend_->dispatch(dispatch(false, rectifiedDepth));
 }
 
@@ -193,8 +181,7 @@ RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::st
   if (list) {
     image = gpu::listImageSize(b, f.imageWidth, f.imageHeight, f.cameraDepth, std::string(owner));
   } else {
-    image = gpu::textureLevelOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
-    gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, image.width, image.height);
+    image = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   }
   plan.width = plan.outWidth = image.width;
   plan.height = plan.outHeight = image.height;

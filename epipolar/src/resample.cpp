@@ -173,21 +173,11 @@ ShadowResamplePass::Plan ShadowResamplePass::plan(const FrameAttribs& f, std::st
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
   Plan plan;
-  if (backend_->name() == "OpenGL") {
-    const gl::TextureLevel shadow = gl::requireTexture2D((p + "shadowMap").c_str(), f.shadowMap);
-    plan.shadowWidth = shadow.width;
-    plan.shadowHeight = shadow.height;
-    gl::requireDepthFormat((p + "shadowMap").c_str(), f.shadowMap);
-    gl::requireTexture2D((p + "output").c_str(), f.output, W, H, GL_R32F);
-  } else {
-    if (f.shadowMap == 0) invalid(p + "shadowMap", "0", "must be a texture");
-    const gpu::TextureDesc shadow = backend_->describe(f.shadowMap);
-    gpu::requireTexture(*backend_, (p + "shadowMap").c_str(), f.shadowMap, shadow.width, shadow.height,
-                        {gpu::Format::Depth32F, gpu::Format::R32F});
-    plan.shadowWidth = shadow.width;
-    plan.shadowHeight = shadow.height;
-    gpu::requireTexture(*backend_, (p + "output").c_str(), f.output, W, H, {gpu::Format::R32F});
-  }
+  const gl::TextureLevel shadow = gpu::requireTexture2DOf(*backend_, (p + "shadowMap").c_str(), f.shadowMap);
+  plan.shadowWidth = shadow.width;
+  plan.shadowHeight = shadow.height;
+  gpu::requireDepthFormatOf(*backend_, (p + "shadowMap").c_str(), f.shadowMap);
+  gpu::requireTexture2DOf(*backend_, (p + "output").c_str(), f.output, W, H, GL_R32F);
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
   if (f.minMaxBuffer != 0) {
     if (MinMaxTreePass::lowLevels(W) < 1)

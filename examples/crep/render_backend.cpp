@@ -35,20 +35,6 @@ void requireBackend(const std::string& backend, const std::string& method, const
 }
 
 #if CREP_HAS_VULKAN
-namespace {
-
-/// RGBA floats of a 3- or 4-channel image (alpha 1 when it has none).
-std::vector<float> rgbaOf(const Image& image) {
-  std::vector<float> out;
-  out.reserve(static_cast<std::size_t>(image.width()) * static_cast<std::size_t>(image.height()) * 4);
-  for (int y = 0; y < image.height(); ++y)
-    for (int x = 0; x < image.width(); ++x)
-      out.insert(out.end(), {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2),
-                             image.channels() == 4 ? image.at(x, y, 3) : 1.0f});
-  return out;
-}
-
-} // namespace
 
 MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const MethodSettings& settings) {
   const scenes::Scene& scene = *s.scene;
@@ -74,15 +60,6 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
   });
   gpu::VulkanBackend vk;
   const scenes::EngineFrame engine(vk, scene, maps);
-  gpu::Texture window; // the sun's light texture (stained-glass)
-  GpuLightTexture lightTexture;
-  if (scene.sunTexture) {
-    window =
-        gpu::Texture(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, scene.sunTexture->rgb.width(),
-                          scene.sunTexture->rgb.height(), 1, "crep render: light texture"});
-    vk.writeTexture(window.id(), rgbaOf(scene.sunTexture->rgb));
-    lightTexture = {window.id(), scene.sunTexture->textureClipFromWorld};
-  }
   gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, frame.width, frame.height, 1,
                            "crep render: scattering"});
   Scattering::CreateInfo info = frontDoorCreateInfo(frame, settings,
@@ -90,9 +67,7 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
                                                                        : Scattering::Method::Prefiltered);
   info.backend = &vk;
   Scattering scattering = out.timings.time("setup", [&] { return Scattering(info); });
-  Scattering::FrameAttribs a = engine.attribs(output.id());
-  if (scene.sunTexture && scene.hasSun) a.lightTexture = &lightTexture;
-  const Scattering::FrameResult r = scattering.run(a);
+  const Scattering::FrameResult r = scattering.run(engine.attribs(output.id()));
   for (const Scattering::Stage& stage : r.stages)
     out.timings.append({{stage.name, stage.wallMilliseconds}});
   // Back to GL for the composite (the tool's own passes).

@@ -147,14 +147,6 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   return info;
 }
 
-/// gl::requireTexture2D(parameter, texture) (any size) on any backend.
-gl::TextureLevel requireTexture2D(const gpu::Backend& backend, const char* parameter, std::uint32_t texture) {
-  if (backend.name() == "OpenGL") return gl::requireTexture2D(parameter, texture);
-  const gl::TextureLevel level = gpu::textureLevelOf(backend, parameter, texture);
-  gpu::requireTexture2DOf(backend, parameter, texture, level.width, level.height);
-  return level;
-}
-
 /// Throws unless every direction of `directions` from `position` is inside the map of M (in front of it, NDC
 /// x and y in [-1, 1] up to 1e-3): the map covers the light's cone or face sector.
 void requireCovers(const std::string& field, const glm::dmat4& M, const glm::dvec3& position,
@@ -176,7 +168,7 @@ void requireCovers(const std::string& field, const glm::dmat4& M, const glm::dve
 void validateLocalMap(const gpu::Backend& backend, const std::string& field, const Scattering::ShadowMap& map,
                       const glm::dvec3& position, std::span<const glm::dvec3> directions,
                       const std::string& what) {
-  requireTexture2D(backend, (field + ".texture").c_str(), map.texture);
+  gpu::requireTexture2DOf(backend, (field + ".texture").c_str(), map.texture);
   gpu::requireDepthFormatOf(backend, (field + ".texture").c_str(), map.texture);
   requireFinite(field + ".bias", map.bias);
   try {
@@ -668,7 +660,7 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
   validateLocalShadowMaps(b, f, p);
   validateLightTextures(b, f, info.evaluate, p);
   if (f.light && f.shadowMap) {
-    requireTexture2D(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
+    gpu::requireTexture2DOf(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
     gpu::requireDepthFormatOf(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
     requireFinite(p + "shadowMap.bias", f.shadowMap->bias);
     try {

@@ -178,8 +178,7 @@ std::size_t EsmPass::memoryBytes() const noexcept {
 void EsmPass::validate(const FrameAttribs& f, std::string_view owner) const {
   const std::string o(owner);
   const std::string map = name(o.c_str(), "shadowMap");
-  const gl::TextureLevel level = gpu::textureLevelOf(*backend_, map.c_str(), f.shadowMap);
-  gpu::requireTexture2DOf(*backend_, map.c_str(), f.shadowMap, level.width, level.height);
+  gpu::requireTexture2DOf(*backend_, map.c_str(), f.shadowMap);
   gpu::requireDepthFormatOf(*backend_, map.c_str(), f.shadowMap);
   requireFinite(name(o.c_str(), "lightClipFromWorld"), f.lightClipFromWorld);
 }
@@ -247,8 +246,7 @@ void FroxelLightingPass::validate(const FrameAttribs& f, std::string_view ownerN
   requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   if (f.esm != 0) {
     const std::string esmName = name(owner, "esm");
-    const gl::TextureLevel esm = gpu::textureLevelOf(*backend_, esmName.c_str(), f.esm);
-    gpu::requireTexture2DOf(*backend_, esmName.c_str(), f.esm, esm.width, esm.height);
+    const gl::TextureLevel esm = gpu::requireTexture2DOf(*backend_, esmName.c_str(), f.esm);
     if (esm.internalFormat != GL_R32F)
       invalid(esmName, "internal format " + std::to_string(esm.internalFormat),
               "must be GL_R32F (EsmPass::esm())");
@@ -387,8 +385,7 @@ void FroxelApplyPass::validate(const FrameAttribs& f, std::string_view ownerName
   const char* owner = o.c_str();
   if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   const std::string depthName = name(owner, "cameraDepth");
-  const gl::TextureLevel depth = gpu::textureLevelOf(*backend_, depthName.c_str(), f.cameraDepth);
-  gpu::requireTexture2DOf(*backend_, depthName.c_str(), f.cameraDepth, depth.width, depth.height);
+  const gl::TextureLevel depth = gpu::requireTexture2DOf(*backend_, depthName.c_str(), f.cameraDepth);
   gpu::requireTexture2DOf(*backend_, name(owner, "output").c_str(), f.output, depth.width, depth.height,
                           GL_RGBA32F);
   requireVolume(*backend_, name(owner, "volume"), f.volume, info_.grid, 0);
@@ -479,15 +476,13 @@ void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) cons
     invalid(name(owner, "light/medium"), "null", "must be set in Mode::Esm");
   if (f.output != 0) {
     const std::string depthName = name(owner, "cameraDepth");
-    const gl::TextureLevel depth = gpu::textureLevelOf(b, depthName.c_str(), f.cameraDepth);
-    gpu::requireTexture2DOf(b, depthName.c_str(), f.cameraDepth, depth.width, depth.height);
+    const gl::TextureLevel depth = gpu::requireTexture2DOf(b, depthName.c_str(), f.cameraDepth);
     gpu::requireTexture2DOf(b, name(owner, "output").c_str(), f.output, depth.width, depth.height,
                             GL_RGBA32F);
   }
   if (f.mode == Mode::Esm && f.shadowMap != 0) {
     const std::string mapName = name(owner, "shadowMap");
-    const gl::TextureLevel map = gpu::textureLevelOf(b, mapName.c_str(), f.shadowMap);
-    gpu::requireTexture2DOf(b, mapName.c_str(), f.shadowMap, map.width, map.height);
+    gpu::requireTexture2DOf(b, mapName.c_str(), f.shadowMap);
     requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
   if (f.mode == Mode::Prefiltered)

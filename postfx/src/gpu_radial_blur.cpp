@@ -66,8 +66,7 @@ void RadialBlurPass::validate(const FrameAttribs& f, std::string_view owner) con
   if (!f.light) invalid(p + "light", "null", "must be set");
   if (!f.medium) invalid(p + "medium", "null", "must be set");
   const gpu::Backend& b = *backend_;
-  const gl::TextureLevel depth = gpu::textureLevelOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
-  gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, depth.width, depth.height);
+  const gl::TextureLevel depth = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
 }

@@ -55,14 +55,12 @@ ShaderStageSource ToneMapPass::toneMapStage(bool rgba8) const {
 void ToneMapPass::validate(const FrameAttribs& f, std::string_view owner) const {
   const std::string p = std::string(owner) + ".";
   const gpu::Backend& b = *backend_;
-  const gl::TextureLevel in = gpu::textureLevelOf(b, (p + "input").c_str(), f.input);
-  gpu::requireTexture2DOf(b, (p + "input").c_str(), f.input, in.width, in.height);
+  const gl::TextureLevel in = gpu::requireTexture2DOf(b, (p + "input").c_str(), f.input);
   if (in.internalFormat != GL_RGBA32F && in.internalFormat != GL_RGBA16F)
     invalid(p + "input", "internal format " + std::to_string(in.internalFormat),
             "must be GL_RGBA32F or GL_RGBA16F");
   if (f.output == f.input) invalid(p + "output", std::to_string(f.output), "must not be the input texture");
-  const gl::TextureLevel out = gpu::textureLevelOf(b, (p + "output").c_str(), f.output);
-  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, out.width, out.height);
+  const gl::TextureLevel out = gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output);
   if (out.internalFormat != GL_RGBA8 && out.internalFormat != GL_RGBA32F)
     invalid(p + "output", "internal format " + std::to_string(out.internalFormat),
             "must be GL_RGBA8 or GL_RGBA32F");

@@ -352,18 +352,14 @@ void PrefilterPass::validate(const FrameAttribs& frame, std::string_view owner) 
 PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_view owner) const {
   const std::string f = std::string(owner) + ".";
   if (frame.layout == nullptr) invalid(f + "layout", "null", "must point to the map's layout");
-  if (backend_->name() == "OpenGL") {
-    const gl::TextureLevel depth = gl::textureLevel((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
-    if (depth.target != GL_TEXTURE_2D)
-      invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a GL_TEXTURE_2D");
-    gl::requireDepthFormat((f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
-    if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
-      invalid(f + "rectifiedDepth", sizeString(depth.width, depth.height),
-              "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
-  } else {
-    gpu::requireTexture(*backend_, (f + "rectifiedDepth").c_str(), frame.rectifiedDepth, info_.mapWidth,
-                        info_.mapHeight, {gpu::Format::Depth32F, gpu::Format::R32F});
-  }
+  const gl::TextureLevel depth =
+      gpu::textureLevelOf(*backend_, (f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
+  if (depth.target != GL_TEXTURE_2D)
+    invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a GL_TEXTURE_2D");
+  gpu::requireDepthFormatOf(*backend_, (f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
+  if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
+    invalid(f + "rectifiedDepth", sizeString(depth.width, depth.height),
+            "must be the created size " + sizeString(info_.mapWidth, info_.mapHeight));
   Plan p;
   p.extinction = frame.extinctionOverride;
   if (p.extinction < 0.0) {

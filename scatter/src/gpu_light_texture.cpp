@@ -39,9 +39,7 @@ gl::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightT
   if (backend.name() == "OpenGL") return validateGpuLightTexture(texture, light, localLight, field);
   const std::string f(field);
   const std::string textureField = f + ".texture";
-  const gl::TextureLevel level = textureLevelOf(backend, textureField.c_str(), texture.texture);
-  if (level.target != GL_TEXTURE_2D)
-    throw InvalidArgument(textureField, std::to_string(texture.texture), "must be a 2D texture");
+  const gl::TextureLevel level = requireTexture2DOf(backend, textureField.c_str(), texture.texture);
   if (level.internalFormat == GL_DEPTH_COMPONENT32F)
     throw InvalidArgument(textureField, std::to_string(texture.texture),
                           "must have a colour format (not depth)");

@@ -81,10 +81,7 @@ gl::TextureLevel listImageSize(const Backend& backend, int imageWidth, int image
                                std::uint32_t cameraDepth, const std::string& owner) {
   if (backend.name() == "OpenGL" || imageWidth != 0 || imageHeight != 0)
     return listImageSize(imageWidth, imageHeight, cameraDepth, owner);
-  const gl::TextureLevel level = textureLevelOf(backend, (owner + ".cameraDepth").c_str(), cameraDepth);
-  if (level.target != GL_TEXTURE_2D)
-    throw InvalidArgument(owner + ".cameraDepth", std::to_string(cameraDepth), "must be a 2D texture");
-  return level;
+  return requireTexture2DOf(backend, (owner + ".cameraDepth").c_str(), cameraDepth);
 }
 
 } // namespace crep::gpu

@@ -140,10 +140,8 @@ WorldMarchPass::Plan WorldMarchPass::plan(const FrameAttribs& f, std::string_vie
   // The image and map sizes are the textures' own.
   const gpu::Backend& b = *backend_;
   Plan plan;
-  plan.depth = gpu::textureLevelOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
-  plan.shadow = gpu::textureLevelOf(b, (p + "shadowMap").c_str(), f.shadowMap);
-  gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, plan.depth.width, plan.depth.height);
-  gpu::requireTexture2DOf(b, (p + "shadowMap").c_str(), f.shadowMap, plan.shadow.width, plan.shadow.height);
+  plan.depth = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  plan.shadow = gpu::requireTexture2DOf(b, (p + "shadowMap").c_str(), f.shadowMap);
   gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   gpu::requireDepthFormatOf(b, (p + "shadowMap").c_str(), f.shadowMap);
   const int width = plan.depth.width, height = plan.depth.height;

@@ -4,6 +4,7 @@
 // compared by relative RMSE and their largest difference; the trees of each backend are those of its map.
 // RectifiedMarchPass (min/max tree march with a block, brute force) then marches the same map on both.
 #include "common/gl_fixture.h"
+#include "common/vulkan_fixture.h"
 
 #include <crep/core/gl.h>
 #include <crep/core/gl_backend.h>
@@ -108,9 +109,7 @@ double relativeRmseRgb(const std::vector<float>& a, const std::vector<float>& b)
 
 TEST_CASE("backends agree: a scene's rectified map and trees on OpenGL and on Vulkan") {
   CREP_REQUIRE_GL();
-  gpu::VulkanBackend::CreateInfo info;
-  info.validation = true;
-  gpu::VulkanBackend vk(info);
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   gpu::GlBackend gl;
   const int width = 320, height = 180, S = 1024, W = 256;
   for (const std::string name : {"forest", "sunset", "colonnade"}) {
@@ -163,7 +162,5 @@ TEST_CASE("backends agree: a scene's rectified map and trees on OpenGL and on Vu
     CHECK(tree <= 1e-4);
     CHECK(brute <= 1e-4);
   }
-  const std::vector<std::string> messages = vk.validationMessages();
-  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
-                                                  << (messages.empty() ? "" : messages.front()));
+  crep::test::checkNoValidationMessages(vk);
 }

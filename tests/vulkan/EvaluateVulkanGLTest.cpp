@@ -11,12 +11,14 @@
 #include "common/local_light_scene.h"
 #include "common/prefilter_gpu.h"
 #include "common/sample_list_util.h"
+#include "common/vulkan_fixture.h"
 
 #include <crep/core/gl_backend.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/light_texture.h>
+#include <crep/scenes/engine_frame.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/vulkan/vulkan_backend.h>
@@ -59,15 +61,6 @@ struct Outputs {
   std::vector<float> image, volume, list; ///< RGBA floats of the output, the volume and the list's output
 };
 
-std::vector<float> rgbaOf(const Image& rgb) {
-  std::vector<float> out;
-  out.reserve(static_cast<std::size_t>(rgb.width()) * static_cast<std::size_t>(rgb.height()) * 4);
-  for (int y = 0; y < rgb.height(); ++y)
-    for (int x = 0; x < rgb.width(); ++x)
-      out.insert(out.end(), {rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2), 1.0f});
-  return out;
-}
-
 gpu::Texture upload(gpu::Backend& b, gpu::Format format, int w, int h, std::span<const float> texels,
                     const char* label) {
   gpu::Texture t(b, {gpu::TextureType::Texture2D, format, w, h, 1, label});
@@ -84,7 +77,7 @@ Outputs runOn(gpu::Backend& b, const Inputs& in, PrefilterPass::CreateInfo p, Ev
   const gpu::Texture depth = upload(b, gpu::Format::R32F, w, h, in.cameraDepth->data(), "camera depth");
   gpu::Texture colors;
   if (in.lightColors != nullptr)
-    colors = upload(b, gpu::Format::RGBA32F, W, H, rgbaOf(*in.lightColors), "light colours");
+    colors = upload(b, gpu::Format::RGBA32F, W, H, scenes::rgbaTexels(*in.lightColors), "light colours");
   p.mapWidth = W;
   p.mapHeight = H;
   p.backend = &b;
@@ -191,28 +184,16 @@ void checkBackendsAgree(const std::string& name, const Outputs& vk, const Output
   }
 }
 
+/// The RGBA texels of an evaluation image (4 channels), as a backend's RGBA32F read-back lays them out.
 std::vector<float> rgbaImage(const Image& image) {
-  std::vector<float> out;
-  for (int y = 0; y < image.height(); ++y)
-    for (int x = 0; x < image.width(); ++x)
-      out.insert(out.end(), {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2), image.at(x, y, 3)});
-  return out;
-}
-
-gpu::VulkanBackend::CreateInfo withValidation() {
-  gpu::VulkanBackend::CreateInfo info;
-  info.validation = true;
-  return info;
+  REQUIRE(image.channels() == 4);
+  return {image.data().begin(), image.data().end()};
 }
 
 struct Backends {
-  gpu::VulkanBackend vk{withValidation()};
+  gpu::VulkanBackend vk{validatedVulkan()};
   gpu::GlBackend gl;
-  ~Backends() {
-    const std::vector<std::string> messages = vk.validationMessages();
-    CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
-                                                    << (messages.empty() ? "" : messages.front()));
-  }
+  ~Backends() { checkNoValidationMessages(vk); }
 };
 
 } // namespace

@@ -5,6 +5,7 @@
 // al. 2002's log-average with adaptation, several operators, RGBA32F and RGBA8 outputs) on an HDR image. Bar:
 // relative RMSE <= 1e-4 between the backends, and for RGBA8 output at most one 8-bit step anywhere.
 #include "common/gl_fixture.h"
+#include "common/vulkan_fixture.h"
 
 #include <crep/core/gl_backend.h>
 #include <crep/postfx/gpu_froxel_fog.h>
@@ -26,12 +27,6 @@ using namespace crep;
 
 namespace {
 
-gpu::VulkanBackend::CreateInfo withValidation() {
-  gpu::VulkanBackend::CreateInfo info;
-  info.validation = true;
-  return info;
-}
-
 /// Relative RMSE of `a` against `b` over the RGB of RGBA floats; `largest` the largest |a - b|.
 double relativeRmse(const std::vector<float>& a, const std::vector<float>& b, double& largest) {
   REQUIRE(a.size() == b.size());
@@ -47,12 +42,6 @@ double relativeRmse(const std::vector<float>& a, const std::vector<float>& b, do
   return std::sqrt(squared / std::max(reference, 1e-30));
 }
 
-void checkNoValidationMessages(const gpu::VulkanBackend& vk) {
-  const std::vector<std::string> messages = vk.validationMessages();
-  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
-                                                  << (messages.empty() ? "" : messages.front()));
-}
-
 } // namespace
 
 TEST_CASE("Vulkan backend: RadialBlurPass gives GL's image in both modes (sunset, the sun in view)") {
@@ -60,7 +49,7 @@ TEST_CASE("Vulkan backend: RadialBlurPass gives GL's image in both modes (sunset
   constexpr int w = 160, h = 90;
   const scenes::Scene scene = scenes::makeScene("sunset", static_cast<double>(w) / h);
   const scenes::EngineMaps maps = scenes::renderEngineMaps(scene, w, h, 256, 64);
-  gpu::VulkanBackend vk(withValidation());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   gpu::GlBackend gl;
   for (const RadialBlurMode mode : {RadialBlurMode::SourceRadiance, RadialBlurMode::OcclusionFraction}) {
     const auto runOn = [&](gpu::Backend& b) {
@@ -82,7 +71,7 @@ TEST_CASE("Vulkan backend: RadialBlurPass gives GL's image in both modes (sunset
     CHECK(std::none_of(a.begin(), a.end(), [](float v) { return !std::isfinite(v); }));
     CHECK(e <= 1e-4);
   }
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE("Vulkan backend: ToneMapPass gives GL's display image and adaptation state") {
@@ -101,7 +90,7 @@ TEST_CASE("Vulkan backend: ToneMapPass gives GL's display image and adaptation s
       p[3] = 1.0f;
     }
   hdr[(30 * w + 10) * 4] = std::numeric_limits<float>::quiet_NaN();
-  gpu::VulkanBackend vk(withValidation());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   gpu::GlBackend gl;
   for (const ToneMapOperator op :
        {ToneMapOperator::Reinhard, ToneMapOperator::Uncharted2, ToneMapOperator::AdaptiveLogarithmic})
@@ -137,7 +126,7 @@ TEST_CASE("Vulkan backend: ToneMapPass gives GL's display image and adaptation s
       CHECK(a.state.valid == 1);
       CHECK(std::abs(a.state.adaptedLuminance - b.state.adaptedLuminance) <= 1e-5 * b.state.adaptedLuminance);
     }
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE(
@@ -147,7 +136,7 @@ TEST_CASE(
   constexpr int w = 128, h = 72;
   const scenes::Scene scene = scenes::makeScene("forest", static_cast<double>(w) / h);
   const scenes::EngineMaps maps = scenes::renderEngineMaps(scene, w, h, 512, 64);
-  gpu::VulkanBackend vk(withValidation());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   gpu::GlBackend gl;
   for (const FroxelFog::Mode mode : {FroxelFog::Mode::Esm, FroxelFog::Mode::Prefiltered}) {
     struct Result {
@@ -216,5 +205,5 @@ TEST_CASE(
     CHECK(e <= 1e-4);
     CHECK(v <= 1e-4);
   }
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }

@@ -5,6 +5,7 @@
 // backend's basis of the same map.
 #include "common/gl_fixture.h"
 #include "common/prefilter_gpu.h"
+#include "common/vulkan_fixture.h"
 
 #include <crep/core/gl.h>
 #include <crep/core/gl_backend.h>
@@ -47,9 +48,7 @@ std::vector<float> prefilterOn(gpu::Backend& backend, const GpuScene& s,
 TEST_CASE("Vulkan backend: PrefilterPass gives the CPU filtered basis in every storage format, as GL does") {
   CREP_REQUIRE_GL();
   const GpuScene s = renderGpuScene("boxes", kMapW, kMapH, kSplits, 161, 93);
-  gpu::VulkanBackend::CreateInfo vkInfo;
-  vkInfo.validation = true;
-  gpu::VulkanBackend vk(vkInfo);
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   gpu::GlBackend gl;
   for (const StorageFormat format : {StorageFormat::RGBA32F, StorageFormat::RGBA16F, StorageFormat::RGBA8}) {
     const std::string token = storageFormatToken(format);
@@ -76,7 +75,5 @@ TEST_CASE("Vulkan backend: PrefilterPass gives the CPU filtered basis in every s
     CHECK(d.over == 0);
     CHECK(relativeRmse <= 1e-4);
   }
-  const std::vector<std::string> messages = vk.validationMessages();
-  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
-                                                  << (messages.empty() ? "" : messages.front()));
+  crep::test::checkNoValidationMessages(vk);
 }

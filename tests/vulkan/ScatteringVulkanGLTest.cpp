@@ -6,6 +6,7 @@
 // spot added in view, from their perspective maps, no sun), and stained-glass (a light texture on the sun);
 // froxel volumes filled on the sunlit ones. Bar: relative RMSE <= 1e-4 between the backends' outputs.
 #include "common/gl_fixture.h"
+#include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gl_backend.h>
@@ -57,15 +58,6 @@ struct FrameOutput {
 };
 
 /// RGBA floats of a 3- or 4-channel image (alpha 1 when it has none).
-std::vector<float> rgbaOf(const Image& image) {
-  std::vector<float> out;
-  for (int y = 0; y < image.height(); ++y)
-    for (int x = 0; x < image.width(); ++x)
-      out.insert(out.end(), {image.at(x, y, 0), image.at(x, y, 1), image.at(x, y, 2),
-                             image.channels() == 4 ? image.at(x, y, 3) : 1.0f});
-  return out;
-}
-
 /// One frame of `in` through crep::Scattering on `b` (the engine's maps given, no drawCasters).
 FrameOutput frameOn(gpu::Backend& b, const EngineInputs& in, Scattering::CreateInfo info,
                     const FroxelGrid* grid = nullptr) {
@@ -77,16 +69,8 @@ FrameOutput frameOn(gpu::Backend& b, const EngineInputs& in, Scattering::CreateI
   info.backend = &b;
   Scattering scattering(info);
   Scattering::FrameAttribs f = engine.attribs(output.id());
-  // The scene's light texture (stained-glass), and a froxel volume filled from the same basis.
-  gpu::Texture window, volume;
-  GpuLightTexture lightTexture;
-  if (s.sunTexture) {
-    window = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, s.sunTexture->rgb.width(),
-                              s.sunTexture->rgb.height(), 1, "light texture"});
-    b.writeTexture(window.id(), rgbaOf(s.sunTexture->rgb));
-    lightTexture = {window.id(), s.sunTexture->textureClipFromWorld};
-    f.lightTexture = &lightTexture;
-  }
+  // A froxel volume filled from the same basis (the scene's light texture comes with the engine frame).
+  gpu::Texture volume;
   Scattering::FroxelTarget froxels;
   if (grid != nullptr) {
     volume = gpu::Texture(b, {gpu::TextureType::Texture3D, gpu::Format::RGBA16F, grid->width, grid->height,
@@ -118,18 +102,12 @@ double relativeRmse(const std::vector<float>& a, const std::vector<float>& b, lo
   return std::sqrt(squared / reference);
 }
 
-gpu::VulkanBackend::CreateInfo withValidation() {
-  gpu::VulkanBackend::CreateInfo info;
-  info.validation = true;
-  return info;
-}
-
 } // namespace
 
 TEST_CASE("Vulkan backend: crep::Scattering gives GL's frame on forest, sunset (sun in view) and "
           "colonnade-night (local lights)") {
   CREP_REQUIRE_GL();
-  gpu::VulkanBackend vk(withValidation());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   gpu::GlBackend gl;
   FroxelGrid grid;
   grid.width = 40;
@@ -172,7 +150,5 @@ TEST_CASE("Vulkan backend: crep::Scattering gives GL's frame on forest, sunset (
       }
     }
   }
-  const std::vector<std::string> messages = vk.validationMessages();
-  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages, the first: "
-                                                  << (messages.empty() ? "" : messages.front()));
+  crep::test::checkNoValidationMessages(vk);
 }

@@ -3,6 +3,7 @@
 // references as they do on GL, bad input is named (the backend's and EvaluatePass's), and the validation
 // layer reports nothing.
 #include "common/map_agreement.h"
+#include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
 #include <crep/core/gpu_backend.h>
@@ -32,21 +33,6 @@ using crep::test::checkResampledMap;
 
 namespace {
 
-gpu::VulkanBackend::CreateInfo validated() {
-  gpu::VulkanBackend::CreateInfo info;
-  info.validation = true;
-  return info;
-}
-
-/// No warning or error of the validation layer so far.
-void checkNoValidationMessages(const gpu::VulkanBackend& vk) {
-  const std::vector<std::string> messages = vk.validationMessages();
-  std::string all;
-  for (const std::string& m : messages)
-    all += "\n" + m;
-  CHECK_MESSAGE(messages.empty(), messages.size() << " validation messages:" << all);
-}
-
 std::vector<float> pattern(std::size_t n, int seed) {
   std::vector<float> v(n);
   for (std::size_t i = 0; i < n; ++i)
@@ -57,7 +43,7 @@ std::vector<float> pattern(std::size_t n, int seed) {
 } // namespace
 
 TEST_CASE("Vulkan backend: buffers and textures of every format and type round-trip exactly") {
-  gpu::VulkanBackend vk(validated());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   MESSAGE("device: " << vk.deviceName());
   CHECK(vk.maxTextureSize() >= 4096);
 
@@ -99,11 +85,11 @@ TEST_CASE("Vulkan backend: buffers and textures of every format and type round-t
     const gpu::TextureDesc d = vk.describe(t.id());
     CHECK((d.width == 13 && d.height == 7 && d.depth == c.depth && d.format == c.format && d.type == c.type));
   }
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE("Vulkan backend: MinMaxTreePass, written once for every backend, gives the CPU trees bit for bit") {
-  gpu::VulkanBackend vk(validated());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   // A width that is not a power of two, and rows of 10 levels (the build's two phases).
   for (const auto& [W, H] : {std::pair{200, 5}, std::pair{1024, 3}, std::pair{1000, 3}}) {
     CAPTURE(W);
@@ -128,11 +114,11 @@ TEST_CASE("Vulkan backend: MinMaxTreePass, written once for every backend, gives
       }
     }
   }
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE("Vulkan backend: bad input is named") {
-  gpu::VulkanBackend vk(validated());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   CHECK_THROWS_WITH_AS(vk.createTexture({gpu::TextureType::Texture2D, gpu::Format::R32F, 0, 4, 1, ""}),
                        doctest::Contains("gpu::TextureDesc.width/height"), InvalidArgument);
   CHECK_THROWS_WITH_AS(vk.createTexture({gpu::TextureType::Texture2D, gpu::Format::R32F, 1 << 20, 4, 1, ""}),
@@ -153,12 +139,12 @@ TEST_CASE("Vulkan backend: bad input is named") {
   CHECK_THROWS_WITH_AS(MinMaxTreePass({.mapWidth = -1, .mapHeight = 4, .backend = &vk}),
                        doctest::Contains("MinMaxTreePass::CreateInfo.mapWidth/mapHeight"), InvalidArgument);
   CHECK_THROWS_AS(vk.prepareProgram("passes/does/not_exist.comp", {}), ShaderError);
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE("Vulkan backend: ShadowResamplePass matches the CPU resampling, and its fused tree levels "
           "MinMaxTreePass") {
-  gpu::VulkanBackend vk(validated());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   const scenes::Scene scene = scenes::makeScene("colonnade", 16.0 / 9.0);
   const glm::dmat4 lightMatrix =
       scenes::standardLightClipFromWorld(scene.sun, scene.boundsMin, scene.boundsMax);
@@ -215,11 +201,11 @@ TEST_CASE("Vulkan backend: ShadowResamplePass matches the CPU resampling, and it
   bad.output = shadowTexture.id(); // a depth texture of another size
   CHECK_THROWS_WITH_AS(pass.run(bad), doctest::Contains("ShadowResamplePass::FrameAttribs.output"),
                        InvalidArgument);
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE("Vulkan backend: EvaluatePass names the field of a texture or buffer it cannot use") {
-  gpu::VulkanBackend vk(validated());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   const scenes::Scene scene = scenes::makeScene("boxes", 16.0 / 9.0);
   RectifyOptions ro;
   ro.splits = 2;
@@ -280,11 +266,11 @@ TEST_CASE("Vulkan backend: EvaluatePass names the field of a texture or buffer i
   EvaluatePass moved = std::move(pass);
   CHECK_THROWS_WITH_AS(pass.run(f), doctest::Contains("EvaluatePass"), InvalidArgument);
   moved.run(f);
-  checkNoValidationMessages(vk);
+  crep::test::checkNoValidationMessages(vk);
 }
 
 TEST_CASE("Vulkan backend: crep::Scattering names what needs the OpenGL backend") {
-  gpu::VulkanBackend vk(validated());
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
   Scattering::CreateInfo info;
   info.width = 64;
   info.height = 32;
@@ -323,6 +309,5 @@ TEST_CASE("Vulkan backend: crep::Scattering names what needs the OpenGL backend"
   f.output = 12345; // no texture of this backend (say, a GL name)
   CHECK_THROWS_WITH_AS(scattering.run(f), doctest::Contains("Scattering::FrameAttribs.output"),
                        InvalidArgument);
-  const std::vector<std::string> messages = vk.validationMessages();
-  CHECK(messages.empty());
+  crep::test::checkNoValidationMessages(vk);
 }

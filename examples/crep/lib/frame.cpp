@@ -5,6 +5,7 @@
 #include <crep/core/error.h>
 #include <crep/core/gl_state.h>
 #include <crep/epipolar/resample.h>
+#include <crep/scenes/engine_frame.h>
 #include <crep/scenes/scene_renderer.h>
 
 #include <epoxy/gl.h>
@@ -19,14 +20,7 @@ LightTextureMap makeLightTextureMap(Image rgb, const glm::dmat4& textureClipFrom
   LightTextureMap m;
   m.textureClipFromWorld = textureClipFromWorld;
   m.texture = gl::createTexture2D(GL_RGBA32F, rgb.width(), rgb.height(), parameter);
-  std::vector<float> rgba(rgb.pixelCount() * 4, 1.0f);
-  for (int y = 0; y < rgb.height(); ++y)
-    for (int x = 0; x < rgb.width(); ++x)
-      for (int c = 0; c < 3; ++c)
-        rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(rgb.width()) +
-              static_cast<std::size_t>(x)) *
-                 4 +
-             static_cast<std::size_t>(c)] = rgb.at(x, y, c);
+  const std::vector<float> rgba = scenes::rgbaTexels(rgb);
   const gl::PixelStoreScope pixelStore;
   glTextureSubImage2D(m.texture.get(), 0, 0, 0, rgb.width(), rgb.height(), GL_RGBA, GL_FLOAT, rgba.data());
   m.image = std::move(rgb);

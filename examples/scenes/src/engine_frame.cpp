@@ -4,6 +4,16 @@
 
 namespace crep::scenes {
 
+std::vector<float> rgbaTexels(const Image& rgb) {
+  std::vector<float> out(rgb.pixelCount() * 4, 1.0f);
+  float* p = out.data();
+  for (int y = 0; y < rgb.height(); ++y)
+    for (int x = 0; x < rgb.width(); ++x, p += 4)
+      for (int c = 0; c < 3; ++c)
+        p[c] = rgb.at(x, y, c);
+  return out;
+}
+
 EngineMaps renderEngineMaps(const Scene& s, int width, int height, int sunMapSize, int localMapSize) {
   EngineMaps m;
   SceneRenderer renderer(s.mesh);
@@ -38,6 +48,13 @@ EngineFrame::EngineFrame(gpu::Backend& b, const Scene& scene, const EngineMaps& 
   if (scene.hasSun) {
     sun_ = depthTexture(b, m.sunMap, "engine frame: sun map");
     sunMap_ = {sun_.id(), m.sunClipFromWorld, m.sunBias};
+    if (scene.sunTexture) {
+      const Image& rgb = scene.sunTexture->rgb;
+      window_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, rgb.width(), rgb.height(),
+                                 1, "engine frame: light texture"});
+      b.writeTexture(window_.id(), rgbaTexels(rgb));
+      lightTexture_ = {window_.id(), scene.sunTexture->textureClipFromWorld};
+    }
   }
   locals_.reserve(m.spotMaps.size() + m.pointMaps.size());
   for (std::size_t i = 0; i < m.spotMaps.size(); ++i) {
@@ -63,6 +80,7 @@ Scattering::FrameAttribs EngineFrame::attribs(std::uint32_t output) const {
   f.pointLights = scene_.pointLights;
   f.spotShadowMaps = spotMaps_;
   f.pointShadowMaps = pointMaps_;
+  if (lightTexture_.texture != 0) f.lightTexture = &lightTexture_;
   return f;
 }
 

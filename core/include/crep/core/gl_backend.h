@@ -51,6 +51,8 @@ Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own);
 
 /// Level 0 of `texture` (gl::textureLevel).
 gl::TextureLevel textureLevelOf(const Backend& backend, const char* parameter, TextureId texture);
+/// gl::requireTexture2D(parameter, texture) on any backend: a 2D texture of any size; returns its level 0.
+gl::TextureLevel requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture);
 /// gl::requireTexture2D(parameter, texture, width, height, internalFormat) on any backend.
 void requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture, int width,
                         int height, std::uint32_t internalFormat = 0);

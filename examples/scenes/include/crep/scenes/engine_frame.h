@@ -11,6 +11,7 @@
 #include <crep/core/gpu_backend.h>
 #include <crep/core/image.h>
 #include <crep/pipeline/scattering.h>
+#include <crep/scatter/gpu_light_texture.h>
 #include <crep/scenes/scene.h>
 
 namespace crep::scenes {
@@ -26,20 +27,27 @@ struct EngineMaps {
   double localBias = 1e-4;          ///< the same for the local lights' maps
 };
 
+/// The RGBA floats a backend's RGBA32F texture takes of an image's RGB (channels 0-2 of 3 or 4), A = 1, row 0
+/// at the bottom.
+std::vector<float> rgbaTexels(const Image& rgb);
+
 /// Renders the maps with GL (needs a current context). Sizes > 0.
 EngineMaps renderEngineMaps(const Scene& scene, int width, int height, int sunMapSize, int localMapSize);
 
-/// The maps as Depth32F textures of `backend` (kept for its lifetime), and the frame over them.
+/// The maps as Depth32F textures of `backend` (kept for its lifetime), the scene's light texture (if any) as
+/// an RGBA32F one, and the frame over them.
 class EngineFrame {
 public:
   EngineFrame(gpu::Backend& backend, const Scene& scene, const EngineMaps& maps);
   /// The frame's attributes writing `output` (RGBA32F, the camera depth's size, a texture of the backend):
-  /// camera, sun and medium of the scene, the maps as shadowMap / spotShadowMaps / pointShadowMaps.
+  /// camera, sun and medium of the scene, the maps as shadowMap / spotShadowMaps / pointShadowMaps, the
+  /// sun's light texture when the scene has one.
   Scattering::FrameAttribs attribs(std::uint32_t output) const;
 
 private:
   const Scene& scene_;
-  gpu::Texture depth_, sun_;
+  gpu::Texture depth_, sun_, window_;
+  GpuLightTexture lightTexture_; ///< window_ and its projection; texture 0 without one
   std::vector<gpu::Texture> locals_;
   Scattering::ShadowMap sunMap_;
   std::vector<Scattering::ShadowMap> spotMaps_, pointMaps_;
