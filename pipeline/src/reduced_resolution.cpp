@@ -1,6 +1,7 @@
 // Reduced-resolution evaluation: checkerboard min/max depth downsample and depth-aware upsample
-// (crep/pipeline/reduced_resolution.h), CPU reference and GL pass.
+// (crep/pipeline/reduced_resolution.h), CPU reference and the pass on a gpu::Backend.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -13,6 +14,8 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace crep {
 
@@ -94,39 +97,71 @@ Image depthAwareUpsample(const Image& low, const Image& lowDepth, const Image& f
   return out;
 }
 
+namespace {
+ShaderStageSource downsampleStage(int factor) {
+  return {ShaderStage::Compute,
+          "passes/pipeline/depth_downsample.comp",
+          {{"CREP_FACTOR", std::to_string(factor)}}};
+}
+ShaderStageSource upsampleStage(int factor) {
+  return {ShaderStage::Compute,
+          "passes/pipeline/depth_upsample.comp",
+          {{"CREP_FACTOR", std::to_string(factor)},
+           {"CREP_DEPTH_EPSILON", std::to_string(kUpsampleDepthEpsilon)}}};
+}
+void dispatch(gpu::Backend& b, const char* label, const ShaderStageSource& stage,
+              std::vector<gpu::Resource> resources, std::vector<gpu::PushValue> push, int width, int height) {
+  gpu::Dispatch d;
+  d.label = label;
+  d.program = stage.path;
+  d.defines = stage.defines;
+  d.resources = std::move(resources);
+  d.push = std::move(push);
+  d.groups = glm::uvec3(static_cast<unsigned>((width + 7) / 8), static_cast<unsigned>((height + 7) / 8), 1u);
+  b.dispatch(d);
+}
+} // namespace
+
 DepthAwareResamplePass::DepthAwareResamplePass(const CreateInfo& info) : info_(info) {
   checkFactor("DepthAwareResamplePass::CreateInfo.factor", info.factor);
   checkMultiple("DepthAwareResamplePass::CreateInfo.width/height", info.width, info.height, info.factor);
-  gl::checkTextureSize("DepthAwareResamplePass::CreateInfo.width/height", info.width, info.height);
-  const std::string f = std::to_string(info.factor);
-  downsampleProgram_ =
-      buildProgram({{ShaderStage::Compute, "passes/pipeline/depth_downsample.comp", {{"CREP_FACTOR", f}}}});
-  upsampleProgram_ =
-      buildProgram({{ShaderStage::Compute,
-                     "passes/pipeline/depth_upsample.comp",
-                     {{"CREP_FACTOR", f}, {"CREP_DEPTH_EPSILON", std::to_string(kUpsampleDepthEpsilon)}}}});
-  sampler_ = gl::createClampSampler(GL_NEAREST);
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::checkTextureSize(*backend_, "DepthAwareResamplePass::CreateInfo.width/height", info.width,
+                        info.height);
+  for (const ShaderStageSource& stage : {downsampleStage(info.factor), upsampleStage(info.factor)})
+    backend_->prepareProgram(stage.path, stage.defines);
 }
 
 DepthAwareResamplePass::~DepthAwareResamplePass() = default;
-DepthAwareResamplePass::DepthAwareResamplePass(DepthAwareResamplePass&&) noexcept = default;
-DepthAwareResamplePass& DepthAwareResamplePass::operator=(DepthAwareResamplePass&&) noexcept = default;
+DepthAwareResamplePass::DepthAwareResamplePass(DepthAwareResamplePass&& o) noexcept
+    : info_(o.info_), ownBackend_(std::move(o.ownBackend_)), backend_(std::exchange(o.backend_, nullptr)) {}
+DepthAwareResamplePass& DepthAwareResamplePass::operator=(DepthAwareResamplePass&& o) noexcept {
+  if (this != &o) {
+    info_ = o.info_;
+    ownBackend_ = std::move(o.ownBackend_);
+    backend_ = std::exchange(o.backend_, nullptr);
+  }
+  return *this;
+}
+
+void DepthAwareResamplePass::requireConstructed() const {
+  if (backend_ == nullptr)
+    invalid("DepthAwareResamplePass", "a moved-from object",
+            "owns no GL objects: assign a constructed one first");
+}
 
 void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t lowDepth) {
-  gl::requireNotMovedFrom(sampler_, "DepthAwareResamplePass");
-  gl::requireTexture2D("DepthAwareResamplePass::downsample.fullDepth", fullDepth, info_.width, info_.height);
-  gl::requireDepthFormat("DepthAwareResamplePass::downsample.fullDepth", fullDepth);
-  gl::requireTexture2D("DepthAwareResamplePass::downsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
-                       GL_R32F);
-  glUseProgram(downsampleProgram_.get());
-  glProgramUniform2i(downsampleProgram_.get(), 0, lowWidth(), lowHeight());
-  glBindTextureUnit(CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT, fullDepth);
-  glBindSampler(CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT, sampler_.get());
-  glBindImageTexture(CREP_DEPTH_DOWNSAMPLE_LOW_DEPTH_IMAGE, lowDepth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(static_cast<GLuint>((lowWidth() + 7) / 8), static_cast<GLuint>((lowHeight() + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(1);
-  gl::checkError("DepthAwareResamplePass::downsample");
+  requireConstructed();
+  gpu::Backend& b = *backend_;
+  gpu::requireTexture2DOf(b, "DepthAwareResamplePass::downsample.fullDepth", fullDepth, info_.width,
+                          info_.height);
+  gpu::requireDepthFormatOf(b, "DepthAwareResamplePass::downsample.fullDepth", fullDepth);
+  gpu::requireTexture2DOf(b, "DepthAwareResamplePass::downsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
+                          GL_R32F);
+  dispatch(b, "DepthAwareResamplePass::downsample", downsampleStage(info_.factor),
+           {gpu::Resource::sampled(CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT, fullDepth),
+            gpu::Resource::image(CREP_DEPTH_DOWNSAMPLE_LOW_DEPTH_IMAGE, lowDepth, gpu::Access::WriteOnly)},
+           {gpu::PushValue::of(0, glm::ivec2(lowWidth(), lowHeight()))}, lowWidth(), lowHeight());
 }
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
@@ -145,31 +180,25 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, const glm::vec4& depthMap) {
-  gl::requireNotMovedFrom(sampler_, "DepthAwareResamplePass");
-  gl::requireTexture2D("DepthAwareResamplePass::upsample.low", low, lowWidth(), lowHeight(), GL_RGBA32F);
-  gl::requireTexture2D("DepthAwareResamplePass::upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
-                       GL_R32F);
-  gl::requireTexture2D("DepthAwareResamplePass::upsample.fullDepth", fullDepth, info_.width, info_.height);
-  gl::requireDepthFormat("DepthAwareResamplePass::upsample.fullDepth", fullDepth);
-  gl::requireTexture2D("DepthAwareResamplePass::upsample.output", output, info_.width, info_.height,
-                       GL_RGBA32F);
-  const GLuint p = upsampleProgram_.get();
-  glUseProgram(p);
-  glProgramUniform4i(p, 0, info_.width, info_.height, lowWidth(), lowHeight());
-  glProgramUniform4f(p, 1, depthMap.x, depthMap.y, depthMap.z, depthMap.w);
-  const std::pair<GLuint, GLuint> textures[3] = {{CREP_DEPTH_UPSAMPLE_LOW_UNIT, low},
-                                                 {CREP_DEPTH_UPSAMPLE_LOW_DEPTH_UNIT, lowDepth},
-                                                 {CREP_DEPTH_UPSAMPLE_FULL_DEPTH_UNIT, fullDepth}};
-  for (const auto& [unit, texture] : textures) {
-    glBindTextureUnit(unit, texture);
-    glBindSampler(unit, sampler_.get());
-  }
-  glBindImageTexture(CREP_DEPTH_UPSAMPLE_OUTPUT_IMAGE, output, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((info_.width + 7) / 8), static_cast<GLuint>((info_.height + 7) / 8),
-                    1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(3);
-  gl::checkError("DepthAwareResamplePass::upsample");
+  requireConstructed();
+  gpu::Backend& b = *backend_;
+  gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.low", low, lowWidth(), lowHeight(),
+                          GL_RGBA32F);
+  gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
+                          GL_R32F);
+  gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.fullDepth", fullDepth, info_.width,
+                          info_.height);
+  gpu::requireDepthFormatOf(b, "DepthAwareResamplePass::upsample.fullDepth", fullDepth);
+  gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.output", output, info_.width, info_.height,
+                          GL_RGBA32F);
+  dispatch(b, "DepthAwareResamplePass::upsample", upsampleStage(info_.factor),
+           {gpu::Resource::sampled(CREP_DEPTH_UPSAMPLE_LOW_UNIT, low),
+            gpu::Resource::sampled(CREP_DEPTH_UPSAMPLE_LOW_DEPTH_UNIT, lowDepth),
+            gpu::Resource::sampled(CREP_DEPTH_UPSAMPLE_FULL_DEPTH_UNIT, fullDepth),
+            gpu::Resource::image(CREP_DEPTH_UPSAMPLE_OUTPUT_IMAGE, output, gpu::Access::WriteOnly)},
+           {gpu::PushValue::of(0, glm::ivec4(info_.width, info_.height, lowWidth(), lowHeight())),
+            gpu::PushValue::of(1, depthMap)},
+           info_.width, info_.height);
 }
 
 } // namespace crep

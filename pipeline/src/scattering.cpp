@@ -129,9 +129,6 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     if (info.sampling != Scattering::Sampling::PerPixel)
       invalid("Scattering::CreateInfo.sampling", "Sampling::Epipolar",
               "needs the OpenGL backend (EpipolarSamplingPass is not on the backend seam yet)");
-    if (factor != 1)
-      invalid("Scattering::CreateInfo.evaluationScale", detail::formatValue(info.evaluationScale),
-              "must be 1 on a backend other than OpenGL (DepthAwareResamplePass is not on the seam yet)");
   }
   if (info.sampling == Scattering::Sampling::Epipolar) {
     validate(info.epipolarSampling, "Scattering::CreateInfo.epipolarSampling");
@@ -377,10 +374,13 @@ struct Scattering::Impl {
       sampling.emplace(EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling});
     const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
     if (factor > 1) {
-      reduced.emplace(DepthAwareResamplePass::CreateInfo{i.width, i.height, factor});
-      lowDepth = gl::createTexture2D(GL_R32F, reduced->lowWidth(), reduced->lowHeight(), "reduced depth");
-      lowOutput =
-          gl::createTexture2D(GL_RGBA32F, reduced->lowWidth(), reduced->lowHeight(), "reduced output");
+      reduced.emplace(DepthAwareResamplePass::CreateInfo{i.width, i.height, factor, backend});
+      const auto low = [&](gpu::Format format, const char* label) {
+        return gpu::Texture(*backend, {gpu::TextureType::Texture2D, format, reduced->lowWidth(),
+                                       reduced->lowHeight(), 1, label});
+      };
+      lowDepth = low(gpu::Format::R32F, "Scattering: reduced depth");
+      lowOutput = low(gpu::Format::RGBA32F, "Scattering: reduced output");
     }
   }
 
@@ -396,7 +396,7 @@ struct Scattering::Impl {
   gpu::Texture resampled;                        ///< R32F: a map resampled from a standard shadow map
   std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
-  gl::Handle lowDepth, lowOutput;                ///< its camera depth (R32F) and scattering (RGBA32F)
+  gpu::Texture lowDepth, lowOutput;              ///< its camera depth (R32F) and scattering (RGBA32F)
   /// Method::MinMaxMarch, or the prefiltered method's tree-marched epipole block: the map's trees ...
   std::optional<MinMaxTreePass> trees;
   std::optional<RectifiedMarchPass> march;      ///< ... and the tree march
@@ -821,10 +821,10 @@ void Scattering::Impl::evaluateRays(const FrameAttribs& f, const DirectionalMap&
 
 // The per-pixel output: every pixel (at evaluationScale), or epipolar sampling's samples and corrections.
 void Scattering::Impl::evaluatePixels(const FrameAttribs& f, FrameResult& r, const DirectionalMap& d) {
-  if (reduced) stage(r, "downsample depth", [&] { reduced->downsample(f.cameraDepth, lowDepth.get()); });
+  if (reduced) stage(r, "downsample depth", [&] { reduced->downsample(f.cameraDepth, lowDepth.id()); });
   if (!sampling)
     stage(r, marching() ? "march" : "evaluate", [&] {
-      evaluateRays(f, d, reduced ? lowDepth.get() : f.cameraDepth, reduced ? lowOutput.get() : f.output,
+      evaluateRays(f, d, reduced ? lowDepth.id() : f.cameraDepth, reduced ? lowOutput.id() : f.output,
                    nullptr, false);
     });
   if (sampling) {
@@ -850,7 +850,7 @@ void Scattering::Impl::evaluatePixels(const FrameAttribs& f, FrameResult& r, con
   }
   if (reduced)
     stage(r, "upsample",
-          [&] { reduced->upsample(lowOutput.get(), lowDepth.get(), f.cameraDepth, f.output, *f.camera); });
+          [&] { reduced->upsample(lowOutput.id(), lowDepth.id(), f.cameraDepth, f.output, *f.camera); });
 }
 
 // Fig. 8: the pixels next to the epipole, where the slices converge and the prefilter's weights, exact for

@@ -152,3 +152,32 @@ TEST_CASE("Vulkan backend: crep::Scattering gives GL's frame on forest, sunset (
   }
   crep::test::checkNoValidationMessages(vk);
 }
+
+TEST_CASE("Vulkan backend: crep::Scattering at a reduced evaluation scale gives GL's frame") {
+  CREP_REQUIRE_GL();
+  gpu::VulkanBackend vk(crep::test::validatedVulkan());
+  gpu::GlBackend gl;
+  for (const std::string name : {"forest", "sunset"}) {
+    const EngineInputs in = renderInputs(name);
+    for (const double scale : {0.5, 0.25}) {
+      CAPTURE(name);
+      CAPTURE(scale);
+      Scattering::CreateInfo info;
+      info.mapSize = 512;
+      info.evaluationScale = scale;
+      const FrameOutput a = frameOn(vk, in, info), b = frameOn(gl, in, info);
+      long long nonFinite = 0;
+      const double e = relativeRmse(a.rgba, b.rgba, nonFinite);
+      bool upsampled = false;
+      for (const Scattering::Stage& st : a.result.stages)
+        upsampled = upsampled || st.name == "upsample";
+      MESSAGE(name << ", evaluationScale " << scale << ", " << std::string(layoutToken(a.result.layout))
+                   << ": Vulkan vs GL relative RMSE " << e << ", " << nonFinite << " non-finite");
+      CHECK(upsampled);
+      CHECK(nonFinite == 0);
+      CHECK(e <= 1e-4);
+      CHECK(a.result.stages.size() == b.result.stages.size());
+    }
+  }
+  crep::test::checkNoValidationMessages(vk);
+}

@@ -281,10 +281,6 @@ TEST_CASE("Vulkan backend: crep::Scattering names what needs the OpenGL backend"
     epipolar.sampling = Scattering::Sampling::Epipolar;
     CHECK_THROWS_WITH_AS(Scattering{epipolar}, doctest::Contains("Scattering::CreateInfo.sampling"),
                          InvalidArgument);
-    Scattering::CreateInfo reduced = info;
-    reduced.evaluationScale = 0.5;
-    CHECK_THROWS_WITH_AS(Scattering{reduced}, doctest::Contains("Scattering::CreateInfo.evaluationScale"),
-                         InvalidArgument);
   }
   Scattering scattering(info);
   const scenes::Scene scene = scenes::makeScene("forest", 2.0);

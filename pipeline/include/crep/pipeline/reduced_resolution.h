@@ -7,7 +7,10 @@
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/image.h>
+
+#include <memory>
 
 namespace crep {
 
@@ -23,13 +26,15 @@ Image downsampleDepth(const Image& depth, int factor);
 Image depthAwareUpsample(const Image& low, const Image& lowDepth, const Image& fullDepth,
                          const Camera& camera, int factor);
 
-/// The GL pass (fixed full size and factor). Requires a current OpenGL 4.5 context, never owns one; leaves
-/// program 0, texture units 0-2 and image unit 0 unbound, and issues the barriers its outputs need.
+/// The GPU pass (fixed full size and factor) on a gpu::Backend. On OpenGL it needs a current 4.5 context and
+/// never owns one; it leaves program 0, texture units 0-2 and image unit 0 unbound.
 class DepthAwareResamplePass {
 public:
   struct CreateInfo {
     int width = 0, height = 0; ///< full resolution, pixels; multiples of factor
     int factor = 2;            ///< 2 or 4
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   /// Throws InvalidArgument naming the field ("DepthAwareResamplePass::CreateInfo.factor", ...).
   explicit DepthAwareResamplePass(const CreateInfo& info);
@@ -43,7 +48,8 @@ public:
   int lowWidth() const noexcept { return info_.width / info_.factor; }
   int lowHeight() const noexcept { return info_.height / info_.factor; }
 
-  /// fullDepth (width x height depth texture) -> lowDepth (R32F, lowWidth x lowHeight). Per frame, O(pixels).
+  /// fullDepth (width x height depth texture, or R32F) -> lowDepth (R32F, lowWidth x lowHeight). Per frame,
+  /// O(pixels). Textures are ids of the backend (GL names on OpenGL).
   void downsample(std::uint32_t fullDepth, std::uint32_t lowDepth);
   /// low (RGBA32F), lowDepth, fullDepth -> output (RGBA32F, full size); depths in `camera`'s convention.
   void upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth, std::uint32_t output,
@@ -55,8 +61,10 @@ public:
 private:
   void upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth, std::uint32_t output,
                 const glm::vec4& depthMap);
+  void requireConstructed() const;
   CreateInfo info_;
-  gl::Handle downsampleProgram_, upsampleProgram_, sampler_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr; ///< null when moved from
 };
 
 } // namespace crep
