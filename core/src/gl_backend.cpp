@@ -6,7 +6,9 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <vector>
 
 namespace crep::gpu {
 
@@ -26,6 +28,8 @@ GLenum internalFormat(Format f) {
     return GL_DEPTH_COMPONENT32F;
   case Format::RGBA8:
     return GL_RGBA8;
+  case Format::RG32I:
+    return GL_RG32I;
   }
   return GL_RGBA32F;
 }
@@ -38,6 +42,8 @@ GLenum pixelFormat(GLint internal) {
   case GL_RG32F:
   case GL_RG16F:
     return GL_RG;
+  case GL_RG32I:
+    return GL_RG_INTEGER;
   case GL_DEPTH_COMPONENT32F:
   case GL_DEPTH_COMPONENT24:
   case GL_DEPTH_COMPONENT16:
@@ -49,7 +55,7 @@ GLenum pixelFormat(GLint internal) {
 }
 
 int channels(GLenum pixel) {
-  return pixel == GL_RGBA ? 4 : pixel == GL_RG ? 2 : 1;
+  return pixel == GL_RGBA ? 4 : pixel == GL_RG || pixel == GL_RG_INTEGER ? 2 : 1;
 }
 
 /// What a GL texture is, from the driver (ids may be the engine's own textures).
@@ -136,6 +142,7 @@ TextureDesc GlBackend::describe(TextureId texture) const {
              : t.internal == GL_RG32F                        ? Format::RG32F
              : t.internal == GL_RGBA16F                      ? Format::RGBA16F
              : t.internal == GL_RGBA8                        ? Format::RGBA8
+             : t.internal == GL_RG32I                        ? Format::RG32I
              : pixelFormat(t.internal) == GL_DEPTH_COMPONENT ? Format::Depth32F
                                                              : Format::RGBA32F;
   d.width = t.width;
@@ -222,10 +229,17 @@ void GlBackend::writeTexture(TextureId texture, std::span<const float> texels) {
     throw InvalidArgument("gpu::Backend::writeTexture texels", std::to_string(texels.size()),
                           "must hold " + std::to_string(needed) + " floats (the whole texture)");
   const gl::PixelStoreScope pixels;
+  // Integer textures take GL_INT texels: the floats converted (exact within +-2^24).
+  const bool integer = pixel == GL_RG_INTEGER;
+  std::vector<GLint> ints(integer ? texels.size() : 0);
+  std::transform(texels.begin(), texels.begin() + static_cast<std::ptrdiff_t>(ints.size()), ints.begin(),
+                 [](float v) { return static_cast<GLint>(std::lround(v)); });
+  const GLenum type = integer ? GL_INT : GL_FLOAT;
+  const void* data = integer ? static_cast<const void*>(ints.data()) : texels.data();
   if (t.target == GL_TEXTURE_2D)
-    glTextureSubImage2D(texture, 0, 0, 0, t.width, t.height, pixel, GL_FLOAT, texels.data());
+    glTextureSubImage2D(texture, 0, 0, 0, t.width, t.height, pixel, type, data);
   else
-    glTextureSubImage3D(texture, 0, 0, 0, 0, t.width, t.height, t.depth, pixel, GL_FLOAT, texels.data());
+    glTextureSubImage3D(texture, 0, 0, 0, 0, t.width, t.height, t.depth, pixel, type, data);
 }
 
 std::vector<std::byte> GlBackend::readBuffer(BufferId buffer, std::size_t offset, std::size_t bytes) {
@@ -244,8 +258,15 @@ std::vector<float> GlBackend::readTexture(TextureId texture) {
                          static_cast<std::size_t>(std::max(t.depth, 1)) *
                          static_cast<std::size_t>(channels(pixel)));
   const gl::PixelStoreScope pixels;
-  glGetTextureImage(texture, 0, pixel, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(float)),
-                    out.data());
+  if (pixel == GL_RG_INTEGER) {
+    std::vector<GLint> ints(out.size());
+    glGetTextureImage(texture, 0, pixel, GL_INT, static_cast<GLsizei>(ints.size() * sizeof(GLint)),
+                      ints.data());
+    std::transform(ints.begin(), ints.end(), out.begin(), [](GLint v) { return static_cast<float>(v); });
+  } else {
+    glGetTextureImage(texture, 0, pixel, GL_FLOAT, static_cast<GLsizei>(out.size() * sizeof(float)),
+                      out.data());
+  }
   gl::checkError("gpu::GlBackend::readTexture");
   return out;
 }

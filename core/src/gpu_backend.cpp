@@ -16,6 +16,7 @@ int componentCount(Format format) {
   case Format::Depth32F:
     return 1;
   case Format::RG32F:
+  case Format::RG32I:
     return 2;
   case Format::RGBA32F:
   case Format::RGBA16F:

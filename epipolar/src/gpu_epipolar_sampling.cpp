@@ -2,8 +2,9 @@
 // lines on the CPU (epipolarLines), then passes/epipolar/coordinates.comp (Sec. 6.1),
 // passes/epipolar/refine.comp (Sec. 6.2, Yusov 2013's criterion), passes/epipolar/interpolate.comp
 // (Sec. 6.5), passes/epipolar/unwarp.comp (Sec. 6.6) and passes/epipolar/upscale.comp (Sec. 6.8), with work
-// lists in between.
+// lists in between, each a gpu::Dispatch on the pass's backend.
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -13,7 +14,11 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <new>
+#include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace crep {
@@ -42,28 +47,20 @@ namespace {
 
 constexpr const char* kCreate = "EpipolarSamplingPass::CreateInfo";
 
-gl::Handle makeTexture(GLenum format, int width, int height) {
-  return gl::createTexture2D(format, width, height, "EpipolarSamplingPass::CreateInfo.width/height");
+unsigned groups(int n, int size) {
+  return static_cast<unsigned>((n + size - 1) / size);
 }
 
-GLuint groups(int n, int size) {
-  return static_cast<GLuint>((n + size - 1) / size);
-}
-
-// The barriers after a stage: its images and lists are read by the next stage, the evaluator (indirect
-// dispatch) or a read-back.
-void stageBarrier() {
-  gl::passOutputBarrier();
-  glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
-}
-
-// Before a stage that reads what the caller's evaluator wrote (images, through image loads).
-void evaluatorBarrier() {
-  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-}
-
-gpu::SampleList makeList(GLuint buffer, GLuint coordinates, GLuint output, int width, int height) {
+gpu::SampleList makeList(std::uint32_t buffer, std::uint32_t coordinates, std::uint32_t output, int width,
+                         int height) {
   return gpu::SampleList{buffer, coordinates, output, width, height, width * height};
+}
+
+// The stage programs (Yusov 2012, Sec. 6.1, 6.2, 6.5, 6.6, 6.8).
+ShaderStageSource stageSource(const char* name, int samples) {
+  std::vector<ShaderDefine> defines;
+  if (std::string_view(name) == "refine") defines.push_back({"CREP_SAMPLES", std::to_string(samples)});
+  return {ShaderStage::Compute, std::string("passes/epipolar/") + name + ".comp", defines};
 }
 
 } // namespace
@@ -75,7 +72,9 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
     throw InvalidArgument(std::string(kCreate) + ".height", std::to_string(info.height), "must be > 0");
   crep::validate(info.options, std::string(kCreate) + ".options");
   const EpipolarSamplingOptions& o = info.options;
-  gl::checkTextureSize("EpipolarSamplingPass::CreateInfo.width/height", info.width, info.height);
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::Backend& b = *backend_;
+  gpu::checkTextureSize(b, "EpipolarSamplingPass::CreateInfo.width/height", info.width, info.height);
   if (info.width % o.downscale != 0)
     throw InvalidArgument(std::string(kCreate) + ".width", std::to_string(info.width),
                           "must be a multiple of options.downscale " + std::to_string(o.downscale));
@@ -85,153 +84,174 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
   // List entries pack x | y << 16.
   if (info.width > 65535 || info.height > 65535 || o.slices > 65535)
     throw GlError("crep: EpipolarSamplingPass: work lists hold at most 65535 texels per axis");
-  gl::checkTextureSize("EpipolarSamplingPass::CreateInfo.options.samples/slices", o.samples, o.slices);
-  GLint maxSize = 0, maxInvocations = 0;
-  glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_SIZE, 0, &maxSize);
-  glGetIntegerv(GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS, &maxInvocations);
-  if (o.samples > maxSize || o.samples > maxInvocations)
+  gpu::checkTextureSize(b, "EpipolarSamplingPass::CreateInfo.options.samples/slices", o.samples, o.slices);
+  const gpu::ComputeLimits limits = b.computeLimits();
+  const int maxGroup = std::min(limits.groupSize[0], limits.invocations);
+  if (o.samples > maxGroup)
     throw GlError("crep: EpipolarSamplingPass::CreateInfo.options.samples " + std::to_string(o.samples) +
-                  " exceeds the compute work group limit " +
-                  std::to_string(std::min(maxSize, maxInvocations)) +
+                  " exceeds the compute work group limit " + std::to_string(maxGroup) +
                   " (one work group of samples threads per line)");
   targetWidth_ = info.width / o.downscale;
   targetHeight_ = info.height / o.downscale;
 
-  coordinatesProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/coordinates.comp", {}}});
-  refineProgram_ = buildProgram(
-      {{ShaderStage::Compute, "passes/epipolar/refine.comp", {{"CREP_SAMPLES", std::to_string(o.samples)}}}});
-  interpolateProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/interpolate.comp", {}}});
-  unwarpProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/unwarp.comp", {}}});
-  if (o.downscale > 1)
-    upscaleProgram_ = buildProgram({{ShaderStage::Compute, "passes/epipolar/upscale.comp", {}}});
-
-  params_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  samplingParams_ = gl::createDynamicBuffer(sizeof(gpu::EpipolarSamplingParams));
-  lineBuffer_ =
-      gl::createDynamicBuffer(sizeof(gpu::EpipolarSamplingLine) * static_cast<std::size_t>(o.slices));
-  sampler_ = gl::createClampSampler(GL_NEAREST);
-
-  coordinates_ = makeTexture(GL_RGBA32F, o.samples, o.slices);
-  unshadowed_ = makeTexture(GL_R32F, o.samples, o.slices);
-  sources_ = makeTexture(GL_RG32I, o.samples, o.slices);
-  samples_ = makeTexture(GL_RGBA32F, o.samples, o.slices);
-  targetCoordinates_ = makeTexture(GL_RGBA32F, targetWidth_, targetHeight_);
-  if (o.downscale > 1) {
-    target_ = makeTexture(GL_RGBA32F, targetWidth_, targetHeight_);
-    fullCoordinates_ = makeTexture(GL_RGBA32F, info.width, info.height);
+  for (const char* stage : {"coordinates", "refine", "interpolate", "unwarp", "upscale"}) {
+    if (std::string_view(stage) == "upscale" && o.downscale == 1) continue;
+    const ShaderStageSource source = stageSource(stage, o.samples);
+    b.prepareProgram(source.path, source.defines);
   }
-  sampleBuffer_ = gpu::createSampleListBuffer(o.samples * o.slices);
-  correctionBuffer_ = gpu::createSampleListBuffer(targetWidth_ * targetHeight_);
-  if (o.downscale > 1) upscaleBuffer_ = gpu::createSampleListBuffer(info.width * info.height);
 
-  sampleList_ = makeList(sampleBuffer_.get(), coordinates_.get(), samples_.get(), o.samples, o.slices);
-  correctionList_ =
-      makeList(correctionBuffer_.get(), targetCoordinates_.get(), target_.get(), targetWidth_, targetHeight_);
+  params_ = gpu::Buffer(b, sizeof(gpu::MarchParams), "EpipolarSamplingPass: march block");
+  samplingParams_ =
+      gpu::Buffer(b, sizeof(gpu::EpipolarSamplingParams), "EpipolarSamplingPass: sampling block");
+  lineBuffer_ = gpu::Buffer(b, sizeof(gpu::EpipolarSamplingLine) * static_cast<std::size_t>(o.slices),
+                            "EpipolarSamplingPass: line table");
+  const auto texture = [&](gpu::Format format, int width, int height, const char* label) {
+    return gpu::Texture(b, {gpu::TextureType::Texture2D, format, width, height, 1, label});
+  };
+  coordinates_ = texture(gpu::Format::RGBA32F, o.samples, o.slices, "EpipolarSamplingPass: coordinates");
+  unshadowed_ = texture(gpu::Format::R32F, o.samples, o.slices, "EpipolarSamplingPass: unshadowed");
+  sources_ = texture(gpu::Format::RG32I, o.samples, o.slices, "EpipolarSamplingPass: sources");
+  samples_ = texture(gpu::Format::RGBA32F, o.samples, o.slices, "EpipolarSamplingPass: samples");
+  targetCoordinates_ =
+      texture(gpu::Format::RGBA32F, targetWidth_, targetHeight_, "EpipolarSamplingPass: target coordinates");
+  if (o.downscale > 1) {
+    target_ = texture(gpu::Format::RGBA32F, targetWidth_, targetHeight_, "EpipolarSamplingPass: target");
+    fullCoordinates_ =
+        texture(gpu::Format::RGBA32F, info.width, info.height, "EpipolarSamplingPass: full coordinates");
+  }
+  sampleBuffer_ = gpu::createSampleListBuffer(b, o.samples * o.slices, "EpipolarSamplingPass: sample list");
+  correctionBuffer_ =
+      gpu::createSampleListBuffer(b, targetWidth_ * targetHeight_, "EpipolarSamplingPass: correction list");
   if (o.downscale > 1)
-    upscaleList_ = makeList(upscaleBuffer_.get(), fullCoordinates_.get(), 0, info.width, info.height);
-  gl::checkError("EpipolarSamplingPass");
+    upscaleBuffer_ =
+        gpu::createSampleListBuffer(b, info.width * info.height, "EpipolarSamplingPass: upscale list");
+
+  sampleList_ = makeList(sampleBuffer_.id(), coordinates_.id(), samples_.id(), o.samples, o.slices);
+  correctionList_ =
+      makeList(correctionBuffer_.id(), targetCoordinates_.id(), target_.id(), targetWidth_, targetHeight_);
+  if (o.downscale > 1)
+    upscaleList_ = makeList(upscaleBuffer_.id(), fullCoordinates_.id(), 0, info.width, info.height);
+}
+
+EpipolarSamplingPass::~EpipolarSamplingPass() = default;
+
+EpipolarSamplingPass::EpipolarSamplingPass(EpipolarSamplingPass&& o) noexcept
+    : info_(o.info_), targetWidth_(o.targetWidth_), targetHeight_(o.targetHeight_),
+      lines_(std::move(o.lines_)), ownBackend_(std::move(o.ownBackend_)),
+      backend_(std::exchange(o.backend_, nullptr)), params_(std::move(o.params_)),
+      samplingParams_(std::move(o.samplingParams_)), lineBuffer_(std::move(o.lineBuffer_)),
+      coordinates_(std::move(o.coordinates_)), unshadowed_(std::move(o.unshadowed_)),
+      sources_(std::move(o.sources_)), samples_(std::move(o.samples_)), target_(std::move(o.target_)),
+      targetCoordinates_(std::move(o.targetCoordinates_)), fullCoordinates_(std::move(o.fullCoordinates_)),
+      sampleBuffer_(std::move(o.sampleBuffer_)), correctionBuffer_(std::move(o.correctionBuffer_)),
+      upscaleBuffer_(std::move(o.upscaleBuffer_)), sampleList_(o.sampleList_),
+      correctionList_(o.correctionList_), upscaleList_(o.upscaleList_) {}
+
+EpipolarSamplingPass& EpipolarSamplingPass::operator=(EpipolarSamplingPass&& o) noexcept {
+  if (this != &o) {
+    this->~EpipolarSamplingPass(); // the textures and buffers go before the backend that made them
+    new (this) EpipolarSamplingPass(std::move(o));
+  }
+  return *this;
 }
 
 void EpipolarSamplingPass::validate(const FrameAttribs& f, std::string_view owner) const {
+  requireConstructed();
   const std::string p = std::string(owner) + ".";
   if (!f.camera) invalid(p + "camera", "null", "must be set");
   if (!f.light) invalid(p + "light", "null", "must be set");
   if (!f.medium) invalid(p + "medium", "null", "must be set");
-  gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth, info_.width, info_.height);
-  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
-  gl::requireTexture2D((p + "output").c_str(), f.output, info_.width, info_.height, GL_RGBA32F);
+  const gpu::Backend& b = *backend_;
+  gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, info_.width, info_.height);
+  gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, info_.width, info_.height, GL_RGBA32F);
 }
 
-void EpipolarSamplingPass::bindCommon(std::uint32_t program) const {
-  glUseProgram(program);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EPIPOLAR_SAMPLING_MARCH_BINDING, params_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_EPIPOLAR_SAMPLING_PARAMS_BINDING, samplingParams_.get());
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_EPIPOLAR_SAMPLING_LINES_BINDING, lineBuffer_.get());
+void EpipolarSamplingPass::dispatch(const char* stage, std::vector<gpu::Resource> resources, unsigned groupsX,
+                                    unsigned groupsY) {
+  const ShaderStageSource source = stageSource(stage, info_.options.samples);
+  gpu::Dispatch d;
+  d.label = std::string("EpipolarSamplingPass (") + stage + ")";
+  d.program = source.path;
+  d.defines = source.defines;
+  // Every stage but the interpolation reads the two blocks and the line table.
+  if (std::string_view(stage) != "interpolate")
+    d.resources = {gpu::Resource::uniform(CREP_EPIPOLAR_SAMPLING_MARCH_BINDING, params_.id()),
+                   gpu::Resource::uniform(CREP_EPIPOLAR_SAMPLING_PARAMS_BINDING, samplingParams_.id()),
+                   gpu::Resource::storage(CREP_EPIPOLAR_SAMPLING_LINES_BINDING, lineBuffer_.id())};
+  d.resources.insert(d.resources.end(), resources.begin(), resources.end());
+  d.groups = glm::uvec3(groupsX, groupsY, 1u);
+  backend_->dispatch(d);
 }
 
 void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
   validate(f);
   const EpipolarSamplingOptions& o = info_.options;
+  gpu::Backend& b = *backend_;
   lines_ = epipolarLines(*f.camera, *f.light, info_.width, info_.height, o);
   const gpu::MarchParams march =
       gpu::makeMarchParams(*f.camera, *f.light, *f.medium, info_.width, info_.height, o.samples, o.slices);
-  glNamedBufferSubData(params_.get(), 0, sizeof(march), &march);
+  b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&march, 1)));
   const gpu::EpipolarSamplingParams params = gpu::makeEpipolarSamplingParams(lines_, o);
-  glNamedBufferSubData(samplingParams_.get(), 0, sizeof(params), &params);
+  b.writeBuffer(samplingParams_.id(), 0, std::as_bytes(std::span(&params, 1)));
   std::vector<gpu::EpipolarSamplingLine> table(lines_.lines.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
     const EpipolarLines::Line& l = lines_.lines[i];
     table[i].ends = glm::vec4(glm::vec2(l.entry), glm::vec2(l.exit));
     table[i].info = glm::ivec4(l.lastValid, lines_.denseEnd, lines_.denseStep, 0);
   }
-  glNamedBufferSubData(lineBuffer_.get(), 0, static_cast<GLsizeiptr>(table.size() * sizeof(table[0])),
-                       table.data());
-
-  bindCommon(coordinatesProgram_.get());
-  glBindTextureUnit(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth);
-  glBindSampler(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, sampler_.get());
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_COORDINATES_OUT_IMAGE, coordinates_.get(), 0, GL_FALSE, 0,
-                     GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_OUT_IMAGE, unshadowed_.get(), 0, GL_FALSE, 0,
-                     GL_WRITE_ONLY, GL_R32F);
-  glDispatchCompute(groups(o.samples, 64), static_cast<GLuint>(o.slices), 1);
-  stageBarrier();
-  gl::unbindPassState(4);
-  gl::checkError("EpipolarSamplingPass::placeSamples");
+  if (!table.empty()) b.writeBuffer(lineBuffer_.id(), 0, std::as_bytes(std::span(table)));
+  dispatch("coordinates",
+           {gpu::Resource::sampled(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth),
+            gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_COORDINATES_OUT_IMAGE, coordinates_.id(),
+                                 gpu::Access::WriteOnly),
+            gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_OUT_IMAGE, unshadowed_.id(),
+                                 gpu::Access::WriteOnly)},
+           groups(o.samples, 64), static_cast<unsigned>(o.slices));
 }
 
 void EpipolarSamplingPass::refine() {
-  const EpipolarSamplingOptions& o = info_.options;
-  gpu::clearSampleList(sampleBuffer_.get());
-  bindCommon(refineProgram_.get());
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.get(), 0, GL_FALSE, 0,
-                     GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_IN_IMAGE, unshadowed_.get(), 0, GL_FALSE, 0,
-                     GL_READ_ONLY, GL_R32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SOURCES_OUT_IMAGE, sources_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     GL_RG32I);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, sampleBuffer_.get());
-  glDispatchCompute(static_cast<GLuint>(o.slices), 1, 1);
-  stageBarrier();
-  gl::unbindPassState(4);
-  gl::checkError("EpipolarSamplingPass::refine");
+  requireConstructed();
+  gpu::clearSampleList(*backend_, sampleBuffer_.id());
+  dispatch(
+      "refine",
+      {gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.id(),
+                            gpu::Access::ReadOnly),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_IN_IMAGE, unshadowed_.id(),
+                            gpu::Access::ReadOnly),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_SOURCES_OUT_IMAGE, sources_.id(), gpu::Access::WriteOnly),
+       gpu::Resource::storage(CREP_SAMPLE_LIST_DEFAULT_BINDING, sampleBuffer_.id())},
+      static_cast<unsigned>(info_.options.slices), 1u);
 }
 
 void EpipolarSamplingPass::interpolate() {
-  const EpipolarSamplingOptions& o = info_.options;
+  requireConstructed();
   evaluatorBarrier();
-  glUseProgram(interpolateProgram_.get());
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SOURCES_IN_IMAGE, sources_.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
-                     GL_RG32I);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SAMPLES_IMAGE, samples_.get(), 0, GL_FALSE, 0, GL_READ_WRITE,
-                     GL_RGBA32F);
-  glDispatchCompute(groups(o.samples, 64), static_cast<GLuint>(o.slices), 1);
-  stageBarrier();
-  gl::unbindPassState(4);
-  gl::checkError("EpipolarSamplingPass::interpolate");
+  const EpipolarSamplingOptions& o = info_.options;
+  dispatch(
+      "interpolate",
+      {gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_SOURCES_IN_IMAGE, sources_.id(), gpu::Access::ReadOnly),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_SAMPLES_IMAGE, samples_.id(), gpu::Access::ReadWrite)},
+      groups(o.samples, 64), static_cast<unsigned>(o.slices));
 }
 
 void EpipolarSamplingPass::unwarp(const FrameAttribs& f) {
   validate(f);
-  const GLuint out = info_.options.downscale > 1 ? target_.get() : f.output;
+  const std::uint32_t out = info_.options.downscale > 1 ? target_.id() : f.output;
   correctionList_.output = out;
   evaluatorBarrier();
-  gpu::clearSampleList(correctionBuffer_.get());
-  bindCommon(unwarpProgram_.get());
-  glBindTextureUnit(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth);
-  glBindSampler(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, sampler_.get());
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.get(), 0, GL_FALSE, 0,
-                     GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_SAMPLES_IN_IMAGE, samples_.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
-                     GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_OUT_IMAGE, targetCoordinates_.get(), 0,
-                     GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, correctionBuffer_.get());
-  glDispatchCompute(groups(targetWidth_, 8), groups(targetHeight_, 8), 1);
-  stageBarrier();
-  gl::unbindPassState(4);
-  gl::checkError("EpipolarSamplingPass::unwarp");
+  gpu::clearSampleList(*backend_, correctionBuffer_.id());
+  dispatch(
+      "unwarp",
+      {gpu::Resource::sampled(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.id(),
+                            gpu::Access::ReadOnly),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_SAMPLES_IN_IMAGE, samples_.id(), gpu::Access::ReadOnly),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, out, gpu::Access::WriteOnly),
+       gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_OUT_IMAGE, targetCoordinates_.id(),
+                            gpu::Access::WriteOnly),
+       gpu::Resource::storage(CREP_SAMPLE_LIST_DEFAULT_BINDING, correctionBuffer_.id())},
+      groups(targetWidth_, 8), groups(targetHeight_, 8));
 }
 
 void EpipolarSamplingPass::upscale(const FrameAttribs& f) {
@@ -239,23 +259,17 @@ void EpipolarSamplingPass::upscale(const FrameAttribs& f) {
   validate(f);
   upscaleList_.output = f.output;
   evaluatorBarrier();
-  gpu::clearSampleList(upscaleBuffer_.get());
-  bindCommon(upscaleProgram_.get());
-  glBindTextureUnit(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth);
-  glBindSampler(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, sampler_.get());
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_TARGET_IN_IMAGE, target_.get(), 0, GL_FALSE, 0, GL_READ_ONLY,
-                     GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_IN_IMAGE, targetCoordinates_.get(), 0,
-                     GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     GL_RGBA32F);
-  glBindImageTexture(CREP_EPIPOLAR_SAMPLING_FULL_COORDINATES_OUT_IMAGE, fullCoordinates_.get(), 0, GL_FALSE,
-                     0, GL_WRITE_ONLY, GL_RGBA32F);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_SAMPLE_LIST_DEFAULT_BINDING, upscaleBuffer_.get());
-  glDispatchCompute(groups(info_.width, 8), groups(info_.height, 8), 1);
-  stageBarrier();
-  gl::unbindPassState(4);
-  gl::checkError("EpipolarSamplingPass::upscale");
+  gpu::clearSampleList(*backend_, upscaleBuffer_.id());
+  dispatch("upscale",
+           {gpu::Resource::sampled(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth),
+            gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_TARGET_IN_IMAGE, target_.id(), gpu::Access::ReadOnly),
+            gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_IN_IMAGE, targetCoordinates_.id(),
+                                 gpu::Access::ReadOnly),
+            gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_OUTPUT_IMAGE, f.output, gpu::Access::WriteOnly),
+            gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_FULL_COORDINATES_OUT_IMAGE, fullCoordinates_.id(),
+                                 gpu::Access::WriteOnly),
+            gpu::Resource::storage(CREP_SAMPLE_LIST_DEFAULT_BINDING, upscaleBuffer_.id())},
+           groups(info_.width, 8), groups(info_.height, 8));
 }
 
 void EpipolarSamplingPass::run(const FrameAttribs& f,
@@ -271,17 +285,29 @@ void EpipolarSamplingPass::run(const FrameAttribs& f,
     upscale(f);
     evaluate(upscaleList_);
   }
-  glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                  GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+// On OpenGL a caller's evaluator may have written the samples or the output with its own GL dispatches: the
+// barrier for them, as the GL pass always issued (other backends order an evaluator that runs on them).
+void EpipolarSamplingPass::evaluatorBarrier() const {
+  if (backend_->name() == "OpenGL")
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+}
+
+void EpipolarSamplingPass::requireConstructed() const {
+  if (backend_ == nullptr)
+    invalid("EpipolarSamplingPass", "a moved-from object",
+            "owns no GPU objects: assign a constructed one first");
 }
 
 EpipolarSamplingPass::Statistics EpipolarSamplingPass::statistics() const {
   Statistics s;
   for (const EpipolarLines::Line& l : lines_.lines)
     s.validSamples += l.lastValid + 1;
-  s.marchedSamples = gpu::sampleListCount(sampleBuffer_.get());
-  s.correctedPixels = gpu::sampleListCount(correctionBuffer_.get());
-  if (upscaleBuffer_) s.correctedFullPixels = gpu::sampleListCount(upscaleBuffer_.get());
+  if (backend_ == nullptr) return s; // moved from
+  s.marchedSamples = gpu::sampleListCount(*backend_, sampleBuffer_.id());
+  s.correctedPixels = gpu::sampleListCount(*backend_, correctionBuffer_.id());
+  if (upscaleBuffer_.id() != 0) s.correctedFullPixels = gpu::sampleListCount(*backend_, upscaleBuffer_.id());
   return s;
 }
 

@@ -124,12 +124,6 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
   if (info.sampling != Scattering::Sampling::PerPixel && info.sampling != Scattering::Sampling::Epipolar)
     invalid("Scattering::CreateInfo.sampling", std::to_string(static_cast<int>(info.sampling)),
             "must be Sampling::PerPixel or Sampling::Epipolar");
-  if (info.backend != nullptr && info.backend->name() != "OpenGL") {
-    // The stages still written with GL calls (docs/BACKENDS.md, "What remains GL-only").
-    if (info.sampling != Scattering::Sampling::PerPixel)
-      invalid("Scattering::CreateInfo.sampling", "Sampling::Epipolar",
-              "needs the OpenGL backend (EpipolarSamplingPass is not on the backend seam yet)");
-  }
   if (info.sampling == Scattering::Sampling::Epipolar) {
     validate(info.epipolarSampling, "Scattering::CreateInfo.epipolarSampling");
     if (factor != 1)
@@ -371,7 +365,7 @@ struct Scattering::Impl {
     }
     if (treeBlock) march->prepare(gpu::LayoutKind::Epipolar);
     if (i.sampling == Sampling::Epipolar)
-      sampling.emplace(EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling});
+      sampling.emplace(EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling, backend});
     const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
     if (factor > 1) {
       reduced.emplace(DepthAwareResamplePass::CreateInfo{i.width, i.height, factor, backend});

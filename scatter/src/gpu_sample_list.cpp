@@ -8,7 +8,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
+#include <span>
 #include <string>
+#include <vector>
 
 namespace crep::gpu {
 
@@ -36,6 +39,25 @@ int sampleListCount(std::uint32_t buffer) {
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   GLuint count = 0;
   glGetNamedBufferSubData(buffer, 12, sizeof(count), &count);
+  return static_cast<int>(count);
+}
+
+Buffer createSampleListBuffer(Backend& backend, int capacity, std::string_view label) {
+  if (capacity <= 0) throw InvalidArgument("SampleList.capacity", std::to_string(capacity), "must be > 0");
+  Buffer buffer(backend, kSampleListHeaderBytes + static_cast<std::size_t>(capacity) * 4, label);
+  clearSampleList(backend, buffer.id());
+  return buffer;
+}
+
+void clearSampleList(Backend& backend, BufferId buffer) {
+  const std::array<std::uint32_t, 4> header{0u, 1u, 1u, 0u}; // an empty list: x groups 0, y 1, z 1, count 0
+  backend.writeBuffer(buffer, 0, std::as_bytes(std::span(header)));
+}
+
+int sampleListCount(Backend& backend, BufferId buffer) {
+  const std::vector<std::byte> bytes = backend.readBuffer(buffer, 12, 4);
+  std::uint32_t count = 0;
+  std::memcpy(&count, bytes.data(), sizeof(count));
   return static_cast<int>(count);
 }
 

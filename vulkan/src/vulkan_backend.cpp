@@ -38,6 +38,8 @@ VkFormat vkFormat(Format f) {
     return VK_FORMAT_D32_SFLOAT;
   case Format::RGBA8:
     return VK_FORMAT_R8G8B8A8_UNORM;
+  case Format::RG32I:
+    return VK_FORMAT_R32G32_SINT;
   }
   return VK_FORMAT_R32G32B32A32_SFLOAT;
 }
@@ -715,6 +717,10 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
     auto* out = static_cast<std::uint8_t*>(s.mapped);
     for (std::size_t i = 0; i < texels.size(); ++i)
       out[i] = static_cast<std::uint8_t>(std::lround(std::clamp(texels[i], 0.0f, 1.0f) * 255.0f));
+  } else if (d.format == Format::RG32I) {
+    auto* out = static_cast<std::int32_t*>(s.mapped);
+    for (std::size_t i = 0; i < texels.size(); ++i)
+      out[i] = static_cast<std::int32_t>(std::lround(texels[i]));
   } else {
     std::memcpy(s.mapped, texels.data(), texels.size_bytes());
   }
@@ -775,6 +781,10 @@ std::vector<float> VulkanBackend::readTexture(TextureId texture) {
     const auto* in = static_cast<const std::uint8_t*>(s.mapped);
     for (std::size_t i = 0; i < out.size(); ++i)
       out[i] = static_cast<float>(in[i]) / 255.0f;
+  } else if (d.format == Format::RG32I) {
+    const auto* in = static_cast<const std::int32_t*>(s.mapped);
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = static_cast<float>(in[i]);
   } else {
     std::memcpy(out.data(), s.mapped, out.size() * sizeof(float));
   }

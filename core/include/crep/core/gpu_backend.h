@@ -23,8 +23,9 @@ namespace crep::gpu {
 enum class TextureType : std::uint8_t { Texture2D, Texture2DArray, Texture3D };
 
 /// Texel formats of the passes' textures. Depth32F is sampled only (a depth map's red channel); RGBA8 is
-/// unsigned normalized (floats in [0, 1] through the Backend).
-enum class Format : std::uint8_t { R32F, RG32F, RGBA32F, RGBA16F, Depth32F, RGBA8 };
+/// unsigned normalized (floats in [0, 1] through the Backend); RG32I is signed integer (storage images only,
+/// integer floats through the Backend, exact within +-2^24).
+enum class Format : std::uint8_t { R32F, RG32F, RGBA32F, RGBA16F, Depth32F, RGBA8, RG32I };
 
 /// Components per texel of `format` (1, 2 or 4) as read and written through the Backend (floats).
 int componentCount(Format format);

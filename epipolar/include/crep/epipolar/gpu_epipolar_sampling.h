@@ -1,18 +1,22 @@
-// Yusov's epipolar sampling on the GPU (Yusov 2012, Sec. 6; Yusov 2013): the stage passes as OpenGL 4.5
-// compute shaders in float, the samples to evaluate as GPU work lists (crep/scatter/gpu_sample_list.h).
-// Stages, bindings, GL state left: epipolar/README.md, "crep/epipolar/gpu_epipolar_sampling.h".
-// Requires a current OpenGL 4.5 context (never owns one); FrameAttribs' textures are the caller's.
+// Yusov's epipolar sampling on the GPU (Yusov 2012, Sec. 6; Yusov 2013): the stage passes as compute
+// shaders in float on a gpu::Backend, the samples to evaluate as GPU work lists
+// (crep/scatter/gpu_sample_list.h). Stages, bindings, GL state left: epipolar/README.md,
+// "crep/epipolar/gpu_epipolar_sampling.h". On OpenGL it needs a current 4.5 context (never owns one);
+// FrameAttribs' textures are the caller's.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string_view>
+#include <vector>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>
@@ -55,6 +59,8 @@ public:
   struct CreateInfo {
     int width = 0, height = 0; ///< W x H camera image (multiples of options.downscale)
     EpipolarSamplingOptions options;
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
   /// Per-frame inputs: non-owning.
   struct FrameAttribs {
@@ -69,8 +75,13 @@ public:
   void validate(const FrameAttribs& frame,
                 std::string_view owner = "EpipolarSamplingPass::FrameAttribs") const;
   /// Throws InvalidArgument naming the field ("EpipolarSamplingPass::CreateInfo.width", ...), GlError
-  /// beyond the GL limits (README) or ShaderError. One-time: builds five programs, O(Ns N + W H) memory.
+  /// beyond the backend's limits (README) or ShaderError. One-time: builds five programs, O(Ns N + W H)
+  /// memory.
   explicit EpipolarSamplingPass(const CreateInfo& info);
+  ~EpipolarSamplingPass();
+  /// Moved from: valid but empty (the stages throw InvalidArgument naming "EpipolarSamplingPass").
+  EpipolarSamplingPass(EpipolarSamplingPass&& other) noexcept;
+  EpipolarSamplingPass& operator=(EpipolarSamplingPass&& other) noexcept;
 
   // The stages of one frame in order; the caller evaluates each list between them. Per frame.
   /// Lines on the CPU (epipolarLines), uploaded; the coordinates pass. Throws InvalidArgument naming the
@@ -97,38 +108,42 @@ public:
   struct Statistics {
     int validSamples = 0, marchedSamples = 0, correctedPixels = 0, correctedFullPixels = 0;
   };
-  /// Reads back the list counts of the last frame (a GPU sync): for tests and tools.
+  /// Reads back the list counts of the last frame (a GPU sync): for tests and tools. Textures and buffers
+  /// below are ids of the backend (GL names on OpenGL).
   Statistics statistics() const;
   const EpipolarLines& lines() const noexcept { return lines_; } ///< this frame's lines (CPU)
   const CreateInfo& info() const noexcept { return info_; }
 
   /// Ns x N RGBA32F (x, y, d, z) of every sample; (-1, -1, -1, -1) for invalid samples
-  std::uint32_t coordinatesTexture() const noexcept { return coordinates_.get(); }
+  std::uint32_t coordinatesTexture() const noexcept { return coordinates_.id(); }
   /// Ns x N R32F: U, the luminance of each sample's unshadowed in-scattering (0 invalid)
-  std::uint32_t unshadowedTexture() const noexcept { return unshadowed_.get(); }
+  std::uint32_t unshadowedTexture() const noexcept { return unshadowed_.id(); }
   /// Ns x N RG32I: sources (left, right); (k, k) marched, (-1, -1) invalid
-  std::uint32_t sourcesTexture() const noexcept { return sources_.get(); }
+  std::uint32_t sourcesTexture() const noexcept { return sources_.id(); }
   /// Ns x N RGBA32F: the evaluator's values at the marched samples, then interpolated (invalid: 0)
-  std::uint32_t sampleTexture() const noexcept { return samples_.get(); }
+  std::uint32_t sampleTexture() const noexcept { return samples_.id(); }
   /// (W/F) x (H/F) RGBA32F, F > 1 (0 for F = 1: the unwarp writes the output)
-  std::uint32_t targetTexture() const noexcept { return target_.get(); }
+  std::uint32_t targetTexture() const noexcept { return target_.id(); }
   /// (W/F) x (H/F) RGBA32F (c.x, c.y, d, z) of every target pixel
-  std::uint32_t targetCoordinatesTexture() const noexcept { return targetCoordinates_.get(); }
+  std::uint32_t targetCoordinatesTexture() const noexcept { return targetCoordinates_.id(); }
   /// W x H RGBA32F, F > 1 (0 for F = 1)
-  std::uint32_t fullCoordinatesTexture() const noexcept { return fullCoordinates_.get(); }
+  std::uint32_t fullCoordinatesTexture() const noexcept { return fullCoordinates_.id(); }
   /// GPU memory it owns, bytes (textures, lists, line table, blocks).
   std::size_t memoryBytes() const noexcept;
 
 private:
-  void bindCommon(std::uint32_t program) const;
+  void requireConstructed() const;
+  void evaluatorBarrier() const;
+  void dispatch(const char* stage, std::vector<gpu::Resource> resources, unsigned groupsX, unsigned groupsY);
 
   CreateInfo info_;
   int targetWidth_ = 0, targetHeight_ = 0;
   EpipolarLines lines_;
-  gl::Handle coordinatesProgram_, refineProgram_, interpolateProgram_, unwarpProgram_, upscaleProgram_;
-  gl::Handle params_, samplingParams_, lineBuffer_, sampler_;
-  gl::Handle coordinates_, unshadowed_, sources_, samples_, target_, targetCoordinates_, fullCoordinates_;
-  gl::Handle sampleBuffer_, correctionBuffer_, upscaleBuffer_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr; ///< ownBackend_ or CreateInfo::backend
+  gpu::Buffer params_, samplingParams_, lineBuffer_;
+  gpu::Texture coordinates_, unshadowed_, sources_, samples_, target_, targetCoordinates_, fullCoordinates_;
+  gpu::Buffer sampleBuffer_, correctionBuffer_, upscaleBuffer_;
   gpu::SampleList sampleList_, correctionList_, upscaleList_;
 };
 

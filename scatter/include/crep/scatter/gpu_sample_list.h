@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include <crep/core/gl.h>
 #include <crep/core/gpu_backend.h>
@@ -34,6 +35,11 @@ void clearSampleList(std::uint32_t buffer);
 void dispatchSampleList(std::uint32_t buffer);
 /// Reads `count` back (a GPU sync: for tests and statistics).
 int sampleListCount(std::uint32_t buffer);
+/// The three above on any backend: a list buffer of `backend` (header cleared), its clear (in order with
+/// the dispatches), and its count (a read-back: a GPU sync).
+Buffer createSampleListBuffer(Backend& backend, int capacity, std::string_view label);
+void clearSampleList(Backend& backend, BufferId buffer);
+int sampleListCount(Backend& backend, BufferId buffer);
 /// A consumer's check: InvalidArgument naming owner + ".buffer", ".coordinates" or ".output".
 void validateSampleList(const SampleList& list, const std::string& owner);
 /// The camera image size a consumer maps entries with: imageWidth x imageHeight when set (both > 0),
