@@ -100,15 +100,9 @@ struct CompareArgs {
   int tileWidth = 0;
   std::vector<std::string> names; ///< the methods, the reference first
   std::string out, csvPath, pngPath;
-  std::string backend = "opengl"; ///< --backend: prefilter and minmax on Vulkan (render_backend.h)
+  std::string backend = "opengl"; ///< --backend: crep::Scattering's methods on Vulkan (render_backend.h)
   bool debugGl = false;
 };
-
-/// The methods --backend vulkan runs on Vulkan (crep::Scattering's); the others, the reference among them,
-/// stay on OpenGL.
-bool runsOnBackend(const std::string& method) {
-  return method == "prefilter" || method == "minmax";
-}
 
 /// Parses and checks the command line: the scene, the sizes (the contact sheet within the image limits),
 /// the methods and the output prefix.
@@ -135,10 +129,11 @@ CompareArgs parseCompareArgs(const std::vector<std::string>& argv) {
   o.names = selectedMethods(args);
   o.backend = args.string("backend", "opengl");
   if (o.backend != "opengl") {
-    requireBackend(o.backend, "prefilter", o.settings);
+    requireBackend(o.backend, "prefilter");
     if (std::none_of(o.names.begin(), o.names.end(), runsOnBackend))
-      throw UsageError("option --backend " + o.backend +
-                       ": runs prefilter and minmax; --methods has neither");
+      throw UsageError(
+          "option --backend " + o.backend +
+          ": runs prefilter, minmax, epipolar-sampling and epipolar-prefilter; --methods has none");
   }
   const glm::ivec2 size = o.size;
   requireMethodImageSize(o.settings, o.names, size,

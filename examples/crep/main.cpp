@@ -45,8 +45,9 @@ const char* const kRender =
             --export-frame DIR  also write the frame as input for `crep scatter`: DIR/depth.exr,
                                 DIR/shadow.exr (float depth-buffer values), DIR/frame.json, and
                                 DIR/lightN.exr for a scene's local lights
-            --backend B         opengl (default) | vulkan: crep::Scattering (--method prefilter or
-                                minmax) on a Vulkan device, given the scene's maps rendered by GL
+            --backend B         opengl (default) | vulkan: crep::Scattering (--method prefilter, minmax,
+                                epipolar-sampling or epipolar-prefilter) on a Vulkan device, given
+                                the scene's maps rendered by GL
             --debug-gl          debug GL context; GL errors abort the command
 )";
 
@@ -80,7 +81,8 @@ const char* const kCompare =
             --tile-width N      width of each image on the sheet in [16, 4096] (default: the image
                                 width within [16, 400])
             --out PREFIX        writes PREFIX.png and PREFIX.csv (default crep-compare-<scene>)
-            --backend B         opengl (default) | vulkan: prefilter and minmax on a Vulkan device
+            --backend B         opengl (default) | vulkan: crep::Scattering's methods (prefilter,
+                                minmax, epipolar-sampling, epipolar-prefilter) on a Vulkan device
                                 (the reference and the other methods on OpenGL)
             --debug-gl          debug GL context; GL errors abort the command
 )";

@@ -313,7 +313,7 @@ int renderCommand(const std::vector<std::string>& argv) {
   requireMethodImageSize(settings, {method}, size,
                          "--size " + std::to_string(size.x) + "x" + std::to_string(size.y), true);
   const std::string backend = args.string("backend", "opengl");
-  requireBackend(backend, method, settings);
+  requireBackend(backend, method);
   const std::string out = args.string("out", "crep-" + sceneName);
   requireOutputPrefix({"--out", out});
   const std::string exportDir = args.string("export-frame", "");

@@ -23,15 +23,19 @@ std::string backendNames() {
   return CREP_HAS_VULKAN ? "opengl | vulkan" : "opengl";
 }
 
-void requireBackend(const std::string& backend, const std::string& method, const MethodSettings& settings) {
+bool runsOnBackend(const std::string& method) {
+  return method == "prefilter" || method == "minmax" || method == "epipolar-sampling" ||
+         method == "epipolar-prefilter";
+}
+
+void requireBackend(const std::string& backend, const std::string& method) {
   if (backend == "opengl") return;
   if (backend != "vulkan" || !CREP_HAS_VULKAN)
     throw UsageError("option --backend: unknown backend '" + backend + "' (one of: " + backendNames() + ")");
-  if (method != "prefilter" && method != "minmax")
-    throw UsageError("option --backend vulkan: runs --method prefilter or minmax (crep::Scattering), not " +
+  if (!runsOnBackend(method))
+    throw UsageError("option --backend vulkan: runs --method prefilter, minmax, epipolar-sampling or "
+                     "epipolar-prefilter (crep::Scattering), not " +
                      method);
-  if (settings.scale != 1.0)
-    throw UsageError("option --backend vulkan: needs --scale 1 (reduced resolution is an OpenGL stage)");
 }
 
 #if CREP_HAS_VULKAN
@@ -62,9 +66,11 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
   const scenes::EngineFrame engine(vk, scene, maps);
   gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, frame.width, frame.height, 1,
                            "crep render: scattering"});
-  Scattering::CreateInfo info = frontDoorCreateInfo(frame, settings,
-                                                    method == "minmax" ? Scattering::Method::MinMaxMarch
-                                                                       : Scattering::Method::Prefiltered);
+  const bool marching = method == "minmax" || method == "epipolar-sampling";
+  const bool sampled = method == "epipolar-sampling" || method == "epipolar-prefilter";
+  Scattering::CreateInfo info = frontDoorCreateInfo(
+      frame, settings, marching ? Scattering::Method::MinMaxMarch : Scattering::Method::Prefiltered,
+      sampled ? Scattering::Sampling::Epipolar : Scattering::Sampling::PerPixel);
   info.backend = &vk;
   Scattering scattering = out.timings.time("setup", [&] { return Scattering(info); });
   const Scattering::FrameResult r = scattering.run(engine.attribs(output.id()));

@@ -11,10 +11,12 @@ namespace crep::tool {
 
 /// The backends --backend takes ("opengl", "vulkan"; "vulkan" only in a build with the Vulkan backend).
 std::string backendNames();
-/// UsageError unless `backend` is one of backendNames() and, for Vulkan, `method` runs there (prefilter,
-/// minmax) and the settings are those the Vulkan frame supports (--scale 1).
-void requireBackend(const std::string& backend, const std::string& method, const MethodSettings& settings);
-/// `method` (prefilter or minmax) on a Vulkan device: stages by the wall clock, the output copied into a GL
+/// The methods that run on another backend: crep::Scattering's (prefilter, minmax, epipolar-sampling,
+/// epipolar-prefilter).
+bool runsOnBackend(const std::string& method);
+/// UsageError unless `backend` is one of backendNames() and, for Vulkan, `method` runs there.
+void requireBackend(const std::string& backend, const std::string& method);
+/// `method` (runsOnBackend) on a Vulkan device: stages by the wall clock, the output copied into a GL
 /// texture for the composite. Throws VulkanError when no Vulkan device answers.
 MethodOutput runOnVulkan(const SceneFrame& frame, const std::string& method, const MethodSettings& settings);
 

@@ -198,7 +198,7 @@ TEST_CASE("Vulkan backend: crep::Scattering with Yusov's epipolar sampling gives
         info.sampling = Scattering::Sampling::Epipolar;
         // Lines on the rows' centres of the sunset's epipolar map (512 rows). With 256 lines each line lies
         // on a boundary between two rows, and float rounding picks either row: both backends sample the
-        // map validly but differently there (measured 2.3e-4 prefiltered, 7e-3 marched; BACKENDS.md).
+        // map validly but differently there (pipeline/README.md, "Sampling::Epipolar").
         info.epipolarSampling.slices = name == "sunset" ? 512 : 256;
         info.epipolarSampling.samples = 128;
         info.epipolarSampling.downscale = downscale;
