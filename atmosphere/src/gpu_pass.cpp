@@ -1,9 +1,10 @@
-// The per-frame GL pass of the atmosphere (crep/atmosphere/gpu_pass.h): crep::atmosphereImage's
-// rays in float (Yusov 2013, Eq. 8 and Listings 1-2; shafts (a) and (b) over the min/max trees of Yusov
-// 2012, Algorithm 2). Shader: passes/atmosphere/atmosphere.comp (with crep/atmosphere.glsl,
-// crep/minmax_walk.glsl).
+// The per-frame pass of the atmosphere on a gpu::Backend (crep/atmosphere/gpu_pass.h):
+// crep::atmosphereImage's rays in float (Yusov 2013, Eq. 8 and Listings 1-2; shafts (a) and (b) over the
+// min/max trees of Yusov 2012, Algorithm 2). Shader: passes/atmosphere/atmosphere.comp (with
+// crep/atmosphere.glsl, crep/minmax_walk.glsl).
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/core/error.h>
+#include <crep/core/gl_backend.h>
 #include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
@@ -15,17 +16,16 @@
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
+#include <new>
+#include <span>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace crep {
 
 namespace {
-
-// Texture units, uniform and storage bindings of passes/atmosphere/atmosphere.comp: CREP_ATMOSPHERE_* of
-// crep/bindings.h.
-constexpr int kUnits = CREP_ATMOSPHERE_SKY_MIE_UNIT + 1; ///< units and bindings unbound afterwards
-                                                         ///< (gl::unbindPassState)
 
 bool walksTrees(AtmosphereShafts shafts) {
   return shafts == AtmosphereShafts::Integrated || shafts == AtmosphereShafts::LitLengthTable;
@@ -36,16 +36,13 @@ void checkSteps(const char* parameter, int steps) {
     throw InvalidArgument(parameter, std::to_string(steps), "must be in [1, 4096]");
 }
 
-/// A GL_TEXTURE_3D (the aerial perspective volume) or GL_TEXTURE_2D (the sky-view table, size.z 0) RGBA32F;
-/// read through the pass's linear clamp-to-edge sampler.
-gl::Handle createViewTable(const glm::ivec3& size) {
-  gl::Handle t = gl::createTexture(size.z > 0 ? GL_TEXTURE_3D : GL_TEXTURE_2D);
-  if (size.z > 0)
-    glTextureStorage3D(t.get(), 1, GL_RGBA32F, size.x, size.y, size.z);
-  else
-    glTextureStorage2D(t.get(), 1, GL_RGBA32F, size.x, size.y);
-  return t;
+/// The aerial perspective volume (3D) or the sky-view table (2D, size.z 0), RGBA32F, read linearly.
+gpu::Texture createViewTable(gpu::Backend& b, const glm::ivec3& size, const char* label) {
+  return gpu::Texture(b, {size.z > 0 ? gpu::TextureType::Texture3D : gpu::TextureType::Texture2D,
+                          gpu::Format::RGBA32F, size.x, size.y, std::max(size.z, 1), label});
 }
+
+constexpr const char* kProgram = "passes/atmosphere/atmosphere.comp";
 
 } // namespace
 
@@ -57,8 +54,10 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
   if (mode < 0 || mode > 3)
     throw InvalidArgument("AtmospherePass::CreateInfo.shafts", std::to_string(mode),
                           "must be an AtmosphereShafts");
+  backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
+  gpu::Backend& b = *backend_;
   if (walksTrees(info.shafts)) {
-    gl::checkTextureSize("AtmospherePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
+    gpu::checkTextureSize(b, "AtmospherePass::CreateInfo.mapWidth/mapHeight", info.mapWidth, info.mapHeight);
     requireTreeLevels("AtmospherePass::CreateInfo.mapWidth", info.mapWidth);
   }
   validateViewTables(info.options, "AtmospherePass::CreateInfo.options");
@@ -66,28 +65,52 @@ AtmospherePass::AtmospherePass(const CreateInfo& info) : info_(info) {
           info.shafts != AtmosphereShafts::Integrated;
   if (view_) {
     const AtmosphereRayOptions& o = info.options;
-    gl::checkTextureSize("AtmospherePass::CreateInfo.options.skyViewSize", o.skyViewSize.x, o.skyViewSize.y);
-    volumeRayleigh_ = createViewTable(o.volumeSize);
-    volumeMie_ = createViewTable(o.volumeSize);
-    skyRayleigh_ = createViewTable(glm::ivec3(o.skyViewSize, 0));
-    skyMie_ = createViewTable(glm::ivec3(o.skyViewSize, 0));
-    volumeProgram_ = buildProgram({{ShaderStage::Compute,
-                                    "passes/atmosphere/atmosphere.comp",
-                                    {{"CREP_ATMOSPHERE_VOLUME_PASS", "1"}}}});
-    skyViewProgram_ = buildProgram({{ShaderStage::Compute,
-                                     "passes/atmosphere/atmosphere.comp",
-                                     {{"CREP_ATMOSPHERE_VOLUME_PASS", "2"}}}});
+    gpu::checkTextureSize(b, "AtmospherePass::CreateInfo.options.skyViewSize", o.skyViewSize.x,
+                          o.skyViewSize.y);
+    volumeRayleigh_ = createViewTable(b, o.volumeSize, "AtmospherePass: volume (Rayleigh)");
+    volumeMie_ = createViewTable(b, o.volumeSize, "AtmospherePass: volume (Mie)");
+    skyRayleigh_ = createViewTable(b, glm::ivec3(o.skyViewSize, 0), "AtmospherePass: sky view (Rayleigh)");
+    skyMie_ = createViewTable(b, glm::ivec3(o.skyViewSize, 0), "AtmospherePass: sky view (Mie)");
+    for (const char* pass : {"1", "2"})
+      b.prepareProgram(kProgram, std::vector<ShaderDefine>{{"CREP_ATMOSPHERE_VOLUME_PASS", pass}});
   }
-  marchParams_ = gl::createDynamicBuffer(sizeof(gpu::MarchParams));
-  atmosphereParams_ = gl::createDynamicBuffer(sizeof(gpu::AtmosphereParams));
-  nearest_ = gl::createClampSampler(GL_NEAREST);
-  linear_ = gl::createClampSampler(GL_LINEAR);
-  if (!walksTrees(info.shafts)) // the one program of None and (c): compile errors surface here
-    programs_[0][0] = buildProgram({{ShaderStage::Compute,
-                                     "passes/atmosphere/atmosphere.comp",
-                                     {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(mode)},
-                                      {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
-  gl::checkError("AtmospherePass");
+  marchParams_ = gpu::Buffer(b, sizeof(gpu::MarchParams), "AtmospherePass: march block");
+  atmosphereParams_ = gpu::Buffer(b, sizeof(gpu::AtmosphereParams), "AtmospherePass: atmosphere block");
+  layoutBuffers_ = gpu::LayoutBuffers(backend_);
+  if (!walksTrees(info.shafts)) { // the one program of None and (c): compile errors surface here
+    const std::vector<ShaderDefine> defines = imageDefines(false, 0);
+    b.prepareProgram(kProgram, defines);
+  }
+}
+
+AtmospherePass::~AtmospherePass() = default;
+
+AtmospherePass::AtmospherePass(AtmospherePass&& o) noexcept
+    : info_(o.info_), ownBackend_(std::move(o.ownBackend_)), backend_(std::exchange(o.backend_, nullptr)),
+      view_(o.view_), volumeRayleigh_(std::move(o.volumeRayleigh_)), volumeMie_(std::move(o.volumeMie_)),
+      skyRayleigh_(std::move(o.skyRayleigh_)), skyMie_(std::move(o.skyMie_)),
+      layoutBuffers_(std::move(o.layoutBuffers_)), marchParams_(std::move(o.marchParams_)),
+      atmosphereParams_(std::move(o.atmosphereParams_)),
+      dummyTransmittance_(std::move(o.dummyTransmittance_)), dummyWidth_(o.dummyWidth_),
+      dummyHeight_(o.dummyHeight_) {}
+
+AtmospherePass& AtmospherePass::operator=(AtmospherePass&& o) noexcept {
+  if (this != &o) {
+    this->~AtmospherePass(); // the textures and buffers go before the backend that made them
+    new (this) AtmospherePass(std::move(o));
+  }
+  return *this;
+}
+
+/// The image program's variant: shafts, layout kind (walks), combined Mie, view tables.
+std::vector<ShaderDefine> AtmospherePass::imageDefines(bool combinedMie, int layoutKind) const {
+  std::vector<ShaderDefine> d = {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(info_.shafts))},
+                                 {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}};
+  if (walksTrees(info_.shafts) || combinedMie) {
+    d.push_back({"CREP_LAYOUT", std::to_string(layoutKind)});
+    d.push_back({"CREP_ATMOSPHERE_COMBINED_MIE", combinedMie ? "1" : "0"});
+  }
+  return d;
 }
 
 /// A validated frame of the pass (AtmospherePass::validate) and what run() derives from it.
@@ -103,10 +126,19 @@ void AtmospherePass::validate(const FrameAttribs& f, std::string_view owner) con
 }
 
 AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_view owner) const {
+  if (backend_ == nullptr)
+    invalid("AtmospherePass", "a moved-from object", "owns no GPU objects: assign a constructed one first");
   const std::string p = std::string(owner) + ".";
+  const gpu::Backend& b = *backend_;
   Plan plan;
   plan.walk = walksTrees(info_.shafts);
   if (!f.tables) invalid(p + "tables", "null", "must be set");
+  if (f.tables->backend() == nullptr)
+    invalid(p + "tables", "a moved-from AtmosphereTablesPass", "must hold tables");
+  // Tables of another backend: their ids mean nothing here (two GL backends share the context's names).
+  if (f.tables->backend() != backend_ && (b.name() != "OpenGL" || f.tables->backend()->name() != "OpenGL"))
+    invalid(p + "tables", std::string("tables on ") + std::string(f.tables->backend()->name()),
+            "must be on the pass's backend (" + std::string(b.name()) + ")");
   if (!f.placement) invalid(p + "placement", "null", "must be set");
   if (!f.camera) invalid(p + "camera", "null", "must be set");
   if (!f.sun) invalid(p + "sun", "null", "must be set");
@@ -115,27 +147,27 @@ AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_vie
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(p + "placement", e.what(), "must be valid");
   }
-  const gl::TextureLevel image = gl::requireTexture2D((p + "cameraDepth").c_str(), f.cameraDepth);
-  gl::requireDepthFormat((p + "cameraDepth").c_str(), f.cameraDepth);
+  const gl::TextureLevel image = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   plan.width = image.width;
   plan.height = image.height;
-  gl::requireTexture2D((p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
   if (f.transmittanceOutput != 0)
-    gl::requireTexture2D((p + "transmittanceOutput").c_str(), f.transmittanceOutput, plan.width, plan.height,
-                         GL_RGBA32F);
+    gpu::requireTexture2DOf(b, (p + "transmittanceOutput").c_str(), f.transmittanceOutput, plan.width,
+                            plan.height, GL_RGBA32F);
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (plan.walk) {
     if (!f.layout) invalid(p + "layout", "null", "must be set (shafts (a), (b))");
     plan.layoutData = gpu::requireGpuLayout(*f.layout, (p + "layout").c_str());
     gpu::requireMapSize(*f.layout, W, H, "AtmospherePass::CreateInfo.mapWidth/mapHeight");
-    gl::requireTexture2D((p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
-    gl::requireDepthFormat((p + "rectifiedDepth").c_str(), f.rectifiedDepth);
-    requireMinMaxBuffer((p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "shafts (a), (b)");
+    gpu::requireTexture2DOf(b, (p + "rectifiedDepth").c_str(), f.rectifiedDepth, W, H);
+    gpu::requireDepthFormatOf(b, (p + "rectifiedDepth").c_str(), f.rectifiedDepth);
+    requireMinMaxBuffer(b, (p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "shafts (a), (b)");
     gpu::LayoutBuffers::requireUploadable(plan.layoutData, H);
   }
   plan.prefiltered = info_.shafts == AtmosphereShafts::PrefilteredVisibility;
   if (plan.prefiltered) {
-    gl::requireTexture2D((p + "prefiltered").c_str(), f.prefiltered, plan.width, plan.height);
+    gpu::requireTexture2DOf(b, (p + "prefiltered").c_str(), f.prefiltered, plan.width, plan.height);
     if (!f.proxyMedium) invalid(p + "proxyMedium", "null", "must be set (shafts (c))");
   }
   return plan;
@@ -143,18 +175,9 @@ AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_vie
 
 void AtmospherePass::run(const FrameAttribs& f) {
   const Plan p = plan(f, "AtmospherePass::FrameAttribs");
-  const bool combined = f.tables->info().options.combinedMie;
-  gl::Handle& program = programs_[combined ? 1 : 0][p.walk ? static_cast<int>(p.layoutData.kind) : 0];
-  if (!program)
-    program = buildProgram({{ShaderStage::Compute,
-                             "passes/atmosphere/atmosphere.comp",
-                             {{"CREP_ATMOSPHERE_SHAFTS", std::to_string(static_cast<int>(info_.shafts))},
-                              {"CREP_LAYOUT", std::to_string(static_cast<int>(p.layoutData.kind))},
-                              {"CREP_ATMOSPHERE_COMBINED_MIE", combined ? "1" : "0"},
-                              {"CREP_ATMOSPHERE_VOLUME", view_ ? "1" : "0"}}}});
   uploadBlocks(f, p);
   if (view_) computeViewTables(*f.tables);
-  dispatchImage(f, p, program.get());
+  dispatchImage(f, p);
 }
 
 void AtmospherePass::uploadBlocks(const FrameAttribs& f, const Plan& p) {
@@ -172,83 +195,90 @@ void AtmospherePass::uploadBlocks(const FrameAttribs& f, const Plan& p) {
     params.block =
         glm::vec4(glm::vec2(info_.options.skyViewSize), static_cast<float>(info_.options.skyViewSteps), 0.0f);
   }
-  glNamedBufferSubData(marchParams_.get(), 0, sizeof(params), &params);
+  backend_->writeBuffer(marchParams_.id(), 0, std::as_bytes(std::span(&params, 1)));
   const AtmosphereTablesPass::CreateInfo& tables = f.tables->info();
   const gpu::AtmosphereParams atmosphere =
       gpu::atmosphereParams(tables.parameters, tables.options, *f.placement);
-  glNamedBufferSubData(atmosphereParams_.get(), 0, sizeof(atmosphere), &atmosphere);
+  backend_->writeBuffer(atmosphereParams_.id(), 0, std::as_bytes(std::span(&atmosphere, 1)));
 }
 
 // Hillaire 2020, Sec. 5.2-5.3: the camera's view tables, one ray per invocation.
 void AtmospherePass::computeViewTables(const AtmosphereTablesPass& tables) {
   const glm::ivec3 vs = info_.options.volumeSize;
   const glm::ivec2 ss = info_.options.skyViewSize;
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_MARCH_BINDING, marchParams_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_PARAMS_BINDING, atmosphereParams_.get());
-  glBindTextureUnit(CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT, tables.opticalDepthTexture());
-  glUseProgram(volumeProgram_.get());
-  glBindImageTexture(CREP_ATMOSPHERE_VOLUME_RAYLEIGH_OUT_IMAGE, volumeRayleigh_.get(), 0, GL_TRUE, 0,
-                     GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_ATMOSPHERE_VOLUME_MIE_OUT_IMAGE, volumeMie_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY,
-                     GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((vs.x + 7) / 8), static_cast<GLuint>((vs.y + 7) / 8), 1);
-  glUseProgram(skyViewProgram_.get());
-  glBindImageTexture(CREP_ATMOSPHERE_SKY_RAYLEIGH_OUT_IMAGE, skyRayleigh_.get(), 0, GL_FALSE, 0,
-                     GL_WRITE_ONLY, GL_RGBA32F);
-  glBindImageTexture(CREP_ATMOSPHERE_SKY_MIE_OUT_IMAGE, skyMie_.get(), 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((ss.x + 7) / 8), static_cast<GLuint>((ss.y + 7) / 8), 1);
-  glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+  const auto dispatch = [&](const char* pass, gpu::TextureId rayleigh, gpu::TextureId mie,
+                            std::uint32_t rayleighImage, std::uint32_t mieImage, glm::ivec2 size) {
+    gpu::Dispatch d;
+    d.label = std::string("AtmospherePass (view tables ") + pass + ")";
+    d.program = kProgram;
+    d.defines = {{"CREP_ATMOSPHERE_VOLUME_PASS", pass}};
+    d.resources = {gpu::Resource::uniform(CREP_ATMOSPHERE_MARCH_BINDING, marchParams_.id()),
+                   gpu::Resource::uniform(CREP_ATMOSPHERE_PARAMS_BINDING, atmosphereParams_.id()),
+                   gpu::Resource::sampled(CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT,
+                                          tables.opticalDepthTexture(), gpu::Filter::Linear),
+                   gpu::Resource::image(rayleighImage, rayleigh, gpu::Access::WriteOnly),
+                   gpu::Resource::image(mieImage, mie, gpu::Access::WriteOnly)};
+    d.groups =
+        glm::uvec3(static_cast<unsigned>((size.x + 7) / 8), static_cast<unsigned>((size.y + 7) / 8), 1u);
+    backend_->dispatch(d);
+  };
+  dispatch("1", volumeRayleigh_.id(), volumeMie_.id(), CREP_ATMOSPHERE_VOLUME_RAYLEIGH_OUT_IMAGE,
+           CREP_ATMOSPHERE_VOLUME_MIE_OUT_IMAGE, glm::ivec2(vs));
+  dispatch("2", skyRayleigh_.id(), skyMie_.id(), CREP_ATMOSPHERE_SKY_RAYLEIGH_OUT_IMAGE,
+           CREP_ATMOSPHERE_SKY_MIE_OUT_IMAGE, ss);
 }
 
-void AtmospherePass::dispatchImage(const FrameAttribs& f, const Plan& p, std::uint32_t program) {
-  const GLuint transmittance = f.transmittanceOutput != 0
-                                   ? f.transmittanceOutput
-                                   : gl::scratchTexture2D(dummyTransmittance_, dummyWidth_, dummyHeight_,
-                                                          GL_RGBA32F, p.width, p.height);
-  glUseProgram(program);
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_MARCH_BINDING, marchParams_.get());
-  glBindBufferBase(GL_UNIFORM_BUFFER, CREP_ATMOSPHERE_PARAMS_BINDING, atmosphereParams_.get());
-  glBindTextureUnit(CREP_ATMOSPHERE_CAMERA_DEPTH_UNIT, f.cameraDepth);
-  glBindSampler(CREP_ATMOSPHERE_CAMERA_DEPTH_UNIT, nearest_.get());
-  // The tables keep their own sampling state (linear, clamp to edge: AtmosphereTablesPass).
-  glBindTextureUnit(CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT, f.tables->opticalDepthTexture());
-  glBindTextureUnit(CREP_ATMOSPHERE_SINGLE_TABLE_UNIT, f.tables->singleTexture());
-  glBindTextureUnit(CREP_ATMOSPHERE_HIGHER_ORDERS_TABLE_UNIT, f.tables->higherOrdersTexture());
-  glBindTextureUnit(CREP_ATMOSPHERE_AMBIENT_TABLE_UNIT, f.tables->ambientTexture());
-  // With combinedMie there is no single Mie table (the shader does not read the unit).
+void AtmospherePass::dispatchImage(const FrameAttribs& f, const Plan& p) {
+  gpu::Backend& b = *backend_;
+  std::uint32_t transmittance = f.transmittanceOutput;
+  if (transmittance == 0) { // not asked for: a scratch target of the image's size
+    if (dummyWidth_ != p.width || dummyHeight_ != p.height) {
+      dummyTransmittance_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, p.width,
+                                             p.height, 1, "AtmospherePass: transmittance (not asked for)"});
+      dummyWidth_ = p.width;
+      dummyHeight_ = p.height;
+    }
+    transmittance = dummyTransmittance_.id();
+  }
   const bool combined = f.tables->info().options.combinedMie;
-  glBindTextureUnit(CREP_ATMOSPHERE_SINGLE_MIE_TABLE_UNIT,
-                    combined ? f.tables->singleTexture() : f.tables->singleMieTexture());
+  const AtmosphereTablesPass& t = *f.tables;
+  const auto linear = [](std::uint32_t unit, gpu::TextureId texture) {
+    return gpu::Resource::sampled(unit, texture, gpu::Filter::Linear);
+  };
+  gpu::Dispatch d;
+  d.label = "AtmospherePass::run";
+  d.program = kProgram;
+  d.defines = imageDefines(combined, p.walk ? static_cast<int>(p.layoutData.kind) : 0);
+  // The tables read linearly, clamped to the edge; with combinedMie there is no single Mie table (the shader
+  // does not read the unit: the single table stands in).
+  d.resources = {
+      gpu::Resource::uniform(CREP_ATMOSPHERE_MARCH_BINDING, marchParams_.id()),
+      gpu::Resource::uniform(CREP_ATMOSPHERE_PARAMS_BINDING, atmosphereParams_.id()),
+      gpu::Resource::sampled(CREP_ATMOSPHERE_CAMERA_DEPTH_UNIT, f.cameraDepth),
+      linear(CREP_ATMOSPHERE_OPTICAL_DEPTH_TABLE_UNIT, t.opticalDepthTexture()),
+      linear(CREP_ATMOSPHERE_SINGLE_TABLE_UNIT, t.singleTexture()),
+      linear(CREP_ATMOSPHERE_HIGHER_ORDERS_TABLE_UNIT, t.higherOrdersTexture()),
+      linear(CREP_ATMOSPHERE_AMBIENT_TABLE_UNIT, t.ambientTexture()),
+      linear(CREP_ATMOSPHERE_SINGLE_MIE_TABLE_UNIT, combined ? t.singleTexture() : t.singleMieTexture()),
+      gpu::Resource::image(CREP_ATMOSPHERE_INSCATTERING_OUT_IMAGE, f.output, gpu::Access::WriteOnly),
+      gpu::Resource::image(CREP_ATMOSPHERE_TRANSMITTANCE_OUT_IMAGE, transmittance, gpu::Access::WriteOnly)};
   if (p.walk) { // Yusov 2012, Algorithm 2: the rows' min/max trees
     layoutBuffers_.upload(p.layoutData, info_.mapHeight);
-    layoutBuffers_.bind(CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
-    glBindTextureUnit(CREP_ATMOSPHERE_RECTIFIED_DEPTH_UNIT, f.rectifiedDepth);
-    glBindSampler(CREP_ATMOSPHERE_RECTIFIED_DEPTH_UNIT, nearest_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, CREP_ATMOSPHERE_MIN_MAX_BINDING, f.minMaxBuffer);
+    layoutBuffers_.appendResources(d.resources, CREP_LAYOUT_DEFAULT_BINDING, CREP_SLICES_DEFAULT_BINDING);
+    d.resources.push_back(gpu::Resource::sampled(CREP_ATMOSPHERE_RECTIFIED_DEPTH_UNIT, f.rectifiedDepth));
+    d.resources.push_back(gpu::Resource::storage(CREP_ATMOSPHERE_MIN_MAX_BINDING, f.minMaxBuffer));
   }
-  if (p.prefiltered) {
-    glBindTextureUnit(CREP_ATMOSPHERE_PREFILTERED_UNIT, f.prefiltered);
-    glBindSampler(CREP_ATMOSPHERE_PREFILTERED_UNIT, nearest_.get());
-  }
+  if (p.prefiltered)
+    d.resources.push_back(gpu::Resource::sampled(CREP_ATMOSPHERE_PREFILTERED_UNIT, f.prefiltered));
   if (view_) {
-    const std::pair<GLuint, GLuint> views[] = {{CREP_ATMOSPHERE_VOLUME_RAYLEIGH_UNIT, volumeRayleigh_.get()},
-                                               {CREP_ATMOSPHERE_VOLUME_MIE_UNIT, volumeMie_.get()},
-                                               {CREP_ATMOSPHERE_SKY_RAYLEIGH_UNIT, skyRayleigh_.get()},
-                                               {CREP_ATMOSPHERE_SKY_MIE_UNIT, skyMie_.get()}};
-    for (const auto& [unit, texture] : views) {
-      glBindTextureUnit(unit, texture);
-      glBindSampler(unit, linear_.get());
-    }
+    d.resources.push_back(linear(CREP_ATMOSPHERE_VOLUME_RAYLEIGH_UNIT, volumeRayleigh_.id()));
+    d.resources.push_back(linear(CREP_ATMOSPHERE_VOLUME_MIE_UNIT, volumeMie_.id()));
+    d.resources.push_back(linear(CREP_ATMOSPHERE_SKY_RAYLEIGH_UNIT, skyRayleigh_.id()));
+    d.resources.push_back(linear(CREP_ATMOSPHERE_SKY_MIE_UNIT, skyMie_.id()));
   }
-  glBindImageTexture(CREP_ATMOSPHERE_INSCATTERING_OUT_IMAGE, f.output, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     GL_RGBA32F);
-  glBindImageTexture(CREP_ATMOSPHERE_TRANSMITTANCE_OUT_IMAGE, transmittance, 0, GL_FALSE, 0, GL_WRITE_ONLY,
-                     GL_RGBA32F);
-  glDispatchCompute(static_cast<GLuint>((p.width + 7) / 8), static_cast<GLuint>((p.height + 7) / 8), 1);
-  gl::passOutputBarrier();
-  gl::unbindPassState(kUnits);
-  gl::checkError("AtmospherePass::run");
+  d.groups =
+      glm::uvec3(static_cast<unsigned>((p.width + 7) / 8), static_cast<unsigned>((p.height + 7) / 8), 1u);
+  b.dispatch(d);
 }
 
 } // namespace crep

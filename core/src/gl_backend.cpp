@@ -120,6 +120,12 @@ int GlBackend::maxArrayLayers() const {
   return gl::maxArrayTextureLayers();
 }
 
+int GlBackend::max3DTextureSize() const {
+  GLint v = 0;
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &v);
+  return v;
+}
+
 ComputeLimits GlBackend::computeLimits() const {
   ComputeLimits l;
   for (GLuint axis = 0; axis < 3; ++axis) {
@@ -229,6 +235,14 @@ void GlBackend::writeTexture(TextureId texture, std::span<const float> texels) {
     throw InvalidArgument("gpu::Backend::writeTexture texels", std::to_string(texels.size()),
                           "must hold " + std::to_string(needed) + " floats (the whole texture)");
   const gl::PixelStoreScope pixels;
+  // Half-float textures take floats already rounded to their nearest half (GL drivers may truncate: Mesa
+  // 22.3 does), so every backend stores the same halves.
+  std::vector<float> rounded;
+  if (t.internal == GL_RGBA16F || t.internal == GL_RG16F || t.internal == GL_R16F) {
+    rounded.resize(texels.size());
+    std::transform(texels.begin(), texels.end(), rounded.begin(), roundedToHalf);
+    texels = rounded;
+  }
   // Integer textures take GL_INT texels: the floats converted (exact within +-2^24).
   const bool integer = pixel == GL_RG_INTEGER;
   std::vector<GLint> ints(integer ? texels.size() : 0);

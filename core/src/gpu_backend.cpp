@@ -4,7 +4,10 @@
 #include <crep/core/gl.h>
 #include <crep/core/gpu_backend.h>
 
+#include <glm/gtc/packing.hpp>
+
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <utility>
 
@@ -24,6 +27,30 @@ int componentCount(Format format) {
     return 4;
   }
   return 4;
+}
+
+// Round to nearest, ties to even, by bits: glm::packHalf1x16 and Mesa 22.3's GL upload truncate instead (one
+// unit in the last place off on about half the values).
+std::uint16_t halfBits(float f) {
+  std::uint32_t x = 0;
+  std::memcpy(&x, &f, sizeof x);
+  const std::uint32_t sign = (x >> 16) & 0x8000u, magnitude = x & 0x7fffffffu;
+  if (magnitude >= 0x7f800000u) // infinity, NaN (kept quiet)
+    return static_cast<std::uint16_t>(sign | 0x7c00u | (magnitude > 0x7f800000u ? 0x200u : 0u));
+  if (magnitude >= 0x477ff000u) return static_cast<std::uint16_t>(sign | 0x7c00u); // rounds to >= 65520
+  if (magnitude < 0x38800000u) { // below 2^-14: a subnormal half, in steps of 2^-24 (exact scaling)
+    float v = 0.0f;
+    std::memcpy(&v, &magnitude, sizeof v);
+    return static_cast<std::uint16_t>(sign | static_cast<std::uint32_t>(std::nearbyint(v * 16777216.0f)));
+  }
+  std::uint32_t h = ((((magnitude >> 23) - 112u) << 10) | ((magnitude & 0x7fffffu) >> 13));
+  const std::uint32_t rest = magnitude & 0x1fffu;
+  if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h; // a carry moves into the exponent, as it should
+  return static_cast<std::uint16_t>(sign | h);
+}
+
+float roundedToHalf(float f) {
+  return glm::unpackHalf1x16(halfBits(f));
 }
 
 Resource Resource::sampled(std::uint32_t binding, TextureId t, Filter f) {

@@ -250,15 +250,16 @@ TEST_CASE("AtmosphereTablesPass: halfFloatTables holds the RGBA32F tables rounde
   GLint format = 0;
   glGetTextureLevelParameteriv(half.singleTexture(), 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
   CHECK(format == GL_RGBA16F);
-  // Half precision keeps 11 significant bits: |h - f| <= 2^-10 |f| whatever the rounding mode of the
-  // conversion, plus 2^-24 for values below half's normal range.
+  // Half precision keeps 11 significant bits and the backends round to the nearest (gpu::halfBits):
+  // |h - f| <= 2^-11 |f|, plus 2^-25 for values below half's normal range. (Mesa's own GL upload truncates,
+  // up to 2^-10 |f|: the GL backend rounds before it uploads.)
   const auto rounded = [](const std::vector<float>& h, const std::vector<float>& f) {
     REQUIRE(h.size() == f.size());
     double worst = 0.0;
     int outside = 0;
     for (std::size_t i = 0; i < f.size(); ++i) {
       const double error = std::abs(double(h[i]) - double(f[i]));
-      if (error > std::ldexp(std::abs(double(f[i])), -10) + std::ldexp(1.0, -24)) ++outside;
+      if (error > std::ldexp(std::abs(double(f[i])), -11) + std::ldexp(1.0, -25)) ++outside;
       if (std::abs(f[i]) > 1e-4f) worst = std::max(worst, error / std::abs(double(f[i])));
     }
     CHECK(outside == 0);

@@ -547,6 +547,10 @@ int VulkanBackend::maxArrayLayers() const {
   return static_cast<int>(impl_->properties.limits.maxImageArrayLayers);
 }
 
+int VulkanBackend::max3DTextureSize() const {
+  return static_cast<int>(impl_->properties.limits.maxImageDimension3D);
+}
+
 ComputeLimits VulkanBackend::computeLimits() const {
   const VkPhysicalDeviceLimits& v = impl_->properties.limits;
   ComputeLimits l;
@@ -587,6 +591,13 @@ TextureId VulkanBackend::createTexture(const TextureDesc& desc) {
   if (desc.depth < 1 || (desc.type == TextureType::Texture2D && desc.depth != 1))
     throw InvalidArgument("gpu::TextureDesc.depth", std::to_string(desc.depth),
                           "must be >= 1 (1 for a Texture2D)");
+  const int max3D = max3DTextureSize();
+  if (desc.type == TextureType::Texture3D &&
+      (desc.width > max3D || desc.height > max3D || desc.depth > max3D))
+    throw InvalidArgument("gpu::TextureDesc.width/height/depth",
+                          std::to_string(desc.width) + " x " + std::to_string(desc.height) + " x " +
+                              std::to_string(desc.depth),
+                          "must each be <= maxImageDimension3D (" + std::to_string(max3D) + ")");
   Impl& v = *impl_;
   ImageEntry e;
   e.desc = desc;
@@ -712,7 +723,7 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
   if (d.format == Format::RGBA16F) {
     auto* out = static_cast<std::uint16_t*>(s.mapped);
     for (std::size_t i = 0; i < texels.size(); ++i)
-      out[i] = glm::packHalf1x16(texels[i]);
+      out[i] = halfBits(texels[i]);
   } else if (d.format == Format::RGBA8) {
     auto* out = static_cast<std::uint8_t*>(s.mapped);
     for (std::size_t i = 0; i < texels.size(); ++i)

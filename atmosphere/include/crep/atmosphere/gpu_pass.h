@@ -1,24 +1,29 @@
-// The per-frame GL pass of the atmosphere: sky, aerial perspective and light shafts of one camera image, the
-// rules of crep::atmosphereImage in float (atmosphere/README.md, "gpu_pass.h"). Requires a current OpenGL 4.5
-// context, never creates or owns one; the FrameAttribs' textures and buffers are the caller's.
+// The per-frame pass of the atmosphere: sky, aerial perspective and light shafts of one camera image, the
+// rules of crep::atmosphereImage in float (atmosphere/README.md, "gpu_pass.h"), on a gpu::Backend. On OpenGL
+// it needs a current 4.5 context and never creates or owns one; the FrameAttribs' textures and buffers are
+// the caller's (ids of the pass's backend).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string_view>
+#include <vector>
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/core/shader_library.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 
 namespace crep {
 
-/// atmosphereImage on the GPU. Leaves program 0, texture units 0-11, image units 0-1, uniform buffers 0-2
-/// and storage buffers 0-1 unbound, and issues gl::passOutputBarrier().
+/// atmosphereImage on the GPU. On GL it leaves program 0 and every unit and binding it used unbound, and
+/// issues the barriers its outputs need (gpu::GlBackend).
 class AtmospherePass {
 public:
   struct CreateInfo {
@@ -28,6 +33,8 @@ public:
     AtmosphereRayOptions options;
     /// (a), (b): the rectified map's W x H texels (> 0, at most 16 tree levels); 0 for None and (c).
     int mapWidth = 0, mapHeight = 0;
+    /// Runs the pass (must outlive it; the tables must be on it); null: a gpu::GlBackend of its own.
+    gpu::Backend* backend = nullptr;
   };
   /// Per-frame inputs: non-owning; the pointers are not stored.
   struct FrameAttribs {
@@ -54,29 +61,38 @@ public:
 
   /// One-time: validates (InvalidArgument naming the field; GlError beyond GL limits), builds the program.
   explicit AtmospherePass(const CreateInfo& info);
+  ~AtmospherePass();
+  /// Moved from: valid but empty (run() throws InvalidArgument naming "AtmospherePass").
+  AtmospherePass(AtmospherePass&& other) noexcept;
+  AtmospherePass& operator=(AtmospherePass&& other) noexcept;
+  AtmospherePass(const AtmospherePass&) = delete;
+  AtmospherePass& operator=(const AtmospherePass&) = delete;
   /// Per frame, O(pixels). Throws InvalidArgument naming the FrameAttribs field (README).
   void run(const FrameAttribs& frame);
 
   const CreateInfo& info() const noexcept { return info_; }
   /// The last run's view tables (RGB as crep::AtmosphereViewTables', RGBA32F 3D / 2D), 0 without them.
-  std::uint32_t volumeRayleighTexture() const noexcept { return volumeRayleigh_.get(); }
-  std::uint32_t volumeMieTexture() const noexcept { return volumeMie_.get(); }
-  std::uint32_t skyRayleighTexture() const noexcept { return skyRayleigh_.get(); }
-  std::uint32_t skyMieTexture() const noexcept { return skyMie_.get(); }
+  std::uint32_t volumeRayleighTexture() const noexcept { return volumeRayleigh_.id(); }
+  std::uint32_t volumeMieTexture() const noexcept { return volumeMie_.id(); }
+  std::uint32_t skyRayleighTexture() const noexcept { return skyRayleigh_.id(); }
+  std::uint32_t skyMieTexture() const noexcept { return skyMie_.id(); }
 
 private:
   struct Plan;
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
   void uploadBlocks(const FrameAttribs& frame, const Plan& plan);
   void computeViewTables(const AtmosphereTablesPass& tables);
-  void dispatchImage(const FrameAttribs& frame, const Plan& plan, std::uint32_t program);
+  void dispatchImage(const FrameAttribs& frame, const Plan& plan);
+  std::vector<ShaderDefine> imageDefines(bool combinedMie, int layoutKind) const;
 
   CreateInfo info_;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr; ///< null when moved from
   bool view_ = false;
-  gl::Handle volumeProgram_, skyViewProgram_, volumeRayleigh_, volumeMie_, skyRayleigh_, skyMie_;
+  gpu::Texture volumeRayleigh_, volumeMie_, skyRayleigh_, skyMie_;
   gpu::LayoutBuffers layoutBuffers_;
-  gl::Handle programs_[2][2]; ///< [combinedMie][layout kind] ((a), (b)); [.][0] for None and (c)
-  gl::Handle marchParams_, atmosphereParams_, nearest_, linear_, dummyTransmittance_;
+  gpu::Buffer marchParams_, atmosphereParams_;
+  gpu::Texture dummyTransmittance_;
   int dummyWidth_ = 0, dummyHeight_ = 0;
 };
 

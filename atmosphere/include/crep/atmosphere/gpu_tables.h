@@ -1,9 +1,10 @@
 // The atmosphere's tables on the GPU (crep/atmosphere/atmosphere.h: the CPU reference and its rules), in
-// float; glsl/crep/atmosphere.glsl reads them (public: engines include it). Requires a current OpenGL 4.5
-// context, never creates or owns one (atmosphere/README.md, "gpu_tables.h").
+// float; glsl/crep/atmosphere.glsl reads them (public: engines include it). Runs on a gpu::Backend; on
+// OpenGL it needs a current 4.5 context and never creates or owns one (atmosphere/README.md, "gpu_tables.h").
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,6 +14,7 @@
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/core/camera.h>
 #include <crep/core/gl.h>
+#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/rectify/rectified_map.h>
@@ -46,11 +48,18 @@ public:
   struct CreateInfo {
     AtmosphereParameters parameters;
     AtmospherePrecomputeOptions options; ///< keepOrders is ignored
-    /// The 4D tables as GL_RGBA16F: half the memory, each value rounded once (relative 2^-11).
+    /// The 4D tables as RGBA16F: half the memory, each value rounded once (relative 2^-11).
     bool halfFloatTables = false;
+    /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
+    gpu::Backend* backend = nullptr;
   };
-  /// Validates (InvalidArgument naming the field, also beyond GL limits), allocates (GlError on failure).
+  /// Validates (InvalidArgument naming the field, also beyond the backend's limits), allocates.
   explicit AtmosphereTablesPass(const CreateInfo& info);
+  ~AtmosphereTablesPass();
+  AtmosphereTablesPass(AtmosphereTablesPass&& other) noexcept;
+  AtmosphereTablesPass& operator=(AtmosphereTablesPass&& other) noexcept;
+  AtmosphereTablesPass(const AtmosphereTablesPass&) = delete;
+  AtmosphereTablesPass& operator=(const AtmosphereTablesPass&) = delete;
 
   /// One-time per atmosphere: computes every table (atmosphere.h's steps, in float); stageTimes() then
   /// holds the wall-clock milliseconds per stage.
@@ -62,17 +71,23 @@ public:
   AtmosphereTables download() const;
 
   const CreateInfo& info() const noexcept { return info_; }
-  std::uint32_t opticalDepthTexture() const noexcept { return opticalDepth_.get(); }
-  std::uint32_t singleTexture() const noexcept { return single_.get(); }
-  std::uint32_t singleMieTexture() const noexcept { return singleMie_.get(); }
-  std::uint32_t higherOrdersTexture() const noexcept { return higher_.get(); }
-  std::uint32_t ambientTexture() const noexcept { return ambient_.get(); }
-  std::uint32_t multipleScatteringLutTexture() const noexcept { return msLut_.get(); }
+  /// The backend the tables live on; null when moved from (the calls then throw InvalidArgument).
+  gpu::Backend* backend() const noexcept { return backend_; }
+  /// The tables: ids of the backend (GL names on OpenGL); 0 for a table the options do not make.
+  std::uint32_t opticalDepthTexture() const noexcept { return opticalDepth_.id(); }
+  std::uint32_t singleTexture() const noexcept { return single_.id(); }
+  std::uint32_t singleMieTexture() const noexcept { return singleMie_.id(); }
+  std::uint32_t higherOrdersTexture() const noexcept { return higher_.id(); }
+  std::uint32_t ambientTexture() const noexcept { return ambient_.id(); }
+  std::uint32_t multipleScatteringLutTexture() const noexcept { return msLut_.id(); }
   const std::vector<std::pair<std::string, double>>& stageTimes() const noexcept { return times_; }
 
 private:
   CreateInfo info_;
-  gl::Handle opticalDepth_, single_, singleMie_, higher_, ambient_, msLut_;
+  void requireConstructed() const;
+  std::unique_ptr<gpu::Backend> ownBackend_;
+  gpu::Backend* backend_ = nullptr; ///< null when moved from
+  gpu::Texture opticalDepth_, single_, singleMie_, higher_, ambient_, msLut_;
   std::vector<std::pair<std::string, double>> times_;
 };
 

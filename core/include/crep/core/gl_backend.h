@@ -18,6 +18,7 @@ public:
   std::string_view name() const override { return "OpenGL"; }
   int maxTextureSize() const override;
   int maxArrayLayers() const override;
+  int max3DTextureSize() const override;
   ComputeLimits computeLimits() const override;
   TextureDesc describe(TextureId texture) const override;
   std::size_t bufferBytes(BufferId buffer) const override;

@@ -30,6 +30,12 @@ enum class Format : std::uint8_t { R32F, RG32F, RGBA32F, RGBA16F, Depth32F, RGBA
 /// Components per texel of `format` (1, 2 or 4) as read and written through the Backend (floats).
 int componentCount(Format format);
 
+/// The IEEE half-float bits of `f`, rounded to the nearest, ties to even (overflow: infinity). Backends store
+/// RGBA16F uploads with it, so every backend rounds alike.
+std::uint16_t halfBits(float f);
+/// `f` rounded to the nearest half-float value (as a float, exact).
+float roundedToHalf(float f);
+
 struct TextureDesc {
   TextureType type = TextureType::Texture2D;
   Format format = Format::RGBA32F;
@@ -121,6 +127,9 @@ public:
   virtual int maxTextureSize() const = 0;
   /// The most layers of a 2D array texture (GL_MAX_ARRAY_TEXTURE_LAYERS, maxImageArrayLayers).
   virtual int maxArrayLayers() const = 0;
+  /// The largest side of a 3D texture (GL_MAX_3D_TEXTURE_SIZE, maxImageDimension3D). Default: 256, the
+  /// least Vulkan guarantees; a backend of your own returns its device's.
+  virtual int max3DTextureSize() const { return 256; }
   /// Compute limits: work-group size per axis, work groups per dispatch per axis, invocations per group.
   virtual ComputeLimits computeLimits() const = 0;
   /// What `texture` is (size, format, type; label empty). InvalidArgument if it is no texture of this
