@@ -4,6 +4,7 @@
 
 #include "args.h"
 #include "atmosphere_frame.h"
+#include "backend_method.h"
 #include "gl_session.h"
 #include "methods.h"
 #include "paths.h"
@@ -264,9 +265,17 @@ GpuTimes timeGpu(const Setup& s, int bases, int repeat, const GpuRun& run = {}) 
 /// Stages of a method run that are per-frame work (not one-time set-up: shader builds, pass creation,
 /// or the rectified map, which every rectified method shares and which is reported on its own).
 bool perFrameStage(const std::string& stage) {
+  // --backend vulkan: the engine's maps read back from GL and the output's way back to GL are the tool's.
+  if (stage == "engine maps (read back from GL)" || stage == "read back (Vulkan)") return false;
   for (const char* skip : {"setup", "shader", "rectify", "shadow pass", "resample", "upload"})
     if (stage.find(skip) != std::string::npos) return false;
   return true;
+}
+
+/// --backend vulkan: one device for the whole run, so the warm-up builds its pipelines once.
+gpu::Backend& vulkanDevice() {
+  static const std::unique_ptr<gpu::Backend> device = tool::makeVulkanBackend();
+  return *device;
 }
 
 struct MethodRow {
@@ -294,9 +303,11 @@ std::vector<MethodRow> runMethods(const BenchOptions& o, const std::string& scen
     std::map<std::string, std::vector<double>> stageMs;
     std::vector<std::string> order;
     std::string used;
+    const bool onVulkan = o.backend == "vulkan" && tool::runsOnBackend(m.name);
     for (int i = 0; i < repeat + 1; ++i) { // first run: warm-up (shader compilation, map)
-      tool::MethodOutput out = m.run(*s.frame, settings);
-      used = out.used;
+      tool::MethodOutput out =
+          onVulkan ? tool::runOnVulkan(s, m.name, settings, &vulkanDevice()) : m.run(*s.frame, settings);
+      used = out.used + (onVulkan ? " on Vulkan" : "");
       if (i == 0) {
         for (const auto& r : out.timings.rows())
           if (r.stage.find("shadow pass (rectified)") != std::string::npos) mapMs = r.ms;
@@ -1156,6 +1167,11 @@ void printHowMeasured(const BenchOptions& o) {
       "\nhow measured: wall-clock median of %d runs, each ending with glFinish (GPU) or on return (CPU);\n"
       "llvmpipe runs the GPU passes on the CPU cores, so CPU/GPU compares two CPU implementations here.\n",
       o.repeat);
+  if (o.backend == "vulkan")
+    std::printf(
+        "--backend vulkan: the rows marked \"on Vulkan\" time each crep::Scattering stage on the\n"
+        "wall clock, ended by the Vulkan backend's finish() (lavapipe here); the maps' read-back from GL\n"
+        "and the output's way back are left out, as are the setup and the shadow inputs.\n");
 }
 
 /// Memory copies of the bytes the prefilter writes (W x H x ceil(M / 4) RGBA8 texels).
@@ -1490,6 +1506,10 @@ std::string benchHelp() {
     if (next == std::string::npos) next = quick.size();
     line(quick.substr(at, next - at));
   }
+  line("--backend B: opengl (default) | vulkan: crep::Scattering's methods (prefilter, minmax,");
+  line("epipolar-sampling, epipolar-prefilter) on a Vulkan device in the sections that run the");
+  line("tool's methods (methods, sun-in-view, post-effects, epipolar-sampling, local-lights' spot");
+  line("scene), the engine's maps read back from GL; the rest on OpenGL (backends: both)");
   line("--section NAME[,NAME...]: those sections alone (in the suite's order); the sections,");
   line("in the order the whole suite runs them:");
   for (const BenchSection& s : benchSections()) {
@@ -1551,7 +1571,8 @@ glm::ivec2 parseMapSize(const tool::Args& args, bool quick) {
 } // namespace
 
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
-  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot", "section"}, {"quick"});
+  const tool::Args args(argv, {"scene", "size", "map", "bases", "repeat", "plot", "section", "backend"},
+                        {"quick"});
   BenchOptions o;
   o.scene = args.string("scene", o.scene);
   tool::requireSceneName(o.scene); // a usage error before any GL work
@@ -1569,6 +1590,8 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.repeat = args.integer("repeat", o.quick ? 1 : o.repeat, 1, 1000);
   o.plot = args.string("plot", "");
   if (args.has("section")) o.sections = parseSections(args.string("section", ""));
+  o.backend = args.string("backend", o.backend);
+  tool::requireBackend(o.backend, "prefilter");
   if (!o.plot.empty()) {
     for (const char* needed : kPlotSections)
       if (!o.sections.empty() && std::find(o.sections.begin(), o.sections.end(), needed) == o.sections.end())
@@ -1586,8 +1609,11 @@ void runBenchSuite(const BenchOptions& o) {
   scenes::registerShaders(); // the methods' reference march and the scene rasterizer (examples/glsl/)
   tool::StageTimings contextTimings;
   tool::ensureGlContext("bench", false, contextTimings);
-  std::printf("crep bench: scene %s | screen %dx%d | map %dx%d | M = %d | median of %d runs\n",
-              o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.mapHeight, o.bases, o.repeat);
+  std::printf("crep bench: scene %s | screen %dx%d | map %dx%d | M = %d | median of %d runs%s\n",
+              o.scene.c_str(), o.screenWidth, o.screenHeight, o.mapWidth, o.mapHeight, o.bases, o.repeat,
+              o.backend == "opengl" ? ""
+                                    : " | --backend vulkan: prefilter, minmax, epipolar-sampling and "
+                                      "epipolar-prefilter on a Vulkan device where the tool's methods run");
   BenchRun run(o, !o.sections.empty());
   for (const BenchSection& section : benchSections())
     if (o.sections.empty() ||

@@ -24,6 +24,9 @@ struct BenchOptions {
   std::string plot; ///< with the Table 1/2 rows: write them as an SVG bar chart beside the paper's
   /// The sections to run, in the suite's order (benchSections()); empty: the whole suite.
   std::vector<std::string> sections;
+  /// "opengl", or "vulkan": the tool's crep::Scattering methods (prefilter, minmax, epipolar-sampling,
+  /// epipolar-prefilter) in the sections that run the tool's methods go to a Vulkan device.
+  std::string backend = "opengl";
 };
 
 /// The run's state shared by its sections (bench_suite.cpp): the options, the frame of the run's scene
@@ -46,8 +49,9 @@ const std::vector<BenchSection>& benchSections();
 std::string benchHelp();
 
 /// Parses [--scene NAME] [--size WxH] [--map WxH] [--bases M] [--repeat N] [--quick] [--plot FILE.svg]
-/// [--section NAME[,NAME...]] (names from benchSections()); throws crep::tool::UsageError naming the
-/// option (an unknown section: the message lists the valid names). Needs no GL context.
+/// [--section NAME[,NAME...]] (names from benchSections()) [--backend opengl|vulkan]; throws
+/// crep::tool::UsageError naming the option (an unknown section: the message lists the valid names). Needs no
+/// GL context.
 BenchOptions parseBenchOptions(const std::vector<std::string>& argv);
 
 /// Runs the suite (or the sections of options.sections), printing to stdout. Creates the process's GL

@@ -9,7 +9,7 @@
 #include "methods.h"
 #include "options.h"
 #include "paths.h"
-#include "render_backend.h"
+#include "backend_method.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -100,7 +100,7 @@ struct CompareArgs {
   int tileWidth = 0;
   std::vector<std::string> names; ///< the methods, the reference first
   std::string out, csvPath, pngPath;
-  std::string backend = "opengl"; ///< --backend: crep::Scattering's methods on Vulkan (render_backend.h)
+  std::string backend = "opengl"; ///< --backend: crep::Scattering's methods on Vulkan (backend_method.h)
   bool debugGl = false;
 };
 

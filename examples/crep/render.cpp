@@ -13,7 +13,7 @@
 #include "methods.h"
 #include "options.h"
 #include "paths.h"
-#include "render_backend.h"
+#include "backend_method.h"
 #include "scene_frame.h"
 #include "timings.h"
 

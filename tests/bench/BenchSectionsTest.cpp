@@ -77,3 +77,17 @@ TEST_CASE("bench --quick: smaller default sizes and one run, explicit options ke
   CHECK(full.mapWidth == 1024);
   CHECK(full.repeat == 5);
 }
+
+TEST_CASE("bench --backend: opengl by default, an unknown backend is a usage error naming the option") {
+  CHECK(parseBenchOptions({}).backend == "opengl");
+  CHECK(parseBenchOptions({"--backend", "opengl"}).backend == "opengl");
+  std::string message;
+  try {
+    (void)parseBenchOptions({"--backend", "metal"});
+  } catch (const crep::tool::UsageError& e) {
+    message = e.what();
+  }
+  CHECK(message.find("--backend") != std::string::npos);
+  CHECK(message.find("metal") != std::string::npos);
+  CHECK(crep::bench::benchHelp().find("--backend") != std::string::npos);
+}

@@ -87,6 +87,21 @@ TEST_CASE(
   }
 }
 
+TEST_CASE("crep bench --backend vulkan: the front door's methods on Vulkan beside the others on OpenGL") {
+  CREP_REQUIRE_GL();
+  const ArgvResult r = runCrepArgv({"bench", "--quick", "--section", "sun-in-view", "--backend", "vulkan",
+                                    "--size", "160x90", "--map", "128x128"});
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  for (const char* row : {"[ran prefilter on Vulkan]", "[ran epipolar-sampling on Vulkan]",
+                          "[ran epipolar-prefilter on Vulkan]", "[ran minmax on Vulkan]"})
+    CHECK(r.output.find(row) != std::string::npos);
+  CHECK(r.output.find("--backend vulkan: the rows marked") != std::string::npos);
+  // The maps' way from GL and the output's way back are not a stage of the frame.
+  CHECK(r.output.find("engine maps (read back from GL)") == std::string::npos);
+  CHECK(r.output.find("read back (Vulkan)") == std::string::npos);
+}
+
 TEST_CASE("crep render --backend vulkan: epipolar sampling and a reduced scale, as close to the reference as "
           "on OpenGL") {
   CREP_REQUIRE_GL();

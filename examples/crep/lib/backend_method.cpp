@@ -1,5 +1,5 @@
-// `crep render --backend vulkan` (render_backend.h).
-#include "render_backend.h"
+// The front door's methods on another backend (backend_method.h): `crep render/compare/bench --backend`.
+#include "backend_method.h"
 
 #include "args.h"
 
@@ -40,7 +40,19 @@ void requireBackend(const std::string& backend, const std::string& method) {
 
 #if CREP_HAS_VULKAN
 
-MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const MethodSettings& settings) {
+std::unique_ptr<gpu::Backend> makeVulkanBackend() {
+  return std::make_unique<gpu::VulkanBackend>();
+}
+
+namespace {
+std::string deviceName(const gpu::Backend& b) {
+  const auto* vk = dynamic_cast<const gpu::VulkanBackend*>(&b);
+  return vk != nullptr ? vk->deviceName() : std::string(b.name());
+}
+} // namespace
+
+MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const MethodSettings& settings,
+                         gpu::Backend* vulkan) {
   const scenes::Scene& scene = *s.scene;
   const FrameInputs& frame = *s.frame;
   MethodOutput out;
@@ -62,7 +74,8 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
     m.localBias = kLocalShadowBias;
     return m;
   });
-  gpu::VulkanBackend vk;
+  std::unique_ptr<gpu::Backend> own = vulkan == nullptr ? makeVulkanBackend() : nullptr;
+  gpu::Backend& vk = vulkan != nullptr ? *vulkan : *own;
   const scenes::EngineFrame engine(vk, scene, maps);
   gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, frame.width, frame.height, 1,
                            "crep render: scattering"});
@@ -84,13 +97,18 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
                       texels.data());
   out.detail = std::string(scene.hasSun ? layoutToken(r.layout) : "no directional light") + " layout, map " +
                std::to_string(settings.mapSize) + "^2, " + std::to_string(r.localLights.size()) +
-               " local lights; on Vulkan (" + vk.deviceName() + ")";
+               " local lights; on Vulkan (" + deviceName(vk) + ")";
   return out;
 }
 #else
-MethodOutput runOnVulkan(const SceneFrame&, const std::string&, const MethodSettings&) {
+std::unique_ptr<gpu::Backend> makeVulkanBackend() {
   throw UsageError(
       "option --backend vulkan: this build has no Vulkan backend (configure with -DCREP_VULKAN=ON)");
+}
+
+MethodOutput runOnVulkan(const SceneFrame&, const std::string&, const MethodSettings&, gpu::Backend*) {
+  makeVulkanBackend();
+  return {};
 }
 #endif
 
