@@ -120,6 +120,29 @@ int GlBackend::maxArrayLayers() const {
   return gl::maxArrayTextureLayers();
 }
 
+void GlBackend::beginTimer() {
+  if (!timer_) timer_.emplace();
+  if (timing_) timer_->cancel();
+  timer_->begin();
+  timing_ = true;
+}
+
+double GlBackend::endTimer() {
+  if (!timing_) {
+    finish();
+    return 0.0;
+  }
+  timer_->end();
+  timing_ = false;
+  finish();
+  return timer_->milliseconds();
+}
+
+void GlBackend::cancelTimer() noexcept {
+  if (timer_) timer_->cancel();
+  timing_ = false;
+}
+
 int GlBackend::max3DTextureSize() const {
   GLint v = 0;
   glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &v);

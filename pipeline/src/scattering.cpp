@@ -345,10 +345,7 @@ struct Scattering::Impl {
         evaluate(evaluateInfo(i.prefilter.bases, i.evaluate, i.localLightClosedForm, backend)),
         resample({.mapWidth = i.mapSize, .mapHeight = i.mapSize, .backend = backend}),
         block({.options = i.epipoleBlock, .backend = backend}) {
-    if (gl) {
-      rectified.emplace(RectifiedShadowPass::CreateInfo{i.mapSize, i.mapSize});
-      timer.emplace();
-    }
+    if (gl) rectified.emplace(RectifiedShadowPass::CreateInfo{i.mapSize, i.mapSize});
     resampled = gpu::Texture(*backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, i.mapSize, i.mapSize,
                                         1, "Scattering: resampled map"});
     // The min/max trees and their march: Method::MinMaxMarch's, or the prefiltered method's epipole block.
@@ -395,7 +392,6 @@ struct Scattering::Impl {
   std::optional<MinMaxTreePass> trees;
   std::optional<RectifiedMarchPass> march;      ///< ... and the tree march
   std::optional<EpipolarSamplingPass> sampling; ///< Sampling::Epipolar
-  std::optional<gl::GpuTimer> timer;            ///< GL: the stages' GL_TIME_ELAPSED
   bool running = false;                         ///< inside run(): a call from drawCasters is refused
   /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
   /// made on the first frame with local lights; their fallback's perspective shadow map.
@@ -481,7 +477,8 @@ struct Scattering::Impl {
     backend->dispatch(d);
   }
 
-  /// Runs `work` as one stage: with stageTimings, its GL_TIME_ELAPSED and wall clock (ended by glFinish).
+  /// Runs `work` as one stage: with stageTimings, the backend's GPU timer (GL_TIME_ELAPSED, Vulkan
+  /// timestamps) and the wall clock, both ended by the backend's finish.
   template <class Work>
   Stage timedStage(const char* name, const Work& work) {
     if (!info.stageTimings) {
@@ -489,23 +486,16 @@ struct Scattering::Impl {
       return {name, 0.0, 0.0};
     }
     const auto start = std::chrono::steady_clock::now();
-    if (!timer) { // other backends: the wall clock to the end of the stage's work (gpuMilliseconds 0)
-      work();
-      backend->finish();
-      const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
-      return {name, 0.0, wall.count()};
-    }
-    timer->begin();
+    backend->beginTimer();
     try {
       work();
     } catch (...) {
-      timer->cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
+      backend->cancelTimer(); // GL: no GL_TIME_ELAPSED query left active in the caller's context
       throw;
     }
-    timer->end();
-    glFinish();
+    const double gpu = backend->endTimer();
     const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
-    return {name, timer->milliseconds(), wall.count()};
+    return {name, gpu, wall.count()};
   }
   /// timedStage() appended to the frame's stages.
   template <class Work>
@@ -601,10 +591,8 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   struct OnExit {
     Impl& m;
     ~OnExit() {
-      if (m.gl) {
-        m.timer->cancel();
-        gl::unbindPassState(8);
-      }
+      m.backend->cancelTimer();
+      if (m.gl) gl::unbindPassState(8);
       m.running = false;
     }
   } onExit{m};

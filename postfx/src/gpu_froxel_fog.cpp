@@ -14,7 +14,6 @@
 
 #include <epoxy/gl.h>
 
-#include <chrono>
 #include <cmath>
 #include <span>
 #include <string>
@@ -442,7 +441,6 @@ FroxelFog::FroxelFog(const CreateInfo& info)
     for (gpu::Texture& h : history_)
       h = createFroxelVolume(*backend_, info.grid, info.format, "FroxelFog::CreateInfo");
   volume_ = current_.id();
-  if (backend_->name() == "OpenGL") timer_.emplace();
 }
 
 glm::dvec3 FroxelFog::lightingJitter(int frameIndex) const {
@@ -495,25 +493,17 @@ void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) cons
 void FroxelFog::run(const FrameAttribs& f) {
   validate(f);
   timings_ = Timings{};
-  // GL: GL_TIME_ELAPSED per stage; other backends: the wall clock to the stage's end (finish()).
+  // The backend's GPU timer per stage (GL_TIME_ELAPSED, Vulkan timestamps).
   const auto stage = [&](double& ms, const auto& body) {
     if (!info_.timings) return body();
-    if (!timer_) {
-      const auto start = std::chrono::steady_clock::now();
-      body();
-      backend_->finish();
-      ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-      return;
-    }
-    timer_->begin();
+    backend_->beginTimer();
     try {
       body();
     } catch (...) {
-      timer_->cancel(); // no GL_TIME_ELAPSED query left active in the caller's context
+      backend_->cancelTimer(); // GL: no GL_TIME_ELAPSED query left active in the caller's context
       throw;
     }
-    timer_->end();
-    ms = timer_->milliseconds();
+    ms = backend_->endTimer();
   };
   const glm::dvec3 j = jitter(f.frameIndex);
   if (f.mode == Mode::Esm) {

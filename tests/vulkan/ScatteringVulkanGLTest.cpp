@@ -169,8 +169,16 @@ TEST_CASE("Vulkan backend: crep::Scattering at a reduced evaluation scale gives 
       long long nonFinite = 0;
       const double e = relativeRmse(a.rgba, b.rgba, nonFinite);
       bool upsampled = false;
-      for (const Scattering::Stage& st : a.result.stages)
+      double gpu = 0.0, wall = 0.0;
+      for (const Scattering::Stage& st : a.result.stages) {
         upsampled = upsampled || st.name == "upsample";
+        gpu += st.gpuMilliseconds;
+        wall += st.wallMilliseconds;
+        CHECK(st.gpuMilliseconds >= 0.0);
+        CHECK(st.gpuMilliseconds <= st.wallMilliseconds + 0.5); // the GPU's span lies within the stage's
+      }
+      MESSAGE("stages on Vulkan: GPU (timestamps) " << gpu << " ms, wall clock " << wall << " ms");
+      CHECK(gpu > 0.0); // lavapipe's compute queue has timestamps
       MESSAGE(name << ", evaluationScale " << scale << ", " << std::string(layoutToken(a.result.layout))
                    << ": Vulkan vs GL relative RMSE " << e << ", " << nonFinite << " non-finite");
       CHECK(upsampled);

@@ -129,6 +129,9 @@ struct VulkanBackend::Impl {
   VkFence fence = VK_NULL_HANDLE;
   bool recording = false;
   VkSampler nearest = VK_NULL_HANDLE, linear = VK_NULL_HANDLE;
+  VkQueryPool timestamps = VK_NULL_HANDLE; ///< two timestamps (beginTimer, endTimer); null without them
+  std::uint32_t timestampBits = 0;         ///< the queue family's timestampValidBits
+  bool timing = false;                     ///< a span's first timestamp is recorded
   PFN_vkCmdPushDescriptorSetKHR pushDescriptorSet = nullptr;
 
   std::map<TextureId, ImageEntry> images;
@@ -225,6 +228,7 @@ void VulkanBackend::Impl::pickDevice(const std::string& name) {
       if ((props[i].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0) {
         physical = d;
         family = i;
+        timestampBits = props[i].timestampValidBits;
         properties = p;
         vkGetPhysicalDeviceMemoryProperties(d, &memory);
         return;
@@ -277,6 +281,13 @@ void VulkanBackend::Impl::createDevice() {
   VkFenceCreateInfo fi{};
   fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
   check(vkCreateFence(device, &fi, nullptr, &fence), "vkCreateFence");
+  if (timestampBits > 0 && properties.limits.timestampPeriod > 0.0f) {
+    VkQueryPoolCreateInfo qi{};
+    qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qi.queryCount = 2;
+    check(vkCreateQueryPool(device, &qi, nullptr, &timestamps), "vkCreateQueryPool (timestamps)");
+  }
   for (auto [filter, sampler] :
        {std::pair{VK_FILTER_NEAREST, &nearest}, std::pair{VK_FILTER_LINEAR, &linear}}) {
     VkSamplerCreateInfo si{};
@@ -516,6 +527,7 @@ VulkanBackend::Impl::~Impl() {
     vkDestroySampler(device, nearest, nullptr);
     vkDestroySampler(device, linear, nullptr);
     vkDestroyFence(device, fence, nullptr);
+    if (timestamps != VK_NULL_HANDLE) vkDestroyQueryPool(device, timestamps, nullptr);
     vkDestroyCommandPool(device, pool, nullptr);
     vkDestroyDevice(device, nullptr);
   }
@@ -858,6 +870,38 @@ void VulkanBackend::dispatch(const Dispatch& given) {
 
 void VulkanBackend::finish() {
   impl_->submit();
+}
+
+void VulkanBackend::beginTimer() {
+  Impl& v = *impl_;
+  if (v.timestamps == VK_NULL_HANDLE) return;
+  v.begin();
+  vkCmdResetQueryPool(v.cmd, v.timestamps, 0, 2);
+  vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, v.timestamps, 0);
+  v.timing = true;
+}
+
+double VulkanBackend::endTimer() {
+  Impl& v = *impl_;
+  if (!v.timing) {
+    finish();
+    return 0.0;
+  }
+  v.begin();
+  vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, v.timestamps, 1);
+  v.timing = false;
+  v.submit();
+  std::uint64_t ticks[2] = {0, 0};
+  check(vkGetQueryPoolResults(v.device, v.timestamps, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+        "vkGetQueryPoolResults (timestamps)");
+  const std::uint64_t mask = v.timestampBits >= 64 ? ~0ull : (1ull << v.timestampBits) - 1ull;
+  const std::uint64_t elapsed = (ticks[1] - ticks[0]) & mask; // a wrapped counter too
+  return static_cast<double>(elapsed) * static_cast<double>(v.properties.limits.timestampPeriod) * 1e-6;
+}
+
+void VulkanBackend::cancelTimer() noexcept {
+  impl_->timing = false; // the next span resets the pool before its first timestamp
 }
 
 } // namespace crep::gpu

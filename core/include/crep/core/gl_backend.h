@@ -4,6 +4,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <crep/core/gl.h>
@@ -36,9 +37,15 @@ public:
   /// every unit and binding it used unbound (what the library's GL passes leave).
   void dispatch(const Dispatch& dispatch) override;
   void finish() override;
+  /// GL_TIME_ELAPSED (Mesa's llvmpipe measures about 0 for compute work).
+  void beginTimer() override;
+  double endTimer() override;
+  void cancelTimer() noexcept override;
 
 private:
   gl::Handle nearest_, linear_;
+  std::optional<gl::GpuTimer> timer_;
+  bool timing_ = false;
   std::map<std::string, gl::Handle> programs_; ///< by program and defines
   gl::Handle& program(const std::string& path, std::span<const ShaderDefine> defines);
 };

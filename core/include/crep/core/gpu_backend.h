@@ -157,6 +157,16 @@ public:
   virtual void dispatch(const Dispatch& dispatch) = 0;
   /// Waits for every call so far (timing; the API's own queue otherwise runs ahead).
   virtual void finish() = 0;
+
+  /// GPU time of a span of calls (stage timings): beginTimer(), the calls, then endTimer(), which finishes
+  /// and returns the GPU milliseconds between the two (0 where the device measures none). cancelTimer()
+  /// ends a span without a result (a stage that threw). Default: no GPU timer (endTimer() finishes, 0).
+  virtual void beginTimer() {}
+  virtual double endTimer() {
+    finish();
+    return 0.0;
+  }
+  virtual void cancelTimer() noexcept {}
 };
 
 /// InvalidArgument naming `parameter` for sizes <= 0; beyond backend.maxTextureSize() GlError on the GL

@@ -111,8 +111,7 @@ public:
     /// Depth bias of that map in the world-space marches (depth-buffer units), finite and >= 0.
     double ownShadowMapBias = 1e-4;
     /// Runs the frame (must outlive the object); null: a gpu::GlBackend of its own on the current GL
-    /// context. Other backends take the engine's shadow maps (no drawCasters), Sampling::PerPixel and
-    /// evaluationScale 1; their stages are timed by the wall clock (gpuMilliseconds 0).
+    /// context. Other backends take the engine's shadow maps (no drawCasters).
     gpu::Backend* backend = nullptr;
   };
 
@@ -175,15 +174,15 @@ public:
     bool preRenderedMap = false;   ///< its shadow input was the given perspective map, not drawCasters
     std::string message;           ///< the rectification's explanation
     double wallMilliseconds = 0.0; ///< CPU wall clock of its stages (0 without stageTimings)
-    double gpuMilliseconds = 0.0;  ///< GL_TIME_ELAPSED of its stages
+    double gpuMilliseconds = 0.0;  ///< the backend's GPU timer over its stages
   };
 
   enum class Layout { Projective, Epipolar };
 
   struct Stage {
     std::string name;
-    double gpuMilliseconds = 0.0;  ///< GL_TIME_ELAPSED of the stage (some drivers report 0 for compute)
-    double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by glFinish
+    double gpuMilliseconds = 0.0;  ///< the backend's GPU timer (GL_TIME_ELAPSED: 0 on llvmpipe; Vulkan)
+    double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by the backend's finish()
   };
 
   /// Without a directional light the directional members keep their defaults; stages start "transmittance".

@@ -7,7 +7,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string_view>
 
 #include <glm/glm.hpp>
@@ -237,8 +236,8 @@ public:
     glm::dvec3 ambient{0.0}; ///< isotropic ambient radiance per channel, >= 0 (default 0)
     TemporalOptions temporal;
     std::uint32_t format = 0x881A; ///< GL_RGBA16F (default) or GL_RGBA32F
-    /// Per-stage GPU times with GL_TIME_ELAPSED queries (a stall per stage: tools only); other backends:
-    /// the wall clock to each stage's end.
+    /// Per-stage GPU times by the backend's timer (GL_TIME_ELAPSED, Vulkan timestamps; a stall per stage:
+    /// tools only).
     bool timings = false;
     gpu::Backend* backend = nullptr; ///< runs every pass (outlives it); null: a GL backend of its own
   };
@@ -294,7 +293,6 @@ private:
   int latest_ = -1; ///< index of history_ written last, -1 = none
   std::uint32_t volume_ = 0;
   Timings timings_;
-  std::optional<gl::GpuTimer> timer_; ///< GL: the stages' GL_TIME_ELAPSED
 };
 
 } // namespace crep

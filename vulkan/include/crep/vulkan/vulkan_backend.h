@@ -53,6 +53,10 @@ public:
   std::vector<float> readTexture(TextureId texture) override;
   void dispatch(const Dispatch& dispatch) override;
   void finish() override;
+  /// Timestamp queries on the compute queue (0 ms where its family has no timestamp bits).
+  void beginTimer() override;
+  double endTimer() override;
+  void cancelTimer() noexcept override;
 
   std::string deviceName() const; ///< the physical device's name
   /// The validation layer's warnings and errors so far (CreateInfo::validation), oldest first.
