@@ -37,7 +37,7 @@ public:
   /// every unit and binding it used unbound (what the library's GL passes leave).
   void dispatch(const Dispatch& dispatch) override;
   void finish() override;
-  /// GL_TIME_ELAPSED (Mesa's llvmpipe measures about 0 for compute work).
+  /// GL_TIME_ELAPSED (some drivers measure nothing for compute work).
   void beginTimer() override;
   double endTimer() override;
   void cancelTimer() noexcept override;

@@ -181,7 +181,7 @@ public:
 
   struct Stage {
     std::string name;
-    double gpuMilliseconds = 0.0;  ///< the backend's GPU timer (GL_TIME_ELAPSED: 0 on llvmpipe; Vulkan)
+    double gpuMilliseconds = 0.0;  ///< the backend's GPU timer (some GL drivers report 0)
     double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by the backend's finish()
   };
 

@@ -53,7 +53,7 @@ public:
   std::vector<float> readTexture(TextureId texture) override;
   void dispatch(const Dispatch& dispatch) override;
   void finish() override;
-  /// Timestamp queries on the compute queue (0 ms where its family has no timestamp bits).
+  /// Timestamp queries on the compute queue (0 where its family has no timestamp bits).
   void beginTimer() override;
   double endTimer() override;
   void cancelTimer() noexcept override;
