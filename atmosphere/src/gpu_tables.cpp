@@ -143,9 +143,8 @@ struct TableStages {
 };
 
 TableStages tableStages(const AtmospherePrecomputeOptions& o) {
-  const auto stage = [](const char* name, std::vector<ShaderDefine> defines) {
-    return ShaderStageSource{ShaderStage::Compute, std::string("passes/atmosphere/") + name + ".comp",
-                             std::move(defines)};
+  const auto stage = [](const char* path, std::vector<ShaderDefine> defines) {
+    return ShaderStageSource{ShaderStage::Compute, path, std::move(defines)};
   };
   const auto steps = [](int n) {
     return std::vector<ShaderDefine>{{"CREP_ATMOSPHERE_STEPS", std::to_string(n)}};
@@ -162,18 +161,18 @@ TableStages tableStages(const AtmospherePrecomputeOptions& o) {
   std::vector<ShaderDefine> msDefines = steps(o.multipleScatteringSteps);
   msDefines.push_back({"CREP_ATMOSPHERE_SAMPLES", std::to_string(o.sphereSamples)});
   TableStages t;
-  t.optical = stage("optical_depth", steps(o.opticalDepthSteps));
-  t.single = stage("single", singleDefines);
-  t.sum = stage("sum", {});
-  t.copy = stage("sum", {{"CREP_ATMOSPHERE_SUM_MODE", "1"}});
-  t.clear = stage("sum", {{"CREP_ATMOSPHERE_SUM_MODE", "2"}});
+  t.optical = stage("passes/atmosphere/optical_depth.comp", steps(o.opticalDepthSteps));
+  t.single = stage("passes/atmosphere/single.comp", singleDefines);
+  t.sum = stage("passes/atmosphere/sum.comp", {});
+  t.copy = stage("passes/atmosphere/sum.comp", {{"CREP_ATMOSPHERE_SUM_MODE", "1"}});
+  t.clear = stage("passes/atmosphere/sum.comp", {{"CREP_ATMOSPHERE_SUM_MODE", "2"}});
   t.ambient =
-      stage("ambient",
+      stage("passes/atmosphere/ambient.comp",
             {{"CREP_ATMOSPHERE_SAMPLES", std::to_string(kAmbientSampleFactor * o.sphereSamples)}, combined});
-  t.ms = stage("ms", msDefines);
-  t.firstScattered = stage("scattered", firstOrder);
-  t.scattered = stage("scattered", samples);
-  t.order = stage("order", steps(o.orderSteps));
+  t.ms = stage("passes/atmosphere/ms.comp", msDefines);
+  t.firstScattered = stage("passes/atmosphere/scattered.comp", firstOrder);
+  t.scattered = stage("passes/atmosphere/scattered.comp", samples);
+  t.order = stage("passes/atmosphere/order.comp", steps(o.orderSteps));
   return t;
 }
 

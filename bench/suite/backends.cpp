@@ -1,5 +1,7 @@
 #include "backends.h"
 
+#include <crep/atmosphere/gpu_pass.h>
+#include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
 #include <crep/core/gl_backend.h>
 #include <crep/epipolar/gpu_march.h>
@@ -18,6 +20,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -67,6 +70,14 @@ struct BackendFrame {
 };
 
 #if CREP_HAS_VULKAN
+/// A row of the whole-frame table: a scene and what differs from the front door's defaults.
+struct FrameVariant {
+  const char* scene;
+  const char* label;
+  double evaluationScale = 1.0;
+  bool epipolarSampling = false;
+};
+
 /// The whole frame of a scene through crep::Scattering on one backend, from the engine's maps.
 struct ScatteringFrame {
   gpu::Backend& backend;
@@ -76,16 +87,19 @@ struct ScatteringFrame {
   std::vector<double> ms;
 
   ScatteringFrame(gpu::Backend& b, const scenes::Scene& scene, const scenes::EngineMaps& maps, int width,
-                  int height, int mapSize)
+                  int height, int mapSize, const FrameVariant& v)
       : backend(b), engine(b, scene, maps),
         output(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, width, height, 1, "bench: output"}),
-        scattering(createInfo(b, width, height, mapSize)) {}
+        scattering(createInfo(b, width, height, mapSize, v)) {}
 
-  static Scattering::CreateInfo createInfo(gpu::Backend& b, int width, int height, int mapSize) {
+  static Scattering::CreateInfo createInfo(gpu::Backend& b, int width, int height, int mapSize,
+                                           const FrameVariant& v) {
     Scattering::CreateInfo info;
     info.width = width;
     info.height = height;
     info.mapSize = mapSize;
+    info.evaluationScale = v.evaluationScale;
+    if (v.epipolarSampling) info.sampling = Scattering::Sampling::Epipolar;
     info.stageTimings = false; // the frame whole, ended by the backend's finish()
     info.backend = &b;
     return info;
@@ -99,34 +113,122 @@ struct ScatteringFrame {
   }
 };
 
+/// 320x180 and the bench's size (once when they are the same).
+std::vector<std::pair<int, int>> benchSizes(const BenchOptions& o) {
+  std::vector<std::pair<int, int>> sizes = {{320, 180}};
+  if (o.screenWidth != 320 || o.screenHeight != 180) sizes.emplace_back(o.screenWidth, o.screenHeight);
+  return sizes;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-/// The frames of the port's goal (forest, sunset with the sun in view, colonnade-night's local lights) at
-/// 320x180 and at the bench's size, crep::Scattering on each backend, interleaved.
+/// Runs each of `frames` once (warm-up: programs, pipelines, tables made on first use), then `repeats`
+/// times interleaved; the medians.
+template <class Frame>
+std::pair<double, double> interleaved(Frame (&frames)[2], int repeats) {
+  for (Frame& f : frames)
+    f.run();
+  for (Frame& f : frames)
+    f.ms.clear();
+  for (int r = 0; r < repeats; ++r)
+    for (Frame& f : frames)
+      f.run();
+  return {median(frames[0].ms), median(frames[1].ms)};
+}
+
+/// The frames of the port's goal (forest, sunset with the sun in view, colonnade-night's local lights), a
+/// reduced evaluation scale and Yusov's epipolar sampling, at 320x180 and at the bench's size,
+/// crep::Scattering on each backend, interleaved.
 void scatteringFrames(const BenchOptions& o, gpu::Backend& vk, gpu::Backend& gl) {
   const int repeats = std::max(o.repeat, 3);
   std::printf("\n  crep::Scattering, the whole frame from the engine's maps (sun 2048^2, local lights "
               "512^2), map %d^2, wall ms, median of %d, interleaved:\n",
               o.mapWidth, repeats);
-  std::printf("  %-18s %-10s %12s %12s %8s\n", "scene", "size", "OpenGL", "Vulkan", "ratio");
-  for (const char* name : {"forest", "sunset", "colonnade-night"})
-    for (const auto& [w, h] : {std::pair{320, 180}, std::pair{o.screenWidth, o.screenHeight}}) {
-      const scenes::Scene scene = scenes::makeScene(name, static_cast<double>(w) / h);
+  std::printf("  %-38s %-10s %12s %12s %8s\n", "frame", "size", "OpenGL", "Vulkan", "ratio");
+  const FrameVariant variants[] = {{"forest", ""},
+                                   {"sunset", ""},
+                                   {"colonnade-night", ""},
+                                   {"forest", ", evaluationScale 0.5", 0.5},
+                                   {"sunset", ", epipolar sampling", 1.0, true}};
+  for (const FrameVariant& v : variants)
+    for (const auto& [w, h] : benchSizes(o)) {
+      if (v.evaluationScale < 1.0 && (w % 2 != 0 || h % 2 != 0)) continue; // the scale needs even sizes
+      const scenes::Scene scene = scenes::makeScene(v.scene, static_cast<double>(w) / h);
       const scenes::EngineMaps maps = scenes::renderEngineMaps(scene, w, h, 2048, 512);
-      ScatteringFrame frames[] = {{gl, scene, maps, w, h, o.mapWidth}, {vk, scene, maps, w, h, o.mapWidth}};
-      for (ScatteringFrame& f : frames) // warm-up: programs, pipelines, the tables made on first use
-        f.run();
-      for (ScatteringFrame& f : frames)
-        f.ms.clear();
-      for (int r = 0; r < repeats; ++r)
-        for (ScatteringFrame& f : frames)
-          f.run();
-      const double a = median(frames[0].ms), b = median(frames[1].ms);
-      std::printf("  %-18s %4dx%-5d %12.2f %12.2f %8.2f\n", name, w, h, a, b, b / a);
+      ScatteringFrame frames[] = {{gl, scene, maps, w, h, o.mapWidth, v},
+                                  {vk, scene, maps, w, h, o.mapWidth, v}};
+      const auto [a, b] = interleaved(frames, repeats);
+      std::printf("  %-38s %4dx%-5d %12.2f %12.2f %8.2f\n", (std::string(v.scene) + v.label).c_str(), w, h, a,
+                  b, b / a);
     }
+}
+
+/// One backend's atmosphere: tables computed once (not timed), then AtmospherePass per frame.
+struct AtmosphereFrame {
+  gpu::Backend& backend;
+  gpu::Texture depth, output;
+  AtmosphereTablesPass tables;
+  AtmospherePass pass;
+  const scenes::Scene& scene;
+  AtmospherePlacement placement;
+  std::vector<double> ms;
+
+  AtmosphereFrame(gpu::Backend& b, const scenes::Scene& s, const Image& cameraDepth)
+      : backend(b), depth(b, {gpu::TextureType::Texture2D, gpu::Format::Depth32F, cameraDepth.width(),
+                              cameraDepth.height(), 1, "bench: camera depth"}),
+        output(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, cameraDepth.width(),
+                   cameraDepth.height(), 1, "bench: atmosphere"}),
+        tables(tablesInfo(b)), pass(passInfo(b)), scene(s) {
+    b.writeTexture(depth.id(), cameraDepth.data());
+    tables.compute();
+    placement.metersPerUnit = 50.0;
+  }
+
+  static AtmospherePass::CreateInfo passInfo(gpu::Backend& b) {
+    AtmospherePass::CreateInfo info;
+    info.backend = &b;
+    return info;
+  }
+
+  static AtmosphereTablesPass::CreateInfo tablesInfo(gpu::Backend& b) {
+    AtmosphereTablesPass::CreateInfo info;
+    info.options.size = {16, 64, 16, 8}; // the frame reads them; their size barely changes its cost
+    info.options.orders = 2;
+    info.backend = &b;
+    return info;
+  }
+
+  void run() {
+    const auto start = std::chrono::steady_clock::now();
+    AtmospherePass::FrameAttribs f;
+    f.tables = &tables;
+    f.placement = &placement;
+    f.camera = &scene.camera;
+    f.sun = &scene.sun;
+    f.cameraDepth = depth.id();
+    f.output = output.id();
+    pass.run(f);
+    backend.finish();
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+};
+
+/// The atmosphere's per-frame pass (sky and aerial perspective from the view tables, no shafts) on each
+/// backend, the terrain scene's camera depth.
+void atmosphereFrames(const BenchOptions& o, gpu::Backend& vk, gpu::Backend& gl) {
+  const int repeats = std::max(o.repeat, 3);
+  std::printf("\n  AtmospherePass (terrain, no shafts, view tables), wall ms, median of %d, interleaved:\n",
+              repeats);
+  for (const auto& [w, h] : benchSizes(o)) {
+    const scenes::Scene scene = scenes::makeScene("terrain", static_cast<double>(w) / h);
+    const scenes::EngineMaps maps = scenes::renderEngineMaps(scene, w, h, 256, 256);
+    AtmosphereFrame frames[] = {{gl, scene, maps.cameraDepth}, {vk, scene, maps.cameraDepth}};
+    const auto [a, b] = interleaved(frames, repeats);
+    std::printf("  %-38s %4dx%-5d %12.2f %12.2f %8.2f\n", "terrain, atmosphere", w, h, a, b, b / a);
+  }
 }
 #endif
 
@@ -173,6 +275,7 @@ void backendsBench(const BenchOptions& o) {
   std::printf("  %-24s %10.2f ms   (%s)\n", "Vulkan", frames[1].median(), vk->deviceName().c_str());
   std::printf("  %-24s %10.2f\n", "ratio Vulkan / OpenGL", frames[1].median() / frames[0].median());
   scatteringFrames(o, *vk, gl);
+  atmosphereFrames(o, *vk, gl);
 #else
   std::printf("  not built: configure with -DCREP_VULKAN=ON (the Vulkan backend)\n");
 #endif

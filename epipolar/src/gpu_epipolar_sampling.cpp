@@ -57,10 +57,11 @@ gpu::SampleList makeList(std::uint32_t buffer, std::uint32_t coordinates, std::u
 }
 
 // The stage programs (Yusov 2012, Sec. 6.1, 6.2, 6.5, 6.6, 6.8).
-ShaderStageSource stageSource(const char* name, int samples) {
+ShaderStageSource stageSource(const char* path, int samples) {
   std::vector<ShaderDefine> defines;
-  if (std::string_view(name) == "refine") defines.push_back({"CREP_SAMPLES", std::to_string(samples)});
-  return {ShaderStage::Compute, std::string("passes/epipolar/") + name + ".comp", defines};
+  if (std::string_view(path) == "passes/epipolar/refine.comp")
+    defines.push_back({"CREP_SAMPLES", std::to_string(samples)});
+  return {ShaderStage::Compute, path, defines};
 }
 
 } // namespace
@@ -94,8 +95,10 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
   targetWidth_ = info.width / o.downscale;
   targetHeight_ = info.height / o.downscale;
 
-  for (const char* stage : {"coordinates", "refine", "interpolate", "unwarp", "upscale"}) {
-    if (std::string_view(stage) == "upscale" && o.downscale == 1) continue;
+  for (const char* stage :
+       {"passes/epipolar/coordinates.comp", "passes/epipolar/refine.comp", "passes/epipolar/interpolate.comp",
+        "passes/epipolar/unwarp.comp", "passes/epipolar/upscale.comp"}) {
+    if (std::string_view(stage) == "passes/epipolar/upscale.comp" && o.downscale == 1) continue;
     const ShaderStageSource source = stageSource(stage, o.samples);
     b.prepareProgram(source.path, source.defines);
   }
@@ -175,7 +178,7 @@ void EpipolarSamplingPass::dispatch(const char* stage, std::vector<gpu::Resource
   d.program = source.path;
   d.defines = source.defines;
   // Every stage but the interpolation reads the two blocks and the line table.
-  if (std::string_view(stage) != "interpolate")
+  if (std::string_view(stage) != "passes/epipolar/interpolate.comp")
     d.resources = {gpu::Resource::uniform(CREP_EPIPOLAR_SAMPLING_MARCH_BINDING, params_.id()),
                    gpu::Resource::uniform(CREP_EPIPOLAR_SAMPLING_PARAMS_BINDING, samplingParams_.id()),
                    gpu::Resource::storage(CREP_EPIPOLAR_SAMPLING_LINES_BINDING, lineBuffer_.id())};
@@ -201,7 +204,7 @@ void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
     table[i].info = glm::ivec4(l.lastValid, lines_.denseEnd, lines_.denseStep, 0);
   }
   if (!table.empty()) b.writeBuffer(lineBuffer_.id(), 0, std::as_bytes(std::span(table)));
-  dispatch("coordinates",
+  dispatch("passes/epipolar/coordinates.comp",
            {gpu::Resource::sampled(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth),
             gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_COORDINATES_OUT_IMAGE, coordinates_.id(),
                                  gpu::Access::WriteOnly),
@@ -214,7 +217,7 @@ void EpipolarSamplingPass::refine() {
   requireConstructed();
   gpu::clearSampleList(*backend_, sampleBuffer_.id());
   dispatch(
-      "refine",
+      "passes/epipolar/refine.comp",
       {gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.id(),
                             gpu::Access::ReadOnly),
        gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_UNSHADOWED_IN_IMAGE, unshadowed_.id(),
@@ -229,7 +232,7 @@ void EpipolarSamplingPass::interpolate() {
   evaluatorBarrier();
   const EpipolarSamplingOptions& o = info_.options;
   dispatch(
-      "interpolate",
+      "passes/epipolar/interpolate.comp",
       {gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_SOURCES_IN_IMAGE, sources_.id(), gpu::Access::ReadOnly),
        gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_SAMPLES_IMAGE, samples_.id(), gpu::Access::ReadWrite)},
       groups(o.samples, 64), static_cast<unsigned>(o.slices));
@@ -242,7 +245,7 @@ void EpipolarSamplingPass::unwarp(const FrameAttribs& f) {
   evaluatorBarrier();
   gpu::clearSampleList(*backend_, correctionBuffer_.id());
   dispatch(
-      "unwarp",
+      "passes/epipolar/unwarp.comp",
       {gpu::Resource::sampled(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth),
        gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_COORDINATES_IN_IMAGE, coordinates_.id(),
                             gpu::Access::ReadOnly),
@@ -260,7 +263,7 @@ void EpipolarSamplingPass::upscale(const FrameAttribs& f) {
   upscaleList_.output = f.output;
   evaluatorBarrier();
   gpu::clearSampleList(*backend_, upscaleBuffer_.id());
-  dispatch("upscale",
+  dispatch("passes/epipolar/upscale.comp",
            {gpu::Resource::sampled(CREP_EPIPOLAR_SAMPLING_CAMERA_DEPTH_UNIT, f.cameraDepth),
             gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_TARGET_IN_IMAGE, target_.id(), gpu::Access::ReadOnly),
             gpu::Resource::image(CREP_EPIPOLAR_SAMPLING_TARGET_COORDINATES_IN_IMAGE, targetCoordinates_.id(),
