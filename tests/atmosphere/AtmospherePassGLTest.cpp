@@ -2,6 +2,7 @@
 // built-in scene with a real rectified shadow map: both sides read the same tables (computed once on the
 // GPU and downloaded) and the same map (rendered on the GPU, read back for the CPU trees and sections).
 #include "common/analytic_reference.h"
+#include "common/atmosphere_tables.h"
 #include "common/error_checks.h"
 #include "common/gl_fixture.h"
 #include "common/gl_scene_maps.h"
@@ -41,16 +42,7 @@ struct Tables {
 
 Tables& tables() {
   static Tables t = [] {
-    AtmosphereTablesPass::CreateInfo info;
-    info.options.size = {8, 16, 8, 4};
-    info.options.orders = 2;
-    info.options.singleSteps = 32;
-    info.options.orderSteps = 32;
-    info.options.sphereSamples = 32;
-    info.options.opticalDepthHeight = 32;
-    info.options.opticalDepthZenith = 64;
-    info.options.opticalDepthSteps = 64;
-    info.options.ambientSize = 16;
+    const AtmosphereTablesPass::CreateInfo info = smallAtmosphereTables(2);
     Tables r;
     r.pass = std::make_unique<AtmosphereTablesPass>(info);
     r.pass->compute();

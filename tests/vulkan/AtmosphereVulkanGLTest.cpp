@@ -3,6 +3,7 @@
 // scattering LUT, one order, half-float tables), then AtmospherePass in every shafts mode on the terrain
 // scene's camera depth and rectified map, each backend reading its own tables. Bar: relative RMSE <= 1e-4
 // between the backends, the issue's bound for the frame.
+#include "common/atmosphere_tables.h"
 #include "common/gl_fixture.h"
 #include "common/gl_scene_maps.h"
 #include "common/vulkan_fixture.h"
@@ -29,20 +30,6 @@ using namespace crep;
 namespace {
 
 constexpr int kWidth = 64, kHeight = 36, kMapWidth = 256, kMapHeight = 128;
-
-AtmosphereTablesPass::CreateInfo smallTables() {
-  AtmosphereTablesPass::CreateInfo info;
-  info.options.size = {8, 16, 8, 4};
-  info.options.orders = 3;
-  info.options.singleSteps = 32;
-  info.options.orderSteps = 32;
-  info.options.sphereSamples = 32;
-  info.options.opticalDepthHeight = 32;
-  info.options.opticalDepthZenith = 64;
-  info.options.opticalDepthSteps = 64;
-  info.options.ambientSize = 16;
-  return info;
-}
 
 /// Relative RMSE of a against b over every value (b's energy); the plain RMSE where b is all zero.
 double relativeRmse(const std::vector<float>& a, const std::vector<float>& b) {
@@ -146,7 +133,7 @@ TEST_CASE("Vulkan backend: the atmosphere's tables give GL's") {
                        Case{"single scattering only", AtmosphereMultipleScattering::Orders, 1, false},
                        Case{"orders, RGBA16F tables", AtmosphereMultipleScattering::Orders, 2, true}}) {
     CAPTURE(std::string(c.name));
-    AtmosphereTablesPass::CreateInfo info = smallTables();
+    AtmosphereTablesPass::CreateInfo info = test::smallAtmosphereTables(3);
     info.options.multipleScattering = c.method;
     info.options.orders = c.orders;
     info.halfFloatTables = c.half;
@@ -197,7 +184,7 @@ TEST_CASE("Vulkan backend: the atmosphere pass gives GL's image in every shafts 
     march.run(m);
     prefiltered = gl.readTexture(out.id());
   }
-  AtmosphereTablesPass::CreateInfo info = smallTables();
+  AtmosphereTablesPass::CreateInfo info = test::smallAtmosphereTables(3);
   info.backend = &vk;
   AtmosphereTablesPass vkTables(info);
   vkTables.compute();
