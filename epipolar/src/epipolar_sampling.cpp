@@ -136,9 +136,16 @@ glm::dvec2 EpipolarLines::samplePoint(int line, int k) const {
 }
 
 // Yusov 2012, Sec. 6.1: epipole, exit arc, line end points (rescaled short lines), valid sample range.
+double epipolarLineOffset(int rows, int lines) {
+  if (rows <= 0 || lines <= 0 || rows % lines != 0 || (rows / lines) % 2 != 0) return 0.0;
+  return 0.5 / (rows / lines);
+}
+
 EpipolarLines epipolarLines(const Camera& camera, const DirectionalLight& light, int width, int height,
-                            const EpipolarSamplingOptions& options) {
+                            const EpipolarSamplingOptions& options, double lineOffset) {
   validate(options);
+  if (!(lineOffset >= 0.0 && lineOffset <= 0.5))
+    throw InvalidArgument("lineOffset", detail::formatValue(lineOffset), "must be in [0, 0.5]");
   if (width <= 0 || width > Image::kMaxDimension || width % options.downscale != 0)
     throw InvalidArgument("width", detail::formatValue(width),
                           "must be in [1, " + std::to_string(Image::kMaxDimension) +
@@ -191,6 +198,8 @@ EpipolarLines epipolarLines(const Camera& camera, const DirectionalLight& light,
   }
 
   const int N = options.slices, Ns = options.samples;
+  // The lines' slots start lineOffset of a spacing later (sliceOf and the GPU unwarp measure from arcBegin).
+  out.arcBegin = positiveMod(out.arcBegin + lineOffset * out.arcLength / N, P);
   out.lines.resize(static_cast<std::size_t>(N));
   for (int i = 0; i < N; ++i) {
     EpipolarLines::Line& line = out.lines[static_cast<std::size_t>(i)];

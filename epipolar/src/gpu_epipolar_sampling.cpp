@@ -72,6 +72,9 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
   if (info.height <= 0)
     throw InvalidArgument(std::string(kCreate) + ".height", std::to_string(info.height), "must be > 0");
   crep::validate(info.options, std::string(kCreate) + ".options");
+  if (!(info.lineOffset >= 0.0 && info.lineOffset <= 0.5))
+    throw InvalidArgument(std::string(kCreate) + ".lineOffset", detail::formatValue(info.lineOffset),
+                          "must be in [0, 0.5]");
   const EpipolarSamplingOptions& o = info.options;
   backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
   gpu::Backend& b = *backend_;
@@ -191,7 +194,7 @@ void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
   validate(f);
   const EpipolarSamplingOptions& o = info_.options;
   gpu::Backend& b = *backend_;
-  lines_ = epipolarLines(*f.camera, *f.light, info_.width, info_.height, o);
+  lines_ = epipolarLines(*f.camera, *f.light, info_.width, info_.height, o, info_.lineOffset);
   const gpu::MarchParams march =
       gpu::makeMarchParams(*f.camera, *f.light, *f.medium, info_.width, info_.height, o.samples, o.slices);
   b.writeBuffer(params_.id(), 0, std::as_bytes(std::span(&march, 1)));

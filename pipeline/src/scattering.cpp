@@ -361,8 +361,12 @@ struct Scattering::Impl {
                                                    backend});
     }
     if (treeBlock) march->prepare(gpu::LayoutKind::Epipolar);
-    if (i.sampling == Sampling::Epipolar)
-      sampling.emplace(EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling, backend});
+    if (i.sampling == Sampling::Epipolar) {
+      // Its lines share the border arc of the sun's epipolar map (mapSize rows): none on a row boundary.
+      sampling.emplace(
+          EpipolarSamplingPass::CreateInfo{i.width, i.height, i.epipolarSampling, backend,
+                                           epipolarLineOffset(i.mapSize, i.epipolarSampling.slices)});
+    }
     const int factor = static_cast<int>(std::lround(1.0 / i.evaluationScale));
     if (factor > 1) {
       reduced.emplace(DepthAwareResamplePass::CreateInfo{i.width, i.height, factor, backend});

@@ -547,6 +547,12 @@ TEST_CASE("EpipolarSampling GL: validation names the field") {
   CHECK(invalidParameter([&] {
           EpipolarSamplingPass({162, 88, o});
         }) == "EpipolarSamplingPass::CreateInfo.width");
+  for (const double offset : {-0.1, 0.75}) {
+    CAPTURE(offset);
+    CHECK(invalidParameter([&] {
+            EpipolarSamplingPass({kWidth, kHeight, smallOptions(), nullptr, offset});
+          }) == "EpipolarSamplingPass::CreateInfo.lineOffset");
+  }
 
   Scene scene(sideLight());
   EpipolarSamplingPass pass({kWidth, kHeight, smallOptions()});

@@ -223,45 +223,86 @@ TEST_CASE("EpipolarSampling lines: valid samples fill the visible segment, exits
   }
 }
 
-TEST_CASE("EpipolarSampling lines: sliceOf of a line's samples returns the line") {
+TEST_CASE("EpipolarSampling lines: sliceOf of a line's samples returns the line, with any line offset") {
   const int W = 160, H = 90;
   const Camera camera = groundCamera(W, H);
   EpipolarSamplingOptions o;
   o.slices = 256;
   o.samples = 64;
-  for (const LineCase& c : kLineCases) {
-    const std::string name = c.name;
-    CAPTURE(name);
-    const EpipolarLines lines = epipolarLines(camera, lightAt(camera, c.ndc, c.front), W, H, o);
-    const double N = o.slices;
-    double worst = 0.0;
-    int checked = 0;
-    for (int i = 0; i < o.slices; ++i)
-      for (int k = 0; k <= lines.lines[static_cast<std::size_t>(i)].lastValid; ++k) {
-        const glm::dvec2 p = lines.samplePoint(i, k);
-        if (glm::length(p - lines.epipole) < 1e-3) {
-          CHECK_FALSE(lines.sliceOf(p).has_value());
-          continue;
+  for (const double offset : {0.0, 0.25, 0.5})
+    for (const LineCase& c : kLineCases) {
+      const std::string name = c.name;
+      CAPTURE(name);
+      CAPTURE(offset);
+      const EpipolarLines lines = epipolarLines(camera, lightAt(camera, c.ndc, c.front), W, H, o, offset);
+      const EpipolarLines unshifted = epipolarLines(camera, lightAt(camera, c.ndc, c.front), W, H, o);
+      const double N = o.slices;
+      double worst = 0.0, worstExit = 0.0;
+      int checked = 0;
+      for (int i = 0; i < o.slices; ++i) {
+        // Line i runs toward the border point (i + 0.5 + offset) spacings into the unshifted exit arc.
+        const EpipolarLines::Line& l = lines.lines[static_cast<std::size_t>(i)];
+        const glm::dvec2 X =
+            lines.borderPoint(unshifted.arcBegin + (i + 0.5 + offset) / N * unshifted.arcLength);
+        const glm::dvec2 along = l.exit - l.entry, toX = X - l.entry;
+        if (glm::length(along) > 1e-6 && glm::length(toX) > 1e-6)
+          worstExit = std::max(worstExit, std::abs(along.x * toX.y - along.y * toX.x) /
+                                              (glm::length(along) * glm::length(toX)));
+        for (int k = 0; k <= lines.lines[static_cast<std::size_t>(i)].lastValid; ++k) {
+          const glm::dvec2 p = lines.samplePoint(i, k);
+          if (glm::length(p - lines.epipole) < 1e-3) {
+            CHECK_FALSE(lines.sliceOf(p).has_value());
+            continue;
+          }
+          const std::optional<double> s = lines.sliceOf(p);
+          REQUIRE(s.has_value());
+          worst = std::max(worst, std::abs(*s - i));
+          ++checked;
         }
-        const std::optional<double> s = lines.sliceOf(p);
-        REQUIRE(s.has_value());
-        worst = std::max(worst, std::abs(*s - i));
-        ++checked;
       }
-    CHECK(worst < 1e-6);
-    CHECK(checked > o.slices * 10);
-    if (lines.epipoleOnScreen) {
-      // The wrap-around: the ray from e through the top-left corner (sigma = 0 = P) is half a slice before
-      // slice 0 and half a slice after slice N - 1.
-      const glm::dvec2 corner(0.0, H);
-      const std::optional<double> s = lines.sliceOf(lines.epipole + 0.5 * (corner - lines.epipole));
-      REQUIRE(s.has_value());
-      CHECK(cyclicDistance(*s, -0.5, N) < 1e-6);
-      CHECK(*s >= -0.5 - 1e-9);
-      CHECK(*s < N - 0.5 + 1e-9);
-      CHECK_FALSE(lines.sliceOf(lines.epipole + glm::dvec2(4e-4, -5e-4)).has_value());
+      CHECK(worst < 1e-6);
+      CHECK(worstExit < 1e-6);
+      CHECK(checked > o.slices * 10);
+      if (lines.epipoleOnScreen) {
+        // The wrap-around: the ray from e through the top-left corner (sigma = 0 = P) is half a slice (plus
+        // the offset) before slice 0 and half a slice (less it) after slice N - 1.
+        const glm::dvec2 corner(0.0, H);
+        const std::optional<double> s = lines.sliceOf(lines.epipole + 0.5 * (corner - lines.epipole));
+        REQUIRE(s.has_value());
+        CHECK(cyclicDistance(*s, -0.5 - offset, N) < 1e-6);
+        CHECK(*s >= -0.5 - offset - 1e-9);
+        CHECK(*s < N - 0.5 - offset + 1e-9);
+        CHECK_FALSE(lines.sliceOf(lines.epipole + glm::dvec2(4e-4, -5e-4)).has_value());
+      }
+    }
+  CHECK_THROWS_WITH_AS(epipolarLines(camera, lightAt(camera, kLineCases[0].ndc, true), W, H, o, 0.6),
+                       doctest::Contains("lineOffset"), InvalidArgument);
+}
+
+TEST_CASE("EpipolarSampling lines: the offset that puts lines on the centres of a map's rows") {
+  // Line i at (i + 0.5 + offset) / N of the arc, row r's centre at (r + 0.5) / R: with R = m N the line is
+  // at m (i + 0.5 + offset) - 0.5 rows from row 0's centre, an integer for every i exactly when it is one
+  // for i = 0.
+  for (const auto& [rows, lines] : {std::pair{1024, 1024}, std::pair{512, 256}, std::pair{1024, 256},
+                                    std::pair{768, 256}, std::pair{1000, 256}, std::pair{256, 512}}) {
+    CAPTURE(rows);
+    CAPTURE(lines);
+    const double offset = epipolarLineOffset(rows, lines);
+    CHECK(offset >= 0.0);
+    CHECK(offset <= 0.5);
+    if (rows % lines != 0) {
+      CHECK(offset == 0.0);
+      continue;
+    }
+    const double m = static_cast<double>(rows) / lines;
+    for (int i : {0, 1, lines / 2, lines - 1}) {
+      const double fromCentre = m * (i + 0.5 + offset) - 0.5;
+      CHECK(std::abs(fromCentre - std::round(fromCentre)) < 1e-12); // on a row's centre
     }
   }
+  CHECK(epipolarLineOffset(512, 256) == 0.25);
+  CHECK(epipolarLineOffset(1024, 1024) == 0.0);
+  CHECK(epipolarLineOffset(0, 256) == 0.0);
 }
 
 TEST_CASE("EpipolarSampling lines: a light parallel to the image plane gives finite, nearly parallel lines") {

@@ -65,9 +65,16 @@ struct EpipolarLines {
 };
 
 /// Yusov 2012, Sec. 6.1: epipole, exit arc and every line. Throws InvalidArgument for bad options or
-/// "width" / "height" (<= 0, > Image::kMaxDimension, not a multiple of options.downscale). Per frame, O(N).
+/// "width" / "height" (<= 0, > Image::kMaxDimension, not a multiple of options.downscale) or "lineOffset"
+/// (outside [0, 0.5]). Per frame, O(N). lineOffset moves every line along the border by that fraction of
+/// the line spacing (arcBegin with it): crep::Scattering puts the lines on its epipolar map's row centres.
 EpipolarLines epipolarLines(const Camera& camera, const DirectionalLight& light, int width, int height,
-                            const EpipolarSamplingOptions& options);
+                            const EpipolarSamplingOptions& options, double lineOffset = 0.0);
+
+/// The lineOffset that puts `lines` lines on the centres of `rows` rows spanning the same border arc: with
+/// rows = m lines and m even each line would lie on a boundary between two rows (half a row moves it to a
+/// centre); 0 otherwise (no line on a boundary, or a ratio that does not repeat).
+double epipolarLineOffset(int rows, int lines);
 
 /// Stage 2 output.
 struct EpipolarSamples {

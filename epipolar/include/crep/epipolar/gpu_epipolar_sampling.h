@@ -61,6 +61,9 @@ public:
     EpipolarSamplingOptions options;
     /// Runs the pass (must outlive it); null: a gpu::GlBackend of its own on the current GL context.
     gpu::Backend* backend = nullptr;
+    /// epipolarLines' lineOffset, in [0, 0.5]: the lines moved along the border by this fraction of their
+    /// spacing (crep::Scattering: epipolarLineOffset of its map's rows, so no line lies on a row boundary).
+    double lineOffset = 0.0;
   };
   /// Per-frame inputs: non-owning.
   struct FrameAttribs {
