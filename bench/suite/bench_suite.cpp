@@ -1591,7 +1591,7 @@ BenchOptions parseBenchOptions(const std::vector<std::string>& argv) {
   o.plot = args.string("plot", "");
   if (args.has("section")) o.sections = parseSections(args.string("section", ""));
   o.backend = args.string("backend", o.backend);
-  tool::requireBackend(o.backend, "prefilter");
+  tool::requireBackend(o.backend);
   if (!o.plot.empty()) {
     for (const char* needed : kPlotSections)
       if (!o.sections.empty() && std::find(o.sections.begin(), o.sections.end(), needed) == o.sections.end())

@@ -3,13 +3,13 @@
 // reference, metrics and timings printed on the sheet) and a CSV (relative RMSE, PSNR, max and mean
 // absolute error of the in-scattered radiance against the reference, milliseconds per stage).
 #include "args.h"
+#include "backend_method.h"
 #include "commands.h"
 #include "contact_sheet.h"
 #include "gl_session.h"
 #include "methods.h"
 #include "options.h"
 #include "paths.h"
-#include "backend_method.h"
 #include "scene_frame.h"
 #include "timings.h"
 
@@ -129,7 +129,7 @@ CompareArgs parseCompareArgs(const std::vector<std::string>& argv) {
   o.names = selectedMethods(args);
   o.backend = args.string("backend", "opengl");
   if (o.backend != "opengl") {
-    requireBackend(o.backend, "prefilter");
+    requireBackend(o.backend);
     if (std::none_of(o.names.begin(), o.names.end(), runsOnBackend))
       throw UsageError(
           "option --backend " + o.backend +

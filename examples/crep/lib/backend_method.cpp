@@ -15,6 +15,8 @@
 
 #include <epoxy/gl.h>
 
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace crep::tool {
@@ -23,16 +25,31 @@ std::string backendNames() {
   return CREP_HAS_VULKAN ? "opengl | vulkan" : "opengl";
 }
 
+namespace {
+/// The front door's method and sampling of a tool method that is crep::Scattering's; nullopt for the others.
+std::optional<std::pair<Scattering::Method, Scattering::Sampling>> frontDoorMethod(const std::string& name) {
+  using M = Scattering::Method;
+  using S = Scattering::Sampling;
+  if (name == "prefilter") return std::pair{M::Prefiltered, S::PerPixel};
+  if (name == "minmax") return std::pair{M::MinMaxMarch, S::PerPixel};
+  if (name == "epipolar-sampling") return std::pair{M::MinMaxMarch, S::Epipolar};
+  if (name == "epipolar-prefilter") return std::pair{M::Prefiltered, S::Epipolar};
+  return std::nullopt;
+}
+} // namespace
+
 bool runsOnBackend(const std::string& method) {
-  return method == "prefilter" || method == "minmax" || method == "epipolar-sampling" ||
-         method == "epipolar-prefilter";
+  return frontDoorMethod(method).has_value();
+}
+
+void requireBackend(const std::string& backend) {
+  if (backend != "opengl" && (backend != "vulkan" || !CREP_HAS_VULKAN))
+    throw UsageError("option --backend: unknown backend '" + backend + "' (one of: " + backendNames() + ")");
 }
 
 void requireBackend(const std::string& backend, const std::string& method) {
-  if (backend == "opengl") return;
-  if (backend != "vulkan" || !CREP_HAS_VULKAN)
-    throw UsageError("option --backend: unknown backend '" + backend + "' (one of: " + backendNames() + ")");
-  if (!runsOnBackend(method))
+  requireBackend(backend);
+  if (backend != "opengl" && !runsOnBackend(method))
     throw UsageError("option --backend vulkan: runs --method prefilter, minmax, epipolar-sampling or "
                      "epipolar-prefilter (crep::Scattering), not " +
                      method);
@@ -53,6 +70,7 @@ std::string deviceName(const gpu::Backend& b) {
 
 MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const MethodSettings& settings,
                          gpu::Backend* vulkan) {
+  requireBackend("vulkan", method); // a UsageError for a method that is not crep::Scattering's
   const scenes::Scene& scene = *s.scene;
   const FrameInputs& frame = *s.frame;
   MethodOutput out;
@@ -79,11 +97,8 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
   const scenes::EngineFrame engine(vk, scene, maps);
   gpu::Texture output(vk, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, frame.width, frame.height, 1,
                            "crep render: scattering"});
-  const bool marching = method == "minmax" || method == "epipolar-sampling";
-  const bool sampled = method == "epipolar-sampling" || method == "epipolar-prefilter";
-  Scattering::CreateInfo info = frontDoorCreateInfo(
-      frame, settings, marching ? Scattering::Method::MinMaxMarch : Scattering::Method::Prefiltered,
-      sampled ? Scattering::Sampling::Epipolar : Scattering::Sampling::PerPixel);
+  const auto [frontDoor, sampling] = *frontDoorMethod(method);
+  Scattering::CreateInfo info = frontDoorCreateInfo(frame, settings, frontDoor, sampling);
   info.backend = &vk;
   Scattering scattering = out.timings.time("setup", [&] { return Scattering(info); });
   const Scattering::FrameResult r = scattering.run(engine.attribs(output.id()));

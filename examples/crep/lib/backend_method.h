@@ -17,7 +17,9 @@ std::string backendNames();
 /// The methods that run on another backend: crep::Scattering's (prefilter, minmax, epipolar-sampling,
 /// epipolar-prefilter).
 bool runsOnBackend(const std::string& method);
-/// UsageError unless `backend` is one of backendNames() and, for Vulkan, `method` runs there.
+/// UsageError unless `backend` is one of backendNames().
+void requireBackend(const std::string& backend);
+/// The same, and for Vulkan `method` must run there.
 void requireBackend(const std::string& backend, const std::string& method);
 /// A Vulkan device (gpu::VulkanBackend) to keep across runs: its pipelines stay built. UsageError in a build
 /// without the Vulkan backend; VulkanError when no Vulkan device answers.
