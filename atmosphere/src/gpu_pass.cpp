@@ -126,8 +126,7 @@ void AtmospherePass::validate(const FrameAttribs& f, std::string_view owner) con
 }
 
 AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_view owner) const {
-  if (backend_ == nullptr)
-    invalid("AtmospherePass", "a moved-from object", "owns no GPU objects: assign a constructed one first");
+  gpu::requireNotMovedFrom(backend_, "AtmospherePass");
   const std::string p = std::string(owner) + ".";
   const gpu::Backend& b = *backend_;
   Plan plan;

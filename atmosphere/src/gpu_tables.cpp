@@ -128,12 +128,6 @@ AtmosphereTablesPass& AtmosphereTablesPass::operator=(AtmosphereTablesPass&& o) 
   return *this;
 }
 
-void AtmosphereTablesPass::requireConstructed() const {
-  if (backend_ == nullptr)
-    invalid("AtmosphereTablesPass", "a moved-from object",
-            "owns no GPU objects: assign a constructed one first");
-}
-
 namespace {
 
 /// The programs of the table stages (one compute shader each, one texel per invocation) for `o`: the J_n /
@@ -246,9 +240,9 @@ struct TableRun {
   }
   /// accumulator += addend (sum), = addend (copy) or = 0 (clear: addend 0).
   void accumulate(const ShaderStageSource& stage, gpu::TextureId accumulator, gpu::TextureId addend) const {
-    std::vector<gpu::Resource> r = {gpu::Resource::image(
-        CREP_ATMOSPHERE_TABLES_SUM_ACCUMULATOR_IMAGE, accumulator,
-        addend != 0 && &stage == &stages.sum ? gpu::Access::ReadWrite : gpu::Access::WriteOnly)};
+    std::vector<gpu::Resource> r = {
+        gpu::Resource::image(CREP_ATMOSPHERE_TABLES_SUM_ACCUMULATOR_IMAGE, accumulator,
+                             &stage == &stages.sum ? gpu::Access::ReadWrite : gpu::Access::WriteOnly)};
     if (addend != 0)
       r.push_back(
           gpu::Resource::image(CREP_ATMOSPHERE_TABLES_SUM_ADDEND_IMAGE, addend, gpu::Access::ReadOnly));
@@ -322,7 +316,7 @@ void computeOrders(const TableRun& t, StageClock& clock) {
 } // namespace
 
 void AtmosphereTablesPass::compute() {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "AtmosphereTablesPass");
   const AtmospherePrecomputeOptions& o = info_.options;
   gpu::Backend& b = *backend_;
   times_.clear();
@@ -401,7 +395,7 @@ Image rgb(const std::vector<float>& rgba, int width, int height) {
 } // namespace
 
 void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "AtmosphereTablesPass");
   const AtmospherePrecomputeOptions& o = info_.options;
   const auto fail = [](const std::string& why) {
     throw InvalidArgument("AtmosphereTablesPass::upload.tables", "(tables)", why);
@@ -435,7 +429,7 @@ void AtmosphereTablesPass::upload(const AtmosphereTables& tables) {
 }
 
 AtmosphereTables AtmosphereTablesPass::download() const {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "AtmosphereTablesPass");
   const AtmospherePrecomputeOptions& o = info_.options;
   gpu::Backend& b = *backend_;
   AtmosphereTables t;

@@ -53,6 +53,12 @@ float roundedToHalf(float f) {
   return glm::unpackHalf1x16(halfBits(f));
 }
 
+void requireNotMovedFrom(const Backend* backend, const char* owner) {
+  if (backend == nullptr)
+    throw InvalidArgument(owner, "a moved-from object",
+                          "owns no GPU objects: assign a constructed one first");
+}
+
 Resource Resource::sampled(std::uint32_t binding, TextureId t, Filter f) {
   Resource r;
   r.kind = ResourceKind::SampledTexture;

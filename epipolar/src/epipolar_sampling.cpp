@@ -135,11 +135,14 @@ glm::dvec2 EpipolarLines::samplePoint(int line, int k) const {
   return l.entry + (l.exit - l.entry) * (static_cast<double>(k) / static_cast<double>(samples - 1));
 }
 
-// Yusov 2012, Sec. 6.1: epipole, exit arc, line end points (rescaled short lines), valid sample range.
+// Line i at (i + 0.5 + offset) / N of the arc, row r's centre at (r + 0.5) / R: for R = m N a centre when
+// m (0.5 + offset) - 0.5 is an integer, already for offset 0 when m is odd.
 double epipolarLineOffset(int rows, int lines) {
   if (rows <= 0 || lines <= 0 || rows % lines != 0 || (rows / lines) % 2 != 0) return 0.0;
   return 0.5 / (rows / lines);
 }
+
+// Yusov 2012, Sec. 6.1: epipole, exit arc, line end points (rescaled short lines), valid sample range.
 
 EpipolarLines epipolarLines(const Camera& camera, const DirectionalLight& light, int width, int height,
                             const EpipolarSamplingOptions& options, double lineOffset) {

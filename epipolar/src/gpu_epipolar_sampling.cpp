@@ -162,7 +162,7 @@ EpipolarSamplingPass& EpipolarSamplingPass::operator=(EpipolarSamplingPass&& o) 
 }
 
 void EpipolarSamplingPass::validate(const FrameAttribs& f, std::string_view owner) const {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "EpipolarSamplingPass");
   const std::string p = std::string(owner) + ".";
   if (!f.camera) invalid(p + "camera", "null", "must be set");
   if (!f.light) invalid(p + "light", "null", "must be set");
@@ -217,7 +217,7 @@ void EpipolarSamplingPass::placeSamples(const FrameAttribs& f) {
 }
 
 void EpipolarSamplingPass::refine() {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "EpipolarSamplingPass");
   gpu::clearSampleList(*backend_, sampleBuffer_.id());
   dispatch(
       "passes/epipolar/refine.comp",
@@ -231,7 +231,7 @@ void EpipolarSamplingPass::refine() {
 }
 
 void EpipolarSamplingPass::interpolate() {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "EpipolarSamplingPass");
   evaluatorBarrier();
   const EpipolarSamplingOptions& o = info_.options;
   dispatch(
@@ -298,12 +298,6 @@ void EpipolarSamplingPass::run(const FrameAttribs& f,
 void EpipolarSamplingPass::evaluatorBarrier() const {
   if (backend_->name() == "OpenGL")
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-}
-
-void EpipolarSamplingPass::requireConstructed() const {
-  if (backend_ == nullptr)
-    invalid("EpipolarSamplingPass", "a moved-from object",
-            "owns no GPU objects: assign a constructed one first");
 }
 
 EpipolarSamplingPass::Statistics EpipolarSamplingPass::statistics() const {

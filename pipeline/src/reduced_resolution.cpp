@@ -144,14 +144,8 @@ DepthAwareResamplePass& DepthAwareResamplePass::operator=(DepthAwareResamplePass
   return *this;
 }
 
-void DepthAwareResamplePass::requireConstructed() const {
-  if (backend_ == nullptr)
-    invalid("DepthAwareResamplePass", "a moved-from object",
-            "owns no GL objects: assign a constructed one first");
-}
-
 void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t lowDepth) {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "DepthAwareResamplePass");
   gpu::Backend& b = *backend_;
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::downsample.fullDepth", fullDepth, info_.width,
                           info_.height);
@@ -180,7 +174,7 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
 
 void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth,
                                       std::uint32_t output, const glm::vec4& depthMap) {
-  requireConstructed();
+  gpu::requireNotMovedFrom(backend_, "DepthAwareResamplePass");
   gpu::Backend& b = *backend_;
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.low", low, lowWidth(), lowHeight(),
                           GL_RGBA32F);

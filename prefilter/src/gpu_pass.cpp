@@ -404,8 +404,7 @@ PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_v
 }
 
 void PrefilterPass::run(const FrameAttribs& frame) {
-  if (backend_ == nullptr)
-    invalid("PrefilterPass", "a moved-from object", "owns no GL objects: assign a constructed one first");
+  gpu::requireNotMovedFrom(backend_, "PrefilterPass");
   const Plan p = plan(frame, "PrefilterPass::FrameAttribs");
   if (p.textured) prepareTextured(p.local);
   const std::size_t weightBytes = upload(frame, p);
@@ -870,8 +869,7 @@ EvaluatePass::Plan EvaluatePass::plan(const FrameAttribs& frame, std::string_vie
 }
 
 void EvaluatePass::run(const FrameAttribs& frame) {
-  if (backend_ == nullptr)
-    invalid("EvaluatePass", "a moved-from object", "owns no GPU objects: assign a constructed one first");
+  gpu::requireNotMovedFrom(backend_, "EvaluatePass");
   const Plan p = plan(frame, "EvaluatePass::FrameAttribs");
   if (p.local) uploadLocalLight(frame);
   if (!p.projective)

@@ -84,7 +84,6 @@ public:
 
 private:
   CreateInfo info_;
-  void requireConstructed() const;
   std::unique_ptr<gpu::Backend> ownBackend_;
   gpu::Backend* backend_ = nullptr; ///< null when moved from
   gpu::Texture opticalDepth_, single_, singleMie_, higher_, ambient_, msLut_;

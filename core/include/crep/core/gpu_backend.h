@@ -169,6 +169,10 @@ public:
   virtual void cancelTimer() noexcept {}
 };
 
+/// A pass's check that it was not moved from (its backend pointer is then null): InvalidArgument naming
+/// `owner` ("EvaluatePass", ...).
+void requireNotMovedFrom(const Backend* backend, const char* owner);
+
 /// InvalidArgument naming `parameter` for sizes <= 0; beyond backend.maxTextureSize() GlError on the GL
 /// backend (as gl::checkTextureSize), InvalidArgument on others.
 void checkTextureSize(const Backend& backend, const char* parameter, int width, int height);

@@ -135,7 +135,6 @@ public:
   std::size_t memoryBytes() const noexcept;
 
 private:
-  void requireConstructed() const;
   void evaluatorBarrier() const;
   void dispatch(const char* stage, std::vector<gpu::Resource> resources, unsigned groupsX, unsigned groupsY);
 

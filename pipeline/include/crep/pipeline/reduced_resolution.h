@@ -61,7 +61,6 @@ public:
 private:
   void upsample(std::uint32_t low, std::uint32_t lowDepth, std::uint32_t fullDepth, std::uint32_t output,
                 const glm::vec4& depthMap);
-  void requireConstructed() const;
   CreateInfo info_;
   std::unique_ptr<gpu::Backend> ownBackend_;
   gpu::Backend* backend_ = nullptr; ///< null when moved from
