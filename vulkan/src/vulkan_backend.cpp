@@ -1,27 +1,135 @@
 // gpu::Backend on Vulkan 1.1 (crep/vulkan/vulkan_backend.h). One command buffer records the calls in
-// order; a read or finish() submits it and waits. Choices made for a real GPU are marked "GPU:".
+// order; a read or finish() submits it and waits. Every Vulkan function is called through the table `Vk`,
+// loaded from the given vkGetInstanceProcAddr / vkGetDeviceProcAddr (the engine's loader, or libvulkan's for
+// a device of its own). Choices made for a real GPU are marked "GPU:".
+#define VK_NO_PROTOTYPES // no Vulkan prototype may be called by mistake: only the table's pointers
 #include "crep/bindings.h"
 
 #include <crep/vulkan/vulkan_backend.h>
 
 #include <shaderc/shaderc.hpp>
-#include <vulkan/vulkan.h>
+#include <vulkan/vulkan_core.h>
 
 #include <glm/gtc/packing.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <mutex>
 
+// libvulkan's entry point (linked through Vulkan::Vulkan), for the backend's own device: VK_NO_PROTOTYPES
+// hides the header's declaration.
+extern "C" VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetInstanceProcAddr(VkInstance instance,
+                                                                          const char* pName);
+
 namespace crep::gpu {
 
 namespace {
 
+// The Vulkan functions the backend calls, by how they are loaded. Those of the first two lists and
+// vkDestroyDevice / vkDeviceWaitIdle serve only a device of the backend's own: on an engine's device they are
+// not even looked up.
+#define CREP_VK_GLOBAL_FUNCTIONS(X) X(vkCreateInstance) X(vkEnumerateInstanceLayerProperties)
+#define CREP_VK_OWN_INSTANCE_FUNCTIONS(X)                                                                    \
+  X(vkDestroyInstance) X(vkEnumeratePhysicalDevices) X(vkCreateDevice) X(vkEnumerateDeviceExtensionProperties)
+#define CREP_VK_INSTANCE_FUNCTIONS(X)                                                                        \
+  X(vkGetPhysicalDeviceProperties)                                                                           \
+  X(vkGetPhysicalDeviceQueueFamilyProperties)                                                                \
+  X(vkGetPhysicalDeviceMemoryProperties)                                                                     \
+  X(vkGetPhysicalDeviceFeatures)                                                                             \
+  X(vkGetPhysicalDeviceFormatProperties)
+#define CREP_VK_OWN_DEVICE_FUNCTIONS(X) X(vkDestroyDevice) X(vkDeviceWaitIdle) X(vkGetDeviceQueue)
+#define CREP_VK_DEVICE_FUNCTIONS(X)                                                                          \
+  X(vkCreateCommandPool)                                                                                     \
+  X(vkDestroyCommandPool)                                                                                    \
+  X(vkAllocateCommandBuffers)                                                                                \
+  X(vkBeginCommandBuffer)                                                                                    \
+  X(vkEndCommandBuffer)                                                                                      \
+  X(vkResetCommandBuffer)                                                                                    \
+  X(vkCreateFence)                                                                                           \
+  X(vkDestroyFence)                                                                                          \
+  X(vkWaitForFences)                                                                                         \
+  X(vkResetFences)                                                                                           \
+  X(vkQueueSubmit)                                                                                           \
+  X(vkCreateQueryPool)                                                                                       \
+  X(vkDestroyQueryPool)                                                                                      \
+  X(vkGetQueryPoolResults)                                                                                   \
+  X(vkCreateSampler)                                                                                         \
+  X(vkDestroySampler)                                                                                        \
+  X(vkCreateBuffer)                                                                                          \
+  X(vkDestroyBuffer)                                                                                         \
+  X(vkGetBufferMemoryRequirements)                                                                           \
+  X(vkBindBufferMemory)                                                                                      \
+  X(vkCreateImage)                                                                                           \
+  X(vkDestroyImage)                                                                                          \
+  X(vkGetImageMemoryRequirements)                                                                            \
+  X(vkBindImageMemory)                                                                                       \
+  X(vkCreateImageView)                                                                                       \
+  X(vkDestroyImageView)                                                                                      \
+  X(vkAllocateMemory)                                                                                        \
+  X(vkFreeMemory)                                                                                            \
+  X(vkMapMemory)                                                                                             \
+  X(vkUnmapMemory)                                                                                           \
+  X(vkCreateShaderModule)                                                                                    \
+  X(vkDestroyShaderModule)                                                                                   \
+  X(vkCreateDescriptorSetLayout)                                                                             \
+  X(vkDestroyDescriptorSetLayout)                                                                            \
+  X(vkCreatePipelineLayout)                                                                                  \
+  X(vkDestroyPipelineLayout)                                                                                 \
+  X(vkCreateComputePipelines)                                                                                \
+  X(vkDestroyPipeline)                                                                                       \
+  X(vkCreateDescriptorPool)                                                                                  \
+  X(vkDestroyDescriptorPool)                                                                                 \
+  X(vkResetDescriptorPool)                                                                                   \
+  X(vkAllocateDescriptorSets)                                                                                \
+  X(vkUpdateDescriptorSets)                                                                                  \
+  X(vkCmdPipelineBarrier)                                                                                    \
+  X(vkCmdCopyBuffer)                                                                                         \
+  X(vkCmdUpdateBuffer)                                                                                       \
+  X(vkCmdCopyBufferToImage)                                                                                  \
+  X(vkCmdCopyImageToBuffer)                                                                                  \
+  X(vkCmdBindPipeline)                                                                                       \
+  X(vkCmdBindDescriptorSets)                                                                                 \
+  X(vkCmdPushConstants)                                                                                      \
+  X(vkCmdDispatch)                                                                                           \
+  X(vkCmdDispatchIndirect)                                                                                   \
+  X(vkCmdResetQueryPool)                                                                                     \
+  X(vkCmdWriteTimestamp)
+
+/// The function table: one pointer per function of the lists above, and the optional ones (null when not
+/// loaded: the extension is not used).
+struct Vk {
+#define CREP_VK_MEMBER(name) PFN_##name name = nullptr;
+  CREP_VK_GLOBAL_FUNCTIONS(CREP_VK_MEMBER)
+  CREP_VK_OWN_INSTANCE_FUNCTIONS(CREP_VK_MEMBER)
+  CREP_VK_INSTANCE_FUNCTIONS(CREP_VK_MEMBER)
+  CREP_VK_OWN_DEVICE_FUNCTIONS(CREP_VK_MEMBER)
+  CREP_VK_DEVICE_FUNCTIONS(CREP_VK_MEMBER)
+#undef CREP_VK_MEMBER
+  PFN_vkCmdPushDescriptorSetKHR vkCmdPushDescriptorSetKHR = nullptr;             ///< VK_KHR_push_descriptor
+  PFN_vkCreateDebugUtilsMessengerEXT vkCreateDebugUtilsMessengerEXT = nullptr;   ///< own instance, validation
+  PFN_vkDestroyDebugUtilsMessengerEXT vkDestroyDebugUtilsMessengerEXT = nullptr; ///< own instance, validation
+};
+
+/// `f` as the function type F; a VulkanError naming the function and the loader when it is null.
+template <class F>
+F loaded(PFN_vkVoidFunction f, const char* name, const char* loader) {
+  if (f == nullptr)
+    throw VulkanError(std::string("crep: VulkanBackend: ") + loader + " returned no " + name +
+                      " (a function the backend calls)");
+  return reinterpret_cast<F>(f);
+}
+
 void check(VkResult r, const char* what) {
   if (r != VK_SUCCESS)
     throw VulkanError("crep: " + std::string(what) + " failed (VkResult " + std::to_string(r) + ")");
+}
+
+std::string versionText(std::uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
 }
 
 VkFormat vkFormat(Format f) {
@@ -48,6 +156,70 @@ VkFormat vkFormat(Format f) {
 std::size_t texelBytes(Format f) {
   return f == Format::RGBA16F ? 8 : f == Format::RGBA8 ? 4 : static_cast<std::size_t>(componentCount(f)) * 4;
 }
+
+// ---------------------------------------------------------------------------------------------------
+// The requirements (VulkanBackend::requirements()), as tables the checks read.
+
+constexpr std::uint32_t kApiVersion = VK_API_VERSION_1_1;
+
+struct FeatureNeed {
+  const char* name;
+  VkBool32 VkPhysicalDeviceFeatures::*member;
+  const char* why;
+};
+constexpr FeatureNeed kFeatures[] = {
+    {"shaderStorageImageWriteWithoutFormat", &VkPhysicalDeviceFeatures::shaderStorageImageWriteWithoutFormat,
+     "the froxel variant of the evaluation (EvaluatePass::FrameAttribs::froxels, Scattering's froxel target) "
+     "writes its RGBA16F or RGBA32F volume through an image without a format qualifier"},
+};
+
+constexpr VkFormatFeatureFlags kTransfer =
+    VK_FORMAT_FEATURE_TRANSFER_SRC_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT;
+constexpr VkFormatFeatureFlags kColour =
+    VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | kTransfer;
+constexpr VkFormatFeatureFlags kFloatColour = kColour | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+
+struct FormatNeed {
+  Format format;
+  const char* name;
+  VkFormatFeatureFlags features;
+  const char* why;
+};
+constexpr const char* kFloatWhy =
+    "every colour texture is created for sampling, storage and copies, and a "
+    "float one is sampled with either filter (gpu::Resource::filter: the basis, "
+    "the tables, the froxel volume); Vulkan guarantees linear filtering of the "
+    "8- and 16-bit formats only";
+constexpr FormatNeed kFormats[] = {
+    {Format::R32F, "VK_FORMAT_R32_SFLOAT", kFloatColour, kFloatWhy},
+    {Format::RG32F, "VK_FORMAT_R32G32_SFLOAT", kFloatColour, kFloatWhy},
+    {Format::RGBA32F, "VK_FORMAT_R32G32B32A32_SFLOAT", kFloatColour, kFloatWhy},
+    {Format::RGBA16F, "VK_FORMAT_R16G16B16A16_SFLOAT", kFloatColour, kFloatWhy},
+    {Format::RGBA8, "VK_FORMAT_R8G8B8A8_UNORM", kFloatColour, kFloatWhy},
+    {Format::RG32I, "VK_FORMAT_R32G32_SINT", kColour,
+     "gpu::Format::RG32I (the epipolar sampling's integer textures): every colour texture is created for "
+     "sampling, storage and copies"},
+    {Format::Depth32F, "VK_FORMAT_D32_SFLOAT", VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | kTransfer,
+     "depth maps (gpu::Format::Depth32F) are sampled and copied; Vulkan guarantees D16 only"},
+};
+
+std::string formatFeatureNames(VkFormatFeatureFlags f) {
+  std::string s;
+  for (const auto& [bit, name] :
+       {std::pair{VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT, "SAMPLED_IMAGE"},
+        std::pair{VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT, "STORAGE_IMAGE"},
+        std::pair{VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT, "SAMPLED_IMAGE_FILTER_LINEAR"},
+        std::pair{VK_FORMAT_FEATURE_TRANSFER_SRC_BIT, "TRANSFER_SRC"},
+        std::pair{VK_FORMAT_FEATURE_TRANSFER_DST_BIT, "TRANSFER_DST"}})
+    if ((f & static_cast<VkFormatFeatureFlags>(bit)) != 0) s += std::string(s.empty() ? "" : ", ") + name;
+  return s;
+}
+
+constexpr const char* kPushWhy =
+    "each dispatch pushes its descriptors into the command buffer (vkCmdPushDescriptorSetKHR); without it "
+    "(or with CreateInfo::pushDescriptors false) each dispatch allocates a descriptor set from a pool, and "
+    "the "
+    "pools are reset once the submission that used them has completed";
 
 std::uint32_t vulkanBinding(const Resource& r) {
   switch (r.kind) {
@@ -76,6 +248,34 @@ VkDescriptorType descriptorType(ResourceKind k) {
   }
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
+
+/// The index of a resource kind in DescriptorPool's counts.
+std::size_t kindIndex(ResourceKind k) {
+  switch (k) {
+  case ResourceKind::SampledTexture:
+    return 0;
+  case ResourceKind::StorageImage:
+    return 1;
+  case ResourceKind::UniformBuffer:
+    return 2;
+  case ResourceKind::StorageBuffer:
+    return 3;
+  }
+  return 3;
+}
+constexpr std::array<VkDescriptorType, 4> kPoolTypes = {
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+    VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+
+/// Without push descriptors: a pool and what has been allocated from it since its last reset. GPU: 64 sets
+/// of up to 512 descriptors of each type per pool, reset once per submission (the backend submits and waits
+/// at each read or finish()); more pools are added when a submission needs more.
+struct DescriptorPool {
+  static constexpr std::uint32_t kSets = 64, kDescriptors = 512;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  std::uint32_t sets = 0;
+  std::array<std::uint32_t, 4> descriptors{};
+};
 
 /// The validation layer's warnings and errors (its callback may run on any thread).
 struct MessageLog {
@@ -111,11 +311,39 @@ struct Pipeline {
   VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline pipeline = VK_NULL_HANDLE;
+  std::array<std::uint32_t, 4> descriptors{}; ///< per kindIndex: the set's descriptors (pools only)
 };
 
 } // namespace
 
+std::vector<VulkanBackend::Requirement> VulkanBackend::requirements() {
+  using K = Requirement::Kind;
+  std::vector<Requirement> r;
+  r.push_back({K::ApiVersion, "1.1", true,
+               "the shaders are compiled to SPIR-V 1.3 for Vulkan 1.1 (shaderc's vulkan1.1 target); the "
+               "physical device's apiVersion and the instance's (EngineDevice::apiVersion) must be >= 1.1"});
+  r.push_back(
+      {K::QueueFamily, "VK_QUEUE_COMPUTE_BIT", true,
+       "every call is a compute dispatch, a copy or a buffer update on the one queue given (a compute "
+       "family supports transfers too)"});
+  r.push_back({K::QueueFamily, "timestampValidBits", false,
+               "beginTimer / endTimer write timestamps on the queue; without them (0 bits, or a "
+               "timestampPeriod of 0) the stages' GPU times are 0"});
+  r.push_back({K::DeviceExtension, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME, false, kPushWhy});
+  for (const FeatureNeed& f : kFeatures)
+    r.push_back({K::DeviceFeature, f.name, true, f.why});
+  for (const FormatNeed& f : kFormats)
+    r.push_back({K::FormatFeature, std::string(f.name) + ": " + formatFeatureNames(f.features), true, f.why});
+  return r;
+}
+
 struct VulkanBackend::Impl {
+  Vk vk;
+  PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;
+  PFN_vkGetDeviceProcAddr getDeviceProcAddr = nullptr;
+  bool ownsDevice = false; ///< the instance and device are the backend's (no CreateInfo::device)
+  const VkAllocationCallbacks* allocator = nullptr;
+  VkPipelineCache pipelineCache = VK_NULL_HANDLE;
   VkInstance instance = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
@@ -132,7 +360,9 @@ struct VulkanBackend::Impl {
   VkQueryPool timestamps = VK_NULL_HANDLE; ///< two timestamps (beginTimer, endTimer); null without them
   std::uint32_t timestampBits = 0;         ///< the queue family's timestampValidBits
   bool timing = false;                     ///< a span's first timestamp is recorded
-  PFN_vkCmdPushDescriptorSetKHR pushDescriptorSet = nullptr;
+  bool pushDescriptors = false;            ///< vkCmdPushDescriptorSetKHR, else sets from descriptorPools
+  std::vector<DescriptorPool> descriptorPools;
+  std::size_t currentPool = 0; ///< the pool the next set comes from; those before it are full
 
   std::map<TextureId, ImageEntry> images;
   std::map<BufferId, BufferEntry> buffers;
@@ -145,15 +375,23 @@ struct VulkanBackend::Impl {
 
   void createInstance(bool validation);
   void pickDevice(const std::string& name);
-  void createDevice();
+  void createDevice(bool wantPushDescriptors);
+  void adoptDevice(const EngineDevice& e, bool wantPushDescriptors);
+  void loadInstanceFunctions();
+  void loadDeviceFunctions();
+  void readPhysicalDevice(const char* field);
+  void checkRequirements(const VkPhysicalDeviceFeatures& enabled, const char* field);
+  void createObjects();
   std::uint32_t memoryType(std::uint32_t bits, VkMemoryPropertyFlags required,
                            VkMemoryPropertyFlags preferred) const;
   BufferEntry makeBuffer(std::size_t bytes, VkBufferUsageFlags usage);
   void freeBuffer(BufferEntry& b);
+  void destroyImage(ImageEntry& e);
   void begin();
   void barrier();
   void transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to);
   void submit();
+  VkDescriptorSet allocateSet(const Pipeline& p);
   VkShaderModule module(const std::string& program, std::span<const ShaderDefine> defines);
   Pipeline& pipeline(const Dispatch& d, std::size_t pushBytes);
   ImageEntry& image(TextureId id, const char* what);
@@ -161,19 +399,51 @@ struct VulkanBackend::Impl {
   ~Impl();
 };
 
+void VulkanBackend::Impl::loadInstanceFunctions() {
+#define CREP_VK_LOAD(name)                                                                                   \
+  vk.name = loaded<PFN_##name>(getInstanceProcAddr(instance, #name), #name, "vkGetInstanceProcAddr");
+  if (ownsDevice) {
+    CREP_VK_OWN_INSTANCE_FUNCTIONS(CREP_VK_LOAD)
+  }
+  CREP_VK_INSTANCE_FUNCTIONS(CREP_VK_LOAD)
+#undef CREP_VK_LOAD
+  if (getDeviceProcAddr == nullptr)
+    getDeviceProcAddr = loaded<PFN_vkGetDeviceProcAddr>(getInstanceProcAddr(instance, "vkGetDeviceProcAddr"),
+                                                        "vkGetDeviceProcAddr", "vkGetInstanceProcAddr");
+}
+
+void VulkanBackend::Impl::loadDeviceFunctions() {
+#define CREP_VK_LOAD(name)                                                                                   \
+  vk.name = loaded<PFN_##name>(getDeviceProcAddr(device, #name), #name, "vkGetDeviceProcAddr");
+  if (ownsDevice) {
+    CREP_VK_OWN_DEVICE_FUNCTIONS(CREP_VK_LOAD)
+  }
+  CREP_VK_DEVICE_FUNCTIONS(CREP_VK_LOAD)
+  if (pushDescriptors) {
+    CREP_VK_LOAD(vkCmdPushDescriptorSetKHR)
+  }
+#undef CREP_VK_LOAD
+}
+
 void VulkanBackend::Impl::createInstance(bool validation) {
+  getInstanceProcAddr = ::vkGetInstanceProcAddr;
+#define CREP_VK_LOAD(name)                                                                                   \
+  vk.name = loaded<PFN_##name>(getInstanceProcAddr(VK_NULL_HANDLE, #name), #name,                            \
+                               "libvulkan's vkGetInstanceProcAddr");
+  CREP_VK_GLOBAL_FUNCTIONS(CREP_VK_LOAD)
+#undef CREP_VK_LOAD
   VkApplicationInfo app{};
   app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
   app.pApplicationName = "crepuscular";
   app.pEngineName = "crepuscular";
-  app.apiVersion = VK_API_VERSION_1_1;
+  app.apiVersion = kApiVersion;
   const char* layers[] = {"VK_LAYER_KHRONOS_validation"};
   const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
   if (validation) {
     std::uint32_t count = 0;
-    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    vk.vkEnumerateInstanceLayerProperties(&count, nullptr);
     std::vector<VkLayerProperties> available(count);
-    vkEnumerateInstanceLayerProperties(&count, available.data());
+    vk.vkEnumerateInstanceLayerProperties(&count, available.data());
     if (std::none_of(available.begin(), available.end(),
                      [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, layers[0]) == 0; }))
       throw VulkanError(
@@ -199,38 +469,40 @@ void VulkanBackend::Impl::createInstance(bool validation) {
     ci.ppEnabledExtensionNames = extensions;
     ci.pNext = &debug; // messages of instance creation too
   }
-  check(vkCreateInstance(&ci, nullptr, &instance), "vkCreateInstance (is a Vulkan driver installed? Debian: "
-                                                   "mesa-vulkan-drivers)");
+  check(vk.vkCreateInstance(&ci, allocator, &instance),
+        "vkCreateInstance (is a Vulkan driver installed? Debian: mesa-vulkan-drivers)");
+  loadInstanceFunctions();
   if (validation) {
-    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
-    if (create == nullptr) throw VulkanError("crep: vkCreateDebugUtilsMessengerEXT is not available");
-    check(create(instance, &debug, nullptr, &messenger), "vkCreateDebugUtilsMessengerEXT");
+    vk.vkCreateDebugUtilsMessengerEXT = loaded<PFN_vkCreateDebugUtilsMessengerEXT>(
+        getInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"), "vkCreateDebugUtilsMessengerEXT",
+        "vkGetInstanceProcAddr");
+    vk.vkDestroyDebugUtilsMessengerEXT = loaded<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        getInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"), "vkDestroyDebugUtilsMessengerEXT",
+        "vkGetInstanceProcAddr");
+    check(vk.vkCreateDebugUtilsMessengerEXT(instance, &debug, allocator, &messenger),
+          "vkCreateDebugUtilsMessengerEXT");
   }
 }
 
 void VulkanBackend::Impl::pickDevice(const std::string& name) {
   std::uint32_t count = 0;
-  vkEnumeratePhysicalDevices(instance, &count, nullptr);
+  vk.vkEnumeratePhysicalDevices(instance, &count, nullptr);
   std::vector<VkPhysicalDevice> devices(count);
-  vkEnumeratePhysicalDevices(instance, &count, devices.data());
+  vk.vkEnumeratePhysicalDevices(instance, &count, devices.data());
   std::string seen;
   for (VkPhysicalDevice d : devices) {
     VkPhysicalDeviceProperties p;
-    vkGetPhysicalDeviceProperties(d, &p);
+    vk.vkGetPhysicalDeviceProperties(d, &p);
     seen += std::string(seen.empty() ? "" : ", ") + p.deviceName;
     if (!name.empty() && std::string(p.deviceName).find(name) == std::string::npos) continue;
     std::uint32_t families = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
+    vk.vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
     std::vector<VkQueueFamilyProperties> props(families);
-    vkGetPhysicalDeviceQueueFamilyProperties(d, &families, props.data());
+    vk.vkGetPhysicalDeviceQueueFamilyProperties(d, &families, props.data());
     for (std::uint32_t i = 0; i < families; ++i)
       if ((props[i].queueFlags & VK_QUEUE_COMPUTE_BIT) != 0) {
         physical = d;
         family = i;
-        timestampBits = props[i].timestampValidBits;
-        properties = p;
-        vkGetPhysicalDeviceMemoryProperties(d, &memory);
         return;
       }
   }
@@ -239,54 +511,134 @@ void VulkanBackend::Impl::pickDevice(const std::string& name) {
                     " (devices: " + (seen.empty() ? "none" : seen) + ")");
 }
 
-void VulkanBackend::Impl::createDevice() {
+void VulkanBackend::Impl::readPhysicalDevice(const char* field) {
+  vk.vkGetPhysicalDeviceProperties(physical, &properties);
+  vk.vkGetPhysicalDeviceMemoryProperties(physical, &memory);
+  const std::string where = std::string(field) + " (\"" + properties.deviceName + "\")";
+  if (properties.apiVersion < kApiVersion)
+    throw VulkanError("crep: " + where + ": Vulkan " + versionText(properties.apiVersion) +
+                      ", the backend needs 1.1 (" + requirements()[0].why + ")");
+  std::uint32_t families = 0;
+  vk.vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> props(families);
+  vk.vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, props.data());
+  if (family >= families || (props[family].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0)
+    throw VulkanError(
+        "crep: " + (ownsDevice ? where : std::string("VulkanBackend::CreateInfo.device.queueFamily")) +
+        ": family " + std::to_string(family) +
+        (family >= families ? " does not exist (the device has " + std::to_string(families) + ")"
+                            : " has no VK_QUEUE_COMPUTE_BIT") +
+        " (" + requirements()[1].why + ")");
+  timestampBits = props[family].timestampValidBits;
+}
+
+void VulkanBackend::Impl::checkRequirements(const VkPhysicalDeviceFeatures& enabled, const char* field) {
+  for (const FeatureNeed& f : kFeatures)
+    if (enabled.*f.member != VK_TRUE)
+      throw VulkanError("crep: " + std::string(field) + ": " + f.name + " is not " +
+                        (ownsDevice ? "supported" : "enabled") + " (" + f.why + ")");
+  for (const FormatNeed& f : kFormats) {
+    VkFormatProperties p{};
+    vk.vkGetPhysicalDeviceFormatProperties(physical, vkFormat(f.format), &p);
+    const VkFormatFeatureFlags missing = f.features & ~p.optimalTilingFeatures;
+    if (missing != 0)
+      throw VulkanError("crep: VulkanBackend: the physical device \"" + std::string(properties.deviceName) +
+                        "\" lacks " + f.name + ": " + formatFeatureNames(missing) +
+                        " in optimalTilingFeatures (" + f.why + ")");
+  }
+}
+
+void VulkanBackend::Impl::createDevice(bool wantPushDescriptors) {
+  readPhysicalDevice("VulkanBackend: the physical device");
+  VkPhysicalDeviceFeatures supported{};
+  vk.vkGetPhysicalDeviceFeatures(physical, &supported);
+  checkRequirements(
+      supported,
+      ("VulkanBackend: the physical device \"" + std::string(properties.deviceName) + "\"").c_str());
+  std::uint32_t count = 0;
+  vk.vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, nullptr);
+  std::vector<VkExtensionProperties> available(count);
+  vk.vkEnumerateDeviceExtensionProperties(physical, nullptr, &count, available.data());
+  pushDescriptors = wantPushDescriptors &&
+                    std::any_of(available.begin(), available.end(), [](const VkExtensionProperties& e) {
+                      return std::strcmp(e.extensionName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0;
+                    });
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo q{};
   q.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
   q.queueFamilyIndex = family;
   q.queueCount = 1;
   q.pQueuePriorities = &priority;
-  VkPhysicalDeviceFeatures supported{};
-  vkGetPhysicalDeviceFeatures(physical, &supported);
-  VkPhysicalDeviceFeatures features{};
-  // The froxel variant of the evaluation writes its volume without a format qualifier.
-  features.shaderStorageImageWriteWithoutFormat = supported.shaderStorageImageWriteWithoutFormat;
-  features.shaderStorageImageExtendedFormats = supported.shaderStorageImageExtendedFormats;
+  VkPhysicalDeviceFeatures features{}; // what requirements() lists, nothing more
+  for (const FeatureNeed& f : kFeatures)
+    features.*f.member = VK_TRUE;
   const char* extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
   VkDeviceCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
   ci.queueCreateInfoCount = 1;
   ci.pQueueCreateInfos = &q;
-  ci.enabledExtensionCount = 1;
+  ci.enabledExtensionCount = pushDescriptors ? 1 : 0;
   ci.ppEnabledExtensionNames = extensions;
   ci.pEnabledFeatures = &features;
-  check(vkCreateDevice(physical, &ci, nullptr, &device), "vkCreateDevice (with VK_KHR_push_descriptor)");
-  vkGetDeviceQueue(device, family, 0, &queue);
-  pushDescriptorSet = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
-      vkGetDeviceProcAddr(device, "vkCmdPushDescriptorSetKHR"));
-  if (pushDescriptorSet == nullptr) throw VulkanError("crep: vkCmdPushDescriptorSetKHR is not available");
+  check(vk.vkCreateDevice(physical, &ci, allocator, &device), "vkCreateDevice");
+  loadDeviceFunctions();
+  vk.vkGetDeviceQueue(device, family, 0, &queue);
+}
 
+void VulkanBackend::Impl::adoptDevice(const EngineDevice& e, bool wantPushDescriptors) {
+  const auto missing = [](const char* field, const char* what) {
+    throw InvalidArgument(std::string("VulkanBackend::CreateInfo.device.") + field, "null",
+                          std::string("must be ") + what);
+  };
+  if (e.getInstanceProcAddr == nullptr)
+    missing("getInstanceProcAddr", "the loader's vkGetInstanceProcAddr (libvulkan's, volk's, ...)");
+  if (e.instance == VK_NULL_HANDLE) missing("instance", "the engine's VkInstance");
+  if (e.physicalDevice == VK_NULL_HANDLE)
+    missing("physicalDevice", "the VkPhysicalDevice the engine's device was created on");
+  if (e.device == VK_NULL_HANDLE) missing("device", "the engine's VkDevice");
+  if (e.queue == VK_NULL_HANDLE) missing("queue", "a VkQueue of queueFamily the backend may submit on");
+  if (e.apiVersion < kApiVersion)
+    throw InvalidArgument("VulkanBackend::CreateInfo.device.apiVersion", versionText(e.apiVersion),
+                          "must be >= 1.1: " + requirements()[0].why);
+  getInstanceProcAddr = e.getInstanceProcAddr;
+  getDeviceProcAddr = e.getDeviceProcAddr;
+  allocator = e.allocator;
+  pipelineCache = e.pipelineCache;
+  instance = e.instance;
+  physical = e.physicalDevice;
+  device = e.device;
+  queue = e.queue;
+  family = e.queueFamily;
+  loadInstanceFunctions();
+  readPhysicalDevice("VulkanBackend::CreateInfo.device.physicalDevice");
+  checkRequirements(e.enabledFeatures, "VulkanBackend::CreateInfo.device.enabledFeatures");
+  pushDescriptors =
+      wantPushDescriptors && std::find(e.enabledExtensions.begin(), e.enabledExtensions.end(),
+                                       VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) != e.enabledExtensions.end();
+  loadDeviceFunctions();
+}
+
+void VulkanBackend::Impl::createObjects() {
   VkCommandPoolCreateInfo pci{};
-
   pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
   pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pci.queueFamilyIndex = family;
-  check(vkCreateCommandPool(device, &pci, nullptr, &pool), "vkCreateCommandPool");
+  check(vk.vkCreateCommandPool(device, &pci, allocator, &pool), "vkCreateCommandPool");
   VkCommandBufferAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   ai.commandPool = pool;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
-  check(vkAllocateCommandBuffers(device, &ai, &cmd), "vkAllocateCommandBuffers");
+  check(vk.vkAllocateCommandBuffers(device, &ai, &cmd), "vkAllocateCommandBuffers");
   VkFenceCreateInfo fi{};
   fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-  check(vkCreateFence(device, &fi, nullptr, &fence), "vkCreateFence");
+  check(vk.vkCreateFence(device, &fi, allocator, &fence), "vkCreateFence");
   if (timestampBits > 0 && properties.limits.timestampPeriod > 0.0f) {
     VkQueryPoolCreateInfo qi{};
     qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qi.queryCount = 2;
-    check(vkCreateQueryPool(device, &qi, nullptr, &timestamps), "vkCreateQueryPool (timestamps)");
+    check(vk.vkCreateQueryPool(device, &qi, allocator, &timestamps), "vkCreateQueryPool (timestamps)");
   }
   for (auto [filter, sampler] :
        {std::pair{VK_FILTER_NEAREST, &nearest}, std::pair{VK_FILTER_LINEAR, &linear}}) {
@@ -296,7 +648,7 @@ void VulkanBackend::Impl::createDevice() {
     si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
     si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     si.maxLod = 0.0f;
-    check(vkCreateSampler(device, &si, nullptr, sampler), "vkCreateSampler");
+    check(vk.vkCreateSampler(device, &si, allocator, sampler), "vkCreateSampler");
   }
 }
 
@@ -316,9 +668,9 @@ BufferEntry VulkanBackend::Impl::makeBuffer(std::size_t bytes, VkBufferUsageFlag
   ci.size = bytes;
   ci.usage = usage;
   ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  check(vkCreateBuffer(device, &ci, nullptr, &b.buffer), "vkCreateBuffer");
+  check(vk.vkCreateBuffer(device, &ci, allocator, &b.buffer), "vkCreateBuffer");
   VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device, b.buffer, &req);
+  vk.vkGetBufferMemoryRequirements(device, b.buffer, &req);
   VkMemoryAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   ai.allocationSize = req.size;
@@ -328,16 +680,16 @@ BufferEntry VulkanBackend::Impl::makeBuffer(std::size_t bytes, VkBufferUsageFlag
   ai.memoryTypeIndex = memoryType(req.memoryTypeBits,
                                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
                                   VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(vkAllocateMemory(device, &ai, nullptr, &b.memory), "vkAllocateMemory (buffer)");
-  check(vkBindBufferMemory(device, b.buffer, b.memory, 0), "vkBindBufferMemory");
-  check(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+  check(vk.vkAllocateMemory(device, &ai, allocator, &b.memory), "vkAllocateMemory (buffer)");
+  check(vk.vkBindBufferMemory(device, b.buffer, b.memory, 0), "vkBindBufferMemory");
+  check(vk.vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
   return b;
 }
 
 void VulkanBackend::Impl::freeBuffer(BufferEntry& b) {
-  if (b.memory != VK_NULL_HANDLE) vkUnmapMemory(device, b.memory);
-  vkDestroyBuffer(device, b.buffer, nullptr);
-  vkFreeMemory(device, b.memory, nullptr);
+  if (b.memory != VK_NULL_HANDLE) vk.vkUnmapMemory(device, b.memory);
+  vk.vkDestroyBuffer(device, b.buffer, allocator);
+  vk.vkFreeMemory(device, b.memory, allocator);
   b = {};
 }
 
@@ -346,7 +698,7 @@ void VulkanBackend::Impl::begin() {
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
+  check(vk.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
   recording = true;
 }
 
@@ -359,10 +711,10 @@ void VulkanBackend::Impl::barrier() {
   m.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_UNIFORM_READ_BIT |
                     VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
                     VK_ACCESS_INDIRECT_COMMAND_READ_BIT; // work lists' group counts (Dispatch::indirect)
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
-                           VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
-                       0, 1, &m, 0, nullptr, 0, nullptr);
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
+                              VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                          0, 1, &m, 0, nullptr, 0, nullptr);
 }
 
 namespace {
@@ -384,9 +736,9 @@ void VulkanBackend::Impl::transition(const ImageEntry& e, VkImageLayout from, Vk
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = e.image;
   b.subresourceRange = wholeImage(e.desc);
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
-                       0, nullptr, 1, &b);
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                          nullptr, 0, nullptr, 1, &b);
 }
 
 void VulkanBackend::Impl::submit() {
@@ -395,21 +747,73 @@ void VulkanBackend::Impl::submit() {
   m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   m.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                       VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &m, 0, nullptr, 0, nullptr);
-  check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                          VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &m, 0, nullptr, 0, nullptr);
+  check(vk.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
   recording = false;
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
-  check(vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
-  check(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-  check(vkResetFences(device, 1, &fence), "vkResetFences");
-  check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  check(vk.vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
+  check(vk.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+  check(vk.vkResetFences(device, 1, &fence), "vkResetFences");
+  check(vk.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
   for (BufferEntry& b : staging)
     freeBuffer(b);
   staging.clear();
+  // The submission has completed: its descriptor sets may go (pools mode).
+  for (std::size_t i = 0; i < descriptorPools.size() && i <= currentPool; ++i) {
+    DescriptorPool& dp = descriptorPools[i];
+    if (dp.sets == 0) continue;
+    check(vk.vkResetDescriptorPool(device, dp.pool, 0), "vkResetDescriptorPool");
+    dp.sets = 0;
+    dp.descriptors = {};
+  }
+  currentPool = 0;
+}
+
+VkDescriptorSet VulkanBackend::Impl::allocateSet(const Pipeline& p) {
+  const auto fits = [&](const DescriptorPool& dp) {
+    if (dp.sets + 1 > DescriptorPool::kSets) return false;
+    for (std::size_t k = 0; k < 4; ++k)
+      if (dp.descriptors[k] + p.descriptors[k] > DescriptorPool::kDescriptors) return false;
+    return true;
+  };
+  for (;; ++currentPool) {
+    if (currentPool == descriptorPools.size()) {
+      // Grow: one more pool (kept, and reused after the next submission).
+      std::array<VkDescriptorPoolSize, 4> sizes{};
+      for (std::size_t k = 0; k < 4; ++k)
+        sizes[k] = {kPoolTypes[k], DescriptorPool::kDescriptors};
+      VkDescriptorPoolCreateInfo ci{};
+      ci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+      ci.maxSets = DescriptorPool::kSets;
+      ci.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+      ci.pPoolSizes = sizes.data();
+      DescriptorPool dp;
+      check(vk.vkCreateDescriptorPool(device, &ci, allocator, &dp.pool), "vkCreateDescriptorPool");
+      descriptorPools.push_back(dp);
+    }
+    DescriptorPool& dp = descriptorPools[currentPool];
+    if (!fits(dp)) continue;
+    VkDescriptorSetAllocateInfo ai{};
+    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    ai.descriptorPool = dp.pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &p.setLayout;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    const VkResult r = vk.vkAllocateDescriptorSets(device, &ai, &set);
+    if (r == VK_ERROR_OUT_OF_POOL_MEMORY || r == VK_ERROR_FRAGMENTED_POOL) {
+      dp.sets = DescriptorPool::kSets; // the driver counts otherwise: full until the next reset
+      continue;
+    }
+    check(r, "vkAllocateDescriptorSets");
+    ++dp.sets;
+    for (std::size_t k = 0; k < 4; ++k)
+      dp.descriptors[k] += p.descriptors[k];
+    return set;
+  }
 }
 
 VkShaderModule VulkanBackend::Impl::module(const std::string& program,
@@ -442,7 +846,7 @@ VkShaderModule VulkanBackend::Impl::module(const std::string& program,
   ci.codeSize = words.size() * 4;
   ci.pCode = words.data();
   VkShaderModule m = VK_NULL_HANDLE;
-  check(vkCreateShaderModule(device, &ci, nullptr, &m), "vkCreateShaderModule");
+  check(vk.vkCreateShaderModule(device, &ci, allocator, &m), "vkCreateShaderModule");
   modules[key] = m;
   return m;
 }
@@ -451,7 +855,9 @@ Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d, std::size_t pushBytes
   // One pipeline per variant and resource signature (the descriptor layout follows the dispatch).
   std::string key = variantKey(d.program, d.defines) + "\n#";
   std::vector<VkDescriptorSetLayoutBinding> bindings;
+  std::array<std::uint32_t, 4> descriptors{};
   for (const Resource& r : d.resources) {
+    ++descriptors[kindIndex(r.kind)];
     VkDescriptorSetLayoutBinding b{};
     b.binding = vulkanBinding(r);
     b.descriptorType = descriptorType(r.kind);
@@ -464,12 +870,15 @@ Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d, std::size_t pushBytes
   if (auto it = pipelines.find(key); it != pipelines.end()) return it->second;
 
   Pipeline p;
+  p.descriptors = descriptors;
   VkDescriptorSetLayoutCreateInfo li{};
   li.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  li.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+  li.flags = pushDescriptors ? static_cast<VkDescriptorSetLayoutCreateFlags>(
+                                   VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR)
+                             : 0u;
   li.bindingCount = static_cast<std::uint32_t>(bindings.size());
   li.pBindings = bindings.data();
-  check(vkCreateDescriptorSetLayout(device, &li, nullptr, &p.setLayout), "vkCreateDescriptorSetLayout");
+  check(vk.vkCreateDescriptorSetLayout(device, &li, allocator, &p.setLayout), "vkCreateDescriptorSetLayout");
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, static_cast<std::uint32_t>(pushBytes)};
   VkPipelineLayoutCreateInfo pl{};
   pl.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
@@ -477,7 +886,7 @@ Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d, std::size_t pushBytes
   pl.pSetLayouts = &p.setLayout;
   pl.pushConstantRangeCount = pushBytes == 0 ? 0 : 1;
   pl.pPushConstantRanges = &range;
-  check(vkCreatePipelineLayout(device, &pl, nullptr, &p.layout), "vkCreatePipelineLayout");
+  check(vk.vkCreatePipelineLayout(device, &pl, allocator, &p.layout), "vkCreatePipelineLayout");
   VkComputePipelineCreateInfo ci{};
   ci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
   ci.stage = {};
@@ -486,7 +895,7 @@ Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d, std::size_t pushBytes
   ci.stage.module = module(d.program, d.defines);
   ci.stage.pName = "main";
   ci.layout = p.layout;
-  check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline),
+  check(vk.vkCreateComputePipelines(device, pipelineCache, 1, &ci, allocator, &p.pipeline),
         "vkCreateComputePipelines");
   return pipelines[key] = p;
 }
@@ -505,38 +914,44 @@ BufferEntry& VulkanBackend::Impl::buffer(BufferId id, const char* what) {
   return it->second;
 }
 
+void VulkanBackend::Impl::destroyImage(ImageEntry& e) {
+  vk.vkDestroyImageView(device, e.view, allocator);
+  vk.vkDestroyImage(device, e.image, allocator);
+  vk.vkFreeMemory(device, e.memory, allocator);
+  e = {};
+}
+
 VulkanBackend::Impl::~Impl() {
-  if (device != VK_NULL_HANDLE) {
-    vkDeviceWaitIdle(device);
+  // Every submission was waited for (submit()); what is recorded and not submitted is dropped with the
+  // command pool. On an engine's device nothing waits on the device or its queue (the engine may use them).
+  if (device != VK_NULL_HANDLE && vk.vkDestroyCommandPool != nullptr) {
+    if (ownsDevice) vk.vkDeviceWaitIdle(device);
     for (BufferEntry& b : staging)
       freeBuffer(b);
     for (auto& [id, b] : buffers)
       freeBuffer(b);
-    for (auto& [id, i] : images) {
-      vkDestroyImageView(device, i.view, nullptr);
-      vkDestroyImage(device, i.image, nullptr);
-      vkFreeMemory(device, i.memory, nullptr);
-    }
+    for (auto& [id, i] : images)
+      destroyImage(i);
     for (auto& [key, p] : pipelines) {
-      vkDestroyPipeline(device, p.pipeline, nullptr);
-      vkDestroyPipelineLayout(device, p.layout, nullptr);
-      vkDestroyDescriptorSetLayout(device, p.setLayout, nullptr);
+      vk.vkDestroyPipeline(device, p.pipeline, allocator);
+      vk.vkDestroyPipelineLayout(device, p.layout, allocator);
+      vk.vkDestroyDescriptorSetLayout(device, p.setLayout, allocator);
     }
     for (auto& [key, m] : modules)
-      vkDestroyShaderModule(device, m, nullptr);
-    vkDestroySampler(device, nearest, nullptr);
-    vkDestroySampler(device, linear, nullptr);
-    vkDestroyFence(device, fence, nullptr);
-    if (timestamps != VK_NULL_HANDLE) vkDestroyQueryPool(device, timestamps, nullptr);
-    vkDestroyCommandPool(device, pool, nullptr);
-    vkDestroyDevice(device, nullptr);
+      vk.vkDestroyShaderModule(device, m, allocator);
+    for (DescriptorPool& dp : descriptorPools)
+      vk.vkDestroyDescriptorPool(device, dp.pool, allocator);
+    vk.vkDestroySampler(device, nearest, allocator);
+    vk.vkDestroySampler(device, linear, allocator);
+    vk.vkDestroyFence(device, fence, allocator);
+    if (timestamps != VK_NULL_HANDLE) vk.vkDestroyQueryPool(device, timestamps, allocator);
+    vk.vkDestroyCommandPool(device, pool, allocator);
   }
-  if (messenger != VK_NULL_HANDLE) {
-    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
-    if (destroy != nullptr) destroy(instance, messenger, nullptr);
-  }
-  if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+  if (!ownsDevice) return; // the engine's instance and device stay
+  if (device != VK_NULL_HANDLE && vk.vkDestroyDevice != nullptr) vk.vkDestroyDevice(device, allocator);
+  if (messenger != VK_NULL_HANDLE) vk.vkDestroyDebugUtilsMessengerEXT(instance, messenger, allocator);
+  if (instance != VK_NULL_HANDLE && vk.vkDestroyInstance != nullptr)
+    vk.vkDestroyInstance(instance, allocator);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -544,9 +959,24 @@ VulkanBackend::Impl::~Impl() {
 VulkanBackend::VulkanBackend() : VulkanBackend(CreateInfo{}) {}
 
 VulkanBackend::VulkanBackend(const CreateInfo& info) : impl_(std::make_unique<Impl>()) {
-  impl_->createInstance(info.validation);
-  impl_->pickDevice(info.deviceName);
-  impl_->createDevice();
+  Impl& v = *impl_;
+  if (info.device) {
+    if (info.validation)
+      throw InvalidArgument(
+          "VulkanBackend::CreateInfo.validation", "true",
+          "must be false with an engine device (CreateInfo.device): the engine's instance has "
+          "its own layers and debug messenger");
+    if (!info.deviceName.empty())
+      throw InvalidArgument("VulkanBackend::CreateInfo.deviceName", "\"" + info.deviceName + "\"",
+                            "must be empty with an engine device (CreateInfo.device)");
+    v.adoptDevice(*info.device, info.pushDescriptors);
+  } else {
+    v.ownsDevice = true;
+    v.createInstance(info.validation);
+    v.pickDevice(info.deviceName);
+    v.createDevice(info.pushDescriptors);
+  }
+  v.createObjects();
 }
 
 VulkanBackend::~VulkanBackend() = default;
@@ -577,6 +1007,10 @@ ComputeLimits VulkanBackend::computeLimits() const {
 
 std::string VulkanBackend::deviceName() const {
   return impl_->properties.deviceName;
+}
+
+bool VulkanBackend::usesPushDescriptors() const {
+  return impl_->pushDescriptors;
 }
 
 std::vector<std::string> VulkanBackend::validationMessages() const {
@@ -628,15 +1062,15 @@ TextureId VulkanBackend::createTexture(const TextureDesc& desc) {
              (depth ? 0u : static_cast<VkImageUsageFlags>(VK_IMAGE_USAGE_STORAGE_BIT));
   ci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   ci.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  check(vkCreateImage(v.device, &ci, nullptr, &e.image), "vkCreateImage");
+  check(v.vk.vkCreateImage(v.device, &ci, v.allocator, &e.image), "vkCreateImage");
   VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(v.device, e.image, &req);
+  v.vk.vkGetImageMemoryRequirements(v.device, e.image, &req);
   VkMemoryAllocateInfo ai{};
   ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   ai.allocationSize = req.size;
   ai.memoryTypeIndex = v.memoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(vkAllocateMemory(v.device, &ai, nullptr, &e.memory), "vkAllocateMemory (image)");
-  check(vkBindImageMemory(v.device, e.image, e.memory, 0), "vkBindImageMemory");
+  check(v.vk.vkAllocateMemory(v.device, &ai, v.allocator, &e.memory), "vkAllocateMemory (image)");
+  check(v.vk.vkBindImageMemory(v.device, e.image, e.memory, 0), "vkBindImageMemory");
   VkImageViewCreateInfo vi{};
   vi.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
   vi.image = e.image;
@@ -647,7 +1081,7 @@ TextureId VulkanBackend::createTexture(const TextureDesc& desc) {
   vi.subresourceRange = {
       static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0,
       ci.arrayLayers};
-  check(vkCreateImageView(v.device, &vi, nullptr, &e.view), "vkCreateImageView");
+  check(v.vk.vkCreateImageView(v.device, &vi, v.allocator, &e.view), "vkCreateImageView");
   // GPU: every image lives in VK_IMAGE_LAYOUT_GENERAL (sampled, stored and copied without transitions); some
   // GPUs sample faster from SHADER_READ_ONLY_OPTIMAL.
   v.begin();
@@ -660,9 +1094,9 @@ TextureId VulkanBackend::createTexture(const TextureDesc& desc) {
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = e.image;
   b.subresourceRange = vi.subresourceRange;
-  vkCmdPipelineBarrier(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
-                       0, nullptr, 1, &b);
+  v.vk.vkCmdPipelineBarrier(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                            nullptr, 0, nullptr, 1, &b);
   const TextureId id = v.nextId++;
   v.images[id] = e;
   return id;
@@ -673,9 +1107,7 @@ void VulkanBackend::destroyTexture(TextureId texture) {
   const auto it = v.images.find(texture);
   if (it == v.images.end()) return;
   v.submit(); // the recorded calls may use it
-  vkDestroyImageView(v.device, it->second.view, nullptr);
-  vkDestroyImage(v.device, it->second.image, nullptr);
-  vkFreeMemory(v.device, it->second.memory, nullptr);
+  v.destroyImage(it->second);
   v.images.erase(it);
 }
 
@@ -711,13 +1143,13 @@ void VulkanBackend::writeBuffer(BufferId buffer, std::size_t offset, std::span<c
   v.barrier();
   if (bytes.size() <= 65536 && offset % 4 == 0 && bytes.size() % 4 == 0) {
     // Small writes (a pass's blocks) go into the command buffer itself: no allocation per write.
-    vkCmdUpdateBuffer(v.cmd, b.buffer, offset, bytes.size(), bytes.data());
+    v.vk.vkCmdUpdateBuffer(v.cmd, b.buffer, offset, bytes.size(), bytes.data());
     return;
   }
   BufferEntry s = v.makeBuffer(bytes.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   std::memcpy(s.mapped, bytes.data(), bytes.size());
   const VkBufferCopy region{0, offset, bytes.size()};
-  vkCmdCopyBuffer(v.cmd, s.buffer, b.buffer, 1, &region);
+  v.vk.vkCmdCopyBuffer(v.cmd, s.buffer, b.buffer, 1, &region);
   v.staging.push_back(s);
 }
 
@@ -758,7 +1190,7 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
                         d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
   // Copies in the transfer layouts (GPU: the fast path of a copy engine), then back to GENERAL.
   v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-  vkCmdCopyBufferToImage(v.cmd, s.buffer, e.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  v.vk.vkCmdCopyBufferToImage(v.cmd, s.buffer, e.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
   v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
   v.staging.push_back(s);
 }
@@ -792,7 +1224,7 @@ std::vector<float> VulkanBackend::readTexture(TextureId texture) {
   region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
                         d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
   v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-  vkCmdCopyImageToBuffer(v.cmd, e.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.buffer, 1, &region);
+  v.vk.vkCmdCopyImageToBuffer(v.cmd, e.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.buffer, 1, &region);
   v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
   v.submit();
   std::vector<float> out(count * static_cast<std::size_t>(componentCount(d.format)));
@@ -854,18 +1286,27 @@ void VulkanBackend::dispatch(const Dispatch& given) {
   }
   v.begin();
   v.barrier();
-  vkCmdBindPipeline(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-  if (!writes.empty())
-    v.pushDescriptorSet(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0,
-                        static_cast<std::uint32_t>(writes.size()), writes.data());
+  v.vk.vkCmdBindPipeline(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+  if (!writes.empty() && v.pushDescriptors) {
+    v.vk.vkCmdPushDescriptorSetKHR(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0,
+                                   static_cast<std::uint32_t>(writes.size()), writes.data());
+  } else if (!writes.empty()) {
+    // A set of its own per dispatch, written before it is bound (never updated after).
+    const VkDescriptorSet set = v.allocateSet(p);
+    for (VkWriteDescriptorSet& w : writes)
+      w.dstSet = set;
+    v.vk.vkUpdateDescriptorSets(v.device, static_cast<std::uint32_t>(writes.size()), writes.data(), 0,
+                                nullptr);
+    v.vk.vkCmdBindDescriptorSets(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &set, 0, nullptr);
+  }
   if (!push.empty())
-    vkCmdPushConstants(v.cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                       static_cast<std::uint32_t>(push.size()), push.data());
+    v.vk.vkCmdPushConstants(v.cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                            static_cast<std::uint32_t>(push.size()), push.data());
   if (d.indirect != 0)
-    vkCmdDispatchIndirect(v.cmd, v.buffer(d.indirect, (d.label + " indirect").c_str()).buffer,
-                          d.indirectOffset);
+    v.vk.vkCmdDispatchIndirect(v.cmd, v.buffer(d.indirect, (d.label + " indirect").c_str()).buffer,
+                               d.indirectOffset);
   else if (d.groups.x > 0 && d.groups.y > 0 && d.groups.z > 0)
-    vkCmdDispatch(v.cmd, d.groups.x, d.groups.y, d.groups.z);
+    v.vk.vkCmdDispatch(v.cmd, d.groups.x, d.groups.y, d.groups.z);
 }
 
 void VulkanBackend::finish() {
@@ -876,8 +1317,8 @@ void VulkanBackend::beginTimer() {
   Impl& v = *impl_;
   if (v.timestamps == VK_NULL_HANDLE) return;
   v.begin();
-  vkCmdResetQueryPool(v.cmd, v.timestamps, 0, 2);
-  vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, v.timestamps, 0);
+  v.vk.vkCmdResetQueryPool(v.cmd, v.timestamps, 0, 2);
+  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, v.timestamps, 0);
   v.timing = true;
 }
 
@@ -888,12 +1329,12 @@ double VulkanBackend::endTimer() {
     return 0.0;
   }
   v.begin();
-  vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, v.timestamps, 1);
+  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, v.timestamps, 1);
   v.timing = false;
   v.submit();
   std::uint64_t ticks[2] = {0, 0};
-  check(vkGetQueryPoolResults(v.device, v.timestamps, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
-                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+  check(v.vk.vkGetQueryPoolResults(v.device, v.timestamps, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
+                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
         "vkGetQueryPoolResults (timestamps)");
   const std::uint64_t mask = v.timestampBits >= 64 ? ~0ull : (1ull << v.timestampBits) - 1ull;
   const std::uint64_t elapsed = (ticks[1] - ticks[0]) & mask; // a wrapped counter too

@@ -1,18 +1,28 @@
 // gpu::Backend on a Vulkan 1.1 device (Mesa's lavapipe here, any conformant driver elsewhere): the library's
 // passes from the same descriptions as on GL, their shaders compiled from the same GLSL to SPIR-V at run
-// time (shaderc), bindings as in docs/PORTABLE_SHADERS.md. Rules and limits: docs/BACKENDS.md.
+// time (shaderc), bindings as in docs/PORTABLE_SHADERS.md. On a device of its own (tools, tests) or on the
+// engine's (CreateInfo::device). Rules and limits: docs/BACKENDS.md.
+//
+// Includes <vulkan/vulkan_core.h> for the handle types. An engine that loads Vulkan itself (volk and the
+// like) defines VK_NO_PROTOTYPES before it, or includes its loader's header first; the backend itself calls
+// every Vulkan function through the loader it is given.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <vulkan/vulkan_core.h>
 
 #include <crep/core/error.h>
 #include <crep/core/gpu_backend.h>
 
 namespace crep::gpu {
 
-/// A Vulkan call failed, or no device or queue could serve the backend.
+/// A Vulkan call failed, or no device or queue could serve the backend, or the device lacks what the backend
+/// needs (VulkanBackend::requirements()).
 class VulkanError : public Error {
 public:
   using Error::Error;
@@ -20,15 +30,84 @@ public:
 
 class VulkanBackend final : public Backend {
 public:
-  struct CreateInfo {
-    /// Turns on VK_LAYER_KHRONOS_validation (Debian package vulkan-validationlayers) and records each of
-    /// its warnings and errors (validationMessages()). Default off: a cost for every call.
-    bool validation = false;
-    /// A part of the physical device's name to pick it by; empty: the first with a compute queue.
-    std::string deviceName;
+  /// The engine's own Vulkan objects, for a backend that runs on them. The backend creates no instance and no
+  /// device of its own and destroys none of these; it creates and destroys its own command pool, fence,
+  /// samplers, query pool, descriptor pools, pipelines, images, buffers and their memory on `device`.
+  /// The engine keeps every object here alive until the backend is destroyed.
+  struct EngineDevice {
+    VkInstance instance = VK_NULL_HANDLE;             ///< required
+    VkPhysicalDevice physicalDevice = VK_NULL_HANDLE; ///< required: the one `device` was created on
+    VkDevice device = VK_NULL_HANDLE;                 ///< required
+    /// The family of `queue`; it must have VK_QUEUE_COMPUTE_BIT.
+    std::uint32_t queueFamily = 0;
+    /// Required: a queue of `queueFamily` the backend submits its own work on. Vulkan's external
+    /// synchronization rule: while a call of the backend runs, no other thread may use this queue
+    /// (vkQueueSubmit, vkQueueWaitIdle, vkQueuePresentKHR, ...) nor call vkDeviceWaitIdle. A call returns
+    /// with its work either recorded (not yet submitted) or submitted and completed (a read, finish(),
+    /// endTimer(), the destruction of a texture or buffer): the backend never leaves a submission running.
+    VkQueue queue = VK_NULL_HANDLE;
+    /// Required: the loader's entry point (libvulkan's, volk's vkGetInstanceProcAddr, ...). Every Vulkan
+    /// function the backend calls is resolved through it, or through `getDeviceProcAddr`.
+    PFN_vkGetInstanceProcAddr getInstanceProcAddr = nullptr;
+    /// Optional: the device-level entry point; null: obtained from getInstanceProcAddr(instance, ...).
+    PFN_vkGetDeviceProcAddr getDeviceProcAddr = nullptr;
+    /// Optional: used by each vkCreateComputePipelines. One created with
+    /// VK_PIPELINE_CACHE_CREATE_EXTERNALLY_SYNCHRONIZED_BIT must not be used by another thread meanwhile.
+    VkPipelineCache pipelineCache = VK_NULL_HANDLE;
+    /// Optional: the host allocator of every object the backend creates, allocates, destroys or frees.
+    const VkAllocationCallbacks* allocator = nullptr;
+    /// The apiVersion of the engine's VkApplicationInfo (VK_MAKE_API_VERSION); must be >= 1.1.
+    std::uint32_t apiVersion = VK_API_VERSION_1_1;
+    /// The device extensions enabled on `device` (VkDeviceCreateInfo::ppEnabledExtensionNames): the backend
+    /// cannot query them of a device it did not create. VK_KHR_push_descriptor is used when listed.
+    std::vector<std::string> enabledExtensions;
+    /// The features enabled on `device` (VkDeviceCreateInfo::pEnabledFeatures, or
+    /// VkPhysicalDeviceFeatures2::features). The required ones (requirements()) must be VK_TRUE.
+    VkPhysicalDeviceFeatures enabledFeatures{};
   };
-  /// Creates its own instance, device and compute queue. VulkanError when there is no Vulkan driver, no
-  /// matching device, or (with validation) no validation layer.
+
+  struct CreateInfo {
+    /// Self-created device only: turns on VK_LAYER_KHRONOS_validation (Debian package
+    /// vulkan-validationlayers) and records each of its warnings and errors (validationMessages()). Default
+    /// off: a cost for every call. With an engine device the engine's instance has its own layers and
+    /// messenger: `validation` must be false there.
+    bool validation = false;
+    /// Self-created device only: a part of the physical device's name to pick it by; empty: the first with a
+    /// compute queue. Must be empty with an engine device.
+    std::string deviceName;
+    /// The engine's device to run on; empty (default): the backend creates its own instance, device and
+    /// compute queue (and destroys them).
+    std::optional<EngineDevice> device;
+    /// Use VK_KHR_push_descriptor where the device has it enabled (engine device) or supports it (own
+    /// device). false, or without the extension: descriptor sets allocated from descriptor pools, which are
+    /// recycled after the submission that used them has completed. Default true.
+    bool pushDescriptors = true;
+  };
+
+  /// What the backend needs of a device or uses when present, each with why.
+  struct Requirement {
+    enum class Kind {
+      ApiVersion,      ///< `name` "1.1": of the physical device and of the instance
+      QueueFamily,     ///< a capability of the queue's family
+      DeviceExtension, ///< `name` an extension to enable on the device
+      DeviceFeature,   ///< `name` a member of VkPhysicalDeviceFeatures to enable
+      FormatFeature,   ///< `name` "VK_FORMAT_...: FEATURE": optimal-tiling format features of the device
+    };
+    Kind kind;
+    std::string name;
+    bool required; ///< false: used when present, with the fallback `why` names
+    std::string why;
+  };
+  /// The list checked at creation: a missing required entry is a VulkanError naming it and, on an engine
+  /// device, the CreateInfo field it was looked up in. Not listed because not needed:
+  /// shaderStorageImageExtendedFormats (the shaders store to R32F, RG32F, RG32I, RGBA8, RGBA16F and RGBA32F,
+  /// each a storage format every Vulkan device has) and shaderFloat64 (float-only shaders).
+  static std::vector<Requirement> requirements();
+
+  /// Creates its own instance, device and compute queue, or runs on `info.device`. VulkanError when there
+  /// is no Vulkan driver, no matching device, (with validation) no validation layer, or when the device
+  /// lacks a required entry of requirements(); InvalidArgument naming the CreateInfo field when an engine
+  /// device is given without one of its required handles or loader, or with `validation` / `deviceName`.
   explicit VulkanBackend(const CreateInfo& info);
   VulkanBackend(); ///< default CreateInfo
   ~VulkanBackend() override;
@@ -59,6 +138,8 @@ public:
   void cancelTimer() noexcept override;
 
   std::string deviceName() const; ///< the physical device's name
+  /// Whether dispatches push their descriptors (VK_KHR_push_descriptor) rather than allocate sets from pools.
+  bool usesPushDescriptors() const;
   /// The validation layer's warnings and errors so far (CreateInfo::validation), oldest first.
   std::vector<std::string> validationMessages() const;
 
