@@ -60,7 +60,7 @@ public:
     std::uint32_t apiVersion = VK_API_VERSION_1_1;
     /// The device extensions enabled on `device` (VkDeviceCreateInfo::ppEnabledExtensionNames): the backend
     /// cannot query them of a device it did not create. VK_KHR_push_descriptor is used when listed.
-    std::vector<std::string> enabledExtensions;
+    std::vector<std::string> enabledExtensions{};
     /// The features enabled on `device` (VkDeviceCreateInfo::pEnabledFeatures, or
     /// VkPhysicalDeviceFeatures2::features). The required ones (requirements()) must be VK_TRUE.
     VkPhysicalDeviceFeatures enabledFeatures{};
@@ -74,10 +74,10 @@ public:
     bool validation = false;
     /// Self-created device only: a part of the physical device's name to pick it by; empty: the first with a
     /// compute queue. Must be empty with an engine device.
-    std::string deviceName;
+    std::string deviceName{};
     /// The engine's device to run on; empty (default): the backend creates its own instance, device and
     /// compute queue (and destroys them).
-    std::optional<EngineDevice> device;
+    std::optional<EngineDevice> device{};
     /// Use VK_KHR_push_descriptor where the device has it enabled (engine device) or supports it (own
     /// device). false, or without the extension: descriptor sets allocated from descriptor pools, which are
     /// recycled after the submission that used them has completed. Default true.
