@@ -14,16 +14,17 @@ cmake_minimum_required(VERSION 3.25)
 # 3. Shaders: every file of glsl/ (embedded into the runtime library) is used by the library: its name
 #    appears in a library module's source or in another glsl/ file. Tool shaders live in examples/glsl/,
 #    test fixtures in tests/glsl/.
-set(library_modules core rectify scatter epipolar prefilter pipeline atmosphere postfx vulkan)
+set(library_modules core gpu rectify scatter epipolar prefilter pipeline atmosphere postfx vulkan)
 set(allowed_core "core")
+set(allowed_gpu "core;gpu") # the seam gpu::Backend, the shader library and the GL backend
 set(allowed_rectify "core;rectify")
-set(allowed_scatter "core;rectify;scatter")
-set(allowed_epipolar "core;rectify;scatter;epipolar") # never its sibling prefilter/
-set(allowed_prefilter "core;rectify;scatter;prefilter") # never its sibling epipolar/
-set(allowed_pipeline "core;rectify;scatter;epipolar;prefilter;pipeline") # the front door: uses both siblings
-set(allowed_atmosphere "core;rectify;scatter;epipolar;atmosphere") # the sky: no post effect, no front door
-set(allowed_postfx "core;rectify;scatter;epipolar;prefilter;pipeline;postfx")
-set(allowed_vulkan "core;vulkan") # a backend of core's gpu::Backend seam: no pass includes it
+set(allowed_scatter "core;gpu;rectify;scatter")
+set(allowed_epipolar "core;gpu;rectify;scatter;epipolar") # never its sibling prefilter/
+set(allowed_prefilter "core;gpu;rectify;scatter;prefilter") # never its sibling epipolar/
+set(allowed_pipeline "core;gpu;rectify;scatter;epipolar;prefilter;pipeline") # the front door: uses both siblings
+set(allowed_atmosphere "core;gpu;rectify;scatter;epipolar;atmosphere") # the sky: no post effect, no front door
+set(allowed_postfx "core;gpu;rectify;scatter;epipolar;prefilter;pipeline;postfx")
+set(allowed_vulkan "core;gpu;vulkan") # a backend of gpu/'s gpu::Backend seam: no pass includes it
 set(allowed_support "core;support")
 set(failures "")
 

@@ -4,12 +4,13 @@
 // crep/atmosphere.glsl, crep/minmax_walk.glsl).
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 
 #include "crep/bindings.h"
@@ -135,7 +136,8 @@ AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_vie
   if (f.tables->backend() == nullptr)
     invalid(p + "tables", "a moved-from AtmosphereTablesPass", "must hold tables");
   // Tables of another backend: their ids mean nothing here (two GL backends share the context's names).
-  if (f.tables->backend() != backend_ && (b.name() != "OpenGL" || f.tables->backend()->name() != "OpenGL"))
+  if (f.tables->backend() != backend_ &&
+      (b.kind() != gpu::BackendKind::OpenGL || f.tables->backend()->kind() != gpu::BackendKind::OpenGL))
     invalid(p + "tables", std::string("tables on ") + std::string(f.tables->backend()->name()),
             "must be on the pass's backend (" + std::string(b.name()) + ")");
   if (!f.placement) invalid(p + "placement", "null", "must be set");
@@ -146,14 +148,14 @@ AtmospherePass::Plan AtmospherePass::plan(const FrameAttribs& f, std::string_vie
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(p + "placement", e.what(), "must be valid");
   }
-  const gl::TextureLevel image = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  const gpu::TextureLevel image = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   plan.width = image.width;
   plan.height = image.height;
-  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, plan.width, plan.height, gpu::Format::RGBA32F);
   if (f.transmittanceOutput != 0)
     gpu::requireTexture2DOf(b, (p + "transmittanceOutput").c_str(), f.transmittanceOutput, plan.width,
-                            plan.height, GL_RGBA32F);
+                            plan.height, gpu::Format::RGBA32F);
   const int W = info_.mapWidth, H = info_.mapHeight;
   if (plan.walk) {
     if (!f.layout) invalid(p + "layout", "null", "must be set (shafts (a), (b))");

@@ -6,8 +6,9 @@
 // glsl/crep/atmosphere.glsl.
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 
 #include "crep/bindings.h"
 
@@ -84,7 +85,7 @@ AtmosphereTablesPass::AtmosphereTablesPass(const CreateInfo& info) : info_(info)
   validate(info.parameters, info.options);
   backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
   gpu::Backend& b = *backend_;
-  const bool gl = b.name() == "OpenGL";
+  const bool gl = b.kind() == gpu::BackendKind::OpenGL;
   const AtmospherePrecomputeOptions& o = info.options;
   const std::string size = std::string(kOptions) + ".size.";
   const int max3D = b.max3DTextureSize();

@@ -3,7 +3,7 @@
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>

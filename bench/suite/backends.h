@@ -1,4 +1,4 @@
-// The bench section "backends": the passes written against the backend seam (crep/core/gpu_backend.h) on
+// The bench section "backends": the passes written against the backend seam (crep/gpu/backend.h) on
 // the GL backend (llvmpipe here) and the Vulkan backend (lavapipe), the same inputs, side by side.
 #pragma once
 

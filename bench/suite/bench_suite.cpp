@@ -12,7 +12,7 @@
 #include "timings.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/pipeline/rectified_shadow_pass.h>

@@ -4,9 +4,10 @@
 // (Sec. 6.5), passes/epipolar/unwarp.comp (Sec. 6.6) and passes/epipolar/upscale.comp (Sec. 6.8), with work
 // lists in between, each a gpu::Dispatch on the pass's backend.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 
 #include "crep/bindings.h"
@@ -87,14 +88,18 @@ EpipolarSamplingPass::EpipolarSamplingPass(const CreateInfo& info) : info_(info)
                           "must be a multiple of options.downscale " + std::to_string(o.downscale));
   // List entries pack x | y << 16.
   if (info.width > 65535 || info.height > 65535 || o.slices > 65535)
-    throw GlError("crep: EpipolarSamplingPass: work lists hold at most 65535 texels per axis");
+    throw InvalidArgument(std::string(kCreate) + ".width/height/options.slices",
+                          std::to_string(info.width) + " x " + std::to_string(info.height) + ", " +
+                              std::to_string(o.slices),
+                          "must each be <= 65535 (work lists pack x | y << 16)");
   gpu::checkTextureSize(b, "EpipolarSamplingPass::CreateInfo.options.samples/slices", o.samples, o.slices);
   const gpu::ComputeLimits limits = b.computeLimits();
   const int maxGroup = std::min(limits.groupSize[0], limits.invocations);
   if (o.samples > maxGroup)
-    throw GlError("crep: EpipolarSamplingPass::CreateInfo.options.samples " + std::to_string(o.samples) +
-                  " exceeds the compute work group limit " + std::to_string(maxGroup) +
-                  " (one work group of samples threads per line)");
+    gpu::throwBeyondLimit(b, "EpipolarSamplingPass::CreateInfo.options.samples (one work group per line)",
+                          std::to_string(o.samples),
+                          "min(GL_MAX_COMPUTE_WORK_GROUP_SIZE[0], GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS)",
+                          "work-group size", maxGroup);
   targetWidth_ = info.width / o.downscale;
   targetHeight_ = info.height / o.downscale;
 
@@ -170,7 +175,8 @@ void EpipolarSamplingPass::validate(const FrameAttribs& f, std::string_view owne
   const gpu::Backend& b = *backend_;
   gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, info_.width, info_.height);
   gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
-  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, info_.width, info_.height, GL_RGBA32F);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, info_.width, info_.height,
+                          gpu::Format::RGBA32F);
 }
 
 void EpipolarSamplingPass::dispatch(const char* stage, std::vector<gpu::Resource> resources, unsigned groupsX,
@@ -296,7 +302,7 @@ void EpipolarSamplingPass::run(const FrameAttribs& f,
 // On OpenGL a caller's evaluator may have written the samples or the output with its own GL dispatches: the
 // barrier for them, as the GL pass always issued (other backends order an evaluator that runs on them).
 void EpipolarSamplingPass::evaluatorBarrier() const {
-  if (backend_->name() == "OpenGL")
+  if (backend_->kind() == gpu::BackendKind::OpenGL)
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
 }
 

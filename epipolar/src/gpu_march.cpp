@@ -3,11 +3,12 @@
 // world-space reference march is WorldMarchPass in scatter/ (crep/scatter/gpu_world_march.h). Shaders:
 // passes/epipolar/minmax_build.comp, passes/epipolar/march_rectified.comp, crep/layout.glsl.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 
 #include <crep/scatter/gpu_layout_buffers.h>
 
@@ -35,8 +36,7 @@ LayoutKind layoutKind(const RectifiedLayout& layout) {
 
 void requireTreeLevels(const char* parameter, int mapWidth) {
   if (MinMaxTrees::levelCount(mapWidth) > 16)
-    throw GlError("crep: " + std::string(parameter) + " " + std::to_string(mapWidth) +
-                  " needs more than 16 tree levels");
+    throw InvalidArgument(parameter, std::to_string(mapWidth), "must need at most 16 tree levels");
 }
 
 namespace {
@@ -177,7 +177,7 @@ RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::st
   // given, and the outputs are the list's.
   const gpu::Backend& b = *backend_;
   const gpu::SampleList* list = f.list;
-  gl::TextureLevel image;
+  gpu::TextureLevel image;
   if (list) {
     image = gpu::listImageSize(b, f.imageWidth, f.imageHeight, f.cameraDepth, std::string(owner));
   } else {
@@ -193,11 +193,12 @@ RectifiedMarchPass::Plan RectifiedMarchPass::plan(const FrameAttribs& f, std::st
     plan.outWidth = list->width;
     plan.outHeight = list->height;
   } else {
-    gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, plan.width, plan.height, GL_RGBA32F);
+    gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, plan.width, plan.height,
+                            gpu::Format::RGBA32F);
   }
   if (f.stepsOutput != 0)
     gpu::requireTexture2DOf(b, (p + "stepsOutput").c_str(), f.stepsOutput, plan.outWidth, plan.outHeight,
-                            GL_R32F);
+                            gpu::Format::R32F);
   if (f.lightColors != 0) gpu::requireTexture2DOf(b, (p + "lightColors").c_str(), f.lightColors, W, H);
   if (info_.mode == Mode::MinMaxTree)
     requireMinMaxBuffer(b, (p + "minMaxBuffer").c_str(), f.minMaxBuffer, W, H, "MinMaxTree mode");

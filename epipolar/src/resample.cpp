@@ -1,14 +1,15 @@
 // Point resampling of a standard shadow map into a rectified map with blocker clamping (Klehm et al. 2014,
 // Sec. 4.1); rules in crep/epipolar/resample.h. Shader: passes/epipolar_resample.comp.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
 #include <crep/core/parallel.h>
-#include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_layout.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 
 #include <crep/scatter/gpu_layout_buffers.h>
 
@@ -173,11 +174,11 @@ ShadowResamplePass::Plan ShadowResamplePass::plan(const FrameAttribs& f, std::st
   const int W = info_.mapWidth, H = info_.mapHeight;
   gpu::requireMapSize(*f.layout, W, H, "ShadowResamplePass::CreateInfo.mapWidth/mapHeight");
   Plan plan;
-  const gl::TextureLevel shadow = gpu::requireTexture2DOf(*backend_, (p + "shadowMap").c_str(), f.shadowMap);
+  const gpu::TextureLevel shadow = gpu::requireTexture2DOf(*backend_, (p + "shadowMap").c_str(), f.shadowMap);
   plan.shadowWidth = shadow.width;
   plan.shadowHeight = shadow.height;
   gpu::requireDepthFormatOf(*backend_, (p + "shadowMap").c_str(), f.shadowMap);
-  gpu::requireTexture2DOf(*backend_, (p + "output").c_str(), f.output, W, H, GL_R32F);
+  gpu::requireTexture2DOf(*backend_, (p + "output").c_str(), f.output, W, H, gpu::Format::R32F);
   validateLayoutLightMatrix(*f.layout, f.lightClipFromWorld);
   if (f.minMaxBuffer != 0) {
     if (MinMaxTreePass::lowLevels(W) < 1)

@@ -1,5 +1,5 @@
 #include <crep/core/error.h>
-#include <crep/core/gl_state.h>
+#include <crep/gpu/gl_state.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 
 #include <epoxy/gl.h>

@@ -1,8 +1,9 @@
 // Reduced-resolution evaluation: checkerboard min/max depth downsample and depth-aware upsample
 // (crep/pipeline/reduced_resolution.h), CPU reference and the pass on a gpu::Backend.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -151,7 +152,7 @@ void DepthAwareResamplePass::downsample(std::uint32_t fullDepth, std::uint32_t l
                           info_.height);
   gpu::requireDepthFormatOf(b, "DepthAwareResamplePass::downsample.fullDepth", fullDepth);
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::downsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
-                          GL_R32F);
+                          gpu::Format::R32F);
   dispatch(b, "DepthAwareResamplePass::downsample", downsampleStage(info_.factor),
            {gpu::Resource::sampled(CREP_DEPTH_DOWNSAMPLE_FULL_DEPTH_UNIT, fullDepth),
             gpu::Resource::image(CREP_DEPTH_DOWNSAMPLE_LOW_DEPTH_IMAGE, lowDepth, gpu::Access::WriteOnly)},
@@ -177,14 +178,14 @@ void DepthAwareResamplePass::upsample(std::uint32_t low, std::uint32_t lowDepth,
   gpu::requireNotMovedFrom(backend_, "DepthAwareResamplePass");
   gpu::Backend& b = *backend_;
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.low", low, lowWidth(), lowHeight(),
-                          GL_RGBA32F);
+                          gpu::Format::RGBA32F);
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.lowDepth", lowDepth, lowWidth(), lowHeight(),
-                          GL_R32F);
+                          gpu::Format::R32F);
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.fullDepth", fullDepth, info_.width,
                           info_.height);
   gpu::requireDepthFormatOf(b, "DepthAwareResamplePass::upsample.fullDepth", fullDepth);
   gpu::requireTexture2DOf(b, "DepthAwareResamplePass::upsample.output", output, info_.width, info_.height,
-                          GL_RGBA32F);
+                          gpu::Format::RGBA32F);
   dispatch(b, "DepthAwareResamplePass::upsample", upsampleStage(info_.factor),
            {gpu::Resource::sampled(CREP_DEPTH_UPSAMPLE_LOW_UNIT, low),
             gpu::Resource::sampled(CREP_DEPTH_UPSAMPLE_LOW_DEPTH_UNIT, lowDepth),

@@ -2,14 +2,15 @@
 // projective rectification (Sec. 4.2) or epipolar resampling fallback (Sec. 4.1) plus the epipole block
 // (Fig. 8), from the passes of scatter/, epipolar/ and prefilter/.
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/gl_state.h>
-#include <crep/core/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/gl_state.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/pipeline/scattering.h>
@@ -250,10 +251,11 @@ void validateFroxelTarget(const gpu::Backend& backend, const Scattering::FroxelT
   validate(t.grid, owner.c_str());
   froxelDepthRange(t.grid, camera, owner.c_str());
   validateFroxelJitter(t.jitter, owner + ".jitter");
-  const gl::TextureLevel v = gpu::textureLevelOf(backend, (owner + ".volume").c_str(), t.volume);
-  if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
+  const gpu::TextureLevel v = gpu::textureLevelOf(backend, (owner + ".volume").c_str(), t.volume);
+  if (v.type != gpu::TextureType::Texture3D ||
+      (v.format != gpu::Format::RGBA16F && v.format != gpu::Format::RGBA32F))
     invalid(owner + ".volume", "texture " + std::to_string(t.volume),
-            "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
+            "must be a 3D texture of format RGBA16F or RGBA32F");
   if (v.width != t.grid.width || v.height != t.grid.height || v.depth != t.grid.depth)
     invalid(owner + ".volume",
             std::to_string(v.width) + " x " + std::to_string(v.height) + " x " + std::to_string(v.depth),
@@ -340,7 +342,8 @@ EvaluatePass::CreateInfo evaluateInfo(int bases, const EvaluateOptions& options,
 
 struct Scattering::Impl {
   explicit Impl(const CreateInfo& i)
-      : info(validated(i)), backend(&gpu::givenOrGl(i.backend, ownBackend)), gl(backend->name() == "OpenGL"),
+      : info(validated(i)), backend(&gpu::givenOrGl(i.backend, ownBackend)),
+        gl(backend->kind() == gpu::BackendKind::OpenGL),
         prefilter(prefilterInfo(i.mapSize, i.prefilter, backend)),
         evaluate(evaluateInfo(i.prefilter.bases, i.evaluate, i.localLightClosedForm, backend)),
         resample({.mapWidth = i.mapSize, .mapHeight = i.mapSize, .backend = backend}),
@@ -622,7 +625,8 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
   if (!f.medium) invalid(p + "medium", "null", "must be set");
   if (f.output != 0 || !f.froxels) { // a froxel volume alone reads no camera depth
     gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, info.width, info.height);
-    gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, info.width, info.height, GL_RGBA32F);
+    gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, info.width, info.height,
+                            gpu::Format::RGBA32F);
     requireOutputNotAnInput(f, p);
     gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   }

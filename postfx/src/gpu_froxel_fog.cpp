@@ -2,11 +2,12 @@
 // Fog"). Shaders: passes/postfx/esm_downsample.comp, passes/postfx/esm_blur.comp,
 // passes/postfx/froxel_light.comp, passes/postfx/froxel_accumulate.comp, passes/postfx/froxel_temporal.comp,
 // passes/postfx/froxel_apply.comp, crep/froxel.glsl.
+#include <crep/gpu/checks.h>
 #include <crep/postfx/gpu_froxel_fog.h>
 
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/ray.h>
 
@@ -59,26 +60,25 @@ void requireJitter(const glm::dvec3& j, const std::string& parameter) {
 /// A caller's volume: an existing 3D texture of the grid's size (and `format` when not 0) of `backend`.
 void requireVolume(const gpu::Backend& backend, const std::string& parameter, std::uint32_t texture,
                    const FroxelGrid& grid, std::uint32_t format) {
-  const gl::TextureLevel l = gpu::textureLevelOf(backend, parameter.c_str(), texture);
-  if (l.target != GL_TEXTURE_3D)
-    throw InvalidArgument(parameter, std::to_string(texture), "must be a GL_TEXTURE_3D");
+  const gpu::TextureLevel l = gpu::textureLevelOf(backend, parameter.c_str(), texture);
+  if (l.type != gpu::TextureType::Texture3D)
+    throw InvalidArgument(parameter, std::to_string(texture), "must be a 3D texture");
   if (l.width != grid.width || l.height != grid.height || l.depth != grid.depth)
     throw InvalidArgument(
         parameter, std::to_string(l.width) + "x" + std::to_string(l.height) + "x" + std::to_string(l.depth),
         "must be the grid's size " + std::to_string(grid.width) + "x" + std::to_string(grid.height) + "x" +
             std::to_string(grid.depth));
-  if (format != 0 && l.internalFormat != format)
-    throw InvalidArgument(parameter, "internal format " + std::to_string(l.internalFormat),
-                          std::string("must be ") + (format == GL_RGBA32F ? "GL_RGBA32F" : "GL_RGBA16F"));
-  if (format == 0 && l.internalFormat != GL_RGBA16F && l.internalFormat != GL_RGBA32F)
-    throw InvalidArgument(parameter, "internal format " + std::to_string(l.internalFormat),
-                          "must be GL_RGBA16F or GL_RGBA32F");
+  const std::string given = l.format ? gpu::formatName(*l.format) : "another format";
+  if (format != 0 && l.format != froxelFormat(format))
+    throw InvalidArgument(parameter, given, std::string("must be ") + gpu::formatName(froxelFormat(format)));
+  if (format == 0 && l.format != gpu::Format::RGBA16F && l.format != gpu::Format::RGBA32F)
+    throw InvalidArgument(parameter, given, "must be RGBA16F or RGBA32F");
 }
 
 /// Checks the grid (validate) and, on GL, the driver's 3D texture limit (other backends: at creation).
 void requireGrid(const FroxelGrid& grid, const char* owner, const gpu::Backend* backend = nullptr) {
   validate(grid, owner);
-  if (backend != nullptr && backend->name() != "OpenGL") return;
+  if (backend != nullptr && backend->kind() != gpu::BackendKind::OpenGL) return;
   GLint limit = 0;
   glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &limit);
   const int sizes[3] = {grid.width, grid.height, grid.depth};
@@ -185,7 +185,7 @@ void EsmPass::validate(const FrameAttribs& f, std::string_view owner) const {
 void EsmPass::run(const FrameAttribs& f) {
   validate(f);
   gpu::Backend& b = *backend_;
-  const gl::TextureLevel map = gpu::textureLevelOf(b, "EsmPass::FrameAttribs.shadowMap", f.shadowMap);
+  const gpu::TextureLevel map = gpu::textureLevelOf(b, "EsmPass::FrameAttribs.shadowMap", f.shadowMap);
   const double c = esmDepthExponent(info_.options, f.lightClipFromWorld);
   const int factor = info_.options.downsample;
   const int w = (map.width + factor - 1) / factor, h = (map.height + factor - 1) / factor;
@@ -245,10 +245,10 @@ void FroxelLightingPass::validate(const FrameAttribs& f, std::string_view ownerN
   requireFinite(name(owner, "noiseOffset"), f.noiseOffset);
   if (f.esm != 0) {
     const std::string esmName = name(owner, "esm");
-    const gl::TextureLevel esm = gpu::requireTexture2DOf(*backend_, esmName.c_str(), f.esm);
-    if (esm.internalFormat != GL_R32F)
-      invalid(esmName, "internal format " + std::to_string(esm.internalFormat),
-              "must be GL_R32F (EsmPass::esm())");
+    const gpu::TextureLevel esm = gpu::requireTexture2DOf(*backend_, esmName.c_str(), f.esm);
+    if (esm.format != gpu::Format::R32F)
+      invalid(esmName, esm.format ? gpu::formatName(*esm.format) : "another format",
+              "must be R32F (EsmPass::esm())");
     requireFinite(name(owner, "lightClipFromWorld"), f.lightClipFromWorld);
   }
 }
@@ -256,8 +256,9 @@ void FroxelLightingPass::validate(const FrameAttribs& f, std::string_view ownerN
 void FroxelLightingPass::run(const FrameAttribs& f) {
   validate(f);
   gpu::Backend& b = *backend_;
-  const gl::TextureLevel esm =
-      f.esm != 0 ? gpu::textureLevelOf(b, "FroxelLightingPass::FrameAttribs.esm", f.esm) : gl::TextureLevel{};
+  const gpu::TextureLevel esm = f.esm != 0
+                                    ? gpu::textureLevelOf(b, "FroxelLightingPass::FrameAttribs.esm", f.esm)
+                                    : gpu::TextureLevel{};
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
   assignMedium(p, *f.medium);
@@ -384,16 +385,16 @@ void FroxelApplyPass::validate(const FrameAttribs& f, std::string_view ownerName
   const char* owner = o.c_str();
   if (!f.camera) invalid(name(owner, "camera"), "null", "must be set");
   const std::string depthName = name(owner, "cameraDepth");
-  const gl::TextureLevel depth = gpu::requireTexture2DOf(*backend_, depthName.c_str(), f.cameraDepth);
+  const gpu::TextureLevel depth = gpu::requireTexture2DOf(*backend_, depthName.c_str(), f.cameraDepth);
   gpu::requireTexture2DOf(*backend_, name(owner, "output").c_str(), f.output, depth.width, depth.height,
-                          GL_RGBA32F);
+                          gpu::Format::RGBA32F);
   requireVolume(*backend_, name(owner, "volume"), f.volume, info_.grid, 0);
   requireJitter(f.offset, name(owner, "offset"));
 }
 
 void FroxelApplyPass::run(const FrameAttribs& f) {
   validate(f);
-  const gl::TextureLevel depth =
+  const gpu::TextureLevel depth =
       gpu::textureLevelOf(*backend_, "FroxelApplyPass::FrameAttribs.cameraDepth", f.cameraDepth);
   gpu::FroxelParams p;
   assignFrame(p, *f.camera, info_.grid);
@@ -474,9 +475,9 @@ void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) cons
     invalid(name(owner, "light/medium"), "null", "must be set in Mode::Esm");
   if (f.output != 0) {
     const std::string depthName = name(owner, "cameraDepth");
-    const gl::TextureLevel depth = gpu::requireTexture2DOf(b, depthName.c_str(), f.cameraDepth);
+    const gpu::TextureLevel depth = gpu::requireTexture2DOf(b, depthName.c_str(), f.cameraDepth);
     gpu::requireTexture2DOf(b, name(owner, "output").c_str(), f.output, depth.width, depth.height,
-                            GL_RGBA32F);
+                            gpu::Format::RGBA32F);
   }
   if (f.mode == Mode::Esm && f.shadowMap != 0) {
     const std::string mapName = name(owner, "shadowMap");

@@ -2,8 +2,9 @@
 // crep/postfx/radial_blur.h). Shaders: passes/postfx/radial_source.comp, passes/postfx/radial_blur.comp,
 // crep/radial_blur.glsl, crep/march.glsl.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/postfx/gpu_radial_blur.h>
 #include <crep/scatter/gpu_world_march.h>
 
@@ -66,15 +67,16 @@ void RadialBlurPass::validate(const FrameAttribs& f, std::string_view owner) con
   if (!f.light) invalid(p + "light", "null", "must be set");
   if (!f.medium) invalid(p + "medium", "null", "must be set");
   const gpu::Backend& b = *backend_;
-  const gl::TextureLevel depth = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
+  const gpu::TextureLevel depth = gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
-  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, depth.width, depth.height, GL_RGBA32F);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, depth.width, depth.height,
+                          gpu::Format::RGBA32F);
 }
 
 void RadialBlurPass::run(const FrameAttribs& f) {
   validate(f);
   gpu::Backend& b = *backend_;
-  const gl::TextureLevel depth =
+  const gpu::TextureLevel depth =
       gpu::textureLevelOf(b, "RadialBlurPass::FrameAttribs.cameraDepth", f.cameraDepth);
   const int width = depth.width, height = depth.height;
   const RadialBlurOptions& o = info_.options;

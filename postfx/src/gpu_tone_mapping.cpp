@@ -3,8 +3,9 @@
 // operators of glsl/crep/tone_mapping.glsl. Shaders: passes/postfx/luminance_reduce.comp,
 // passes/postfx/luminance_adapt.comp, passes/tone_map.comp.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/postfx/gpu_tone_mapping.h>
 
 #include "crep/bindings.h"
@@ -55,15 +56,15 @@ ShaderStageSource ToneMapPass::toneMapStage(bool rgba8) const {
 void ToneMapPass::validate(const FrameAttribs& f, std::string_view owner) const {
   const std::string p = std::string(owner) + ".";
   const gpu::Backend& b = *backend_;
-  const gl::TextureLevel in = gpu::requireTexture2DOf(b, (p + "input").c_str(), f.input);
-  if (in.internalFormat != GL_RGBA32F && in.internalFormat != GL_RGBA16F)
-    invalid(p + "input", "internal format " + std::to_string(in.internalFormat),
-            "must be GL_RGBA32F or GL_RGBA16F");
+  const gpu::TextureLevel in = gpu::requireTexture2DOf(b, (p + "input").c_str(), f.input);
+  if (in.format != gpu::Format::RGBA32F && in.format != gpu::Format::RGBA16F)
+    invalid(p + "input", in.format ? gpu::formatName(*in.format) : "another format",
+            "must be RGBA32F or RGBA16F");
   if (f.output == f.input) invalid(p + "output", std::to_string(f.output), "must not be the input texture");
-  const gl::TextureLevel out = gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output);
-  if (out.internalFormat != GL_RGBA8 && out.internalFormat != GL_RGBA32F)
-    invalid(p + "output", "internal format " + std::to_string(out.internalFormat),
-            "must be GL_RGBA8 or GL_RGBA32F");
+  const gpu::TextureLevel out = gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output);
+  if (out.format != gpu::Format::RGBA8 && out.format != gpu::Format::RGBA32F)
+    invalid(p + "output", out.format ? gpu::formatName(*out.format) : "another format",
+            "must be RGBA8 or RGBA32F");
   if (out.width != in.width || out.height != in.height)
     invalid(p + "output", std::to_string(out.width) + "x" + std::to_string(out.height),
             "must be the input's size " + std::to_string(in.width) + "x" + std::to_string(in.height));
@@ -73,8 +74,8 @@ void ToneMapPass::validate(const FrameAttribs& f, std::string_view owner) const 
 void ToneMapPass::run(const FrameAttribs& f) {
   validate(f);
   gpu::Backend& b = *backend_;
-  const gl::TextureLevel in = gpu::textureLevelOf(b, "ToneMapPass::FrameAttribs.input", f.input);
-  const gl::TextureLevel out = gpu::textureLevelOf(b, "ToneMapPass::FrameAttribs.output", f.output);
+  const gpu::TextureLevel in = gpu::textureLevelOf(b, "ToneMapPass::FrameAttribs.input", f.input);
+  const gpu::TextureLevel out = gpu::textureLevelOf(b, "ToneMapPass::FrameAttribs.output", f.output);
 
   const ToneMapOptions& o = info_.options;
   const int groupsX = (in.width + kReductionTile - 1) / kReductionTile;
@@ -111,7 +112,7 @@ void ToneMapPass::run(const FrameAttribs& f) {
                 {},
                 glm::uvec3(1u)});
   }
-  const ShaderStageSource stage = toneMapStage(out.internalFormat == GL_RGBA8);
+  const ShaderStageSource stage = toneMapStage(out.format == gpu::Format::RGBA8);
   b.dispatch({"ToneMapPass::run",
               stage.path,
               stage.defines,

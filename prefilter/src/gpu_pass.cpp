@@ -6,8 +6,9 @@
 // (gpu::RegionWeights), fills the shared blocks (gpu_structs.h) and dispatches. Contract:
 // crep/prefilter/prefilter.h.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/airlight.h>
 #include <crep/scatter/gpu_world_march.h>
@@ -66,27 +67,28 @@ void requireAtLeast(const char* parameter, int value, int minimum) {
   if (value < minimum) invalid(parameter, detail::formatValue(value), "must be >= " + str(minimum));
 }
 
-/// Local size and dispatch counts against GL_MAX_COMPUTE_WORK_GROUP_{SIZE,INVOCATIONS,COUNT} (the
-/// backend's compute limits).
-void checkWorkgroup(const gpu::ComputeLimits& limits, const char* const names[3], const int local[3],
+/// Local size and dispatch counts against the backend's compute limits (GL_MAX_COMPUTE_WORK_GROUP_{SIZE,
+/// INVOCATIONS,COUNT} on GL).
+void checkWorkgroup(const gpu::Backend& backend, const char* const names[3], const int local[3],
                     const int groups[3]) {
+  const gpu::ComputeLimits limits = backend.computeLimits();
   long long invocations = 1;
   for (int axis = 0; axis < 3; ++axis) {
-    const int maxSize = limits.groupSize[axis];
-    if (local[axis] > maxSize)
-      throw GlError(std::string(names[axis]) + " = " + str(local[axis]) +
-                    " exceeds GL_MAX_COMPUTE_WORK_GROUP_SIZE[" + str(axis) + "] = " + str(maxSize));
-    const int maxCount = limits.groupCount[axis];
-    if (groups[axis] > maxCount)
-      throw GlError(std::string(names[axis]) + " = " + str(local[axis]) + " needs " + str(groups[axis]) +
-                    " workgroups, beyond GL_MAX_COMPUTE_WORK_GROUP_COUNT[" + str(axis) +
-                    "] = " + str(maxCount));
+    if (local[axis] > limits.groupSize[axis])
+      gpu::throwBeyondLimit(backend, names[axis], str(local[axis]),
+                            "GL_MAX_COMPUTE_WORK_GROUP_SIZE[" + str(axis) + "]",
+                            "work-group size on axis " + str(axis), limits.groupSize[axis]);
+    if (groups[axis] > limits.groupCount[axis])
+      gpu::throwBeyondLimit(backend, names[axis],
+                            str(local[axis]) + " (" + str(groups[axis]) + " workgroups)",
+                            "GL_MAX_COMPUTE_WORK_GROUP_COUNT[" + str(axis) + "]",
+                            "work-group count on axis " + str(axis), limits.groupCount[axis]);
     invocations *= local[axis];
   }
-  const int maxInvocations = limits.invocations;
-  if (invocations > maxInvocations)
-    throw GlError(std::string(names[0]) + " x " + names[1] + " x " + names[2] + " = " + str(invocations) +
-                  " exceeds GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS = " + str(maxInvocations));
+  if (invocations > limits.invocations)
+    gpu::throwBeyondLimit(backend, std::string(names[0]) + " x " + names[1] + " x " + names[2],
+                          str(invocations), "GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS",
+                          "invocations per work group", limits.invocations);
 }
 
 gpu::Format basisFormat(StorageFormat format) {
@@ -99,18 +101,6 @@ gpu::Format basisFormat(StorageFormat format) {
     break;
   }
   return gpu::Format::RGBA32F;
-}
-
-GLenum internalFormat(StorageFormat format) {
-  switch (format) {
-  case StorageFormat::RGBA8:
-    return GL_RGBA8;
-  case StorageFormat::RGBA16F:
-    return GL_RGBA16F;
-  case StorageFormat::RGBA32F:
-    break;
-  }
-  return GL_RGBA32F;
 }
 
 const char* imageFormatQualifier(StorageFormat format) {
@@ -288,18 +278,17 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   backend_ = &gpu::givenOrGl(info.backend, ownBackend_);
   gpu::Backend& b = *backend_;
   const int maxSize = b.maxTextureSize();
-  const std::string limitName =
-      b.name() == "OpenGL" ? "GL_MAX_TEXTURE_SIZE" : "the device's maximum texture size";
   if (info.mapWidth > maxSize)
-    throw GlError("PrefilterPass::CreateInfo.mapWidth = " + str(info.mapWidth) + " exceeds " + limitName +
-                  " = " + str(maxSize));
+    gpu::throwBeyondLimit(b, "PrefilterPass::CreateInfo.mapWidth", str(info.mapWidth), "GL_MAX_TEXTURE_SIZE",
+                          "maximum texture size", maxSize);
   if (info.mapHeight > maxSize)
-    throw GlError("PrefilterPass::CreateInfo.mapHeight = " + str(info.mapHeight) + " exceeds " + limitName +
-                  " = " + str(maxSize));
+    gpu::throwBeyondLimit(b, "PrefilterPass::CreateInfo.mapHeight", str(info.mapHeight),
+                          "GL_MAX_TEXTURE_SIZE", "maximum texture size", maxSize);
   const int maxLayers = b.maxArrayLayers();
   if (layers() > maxLayers)
-    throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(o.bases) + " needs " + str(layers()) +
-                  " layers, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
+    gpu::throwBeyondLimit(b, "PrefilterPass::CreateInfo.options.bases",
+                          str(o.bases) + " (" + str(layers()) + " layers)", "GL_MAX_ARRAY_TEXTURE_LAYERS",
+                          "array layers", maxLayers);
   {
     const char* names[3] = {"PrefilterPass::CreateInfo.workgroupRows",
                             "PrefilterPass::CreateInfo.workgroupBaseGroups",
@@ -309,7 +298,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
     const int groups[3] = {ceilDiv(info.mapHeight, info.workgroupRows),
                            ceilDiv(baseGroups(info), info.workgroupBaseGroups),
                            ceilDiv(info.mapWidth, info.workgroupRegions)};
-    checkWorkgroup(b.computeLimits(), names, local, groups);
+    checkWorkgroup(b, names, local, groups);
   }
 
   const ShaderStageSource stage = prefilterStages(info, false)[0];
@@ -352,10 +341,10 @@ void PrefilterPass::validate(const FrameAttribs& frame, std::string_view owner) 
 PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_view owner) const {
   const std::string f = std::string(owner) + ".";
   if (frame.layout == nullptr) invalid(f + "layout", "null", "must point to the map's layout");
-  const gl::TextureLevel depth =
+  const gpu::TextureLevel depth =
       gpu::textureLevelOf(*backend_, (f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
-  if (depth.target != GL_TEXTURE_2D)
-    invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a GL_TEXTURE_2D");
+  if (depth.type != gpu::TextureType::Texture2D)
+    invalid(f + "rectifiedDepth", "texture " + str(frame.rectifiedDepth), "must be a 2D texture");
   gpu::requireDepthFormatOf(*backend_, (f + "rectifiedDepth").c_str(), frame.rectifiedDepth);
   if (depth.width != info_.mapWidth || depth.height != info_.mapHeight)
     invalid(f + "rectifiedDepth", sizeString(depth.width, depth.height),
@@ -379,7 +368,7 @@ PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_v
   p.local = frame.localLight != nullptr;
   p.textured = frame.lightColors != 0;
   if (p.textured) {
-    if (backend_->name() == "OpenGL")
+    if (backend_->kind() == gpu::BackendKind::OpenGL)
       gl::requireTexture2D((f + "lightColors").c_str(), frame.lightColors, W, H);
     else
       gpu::requireTexture(*backend_, (f + "lightColors").c_str(), frame.lightColors, W, H,
@@ -391,9 +380,10 @@ PrefilterPass::Plan PrefilterPass::plan(const FrameAttribs& frame, std::string_v
     if (!texturedTexture_) {
       const int maxLayers = backend_->maxArrayLayers();
       if (3 * layers() > maxLayers)
-        throw GlError("PrefilterPass::CreateInfo.options.bases = " + str(info_.options.bases) + " needs " +
-                      str(3 * layers()) +
-                      " layers with a light texture, beyond GL_MAX_ARRAY_TEXTURE_LAYERS = " + str(maxLayers));
+        gpu::throwBeyondLimit(*backend_, "PrefilterPass::CreateInfo.options.bases",
+                              str(info_.options.bases) + " (" + str(3 * layers()) +
+                                  " layers with a light texture)",
+                              "GL_MAX_ARRAY_TEXTURE_LAYERS", "array layers", maxLayers);
     }
   }
   if (p.local && frame.medium == nullptr) invalid(f + "medium", "null", "must be set with a localLight");
@@ -652,7 +642,7 @@ EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
                             "EvaluatePass::CreateInfo.workgroupHeight", "(none)"};
     const int local[3] = {info.workgroupWidth, info.workgroupHeight, 1};
     const int groups[3] = {1, 1, 1};
-    checkWorkgroup(b.computeLimits(), names, local, groups);
+    checkWorkgroup(b, names, local, groups);
   }
   const auto prepare = [&b](const ShaderStageSource& s) { b.prepareProgram(s.path, s.defines); };
   prepare(evaluateStages(info, -1)[0]);
@@ -718,20 +708,20 @@ void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateIn
     invalid(f + "basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info.bases));
   const int basisLayers = (basis.textured ? 3 : 1) * layerCount(basis.bases);
-  const gl::TextureLevel b = gpu::textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
-  if (b.target != GL_TEXTURE_2D_ARRAY || b.width != basis.width || b.height != basis.height ||
+  const gpu::TextureLevel b = gpu::textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
+  if (b.type != gpu::TextureType::Texture2DArray || b.width != basis.width || b.height != basis.height ||
       b.depth < basisLayers)
     invalid(f + "basis.texture", "texture " + str(basis.texture),
-            "must be a GL_TEXTURE_2D_ARRAY of " + sizeString(basis.width, basis.height) + " x " +
+            "must be a 2D array texture of " + sizeString(basis.width, basis.height) + " x " +
                 str(basisLayers) + " layers");
   if (basis.textured) {
     // Light textures (prefilter.h): the textured variants exist for the scattering prefix table (the
     // default) and the direct path without a table.
-    const gl::TextureLevel mean =
+    const gpu::TextureLevel mean =
         gpu::textureLevelOf(backend, (f + "basis.meanColor").c_str(), basis.meanColor);
-    if (mean.target != GL_TEXTURE_2D || mean.width != basis.width || mean.height != basis.height)
+    if (mean.type != gpu::TextureType::Texture2D || mean.width != basis.width || mean.height != basis.height)
       invalid(f + "basis.meanColor", "texture " + str(basis.meanColor),
-              "must be a GL_TEXTURE_2D of " + sizeString(basis.width, basis.height));
+              "must be a 2D texture of " + sizeString(basis.width, basis.height));
     if (info.options.nearPlaneCorrection)
       invalid(f + "basis.textured", "true",
               "a light texture is not supported with CreateInfo.options.nearPlaneCorrection");
@@ -760,11 +750,12 @@ FroxelDepthRange validateFroxels(const gpu::Backend& backend, const EvaluatePass
   if (info.memoryLimit)
     invalid(owner, "a volume",
             "must be 0 with CreateInfo.memoryLimit (a benchmark variant of the per-pixel pass)");
-  const gl::TextureLevel v = gpu::textureLevelOf(backend, (owner + ".volume").c_str(), froxels.volume);
+  const gpu::TextureLevel v = gpu::textureLevelOf(backend, (owner + ".volume").c_str(), froxels.volume);
   const FroxelGrid& g = froxels.grid;
-  if (v.target != GL_TEXTURE_3D || (v.internalFormat != GL_RGBA16F && v.internalFormat != GL_RGBA32F))
+  if (v.type != gpu::TextureType::Texture3D ||
+      (v.format != gpu::Format::RGBA16F && v.format != gpu::Format::RGBA32F))
     invalid(owner + ".volume", "texture " + str(froxels.volume),
-            "must be a GL_TEXTURE_3D of format GL_RGBA16F or GL_RGBA32F");
+            "must be a 3D texture of format RGBA16F or RGBA32F");
   if (v.width != g.width || v.height != g.height || v.depth != g.depth)
     invalid(owner + ".volume", sizeString(v.width, v.height) + " x " + str(v.depth),
             "must have the grid's size " + sizeString(g.width, g.height) + " x " + str(g.depth));
@@ -774,21 +765,22 @@ FroxelDepthRange validateFroxels(const gpu::Backend& backend, const EvaluatePass
   const int localSize[3] = {info.workgroupWidth, info.workgroupHeight, 1};
   const int groups[3] = {ceilDiv(g.width, info.workgroupWidth), ceilDiv(g.height, info.workgroupHeight),
                          g.depth};
-  checkWorkgroup(backend.computeLimits(), names, localSize, groups);
+  checkWorkgroup(backend, names, localSize, groups);
   return range;
 }
 
 /// The camera depth and output textures of the per-pixel evaluation; returns the depth's level.
-gl::TextureLevel validatePixelTextures(const gpu::Backend& backend, const EvaluatePass::CreateInfo& info,
-                                       const EvaluatePass::FrameAttribs& frame, const std::string& f) {
-  const gl::TextureLevel depth = gpu::textureLevelOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
-  if (depth.target != GL_TEXTURE_2D)
-    invalid(f + "cameraDepth", "texture " + str(frame.cameraDepth), "must be a GL_TEXTURE_2D");
+gpu::TextureLevel validatePixelTextures(const gpu::Backend& backend, const EvaluatePass::CreateInfo& info,
+                                        const EvaluatePass::FrameAttribs& frame, const std::string& f) {
+  const gpu::TextureLevel depth =
+      gpu::textureLevelOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
+  if (depth.type != gpu::TextureType::Texture2D)
+    invalid(f + "cameraDepth", "texture " + str(frame.cameraDepth), "must be a 2D texture");
   gpu::requireDepthFormatOf(backend, (f + "cameraDepth").c_str(), frame.cameraDepth);
-  const gl::TextureLevel out = gpu::textureLevelOf(backend, (f + "output").c_str(), frame.output);
-  if (out.target != GL_TEXTURE_2D || out.internalFormat != internalFormat(info.outputFormat))
+  const gpu::TextureLevel out = gpu::textureLevelOf(backend, (f + "output").c_str(), frame.output);
+  if (out.type != gpu::TextureType::Texture2D || out.format != basisFormat(info.outputFormat))
     invalid(f + "output", "texture " + str(frame.output),
-            std::string("must be a GL_TEXTURE_2D of format ") + storageFormatToken(info.outputFormat));
+            std::string("must be a 2D texture of format ") + storageFormatToken(info.outputFormat));
   if (out.width != depth.width || out.height != depth.height)
     invalid(f + "output", sizeString(out.width, out.height),
             "must have the size of cameraDepth " + sizeString(depth.width, depth.height));
@@ -819,14 +811,14 @@ EvaluatePass::Plan EvaluatePass::plan(const FrameAttribs& frame, std::string_vie
   p.pixels = !p.list && (frame.output != 0 || !p.froxels);
   if (p.froxels) p.froxelRange = validateFroxels(*backend_, info_, frame.froxels, *frame.camera, p.local, f);
   if (p.list) {
-    const gl::TextureLevel image = gpu::listImageSize(*backend_, frame.imageWidth, frame.imageHeight,
-                                                      frame.cameraDepth, std::string(owner));
+    const gpu::TextureLevel image = gpu::listImageSize(*backend_, frame.imageWidth, frame.imageHeight,
+                                                       frame.cameraDepth, std::string(owner));
     gpu::validateSampleList(*backend_, *p.list, f + "list");
     p.imageWidth = image.width;
     p.imageHeight = image.height;
   }
   if (p.pixels) {
-    const gl::TextureLevel depth = validatePixelTextures(*backend_, info_, frame, f);
+    const gpu::TextureLevel depth = validatePixelTextures(*backend_, info_, frame, f);
     p.imageWidth = depth.width;
     p.imageHeight = depth.height;
   }
@@ -922,7 +914,7 @@ void EvaluatePass::uploadLocalLight(const FrameAttribs& frame) {
 /// and the prefix programs.
 void EvaluatePass::appendLocalResources(std::vector<gpu::Resource>& out) const {
   // GL: a uniform block; the Vulkan form of the shader reads it as a storage buffer (crep/scattering.glsl).
-  out.push_back(backend_->name() == "OpenGL"
+  out.push_back(backend_->kind() == gpu::BackendKind::OpenGL
                     ? gpu::Resource::uniform(CREP_LOCAL_LIGHT_DEFAULT_BINDING, localBuffer_.id())
                     : gpu::Resource::storage(CREP_LOCAL_LIGHT_STORAGE_DEFAULT_BINDING, localBuffer_.id()));
   if (info_.localClosedForm)

@@ -1,6 +1,6 @@
 // Upload of a layout's GPU description (crep/scatter/gpu_layout_buffers.h).
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 
 #include <epoxy/gl.h>

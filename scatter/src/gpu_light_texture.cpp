@@ -2,8 +2,9 @@
 // caller's texture and projection, and the colour map pass (glsl/passes/scatter/light_colors.comp). Rules in
 // crep/scatter/light_texture.h.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/light_texture.h>
 
@@ -17,12 +18,15 @@ namespace crep {
 
 namespace gpu {
 
-gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
-                                         const LocalLight* localLight, std::string_view field) {
+gpu::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
+                                          const LocalLight* localLight, std::string_view field) {
   const std::string f(field);
   const std::string textureField = f + ".texture";
-  const gl::TextureLevel level = gl::requireTexture2D(textureField.c_str(), texture.texture);
+  const gl::TextureLevel glLevel = gl::requireTexture2D(textureField.c_str(), texture.texture);
   gl::requireColorFormat(textureField.c_str(), texture.texture);
+  gpu::TextureLevel level;
+  level.width = glLevel.width;
+  level.height = glLevel.height;
   if (level.width <= 0 || level.height <= 0)
     throw InvalidArgument(textureField, std::to_string(level.width) + " x " + std::to_string(level.height),
                           "must have a level 0");
@@ -33,14 +37,15 @@ gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const D
   return level;
 }
 
-gl::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightTexture& texture,
-                                         const DirectionalLight* light, const LocalLight* localLight,
-                                         std::string_view field) {
-  if (backend.name() == "OpenGL") return validateGpuLightTexture(texture, light, localLight, field);
+gpu::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightTexture& texture,
+                                          const DirectionalLight* light, const LocalLight* localLight,
+                                          std::string_view field) {
+  if (backend.kind() == BackendKind::OpenGL)
+    return validateGpuLightTexture(texture, light, localLight, field);
   const std::string f(field);
   const std::string textureField = f + ".texture";
-  const gl::TextureLevel level = requireTexture2DOf(backend, textureField.c_str(), texture.texture);
-  if (level.internalFormat == GL_DEPTH_COMPONENT32F)
+  const gpu::TextureLevel level = requireTexture2DOf(backend, textureField.c_str(), texture.texture);
+  if (level.isDepth)
     throw InvalidArgument(textureField, std::to_string(texture.texture),
                           "must have a colour format (not depth)");
   if (localLight)
@@ -50,7 +55,7 @@ gl::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightT
   return level;
 }
 
-LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gl::TextureLevel& level,
+LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gpu::TextureLevel& level,
                                           int mapWidth, int mapHeight, const LocalLight* localLight) {
   LightTextureParams p;
   p.textureClipFromWorld = glm::mat4(texture.textureClipFromWorld);
@@ -85,7 +90,7 @@ std::size_t LightColorMapPass::memoryBytes() const noexcept {
 // component), crep::lightColorMap in float.
 /// A validated frame of the pass (LightColorMapPass::validate) and what run() derives from it.
 struct LightColorMapPass::Plan {
-  gl::TextureLevel level;   ///< the light texture's level 0
+  gpu::TextureLevel level;  ///< the light texture's level 0
   GpuLayoutData layoutData; ///< the map's layout block
 };
 

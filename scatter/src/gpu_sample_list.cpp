@@ -1,8 +1,9 @@
 // GPU work lists (crep/scatter/gpu_sample_list.h).
 #include <crep/core/error.h>
+#include <crep/gpu/checks.h>
 #include <crep/scatter/gpu_sample_list.h>
 
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl_backend.h>
 
 #include <epoxy/gl.h>
 
@@ -70,22 +71,27 @@ void validateSampleList(const SampleList& list, const std::string& owner) {
   gl::requireTexture2D((owner + ".output").c_str(), list.output, list.width, list.height, GL_RGBA32F);
 }
 
-gl::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
-                               const std::string& owner) {
-  if (imageWidth == 0 && imageHeight == 0)
-    return gl::requireTexture2D((owner + ".cameraDepth").c_str(), cameraDepth);
+gpu::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
+                                const std::string& owner) {
+  if (imageWidth == 0 && imageHeight == 0) {
+    const gl::TextureLevel depth = gl::requireTexture2D((owner + ".cameraDepth").c_str(), cameraDepth);
+    gpu::TextureLevel size;
+    size.width = depth.width;
+    size.height = depth.height;
+    return size;
+  }
   if (imageWidth <= 0 || imageHeight <= 0)
     throw InvalidArgument(owner + ".imageWidth/imageHeight",
                           std::to_string(imageWidth) + " x " + std::to_string(imageHeight),
                           "must both be > 0 (or both 0: cameraDepth's size)");
-  gl::TextureLevel size;
+  gpu::TextureLevel size;
   size.width = imageWidth;
   size.height = imageHeight;
   return size;
 }
 
 void validateSampleList(const Backend& backend, const SampleList& list, const std::string& owner) {
-  if (backend.name() == "OpenGL") return validateSampleList(list, owner);
+  if (backend.kind() == BackendKind::OpenGL) return validateSampleList(list, owner);
   const std::size_t bytes =
       requireBufferOf(backend, (owner + ".buffer").c_str(), list.buffer, "must name the list's buffer");
   const std::size_t needed = static_cast<std::size_t>(kSampleListHeaderBytes) +
@@ -95,13 +101,14 @@ void validateSampleList(const Backend& backend, const SampleList& list, const st
                           "must hold the header and capacity = " + std::to_string(list.capacity) +
                               " entries (capacity >= 1)");
   requireTexture2DOf(backend, (owner + ".coordinates").c_str(), list.coordinates, list.width, list.height,
-                     GL_RGBA32F);
-  requireTexture2DOf(backend, (owner + ".output").c_str(), list.output, list.width, list.height, GL_RGBA32F);
+                     gpu::Format::RGBA32F);
+  requireTexture2DOf(backend, (owner + ".output").c_str(), list.output, list.width, list.height,
+                     gpu::Format::RGBA32F);
 }
 
-gl::TextureLevel listImageSize(const Backend& backend, int imageWidth, int imageHeight,
-                               std::uint32_t cameraDepth, const std::string& owner) {
-  if (backend.name() == "OpenGL" || imageWidth != 0 || imageHeight != 0)
+gpu::TextureLevel listImageSize(const Backend& backend, int imageWidth, int imageHeight,
+                                std::uint32_t cameraDepth, const std::string& owner) {
+  if (backend.kind() == BackendKind::OpenGL || imageWidth != 0 || imageHeight != 0)
     return listImageSize(imageWidth, imageHeight, cameraDepth, owner);
   return requireTexture2DOf(backend, (owner + ".cameraDepth").c_str(), cameraDepth);
 }

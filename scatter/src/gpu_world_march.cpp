@@ -2,8 +2,9 @@
 // Eq. 1 and 3) and the shared march block. Shader: passes/scatter/march_reference.comp, crep/march.glsl,
 // crep/local_light.glsl.
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scatter/gpu_world_march.h>
 
 #include "crep/bindings.h"
@@ -125,7 +126,7 @@ WorldMarchPass::WorldMarchPass(const CreateInfo& info) : info_(info) {
 
 /// A validated frame of the pass (WorldMarchPass::validate) and what run() derives from it.
 struct WorldMarchPass::Plan {
-  gl::TextureLevel depth, shadow, lightTexture; ///< level 0 of the camera depth, the map, the light texture
+  gpu::TextureLevel depth, shadow, lightTexture; ///< level 0 of the camera depth, the map, the light texture
 };
 
 void WorldMarchPass::validate(const FrameAttribs& frame, std::string_view owner) const {
@@ -145,9 +146,9 @@ WorldMarchPass::Plan WorldMarchPass::plan(const FrameAttribs& f, std::string_vie
   gpu::requireDepthFormatOf(b, (p + "cameraDepth").c_str(), f.cameraDepth);
   gpu::requireDepthFormatOf(b, (p + "shadowMap").c_str(), f.shadowMap);
   const int width = plan.depth.width, height = plan.depth.height;
-  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, width, height, GL_RGBA32F);
+  gpu::requireTexture2DOf(b, (p + "output").c_str(), f.output, width, height, gpu::Format::RGBA32F);
   if (f.stepsOutput != 0)
-    gpu::requireTexture2DOf(b, (p + "stepsOutput").c_str(), f.stepsOutput, width, height, GL_R32F);
+    gpu::requireTexture2DOf(b, (p + "stepsOutput").c_str(), f.stepsOutput, width, height, gpu::Format::R32F);
   requireFinite(p + "lightClipFromWorld", f.lightClipFromWorld);
   if (const LocalLight* l = f.localLight) {
     const auto finite3 = [](const glm::dvec3& v) {
@@ -173,7 +174,7 @@ WorldMarchPass::Plan WorldMarchPass::plan(const FrameAttribs& f, std::string_vie
 void WorldMarchPass::run(const FrameAttribs& f) {
   const Plan p = plan(f, "WorldMarchPass::FrameAttribs");
   const int width = p.depth.width, height = p.depth.height;
-  const gl::TextureLevel& shadow = p.shadow;
+  const gpu::TextureLevel& shadow = p.shadow;
   const bool textured = f.lightTexture.texture != 0;
   gpu::MarchParams params = f.light ? gpu::makeMarchParams(*f.camera, *f.light, *f.medium, width, height,
                                                            shadow.width, shadow.height)

@@ -7,8 +7,8 @@
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>

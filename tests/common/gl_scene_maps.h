@@ -8,7 +8,7 @@
 #include "common/analytic_reference.h"
 #include "common/local_light_scene.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>

@@ -3,7 +3,7 @@
 // offsets).
 #pragma once
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 #include <crep/scatter/froxel_grid.h>
 

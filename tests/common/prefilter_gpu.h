@@ -6,7 +6,7 @@
 
 #include "common/gl_util.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>

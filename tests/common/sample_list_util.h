@@ -6,7 +6,7 @@
 
 #include "common/analytic_reference.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 #include <crep/scatter/gpu_sample_list.h>
 

@@ -1,6 +1,6 @@
 #include "common/shader_tools.h"
 
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>
 

@@ -13,7 +13,7 @@ namespace crep::test {
 inline const std::filesystem::path kSourceRoot = CREP_SOURCE_DIR;
 
 inline const std::vector<std::string> kLibraryModules = {
-    "core", "rectify", "scatter", "epipolar", "prefilter", "pipeline", "atmosphere", "postfx", "vulkan"};
+    "core", "gpu", "rectify", "scatter", "epipolar", "prefilter", "pipeline", "atmosphere", "postfx", "vulkan"};
 
 /// The whole file, bytes as stored; empty if it cannot be read.
 inline std::string readSourceFile(const std::filesystem::path& p) {

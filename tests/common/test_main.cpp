@@ -9,7 +9,7 @@
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
 
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scenes/shaders.h>
 
 #include <cstdio>

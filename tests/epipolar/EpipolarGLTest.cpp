@@ -9,8 +9,8 @@
 #include "common/map_agreement.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>

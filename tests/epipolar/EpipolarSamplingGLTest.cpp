@@ -11,8 +11,8 @@
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/epipolar/epipolar_sampling.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
 #include <crep/scatter/gpu_sample_list.h>

@@ -12,7 +12,7 @@
 #include "common/local_light_scene.h"
 #include "common/sample_list_util.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>

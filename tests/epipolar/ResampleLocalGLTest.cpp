@@ -6,7 +6,7 @@
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/resample.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/rectify/rectified_map.h>

@@ -16,7 +16,7 @@
 #include "pipeline/scattering_frame.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl_state.h>
+#include <crep/gpu/gl_state.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scatter/gpu_light_texture.h>

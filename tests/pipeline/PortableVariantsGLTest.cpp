@@ -6,7 +6,7 @@
 #include "common/shader_tools.h"
 #include "pipeline/scattering_frame.h"
 
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>

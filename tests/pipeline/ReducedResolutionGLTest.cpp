@@ -4,7 +4,7 @@
 #include "common/gl_fixture.h"
 #include "pipeline/scattering_frame.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/pipeline/scattering.h>
 

@@ -8,7 +8,7 @@
 #include "pipeline/scattering_frame.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/march.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>

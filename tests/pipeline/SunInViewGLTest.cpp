@@ -7,7 +7,7 @@
 #include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/pipeline/scattering.h>
 

@@ -6,7 +6,7 @@
 
 #include "common/analytic_reference.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/pipeline/scattering.h>

@@ -9,7 +9,7 @@
 #include "common/gl_util.h"
 
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/postfx/froxel_fog.h>
 #include <crep/postfx/gpu_froxel_fog.h>

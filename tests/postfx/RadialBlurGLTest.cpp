@@ -8,7 +8,7 @@
 #include "common/gl_util.h"
 
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/postfx/gpu_radial_blur.h>
 #include <crep/postfx/radial_blur.h>
 #include <crep/support/image_compare.h>

@@ -8,8 +8,8 @@
 #include "common/gl_util.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/postfx/gpu_tone_mapping.h>
 #include <crep/postfx/tone_mapping.h>
 

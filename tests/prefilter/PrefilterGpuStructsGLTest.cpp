@@ -9,7 +9,7 @@
 #include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/gpu_structs.h>
 #include <crep/support/image_compare.h>

@@ -9,7 +9,7 @@
 #include "common/gl_fixture.h"
 #include "common/prefilter_gpu.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/ray.h>
 

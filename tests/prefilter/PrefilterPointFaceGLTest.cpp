@@ -10,7 +10,7 @@
 #include "common/prefilter_gpu.h"
 #include "prefilter/colonnade_point_light.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/scatter/rectified_march.h>
 #include <crep/scenes/scene.h>

@@ -302,3 +302,38 @@ TEST_CASE("binding points are named once: the library's host code binds by the n
   CAPTURE(where);
   CHECK(count == 0);
 }
+
+TEST_CASE("the seam speaks its own words: no GL in its headers, no backend picked by its name") {
+  // The seam's headers (backend, checks, shader library) and the Vulkan backend's include no GL header and
+  // name no GL type or enum outside comments; no library source compares Backend::name() (the kind is
+  // gpu::Backend::kind()). The probes show the patterns match what they must.
+  static const std::regex glWord(R"(\bgl::|\bGL_[A-Z]|crep/gpu/gl(_backend|_state)?\.h)");
+  static const std::regex nameCompare(R"(name\(\)\s*[!=]=)");
+  REQUIRE(std::regex_search(std::string("gl::TextureLevel f();"), glWord));
+  REQUIRE(std::regex_search(std::string("#include <crep/gpu/gl.h>"), glWord));
+  REQUIRE_FALSE(std::regex_search(std::string("std::string_view name() const;"), nameCompare));
+  REQUIRE(std::regex_search(std::string("if (b.name() == \"OpenGL\")"), nameCompare));
+  std::string where;
+  for (const char* header :
+       {"gpu/include/crep/gpu/backend.h", "gpu/include/crep/gpu/checks.h",
+        "gpu/include/crep/gpu/shader_library.h", "vulkan/include/crep/vulkan/vulkan_backend.h"}) {
+    const fs::path f = kRoot / header;
+    REQUIRE(fs::exists(f));
+    int n = 0;
+    for (const auto& l : lines(readSourceFile(f))) {
+      ++n;
+      const std::string code = l.substr(0, l.find("//"));
+      if (std::regex_search(code, glWord)) where += "\n  " + std::string(header) + ":" + std::to_string(n);
+    }
+  }
+  for (const auto& m : kLibraryModules)
+    for (const auto& f : filesUnder(kRoot / m, {".cpp", ".h"})) {
+      int n = 0;
+      for (const auto& l : lines(readSourceFile(f))) {
+        ++n;
+        if (std::regex_search(l.substr(0, l.find("//")), nameCompare))
+          where += "\n  " + fs::relative(f, kRoot).string() + ":" + std::to_string(n);
+      }
+    }
+  CHECK_MESSAGE(where.empty(), "GL in the seam, or a backend picked by name:" << where);
+}

@@ -13,7 +13,7 @@
 #include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>

@@ -13,7 +13,7 @@
 #include "common/prefilter_gpu.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/scatter/gpu_world_march.h>
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scatter/world_march.h>

@@ -1,8 +1,8 @@
-// The headless context and the GL helpers (crep/support/gl_context.h, crep/core/gl.h).
+// The headless context and the GL helpers (crep/support/gl_context.h, crep/gpu/gl.h).
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/support/gl_context.h>
 
 #include <doctest/doctest.h>

@@ -6,8 +6,8 @@
 #include "common/gl_fixture.h"
 #include "common/vulkan_fixture.h"
 
-#include <crep/core/gl.h>
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>

@@ -13,7 +13,7 @@
 #include "common/sample_list_util.h"
 #include "common/vulkan_fixture.h"
 
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
 #include <crep/prefilter/gpu_pass.h>

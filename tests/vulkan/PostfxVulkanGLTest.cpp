@@ -7,7 +7,7 @@
 #include "common/gl_fixture.h"
 #include "common/vulkan_fixture.h"
 
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/postfx/gpu_froxel_fog.h>
 #include <crep/postfx/gpu_radial_blur.h>
 #include <crep/postfx/gpu_tone_mapping.h>

@@ -7,8 +7,8 @@
 #include "common/prefilter_gpu.h"
 #include "common/vulkan_fixture.h"
 
-#include <crep/core/gl.h>
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/vulkan/vulkan_backend.h>
 

@@ -6,7 +6,7 @@
 #include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/scenes/scene.h>
 #include <crep/vulkan/vulkan_backend.h>

@@ -9,7 +9,7 @@
 #include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scenes/engine_frame.h>

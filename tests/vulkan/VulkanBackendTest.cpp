@@ -6,7 +6,7 @@
 #include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>

@@ -5,6 +5,7 @@
 #define VK_NO_PROTOTYPES // no Vulkan prototype may be called by mistake: only the table's pointers
 #include "crep/bindings.h"
 
+#include <crep/gpu/checks.h>
 #include <crep/vulkan/vulkan_backend.h>
 
 #include <shaderc/shaderc.hpp>

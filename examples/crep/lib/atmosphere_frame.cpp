@@ -5,7 +5,7 @@
 
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/epipolar/gpu_march.h>
 
 #include <epoxy/gl.h>

@@ -15,7 +15,7 @@
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/light.h>
 
 #include <memory>

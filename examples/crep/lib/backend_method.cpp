@@ -4,7 +4,7 @@
 #include "args.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scenes/engine_frame.h>

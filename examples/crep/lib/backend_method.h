@@ -5,7 +5,7 @@
 #include "methods.h"
 #include "scene_frame.h"
 
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 
 #include <memory>
 #include <string>

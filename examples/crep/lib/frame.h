@@ -6,7 +6,7 @@
 #include "timings.h"
 
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>

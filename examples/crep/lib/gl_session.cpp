@@ -3,8 +3,8 @@
 #include "frame.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl_state.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl_state.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/support/gl_context.h>
 
 #include <epoxy/gl.h>

@@ -4,7 +4,7 @@
 
 #include "timings.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 
 #include <cstdint>

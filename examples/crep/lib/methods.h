@@ -6,7 +6,7 @@
 #include "frame.h"
 #include "timings.h"
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
 
 #include <functional>

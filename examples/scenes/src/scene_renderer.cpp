@@ -1,6 +1,6 @@
 #include <crep/core/error.h>
-#include <crep/core/gl_state.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl_state.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/scenes/scene_renderer.h>
 #include <crep/scenes/shaders.h>

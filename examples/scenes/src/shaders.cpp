@@ -1,4 +1,4 @@
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scenes/shaders.h>
 
 #include <span>

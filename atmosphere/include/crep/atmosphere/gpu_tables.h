@@ -13,8 +13,8 @@
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/rectify/rectified_map.h>

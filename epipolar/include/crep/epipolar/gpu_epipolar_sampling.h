@@ -15,8 +15,8 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>

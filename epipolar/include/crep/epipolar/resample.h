@@ -10,8 +10,8 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>

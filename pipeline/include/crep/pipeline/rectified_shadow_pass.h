@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectify.h>
 
 namespace crep {

@@ -6,8 +6,8 @@
 #include <cstdint>
 
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
 
 #include <memory>

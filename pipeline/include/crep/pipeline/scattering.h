@@ -16,7 +16,7 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>

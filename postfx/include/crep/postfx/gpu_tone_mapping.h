@@ -9,9 +9,9 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/postfx/tone_mapping.h>
 
 namespace crep {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/prefilter/gpu_structs.h>

@@ -6,8 +6,8 @@
 #include <memory>
 #include <vector>
 
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectified_map.h>
 
 namespace crep::gpu {

@@ -10,9 +10,10 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
 #include <crep/core/light.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 #include <crep/scatter/ray_scattering.h>
@@ -39,16 +40,16 @@ struct GpuLightTexture {
 };
 
 namespace gpu {
-/// Throws InvalidArgument naming `<field>.texture` (not a GL_TEXTURE_2D) or `<field>.textureClipFromWorld`
+/// Throws InvalidArgument naming `<field>.texture` (not a 2D texture) or `<field>.textureClipFromWorld`
 /// (validateLightProjection). Returns the texture's level 0.
-gl::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
-                                         const LocalLight* localLight, std::string_view field);
+gpu::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const DirectionalLight* light,
+                                          const LocalLight* localLight, std::string_view field);
 /// The same for a texture of `backend` (any colour format, not depth).
-gl::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightTexture& texture,
-                                         const DirectionalLight* light, const LocalLight* localLight,
-                                         std::string_view field);
+gpu::TextureLevel validateGpuLightTexture(const Backend& backend, const GpuLightTexture& texture,
+                                          const DirectionalLight* light, const LocalLight* localLight,
+                                          std::string_view field);
 /// The block of `texture` (level 0 `level`) for a mapWidth x mapHeight colour map; w = 0 without localLight.
-LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gl::TextureLevel& level,
+LightTextureParams makeLightTextureParams(const GpuLightTexture& texture, const gpu::TextureLevel& level,
                                           int mapWidth, int mapHeight, const LocalLight* localLight);
 } // namespace gpu
 

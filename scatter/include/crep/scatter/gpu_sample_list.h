@@ -7,8 +7,9 @@
 #include <string>
 #include <string_view>
 
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/checks.h>
+#include <crep/gpu/gl.h>
 
 namespace crep::gpu {
 
@@ -44,12 +45,12 @@ int sampleListCount(Backend& backend, BufferId buffer);
 void validateSampleList(const SampleList& list, const std::string& owner);
 /// The camera image size a consumer maps entries with: imageWidth x imageHeight when set (both > 0),
 /// else cameraDepth's size. InvalidArgument naming owner + ".imageWidth/imageHeight" or ".cameraDepth".
-gl::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
-                               const std::string& owner);
+gpu::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
+                                const std::string& owner);
 /// The two checks above for a list of `backend`'s objects (on a GlBackend, the same checks); the buffer
 /// must also hold the header and `capacity` entries.
 void validateSampleList(const Backend& backend, const SampleList& list, const std::string& owner);
-gl::TextureLevel listImageSize(const Backend& backend, int imageWidth, int imageHeight,
-                               std::uint32_t cameraDepth, const std::string& owner);
+gpu::TextureLevel listImageSize(const Backend& backend, int imageWidth, int imageHeight,
+                                std::uint32_t cameraDepth, const std::string& owner);
 
 } // namespace crep::gpu

@@ -11,9 +11,9 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/core/gl.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/gl.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/ray_scattering.h>
 #include <crep/scatter/world_march.h>

@@ -17,7 +17,7 @@
 #include <vulkan/vulkan_core.h>
 
 #include <crep/core/error.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 
 namespace crep::gpu {
 
@@ -115,6 +115,7 @@ public:
   VulkanBackend& operator=(const VulkanBackend&) = delete;
 
   std::string_view name() const override { return "Vulkan"; }
+  BackendKind kind() const override { return BackendKind::Vulkan; }
   int maxTextureSize() const override;
   int maxArrayLayers() const override;
   int max3DTextureSize() const override;

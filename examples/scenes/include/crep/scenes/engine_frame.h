@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_light_texture.h>

@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>

@@ -1,7 +1,7 @@
-// gpu::halfBits / roundedToHalf (crep/core/gpu_backend.h): IEEE 754 binary16 rounding to the nearest, ties
+// gpu::halfBits / roundedToHalf (crep/gpu/backend.h): IEEE 754 binary16 rounding to the nearest, ties
 // to even, checked against the format's definition: every half value maps to itself, every midpoint between
 // two neighbours goes to the even one, and the special values.
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 
 #include <doctest/doctest.h>
 

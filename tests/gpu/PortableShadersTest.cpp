@@ -4,7 +4,7 @@
 // (work-group sizes, the variants a frame builds) is in tests/pipeline/PortableVariantsGLTest.cpp.
 #include "common/shader_tools.h"
 
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>
 

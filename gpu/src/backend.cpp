@@ -1,8 +1,7 @@
-// The backend-independent parts of the seam (crep/core/gpu_backend.h): resource and push-constant
+// The backend-independent parts of the seam (crep/gpu/backend.h): resource and push-constant
 // helpers, and the owning handles.
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
 
 #include <glm/gtc/packing.hpp>
 
@@ -51,12 +50,6 @@ std::uint16_t halfBits(float f) {
 
 float roundedToHalf(float f) {
   return glm::unpackHalf1x16(halfBits(f));
-}
-
-void requireNotMovedFrom(const Backend* backend, const char* owner) {
-  if (backend == nullptr)
-    throw InvalidArgument(owner, "a moved-from object",
-                          "owns no GPU objects: assign a constructed one first");
 }
 
 Resource Resource::sampled(std::uint32_t binding, TextureId t, Filter f) {
@@ -164,30 +157,6 @@ std::vector<std::byte> packPushConstants(std::span<const PushValue> values) {
     throw InvalidArgument("gpu::Dispatch.push", std::to_string(out.size()) + " bytes",
                           "must pack into at most 128 bytes");
   return out;
-}
-
-void checkTextureSize(const Backend& backend, const char* parameter, int width, int height) {
-  if (backend.name() == "OpenGL") return gl::checkTextureSize(parameter, width, height);
-  const std::string value = std::to_string(width) + " x " + std::to_string(height);
-  if (width <= 0 || height <= 0) throw InvalidArgument(parameter, value, "width and height must be > 0");
-  const int limit = backend.maxTextureSize();
-  if (width > limit || height > limit)
-    throw InvalidArgument(parameter, value,
-                          "must not exceed the " + std::string(backend.name()) +
-                              " device's maximum texture size " + std::to_string(limit));
-}
-
-void requireTexture(const Backend& backend, const char* parameter, TextureId texture, int width, int height,
-                    std::initializer_list<Format> formats) {
-  if (texture == 0) throw InvalidArgument(parameter, "0", "must be a texture");
-  const TextureDesc d = backend.describe(texture);
-  if (d.type != TextureType::Texture2D || d.width != width || d.height != height)
-    throw InvalidArgument(parameter, std::to_string(d.width) + " x " + std::to_string(d.height),
-                          "must be a 2D texture of " + std::to_string(width) + " x " +
-                              std::to_string(height));
-  if (std::find(formats.begin(), formats.end(), d.format) == formats.end())
-    throw InvalidArgument(parameter, "format " + std::to_string(static_cast<int>(d.format)),
-                          "has a format the pass cannot read");
 }
 
 void writeGrowing(Backend& backend, Buffer& buffer, std::span<const std::byte> bytes,

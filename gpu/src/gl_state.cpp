@@ -1,6 +1,6 @@
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
-#include <crep/core/gl_state.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/gl_state.h>
 
 #include <epoxy/gl.h>
 

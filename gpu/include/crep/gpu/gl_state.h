@@ -1,5 +1,5 @@
 // The library's GL state contract (docs/GL_STATE.md): DepthPassScope for depth-only passes, PixelStoreScope
-// for uploads and readbacks; each saves, sets and restores the state (core/README.md, "gl_state.h"). GL names
+// for uploads and readbacks; each saves, sets and restores the state (gpu/README.md, "gl_state.h"). GL names
 // and enums are std::uint32_t / int. Requires a current OpenGL 4.5 context.
 #pragma once
 

@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include <crep/core/gl.h>
-#include <crep/core/gpu_backend.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 
 namespace crep::gpu {
 
@@ -17,6 +17,7 @@ public:
   /// Needs a current context; creates two sampler objects (nearest and linear, clamped).
   GlBackend();
   std::string_view name() const override { return "OpenGL"; }
+  BackendKind kind() const override { return BackendKind::OpenGL; }
   int maxTextureSize() const override;
   int maxArrayLayers() const override;
   int max3DTextureSize() const override;
@@ -52,22 +53,5 @@ private:
 
 /// `given`, or else a GlBackend made into `own` on the current GL context: the default backend of a pass.
 Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own);
-
-// A pass's checks of its inputs on any backend, in GL's terms: the GL query on a GlBackend (any GL format
-// an engine may pass), else Backend::describe() / bufferBytes() with the type and format as their GL enums.
-// Each throws InvalidArgument naming `parameter`.
-
-/// Level 0 of `texture` (gl::textureLevel).
-gl::TextureLevel textureLevelOf(const Backend& backend, const char* parameter, TextureId texture);
-/// gl::requireTexture2D(parameter, texture) on any backend: a 2D texture of any size; returns its level 0.
-gl::TextureLevel requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture);
-/// gl::requireTexture2D(parameter, texture, width, height, internalFormat) on any backend.
-void requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture, int width,
-                        int height, std::uint32_t internalFormat = 0);
-/// gl::requireDepthFormat: other backends accept Depth32F and R32F.
-void requireDepthFormatOf(const Backend& backend, const char* parameter, TextureId texture);
-/// gl::requireBuffer: a buffer of the backend; returns its size in bytes.
-std::size_t requireBufferOf(const Backend& backend, const char* parameter, BufferId buffer,
-                            const std::string& requirement);
 
 } // namespace crep::gpu

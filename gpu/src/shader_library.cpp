@@ -19,7 +19,8 @@
 // of most parser-level errors to 0 (its YYLLOC_DEFAULT resets it) while keeping the line, so the
 // line alone must identify the file; other compilers (glslang, NVIDIA) report both correctly.
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 
 #include <epoxy/gl.h>
 

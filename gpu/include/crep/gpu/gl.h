@@ -4,9 +4,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
+#include <span>
 #include <string>
 
 #include <crep/core/image.h>
+#include <crep/gpu/shader_library.h>
 
 namespace crep::gl {
 
@@ -146,3 +149,12 @@ private:
 };
 
 } // namespace crep::gl
+
+namespace crep {
+
+/// Compiles and links a program from registered files (current context required). Throws ShaderError
+/// whose message holds the translated compile or link log.
+gl::Handle buildProgram(std::initializer_list<ShaderStageSource> stages);
+gl::Handle buildProgram(std::span<const ShaderStageSource> stages);
+
+} // namespace crep

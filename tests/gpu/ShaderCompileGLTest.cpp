@@ -3,9 +3,9 @@
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/core/gl.h>
+#include <crep/gpu/gl.h>
 #include <crep/core/medium.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>
 #include <epoxy/gl.h>

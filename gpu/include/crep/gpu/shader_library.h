@@ -1,6 +1,6 @@
 // The shader library: GLSL sources embedded at build time (no file read at run time), the library's own and
 // those a program adds with addFiles(); `#include "path"` resolved, `#line` markers kept, variants by
-// prepended #defines. Rules: core/README.md, "shader_library.h".
+// prepended #defines. Rules: gpu/README.md, "shader_library.h".
 #pragma once
 
 #include <cstdint>
@@ -9,8 +9,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <crep/core/gl.h>
 
 namespace crep {
 
@@ -59,13 +57,9 @@ struct ShaderStageSource {
   std::vector<ShaderDefine> defines;
 };
 
-/// Compiles and links a program from registered files (current context required). Throws ShaderError
-/// whose message holds the translated compile or link log.
-gl::Handle buildProgram(std::initializer_list<ShaderStageSource> stages);
-gl::Handle buildProgram(std::span<const ShaderStageSource> stages);
-
-/// Every distinct stage (path and defines) buildProgram compiled in this process, in first-use order: the
-/// variants an engine's frames use, to precompile for another API (docs/PORTABLE_SHADERS.md). Thread-safe.
+/// Every distinct stage (path and defines) gl::buildProgram (crep/gpu/gl.h) compiled in this process, in
+/// first-use order: the variants an engine's frames use, to precompile for another API
+/// (docs/PORTABLE_SHADERS.md). Thread-safe.
 std::vector<ShaderStageSource> programVariantsBuilt();
 
 } // namespace crep

@@ -4,7 +4,7 @@
 #include "common/shader_tools.h"
 
 #include <crep/core/error.h>
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>
 

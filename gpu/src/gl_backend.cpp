@@ -1,7 +1,7 @@
-// gpu::Backend on the caller's OpenGL 4.5 context (crep/core/gl_backend.h).
+// gpu::Backend on the caller's OpenGL 4.5 context (crep/gpu/gl_backend.h).
 #include <crep/core/error.h>
-#include <crep/core/gl_backend.h>
-#include <crep/core/gl_state.h>
+#include <crep/gpu/gl_backend.h>
+#include <crep/gpu/gl_state.h>
 
 #include <epoxy/gl.h>
 
@@ -378,76 +378,6 @@ Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own) {
   if (given != nullptr) return *given;
   if (!own) own = std::make_unique<GlBackend>();
   return *own;
-}
-
-gl::TextureLevel textureLevelOf(const Backend& backend, const char* parameter, TextureId texture) {
-  if (backend.name() == "OpenGL") return gl::textureLevel(parameter, texture);
-  if (texture == 0) throw InvalidArgument(parameter, "0", "must be a texture");
-  TextureDesc d;
-  try {
-    d = backend.describe(texture);
-  } catch (const InvalidArgument&) {
-    throw InvalidArgument(parameter, std::to_string(texture),
-                          "must be a texture of the pass's " + std::string(backend.name()) + " backend");
-  }
-  gl::TextureLevel level;
-  level.target = d.type == TextureType::Texture2D        ? GL_TEXTURE_2D
-                 : d.type == TextureType::Texture2DArray ? GL_TEXTURE_2D_ARRAY
-                                                         : GL_TEXTURE_3D;
-  level.width = d.width;
-  level.height = d.height;
-  level.depth = d.depth;
-  level.internalFormat = internalFormat(d.format);
-  return level;
-}
-
-gl::TextureLevel requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture) {
-  if (backend.name() == "OpenGL") return gl::requireTexture2D(parameter, texture);
-  const gl::TextureLevel level = textureLevelOf(backend, parameter, texture);
-  requireTexture2DOf(backend, parameter, texture, level.width, level.height);
-  return level;
-}
-
-void requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture, int width,
-                        int height, std::uint32_t format) {
-  if (backend.name() == "OpenGL") return gl::requireTexture2D(parameter, texture, width, height, format);
-  if (width <= 0 || height <= 0)
-    throw InvalidArgument(parameter, std::to_string(width) + " x " + std::to_string(height),
-                          "size must be > 0");
-  const gl::TextureLevel level = textureLevelOf(backend, parameter, texture);
-  if (level.target != GL_TEXTURE_2D)
-    throw InvalidArgument(parameter, "texture " + std::to_string(texture), "must be a 2D texture");
-  if (level.width != width || level.height != height)
-    throw InvalidArgument(parameter,
-                          "texture of " + std::to_string(level.width) + " x " + std::to_string(level.height),
-                          "must be " + std::to_string(width) + " x " + std::to_string(height));
-  if (format != 0 && level.internalFormat != format)
-    throw InvalidArgument(parameter, "texture " + std::to_string(texture),
-                          format == GL_RGBA32F ? "must be RGBA32F"
-                          : format == GL_R32F  ? "must be R32F"
-                                               : "has a format the pass cannot use");
-}
-
-void requireDepthFormatOf(const Backend& backend, const char* parameter, TextureId texture) {
-  if (backend.name() == "OpenGL") return gl::requireDepthFormat(parameter, texture);
-  const std::uint32_t format = textureLevelOf(backend, parameter, texture).internalFormat;
-  if (format != GL_DEPTH_COMPONENT32F && format != GL_R32F)
-    throw InvalidArgument(parameter, "texture " + std::to_string(texture),
-                          "must be a depth (Depth32F) or R32F texture");
-}
-
-std::size_t requireBufferOf(const Backend& backend, const char* parameter, BufferId buffer,
-                            const std::string& requirement) {
-  if (backend.name() == "OpenGL")
-    return static_cast<std::size_t>(gl::requireBuffer(parameter, buffer, requirement));
-  if (buffer == 0) throw InvalidArgument(parameter, "0", requirement);
-  try {
-    return backend.bufferBytes(buffer);
-  } catch (const InvalidArgument&) {
-    throw InvalidArgument(parameter, std::to_string(buffer),
-                          requirement + " (a buffer of the pass's " + std::string(backend.name()) +
-                              " backend)");
-  }
 }
 
 void GlBackend::finish() {

@@ -1,6 +1,6 @@
 // The seam between the passes and a graphics API: a pass describes each dispatch (program and defines,
 // resources at their crep/bindings.h numbers, push-constant bytes, group counts) and a Backend runs it.
-// GlBackend (crep/core/gl_backend.h) runs on the caller's OpenGL 4.5 context, VulkanBackend
+// GlBackend (crep/gpu/gl_backend.h) runs on the caller's OpenGL 4.5 context, VulkanBackend
 // (crep/vulkan/vulkan_backend.h) on a Vulkan device; an engine's RHI implements the same interface.
 // Rules and what an implementation must guarantee: docs/BACKENDS.md.
 #pragma once
@@ -16,7 +16,7 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/core/shader_library.h>
+#include <crep/gpu/shader_library.h>
 
 namespace crep::gpu {
 
@@ -117,12 +117,18 @@ struct Dispatch {
 /// A program variant's key for a backend's caches: the path, then each define as "NAME=value".
 std::string variantKey(std::string_view program, std::span<const ShaderDefine> defines);
 
+/// Which API a backend drives. The passes ask it only where OpenGL differs: the GL backend's own checks and
+/// messages (an engine's GL texture may be in any GL format), and the barrier a GL caller's own dispatches
+/// need. An engine's backend is Other.
+enum class BackendKind : std::uint8_t { OpenGL, Vulkan, Other };
+
 /// What a pass needs of a graphics API. Every call is in order: a dispatch sees the writes of every call
 /// before it (writes, dispatches), a read sees every call before it. Not thread-safe.
 class Backend {
 public:
   virtual ~Backend() = default;
-  virtual std::string_view name() const = 0; ///< "OpenGL", "Vulkan", ...
+  virtual std::string_view name() const = 0; ///< for messages: "OpenGL", "Vulkan", an engine's own
+  virtual BackendKind kind() const { return BackendKind::Other; }
   /// The largest width or height of a 2D texture (GL_MAX_TEXTURE_SIZE, maxImageDimension2D).
   virtual int maxTextureSize() const = 0;
   /// The most layers of a 2D array texture (GL_MAX_ARRAY_TEXTURE_LAYERS, maxImageArrayLayers).
@@ -168,19 +174,6 @@ public:
   }
   virtual void cancelTimer() noexcept {}
 };
-
-/// A pass's check that it was not moved from (its backend pointer is then null): InvalidArgument naming
-/// `owner` ("EvaluatePass", ...).
-void requireNotMovedFrom(const Backend* backend, const char* owner);
-
-/// InvalidArgument naming `parameter` for sizes <= 0; beyond backend.maxTextureSize() GlError on the GL
-/// backend (as gl::checkTextureSize), InvalidArgument on others.
-void checkTextureSize(const Backend& backend, const char* parameter, int width, int height);
-
-/// InvalidArgument naming `parameter` unless `texture` is a 2D texture of the backend, width x height, in
-/// one of `formats`.
-void requireTexture(const Backend& backend, const char* parameter, TextureId texture, int width, int height,
-                    std::initializer_list<Format> formats);
 
 class Buffer;
 /// Writes `bytes` at offset 0 of `buffer`, first replacing it by a buffer of `backend` of the next power of
