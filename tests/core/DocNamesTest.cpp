@@ -78,6 +78,8 @@ const std::set<std::string> kProse = {
     "tY", // math: x tan(fovX), y tan(fovY)
     "scatteringTexture",
     "drawShadowCasters", // the engine's names in a snippet
+    "shaderStorageImageExtendedFormats",
+    "shaderFloat64", // Vulkan device features (VkPhysicalDeviceFeatures members)
 };
 
 /// Removes "quoted" text (parameter names of error messages) from comment text.
@@ -96,12 +98,18 @@ std::string withoutQuotes(const std::string& text) {
 bool foreign(const std::string& qualified) {
   for (const char* prefix : {"std::", "glm::", "Eigen::", "doctest::"})
     if (qualified.rfind(prefix, 0) == 0) return true;
+  if (qualified.size() > 2 && qualified[0] == 'V' && qualified[1] == 'k' &&
+      std::isupper(static_cast<unsigned char>(qualified[2])))
+    return true; // a member of a Vulkan struct, e.g. VkPhysicalDeviceFeatures2::features
   const std::string last =
       qualified.substr(qualified.rfind(':') == std::string::npos ? 0 : qualified.rfind(':') + 1);
   if (last.size() > 2 && last[0] == 'g' && last[1] == 'l' &&
       std::isupper(static_cast<unsigned char>(last[2])))
     return true; // an OpenGL function
-  return last.rfind("GL_", 0) == 0;
+  if (last.size() > 2 && (last[0] == 'v' || last[0] == 'V') && last[1] == 'k' &&
+      std::isupper(static_cast<unsigned char>(last[2])))
+    return true; // a Vulkan function or type
+  return last.rfind("GL_", 0) == 0 || last.rfind("VK_", 0) == 0;
 }
 
 } // namespace
