@@ -61,6 +61,20 @@ struct LoaderSpy {
   static inline std::map<std::string, int> instanceLookups, deviceLookups; ///< name -> times asked
   static inline int createInstanceCalls = 0, createDeviceCalls = 0, destroyDeviceCalls = 0,
                     destroyInstanceCalls = 0;
+  /// What would make a frame wait: submissions and host waits by the backend (the engine's own calls go
+  /// through its own pointers and are not counted). A query read counts as a wait when it asks to wait.
+  static inline int queueSubmitCalls = 0, waitForFencesCalls = 0, queueWaitIdleCalls = 0,
+                    deviceWaitIdleCalls = 0, waitingQueryReads = 0;
+  static inline PFN_vkQueueSubmit realQueueSubmit = nullptr;
+  static inline PFN_vkWaitForFences realWaitForFences = nullptr;
+  static inline PFN_vkQueueWaitIdle realQueueWaitIdle = nullptr;
+  static inline PFN_vkDeviceWaitIdle realDeviceWaitIdle = nullptr;
+  static inline PFN_vkGetQueryPoolResults realGetQueryPoolResults = nullptr;
+  /// Submissions and waits so far.
+  static int stalls() {
+    return queueSubmitCalls + waitForFencesCalls + queueWaitIdleCalls + deviceWaitIdleCalls +
+           waitingQueryReads;
+  }
   static inline PFN_vkCreateInstance realCreateInstance = nullptr;
   static inline PFN_vkCreateDevice realCreateDevice = nullptr;
   static inline PFN_vkDestroyDevice realDestroyDevice = nullptr;
@@ -72,6 +86,7 @@ struct LoaderSpy {
     instanceLookups.clear();
     deviceLookups.clear();
     createInstanceCalls = createDeviceCalls = destroyDeviceCalls = destroyInstanceCalls = 0;
+    queueSubmitCalls = waitForFencesCalls = queueWaitIdleCalls = deviceWaitIdleCalls = waitingQueryReads = 0;
   }
   static int lookups() {
     int n = 0;
@@ -105,6 +120,31 @@ struct LoaderSpy {
     realDestroyInstance(i, a);
   }
 
+  static VKAPI_ATTR VkResult VKAPI_CALL queueSubmit(VkQueue q, std::uint32_t n, const VkSubmitInfo* si,
+                                                    VkFence f) {
+    ++queueSubmitCalls;
+    return realQueueSubmit(q, n, si, f);
+  }
+  static VKAPI_ATTR VkResult VKAPI_CALL waitForFences(VkDevice d, std::uint32_t n, const VkFence* f,
+                                                      VkBool32 all, std::uint64_t timeout) {
+    ++waitForFencesCalls;
+    return realWaitForFences(d, n, f, all, timeout);
+  }
+  static VKAPI_ATTR VkResult VKAPI_CALL queueWaitIdle(VkQueue q) {
+    ++queueWaitIdleCalls;
+    return realQueueWaitIdle(q);
+  }
+  static VKAPI_ATTR VkResult VKAPI_CALL deviceWaitIdle(VkDevice d) {
+    ++deviceWaitIdleCalls;
+    return realDeviceWaitIdle(d);
+  }
+  static VKAPI_ATTR VkResult VKAPI_CALL getQueryPoolResults(VkDevice d, VkQueryPool p, std::uint32_t first,
+                                                            std::uint32_t count, std::size_t size, void* data,
+                                                            VkDeviceSize stride, VkQueryResultFlags flags) {
+    if ((flags & VK_QUERY_RESULT_WAIT_BIT) != 0) ++waitingQueryReads;
+    return realGetQueryPoolResults(d, p, first, count, size, data, stride, flags);
+  }
+
   /// The counting form of `name`, or `real` itself.
   static PFN_vkVoidFunction wrap(const char* name, PFN_vkVoidFunction real) {
     if (real == nullptr) return nullptr;
@@ -125,6 +165,17 @@ struct LoaderSpy {
       realDestroyInstance = reinterpret_cast<PFN_vkDestroyInstance>(real);
       return reinterpret_cast<PFN_vkVoidFunction>(&destroyInstance);
     }
+#define CREP_TEST_COUNT(vkName, member, wrapper)                                                             \
+  if (n == #vkName) {                                                                                        \
+    member = reinterpret_cast<PFN_##vkName>(real);                                                           \
+    return reinterpret_cast<PFN_vkVoidFunction>(&wrapper);                                                   \
+  }
+    CREP_TEST_COUNT(vkQueueSubmit, realQueueSubmit, queueSubmit)
+    CREP_TEST_COUNT(vkWaitForFences, realWaitForFences, waitForFences)
+    CREP_TEST_COUNT(vkQueueWaitIdle, realQueueWaitIdle, queueWaitIdle)
+    CREP_TEST_COUNT(vkDeviceWaitIdle, realDeviceWaitIdle, deviceWaitIdle)
+    CREP_TEST_COUNT(vkGetQueryPoolResults, realGetQueryPoolResults, getQueryPoolResults)
+#undef CREP_TEST_COUNT
     if (n == "vkGetInstanceProcAddr") return reinterpret_cast<PFN_vkVoidFunction>(&getInstanceProcAddr);
     if (n == "vkGetDeviceProcAddr") {
       realDeviceProcAddr = reinterpret_cast<PFN_vkGetDeviceProcAddr>(real);
@@ -209,6 +260,7 @@ public:
     bool giveDeviceProcAddr = true;             ///< hand the backend vkGetDeviceProcAddr too
     bool giveAllocator = false;                 ///< hand the backend allocator() for its objects
     bool givePipelineCache = false;             ///< create a VkPipelineCache and hand it to the backend
+    bool synchronizationValidation = false;     ///< the layer's synchronization validation on too
   };
 
   explicit EngineVulkanDevice(Options options) : options_(options) {
@@ -220,7 +272,8 @@ public:
     app.pApplicationName = "crepuscular test engine";
     app.apiVersion = VK_API_VERSION_1_1;
     const char* layers[] = {"VK_LAYER_KHRONOS_validation"};
-    const char* instanceExtensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    const char* instanceExtensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME,
+                                        VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME};
     VkDebugUtilsMessengerCreateInfoEXT debug{};
     debug.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
     debug.messageSeverity =
@@ -230,13 +283,20 @@ public:
                         VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     debug.pfnUserCallback = &EngineVulkanDevice::onMessage;
     debug.pUserData = this;
+    const VkValidationFeatureEnableEXT syncValidation =
+        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkValidationFeaturesEXT features{};
+    features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+    features.enabledValidationFeatureCount = 1;
+    features.pEnabledValidationFeatures = &syncValidation;
+    features.pNext = &debug;
     VkInstanceCreateInfo ici{};
     ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
-    ici.pNext = &debug;
+    ici.pNext = options.synchronizationValidation ? static_cast<const void*>(&features) : &debug;
     ici.pApplicationInfo = &app;
     ici.enabledLayerCount = 1;
     ici.ppEnabledLayerNames = layers;
-    ici.enabledExtensionCount = 1;
+    ici.enabledExtensionCount = options.synchronizationValidation ? 2u : 1u;
     ici.ppEnabledExtensionNames = instanceExtensions;
     REQUIRE(createInstance(&ici, nullptr, &instance_) == VK_SUCCESS);
     const auto createMessenger =
@@ -336,6 +396,18 @@ public:
     e.enabledFeatures = features_;
     return e;
   }
+
+  /// A device-level function of the engine's own (not through the backend's counting loader).
+  template <class F>
+  F deviceFunction(const char* name) const {
+    const PFN_vkVoidFunction f = gdpa_(device_, name);
+    const bool found = f != nullptr;
+    REQUIRE_MESSAGE(found, name);
+    return reinterpret_cast<F>(f);
+  }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  std::uint32_t queueFamily() const { return family_; }
 
   /// The allocation callbacks handed to the backend (Options::giveAllocator).
   CountingAllocator& allocator() { return allocator_; }

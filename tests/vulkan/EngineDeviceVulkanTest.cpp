@@ -8,6 +8,7 @@
 // with descriptor sets from pools; a device without a required feature, a missing loader or handle is named;
 // the engine's layer reports nothing, the destruction of its device included (objects left behind).
 #include "common/atmosphere_tables.h"
+#include "common/synthetic_engine_maps.h"
 #include "common/vulkan_fixture.h"
 
 #include <crep/atmosphere/gpu_tables.h>
@@ -37,30 +38,8 @@ namespace {
 
 constexpr int kWidth = 160, kHeight = 90, kSunMap = 512;
 
-/// A scene's engine maps made up on the CPU (no GL here): a camera depth with sky, steps and slopes, and an
-/// orthographic sun map over the view frustum with boxes and smooth relief.
 scenes::EngineMaps syntheticMaps(const scenes::Scene& s) {
-  scenes::EngineMaps m;
-  m.cameraDepth = Image(kWidth, kHeight, 1);
-  for (int j = 0; j < kHeight; ++j)
-    for (int i = 0; i < kWidth; ++i) {
-      const double u = (i + 0.5) / kWidth, v = (j + 0.5) / kHeight;
-      const bool sky = v > 0.65 + 0.1 * std::sin(9.0 * u);
-      const bool trunk = (i / 12) % 4 == 1 && v < 0.8;
-      m.cameraDepth.at(i, j) =
-          sky ? 1.0f : static_cast<float>(trunk ? 0.985 : 0.995 - 0.02 * v + 0.002 * std::sin(20.0 * u));
-    }
-  const auto corners = s.camera.frustumCorners();
-  m.sunClipFromWorld = orthographicLightClipFromWorld(s.sun, corners);
-  m.sunMap = Image(kSunMap, kSunMap, 1);
-  for (int j = 0; j < kSunMap; ++j)
-    for (int i = 0; i < kSunMap; ++i) {
-      const double u = (i + 0.5) / kSunMap, v = (j + 0.5) / kSunMap;
-      const bool box = (i / 40 + j / 56) % 3 == 0;
-      m.sunMap.at(i, j) =
-          static_cast<float>(0.6 + 0.2 * std::sin(7.0 * u) * std::cos(5.0 * v) - (box ? 0.3 : 0.0));
-    }
-  return m;
+  return crep::test::syntheticMaps(s, kWidth, kHeight, kSunMap);
 }
 
 /// A named image read back from a backend.

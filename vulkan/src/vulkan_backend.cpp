@@ -354,16 +354,33 @@ struct VulkanBackend::Impl {
   VkQueue queue = VK_NULL_HANDLE;
   std::uint32_t family = 0;
   VkCommandPool pool = VK_NULL_HANDLE;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkCommandBuffer ownCmd = VK_NULL_HANDLE; ///< the backend's own: calls outside frames, submitted by it
+  VkCommandBuffer cmd = VK_NULL_HANDLE;    ///< where calls record now: ownCmd, or the frame's (beginFrame)
   VkFence fence = VK_NULL_HANDLE;
-  bool recording = false;
+  bool recording = false; ///< ownCmd is recording
+
+  // Frames recorded into the engine's command buffers (beginFrame / endFrame).
+  std::uint32_t framesInFlight = 3;
+  bool inFrame = false;
+  std::uint64_t frameIndex = 0;     ///< the frame being recorded, or the last one recorded
+  std::uint64_t completedFrame = 0; ///< every frame <= this one has completed (the engine said so)
+  /// Objects released once the frame they were last used in has completed: staging buffers, textures and
+  /// buffers destroyed while frames that may use them are in flight.
+  struct Retired {
+    std::uint64_t frame = 0;
+    std::vector<BufferEntry> buffers;
+    std::vector<ImageEntry> images;
+  };
+  std::vector<Retired> retired;
+  std::vector<std::vector<DescriptorPool>> framePools; ///< per frame slot (pools mode)
   VkSampler nearest = VK_NULL_HANDLE, linear = VK_NULL_HANDLE;
-  VkQueryPool timestamps = VK_NULL_HANDLE; ///< two timestamps (beginTimer, endTimer); null without them
-  std::uint32_t timestampBits = 0;         ///< the queue family's timestampValidBits
-  bool timing = false;                     ///< a span's first timestamp is recorded
-  bool pushDescriptors = false;            ///< vkCmdPushDescriptorSetKHR, else sets from descriptorPools
-  std::vector<DescriptorPool> descriptorPools;
-  std::size_t currentPool = 0; ///< the pool the next set comes from; those before it are full
+  VkQueryPool timestamps = VK_NULL_HANDLE;     ///< two timestamps (beginTimer, endTimer); null without them
+  std::uint32_t timestampBits = 0;             ///< the queue family's timestampValidBits
+  bool timing = false;                         ///< a span's first timestamp is recorded
+  bool pushDescriptors = false;                ///< vkCmdPushDescriptorSetKHR, else sets from descriptorPools
+  std::vector<DescriptorPool> descriptorPools; ///< ownCmd's (pools mode); a frame's are in framePools
+  std::size_t currentPool = 0;                 ///< the pool the next set comes from; those before it are full
+  std::vector<std::size_t> frameCurrentPool;   ///< currentPool of each frame slot
 
   std::map<TextureId, ImageEntry> images;
   std::map<BufferId, BufferEntry> buffers;
@@ -392,6 +409,10 @@ struct VulkanBackend::Impl {
   void barrier();
   void transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to);
   void submit();
+  void refuseInFrame(const char* call) const;
+  Retired& retiring();
+  void release(std::uint64_t completed);
+  void resetPools(std::vector<DescriptorPool>& pools);
   VkDescriptorSet allocateSet(const Pipeline& p);
   VkShaderModule module(const std::string& program, std::span<const ShaderDefine> defines);
   Pipeline& pipeline(const Dispatch& d, std::size_t pushBytes);
@@ -630,7 +651,8 @@ void VulkanBackend::Impl::createObjects() {
   ai.commandPool = pool;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
-  check(vk.vkAllocateCommandBuffers(device, &ai, &cmd), "vkAllocateCommandBuffers");
+  check(vk.vkAllocateCommandBuffers(device, &ai, &ownCmd), "vkAllocateCommandBuffers");
+  cmd = ownCmd;
   VkFenceCreateInfo fi{};
   fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
   check(vk.vkCreateFence(device, &fi, allocator, &fence), "vkCreateFence");
@@ -695,12 +717,50 @@ void VulkanBackend::Impl::freeBuffer(BufferEntry& b) {
 }
 
 void VulkanBackend::Impl::begin() {
-  if (recording) return;
+  if (inFrame || recording) return; // a frame records into the engine's command buffer
   VkCommandBufferBeginInfo bi{};
   bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  check(vk.vkBeginCommandBuffer(cmd, &bi), "vkBeginCommandBuffer");
+  check(vk.vkBeginCommandBuffer(ownCmd, &bi), "vkBeginCommandBuffer");
   recording = true;
+}
+
+void VulkanBackend::Impl::refuseInFrame(const char* call) const {
+  if (inFrame)
+    throw InvalidArgument(call, "inside frame " + std::to_string(frameIndex),
+                          "would wait for the GPU: call it outside beginFrame() / endFrame()");
+}
+
+VulkanBackend::Impl::Retired& VulkanBackend::Impl::retiring() {
+  // What the frame being recorded (or the last one recorded, outside frames) may still use.
+  if (retired.empty() || retired.back().frame != frameIndex) retired.push_back({frameIndex, {}, {}});
+  return retired.back();
+}
+
+void VulkanBackend::Impl::release(std::uint64_t completed) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < retired.size(); ++i) {
+    Retired& r = retired[i];
+    if (r.frame > completed) {
+      if (kept != i) retired[kept] = std::move(r);
+      ++kept;
+      continue;
+    }
+    for (BufferEntry& b : r.buffers)
+      freeBuffer(b);
+    for (ImageEntry& image : r.images)
+      destroyImage(image);
+  }
+  retired.resize(kept);
+}
+
+void VulkanBackend::Impl::resetPools(std::vector<DescriptorPool>& pools) {
+  for (DescriptorPool& dp : pools) {
+    if (dp.sets == 0) continue;
+    check(vk.vkResetDescriptorPool(device, dp.pool, 0), "vkResetDescriptorPool");
+    dp.sets = 0;
+    dp.descriptors = {};
+  }
 }
 
 void VulkanBackend::Impl::barrier() {
@@ -748,41 +808,39 @@ void VulkanBackend::Impl::submit() {
   m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   m.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+  vk.vkCmdPipelineBarrier(ownCmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                           VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &m, 0, nullptr, 0, nullptr);
-  check(vk.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  check(vk.vkEndCommandBuffer(ownCmd), "vkEndCommandBuffer");
   recording = false;
   VkSubmitInfo si{};
   si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
   si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
+  si.pCommandBuffers = &ownCmd;
   check(vk.vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
   check(vk.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
   check(vk.vkResetFences(device, 1, &fence), "vkResetFences");
-  check(vk.vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  check(vk.vkResetCommandBuffer(ownCmd, 0), "vkResetCommandBuffer");
   for (BufferEntry& b : staging)
     freeBuffer(b);
   staging.clear();
   // The submission has completed: its descriptor sets may go (pools mode).
-  for (std::size_t i = 0; i < descriptorPools.size() && i <= currentPool; ++i) {
-    DescriptorPool& dp = descriptorPools[i];
-    if (dp.sets == 0) continue;
-    check(vk.vkResetDescriptorPool(device, dp.pool, 0), "vkResetDescriptorPool");
-    dp.sets = 0;
-    dp.descriptors = {};
-  }
+  resetPools(descriptorPools);
   currentPool = 0;
 }
 
 VkDescriptorSet VulkanBackend::Impl::allocateSet(const Pipeline& p) {
+  // A frame's sets come from its slot's pools, reset when the slot is reused (its frame has completed).
+  const std::size_t slot = static_cast<std::size_t>(frameIndex % framesInFlight);
+  std::vector<DescriptorPool>& pools = inFrame ? framePools[slot] : descriptorPools;
+  std::size_t& current = inFrame ? frameCurrentPool[slot] : currentPool;
   const auto fits = [&](const DescriptorPool& dp) {
     if (dp.sets + 1 > DescriptorPool::kSets) return false;
     for (std::size_t k = 0; k < 4; ++k)
       if (dp.descriptors[k] + p.descriptors[k] > DescriptorPool::kDescriptors) return false;
     return true;
   };
-  for (;; ++currentPool) {
-    if (currentPool == descriptorPools.size()) {
+  for (;; ++current) {
+    if (current == pools.size()) {
       // Grow: one more pool (kept, and reused after the next submission).
       std::array<VkDescriptorPoolSize, 4> sizes{};
       for (std::size_t k = 0; k < 4; ++k)
@@ -794,9 +852,9 @@ VkDescriptorSet VulkanBackend::Impl::allocateSet(const Pipeline& p) {
       ci.pPoolSizes = sizes.data();
       DescriptorPool dp;
       check(vk.vkCreateDescriptorPool(device, &ci, allocator, &dp.pool), "vkCreateDescriptorPool");
-      descriptorPools.push_back(dp);
+      pools.push_back(dp);
     }
-    DescriptorPool& dp = descriptorPools[currentPool];
+    DescriptorPool& dp = pools[current];
     if (!fits(dp)) continue;
     VkDescriptorSetAllocateInfo ai{};
     ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
@@ -927,6 +985,8 @@ VulkanBackend::Impl::~Impl() {
   // command pool. On an engine's device nothing waits on the device or its queue (the engine may use them).
   if (device != VK_NULL_HANDLE && vk.vkDestroyCommandPool != nullptr) {
     if (ownsDevice) vk.vkDeviceWaitIdle(device);
+    // On an engine's device every frame recorded must have completed (the backend's contract).
+    release(UINT64_MAX);
     for (BufferEntry& b : staging)
       freeBuffer(b);
     for (auto& [id, b] : buffers)
@@ -942,6 +1002,9 @@ VulkanBackend::Impl::~Impl() {
       vk.vkDestroyShaderModule(device, m, allocator);
     for (DescriptorPool& dp : descriptorPools)
       vk.vkDestroyDescriptorPool(device, dp.pool, allocator);
+    for (std::vector<DescriptorPool>& pools : framePools)
+      for (DescriptorPool& dp : pools)
+        vk.vkDestroyDescriptorPool(device, dp.pool, allocator);
     vk.vkDestroySampler(device, nearest, allocator);
     vk.vkDestroySampler(device, linear, allocator);
     vk.vkDestroyFence(device, fence, allocator);
@@ -977,6 +1040,12 @@ VulkanBackend::VulkanBackend(const CreateInfo& info) : impl_(std::make_unique<Im
     v.pickDevice(info.deviceName);
     v.createDevice(info.pushDescriptors);
   }
+  if (info.framesInFlight < 1 || info.framesInFlight > 16)
+    throw InvalidArgument("VulkanBackend::CreateInfo.framesInFlight", std::to_string(info.framesInFlight),
+                          "must be in [1, 16]");
+  v.framesInFlight = info.framesInFlight;
+  v.framePools.resize(info.framesInFlight);
+  v.frameCurrentPool.assign(info.framesInFlight, 0);
   v.createObjects();
 }
 
@@ -1107,8 +1176,12 @@ void VulkanBackend::destroyTexture(TextureId texture) {
   Impl& v = *impl_;
   const auto it = v.images.find(texture);
   if (it == v.images.end()) return;
-  v.submit(); // the recorded calls may use it
-  v.destroyImage(it->second);
+  if (v.inFrame || v.frameIndex > v.completedFrame) {
+    v.retiring().images.push_back(it->second); // frames in flight may use it: released once they complete
+  } else {
+    v.submit(); // the recorded calls may use it
+    v.destroyImage(it->second);
+  }
   v.images.erase(it);
 }
 
@@ -1127,8 +1200,12 @@ void VulkanBackend::destroyBuffer(BufferId buffer) {
   Impl& v = *impl_;
   const auto it = v.buffers.find(buffer);
   if (it == v.buffers.end()) return;
-  v.submit();
-  v.freeBuffer(it->second);
+  if (v.inFrame || v.frameIndex > v.completedFrame) {
+    v.retiring().buffers.push_back(it->second);
+  } else {
+    v.submit();
+    v.freeBuffer(it->second);
+  }
   v.buffers.erase(it);
 }
 
@@ -1151,7 +1228,7 @@ void VulkanBackend::writeBuffer(BufferId buffer, std::size_t offset, std::span<c
   std::memcpy(s.mapped, bytes.data(), bytes.size());
   const VkBufferCopy region{0, offset, bytes.size()};
   v.vk.vkCmdCopyBuffer(v.cmd, s.buffer, b.buffer, 1, &region);
-  v.staging.push_back(s);
+  (v.inFrame ? v.retiring().buffers : v.staging).push_back(s);
 }
 
 void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texels) {
@@ -1193,11 +1270,12 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
   v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
   v.vk.vkCmdCopyBufferToImage(v.cmd, s.buffer, e.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
   v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
-  v.staging.push_back(s);
+  (v.inFrame ? v.retiring().buffers : v.staging).push_back(s);
 }
 
 std::vector<std::byte> VulkanBackend::readBuffer(BufferId buffer, std::size_t offset, std::size_t bytes) {
   Impl& v = *impl_;
+  v.refuseInFrame("gpu::VulkanBackend::readBuffer");
   BufferEntry& b = v.buffer(buffer, "gpu::VulkanBackend::readBuffer buffer");
   if (offset + bytes > b.bytes)
     throw InvalidArgument("gpu::VulkanBackend::readBuffer bytes", std::to_string(offset + bytes),
@@ -1210,6 +1288,7 @@ std::vector<std::byte> VulkanBackend::readBuffer(BufferId buffer, std::size_t of
 
 std::vector<float> VulkanBackend::readTexture(TextureId texture) {
   Impl& v = *impl_;
+  v.refuseInFrame("gpu::VulkanBackend::readTexture");
   const ImageEntry& e = v.image(texture, "gpu::VulkanBackend::readTexture texture");
   const TextureDesc& d = e.desc;
   const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
@@ -1311,7 +1390,81 @@ void VulkanBackend::dispatch(const Dispatch& given) {
 }
 
 void VulkanBackend::finish() {
+  impl_->refuseInFrame("gpu::VulkanBackend::finish");
   impl_->submit();
+}
+
+void VulkanBackend::beginFrame(const Frame& frame) {
+  Impl& v = *impl_;
+  const char* field = "gpu::VulkanBackend::beginFrame frame";
+  if (v.inFrame)
+    throw InvalidArgument(std::string(field) + ".index", std::to_string(frame.index),
+                          "frame " + std::to_string(v.frameIndex) + " is still being recorded (endFrame())");
+  if (frame.commandBuffer == VK_NULL_HANDLE)
+    throw InvalidArgument(std::string(field) + ".commandBuffer", "null", "must be the engine's, recording");
+  if (frame.index <= v.frameIndex)
+    throw InvalidArgument(std::string(field) + ".index", std::to_string(frame.index),
+                          "must be > the last frame's index " + std::to_string(v.frameIndex));
+  if (frame.completed >= frame.index || frame.completed < v.completedFrame)
+    throw InvalidArgument(std::string(field) + ".completed", std::to_string(frame.completed),
+                          "must be < index " + std::to_string(frame.index) + " and >= the last frame's " +
+                              std::to_string(v.completedFrame));
+  if (frame.index - frame.completed > v.framesInFlight)
+    throw InvalidArgument(
+        std::string(field) + ".completed", std::to_string(frame.completed),
+        "must be >= index - framesInFlight = " + std::to_string(frame.index - v.framesInFlight) +
+            " (wait for that frame before recording this one)");
+  // Work recorded outside frames since the last one (pass creation, uploads) goes first, submitted and
+  // waited for here: call finish() after setting up so that no frame starts with a wait.
+  v.submit();
+  v.completedFrame = frame.completed;
+  v.release(frame.completed);
+  v.frameIndex = frame.index;
+  const std::size_t slot = static_cast<std::size_t>(frame.index % v.framesInFlight);
+  v.resetPools(v.framePools[slot]); // its last frame (index - framesInFlight) has completed
+  v.frameCurrentPool[slot] = 0;
+  v.inFrame = true;
+  v.cmd = frame.commandBuffer;
+  // Entry: the engine's earlier writes (any stage) are visible to the library's compute and transfer work.
+  VkMemoryBarrier m{};
+  m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  m.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+  m.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_UNIFORM_READ_BIT |
+                    VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+  v.vk.vkCmdPipelineBarrier(v.cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT |
+                                VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT,
+                            0, 1, &m, 0, nullptr, 0, nullptr);
+}
+
+void VulkanBackend::endFrame() {
+  Impl& v = *impl_;
+  if (!v.inFrame)
+    throw InvalidArgument("gpu::VulkanBackend::endFrame", "no frame", "must follow beginFrame()");
+  // Exit: the library's writes (compute, transfer) are visible to whatever the engine records next.
+  VkMemoryBarrier m{};
+  m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  m.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+  v.vk.vkCmdPipelineBarrier(v.cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                            VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &m, 0, nullptr, 0, nullptr);
+  v.inFrame = false;
+  v.cmd = v.ownCmd;
+}
+
+void VulkanBackend::frameCompleted(std::uint64_t completed) {
+  Impl& v = *impl_;
+  if (completed > v.frameIndex || completed < v.completedFrame)
+    throw InvalidArgument("gpu::VulkanBackend::frameCompleted completed", std::to_string(completed),
+                          "must be in [" + std::to_string(v.completedFrame) + ", " +
+                              std::to_string(v.frameIndex) + "]");
+  v.completedFrame = completed;
+  v.release(completed);
+}
+
+bool VulkanBackend::inFrame() const {
+  return impl_->inFrame;
 }
 
 void VulkanBackend::beginTimer() {
@@ -1325,6 +1478,7 @@ void VulkanBackend::beginTimer() {
 
 double VulkanBackend::endTimer() {
   Impl& v = *impl_;
+  v.refuseInFrame("gpu::VulkanBackend::endTimer");
   if (!v.timing) {
     finish();
     return 0.0;

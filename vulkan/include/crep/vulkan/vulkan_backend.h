@@ -82,6 +82,20 @@ public:
     /// device). false, or without the extension: descriptor sets allocated from descriptor pools, which are
     /// recycled after the submission that used them has completed. Default true.
     bool pushDescriptors = true;
+    /// Frames the engine records before it waits for the oldest of them (beginFrame()): the rings of
+    /// per-frame data (descriptor sets, staging, retired objects) hold this many. In [1, 16], default 3.
+    std::uint32_t framesInFlight = 3;
+  };
+
+  /// One frame recorded into the engine's command buffer (docs/VULKAN_STATE.md).
+  struct Frame {
+    /// The engine's primary command buffer, recording, outside a render pass, of a family with compute.
+    VkCommandBuffer commandBuffer = VK_NULL_HANDLE;
+    /// The frame's number, > every earlier frame's (e.g. the engine's frame counter from 1).
+    std::uint64_t index = 0;
+    /// Every frame with an index <= `completed` has completed on the GPU (the engine's fence or timeline
+    /// value); 0: none yet. In [index - framesInFlight, index - 1], and never less than before.
+    std::uint64_t completed = 0;
   };
 
   /// What the backend needs of a device or uses when present, each with why.
@@ -137,6 +151,19 @@ public:
   void beginTimer() override;
   double endTimer() override;
   void cancelTimer() noexcept override;
+
+  /// Records every call until endFrame() into `frame.commandBuffer`: no submission and no wait by the
+  /// library. Reads, finish() and endTimer() are refused there (InvalidArgument naming the call). Objects
+  /// destroyed, staging and descriptor sets are released once `completed` of a later frame covers this one.
+  /// Work recorded outside frames since the last one is submitted and waited for first (call finish()
+  /// after setting up). InvalidArgument naming the Frame field for a null buffer, an index not after the
+  /// last one, or a `completed` out of its range.
+  void beginFrame(const Frame& frame);
+  /// Records the exit barrier (docs/VULKAN_STATE.md); later calls go to the backend's own command buffer.
+  void endFrame();
+  /// Outside frames: every frame <= `completed` has completed (its retired objects are released now).
+  void frameCompleted(std::uint64_t completed);
+  bool inFrame() const;
 
   std::string deviceName() const; ///< the physical device's name
   /// Whether dispatches push their descriptors (VK_KHR_push_descriptor) rather than allocate sets from pools.
