@@ -418,7 +418,8 @@ public:
     return messages_;
   }
 
-private:
+  VkPhysicalDevice physicalDevice() const { return physical_; }
+  /// An instance-level function of the engine's own.
   template <class F>
   F instanceFunction(const char* name) const {
     const PFN_vkVoidFunction f = gipa_(instance_, name);
@@ -426,6 +427,8 @@ private:
     REQUIRE_MESSAGE(found, name);
     return reinterpret_cast<F>(f);
   }
+
+private:
   static VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                   VkDebugUtilsMessageTypeFlagsEXT,
                                                   const VkDebugUtilsMessengerCallbackDataEXT* data,

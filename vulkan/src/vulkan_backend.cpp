@@ -296,9 +296,15 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT 
 
 struct ImageEntry {
   VkImage image = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE; ///< null for an engine's image (importTexture)
   VkImageView view = VK_NULL_HANDLE;
   TextureDesc desc;
+  bool imported = false; ///< the engine's: never destroyed by the backend
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT;
+  VkImageUsageFlags usage = 0;
+  VkImageLayout home = VK_IMAGE_LAYOUT_GENERAL;    ///< its layout between the backend's calls and frames
+  VkImageLayout current = VK_IMAGE_LAYOUT_GENERAL; ///< its layout at this point of the recorded commands
 };
 
 struct BufferEntry {
@@ -408,6 +414,9 @@ struct VulkanBackend::Impl {
   void begin();
   void barrier();
   void transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to);
+  std::vector<TextureId> moved; ///< engine images out of their home layout in the recorded commands
+  void useImage(TextureId id, ImageEntry& e, bool storage);
+  void restoreImages();
   void submit();
   void refuseInFrame(const char* call) const;
   Retired& retiring();
@@ -779,12 +788,35 @@ void VulkanBackend::Impl::barrier() {
 }
 
 namespace {
-VkImageSubresourceRange wholeImage(const TextureDesc& d) {
-  return {static_cast<VkImageAspectFlags>(d.format == Format::Depth32F ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                                                       : VK_IMAGE_ASPECT_COLOR_BIT),
-          0, 1, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
+VkImageSubresourceRange wholeImage(const ImageEntry& e) {
+  return {e.aspect, 0, 1, 0,
+          e.desc.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(e.desc.depth) : 1u};
+}
+bool sampleable(VkImageLayout l) {
+  return l == VK_IMAGE_LAYOUT_GENERAL || l == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL ||
+         l == VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL;
 }
 } // namespace
+
+void VulkanBackend::Impl::useImage(TextureId id, ImageEntry& e, bool storage) {
+  // An engine's image is sampled in its own layout when it can be, else moved to GENERAL until the
+  // frame's end (or the submission's, outside frames), then moved back (docs/VULKAN_STATE.md).
+  const VkImageLayout needed = storage || !sampleable(e.current) ? VK_IMAGE_LAYOUT_GENERAL : e.current;
+  if (needed == e.current) return;
+  transition(e, e.current, needed);
+  if (e.current == e.home) moved.push_back(id);
+  e.current = needed;
+}
+
+void VulkanBackend::Impl::restoreImages() {
+  for (TextureId id : moved) {
+    const auto it = images.find(id);
+    if (it == images.end() || it->second.current == it->second.home) continue;
+    transition(it->second, it->second.current, it->second.home);
+    it->second.current = it->second.home;
+  }
+  moved.clear();
+}
 
 void VulkanBackend::Impl::transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to) {
   VkImageMemoryBarrier b{};
@@ -796,7 +828,7 @@ void VulkanBackend::Impl::transition(const ImageEntry& e, VkImageLayout from, Vk
   b.newLayout = to;
   b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = e.image;
-  b.subresourceRange = wholeImage(e.desc);
+  b.subresourceRange = wholeImage(e);
   vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
                           nullptr, 0, nullptr, 1, &b);
@@ -804,6 +836,7 @@ void VulkanBackend::Impl::transition(const ImageEntry& e, VkImageLayout from, Vk
 
 void VulkanBackend::Impl::submit() {
   if (!recording) return;
+  restoreImages();
   VkMemoryBarrier m{};
   m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
   m.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
@@ -992,7 +1025,7 @@ VulkanBackend::Impl::~Impl() {
     for (auto& [id, b] : buffers)
       freeBuffer(b);
     for (auto& [id, i] : images)
-      destroyImage(i);
+      if (!i.imported) destroyImage(i); // the engine's images are the engine's
     for (auto& [key, p] : pipelines) {
       vk.vkDestroyPipeline(device, p.pipeline, allocator);
       vk.vkDestroyPipelineLayout(device, p.layout, allocator);
@@ -1152,6 +1185,9 @@ TextureId VulkanBackend::createTexture(const TextureDesc& desc) {
       static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0,
       ci.arrayLayers};
   check(v.vk.vkCreateImageView(v.device, &vi, v.allocator, &e.view), "vkCreateImageView");
+  e.format = ci.format;
+  e.aspect = vi.subresourceRange.aspectMask;
+  e.usage = ci.usage;
   // GPU: every image lives in VK_IMAGE_LAYOUT_GENERAL (sampled, stored and copied without transitions); some
   // GPUs sample faster from SHADER_READ_ONLY_OPTIMAL.
   v.begin();
@@ -1176,6 +1212,15 @@ void VulkanBackend::destroyTexture(TextureId texture) {
   Impl& v = *impl_;
   const auto it = v.images.find(texture);
   if (it == v.images.end()) return;
+  if (it->second.imported) {
+    // The engine's image: forgotten, never destroyed; it must still be in its home layout.
+    if (it->second.current != it->second.home)
+      throw InvalidArgument(
+          "gpu::VulkanBackend::destroyTexture texture", std::to_string(texture),
+          "is an engine image in use by the frame being recorded: forget it after endFrame()");
+    v.images.erase(it);
+    return;
+  }
   if (v.inFrame || v.frameIndex > v.completedFrame) {
     v.retiring().images.push_back(it->second); // frames in flight may use it: released once they complete
   } else {
@@ -1183,6 +1228,89 @@ void VulkanBackend::destroyTexture(TextureId texture) {
     v.destroyImage(it->second);
   }
   v.images.erase(it);
+}
+
+namespace {
+/// The seam's format of an engine image's VkFormat (any depth format reads as Depth32F); false if none.
+bool seamFormat(VkFormat f, Format& out, VkImageAspectFlags& aspect) {
+  aspect = VK_IMAGE_ASPECT_COLOR_BIT;
+  switch (f) {
+  case VK_FORMAT_D32_SFLOAT_S8_UINT:
+  case VK_FORMAT_D24_UNORM_S8_UINT:
+  case VK_FORMAT_D16_UNORM_S8_UINT:
+    aspect = VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
+    out = Format::Depth32F;
+    return true;
+  case VK_FORMAT_D32_SFLOAT:
+  case VK_FORMAT_X8_D24_UNORM_PACK32:
+  case VK_FORMAT_D16_UNORM:
+    aspect = VK_IMAGE_ASPECT_DEPTH_BIT;
+    out = Format::Depth32F;
+    return true;
+  default:
+    break;
+  }
+  for (Format candidate :
+       {Format::R32F, Format::RG32F, Format::RGBA32F, Format::RGBA16F, Format::RGBA8, Format::RG32I})
+    if (vkFormat(candidate) == f) {
+      out = candidate;
+      return true;
+    }
+  return false;
+}
+} // namespace
+
+TextureId VulkanBackend::importTexture(const EngineImage& image) {
+  Impl& v = *impl_;
+  const std::string field = "gpu::VulkanBackend::importTexture image.";
+  if (image.image == VK_NULL_HANDLE)
+    throw InvalidArgument(field + "image", "null", "must be the engine's VkImage");
+  if (image.view == VK_NULL_HANDLE)
+    throw InvalidArgument(field + "view", "null",
+                          "must be a view of the whole image (its depth aspect for depth)");
+  ImageEntry e;
+  if (!seamFormat(image.format, e.desc.format, e.aspect))
+    throw InvalidArgument(field + "format", std::to_string(static_cast<int>(image.format)),
+                          "must be R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT, R16G16B16A16_SFLOAT, "
+                          "R8G8B8A8_UNORM, R32G32_SINT or a depth format");
+  if (image.width == 0 || image.height == 0 || image.depth == 0)
+    throw InvalidArgument(field + "width/height/depth",
+                          std::to_string(image.width) + " x " + std::to_string(image.height) + " x " +
+                              std::to_string(image.depth),
+                          "must each be > 0");
+  if ((image.usage & (VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT)) == 0)
+    throw InvalidArgument(field + "usage", std::to_string(image.usage),
+                          "must include VK_IMAGE_USAGE_SAMPLED_BIT or VK_IMAGE_USAGE_STORAGE_BIT");
+  if (image.layout == VK_IMAGE_LAYOUT_UNDEFINED || image.layout == VK_IMAGE_LAYOUT_PREINITIALIZED)
+    throw InvalidArgument(field + "layout", std::to_string(static_cast<int>(image.layout)),
+                          "must be the layout its contents are in");
+  e.desc.type = image.type;
+  e.desc.width = static_cast<int>(image.width);
+  e.desc.height = static_cast<int>(image.height);
+  e.desc.depth = static_cast<int>(image.depth);
+  e.desc.label = image.label;
+  e.image = image.image;
+  e.view = image.view;
+  e.imported = true;
+  e.format = image.format;
+  e.usage = image.usage;
+  e.home = e.current = image.layout;
+  const TextureId id = v.nextId++;
+  v.images[id] = e;
+  return id;
+}
+
+void VulkanBackend::setTextureLayout(TextureId texture, VkImageLayout layout) {
+  Impl& v = *impl_;
+  ImageEntry& e = v.image(texture, "gpu::VulkanBackend::setTextureLayout texture");
+  if (!e.imported || e.current != e.home)
+    throw InvalidArgument("gpu::VulkanBackend::setTextureLayout texture", std::to_string(texture),
+                          e.imported ? "is in use by the frame being recorded (set it before its first use)"
+                                     : "must be an engine image (importTexture)");
+  if (layout == VK_IMAGE_LAYOUT_UNDEFINED || layout == VK_IMAGE_LAYOUT_PREINITIALIZED)
+    throw InvalidArgument("gpu::VulkanBackend::setTextureLayout layout",
+                          std::to_string(static_cast<int>(layout)), "must be the layout its contents are in");
+  e.home = e.current = layout;
 }
 
 BufferId VulkanBackend::createBuffer(std::size_t bytes, std::string_view) {
@@ -1233,7 +1361,11 @@ void VulkanBackend::writeBuffer(BufferId buffer, std::size_t offset, std::span<c
 
 void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texels) {
   Impl& v = *impl_;
-  const ImageEntry& e = v.image(texture, "gpu::VulkanBackend::writeTexture texture");
+  ImageEntry& e = v.image(texture, "gpu::VulkanBackend::writeTexture texture");
+  if (e.format != vkFormat(e.desc.format))
+    throw InvalidArgument("gpu::VulkanBackend::writeTexture texture", std::to_string(texture),
+                          "is an engine image in a format the backend does not copy (" +
+                              std::to_string(static_cast<int>(e.format)) + ")");
   const TextureDesc& d = e.desc;
   const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
                             static_cast<std::size_t>(d.depth);
@@ -1267,9 +1399,9 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
   region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
                         d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
   // Copies in the transfer layouts (GPU: the fast path of a copy engine), then back to GENERAL.
-  v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+  v.transition(e, e.current, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
   v.vk.vkCmdCopyBufferToImage(v.cmd, s.buffer, e.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-  v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+  v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, e.current);
   (v.inFrame ? v.retiring().buffers : v.staging).push_back(s);
 }
 
@@ -1289,7 +1421,11 @@ std::vector<std::byte> VulkanBackend::readBuffer(BufferId buffer, std::size_t of
 std::vector<float> VulkanBackend::readTexture(TextureId texture) {
   Impl& v = *impl_;
   v.refuseInFrame("gpu::VulkanBackend::readTexture");
-  const ImageEntry& e = v.image(texture, "gpu::VulkanBackend::readTexture texture");
+  ImageEntry& e = v.image(texture, "gpu::VulkanBackend::readTexture texture");
+  if (e.format != vkFormat(e.desc.format))
+    throw InvalidArgument("gpu::VulkanBackend::readTexture texture", std::to_string(texture),
+                          "is an engine image in a format the backend does not copy (" +
+                              std::to_string(static_cast<int>(e.format)) + ")");
   const TextureDesc& d = e.desc;
   const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
                             static_cast<std::size_t>(d.depth);
@@ -1303,9 +1439,9 @@ std::vector<float> VulkanBackend::readTexture(TextureId texture) {
       0, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
   region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
                         d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
-  v.transition(e, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  v.transition(e, e.current, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   v.vk.vkCmdCopyImageToBuffer(v.cmd, e.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.buffer, 1, &region);
-  v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
+  v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, e.current);
   v.submit();
   std::vector<float> out(count * static_cast<std::size_t>(componentCount(d.format)));
   if (d.format == Format::RGBA16F) {
@@ -1343,6 +1479,18 @@ void VulkanBackend::dispatch(const Dispatch& given) {
   std::vector<VkDescriptorImageInfo> imageInfos(d.resources.size());
   std::vector<VkDescriptorBufferInfo> bufferInfos(d.resources.size());
   std::vector<VkWriteDescriptorSet> writes;
+  v.begin();
+  v.barrier();
+  for (const Resource& r : d.resources) {
+    if (r.kind != ResourceKind::SampledTexture && r.kind != ResourceKind::StorageImage) continue;
+    ImageEntry& e = v.image(r.texture, (d.label + " texture").c_str());
+    const bool storage = r.kind == ResourceKind::StorageImage;
+    if ((e.usage & (storage ? VK_IMAGE_USAGE_STORAGE_BIT : VK_IMAGE_USAGE_SAMPLED_BIT)) == 0)
+      throw InvalidArgument(d.label + " texture", std::to_string(r.texture),
+                            storage ? "must have VK_IMAGE_USAGE_STORAGE_BIT (the pass writes it)"
+                                    : "must have VK_IMAGE_USAGE_SAMPLED_BIT (the pass samples it)");
+    if (e.imported) v.useImage(r.texture, e, storage);
+  }
   for (std::size_t i = 0; i < d.resources.size(); ++i) {
     const Resource& r = d.resources[i];
     VkWriteDescriptorSet w{};
@@ -1355,7 +1503,7 @@ void VulkanBackend::dispatch(const Dispatch& given) {
       imageInfos[i] = {r.kind == ResourceKind::SampledTexture
                            ? (r.filter == Filter::Linear ? v.linear : v.nearest)
                            : VK_NULL_HANDLE,
-                       e.view, VK_IMAGE_LAYOUT_GENERAL};
+                       e.view, e.current};
       w.pImageInfo = &imageInfos[i];
     } else {
       const BufferEntry& b = v.buffer(r.buffer, (d.label + " buffer").c_str());
@@ -1364,8 +1512,6 @@ void VulkanBackend::dispatch(const Dispatch& given) {
     }
     writes.push_back(w);
   }
-  v.begin();
-  v.barrier();
   v.vk.vkCmdBindPipeline(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
   if (!writes.empty() && v.pushDescriptors) {
     v.vk.vkCmdPushDescriptorSetKHR(v.cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0,
@@ -1442,6 +1588,7 @@ void VulkanBackend::endFrame() {
   Impl& v = *impl_;
   if (!v.inFrame)
     throw InvalidArgument("gpu::VulkanBackend::endFrame", "no frame", "must follow beginFrame()");
+  v.restoreImages(); // the engine's images back in their layouts
   // Exit: the library's writes (compute, transfer) are visible to whatever the engine records next.
   VkMemoryBarrier m{};
   m.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;

@@ -152,6 +152,32 @@ public:
   double endTimer() override;
   void cancelTimer() noexcept override;
 
+  /// An engine's image, used where it is (docs/VULKAN_STATE.md, "The engine's images").
+  struct EngineImage {
+    VkImage image = VK_NULL_HANDLE; ///< required; never destroyed by the backend
+    /// Required: a view of the whole image, its depth aspect only for a depth format (sampled as depth).
+    VkImageView view = VK_NULL_HANDLE;
+    /// R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT, R16G16B16A16_SFLOAT, R8G8B8A8_UNORM, R32G32_SINT, or
+    /// a depth format (D32_SFLOAT, D24_UNORM_S8_UINT, ...; read as gpu::Format::Depth32F).
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    TextureType type = TextureType::Texture2D;
+    std::uint32_t width = 0, height = 0; ///< texels, > 0
+    std::uint32_t depth = 1;             ///< layers (2D array) or slices (3D), > 0
+    /// Its usage flags: SAMPLED for what a pass reads, STORAGE for what it writes (checked per dispatch).
+    VkImageUsageFlags usage = 0;
+    /// The layout the image is in whenever the backend's calls or frames begin, and is left in when they
+    /// end (e.g. SHADER_READ_ONLY_OPTIMAL, DEPTH_STENCIL_READ_ONLY_OPTIMAL, GENERAL).
+    VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    std::string label{};
+  };
+  /// An id for `image` that every pass takes like the backend's own textures (a camera depth, shadow maps,
+  /// outputs, froxel volumes), with no copy. The engine keeps it alive while frames that use it are in
+  /// flight; destroyTexture() forgets it. InvalidArgument naming the EngineImage field.
+  TextureId importTexture(const EngineImage& image);
+  /// The layout an engine image is in from now on (outside the library's use of it): a frame's own state,
+  /// e.g. after the engine moved it between frames. InvalidArgument for another texture or one in use.
+  void setTextureLayout(TextureId texture, VkImageLayout layout);
+
   /// Records every call until endFrame() into `frame.commandBuffer`: no submission and no wait by the
   /// library. Reads, finish() and endTimer() are refused there (InvalidArgument naming the call). Objects
   /// destroyed, staging and descriptor sets are released once `completed` of a later frame covers this one.
