@@ -3,10 +3,10 @@
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
-#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/engine_frame.h>
@@ -113,6 +113,87 @@ struct ScatteringFrame {
   }
 };
 
+/// The same frame recorded into an engine's command buffer (VulkanBackend::beginFrame / endFrame) on the
+/// backend's own device, as a Vulkan engine runs it: the CPU time of recording it, then the frame's wall
+/// time to the end of the engine's fence wait.
+struct RecordedFrame {
+  gpu::VulkanBackend& backend;
+  scenes::EngineFrame engine;
+  gpu::Texture output;
+  Scattering scattering;
+  gpu::VulkanBackend::EngineDevice device;
+  PFN_vkGetDeviceProcAddr proc = nullptr;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+  std::uint64_t& index; ///< the backend's frame counter, shared by every RecordedFrame on it
+  std::vector<double> recordMs, ms;
+
+  template <class F>
+  F fn(const char* name) const {
+    return reinterpret_cast<F>(proc(device.device, name));
+  }
+
+  RecordedFrame(gpu::VulkanBackend& b, std::uint64_t& frameCounter, const scenes::Scene& scene,
+                const scenes::EngineMaps& maps, int width, int height, int mapSize, const FrameVariant& v)
+      : backend(b), engine(b, scene, maps),
+        output(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, width, height, 1, "bench: output"}),
+        scattering(ScatteringFrame::createInfo(b, width, height, mapSize, v)), device(b.runsOn()),
+        index(frameCounter) {
+    proc = device.getDeviceProcAddr != nullptr
+               ? device.getDeviceProcAddr
+               : reinterpret_cast<PFN_vkGetDeviceProcAddr>(
+                     device.getInstanceProcAddr(device.instance, "vkGetDeviceProcAddr"));
+    VkCommandPoolCreateInfo pci{};
+    pci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pci.queueFamilyIndex = device.queueFamily;
+    fn<PFN_vkCreateCommandPool>("vkCreateCommandPool")(device.device, &pci, nullptr, &pool);
+    VkCommandBufferAllocateInfo ai{};
+    ai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    ai.commandPool = pool;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    fn<PFN_vkAllocateCommandBuffers>("vkAllocateCommandBuffers")(device.device, &ai, &cmd);
+    VkFenceCreateInfo fi{};
+    fi.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+    fn<PFN_vkCreateFence>("vkCreateFence")(device.device, &fi, nullptr, &fence);
+    b.finish(); // the set-up, before the first frame
+  }
+  RecordedFrame(const RecordedFrame&) = delete;
+  RecordedFrame& operator=(const RecordedFrame&) = delete;
+  ~RecordedFrame() {
+    fn<PFN_vkDestroyFence>("vkDestroyFence")(device.device, fence, nullptr);
+    fn<PFN_vkDestroyCommandPool>("vkDestroyCommandPool")(device.device, pool, nullptr);
+  }
+
+  void run() {
+    const auto start = std::chrono::steady_clock::now();
+    fn<PFN_vkResetCommandBuffer>("vkResetCommandBuffer")(cmd, 0);
+    VkCommandBufferBeginInfo bi{};
+    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    fn<PFN_vkBeginCommandBuffer>("vkBeginCommandBuffer")(cmd, &bi);
+    ++index;
+    const auto recordStart = std::chrono::steady_clock::now();
+    backend.beginFrame({cmd, index, index - 1});
+    scattering.run(engine.attribs(output.id()));
+    backend.endFrame();
+    recordMs.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - recordStart).count());
+    fn<PFN_vkEndCommandBuffer>("vkEndCommandBuffer")(cmd);
+    VkSubmitInfo si{};
+    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    fn<PFN_vkQueueSubmit>("vkQueueSubmit")(device.queue, 1, &si, fence);
+    fn<PFN_vkWaitForFences>("vkWaitForFences")(device.device, 1, &fence, VK_TRUE, UINT64_MAX);
+    fn<PFN_vkResetFences>("vkResetFences")(device.device, 1, &fence);
+    backend.frameCompleted(index);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+};
+
 /// 320x180 and the bench's size (once when they are the same).
 std::vector<std::pair<int, int>> benchSizes(const BenchOptions& o) {
   std::vector<std::pair<int, int>> sizes = {{320, 180}};
@@ -141,18 +222,22 @@ std::pair<double, double> interleaved(Frame (&frames)[2], int repeats) {
 
 /// The frames of the port's goal (forest, sunset with the sun in view, colonnade-night's local lights), a
 /// reduced evaluation scale and Yusov's epipolar sampling, at 320x180 and at the bench's size,
-/// crep::Scattering on each backend, interleaved.
-void scatteringFrames(const BenchOptions& o, gpu::Backend& vk, gpu::Backend& gl) {
+/// crep::Scattering on each backend, interleaved; on Vulkan also recorded into an engine's command buffer.
+void scatteringFrames(const BenchOptions& o, gpu::VulkanBackend& vk, gpu::Backend& gl) {
   const int repeats = std::max(o.repeat, 3);
   std::printf("\n  crep::Scattering, the whole frame from the engine's maps (sun 2048^2, local lights "
-              "512^2), map %d^2, wall ms, median of %d, interleaved:\n",
+              "512^2), map %d^2, wall ms, median of %d, interleaved; \"recorded\": the same frame recorded "
+              "into an engine's command buffer (beginFrame/endFrame), its CPU recording time and its wall "
+              "time to the engine's fence:\n",
               o.mapWidth, repeats);
-  std::printf("  %-38s %-10s %12s %12s %8s\n", "frame", "size", "OpenGL", "Vulkan", "ratio");
+  std::printf("  %-38s %-10s %10s %10s %7s %10s %10s %7s\n", "frame", "size", "OpenGL", "Vulkan", "ratio",
+              "record CPU", "recorded", "ratio");
   const FrameVariant variants[] = {{"forest", ""},
                                    {"sunset", ""},
                                    {"colonnade-night", ""},
                                    {"forest", ", evaluationScale 0.5", 0.5},
                                    {"sunset", ", epipolar sampling", 1.0, true}};
+  std::uint64_t frameCounter = 0;
   for (const FrameVariant& v : variants)
     for (const auto& [w, h] : benchSizes(o)) {
       if (v.evaluationScale < 1.0 && (w % 2 != 0 || h % 2 != 0)) continue; // the scale needs even sizes
@@ -160,9 +245,23 @@ void scatteringFrames(const BenchOptions& o, gpu::Backend& vk, gpu::Backend& gl)
       const scenes::EngineMaps maps = scenes::renderEngineMaps(scene, w, h, 2048, 512);
       ScatteringFrame frames[] = {{gl, scene, maps, w, h, o.mapWidth, v},
                                   {vk, scene, maps, w, h, o.mapWidth, v}};
-      const auto [a, b] = interleaved(frames, repeats);
-      std::printf("  %-38s %4dx%-5d %12.2f %12.2f %8.2f\n", (std::string(v.scene) + v.label).c_str(), w, h, a,
-                  b, b / a);
+      RecordedFrame recorded(vk, frameCounter, scene, maps, w, h, o.mapWidth, v);
+      recorded.run(); // warm-up
+      recorded.ms.clear();
+      recorded.recordMs.clear();
+      for (ScatteringFrame& f : frames)
+        f.run();
+      for (ScatteringFrame& f : frames)
+        f.ms.clear();
+      for (int r = 0; r < repeats; ++r) {
+        for (ScatteringFrame& f : frames)
+          f.run();
+        recorded.run();
+      }
+      const double a = median(frames[0].ms), b = median(frames[1].ms), c = median(recorded.ms);
+      std::printf("  %-38s %4dx%-5d %10.2f %10.2f %7.2f %10.2f %10.2f %7.2f\n",
+                  (std::string(v.scene) + v.label).c_str(), w, h, a, b, b / a, median(recorded.recordMs), c,
+                  c / a);
     }
 }
 

@@ -1108,6 +1108,21 @@ ComputeLimits VulkanBackend::computeLimits() const {
   return l;
 }
 
+VulkanBackend::EngineDevice VulkanBackend::runsOn() const {
+  const Impl& v = *impl_;
+  EngineDevice e;
+  e.instance = v.instance;
+  e.physicalDevice = v.physical;
+  e.device = v.device;
+  e.queueFamily = v.family;
+  e.queue = v.queue;
+  e.getInstanceProcAddr = v.getInstanceProcAddr;
+  e.getDeviceProcAddr = v.getDeviceProcAddr;
+  e.pipelineCache = v.pipelineCache;
+  e.allocator = v.allocator;
+  return e;
+}
+
 std::string VulkanBackend::deviceName() const {
   return impl_->properties.deviceName;
 }

@@ -191,6 +191,11 @@ public:
   void frameCompleted(std::uint64_t completed);
   bool inFrame() const;
 
+  /// The objects the backend runs on (its own or CreateInfo::device's) and the loader it uses, e.g. for a
+  /// tool that records frames (beginFrame) on the backend's own device. They stay the backend's on its own
+  /// device: destroy none of them. enabledExtensions and enabledFeatures are left empty.
+  EngineDevice runsOn() const;
+
   std::string deviceName() const; ///< the physical device's name
   /// Whether dispatches push their descriptors (VK_KHR_push_descriptor) rather than allocate sets from pools.
   bool usesPushDescriptors() const;
