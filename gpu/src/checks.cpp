@@ -3,6 +3,7 @@
 #include <crep/core/error.h>
 #include <crep/gpu/checks.h>
 #include <crep/gpu/gl.h>
+#include <crep/gpu/gl_backend.h>
 
 #include <epoxy/gl.h>
 
@@ -21,26 +22,6 @@ std::string sizeText(int width, int height) {
   return std::to_string(width) + " x " + std::to_string(height);
 }
 
-std::uint32_t glFormat(Format f) {
-  switch (f) {
-  case Format::R32F:
-    return GL_R32F;
-  case Format::RG32F:
-    return GL_RG32F;
-  case Format::RGBA32F:
-    return GL_RGBA32F;
-  case Format::RGBA16F:
-    return GL_RGBA16F;
-  case Format::Depth32F:
-    return GL_DEPTH_COMPONENT32F;
-  case Format::RGBA8:
-    return GL_RGBA8;
-  case Format::RG32I:
-    return GL_RG32I;
-  }
-  return GL_RGBA32F;
-}
-
 /// A GL texture's level as the checks see it: its format when it is one of gpu::Format.
 TextureLevel fromGl(const gl::TextureLevel& l) {
   TextureLevel level;
@@ -52,7 +33,7 @@ TextureLevel fromGl(const gl::TextureLevel& l) {
   level.depth = std::max(l.depth, 1);
   for (Format f : {Format::R32F, Format::RG32F, Format::RGBA32F, Format::RGBA16F, Format::Depth32F,
                    Format::RGBA8, Format::RG32I})
-    if (glFormat(f) == l.internalFormat) level.format = f;
+    if (glInternalFormat(f) == l.internalFormat) level.format = f;
   switch (l.internalFormat) {
   case GL_DEPTH_COMPONENT16:
   case GL_DEPTH_COMPONENT24:
@@ -158,7 +139,7 @@ TextureLevel requireTexture2DOf(const Backend& backend, const char* parameter, T
 void requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture, int width,
                         int height, std::optional<Format> format) {
   if (onGl(backend))
-    return gl::requireTexture2D(parameter, texture, width, height, format ? glFormat(*format) : 0u);
+    return gl::requireTexture2D(parameter, texture, width, height, format ? glInternalFormat(*format) : 0u);
   if (width <= 0 || height <= 0)
     throw InvalidArgument(parameter, sizeText(width, height), "size must be > 0");
   const TextureLevel level = textureLevelOf(backend, parameter, texture);

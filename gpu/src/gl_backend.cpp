@@ -14,26 +14,6 @@ namespace crep::gpu {
 
 namespace {
 
-GLenum internalFormat(Format f) {
-  switch (f) {
-  case Format::R32F:
-    return GL_R32F;
-  case Format::RG32F:
-    return GL_RG32F;
-  case Format::RGBA32F:
-    return GL_RGBA32F;
-  case Format::RGBA16F:
-    return GL_RGBA16F;
-  case Format::Depth32F:
-    return GL_DEPTH_COMPONENT32F;
-  case Format::RGBA8:
-    return GL_RGBA8;
-  case Format::RG32I:
-    return GL_RG32I;
-  }
-  return GL_RGBA32F;
-}
-
 GLenum pixelFormat(GLint internal) {
   switch (internal) {
   case GL_R32F:
@@ -106,6 +86,26 @@ void setUniform(GLuint program, const PushValue& v) {
 }
 
 } // namespace
+
+std::uint32_t glInternalFormat(Format f) {
+  switch (f) {
+  case Format::R32F:
+    return GL_R32F;
+  case Format::RG32F:
+    return GL_RG32F;
+  case Format::RGBA32F:
+    return GL_RGBA32F;
+  case Format::RGBA16F:
+    return GL_RGBA16F;
+  case Format::Depth32F:
+    return GL_DEPTH_COMPONENT32F;
+  case Format::RGBA8:
+    return GL_RGBA8;
+  case Format::RG32I:
+    return GL_RG32I;
+  }
+  return GL_RGBA32F;
+}
 
 GlBackend::GlBackend() {
   nearest_ = gl::createClampSampler(GL_NEAREST);
@@ -207,9 +207,9 @@ TextureId GlBackend::createTexture(const TextureDesc& desc) {
                                                                    : GL_TEXTURE_3D;
   gl::Handle t = gl::createTexture(target);
   if (target == GL_TEXTURE_2D)
-    glTextureStorage2D(t.get(), 1, internalFormat(desc.format), desc.width, desc.height);
+    glTextureStorage2D(t.get(), 1, glInternalFormat(desc.format), desc.width, desc.height);
   else
-    glTextureStorage3D(t.get(), 1, internalFormat(desc.format), desc.width, desc.height, desc.depth);
+    glTextureStorage3D(t.get(), 1, glInternalFormat(desc.format), desc.width, desc.height, desc.depth);
   // Linear and clamped by the texture's own state too: an engine's shader may sample it without a sampler
   // object (a pass binds its own).
   glTextureParameteri(t.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);

@@ -51,6 +51,9 @@ private:
   gl::Handle& program(const std::string& path, std::span<const ShaderDefine> defines);
 };
 
+/// The GL internal format of `format` (GL_R32F, ..., GL_DEPTH_COMPONENT32F).
+std::uint32_t glInternalFormat(Format format);
+
 /// `given`, or else a GlBackend made into `own` on the current GL context: the default backend of a pass.
 Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own);
 
