@@ -12,9 +12,9 @@
 #include "timings.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/postfx/gpu_froxel_fog.h>
@@ -719,13 +719,15 @@ struct ScatteringFrame {
       : scene(tool::makeSceneFrame(o.scene, o.screenWidth, o.screenHeight, o.mapWidth, timings)),
         shadow{scene.frame->shadowMap.get(), scene.frame->lightClipFromWorld, scene.frame->shadowBias},
         output(gl::createTexture2D(GL_RGBA32F, o.screenWidth, o.screenHeight)) {}
-  /// crep::Scattering's defaults at this run's screen, square map and M.
+  /// crep::Scattering's defaults at this run's screen, square map and M; the stages timed in the frame
+  /// (blockingTimings: the bench measures).
   static Scattering::CreateInfo createInfo(const BenchOptions& o) {
     Scattering::CreateInfo info;
     info.width = o.screenWidth;
     info.height = o.screenHeight;
     info.mapSize = o.mapWidth;
     info.prefilter.bases = o.bases;
+    info.blockingTimings = true;
     return info;
   }
   Scattering::FrameAttribs attribs() const {

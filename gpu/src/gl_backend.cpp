@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace crep::gpu {
@@ -121,26 +123,57 @@ int GlBackend::maxArrayLayers() const {
 }
 
 void GlBackend::beginTimer() {
-  if (!timer_) timer_.emplace();
-  if (timing_) timer_->cancel();
-  timer_->begin();
-  timing_ = true;
+  cancelTimer(); // spans do not nest
+  if (freeQueries_.empty()) {
+    activeQuery_ = gl::createQuery(GL_TIME_ELAPSED);
+  } else {
+    activeQuery_ = std::move(freeQueries_.back());
+    freeQueries_.pop_back();
+  }
+  glBeginQuery(GL_TIME_ELAPSED, activeQuery_.get());
 }
 
 double GlBackend::endTimer() {
-  if (!timing_) {
+  if (!activeQuery_) {
     finish();
     return 0.0;
   }
-  timer_->end();
-  timing_ = false;
+  glEndQuery(GL_TIME_ELAPSED);
+  gl::Handle query = std::move(activeQuery_);
   finish();
-  return timer_->milliseconds();
+  GLuint64 nanoseconds = 0;
+  glGetQueryObjectui64v(query.get(), GL_QUERY_RESULT, &nanoseconds);
+  freeQueries_.push_back(std::move(query));
+  return static_cast<double>(nanoseconds) * 1e-6;
 }
 
 void GlBackend::cancelTimer() noexcept {
-  if (timer_) timer_->cancel();
-  timing_ = false;
+  if (!activeQuery_) return;
+  glEndQuery(GL_TIME_ELAPSED);
+  activeQuery_.reset(); // its result is never read: deleted rather than reused while it may be pending
+}
+
+TimerId GlBackend::endTimerDeferred() {
+  if (!activeQuery_) return 0;
+  glEndQuery(GL_TIME_ELAPSED);
+  const TimerId id = nextTimer_++;
+  pending_.emplace_back(id, std::move(activeQuery_));
+  if (pending_.size() > kMaxPendingTimers) pending_.pop_front(); // dropped: its id reads 0.0
+  return id;
+}
+
+std::optional<double> GlBackend::timerResult(TimerId id) {
+  const auto it = std::lower_bound(pending_.begin(), pending_.end(), id,
+                                   [](const auto& span, TimerId key) { return span.first < key; });
+  if (it == pending_.end() || it->first != id) return 0.0; // 0, unknown, returned before or dropped
+  GLuint available = GL_FALSE;
+  glGetQueryObjectuiv(it->second.get(), GL_QUERY_RESULT_AVAILABLE, &available);
+  if (available != GL_TRUE) return std::nullopt;
+  GLuint64 nanoseconds = 0;
+  glGetQueryObjectui64v(it->second.get(), GL_QUERY_RESULT_NO_WAIT, &nanoseconds);
+  freeQueries_.push_back(std::move(it->second));
+  pending_.erase(it);
+  return static_cast<double>(nanoseconds) * 1e-6;
 }
 
 int GlBackend::max3DTextureSize() const {

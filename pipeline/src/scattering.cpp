@@ -7,6 +7,7 @@
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/resample.h>
 #include <crep/gpu/checks.h>
+#include <crep/gpu/frame_timers.h>
 #include <crep/gpu/gl.h>
 #include <crep/gpu/gl_backend.h>
 #include <crep/gpu/gl_state.h>
@@ -28,6 +29,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <map>
 #include <numbers>
 #include <numeric>
@@ -400,6 +402,20 @@ struct Scattering::Impl {
   std::optional<RectifiedMarchPass> march;      ///< ... and the tree march
   std::optional<EpipolarSamplingPass> sampling; ///< Sampling::Epipolar
   bool running = false;                         ///< inside run(): a call from drawCasters is refused
+  /// Deferred stage timings (stageTimings, not blockingTimings): the spans of the frames waiting for their
+  /// GPU times, and what each frame reports with them.
+  struct FrameRecord {
+    std::uint64_t frame = 0;
+    std::vector<Stage> stages;    ///< as its FrameResult::stages, one per span
+    std::vector<int> stageLights; ///< per stage: its LightResult's index, or -1
+    std::size_t lights = 0;       ///< its LightResult count
+  };
+  gpu::FrameTimers frameTimers;
+  std::deque<FrameRecord> frameRecords; ///< oldest first, the frames frameTimers holds
+  std::vector<int> spanLights;          ///< this frame's spans so far: their LightResult's index, or -1
+  int currentLight = -1;                ///< inside a local light's stages: its LightResult's index
+  std::uint64_t frames = 0;             ///< run() calls so far
+  void reportTimes(FrameResult& r);
   /// Local lights: one light's scattering (RGBA32F, width x height) and the pass adding it to the output,
   /// made on the first frame with local lights; their fallback's perspective shadow map.
   gpu::Texture localScattering;
@@ -485,7 +501,8 @@ struct Scattering::Impl {
   }
 
   /// Runs `work` as one stage: with stageTimings, the backend's GPU timer (GL_TIME_ELAPSED, Vulkan
-  /// timestamps) and the wall clock, both ended by the backend's finish.
+  /// timestamps) and the wall clock, both ended by the backend's finish with blockingTimings; without, the
+  /// span ended without waiting (its id kept for a later frame's gpuTimes) and the wall clock of recording.
   template <class Work>
   Stage timedStage(const char* name, const Work& work) {
     if (!info.stageTimings) {
@@ -500,7 +517,13 @@ struct Scattering::Impl {
       backend->cancelTimer(); // GL: no GL_TIME_ELAPSED query left active in the caller's context
       throw;
     }
-    const double gpu = backend->endTimer();
+    double gpu = 0.0;
+    if (info.blockingTimings) {
+      gpu = backend->endTimer();
+    } else {
+      frameTimers.add(backend->endTimerDeferred());
+      spanLights.push_back(currentLight);
+    }
     const std::chrono::duration<double, std::milli> wall = std::chrono::steady_clock::now() - start;
     return {name, gpu, wall.count()};
   }
@@ -595,21 +618,61 @@ Scattering::FrameResult Scattering::run(const FrameAttribs& f) {
   // (docs/GL_STATE.md), and the object ready for the next frame. The raster state is restored by the
   // depth passes' own scopes.
   m.running = true;
+  const std::uint64_t frame = m.frames++;
   struct OnExit {
     Impl& m;
     ~OnExit() {
       m.backend->cancelTimer();
       if (m.gl) gl::unbindPassState(8);
       m.running = false;
+      m.currentLight = -1;
     }
   } onExit{m};
   try {
-    return runFrame(f);
+    FrameResult r = runFrame(f);
+    r.frame = frame;
+    if (m.info.stageTimings && !m.info.blockingTimings) m.reportTimes(r);
+    return r;
   } catch (...) {
-    // Raised during this call (by a pass or the caller's callback): not left to the caller.
+    // Raised during this call (by a pass or the caller's callback): not left to the caller. The frame's
+    // spans are never reported.
+    m.frameTimers.discardFrame();
+    m.spanLights.clear();
     if (m.gl) gl::drainErrors();
     throw;
   }
+}
+
+double Scattering::GpuTimes::totalMilliseconds() const {
+  double sum = 0.0;
+  for (const Stage& s : stages)
+    sum += s.gpuMilliseconds;
+  return sum;
+}
+
+// The frame's spans wait for their GPU times; the latest earlier frame whose times have all arrived is
+// reported (polled, never waited for).
+void Scattering::Impl::reportTimes(FrameResult& r) {
+  const std::optional<gpu::FrameTimers::Times> arrived = frameTimers.poll(*backend); // earlier frames only
+  frameTimers.endFrame(r.frame);
+  frameRecords.push_back({r.frame, r.stages, std::move(spanLights), r.localLights.size()});
+  spanLights.clear();
+  if (frameRecords.size() > gpu::FrameTimers::kMaxPendingFrames) frameRecords.pop_front();
+  if (!arrived) return;
+  const auto it = std::find_if(frameRecords.begin(), frameRecords.end(),
+                               [&](const FrameRecord& record) { return record.frame == arrived->frame; });
+  if (it == frameRecords.end()) return;
+  GpuTimes times;
+  times.frame = it->frame;
+  times.stages = std::move(it->stages);
+  times.localLights.assign(it->lights, 0.0);
+  for (std::size_t i = 0; i < times.stages.size() && i < arrived->milliseconds.size(); ++i) {
+    times.stages[i].gpuMilliseconds = arrived->milliseconds[i];
+    const int light = it->stageLights[i];
+    if (light >= 0) times.localLights[static_cast<std::size_t>(light)] += arrived->milliseconds[i];
+  }
+  frameRecords.erase(frameRecords.begin(), it + 1);
+  r.gpuTimes = std::move(times);
 }
 
 void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
@@ -833,7 +896,7 @@ void Scattering::Impl::evaluatePixels(const FrameAttribs& f, FrameResult& r, con
       stage(r, "upscale", [&] { pass.upscale(s); });
       stage(r, "correct (full)", [&] { evaluateRays(f, d, 0, 0, &pass.upscaleCorrectionList(), true); });
     }
-    if (info.stageTimings) {
+    if (info.stageTimings && info.blockingTimings) { // a read-back: it waits for the GPU
       const EpipolarSamplingPass::Statistics st = pass.statistics();
       r.sampling = {st.validSamples, st.marchedSamples, st.correctedPixels, st.correctedFullPixels};
     }
@@ -1048,6 +1111,7 @@ void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, cons
     return;
   }
   LocalLightRun run{*this, f, r, light, lightClipFromWorld, given, texture, result};
+  currentLight = static_cast<int>(r.localLights.size()); // its deferred spans are its LightResult's
   if (rect.projective())
     run.projective(rect);
   else if (info.localLightFallback == LocalLightFallback::Epipolar && info.epipolarRegions >= 2 &&
@@ -1055,6 +1119,7 @@ void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, cons
     run.epipolar();
   else // the world-space march against the light's perspective map (the reference)
     run.worldMarch(run.perspectiveMap(), glm::dvec2(0.0), -1.0, "local light: world-space march");
+  currentLight = -1;
   addLocalScattering(f);
   r.localLights.push_back(result);
 }

@@ -491,11 +491,39 @@ void FroxelFog::validate(const FrameAttribs& f, std::string_view ownerName) cons
   if (f.previousCamera) froxelDepthRange(info_.grid, *f.previousCamera, "FroxelFog::CreateInfo");
 }
 
+namespace {
+
+/// Timings' fields in the order of FroxelFog's stages.
+constexpr std::array<double FroxelFog::Timings::*, 5> kStageTimes = {
+    &FroxelFog::Timings::esm, &FroxelFog::Timings::lighting, &FroxelFog::Timings::accumulate,
+    &FroxelFog::Timings::temporal, &FroxelFog::Timings::apply};
+enum FogStage : std::size_t { kEsm, kLighting, kAccumulate, kTemporal, kApply };
+
+} // namespace
+
+void FroxelFog::reportTimes(std::uint64_t run, const std::array<gpu::TimerId, 5>& spans) {
+  const std::optional<gpu::FrameTimers::Times> arrived = timers_.poll(*backend_); // earlier runs only
+  for (const gpu::TimerId id : spans)
+    timers_.add(id);
+  timers_.endFrame(run);
+  if (!arrived) return;
+  Timings t;
+  t.run = arrived->frame;
+  for (std::size_t k = 0; k < kStageTimes.size() && k < arrived->milliseconds.size(); ++k)
+    t.*kStageTimes[k] = arrived->milliseconds[k];
+  timings_ = t;
+}
+
 void FroxelFog::run(const FrameAttribs& f) {
+  const std::uint64_t run = runs_++;
   validate(f);
-  timings_ = Timings{};
-  // The backend's GPU timer per stage (GL_TIME_ELAPSED, Vulkan timestamps).
-  const auto stage = [&](double& ms, const auto& body) {
+  if (info_.timings && info_.blockingTimings) {
+    timings_ = Timings{};
+    timings_->run = run;
+  }
+  std::array<gpu::TimerId, 5> spans{}; // deferred timings: 0 for stages not run
+  // The backend's GPU timer per stage (GL_TIME_ELAPSED, Vulkan timestamps), waited for with blockingTimings.
+  const auto stage = [&](FogStage k, const auto& body) {
     if (!info_.timings) return body();
     backend_->beginTimer();
     try {
@@ -504,12 +532,15 @@ void FroxelFog::run(const FrameAttribs& f) {
       backend_->cancelTimer(); // GL: no GL_TIME_ELAPSED query left active in the caller's context
       throw;
     }
-    ms = backend_->endTimer();
+    if (info_.blockingTimings)
+      (*timings_).*kStageTimes[k] = backend_->endTimer();
+    else
+      spans[k] = backend_->endTimerDeferred();
   };
   const glm::dvec3 j = jitter(f.frameIndex);
   if (f.mode == Mode::Esm) {
-    if (f.shadowMap != 0) stage(timings_.esm, [&] { esm_.run({f.shadowMap, f.lightClipFromWorld}); });
-    stage(timings_.lighting, [&] {
+    if (f.shadowMap != 0) stage(kEsm, [&] { esm_.run({f.shadowMap, f.lightClipFromWorld}); });
+    stage(kLighting, [&] {
       FroxelLightingPass::FrameAttribs a;
       a.camera = f.camera;
       a.light = f.light;
@@ -521,13 +552,13 @@ void FroxelFog::run(const FrameAttribs& f) {
       a.output = current_.id();
       lighting_.run(a);
     });
-    stage(timings_.accumulate, [&] { accumulate_.run({f.camera, f.medium, j, current_.id()}); });
+    stage(kAccumulate, [&] { accumulate_.run({f.camera, f.medium, j, current_.id()}); });
   }
   glm::dvec3 offset = j;
   volume_ = current_.id();
   if (info_.temporal.historyWeight > 0.0) {
     const int out = latest_ == 0 ? 1 : 0;
-    stage(timings_.temporal, [&] {
+    stage(kTemporal, [&] {
       FroxelTemporalPass::FrameAttribs a;
       a.camera = f.camera;
       a.previousCamera = latest_ >= 0 ? f.previousCamera : nullptr;
@@ -541,8 +572,8 @@ void FroxelFog::run(const FrameAttribs& f) {
     volume_ = history_[static_cast<std::size_t>(out)].id();
     offset = glm::dvec3(0.0); // the blended volume holds its values at the cell centres
   }
-  if (f.output != 0)
-    stage(timings_.apply, [&] { apply_.run({f.camera, f.cameraDepth, volume_, offset, f.output}); });
+  if (f.output != 0) stage(kApply, [&] { apply_.run({f.camera, f.cameraDepth, volume_, offset, f.output}); });
+  if (info_.timings && !info_.blockingTimings) reportTimes(run, spans);
 }
 
 } // namespace crep

@@ -35,6 +35,7 @@ Scattering::CreateInfo samplingInfo(Scattering::Method method, Scattering::Sampl
   info.mapSize = kSamplingMap;
   info.method = method;
   info.sampling = sampling;
+  info.blockingTimings = true; // FrameResult::sampling's counts are read back in the frame
   return info;
 }
 

@@ -9,6 +9,7 @@
 #include "common/gl_util.h"
 
 #include <crep/core/error.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/gpu/shader_library.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/postfx/froxel_fog.h>
@@ -689,7 +690,9 @@ TEST_CASE("FroxelFog GL: the default grid's memory and per-stage GPU timings") {
   const gl::Handle output = gl::createTexture2D(GL_RGBA32F, kW, kH);
   FroxelFog::CreateInfo info; // 160 x 90 x 64, RGBA16F, temporal on
   info.timings = true;
+  info.blockingTimings = true; // the last run's times, waited for
   FroxelFog fog(info);
+  CHECK_FALSE(fog.timings().has_value());
   for (int i = 0; i < 2; ++i) {
     FroxelFog::FrameAttribs f;
     f.camera = &s.camera;
@@ -703,7 +706,10 @@ TEST_CASE("FroxelFog GL: the default grid's memory and per-stage GPU timings") {
     f.previousCamera = i == 0 ? nullptr : &s.camera;
     fog.run(f);
   }
-  const FroxelFog::Timings& t = fog.timings();
+  REQUIRE(fog.timings().has_value());
+  const FroxelFog::Timings t = *fog.timings();
+  CHECK(t.run == 1);
+  CHECK(fog.runCount() == 2);
   // three 160 x 90 x 64 RGBA16F volumes (current + two history) and two R32F ESM textures of (128 / 4)^2
   const std::size_t volume = std::size_t(160) * 90 * 64 * 8;
   MESSAGE(std::string(std::string("default grid: ") + std::to_string(fog.memoryBytes()) +
@@ -722,6 +728,55 @@ TEST_CASE("FroxelFog GL: the default grid's memory and per-stage GPU timings") {
   for (float v : img.data())
     bad += std::isfinite(v) ? 0 : 1;
   CHECK(bad == 0);
+}
+
+TEST_CASE("FroxelFog GL: timings without blockingTimings never wait and arrive with a later run") {
+  CREP_REQUIRE_GL();
+  const Scene s;
+  const Image depth = test::groundDepth(s.camera, kW, kH);
+  const gl::Handle depthTexture = uploadR32F(depth), shadowTexture = uploadR32F(s.shadow);
+  const gl::Handle output = gl::createTexture2D(GL_RGBA32F, kW, kH);
+  gpu::GlBackend backend;
+  FroxelFog::CreateInfo info;
+  info.grid.depth = 32;
+  info.timings = true; // blockingTimings false: the default
+  info.backend = &backend;
+  FroxelFog fog(info);
+  const auto run = [&](int i) {
+    FroxelFog::FrameAttribs f;
+    f.camera = &s.camera;
+    f.light = &s.light;
+    f.medium = &s.medium;
+    f.cameraDepth = depthTexture.get();
+    f.shadowMap = shadowTexture.get();
+    f.lightClipFromWorld = s.lightClipFromWorld;
+    f.output = output.get();
+    f.frameIndex = i;
+    f.previousCamera = i == 0 ? nullptr : &s.camera;
+    fog.run(f);
+  };
+  run(0);
+  // Nothing read in the run: its five spans (ESM, lighting, accumulation, temporal, apply) wait.
+  CHECK_FALSE(fog.timings().has_value());
+  CHECK(backend.pendingTimers() == 5);
+  GLint active = -1;
+  glGetQueryiv(GL_TIME_ELAPSED, GL_CURRENT_QUERY, &active);
+  CHECK(active == 0);
+  glFinish(); // the test waits, so that run 0's times are there for run 1
+  run(1);
+  REQUIRE(fog.timings().has_value());
+  const FroxelFog::Timings t = *fog.timings();
+  CHECK(t.run == 0);
+  CHECK(fog.runCount() == 2);
+  for (const double ms : {t.esm, t.lighting, t.accumulate, t.temporal, t.apply}) {
+    CHECK(std::isfinite(ms));
+    CHECK(ms >= 0.0);
+  }
+  CHECK(backend.pendingTimers() == 5); // run 1's
+  glFinish();
+  run(2);
+  REQUIRE(fog.timings().has_value());
+  CHECK(fog.timings()->run == 1);
 }
 
 TEST_CASE("FroxelFog GL: Mode::Prefiltered with temporal reprojection converges and does not flicker") {

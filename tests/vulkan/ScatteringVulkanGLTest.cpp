@@ -165,6 +165,7 @@ TEST_CASE("Vulkan backend: crep::Scattering at a reduced evaluation scale gives 
       Scattering::CreateInfo info;
       info.mapSize = 512;
       info.evaluationScale = scale;
+      info.blockingTimings = true; // the stages' GPU times in the frame
       const FrameOutput a = frameOn(vk, in, info), b = frameOn(gl, in, info);
       long long nonFinite = 0;
       const double e = relativeRmse(a.rgba, b.rgba, nonFinite);
@@ -210,6 +211,7 @@ TEST_CASE("Vulkan backend: crep::Scattering with Yusov's epipolar sampling gives
         info.epipolarSampling.slices = 256;
         info.epipolarSampling.samples = 128;
         info.epipolarSampling.downscale = downscale;
+        info.blockingTimings = true; // FrameResult::sampling's counts are read back in the frame
         const FrameOutput a = frameOn(vk, in, info), b = frameOn(gl, in, info);
         long long nonFinite = 0;
         const double e = relativeRmse(a.rgba, b.rgba, nonFinite);

@@ -645,6 +645,7 @@ MethodOutput runFroxelPrefilter(FrameInputs& frame, const MethodSettings& settin
   info.rectify = settings.rectify;
   info.prefilter = settings.prefilter;
   info.epipoleBlock.steps = settings.steps;
+  info.blockingTimings = true; // the tool prints each stage's time, GPU work included
   auto scattering = out.timings.time("setup", [&] { return std::make_unique<Scattering>(info); });
   const Scattering::ShadowMap shadow{frame.shadowMap.get(), frame.lightClipFromWorld, frame.shadowBias};
   const Scattering::FroxelTarget target{fog->currentVolume(), fogInfo.grid, fog->jitter(0)};
@@ -700,6 +701,7 @@ Scattering::CreateInfo frontDoorCreateInfo(const FrameInputs& frame, const Metho
   info.epipoleBlockMaxPixels = settings.epipoleBlockMaxPixels;
   // --scale is the per-pixel evaluation's (compare runs the epipolar methods beside it at full size).
   info.evaluationScale = sampling == Scattering::Sampling::PerPixel ? settings.scale : 1.0;
+  info.blockingTimings = true; // the tool prints each stage's time, GPU work included
   return info;
 }
 

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -55,6 +56,9 @@ struct ComputeLimits {
 /// name). 0 is none.
 using TextureId = std::uint32_t;
 using BufferId = std::uint32_t;
+/// A span of GPU time ended without waiting (Backend::endTimerDeferred); each span its own id, never
+/// reused; 0 is none.
+using TimerId = std::uint64_t;
 
 enum class ResourceKind : std::uint8_t { SampledTexture, StorageImage, UniformBuffer, StorageBuffer };
 enum class Filter : std::uint8_t { Nearest, Linear }; ///< sampled textures; always clamped to the edge
@@ -167,12 +171,23 @@ public:
   /// GPU time of a span of calls (stage timings): beginTimer(), the calls, then endTimer(), which finishes
   /// and returns the GPU milliseconds between the two (0 where the device measures none). cancelTimer()
   /// ends a span without a result (a stage that threw). Default: no GPU timer (endTimer() finishes, 0).
+  /// Spans do not nest: beginTimer() during a span cancels it.
   virtual void beginTimer() {}
   virtual double endTimer() {
     finish();
     return 0.0;
   }
   virtual void cancelTimer() noexcept {}
+  /// Ends the span begun by beginTimer() without waiting (no finish, no read): its id for timerResult(), 0
+  /// where the backend measures none (no span begun included). Default: cancelTimer(), 0.
+  virtual TimerId endTimerDeferred() {
+    cancelTimer();
+    return 0;
+  }
+  /// Never waits: the span's GPU milliseconds once they are available, std::nullopt while pending. A
+  /// result is forgotten once returned; 0, an unknown id, one returned before or one the backend dropped
+  /// (it may keep a bounded number pending) give 0.0. Default: 0.0.
+  virtual std::optional<double> timerResult(TimerId) { return 0.0; }
 };
 
 class Buffer;

@@ -2,10 +2,14 @@
 // engine's own GL texture or buffer is used by its name. State left after each call: docs/BACKENDS.md.
 #pragma once
 
+#include <cstddef>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <crep/gpu/backend.h>
 #include <crep/gpu/gl.h>
@@ -38,15 +42,28 @@ public:
   /// every unit and binding it used unbound (what the library's GL passes leave).
   void dispatch(const Dispatch& dispatch) override;
   void finish() override;
-  /// GL_TIME_ELAPSED (some drivers measure nothing for compute work).
+  /// GL_TIME_ELAPSED queries (some drivers measure nothing for compute work), one active at a time: spans do
+  /// not nest, and the caller's own GL_TIME_ELAPSED query must not be active. cancelTimer() leaves none of
+  /// ours active.
   void beginTimer() override;
   double endTimer() override;
   void cancelTimer() noexcept override;
+  /// Ends the span's query (glEndQuery only); timerResult() polls GL_QUERY_RESULT_AVAILABLE and reads the
+  /// result only once available (never glFinish, never a blocking read). A read query is reused.
+  TimerId endTimerDeferred() override;
+  std::optional<double> timerResult(TimerId id) override;
+  /// Most deferred spans pending (ended, result not yet returned): ending one more drops the oldest, whose
+  /// id then reads 0.0.
+  static constexpr std::size_t kMaxPendingTimers = 1024;
+  /// Deferred spans pending now, at most kMaxPendingTimers.
+  std::size_t pendingTimers() const noexcept { return pending_.size(); }
 
 private:
   gl::Handle nearest_, linear_;
-  std::optional<gl::GpuTimer> timer_;
-  bool timing_ = false;
+  gl::Handle activeQuery_;                             ///< the span begun by beginTimer(); empty: none
+  std::vector<gl::Handle> freeQueries_;                ///< GL_TIME_ELAPSED queries read, to reuse
+  std::deque<std::pair<TimerId, gl::Handle>> pending_; ///< ended deferred spans, oldest (lowest id) first
+  TimerId nextTimer_ = 1;
   std::map<std::string, gl::Handle> programs_; ///< by program and defines
   gl::Handle& program(const std::string& path, std::span<const ShaderDefine> defines);
 };

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -16,10 +17,10 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>
+#include <crep/gpu/backend.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
@@ -103,8 +104,12 @@ public:
     Sampling sampling = Sampling::PerPixel;
     /// Options of Sampling::Epipolar (crep/epipolar/epipolar_sampling.h); evaluationScale must then be 1.
     EpipolarSamplingOptions epipolarSampling;
-    /// Time every stage (FrameResult::stages): a query and a glFinish per stage, which stall the pipeline.
+    /// Time every stage with the backend's GPU timer (FrameResult::stages, gpuTimes; pipeline/README.md).
     bool stageTimings = true;
+    /// With stageTimings, wait for each stage's GPU time: a finish and a read per stage, which stall the
+    /// pipeline; for tools and benchmarks (Stage::gpuMilliseconds in the same frame). false: run() never
+    /// waits for the GPU (no finish, no read); the times arrive in a later frame's FrameResult::gpuTimes.
+    bool blockingTimings = false;
     int ownShadowMapSize = 2048; ///< standard shadow map rendered with drawCasters on fallback frames
     /// lcm(rectify.splits * P, epipolarRegions * P), P = prefilter.regionsPerSplit (16 with the defaults).
     int mapSizeMultiple() const;
@@ -173,20 +178,45 @@ public:
     bool epipolar = false;         ///< a Fallback light prefiltered on its epipolar layout, else marched
     bool preRenderedMap = false;   ///< its shadow input was the given perspective map, not drawCasters
     std::string message;           ///< the rectification's explanation
-    double wallMilliseconds = 0.0; ///< CPU wall clock of its stages (0 without stageTimings)
-    double gpuMilliseconds = 0.0;  ///< the backend's GPU timer over its stages
+    double wallMilliseconds = 0.0; ///< its stages' Stage::wallMilliseconds summed (0 without stageTimings)
+    /// With blockingTimings the backend's GPU timer over its stages; else 0: a later frame's
+    /// GpuTimes::localLights has it.
+    double gpuMilliseconds = 0.0;
   };
 
   enum class Layout { Projective, Epipolar };
 
   struct Stage {
     std::string name;
-    double gpuMilliseconds = 0.0;  ///< the backend's GPU timer (some GL drivers report 0)
-    double wallMilliseconds = 0.0; ///< CPU wall clock of the stage, ended by the backend's finish()
+    /// With blockingTimings the backend's GPU timer (some GL drivers report 0); else 0: a later frame's
+    /// FrameResult::gpuTimes has it.
+    double gpuMilliseconds = 0.0;
+    /// CPU wall clock of the stage: with blockingTimings ended by the backend's finish (the GPU's work
+    /// included); else the time to record it.
+    double wallMilliseconds = 0.0;
+  };
+
+  /// The GPU times of one earlier frame, arrived without waiting (stageTimings, not blockingTimings).
+  struct GpuTimes {
+    std::uint64_t frame = 0; ///< the FrameResult::frame they belong to, earlier than the reporting frame
+    /// That frame's stages as its FrameResult::stages (names, order, wallMilliseconds), gpuMilliseconds
+    /// filled: the backend's GPU timer (0 where it measures none).
+    std::vector<Stage> stages;
+    /// GPU milliseconds of that frame's local lights, one per LightResult in its order (0 for Empty).
+    std::vector<double> localLights;
+    double totalMilliseconds() const; ///< the stages' gpuMilliseconds summed
   };
 
   /// Without a directional light the directional members keep their defaults; stages start "transmittance".
   struct FrameResult {
+    /// This run's index: the run() calls of the object before it (those that threw included).
+    std::uint64_t frame = 0;
+    /// stageTimings without blockingTimings: the GPU times of the latest earlier frame whose stages' times
+    /// have all arrived (never waited for), or std::nullopt when none arrived since the last report. A
+    /// frame is reported once at most: earlier ones that arrived with it are skipped, and at most
+    /// gpu::FrameTimers::kMaxPendingFrames wait. Always std::nullopt with blockingTimings or without
+    /// stageTimings.
+    std::optional<GpuTimes> gpuTimes;
     Layout layout = Layout::Projective;
     Rectification rectification;     ///< the decision (reason, measure, threshold when not projective)
     double epipoleBlockRadius = 0.0; ///< pixels, after epipoleBlockMaxPixels; 0 without a block
@@ -194,7 +224,8 @@ public:
     /// Epipolar frames: the standard shadow map used (valid until the next run()); texture 0 if projective.
     ShadowMap shadowMap;
     std::vector<LightResult> localLights; ///< spots, then the faces of each point light
-    /// Sampling::Epipolar with stageTimings: the frame's sample and correction counts (zeros otherwise).
+    /// Sampling::Epipolar with stageTimings and blockingTimings: the frame's sample and correction counts,
+    /// read back from the GPU (zeros otherwise).
     struct SamplingStatistics {
       int validSamples = 0;        ///< epipolar samples on screen
       int marchedSamples = 0;      ///< evaluated by the method (the rest interpolated)

@@ -7,15 +7,17 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string_view>
 
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/frame_timers.h>
+#include <crep/gpu/gl.h>
 #include <crep/postfx/froxel_fog.h>
 #include <crep/scatter/froxel_grid.h>
 
@@ -236,9 +238,12 @@ public:
     glm::dvec3 ambient{0.0}; ///< isotropic ambient radiance per channel, >= 0 (default 0)
     TemporalOptions temporal;
     std::uint32_t format = 0x881A; ///< GL_RGBA16F (default) or GL_RGBA32F
-    /// Per-stage GPU times by the backend's timer (GL_TIME_ELAPSED, Vulkan timestamps; a stall per stage:
-    /// tools only).
+    /// Per-stage GPU times by the backend's timer (GL_TIME_ELAPSED, Vulkan timestamps): timings().
     bool timings = false;
+    /// With timings, wait for each stage's GPU time: a finish and a read per stage, which stall the
+    /// pipeline; for tools (timings() the last run's). false: run() never waits for the GPU; timings() holds
+    /// an earlier run's once its times have arrived.
+    bool blockingTimings = false;
     gpu::Backend* backend = nullptr; ///< runs every pass (outlives it); null: a GL backend of its own
   };
   struct FrameAttribs {
@@ -273,11 +278,17 @@ public:
   /// The integrated volume of the last run() (blended with temporal), sample offset 0, for the engine.
   std::uint32_t volume() const noexcept { return volume_; }
   std::size_t memoryBytes() const noexcept;
-  /// GPU milliseconds of the last run's stages (CreateInfo::timings; 0 for stages not run).
+  /// GPU milliseconds of one run's stages (0 for stages not run, or where the backend measures none).
   struct Timings {
+    std::uint64_t run = 0; ///< the run they belong to: the run() calls before it
     double esm = 0.0, lighting = 0.0, accumulate = 0.0, temporal = 0.0, apply = 0.0;
   };
-  const Timings& timings() const noexcept { return timings_; }
+  /// CreateInfo::timings: with blockingTimings the last run's; without, those of the latest earlier run
+  /// whose times have all arrived (never waited for; kept until a later run's arrive), std::nullopt until
+  /// one has. std::nullopt without timings.
+  const std::optional<Timings>& timings() const noexcept { return timings_; }
+  /// run() calls so far (those that threw included): the next run's Timings::run.
+  std::uint64_t runCount() const noexcept { return runs_; }
 
 private:
   CreateInfo info_;
@@ -292,7 +303,12 @@ private:
   std::array<gpu::Texture, 2> history_;
   int latest_ = -1; ///< index of history_ written last, -1 = none
   std::uint32_t volume_ = 0;
-  Timings timings_;
+  std::optional<Timings> timings_;
+  std::uint64_t runs_ = 0;
+  gpu::FrameTimers timers_; ///< timings without blockingTimings: the runs waiting for their GPU times
+  /// Without blockingTimings: this run's spans (esm, lighting, accumulate, temporal, apply; 0 = not run)
+  /// wait, and the latest earlier run whose times have all arrived becomes timings().
+  void reportTimes(std::uint64_t run, const std::array<gpu::TimerId, 5>& spans);
 };
 
 } // namespace crep
