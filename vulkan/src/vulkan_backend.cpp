@@ -380,7 +380,20 @@ struct VulkanBackend::Impl {
   std::vector<Retired> retired;
   std::vector<std::vector<DescriptorPool>> framePools; ///< per frame slot (pools mode)
   VkSampler nearest = VK_NULL_HANDLE, linear = VK_NULL_HANDLE;
-  VkQueryPool timestamps = VK_NULL_HANDLE;     ///< two timestamps (beginTimer, endTimer); null without them
+  /// Two timestamps per span (beginTimer, endTimer or endTimerDeferred), kSpans spans as a ring; null
+  /// without timestamps.
+  VkQueryPool timestamps = VK_NULL_HANDLE;
+  static constexpr std::uint32_t kSpans = 1024;
+  TimerId lastSpan = 0;          ///< the newest span's id; its queries are 2 (id % kSpans) and the next
+  std::uint64_t submissions = 0; ///< of ownCmd, each waited for
+  /// Deferred spans not yet read: the frame they were recorded in (0: outside frames) and, outside frames,
+  /// the submission that will carry them.
+  struct PendingSpan {
+    std::uint64_t frame = 0;
+    std::uint64_t submission = 0;
+  };
+  std::map<TimerId, PendingSpan> pendingSpans;
+  double spanMilliseconds(TimerId id, bool wait);
   std::uint32_t timestampBits = 0;             ///< the queue family's timestampValidBits
   bool timing = false;                         ///< a span's first timestamp is recorded
   bool pushDescriptors = false;                ///< vkCmdPushDescriptorSetKHR, else sets from descriptorPools
@@ -669,7 +682,7 @@ void VulkanBackend::Impl::createObjects() {
     VkQueryPoolCreateInfo qi{};
     qi.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
     qi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    qi.queryCount = 2;
+    qi.queryCount = 2 * kSpans;
     check(vk.vkCreateQueryPool(device, &qi, allocator, &timestamps), "vkCreateQueryPool (timestamps)");
   }
   for (auto [filter, sampler] :
@@ -850,6 +863,7 @@ void VulkanBackend::Impl::submit() {
   si.commandBufferCount = 1;
   si.pCommandBuffers = &ownCmd;
   check(vk.vkQueueSubmit(queue, 1, &si, fence), "vkQueueSubmit");
+  ++submissions;
   check(vk.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
   check(vk.vkResetFences(device, 1, &fence), "vkResetFences");
   check(vk.vkResetCommandBuffer(ownCmd, 0), "vkResetCommandBuffer");
@@ -1629,12 +1643,28 @@ bool VulkanBackend::inFrame() const {
   return impl_->inFrame;
 }
 
+double VulkanBackend::Impl::spanMilliseconds(TimerId id, bool wait) {
+  const std::uint32_t first = 2 * static_cast<std::uint32_t>(id % kSpans);
+  std::uint64_t ticks[2] = {0, 0};
+  check(vk.vkGetQueryPoolResults(device, timestamps, first, 2, sizeof ticks, ticks, sizeof ticks[0],
+                                 VK_QUERY_RESULT_64_BIT |
+                                     (wait ? static_cast<VkQueryResultFlags>(VK_QUERY_RESULT_WAIT_BIT) : 0u)),
+        "vkGetQueryPoolResults (timestamps)");
+  const std::uint64_t mask = timestampBits >= 64 ? ~0ull : (1ull << timestampBits) - 1ull;
+  const std::uint64_t elapsed = (ticks[1] - ticks[0]) & mask; // a wrapped counter too
+  return static_cast<double>(elapsed) * static_cast<double>(properties.limits.timestampPeriod) * 1e-6;
+}
+
 void VulkanBackend::beginTimer() {
   Impl& v = *impl_;
   if (v.timestamps == VK_NULL_HANDLE) return;
   v.begin();
-  v.vk.vkCmdResetQueryPool(v.cmd, v.timestamps, 0, 2);
-  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, v.timestamps, 0);
+  // A span's two queries in the ring, reset in the command stream before its first timestamp.
+  const TimerId id = ++v.lastSpan;
+  v.pendingSpans.erase(id - std::min<TimerId>(id, Impl::kSpans)); // its slot's previous span: dropped
+  const std::uint32_t first = 2 * static_cast<std::uint32_t>(id % Impl::kSpans);
+  v.vk.vkCmdResetQueryPool(v.cmd, v.timestamps, first, 2);
+  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, v.timestamps, first);
   v.timing = true;
 }
 
@@ -1646,20 +1676,39 @@ double VulkanBackend::endTimer() {
     return 0.0;
   }
   v.begin();
-  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, v.timestamps, 1);
+  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, v.timestamps,
+                           2 * static_cast<std::uint32_t>(v.lastSpan % Impl::kSpans) + 1);
   v.timing = false;
   v.submit();
-  std::uint64_t ticks[2] = {0, 0};
-  check(v.vk.vkGetQueryPoolResults(v.device, v.timestamps, 0, 2, sizeof ticks, ticks, sizeof ticks[0],
-                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-        "vkGetQueryPoolResults (timestamps)");
-  const std::uint64_t mask = v.timestampBits >= 64 ? ~0ull : (1ull << v.timestampBits) - 1ull;
-  const std::uint64_t elapsed = (ticks[1] - ticks[0]) & mask; // a wrapped counter too
-  return static_cast<double>(elapsed) * static_cast<double>(v.properties.limits.timestampPeriod) * 1e-6;
+  return v.spanMilliseconds(v.lastSpan, true);
+}
+
+TimerId VulkanBackend::endTimerDeferred() {
+  Impl& v = *impl_;
+  if (!v.timing) return 0;
+  v.begin();
+  v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, v.timestamps,
+                           2 * static_cast<std::uint32_t>(v.lastSpan % Impl::kSpans) + 1);
+  v.timing = false;
+  v.pendingSpans[v.lastSpan] = {v.inFrame ? v.frameIndex : 0, v.submissions + 1};
+  return v.lastSpan;
+}
+
+std::optional<double> VulkanBackend::timerResult(TimerId id) {
+  Impl& v = *impl_;
+  const auto it = v.pendingSpans.find(id);
+  if (it == v.pendingSpans.end()) return 0.0; // none, read, or dropped (its slot reused)
+  // Its queries hold its timestamps only once the commands that reset and wrote them have completed: the
+  // engine's frame (Frame::completed), or the backend's own submission (each one waited for). Never waits.
+  const bool done =
+      it->second.frame != 0 ? it->second.frame <= v.completedFrame : it->second.submission <= v.submissions;
+  if (!done) return std::nullopt;
+  v.pendingSpans.erase(it);
+  return v.spanMilliseconds(id, false);
 }
 
 void VulkanBackend::cancelTimer() noexcept {
-  impl_->timing = false; // the next span resets the pool before its first timestamp
+  impl_->timing = false; // the span's queries stay unread; its slot is reset when the ring comes round
 }
 
 } // namespace crep::gpu

@@ -147,9 +147,14 @@ public:
   std::vector<float> readTexture(TextureId texture) override;
   void dispatch(const Dispatch& dispatch) override;
   void finish() override;
-  /// Timestamp queries on the compute queue (0 where its family has no timestamp bits).
+  /// Timestamp queries on the compute queue (0 where its family has no timestamp bits), a ring of 1024
+  /// spans: a deferred span not read before 1024 newer ones began reads 0.0. A deferred span's result comes
+  /// once its frame has completed (Frame::completed, frameCompleted()) or, outside frames, once the
+  /// backend's own submission that carried it has been waited for.
   void beginTimer() override;
   double endTimer() override;
+  TimerId endTimerDeferred() override;
+  std::optional<double> timerResult(TimerId id) override;
   void cancelTimer() noexcept override;
 
   /// An engine's image, used where it is (docs/VULKAN_STATE.md, "The engine's images").
