@@ -102,8 +102,9 @@ TEST_CASE("FrameTimers: a frame's times once all its spans resolved, in the orde
   CHECK(b.reads == 0);
 }
 
-TEST_CASE("FrameTimers: the latest resolved frame, earlier ones skipped; a pending span stops its frame's "
-          "asking") {
+TEST_CASE(
+    "FrameTimers: the latest resolved frame, earlier ones skipped, and a pending span stops its frame's "
+    "asking") {
   FakeTimerBackend b;
   gpu::FrameTimers timers;
   const gpu::TimerId a = b.span(), c = b.span(), d = b.span(), e = b.span();
@@ -129,8 +130,9 @@ TEST_CASE("FrameTimers: the latest resolved frame, earlier ones skipped; a pendi
   CHECK_FALSE(timers.poll(b).has_value());
 }
 
-TEST_CASE("FrameTimers: a discarded frame's spans are never asked; beyond kMaxPendingFrames the oldest is "
-          "dropped") {
+TEST_CASE(
+    "FrameTimers: a discarded frame's spans are never asked, and beyond kMaxPendingFrames the oldest is "
+    "dropped") {
   FakeTimerBackend b;
   gpu::FrameTimers timers;
   const gpu::TimerId thrown = b.span();
