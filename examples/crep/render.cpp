@@ -6,6 +6,7 @@
 // sun has a light texture).
 #include "args.h"
 #include "atmosphere_frame.h"
+#include "backend_method.h"
 #include "commands.h"
 #include "contact_sheet.h"
 #include "frame_json.h"
@@ -13,7 +14,6 @@
 #include "methods.h"
 #include "options.h"
 #include "paths.h"
-#include "backend_method.h"
 #include "scene_frame.h"
 #include "timings.h"
 

@@ -11,9 +11,9 @@
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/gl.h>
 #include <crep/scatter/ray.h>
 
 #include <doctest/doctest.h>

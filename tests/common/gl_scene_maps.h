@@ -8,8 +8,8 @@
 #include "common/analytic_reference.h"
 #include "common/local_light_scene.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/gpu_march.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scatter/ray_scattering.h>

@@ -3,8 +3,8 @@
 // offsets).
 #pragma once
 
-#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
+#include <crep/gpu/gl.h>
 #include <crep/scatter/froxel_grid.h>
 
 #include <doctest/doctest.h>

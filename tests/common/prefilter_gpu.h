@@ -6,8 +6,8 @@
 
 #include "common/gl_util.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
+#include <crep/gpu/gl.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>

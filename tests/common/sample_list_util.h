@@ -6,8 +6,8 @@
 
 #include "common/analytic_reference.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
+#include <crep/gpu/gl.h>
 #include <crep/scatter/gpu_sample_list.h>
 
 #include <doctest/doctest.h>

@@ -12,8 +12,9 @@ namespace crep::test {
 
 inline const std::filesystem::path kSourceRoot = CREP_SOURCE_DIR;
 
-inline const std::vector<std::string> kLibraryModules = {
-    "core", "gpu", "rectify", "scatter", "epipolar", "prefilter", "pipeline", "atmosphere", "postfx", "vulkan"};
+inline const std::vector<std::string> kLibraryModules = {"core",     "gpu",       "rectify",  "scatter",
+                                                         "epipolar", "prefilter", "pipeline", "atmosphere",
+                                                         "postfx",   "vulkan"};
 
 /// The whole file, bytes as stored; empty if it cannot be read.
 inline std::string readSourceFile(const std::filesystem::path& p) {

@@ -9,12 +9,12 @@
 #include "common/map_agreement.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/shader_library.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 

@@ -11,10 +11,10 @@
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/shader_library.h>
 #include <crep/epipolar/epipolar_sampling.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/scatter/gpu_sample_list.h>
 
 #include <doctest/doctest.h>

@@ -9,9 +9,9 @@
 #include "common/image_check.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/gl.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>
 

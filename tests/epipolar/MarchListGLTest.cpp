@@ -12,10 +12,10 @@
 #include "common/local_light_scene.h"
 #include "common/sample_list_util.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scatter/gpu_sample_list.h>
 #include <crep/scenes/scene.h>

@@ -6,8 +6,8 @@
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>

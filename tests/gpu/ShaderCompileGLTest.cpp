@@ -3,8 +3,8 @@
 #include "common/gl_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/gl.h>
 #include <crep/gpu/shader_library.h>
 
 #include <doctest/doctest.h>

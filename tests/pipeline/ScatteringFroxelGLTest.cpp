@@ -11,8 +11,8 @@
 #include "pipeline/scattering_frame.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/prefilter/prefilter.h>

@@ -8,8 +8,8 @@
 #include "pipeline/scattering_frame.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/march.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/gpu_world_march.h>

@@ -7,8 +7,8 @@
 #include "common/prefilter_gpu.h"
 #include "pipeline/scattering_frame.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/scattering.h>
 
 #include <doctest/doctest.h>

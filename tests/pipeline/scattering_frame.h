@@ -6,9 +6,9 @@
 
 #include "common/analytic_reference.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scatter/gpu_world_march.h>

@@ -12,8 +12,8 @@
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/error.h>
-#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/gpu_march.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/vulkan/vulkan_backend.h>
 
 #include <doctest/doctest.h>

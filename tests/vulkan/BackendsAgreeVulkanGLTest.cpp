@@ -6,12 +6,12 @@
 #include "common/gl_fixture.h"
 #include "common/vulkan_fixture.h"
 
-#include <crep/gpu/gl.h>
-#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/gl.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
 #include <crep/scenes/scene_renderer.h>

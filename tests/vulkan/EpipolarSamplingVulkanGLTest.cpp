@@ -6,8 +6,8 @@
 #include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/gpu_epipolar_sampling.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/scenes/engine_frame.h>
 #include <crep/scenes/scene.h>
 #include <crep/vulkan/vulkan_backend.h>

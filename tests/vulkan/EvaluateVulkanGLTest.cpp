@@ -13,9 +13,9 @@
 #include "common/sample_list_util.h"
 #include "common/vulkan_fixture.h"
 
-#include <crep/gpu/gl_backend.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/gl_backend.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/scatter/light_texture.h>
 #include <crep/scenes/engine_frame.h>

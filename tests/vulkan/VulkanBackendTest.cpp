@@ -6,12 +6,12 @@
 #include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
 #include <crep/epipolar/epipolar.h>
 #include <crep/epipolar/gpu_march.h>
 #include <crep/epipolar/march.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/backend.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/rectify/rectify.h>

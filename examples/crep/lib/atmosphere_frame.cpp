@@ -5,8 +5,8 @@
 
 #include <crep/atmosphere/gpu_pass.h>
 #include <crep/core/error.h>
-#include <crep/gpu/shader_library.h>
 #include <crep/epipolar/gpu_march.h>
+#include <crep/gpu/shader_library.h>
 
 #include <epoxy/gl.h>
 

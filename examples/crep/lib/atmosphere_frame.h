@@ -15,8 +15,8 @@
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
 #include <crep/core/light.h>
+#include <crep/gpu/gl.h>
 
 #include <memory>
 #include <optional>

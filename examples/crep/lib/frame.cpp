@@ -3,8 +3,8 @@
 #include "gl_session.h"
 
 #include <crep/core/error.h>
-#include <crep/gpu/gl_state.h>
 #include <crep/epipolar/resample.h>
+#include <crep/gpu/gl_state.h>
 #include <crep/scenes/engine_frame.h>
 #include <crep/scenes/scene_renderer.h>
 

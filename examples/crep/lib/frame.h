@@ -6,10 +6,10 @@
 #include "timings.h"
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/gl.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>

@@ -4,8 +4,8 @@
 
 #include "timings.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
+#include <crep/gpu/gl.h>
 
 #include <cstdint>
 #include <initializer_list>

@@ -6,8 +6,8 @@
 #include "frame.h"
 #include "timings.h"
 
-#include <crep/gpu/gl.h>
 #include <crep/epipolar/epipolar.h>
+#include <crep/gpu/gl.h>
 
 #include <functional>
 #include <memory>

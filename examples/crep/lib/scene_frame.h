@@ -6,8 +6,8 @@
 #include "timings.h"
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
 #include <crep/core/light.h>
+#include <crep/gpu/gl.h>
 
 #include <memory>
 #include <optional>

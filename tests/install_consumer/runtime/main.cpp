@@ -15,8 +15,8 @@
 #include <crep/core/error.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
-#include <crep/gpu/shader_library.h>
 #include <crep/core/version.h>
+#include <crep/gpu/shader_library.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/gpu_pass.h>
 #include <crep/rectify/rectified_map.h>

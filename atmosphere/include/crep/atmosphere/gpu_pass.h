@@ -12,10 +12,10 @@
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/atmosphere/gpu_tables.h>
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/gpu/shader_library.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>

@@ -13,10 +13,10 @@
 
 #include <crep/atmosphere/atmosphere.h>
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectified_map.h>
 
 namespace crep {

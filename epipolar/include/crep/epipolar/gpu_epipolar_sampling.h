@@ -15,11 +15,11 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/scatter/gpu_sample_list.h>
 
 namespace crep {

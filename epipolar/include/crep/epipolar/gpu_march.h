@@ -13,11 +13,11 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
 #include <crep/epipolar/gpu_layout.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 #include <crep/scatter/gpu_sample_list.h>
@@ -68,7 +68,8 @@ private:
   gpu::Dispatch dispatch(bool upperOnly, std::uint32_t rectifiedDepth) const;
 };
 
-/// InvalidArgument naming `parameter` when a map of `mapWidth` columns needs more than the GPU walk's 16 levels.
+/// InvalidArgument naming `parameter` when a map of `mapWidth` columns needs more than the GPU walk's 16
+/// levels.
 void requireTreeLevels(const char* parameter, int mapWidth);
 /// InvalidArgument naming `parameter` unless `buffer` holds the trees of a mapWidth x mapHeight map.
 void requireMinMaxBuffer(const char* parameter, std::uint32_t buffer, int mapWidth, int mapHeight,

@@ -10,9 +10,9 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/scatter/gpu_layout_buffers.h>
 

@@ -25,7 +25,8 @@ public:
     std::vector<double> milliseconds; ///< per span in the order of add(): Backend::timerResult's
   };
 
-  /// A span of the frame being recorded: an id of Backend::endTimerDeferred() (0: the backend times none; reads 0).
+  /// A span of the frame being recorded: an id of Backend::endTimerDeferred() (0: the backend times none;
+  /// reads 0).
   void add(TimerId id) { recording_.push_back(id); }
   /// The spans added since the last endFrame() or discardFrame() become frame `frame`'s.
   void endFrame(std::uint64_t frame);

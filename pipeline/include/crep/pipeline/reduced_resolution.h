@@ -6,9 +6,9 @@
 #include <cstdint>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 
 #include <memory>
 

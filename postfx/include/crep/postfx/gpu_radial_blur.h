@@ -10,10 +10,10 @@
 #include <glm/glm.hpp>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/postfx/radial_blur.h>
 
 namespace crep {

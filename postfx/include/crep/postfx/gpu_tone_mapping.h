@@ -9,8 +9,8 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/gpu/gl.h>
 #include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/gpu/shader_library.h>
 #include <crep/postfx/tone_mapping.h>
 

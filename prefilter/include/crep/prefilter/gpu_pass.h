@@ -11,10 +11,10 @@
 #include <vector>
 
 #include <crep/core/camera.h>
-#include <crep/gpu/gl.h>
-#include <crep/gpu/backend.h>
 #include <crep/core/light.h>
 #include <crep/core/medium.h>
+#include <crep/gpu/backend.h>
+#include <crep/gpu/gl.h>
 #include <crep/prefilter/gpu_structs.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>

@@ -8,8 +8,8 @@
 
 #include <glm/glm.hpp>
 
-#include <crep/gpu/backend.h>
 #include <crep/core/image.h>
+#include <crep/gpu/backend.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/scatter/gpu_light_texture.h>
 #include <crep/scenes/scene.h>

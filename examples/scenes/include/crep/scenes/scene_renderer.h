@@ -6,8 +6,8 @@
 #include <memory>
 #include <vector>
 
-#include <crep/gpu/gl.h>
 #include <crep/core/image.h>
+#include <crep/gpu/gl.h>
 #include <crep/rectify/rectify.h>
 #include <crep/scenes/scene.h>
 
