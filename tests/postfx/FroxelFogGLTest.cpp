@@ -169,6 +169,23 @@ Camera panned(double degrees) {
                 base.far());
 }
 
+/// Run i of a still camera over `s` (its ESM mode: the shadow map and its matrix), the previous camera from
+/// run 1 on.
+FroxelFog::FrameAttribs sceneFrame(const Scene& s, std::uint32_t depth, std::uint32_t shadow,
+                                   std::uint32_t output, int i) {
+  FroxelFog::FrameAttribs f;
+  f.camera = &s.camera;
+  f.light = &s.light;
+  f.medium = &s.medium;
+  f.cameraDepth = depth;
+  f.shadowMap = shadow;
+  f.lightClipFromWorld = s.lightClipFromWorld;
+  f.output = output;
+  f.frameIndex = i;
+  f.previousCamera = i == 0 ? nullptr : &s.camera;
+  return f;
+}
+
 std::string fmt(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", v);
@@ -694,17 +711,7 @@ TEST_CASE("FroxelFog GL: the default grid's memory and per-stage GPU timings") {
   FroxelFog fog(info);
   CHECK_FALSE(fog.timings().has_value());
   for (int i = 0; i < 2; ++i) {
-    FroxelFog::FrameAttribs f;
-    f.camera = &s.camera;
-    f.light = &s.light;
-    f.medium = &s.medium;
-    f.cameraDepth = depthTexture.get();
-    f.shadowMap = shadowTexture.get();
-    f.lightClipFromWorld = s.lightClipFromWorld;
-    f.output = output.get();
-    f.frameIndex = i;
-    f.previousCamera = i == 0 ? nullptr : &s.camera;
-    fog.run(f);
+    fog.run(sceneFrame(s, depthTexture.get(), shadowTexture.get(), output.get(), i));
   }
   REQUIRE(fog.timings().has_value());
   const FroxelFog::Timings t = *fog.timings();
@@ -743,17 +750,7 @@ TEST_CASE("FroxelFog GL: timings without blockingTimings never wait and arrive w
   info.backend = &backend;
   FroxelFog fog(info);
   const auto run = [&](int i) {
-    FroxelFog::FrameAttribs f;
-    f.camera = &s.camera;
-    f.light = &s.light;
-    f.medium = &s.medium;
-    f.cameraDepth = depthTexture.get();
-    f.shadowMap = shadowTexture.get();
-    f.lightClipFromWorld = s.lightClipFromWorld;
-    f.output = output.get();
-    f.frameIndex = i;
-    f.previousCamera = i == 0 ? nullptr : &s.camera;
-    fog.run(f);
+    fog.run(sceneFrame(s, depthTexture.get(), shadowTexture.get(), output.get(), i));
   };
   run(0);
   // Nothing read in the run: its five spans (ESM, lighting, accumulation, temporal, apply) wait.
