@@ -22,33 +22,6 @@ std::string sizeText(int width, int height) {
   return std::to_string(width) + " x " + std::to_string(height);
 }
 
-/// A GL texture's level as the checks see it: its format when it is one of gpu::Format.
-TextureLevel fromGl(const gl::TextureLevel& l) {
-  TextureLevel level;
-  level.type = l.target == GL_TEXTURE_2D_ARRAY ? TextureType::Texture2DArray
-               : l.target == GL_TEXTURE_3D     ? TextureType::Texture3D
-                                               : TextureType::Texture2D;
-  level.width = l.width;
-  level.height = l.height;
-  level.depth = std::max(l.depth, 1);
-  for (Format f : {Format::R32F, Format::RG32F, Format::RGBA32F, Format::RGBA16F, Format::Depth32F,
-                   Format::RGBA8, Format::RG32I})
-    if (glInternalFormat(f) == l.internalFormat) level.format = f;
-  switch (l.internalFormat) {
-  case GL_DEPTH_COMPONENT16:
-  case GL_DEPTH_COMPONENT24:
-  case GL_DEPTH_COMPONENT32:
-  case GL_DEPTH_COMPONENT32F:
-  case GL_DEPTH24_STENCIL8:
-  case GL_DEPTH32F_STENCIL8:
-    level.isDepth = true;
-    break;
-  default:
-    break;
-  }
-  return level;
-}
-
 } // namespace
 
 const char* formatName(Format format) {
@@ -110,7 +83,7 @@ void requireTexture(const Backend& backend, const char* parameter, TextureId tex
 }
 
 TextureLevel textureLevelOf(const Backend& backend, const char* parameter, TextureId texture) {
-  if (onGl(backend)) return fromGl(gl::textureLevel(parameter, texture));
+  if (onGl(backend)) return textureLevelFromGl(gl::textureLevel(parameter, texture));
   if (texture == 0) throw InvalidArgument(parameter, "0", "must be a texture");
   TextureDesc d;
   try {
@@ -130,7 +103,7 @@ TextureLevel textureLevelOf(const Backend& backend, const char* parameter, Textu
 }
 
 TextureLevel requireTexture2DOf(const Backend& backend, const char* parameter, TextureId texture) {
-  if (onGl(backend)) return fromGl(gl::requireTexture2D(parameter, texture));
+  if (onGl(backend)) return textureLevelFromGl(gl::requireTexture2D(parameter, texture));
   const TextureLevel level = textureLevelOf(backend, parameter, texture);
   requireTexture2DOf(backend, parameter, texture, level.width, level.height);
   return level;

@@ -109,6 +109,32 @@ std::uint32_t glInternalFormat(Format f) {
   return GL_RGBA32F;
 }
 
+TextureLevel textureLevelFromGl(const gl::TextureLevel& l) {
+  TextureLevel level;
+  level.type = l.target == GL_TEXTURE_2D_ARRAY ? TextureType::Texture2DArray
+               : l.target == GL_TEXTURE_3D     ? TextureType::Texture3D
+                                               : TextureType::Texture2D;
+  level.width = l.width;
+  level.height = l.height;
+  level.depth = std::max(l.depth, 1);
+  for (Format f : {Format::R32F, Format::RG32F, Format::RGBA32F, Format::RGBA16F, Format::Depth32F,
+                   Format::RGBA8, Format::RG32I})
+    if (glInternalFormat(f) == l.internalFormat) level.format = f;
+  switch (l.internalFormat) {
+  case GL_DEPTH_COMPONENT16:
+  case GL_DEPTH_COMPONENT24:
+  case GL_DEPTH_COMPONENT32:
+  case GL_DEPTH_COMPONENT32F:
+  case GL_DEPTH24_STENCIL8:
+  case GL_DEPTH32F_STENCIL8:
+    level.isDepth = true;
+    break;
+  default:
+    break;
+  }
+  return level;
+}
+
 GlBackend::GlBackend() {
   nearest_ = gl::createClampSampler(GL_NEAREST);
   linear_ = gl::createClampSampler(GL_LINEAR);
@@ -196,20 +222,17 @@ TextureDesc GlBackend::describe(TextureId texture) const {
   if (texture == 0 || glIsTexture(texture) != GL_TRUE)
     throw InvalidArgument("gpu::GlBackend texture", std::to_string(texture), "must be a GL texture name");
   const TextureInfo t = query(texture);
+  const TextureLevel level = textureLevelFromGl({static_cast<std::uint32_t>(t.target), t.width, t.height,
+                                                 t.depth, static_cast<std::uint32_t>(t.internal)});
   TextureDesc d;
-  d.type = t.target == GL_TEXTURE_2D_ARRAY ? TextureType::Texture2DArray
-           : t.target == GL_TEXTURE_3D     ? TextureType::Texture3D
-                                           : TextureType::Texture2D;
-  d.format = t.internal == GL_R32F                           ? Format::R32F
-             : t.internal == GL_RG32F                        ? Format::RG32F
-             : t.internal == GL_RGBA16F                      ? Format::RGBA16F
-             : t.internal == GL_RGBA8                        ? Format::RGBA8
-             : t.internal == GL_RG32I                        ? Format::RG32I
+  d.type = level.type;
+  // A format outside gpu::Format reads as the one its components are read as.
+  d.format = level.format                                    ? *level.format
              : pixelFormat(t.internal) == GL_DEPTH_COMPONENT ? Format::Depth32F
                                                              : Format::RGBA32F;
-  d.width = t.width;
-  d.height = t.height;
-  d.depth = std::max(t.depth, 1);
+  d.width = level.width;
+  d.height = level.height;
+  d.depth = level.depth;
   return d;
 }
 

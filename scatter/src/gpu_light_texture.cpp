@@ -22,11 +22,9 @@ gpu::TextureLevel validateGpuLightTexture(const GpuLightTexture& texture, const 
                                           const LocalLight* localLight, std::string_view field) {
   const std::string f(field);
   const std::string textureField = f + ".texture";
-  const gl::TextureLevel glLevel = gl::requireTexture2D(textureField.c_str(), texture.texture);
+  const gpu::TextureLevel level =
+      textureLevelFromGl(gl::requireTexture2D(textureField.c_str(), texture.texture));
   gl::requireColorFormat(textureField.c_str(), texture.texture);
-  gpu::TextureLevel level;
-  level.width = glLevel.width;
-  level.height = glLevel.height;
   if (level.width <= 0 || level.height <= 0)
     throw InvalidArgument(textureField, std::to_string(level.width) + " x " + std::to_string(level.height),
                           "must have a level 0");

@@ -73,13 +73,8 @@ void validateSampleList(const SampleList& list, const std::string& owner) {
 
 gpu::TextureLevel listImageSize(int imageWidth, int imageHeight, std::uint32_t cameraDepth,
                                 const std::string& owner) {
-  if (imageWidth == 0 && imageHeight == 0) {
-    const gl::TextureLevel depth = gl::requireTexture2D((owner + ".cameraDepth").c_str(), cameraDepth);
-    gpu::TextureLevel size;
-    size.width = depth.width;
-    size.height = depth.height;
-    return size;
-  }
+  if (imageWidth == 0 && imageHeight == 0)
+    return textureLevelFromGl(gl::requireTexture2D((owner + ".cameraDepth").c_str(), cameraDepth));
   if (imageWidth <= 0 || imageHeight <= 0)
     throw InvalidArgument(owner + ".imageWidth/imageHeight",
                           std::to_string(imageWidth) + " x " + std::to_string(imageHeight),

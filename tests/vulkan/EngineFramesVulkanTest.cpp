@@ -39,6 +39,15 @@ Camera movedCamera(const Camera& c, int i) {
   return Camera(c.position() + 0.05 * i * right, c.orientation(), c.fovY(), c.aspect(), c.near(), c.far());
 }
 
+/// How many values of `got` are not bit for bit `want`'s (the sizes must agree).
+std::size_t differingValues(const std::vector<float>& got, const std::vector<float>& want) {
+  REQUIRE(got.size() == want.size());
+  std::size_t differing = 0;
+  for (std::size_t k = 0; k < got.size(); ++k)
+    differing += got[k] != want[k] ? 1u : 0u;
+  return differing;
+}
+
 /// The front door's defaults but the size: stage timings on, never waiting (deferred spans).
 Scattering::CreateInfo frameInfo(gpu::Backend& b, Scattering::Method method) {
   Scattering::CreateInfo info;
@@ -208,17 +217,12 @@ TEST_CASE("Vulkan backend on an engine's device: ten frames of a moving camera r
         vk.frameCompleted(kFrames);
         for (int i = 0; i < kFrames; ++i) {
           CAPTURE(i);
-          const std::vector<float> got = vk.readTexture(outputs[static_cast<std::size_t>(i)].id());
           const std::vector<float>& want = expected[static_cast<std::size_t>(i)];
-          REQUIRE(got.size() == want.size());
-          std::size_t differing = 0;
           double signal = 0.0;
-          for (std::size_t k = 0; k < got.size(); ++k) {
-            if (got[k] != want[k]) ++differing;
-            signal += std::abs(want[k]);
-          }
+          for (float v : want)
+            signal += std::abs(v);
           CHECK(signal > 0.0);
-          CHECK(differing == 0);
+          CHECK(differingValues(vk.readTexture(outputs[static_cast<std::size_t>(i)].id()), want) == 0);
         }
         // The frame index must grow, and the engine must have waited for the oldest frame in flight.
         EngineFrames more(device);
@@ -472,13 +476,7 @@ TEST_CASE("Vulkan backend on an engine's device: the engine's own images in plac
       frames.submit(index);
       frames.waitIdle();
       // The engine reads its output with its own copy, from the layout the library left it in.
-      const std::vector<float> got = images.read(outImage, outLayout);
-      const std::vector<float>& want = expected[static_cast<std::size_t>(i)];
-      REQUIRE(got.size() == want.size());
-      std::size_t differing = 0;
-      for (std::size_t k = 0; k < got.size(); ++k)
-        differing += got[k] != want[k] ? 1u : 0u;
-      CHECK(differing == 0);
+      CHECK(differingValues(images.read(outImage, outLayout), expected[static_cast<std::size_t>(i)]) == 0);
     }
     CHECK(LoaderSpy::stalls() - stallsBefore == 0);
     vk.frameCompleted(kImageFrames);

@@ -439,6 +439,8 @@ struct VulkanBackend::Impl {
   VkShaderModule module(const std::string& program, std::span<const ShaderDefine> defines);
   Pipeline& pipeline(const Dispatch& d, std::size_t pushBytes);
   ImageEntry& image(TextureId id, const char* what);
+  /// image(), refused when it is an engine image whose format the transfers do not convert.
+  ImageEntry& copyableImage(TextureId id, const char* what);
   BufferEntry& buffer(BufferId id, const char* what);
   ~Impl();
 };
@@ -831,6 +833,19 @@ void VulkanBackend::Impl::restoreImages() {
   moved.clear();
 }
 
+namespace {
+/// The whole image as one buffer copy (writeTexture, readTexture): layers after each other, tightly packed.
+VkBufferImageCopy wholeCopy(const ImageEntry& e) {
+  const VkImageSubresourceRange range = wholeImage(e);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {range.aspectMask, 0, 0, range.layerCount};
+  region.imageExtent = {static_cast<std::uint32_t>(e.desc.width), static_cast<std::uint32_t>(e.desc.height),
+                        e.desc.type == TextureType::Texture3D ? static_cast<std::uint32_t>(e.desc.depth)
+                                                              : 1u};
+  return region;
+}
+} // namespace
+
 void VulkanBackend::Impl::transition(const ImageEntry& e, VkImageLayout from, VkImageLayout to) {
   VkImageMemoryBarrier b{};
   b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
@@ -1011,6 +1026,15 @@ ImageEntry& VulkanBackend::Impl::image(TextureId id, const char* what) {
   if (it == images.end())
     throw InvalidArgument(what, std::to_string(id), "must be a texture of this VulkanBackend");
   return it->second;
+}
+
+ImageEntry& VulkanBackend::Impl::copyableImage(TextureId id, const char* what) {
+  ImageEntry& e = image(id, what);
+  if (e.format != vkFormat(e.desc.format))
+    throw InvalidArgument(what, std::to_string(id),
+                          "is an engine image in a format the backend does not copy (" +
+                              std::to_string(static_cast<int>(e.format)) + ")");
+  return e;
 }
 
 BufferEntry& VulkanBackend::Impl::buffer(BufferId id, const char* what) {
@@ -1390,11 +1414,7 @@ void VulkanBackend::writeBuffer(BufferId buffer, std::size_t offset, std::span<c
 
 void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texels) {
   Impl& v = *impl_;
-  ImageEntry& e = v.image(texture, "gpu::VulkanBackend::writeTexture texture");
-  if (e.format != vkFormat(e.desc.format))
-    throw InvalidArgument("gpu::VulkanBackend::writeTexture texture", std::to_string(texture),
-                          "is an engine image in a format the backend does not copy (" +
-                              std::to_string(static_cast<int>(e.format)) + ")");
+  ImageEntry& e = v.copyableImage(texture, "gpu::VulkanBackend::writeTexture texture");
   const TextureDesc& d = e.desc;
   const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
                             static_cast<std::size_t>(d.depth);
@@ -1420,13 +1440,7 @@ void VulkanBackend::writeTexture(TextureId texture, std::span<const float> texel
   }
   v.begin();
   v.barrier();
-  VkBufferImageCopy region{};
-  region.imageSubresource = {
-      static_cast<VkImageAspectFlags>(d.format == Format::Depth32F ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                                                   : VK_IMAGE_ASPECT_COLOR_BIT),
-      0, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
-  region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
-                        d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
+  const VkBufferImageCopy region = wholeCopy(e);
   // Copies in the transfer layouts (GPU: the fast path of a copy engine), then back to GENERAL.
   v.transition(e, e.current, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
   v.vk.vkCmdCopyBufferToImage(v.cmd, s.buffer, e.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
@@ -1450,24 +1464,14 @@ std::vector<std::byte> VulkanBackend::readBuffer(BufferId buffer, std::size_t of
 std::vector<float> VulkanBackend::readTexture(TextureId texture) {
   Impl& v = *impl_;
   v.refuseInFrame("gpu::VulkanBackend::readTexture");
-  ImageEntry& e = v.image(texture, "gpu::VulkanBackend::readTexture texture");
-  if (e.format != vkFormat(e.desc.format))
-    throw InvalidArgument("gpu::VulkanBackend::readTexture texture", std::to_string(texture),
-                          "is an engine image in a format the backend does not copy (" +
-                              std::to_string(static_cast<int>(e.format)) + ")");
+  ImageEntry& e = v.copyableImage(texture, "gpu::VulkanBackend::readTexture texture");
   const TextureDesc& d = e.desc;
   const std::size_t count = static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) *
                             static_cast<std::size_t>(d.depth);
   BufferEntry s = v.makeBuffer(count * texelBytes(d.format), VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   v.begin();
   v.barrier();
-  VkBufferImageCopy region{};
-  region.imageSubresource = {
-      static_cast<VkImageAspectFlags>(d.format == Format::Depth32F ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                                                   : VK_IMAGE_ASPECT_COLOR_BIT),
-      0, 0, d.type == TextureType::Texture2DArray ? static_cast<std::uint32_t>(d.depth) : 1u};
-  region.imageExtent = {static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
-                        d.type == TextureType::Texture3D ? static_cast<std::uint32_t>(d.depth) : 1u};
+  const VkBufferImageCopy region = wholeCopy(e);
   v.transition(e, e.current, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   v.vk.vkCmdCopyImageToBuffer(v.cmd, e.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, s.buffer, 1, &region);
   v.transition(e, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, e.current);
@@ -1661,7 +1665,7 @@ void VulkanBackend::beginTimer() {
   v.begin();
   // A span's two queries in the ring, reset in the command stream before its first timestamp.
   const TimerId id = ++v.lastSpan;
-  v.pendingSpans.erase(id - std::min<TimerId>(id, Impl::kSpans)); // its slot's previous span: dropped
+  if (id > Impl::kSpans) v.pendingSpans.erase(id - Impl::kSpans); // its slot's previous span: dropped
   const std::uint32_t first = 2 * static_cast<std::uint32_t>(id % Impl::kSpans);
   v.vk.vkCmdResetQueryPool(v.cmd, v.timestamps, first, 2);
   v.vk.vkCmdWriteTimestamp(v.cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, v.timestamps, first);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <crep/gpu/backend.h>
+#include <crep/gpu/checks.h>
 #include <crep/gpu/gl.h>
 
 namespace crep::gpu {
@@ -70,6 +71,10 @@ private:
 
 /// The GL internal format of `format` (GL_R32F, ..., GL_DEPTH_COMPONENT32F).
 std::uint32_t glInternalFormat(Format format);
+
+/// Level 0 of a GL texture as the checks see it: its gpu::Format when it is one of them, isDepth for any
+/// depth format.
+TextureLevel textureLevelFromGl(const gl::TextureLevel& level);
 
 /// `given`, or else a GlBackend made into `own` on the current GL context: the default backend of a pass.
 Backend& givenOrGl(Backend* given, std::unique_ptr<Backend>& own);
