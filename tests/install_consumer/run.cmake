@@ -5,8 +5,10 @@ cmake_minimum_required(VERSION 3.25)
 #             and evaluation passes on it, then a crep::Scattering frame from its own reversed-Z camera
 #             matrices and shadow map; its link line must not mention OpenEXR or stb
 #   support/  a tool: find_package(crepuscular COMPONENTS support), an EXR round trip
-#   vulkan/   an engine on Vulkan: find_package(crepuscular COMPONENTS vulkan), MinMaxTreePass on
-#             gpu::VulkanBackend against the CPU trees, validation layer on (when built with CREP_VULKAN)
+#   vulkan    the Vulkan engine example (examples/vulkan_engine/, when built with CREP_VULKAN):
+#             find_package(crepuscular COMPONENTS vulkan support), its own device, depth pre-pass and shadow
+#             map, crepuscular recorded into its 10 frames (3 in flight), validation layer with
+#             synchronization validation on and silent, the EXR written
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -56,15 +58,25 @@ if(EXISTS ${WORK_DIR}/prefix/include/crep/vulkan/vulkan_backend.h) # built with 
 endif()
 foreach(consumer IN LISTS consumers)
   set(build ${WORK_DIR}/${consumer})
-  run(${CMAKE_COMMAND} -S ${CONSUMER_SOURCE}/${consumer} -B ${build} -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
-      -DCMAKE_BUILD_TYPE=Release)
+  set(source ${CONSUMER_SOURCE}/${consumer})
+  set(program consumer)
+  set(arguments ${build})
+  if(consumer STREQUAL "vulkan") # the Vulkan engine example itself, built against the install tree
+    set(source ${SOURCE_DIR}/examples/vulkan_engine)
+    set(program crep-vulkan-engine)
+    set(arguments --validation --frames 10 --width 160 --height 90 --out ${build})
+  endif()
+  run(${CMAKE_COMMAND} -S ${source} -B ${build} -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release)
   run(${CMAKE_COMMAND} --build ${build})
-  file(READ ${build}/CMakeFiles/consumer.dir/link.txt link_line)
+  file(READ ${build}/CMakeFiles/${program}.dir/link.txt link_line)
   string(STRIP "${link_line}" link_line)
   message(STATUS "${consumer} consumer link line: ${link_line}")
   set(link_${consumer} "${link_line}")
-  run(${build}/consumer ${build})
+  run(${build}/${program} ${arguments})
 endforeach()
+if(link_vulkan AND NOT EXISTS ${WORK_DIR}/vulkan/vulkan-engine.exr)
+  message(FATAL_ERROR "the Vulkan engine example wrote no ${WORK_DIR}/vulkan/vulkan-engine.exr")
+endif()
 # An engine linking only the runtime library gets neither OpenEXR (nor Imath / Iex) nor stb.
 if(link_runtime MATCHES "[Oo]pen[Ee][Xx][Rr]|Imath|Iex|stb")
   message(FATAL_ERROR "the runtime consumer's link line mentions OpenEXR or stb (${CMAKE_MATCH_0}):\n${link_runtime}")
