@@ -415,6 +415,22 @@ void createImage(VkDevice device, Image& out, std::uint32_t width, std::uint32_t
 }
 } // namespace
 
+void Engine::initialLayout(VkImage image, VkImageAspectFlags aspect, VkImageLayout layout) {
+  // Once, at creation: the image is in its home layout before its first use.
+  immediate([&](VkCommandBuffer cb) {
+    VkImageMemoryBarrier b{};
+    b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = layout;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {aspect, 0, 1, 0, 1};
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                         nullptr, 0, nullptr, 1, &b);
+  });
+}
+
 DepthImage& Engine::createDepthImage(std::uint32_t width, std::uint32_t height) {
   DepthImage& d = depthImages_.emplace_back();
   createImage(device_, d, width, height, VK_IMAGE_ASPECT_DEPTH_BIT, [&](const VkMemoryRequirements& r) {
@@ -429,19 +445,7 @@ DepthImage& Engine::createDepthImage(std::uint32_t width, std::uint32_t height) 
   fi.height = height;
   fi.layers = 1;
   check(vkCreateFramebuffer(device_, &fi, nullptr, &d.framebuffer), "vkCreateFramebuffer");
-  // Into its home layout once, so that it is in it before its first depth pass too.
-  immediate([&](VkCommandBuffer cb) {
-    VkImageMemoryBarrier b{};
-    b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = DepthImage::kLayout;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = d.image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &b);
-  });
+  initialLayout(d.image, VK_IMAGE_ASPECT_DEPTH_BIT, DepthImage::kLayout);
   return d;
 }
 
@@ -450,18 +454,7 @@ ColorImage& Engine::createColorImage(std::uint32_t width, std::uint32_t height) 
   createImage(device_, c, width, height, VK_IMAGE_ASPECT_COLOR_BIT, [&](const VkMemoryRequirements& r) {
     return allocate(r, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   });
-  immediate([&](VkCommandBuffer cb) {
-    VkImageMemoryBarrier b{};
-    b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = ColorImage::kLayout;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = c.image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    b.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                         nullptr, 0, nullptr, 1, &b);
-  });
+  initialLayout(c.image, VK_IMAGE_ASPECT_COLOR_BIT, ColorImage::kLayout);
   return c;
 }
 

@@ -121,6 +121,7 @@ private:
   /// Records `record` into a one-time command buffer, submits it and waits: set-up and downloads only.
   template <class F>
   void immediate(F&& record);
+  void initialLayout(VkImage image, VkImageAspectFlags aspect, VkImageLayout layout);
   std::vector<float> download(VkImage image, VkImageAspectFlags aspect, VkImageLayout layout,
                               std::uint32_t width, std::uint32_t height, std::uint32_t channels);
 
