@@ -73,9 +73,9 @@ public:
 
   /// The SPIR-V of one program variant: `program` is the pass's path in crep::ShaderLibrary (e.g.
   /// "passes/epipolar/resample.comp"), `defines` its variant's defines in the order the pass gives them (as
-  /// crep::programVariantsBuilt() lists them; empty: the default variant). Called on the thread that calls
-  /// the backend, once per distinct variant, when a pass prepares it (prepareProgram) or first dispatches it;
-  /// the module is kept for the backend's lifetime.
+  /// crep::programVariantsBuilt() and the "variants" of the installed resources.json list them; empty: the
+  /// default variant). Called on the thread that calls the backend, once per distinct variant, when a pass
+  /// prepares it (prepareProgram) or first dispatches it; the module is kept for the backend's lifetime.
   ///
   /// Returns the module's bytes, or nothing to have the backend compile that variant's GLSL itself. A
   /// module must be what the backend would have compiled (docs/PORTABLE_SHADERS.md, "Bindings" and "Push
