@@ -1,8 +1,9 @@
 # Portable shaders: every pass of the library (glsl/passes/<module>/<name>.comp, its default variant) and the
 # variants a frame uses (glsl/portable_variants.txt) are compiled to Vulkan SPIR-V (glslc), validated
 # (spirv-val), cross-compiled to HLSL Shader Model 6.0 and to MSL 2.1 (spirv-cross), the HLSL is compiled
-# back by glslang's HLSL front end as a check, and the resources of all of them are described in one
-# resources.json (spirv-cross --reflect, merged by CrepShaderManifest.cmake). Output in
+# back by glslang's HLSL front end as a check and, with the Vulkan attributes a D3D12 engine's HLSL lacks,
+# to the SPIR-V the tests run (hlsl_vulkan/, not installed), and the resources of all of them are described
+# in one resources.json (spirv-cross --reflect, merged by CrepShaderManifest.cmake). Output in
 # ${CMAKE_BINARY_DIR}/shaders, installed to share/crepuscular/shaders/{spirv,hlsl,msl,resources.json}.
 # docs/PORTABLE_SHADERS.md has the rules.
 #
@@ -14,8 +15,8 @@ if(NOT CREP_PORTABLE_SHADERS)
   return()
 endif()
 
-foreach(tool_package IN ITEMS "glslc:glslc" "spirv-val:spirv-tools" "spirv-cross:spirv-cross"
-                               "glslangValidator:glslang-tools")
+foreach(tool_package IN ITEMS "glslc:glslc" "spirv-val:spirv-tools" "spirv-opt:spirv-tools"
+                               "spirv-cross:spirv-cross" "glslangValidator:glslang-tools")
   string(REPLACE ":" ";" pair "${tool_package}")
   list(GET pair 0 tool)
   list(GET pair 1 package)
@@ -51,13 +52,23 @@ file(GLOB_RECURSE crep_shader_passes CONFIGURE_DEPENDS RELATIVE ${CREP_SHADER_SO
      ${CREP_SHADER_SOURCE_DIR}/passes/*.comp)
 list(SORT crep_shader_passes)
 
+# The sampled textures' bindings (unit base up to the image base): spirv-opt merges the Texture and
+# SamplerState glslang makes of the HLSL at each into one combined image sampler (CrepHlslForVulkan.cmake).
+math(EXPR crep_last_unit_binding "${CREP_VULKAN_IMAGE_BASE} - 1")
+set(crep_sampled_bindings)
+foreach(binding RANGE ${CREP_VULKAN_UNIT_BASE} ${crep_last_unit_binding})
+  list(APPEND crep_sampled_bindings "0:${binding}")
+endforeach()
+string(REPLACE ";" " " crep_sampled_bindings "${crep_sampled_bindings}")
+
 set(crep_portable_outputs)
 set(crep_reflections)
 set(crep_pass_names)
 
 # One shipped shader: passes/<pass>.comp with `defines` (a list of NAME=VALUE) as <out> (<module>/<name> for
 # a pass's default variant, <module>/<name>.<tag> for a declared variant) in spirv/, hlsl/, msl/ and
-# reflect/; the HLSL compiled back by glslang as a check (hlsl_check/).
+# reflect/; the HLSL compiled back by glslang as a check (hlsl_check/), and its Vulkan form (hlsl_vulkan/:
+# CrepHlslForVulkan.cmake's copy, glslang, spirv-opt, spirv-val), which tests/vulkan/ runs.
 function(crep_portable_shader pass out defines)
   set(source ${CREP_SHADER_SOURCE_DIR}/passes/${pass}.comp)
   set(dir ${CREP_SHADER_OUTPUT_DIR})
@@ -66,15 +77,19 @@ function(crep_portable_shader pass out defines)
   set(msl ${dir}/msl/${out}.metal)
   set(reflection ${dir}/reflect/${out}.json)
   set(hlsl_check ${dir}/hlsl_check/${out}.spv)
+  set(vulkan_hlsl ${dir}/hlsl_vulkan/${out}.hlsl)
+  set(vulkan_glslang ${dir}/hlsl_vulkan/${out}.glslang.spv)
+  set(vulkan_spv ${dir}/hlsl_vulkan/${out}.spv)
   get_filename_component(module_dir ${pass} DIRECTORY)
   set(glslc_defines)
   foreach(define IN LISTS defines)
     list(APPEND glslc_defines "-D${define}")
   endforeach()
   add_custom_command(
-    OUTPUT ${spv} ${hlsl} ${msl} ${reflection} ${hlsl_check}
+    OUTPUT ${spv} ${hlsl} ${msl} ${reflection} ${hlsl_check} ${vulkan_hlsl} ${vulkan_spv}
     COMMAND ${CMAKE_COMMAND} -E make_directory ${dir}/spirv/${module_dir} ${dir}/hlsl/${module_dir}
             ${dir}/msl/${module_dir} ${dir}/reflect/${module_dir} ${dir}/hlsl_check/${module_dir}
+            ${dir}/hlsl_vulkan/${module_dir}
     COMMAND ${CREP_GLSLC} --target-env=vulkan1.1 -Werror -I ${CREP_SHADER_SOURCE_DIR}
             -ftexture-binding-base ${CREP_VULKAN_UNIT_BASE} -fsampler-binding-base ${CREP_VULKAN_UNIT_BASE}
             -fimage-binding-base ${CREP_VULKAN_IMAGE_BASE} -fubo-binding-base ${CREP_VULKAN_UNIFORM_BASE}
@@ -84,10 +99,18 @@ function(crep_portable_shader pass out defines)
     COMMAND ${CREP_GLSLANGVALIDATOR} -D -S comp -e main -V --target-env vulkan1.1 -o ${hlsl_check} ${hlsl}
     COMMAND ${CREP_SPIRV_CROSS} ${spv} --msl --msl-version 20100 --msl-decoration-binding --output ${msl}
     COMMAND ${CREP_SPIRV_CROSS} ${spv} --reflect --output ${reflection}
-    DEPENDS ${source} ${crep_shader_includes}
-    COMMENT "Portable shader ${out}: SPIR-V, HLSL, MSL"
+    COMMAND ${CMAKE_COMMAND} -DHLSL=${hlsl} -DREFLECTION=${reflection} -DOUTPUT=${vulkan_hlsl} -P
+            ${PROJECT_SOURCE_DIR}/cmake/CrepHlslForVulkan.cmake
+    COMMAND ${CREP_GLSLANGVALIDATOR} -D -S comp -e main -V --target-env vulkan1.1 --no-storage-format --quiet
+            -o ${vulkan_glslang} ${vulkan_hlsl}
+    COMMAND ${CREP_SPIRV_OPT} --convert-to-sampled-image=${crep_sampled_bindings} -o ${vulkan_spv}
+            ${vulkan_glslang}
+    COMMAND ${CREP_SPIRV_VAL} --target-env vulkan1.1 ${vulkan_spv}
+    DEPENDS ${source} ${crep_shader_includes} ${PROJECT_SOURCE_DIR}/cmake/CrepHlslForVulkan.cmake
+    COMMENT "Portable shader ${out}: SPIR-V, HLSL, MSL; the HLSL for Vulkan"
     VERBATIM)
-  set(crep_portable_outputs ${crep_portable_outputs} ${spv} ${hlsl} ${msl} ${hlsl_check} PARENT_SCOPE)
+  set(crep_portable_outputs ${crep_portable_outputs} ${spv} ${hlsl} ${msl} ${hlsl_check} ${vulkan_spv}
+      PARENT_SCOPE)
   # File by file (not the folders), so that a variant taken off the list is not installed from an old build.
   set(share ${CMAKE_INSTALL_DATADIR}/crepuscular/shaders)
   install(FILES ${spv} DESTINATION ${share}/spirv/${module_dir})

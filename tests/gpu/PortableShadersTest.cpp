@@ -2,7 +2,8 @@
 // declared variants (glsl/portable_variants.txt) as Vulkan SPIR-V, HLSL and MSL, and resources.json, checked
 // against the GLSL sources and crep/bindings.h they come from. The build itself runs spirv-val and glslang's
 // HLSL front end on each; the GL side (work-group sizes, the variants a frame builds) is in
-// tests/pipeline/PortableVariantsGLTest.cpp.
+// tests/pipeline/PortableVariantsGLTest.cpp, the HLSL run on Vulkan in
+// tests/vulkan/InstalledHlslVulkanTest.cpp.
 #include "common/shader_tools.h"
 
 #include <crep/gpu/shader_library.h>
