@@ -2,8 +2,11 @@
 # description of every portable pass: its files, work-group size, resources (name, kind, type, format,
 # descriptor set, Vulkan binding, GL binding, HLSL register, MSL index) and push constants. Run by
 # CrepPortableShaders.cmake:
-#   cmake -DOUTPUT=... -DSHADER_DIR=... -DPASSES=m/a,m/b -D{UNIT,IMAGE,UNIFORM,STORAGE}_BASE=N -DVERSION=x -P
-# The format is documented in docs/PORTABLE_SHADERS.md; fields are only ever added.
+#   cmake -DOUTPUT=... -DSHADER_DIR=... -DPASSES=m/a,m/b -D{UNIT,IMAGE,UNIFORM,STORAGE}_BASE=N -DVERSION=x
+#         [-DVARIANTS=glsl/portable_variants.txt] -P
+# "passes" are the default variants; "variants" (added with the declared list) the others, each entry as a
+# pass's plus its "variant" tag and "defines". The format is documented in docs/PORTABLE_SHADERS.md; fields
+# are only ever added.
 cmake_minimum_required(VERSION 3.25)
 
 string(REPLACE "," ";" PASSES "${PASSES}")
@@ -33,14 +36,15 @@ string(JSON json SET "${json}" binding_bases
        "{\"sampled_texture\": ${UNIT_BASE}, \"storage_image\": ${IMAGE_BASE}, \"uniform_buffer\": ${UNIFORM_BASE}, \"storage_buffer\": ${STORAGE_BASE}}")
 string(JSON json SET "${json}" passes "[]")
 
-set(index 0)
-foreach(stem IN LISTS PASSES)
-  file(READ ${SHADER_DIR}/reflect/${stem}.json reflection)
+# One entry of "passes" or "variants": passes/<stem>.comp, its files <out>.{spv,hlsl,metal} and its reflection
+# reflect/<out>.json, into `result`.
+function(crep_pass_entry result stem out)
+  file(READ ${SHADER_DIR}/reflect/${out}.json reflection)
   set(pass "{}")
   string(JSON pass SET "${pass}" name "\"passes/${stem}.comp\"")
-  string(JSON pass SET "${pass}" spirv "\"spirv/${stem}.spv\"")
-  string(JSON pass SET "${pass}" hlsl "\"hlsl/${stem}.hlsl\"")
-  string(JSON pass SET "${pass}" msl "\"msl/${stem}.metal\"")
+  string(JSON pass SET "${pass}" spirv "\"spirv/${out}.spv\"")
+  string(JSON pass SET "${pass}" hlsl "\"hlsl/${out}.hlsl\"")
+  string(JSON pass SET "${pass}" msl "\"msl/${out}.metal\"")
   string(JSON pass SET "${pass}" entry_point
          "{\"spirv\": \"main\", \"hlsl\": \"main\", \"msl\": \"main0\"}")
   string(JSON group GET "${reflection}" entryPoints 0 workgroup_size)
@@ -145,8 +149,38 @@ foreach(stem IN LISTS PASSES)
            "{\"block\": \"${block_name}\", \"size\": ${size}, \"members\": ${out_members}, \"msl_buffer\": 0}")
   endif()
 
+  set(${result} "${pass}" PARENT_SCOPE)
+endfunction()
+
+set(index 0)
+foreach(stem IN LISTS PASSES)
+  crep_pass_entry(pass ${stem} ${stem})
   string(JSON json SET "${json}" passes ${index} "${pass}")
   math(EXPR index "${index} + 1")
 endforeach()
+
+if(DEFINED VARIANTS)
+  include(${CMAKE_CURRENT_LIST_DIR}/CrepShaderVariants.cmake)
+  crep_read_shader_variants(${VARIANTS} variant)
+  string(JSON json SET "${json}" variants "[]")
+  if(variant_COUNT GREATER 0)
+    math(EXPR last "${variant_COUNT} - 1")
+    foreach(i RANGE ${last})
+      set(stem ${variant_${i}_PASS})
+      crep_pass_entry(pass ${stem} ${stem}.${variant_${i}_TAG})
+      string(JSON pass SET "${pass}" variant "\"${variant_${i}_TAG}\"")
+      set(defines "[]")
+      set(d 0)
+      foreach(define IN LISTS variant_${i}_DEFINES)
+        string(REGEX MATCH "^([^=]+)=(.*)$" unused "${define}")
+        set(entry "{\"name\": \"${CMAKE_MATCH_1}\", \"value\": \"${CMAKE_MATCH_2}\"}")
+        string(JSON defines SET "${defines}" ${d} "${entry}")
+        math(EXPR d "${d} + 1")
+      endforeach()
+      string(JSON pass SET "${pass}" defines "${defines}")
+      string(JSON json SET "${json}" variants ${i} "${pass}")
+    endforeach()
+  endif()
+endif()
 
 file(WRITE ${OUTPUT} "${json}\n")

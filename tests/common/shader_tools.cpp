@@ -120,4 +120,24 @@ nlohmann::json portableShaderResources() {
   return nlohmann::json::parse(in);
 }
 
+const nlohmann::json* shippedVariant(const nlohmann::json& resources, std::string_view path,
+                                     std::span<const ShaderDefine> defines) {
+  const auto sameDefines = [&](const nlohmann::json& entry) {
+    const nlohmann::json& listed = entry.at("defines");
+    if (listed.size() != defines.size()) return false;
+    for (std::size_t i = 0; i < defines.size(); ++i)
+      if (listed[i].at("name") != defines[i].name || listed[i].at("value") != defines[i].value) return false;
+    return true;
+  };
+  if (defines.empty()) {
+    for (const nlohmann::json& pass : resources.at("passes"))
+      if (pass.at("name") == path) return &pass;
+    return nullptr;
+  }
+  if (!resources.contains("variants")) return nullptr;
+  for (const nlohmann::json& variant : resources.at("variants"))
+    if (variant.at("name") == path && sameDefines(variant)) return &variant;
+  return nullptr;
+}
+
 } // namespace crep::test

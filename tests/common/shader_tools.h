@@ -4,10 +4,13 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
+
+#include <crep/gpu/shader_library.h>
 
 namespace crep::test {
 
@@ -42,5 +45,11 @@ std::filesystem::path portableShaderDir();
 
 /// resources.json of the build, parsed.
 nlohmann::json portableShaderResources();
+
+/// The entry of `resources` (resources.json) that ships the program variant `path` with `defines`: its
+/// "passes" entry for the default variant (no defines), else the "variants" entry with these defines in this
+/// order; null if none.
+const nlohmann::json* shippedVariant(const nlohmann::json& resources, std::string_view path,
+                                     std::span<const ShaderDefine> defines);
 
 } // namespace crep::test

@@ -79,7 +79,9 @@ const std::set<std::string> kProse = {
     "scatteringTexture",
     "drawShadowCasters", // the engine's names in a snippet
     "shaderStorageImageExtendedFormats",
-    "shaderFloat64", // Vulkan device features (VkPhysicalDeviceFeatures members)
+    "shaderStorageImageReadWithoutFormat",
+    "shaderFloat64",      // Vulkan device features (VkPhysicalDeviceFeatures members)
+    "OpTypeSampledImage", // a SPIR-V instruction
 };
 
 /// Removes "quoted" text (parameter names of error messages) from comment text.

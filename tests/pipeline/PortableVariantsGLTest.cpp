@@ -1,7 +1,9 @@
 // The portable shaders beside the GL programs: resources.json's work-group sizes are the GL programs',
 // and every program variant crep::Scattering builds for its frames (sun projective and in view, a light
 // texture, froxels, spot and point lights) compiles for Vulkan and validates, so a Vulkan backend or an
-// engine precompiling for D3D12 or Metal (crep::programVariantsBuilt) can take each of them.
+// engine precompiling for D3D12 or Metal (crep::programVariantsBuilt) can take each of them; and each is
+// shipped (resources.json's "passes" or "variants", declared in glsl/portable_variants.txt), so the list
+// cannot fall behind the frames.
 #include "common/gl_fixture.h"
 #include "common/shader_tools.h"
 #include "pipeline/scattering_frame.h"
@@ -75,8 +77,9 @@ TEST_CASE("portable shaders: every program variant of the front door's frames co
   local.pointLights = std::span<const PointLight>(&point, 1);
   run("spot lights (off screen and in view) and a point light", local);
 
+  const nlohmann::json resources = portableShaderResources();
   std::set<std::string> passes;
-  int compiled = 0;
+  int compiled = 0, shipped = 0;
   for (const ShaderStageSource& v : programVariantsBuilt()) {
     if (!isLibraryPass(v.path)) continue;
     std::string defines;
@@ -87,10 +90,18 @@ TEST_CASE("portable shaders: every program variant of the front door's frames co
     const ExpandedShader e = ShaderLibrary::expand(v.path, v.defines);
     const RunResult r = compileComputeForVulkan(v.path + "." + std::to_string(compiled), e.text);
     CHECK_MESSAGE(r.exitCode == 0, "not valid for Vulkan:\n" << e.translateLog(r.output));
+    // Shipped: the default variant in resources.json's "passes", any other in its "variants", declared
+    // in glsl/portable_variants.txt (the line to add is the message).
+    const bool listed = shippedVariant(resources, v.path, v.defines) != nullptr;
+    std::string stem = v.path.substr(std::string_view("passes/").size()); // <module>/<pass>.comp
+    stem.resize(stem.size() - std::string_view(".comp").size());
+    CHECK_MESSAGE(listed, "not shipped; glsl/portable_variants.txt needs the line\n" << stem << defines);
+    shipped += listed ? 1 : 0;
     passes.insert(v.path);
     ++compiled;
   }
-  MESSAGE(compiled << " variants of " << passes.size() << " passes from " << frames.size() << " frames");
+  MESSAGE(compiled << " variants of " << passes.size() << " passes from " << frames.size() << " frames, "
+                   << shipped << " of them shipped");
   CHECK(compiled >= 15);
   CHECK(passes.count("passes/prefilter/evaluate.comp") == 1);
   CHECK(passes.count("passes/prefilter/prefilter.comp") == 1);

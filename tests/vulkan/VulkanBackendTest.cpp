@@ -1,7 +1,7 @@
 // gpu::VulkanBackend on Mesa's lavapipe with the validation layer on: transfers round-trip exactly, the
 // passes written once against gpu::Backend (MinMaxTreePass, ShadowResamplePass) agree with their CPU
-// references as they do on GL, bad input is named (the backend's and EvaluatePass's), and the validation
-// layer reports nothing.
+// references as they do on GL, bad input is named (the backend's, CreateInfo::shaderBinary's and
+// EvaluatePass's), and the validation layer reports nothing.
 #include "common/map_agreement.h"
 #include "common/vulkan_fixture.h"
 
@@ -24,7 +24,9 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <span>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <vector>
 
@@ -304,4 +306,30 @@ TEST_CASE("Vulkan backend: crep::Scattering names what needs the OpenGL backend"
   CHECK_THROWS_WITH_AS(scattering.run(f), doctest::Contains("Scattering::FrameAttribs.output"),
                        InvalidArgument);
   crep::test::checkNoValidationMessages(vk);
+}
+
+TEST_CASE("Vulkan backend: CreateInfo::shaderBinary is refused when it is not SPIR-V, naming the program") {
+  std::vector<std::byte> binary;
+  gpu::VulkanBackend::CreateInfo info;
+  info.shaderBinary = [&](std::string_view, std::span<const ShaderDefine>) { return binary; };
+  gpu::VulkanBackend vk(info);
+  const std::string program = "passes/pipeline/accumulate.comp";
+  // Not a whole number of 4-byte words.
+  binary.assign(10, std::byte{0});
+  CHECK_THROWS_WITH_AS(vk.prepareProgram(program, {}),
+                       doctest::Contains("CreateInfo.shaderBinary(\"passes/pipeline/accumulate.comp\")"),
+                       InvalidArgument);
+  CHECK_THROWS_WITH_AS(vk.prepareProgram(program, {}), doctest::Contains("10 bytes"), InvalidArgument);
+  // Words, but not SPIR-V's magic number first (here the number byte-swapped, as a big-endian file has it).
+  const std::uint32_t swapped[] = {0x03022307u, 0x00010300u, 0u, 8u, 0u};
+  binary.resize(sizeof swapped);
+  std::memcpy(binary.data(), swapped, sizeof swapped);
+  CHECK_THROWS_WITH_AS(vk.prepareProgram(program, {}), doctest::Contains("0x03022307"), InvalidArgument);
+  CHECK_THROWS_WITH_AS(vk.prepareProgram(program, {}), doctest::Contains("accumulate.comp"), InvalidArgument);
+  // Nothing: the GLSL is compiled as without a provider; the module is then kept (the provider is not asked
+  // again for that variant).
+  binary.clear();
+  vk.prepareProgram(program, {});
+  binary.assign(10, std::byte{0});
+  CHECK_NOTHROW(vk.prepareProgram(program, {}));
 }

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -405,6 +406,7 @@ struct VulkanBackend::Impl {
   std::map<BufferId, BufferEntry> buffers;
   std::uint32_t nextId = 1;
   std::map<std::string, VkShaderModule> modules;
+  ShaderBinaryProvider shaderBinary; ///< CreateInfo::shaderBinary: the engine's SPIR-V, else shaderc's
   std::map<std::string, Pipeline> pipelines;
   std::vector<BufferEntry> staging; ///< freed after the submission that used them
 
@@ -941,6 +943,36 @@ VkShaderModule VulkanBackend::Impl::module(const std::string& program,
                                            std::span<const ShaderDefine> defines) {
   const std::string key = variantKey(program, defines);
   if (auto it = modules.find(key); it != modules.end()) return it->second;
+  const auto create = [&](const std::uint32_t* code, std::size_t bytes) {
+    VkShaderModuleCreateInfo ci{};
+    ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+    ci.codeSize = bytes;
+    ci.pCode = code;
+    VkShaderModule m = VK_NULL_HANDLE;
+    check(vk.vkCreateShaderModule(device, &ci, allocator, &m), "vkCreateShaderModule");
+    modules[key] = m;
+    return m;
+  };
+  if (shaderBinary) {
+    const std::vector<std::byte> binary = shaderBinary(program, defines);
+    if (!binary.empty()) {
+      constexpr std::uint32_t kMagic = 0x07230203; // the SPIR-V specification's magic number, host order
+      std::vector<std::uint32_t> words(binary.size() / 4);
+      std::memcpy(words.data(), binary.data(), words.size() * 4);
+      const std::string field = "VulkanBackend::CreateInfo.shaderBinary(\"" + program + "\")";
+      if (binary.size() % 4 != 0)
+        throw InvalidArgument(field, std::to_string(binary.size()) + " bytes",
+                              "must be SPIR-V: a whole number of 4-byte words");
+      if (words.front() != kMagic) {
+        char first[16];
+        std::snprintf(first, sizeof first, "0x%08x", words.front());
+        throw InvalidArgument(field, std::string("a module whose first word is ") + first,
+                              "must be SPIR-V: its first word the magic number 0x07230203 (in host byte "
+                              "order)");
+      }
+      return create(words.data(), binary.size());
+    }
+  }
   const ExpandedShader expanded = ShaderLibrary::expand(program, defines);
   shaderc::CompileOptions options;
   options.SetTargetEnvironment(shaderc_target_env_vulkan, shaderc_env_version_vulkan_1_1);
@@ -962,14 +994,7 @@ VkShaderModule VulkanBackend::Impl::module(const std::string& program,
                       expanded.translateLog(result.GetErrorMessage()));
   }
   const std::vector<std::uint32_t> words(result.cbegin(), result.cend());
-  VkShaderModuleCreateInfo ci{};
-  ci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  ci.codeSize = words.size() * 4;
-  ci.pCode = words.data();
-  VkShaderModule m = VK_NULL_HANDLE;
-  check(vk.vkCreateShaderModule(device, &ci, allocator, &m), "vkCreateShaderModule");
-  modules[key] = m;
-  return m;
+  return create(words.data(), words.size() * 4);
 }
 
 Pipeline& VulkanBackend::Impl::pipeline(const Dispatch& d, std::size_t pushBytes) {
@@ -1115,6 +1140,7 @@ VulkanBackend::VulkanBackend(const CreateInfo& info) : impl_(std::make_unique<Im
     throw InvalidArgument("VulkanBackend::CreateInfo.framesInFlight", std::to_string(info.framesInFlight),
                           "must be in [1, 16]");
   v.framesInFlight = info.framesInFlight;
+  v.shaderBinary = info.shaderBinary;
   v.framePools.resize(info.framesInFlight);
   v.frameCurrentPool.assign(info.framesInFlight, 0);
   v.createObjects();

@@ -1,17 +1,22 @@
 // gpu::Backend on a Vulkan 1.1 device (Mesa's lavapipe here, any conformant driver elsewhere): the library's
 // passes from the same descriptions as on GL, their shaders compiled from the same GLSL to SPIR-V at run
-// time (shaderc), bindings as in docs/PORTABLE_SHADERS.md. On a device of its own (tools, tests) or on the
-// engine's (CreateInfo::device). Rules and limits: docs/BACKENDS.md.
+// time (shaderc), or taken precompiled from the engine (CreateInfo::shaderBinary), bindings as in
+// docs/PORTABLE_SHADERS.md. On a device of its own (tools, tests) or on the engine's (CreateInfo::device).
+// Rules and limits: docs/BACKENDS.md.
 //
 // Includes <vulkan/vulkan_core.h> for the handle types. An engine that loads Vulkan itself (volk and the
 // like) defines VK_NO_PROTOTYPES before it, or includes its loader's header first; the backend itself calls
 // every Vulkan function through the loader it is given.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <vulkan/vulkan_core.h>
@@ -66,6 +71,33 @@ public:
     VkPhysicalDeviceFeatures enabledFeatures{};
   };
 
+  /// The SPIR-V of one program variant: `program` is the pass's path in crep::ShaderLibrary (e.g.
+  /// "passes/epipolar/resample.comp"), `defines` its variant's defines in the order the pass gives them (as
+  /// crep::programVariantsBuilt() and the "variants" of the installed resources.json list them; empty: the
+  /// default variant). Called on the thread that calls the backend, once per distinct variant, when a pass
+  /// prepares it (prepareProgram) or first dispatches it; the module is kept for the backend's lifetime.
+  ///
+  /// Returns the module's bytes, or nothing to have the backend compile that variant's GLSL itself. A
+  /// module must be what the backend would have compiled (docs/PORTABLE_SHADERS.md, "Bindings" and "Push
+  /// constants"; the installed share/crepuscular/shaders/spirv/ files are such modules):
+  /// - SPIR-V 1.0 to 1.3 (Vulkan 1.1), in host byte order, with a compute entry point named "main" of the
+  ///   pass's work-group size;
+  /// - every resource in descriptor set 0, at binding gpu::Resource::binding plus its kind's base: a
+  ///   sampled texture at + 0, one VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER (an OpTypeSampledImage
+  ///   variable, not a separate image and sampler), a storage image at + 16, a uniform block at + 24, a
+  ///   storage block at + 32, the blocks in the std140 / std430 layouts of the library's gpu::*Params;
+  /// - the per-dispatch values (gpu::Dispatch::push) as one push-constant block, each member at the next
+  ///   std430 offset of its type, in the order they are given (gpu::packPushConstants);
+  /// - a storage image that is read declares its format (the backend does not enable
+  ///   shaderStorageImageReadWithoutFormat); one written without a format needs
+  ///   shaderStorageImageWriteWithoutFormat, which the backend requires.
+  /// Checked: the size is a non-zero multiple of 4 bytes and the first word is the SPIR-V magic number
+  /// 0x07230203, else InvalidArgument naming CreateInfo::shaderBinary and the program. The rest is the
+  /// engine's: a module that breaks the rules is undefined behaviour (the validation layer reports most).
+  /// An exception thrown by the provider leaves the call that needed the module.
+  using ShaderBinaryProvider =
+      std::function<std::vector<std::byte>(std::string_view program, std::span<const ShaderDefine> defines)>;
+
   struct CreateInfo {
     /// Self-created device only: turns on VK_LAYER_KHRONOS_validation (Debian package
     /// vulkan-validationlayers) and records each of its warnings and errors (validationMessages()). Default
@@ -85,6 +117,10 @@ public:
     /// Frames the engine records before it waits for the oldest of them (beginFrame()): the rings of
     /// per-frame data (descriptor sets, staging, retired objects) hold this many. In [1, 16], default 3.
     std::uint32_t framesInFlight = 3;
+    /// Optional: the engine's precompiled SPIR-V for a program variant, e.g. shipped with the engine and
+    /// loaded from disk, so that no shader is compiled at run time. Empty (default): every variant is
+    /// compiled from the library's GLSL with shaderc, as ShaderBinaryProvider says for an empty result.
+    ShaderBinaryProvider shaderBinary{};
   };
 
   /// One frame recorded into the engine's command buffer (docs/VULKAN_STATE.md).
