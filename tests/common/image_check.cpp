@@ -17,6 +17,23 @@
 
 namespace crep::test {
 
+double relativeRmse(std::span<const float> actual, std::span<const float> reference, long long& nonFinite) {
+  REQUIRE(actual.size() == reference.size());
+  double squared = 0.0, sum = 0.0;
+  nonFinite = 0;
+  for (std::size_t i = 0; i < actual.size(); ++i) {
+    if (!std::isfinite(actual[i])) {
+      ++nonFinite;
+      continue;
+    }
+    const double d = static_cast<double>(actual[i]) - reference[i];
+    squared += d * d;
+    sum += static_cast<double>(reference[i]) * reference[i];
+  }
+  REQUIRE(sum > 0.0);
+  return std::sqrt(squared / sum);
+}
+
 namespace {
 
 std::string sanitize(const std::string& name) {

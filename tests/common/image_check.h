@@ -6,10 +6,15 @@
 #include <crep/support/image_compare.h>
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace crep::test {
+
+/// Relative RMSE of the float values `actual` against `reference` (same count; doctest REQUIRE), skipping
+/// the non-finite values of `actual`, which `nonFinite` counts; the reference must not be all zero.
+double relativeRmse(std::span<const float> actual, std::span<const float> reference, long long& nonFinite);
 
 /// Directory for test artifacts: $CREP_TEST_OUTPUT_DIR if set and non-empty, else the
 /// CREP_TEST_OUTPUT_DIR macro (set by tests/CMakeLists.txt), else <temp>/crep-test-output.

@@ -9,6 +9,7 @@
 // maps. Frames: forest (sun projective: prefiltered with a froxel volume, then the min/max march), sunset
 // (the sun in view: epipolar layout, prefiltered and min/max march), stained-glass (a light texture on the
 // sun), colonnade-night (its three spots, one more in view on its epipolar layout, and a point light).
+#include "common/image_check.h"
 #include "common/shader_tools.h"
 #include "common/synthetic_engine_maps.h"
 #include "common/vulkan_fixture.h"
@@ -36,6 +37,7 @@
 #include <vector>
 
 using namespace crep;
+using crep::test::relativeRmse;
 
 namespace {
 
@@ -169,24 +171,6 @@ Output run(gpu::Backend& b, const scenes::Scene& scene, const scenes::EngineMaps
   out.rgba = b.readTexture(output.id());
   if (frame.froxels) out.volume = b.readTexture(volume.id());
   return out;
-}
-
-/// Relative RMSE of `a` against `b` over all four channels; `nonFinite` counts a's NaN and Inf.
-double relativeRmse(const std::vector<float>& a, const std::vector<float>& b, long long& nonFinite) {
-  REQUIRE(a.size() == b.size());
-  double squared = 0.0, reference = 0.0;
-  nonFinite = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!std::isfinite(a[i])) {
-      ++nonFinite;
-      continue;
-    }
-    const double d = static_cast<double>(a[i]) - b[i];
-    squared += d * d;
-    reference += static_cast<double>(b[i]) * b[i];
-  }
-  REQUIRE(reference > 0.0);
-  return std::sqrt(squared / reference);
 }
 
 std::string joined(const std::set<std::string>& names) {

@@ -6,6 +6,7 @@
 // spot added in view, from their perspective maps, no sun), and stained-glass (a light texture on the sun);
 // froxel volumes filled on the sunlit ones. Bar: relative RMSE <= 1e-4 between the backends' outputs.
 #include "common/gl_fixture.h"
+#include "common/image_check.h"
 #include "common/vulkan_fixture.h"
 
 #include <crep/core/error.h>
@@ -23,6 +24,7 @@
 #include <vector>
 
 using namespace crep;
+using crep::test::relativeRmse;
 
 namespace {
 
@@ -83,23 +85,6 @@ FrameOutput frameOn(gpu::Backend& b, const EngineInputs& in, Scattering::CreateI
   out.rgba = b.readTexture(output.id());
   if (grid != nullptr) out.volume = b.readTexture(volume.id());
   return out;
-}
-
-/// Relative RMSE of `a` against `b` over all four channels; `nonFinite` counts a's NaN and Inf.
-double relativeRmse(const std::vector<float>& a, const std::vector<float>& b, long long& nonFinite) {
-  REQUIRE(a.size() == b.size());
-  double squared = 0.0, reference = 0.0;
-  nonFinite = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (!std::isfinite(a[i])) {
-      ++nonFinite;
-      continue;
-    }
-    const double d = static_cast<double>(a[i]) - b[i];
-    squared += d * d;
-    reference += static_cast<double>(b[i]) * b[i];
-  }
-  return std::sqrt(squared / reference);
 }
 
 } // namespace
