@@ -219,7 +219,6 @@ void Engine::createPipelines() {
   check(vkCreatePipelineLayout(device_, &pl, nullptr, &pipelineLayout_), "vkCreatePipelineLayout");
 
   VkShaderModuleCreateInfo mi{};
-
   mi.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
   mi.codeSize = sizeof(kDepthVertex);
   mi.pCode = kDepthVertex;

@@ -4,6 +4,7 @@
 // engine precompiling for D3D12 or Metal (crep::programVariantsBuilt) can take each of them; and each is
 // shipped (resources.json's "passes" or "variants", declared in glsl/portable_variants.txt), so the list
 // cannot fall behind the frames.
+#include "common/frame_extras.h"
 #include "common/gl_fixture.h"
 #include "common/shader_tools.h"
 #include "pipeline/scattering_frame.h"
@@ -67,10 +68,7 @@ TEST_CASE("portable shaders: every program variant of the front door's frames co
   const SpotLight spots[] = {
       spotToward(c, c.position() - 4.0 * c.forward() + 7.0 * c.up()),
       spotToward(c, c.position() + 9.0 * c.forward() + 1.5 * c.up() - 1.0 * c.right())};
-  const PointLight point({.position = c.position() - 8.0 * c.right() + 4.0 * c.up() - 6.0 * c.forward(),
-                          .color = {1.0, 0.8, 0.6},
-                          .intensity = 60.0,
-                          .range = 80.0});
+  const PointLight point = crep::test::pointBehindLeft(c);
   Scattering::FrameAttribs local = f.attribs(true, false);
   local.light = nullptr;
   local.spotLights = std::span<const SpotLight>(spots);

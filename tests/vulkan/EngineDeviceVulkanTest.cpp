@@ -8,6 +8,7 @@
 // with descriptor sets from pools; a device without a required feature, a missing loader or handle is named;
 // the engine's layer reports nothing, the destruction of its device included (objects left behind).
 #include "common/atmosphere_tables.h"
+#include "common/frame_extras.h"
 #include "common/synthetic_engine_maps.h"
 #include "common/vulkan_fixture.h"
 
@@ -84,22 +85,16 @@ std::vector<Output> runFrames(gpu::Backend& b) {
       info.backend = &b;
       Scattering scattering(info);
       Scattering::FrameAttribs f = engine.attribs(output.id());
-      FroxelGrid grid;
-      grid.width = 20;
-      grid.height = 12;
-      grid.depth = 16;
-      gpu::Texture volume;
-      Scattering::FroxelTarget froxels;
+      const FroxelGrid grid{.width = 20, .height = 12, .depth = 16};
+      crep::test::FroxelVolume volume;
       if (variant.froxels) {
-        volume = gpu::Texture(b, {gpu::TextureType::Texture3D, gpu::Format::RGBA32F, grid.width, grid.height,
-                                  grid.depth, "froxels"});
-        froxels = {volume.id(), grid, glm::dvec3(0.25, -0.25, 0.5)};
-        f.froxels = &froxels;
+        volume = crep::test::FroxelVolume(b, grid, gpu::Format::RGBA32F);
+        f.froxels = &volume.target;
       }
       scattering.run(f);
       const std::string label = name + ", " + variant.label;
       out.push_back({label, b.readTexture(output.id())});
-      if (variant.froxels) out.push_back({label + ": volume", b.readTexture(volume.id())});
+      if (variant.froxels) out.push_back({label + ": volume", b.readTexture(volume.texture.id())});
     }
   }
   AtmosphereTablesPass tables(crep::test::smallAtmosphereTables(1, &b));

@@ -9,6 +9,7 @@
 // maps. Frames: forest (sun projective: prefiltered with a froxel volume, then the min/max march), sunset
 // (the sun in view: epipolar layout, prefiltered and min/max march), stained-glass (a light texture on the
 // sun), colonnade-night (its three spots, one more in view on its epipolar layout, and a point light).
+#include "common/frame_extras.h"
 #include "common/image_check.h"
 #include "common/shader_tools.h"
 #include "common/synthetic_engine_maps.h"
@@ -154,22 +155,16 @@ Output run(gpu::Backend& b, const scenes::Scene& scene, const scenes::EngineMaps
   info.backend = &b;
   Scattering scattering(info);
   Scattering::FrameAttribs f = engine.attribs(output.id());
-  FroxelGrid grid;
-  grid.width = 20;
-  grid.height = 12;
-  grid.depth = 16;
-  gpu::Texture volume;
-  Scattering::FroxelTarget froxels;
+  const FroxelGrid grid{.width = 20, .height = 12, .depth = 16};
+  crep::test::FroxelVolume volume;
   if (frame.froxels) {
-    volume = gpu::Texture(b, {gpu::TextureType::Texture3D, gpu::Format::RGBA16F, grid.width, grid.height,
-                              grid.depth, "froxels"});
-    froxels = {volume.id(), grid, glm::dvec3(0.25, -0.25, 0.5)};
-    f.froxels = &froxels;
+    volume = crep::test::FroxelVolume(b, grid, gpu::Format::RGBA16F);
+    f.froxels = &volume.target;
   }
   Output out;
   out.result = scattering.run(f);
   out.rgba = b.readTexture(output.id());
-  if (frame.froxels) out.volume = b.readTexture(volume.id());
+  if (frame.froxels) out.volume = b.readTexture(volume.texture.id());
   return out;
 }
 
@@ -205,18 +200,8 @@ TEST_CASE("Vulkan backend: crep::Scattering frames run from the installed HLSL (
       // A spot in view, 6 units ahead of the camera and 1 up, aimed down and forward (its epipolar layout,
       // Klehm et al. 2014, Sec. 4.1), and a point light behind the camera to the left.
       const Camera& c = scene.camera;
-      scene.spotLights.push_back(SpotLight({.position = c.position() + 6.0 * c.forward() + 1.0 * c.up(),
-                                            .direction = c.forward() - 2.0 * c.up(),
-                                            .innerConeAngle = 0.4,
-                                            .outerConeAngle = 0.6,
-                                            .color = {1.0, 0.8, 0.6},
-                                            .intensity = 20.0,
-                                            .range = 40.0}));
-      scene.pointLights.push_back(
-          PointLight({.position = c.position() - 8.0 * c.right() + 4.0 * c.up() - 6.0 * c.forward(),
-                      .color = {1.0, 0.8, 0.6},
-                      .intensity = 60.0,
-                      .range = 80.0}));
+      scene.spotLights.push_back(crep::test::spotInView(c));
+      scene.pointLights.push_back(crep::test::pointBehindLeft(c));
     }
     scenes::EngineMaps maps = crep::test::syntheticMaps(scene, kWidth, kHeight, kSunMap);
     for (std::size_t i = 0; i < scene.spotLights.size(); ++i)

@@ -5,6 +5,7 @@
 // epipolar layout and its tree-marched epipole block) at 320x180, colonnade-night (its local lights and a
 // spot added in view, from their perspective maps, no sun), and stained-glass (a light texture on the sun);
 // froxel volumes filled on the sunlit ones. Bar: relative RMSE <= 1e-4 between the backends' outputs.
+#include "common/frame_extras.h"
 #include "common/gl_fixture.h"
 #include "common/image_check.h"
 #include "common/vulkan_fixture.h"
@@ -41,14 +42,7 @@ EngineInputs renderInputs(const std::string& name) {
   if (name == "colonnade-night") {
     // And a spot in view, 6 units ahead of the camera and 1 up, aimed down and forward: its rectification
     // falls back to its epipolar layout (Klehm et al. 2014, Sec. 4.1) with a world-marched epipole block.
-    const Camera& c = in.scene.camera;
-    in.scene.spotLights.push_back(SpotLight({.position = c.position() + 6.0 * c.forward() + 1.0 * c.up(),
-                                             .direction = c.forward() - 2.0 * c.up(),
-                                             .innerConeAngle = 0.4,
-                                             .outerConeAngle = 0.6,
-                                             .color = {1.0, 0.8, 0.6},
-                                             .intensity = 20.0,
-                                             .range = 40.0}));
+    in.scene.spotLights.push_back(crep::test::spotInView(in.scene.camera));
   }
   in.maps = scenes::renderEngineMaps(in.scene, kWidth, kHeight, kSunMap, kLocalMap);
   return in;
@@ -72,18 +66,15 @@ FrameOutput frameOn(gpu::Backend& b, const EngineInputs& in, Scattering::CreateI
   Scattering scattering(info);
   Scattering::FrameAttribs f = engine.attribs(output.id());
   // A froxel volume filled from the same basis (the scene's light texture comes with the engine frame).
-  gpu::Texture volume;
-  Scattering::FroxelTarget froxels;
+  crep::test::FroxelVolume volume;
   if (grid != nullptr) {
-    volume = gpu::Texture(b, {gpu::TextureType::Texture3D, gpu::Format::RGBA16F, grid->width, grid->height,
-                              grid->depth, "froxels"});
-    froxels = {volume.id(), *grid, glm::dvec3(0.25, -0.25, 0.5)};
-    f.froxels = &froxels;
+    volume = crep::test::FroxelVolume(b, *grid, gpu::Format::RGBA16F);
+    f.froxels = &volume.target;
   }
   FrameOutput out;
   out.result = scattering.run(f);
   out.rgba = b.readTexture(output.id());
-  if (grid != nullptr) out.volume = b.readTexture(volume.id());
+  if (grid != nullptr) out.volume = b.readTexture(volume.texture.id());
   return out;
 }
 
