@@ -45,6 +45,9 @@
 // passes/pipeline/accumulate.comp
 #define CREP_ACCUMULATE_ACCUMULATED_IMAGE  0 // crep_accumulated
 #define CREP_ACCUMULATE_ADDEND_IMAGE       1 // crep_addend
+// passes/pipeline/reverse_depth.comp
+#define CREP_REVERSE_DEPTH_MAP_UNIT        0 // crep_reversedMap
+#define CREP_REVERSE_DEPTH_OUT_IMAGE       0 // crep_depthOut
 
 // passes/atmosphere/atmosphere.comp
 #define CREP_ATMOSPHERE_MARCH_BINDING              0 // CrepMarchBlock

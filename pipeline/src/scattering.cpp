@@ -12,7 +12,6 @@
 #include <crep/gpu/gl_backend.h>
 #include <crep/gpu/gl_state.h>
 #include <crep/gpu/shader_library.h>
-#include <crep/pipeline/rectified_shadow_pass.h>
 #include <crep/pipeline/reduced_resolution.h>
 #include <crep/pipeline/scattering.h>
 #include <crep/prefilter/fourier.h>
@@ -184,11 +183,12 @@ void validateLocalShadowMaps(const gpu::Backend& backend, const Scattering::Fram
   if (!f.pointShadowMaps.empty() && f.pointShadowMaps.size() != 6 * f.pointLights.size())
     invalid(prefix + "pointShadowMaps", "size " + std::to_string(f.pointShadowMaps.size()),
             "must be 0 or 6 * pointLights.size() = " + std::to_string(6 * f.pointLights.size()));
-  if (!f.drawCasters && !f.spotLights.empty() && f.spotShadowMaps.empty())
-    invalid(prefix + "drawCasters", "empty", "spot lights without spotShadowMaps render their maps with it");
-  if (!f.drawCasters && !f.pointLights.empty() && f.pointShadowMaps.empty())
+  if (!f.drawCasters && !f.plan && !f.spotLights.empty() && f.spotShadowMaps.empty())
     invalid(prefix + "drawCasters", "empty",
-            "point lights without pointShadowMaps render their maps with it");
+            "spot lights without spotShadowMaps or a plan render their maps with it");
+  if (!f.drawCasters && !f.plan && !f.pointLights.empty() && f.pointShadowMaps.empty())
+    invalid(prefix + "drawCasters", "empty",
+            "point lights without pointShadowMaps or a plan render their maps with it");
   for (std::size_t i = 0; i < f.spotShadowMaps.size(); ++i) {
     const SpotLight& spot = f.spotLights[i];
     // Eight directions on the outer cone: nothing is emitted beyond it.
@@ -282,6 +282,151 @@ void requireOutputNotAnInput(const Scattering::FrameAttribs& f, const std::strin
     check(f.spotShadowMaps[i].texture, "FrameAttribs.spotShadowMaps[" + std::to_string(i) + "].texture");
   for (std::size_t i = 0; i < f.pointShadowMaps.size(); ++i)
     check(f.pointShadowMaps[i].texture, "FrameAttribs.pointShadowMaps[" + std::to_string(i) + "].texture");
+  for (std::size_t i = 0; i < f.planMaps.size(); ++i)
+    check(f.planMaps[i], "FrameAttribs.planMaps[" + std::to_string(i) + "]");
+}
+
+/// A frame's rectifications and the shadow-pass plan made of them (Scattering::plan; run() makes the same
+/// from the same inputs, deterministically).
+struct PlannedFrame {
+  Rectification sun;                 ///< with FrameAttribs::light
+  std::vector<Rectification> locals; ///< the spots, then the six faces of each point light
+  ShadowPassPlan plan;
+};
+
+ShadowPass::Rect rectOf(const SplitViewport& v) {
+  return {v.x, v.y, v.width, v.height};
+}
+
+// One light's pass: Sec. 4.2's rectified map of K splits when projective; the standard map of `standard`
+// (OpenGL convention) that the fallback resamples (Sec. 4.1) or marches; nothing for an empty frustum.
+ShadowPass plannedPass(const Scattering::CreateInfo& info, const ShadowPassPlanOptions& options,
+                       const Rectification& rect, bool sun, const auto& standard, bool served) {
+  ShadowPass p;
+  p.status = rect.status;
+  p.reason = rect.reason;
+  p.message = rect.message;
+  p.clearDepth = options.reversedZ ? 0.0 : 1.0;
+  p.compare = options.reversedZ ? DepthCompare::Greater : DepthCompare::Less;
+  if (rect.projective()) {
+    p.kind = ShadowPass::Kind::Rectified;
+    p.width = p.height = info.mapSize;
+    for (int k = 0; k < rect.splitCount(); ++k) {
+      const ShadowPass::Rect v = rectOf(rect.splitViewport(k, info.mapSize, info.mapSize));
+      p.splits.push_back(
+          {toClipConvention(rect.splits[static_cast<std::size_t>(k)].rectClipFromWorld, options), v, v});
+    }
+  } else if (sun || rect.status == RectifyStatus::Fallback) { // the sun's "empty" falls back too
+    p.kind = ShadowPass::Kind::Standard;
+    p.served = served;
+    p.width = p.height = info.ownShadowMapSize;
+    p.glClipFromWorld = standard();
+    const ShadowPass::Rect all{0, 0, p.width, p.height};
+    if (!served) p.splits.push_back({toClipConvention(p.glClipFromWorld, options), all, all});
+  }
+  return p;
+}
+
+PlannedFrame planFrame(const Scattering::CreateInfo& info, const Scattering::FrameAttribs& f,
+                       const ShadowPassPlanOptions& options, std::uint64_t frame) {
+  PlannedFrame planned;
+  planned.plan.frame = frame;
+  planned.plan.options = options;
+  std::vector<ShadowPass>& passes = planned.plan.passes;
+  if (f.light) {
+    planned.sun = rectify(*f.camera, *f.light, info.rectify);
+    // The fallback's standard map covers the view frustum (casters nearer the light kept by depth clamp).
+    passes.push_back(plannedPass(
+        info, options, planned.sun, true,
+        [&] { return orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners()); },
+        f.shadowMap != nullptr));
+  }
+  for (std::size_t i = 0; i < f.spotLights.size(); ++i) {
+    const SpotLight& spot = f.spotLights[i];
+    planned.locals.push_back(rectify(*f.camera, spot, info.rectify));
+    passes.push_back(plannedPass(
+        info, options, planned.locals.back(), false, [&] { return spot.lightClipFromWorld(); },
+        !f.spotShadowMaps.empty()));
+    passes.back().light = ShadowPass::Light::Spot;
+    passes.back().index = static_cast<int>(i);
+  }
+  for (std::size_t i = 0; i < f.pointLights.size(); ++i) {
+    const PointLight& point = f.pointLights[i];
+    const std::array<Rectification, 6> faces = rectifyPointLight(*f.camera, point, info.rectify);
+    for (int face = 0; face < 6; ++face) {
+      planned.locals.push_back(faces[static_cast<std::size_t>(face)]);
+      passes.push_back(plannedPass(
+          info, options, planned.locals.back(), false, [&] { return point.faceClipFromWorld(face); },
+          !f.pointShadowMaps.empty()));
+      passes.back().light = ShadowPass::Light::PointFace;
+      passes.back().index = static_cast<int>(i);
+      passes.back().face = face;
+    }
+  }
+  return planned;
+}
+
+std::string describe(const ShadowPass& p) {
+  const char* kinds[] = {"none", "rectified", "standard"};
+  std::string light = p.light == ShadowPass::Light::Sun ? std::string("the sun")
+                      : p.light == ShadowPass::Light::Spot
+                          ? "spot " + std::to_string(p.index)
+                          : "point light " + std::to_string(p.index) + " face " + std::to_string(p.face);
+  return light + ", " + kinds[static_cast<int>(p.kind)] + " " + std::to_string(p.width) + "x" +
+         std::to_string(p.height);
+}
+
+bool samePass(const ShadowPass& a, const ShadowPass& b) {
+  if (a.light != b.light || a.index != b.index || a.face != b.face || a.kind != b.kind ||
+      a.served != b.served || a.width != b.width || a.height != b.height ||
+      a.glClipFromWorld != b.glClipFromWorld || a.splits.size() != b.splits.size())
+    return false;
+  for (std::size_t k = 0; k < a.splits.size(); ++k)
+    if (a.splits[k].clipFromWorld != b.splits[k].clipFromWorld ||
+        a.splits[k].viewport != b.splits[k].viewport || a.splits[k].scissor != b.splits[k].scissor)
+      return false;
+  return true;
+}
+
+/// FrameAttribs::plan and planMaps: this run's plan (`expected`, made from the frame) and one map per pass
+/// that needs one, of its size and a depth format (or R32F).
+void validatePlan(const gpu::Backend& backend, const Scattering::FrameAttribs& f,
+                  const ShadowPassPlan& expected, const std::string& prefix) {
+  const ShadowPassPlan& plan = *f.plan;
+  if (f.drawCasters)
+    invalid(prefix + "drawCasters", "set with a plan", "must be empty: the plan's maps are the engine's");
+  if (plan.frame != expected.frame)
+    invalid(prefix + "plan", "made for run " + std::to_string(plan.frame),
+            "must be this run's (" + std::to_string(expected.frame) +
+                "): call plan() every frame, before its shadow passes");
+  if (plan.passes.size() != expected.passes.size())
+    invalid(prefix + "plan", std::to_string(plan.passes.size()) + " passes",
+            "must have this frame's " + std::to_string(expected.passes.size()) +
+                " (one per light: the lights changed since plan())");
+  if (plan.options.convention != expected.options.convention ||
+      plan.options.reversedZ != expected.options.reversedZ)
+    invalid(prefix + "plan.options", "changed", "must be those plan() was called with");
+  for (std::size_t i = 0; i < plan.passes.size(); ++i)
+    if (!samePass(plan.passes[i], expected.passes[i]))
+      invalid(prefix + "plan.passes[" + std::to_string(i) + "]", describe(plan.passes[i]),
+              "must be this frame's (" + describe(expected.passes[i]) +
+                  "): the camera, the lights, the given maps or the options changed since plan()");
+  if (f.planMaps.size() != plan.passes.size())
+    invalid(prefix + "planMaps", "size " + std::to_string(f.planMaps.size()),
+            "must have one entry per plan pass (" + std::to_string(plan.passes.size()) + ")");
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    const ShadowPass& pass = plan.passes[i];
+    const std::string field = prefix + "planMaps[" + std::to_string(i) + "]";
+    if (!pass.needsMap()) {
+      if (f.planMaps[i] != 0)
+        invalid(field, "texture " + std::to_string(f.planMaps[i]),
+                "must be 0: pass " + std::to_string(i) + " (" + describe(pass) +
+                    (pass.served ? ", served" : "") + ") has no map");
+      continue;
+    }
+    gpu::requireTexture2DOf(backend, field.c_str(), f.planMaps[i], pass.width, pass.height);
+    gpu::requireDepthFormatOf(backend, field.c_str(), f.planMaps[i]);
+  }
 }
 
 /// A depth-only render target: a GL_DEPTH_COMPONENT32F texture and its framebuffer.
@@ -295,16 +440,26 @@ struct DepthTarget {
     glNamedFramebufferDrawBuffer(framebuffer.get(), GL_NONE);
     glNamedFramebufferReadBuffer(framebuffer.get(), GL_NONE);
   }
-  /// Clears to 1 and calls draw() with the contract's raster state (docs/GL_STATE.md), restored after;
+  /// The GL convenience of a plan's pass (OpenGL convention): clears once, then draws each split's casters
+  /// in its viewport and scissor, with the contract's raster state (docs/GL_STATE.md), restored after;
   /// `callback` names the caller's callback when it leaves that state changed.
-  template <class Draw>
-  void render(const char* callback, const Draw& draw) {
+  void render(const char* callback, const ShadowPass& pass,
+              const std::function<void(const glm::dmat4& clipFromWorld)>& draw) {
     gl::DepthPassScope scope(framebuffer.get(), size, size);
-    const float one = 1.0f;
-    glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &one);
-    draw();
+    const float clear = static_cast<float>(pass.clearDepth);
+    glClearNamedFramebufferfv(framebuffer.get(), GL_DEPTH, 0, &clear); // once: the scissor box is the map
+    for (const ShadowPass::Split& split : pass.splits) {
+      const ShadowPass::Rect& v = split.viewport;
+      scope.setViewport(v.x, v.y, v.width, v.height); // and the scissor box: a clear stays inside the split
+      draw(split.clipFromWorld);
+    }
     scope.requireUnchanged(callback);
     gl::checkError((std::string("the shadow map drawn by ") + callback).c_str()); // the callback's own errors
+  }
+  /// Made on first use; the same target for every frame.
+  static DepthTarget& of(std::optional<DepthTarget>& target, int size) {
+    if (!target) target.emplace(size);
+    return *target;
   }
 };
 
@@ -350,7 +505,6 @@ struct Scattering::Impl {
         evaluate(evaluateInfo(i.prefilter.bases, i.evaluate, i.localLightClosedForm, backend)),
         resample({.mapWidth = i.mapSize, .mapHeight = i.mapSize, .backend = backend}),
         block({.options = i.epipoleBlock, .backend = backend}) {
-    if (gl) rectified.emplace(RectifiedShadowPass::CreateInfo{i.mapSize, i.mapSize});
     resampled = gpu::Texture(*backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, i.mapSize, i.mapSize,
                                         1, "Scattering: resampled map"});
     // The min/max trees and their march: Method::MinMaxMarch's, or the prefiltered method's epipole block.
@@ -392,9 +546,11 @@ struct Scattering::Impl {
   EvaluatePass evaluate;
   ShadowResamplePass resample;
   WorldMarchPass block;
-  std::optional<RectifiedShadowPass> rectified;  ///< GL: the projective map rasterized with drawCasters
-  gpu::Texture resampled;                        ///< R32F: a map resampled from a standard shadow map
+  std::optional<DepthTarget> rectified; ///< GL: the projective map rasterized with drawCasters
+  /// R32F: a map resampled from a standard shadow map, or a reversed-Z plan map turned back
+  gpu::Texture resampled;
   std::optional<DepthTarget> ownShadowMap;       ///< fallback frames with drawCasters only
+  gpu::Texture unreversedStandard;               ///< a reversed-Z plan's standard map turned back (R32F)
   std::optional<DepthAwareResamplePass> reduced; ///< evaluationScale < 1
   gpu::Texture lowDepth, lowOutput;              ///< its camera depth (R32F) and scattering (RGBA32F)
   /// Method::MinMaxMarch, or the prefiltered method's tree-marched epipole block: the map's trees ...
@@ -420,8 +576,33 @@ struct Scattering::Impl {
   /// made on the first frame with local lights; their fallback's perspective shadow map.
   gpu::Texture localScattering;
   std::optional<DepthTarget> localShadowMap;
-  std::optional<RectifiedShadowPass> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
-  gpu::Texture localResampled; ///< R32F mapSize^2: a local light's map resampled from the engine's map
+  std::optional<DepthTarget> localRectified; ///< keeps FrameResult::rectifiedMap the directional one
+  /// R32F mapSize^2: a local light's map resampled from the engine's map, or its reversed-Z plan map turned
+  /// back; the same for its standard map.
+  gpu::Texture localResampled, localUnreversedStandard;
+  gpu::Texture& localMap() {
+    if (!localResampled)
+      localResampled = gpu::Texture(*backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, info.mapSize,
+                                               info.mapSize, 1, "Scattering: local map"});
+    return localResampled;
+  }
+  /// A reversed-Z map of the engine's plan (ShadowPassPlanOptions::reversedZ) as depth-buffer values into
+  /// `target` (R32F, made here at the map's size on first use): one pass over its texels.
+  std::uint32_t unreversed(std::uint32_t map, const ShadowPass& pass, gpu::Texture& target,
+                           const char* label) {
+    if (!target)
+      target = gpu::Texture(
+          *backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, pass.width, pass.height, 1, label});
+    gpu::Dispatch d;
+    d.label = "Scattering::run (reversed-Z map)";
+    d.program = "passes/pipeline/reverse_depth.comp";
+    d.resources = {gpu::Resource::sampled(CREP_REVERSE_DEPTH_MAP_UNIT, map),
+                   gpu::Resource::image(CREP_REVERSE_DEPTH_OUT_IMAGE, target.id(), gpu::Access::WriteOnly)};
+    d.groups = glm::uvec3(static_cast<unsigned>((pass.width + 7) / 8),
+                          static_cast<unsigned>((pass.height + 7) / 8), 1u);
+    backend->dispatch(d);
+    return target.id();
+  }
   /// The local lights' own passes for an M (CreateInfo::spotLightBases, localLightBases) or table samples
   /// (spotLightTableSamples, localLightTableSamples) that differ from the directional light's, made on
   /// first use; the evaluations keyed by (M, Z).
@@ -543,8 +724,10 @@ struct Scattering::Impl {
     bool treesFromResample = false; ///< the resampling wrote the trees' low levels
   };
   bool marching() const { return info.method == Method::MinMaxMarch; }
-  void projectiveMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d);
-  void epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d);
+  void projectiveMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d, const ShadowPass& pass,
+                     std::uint32_t planMap);
+  void epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d, const ShadowPass& pass,
+                   std::uint32_t planMap);
   void evaluateRays(const FrameAttribs& f, const DirectionalMap& d, std::uint32_t depth, std::uint32_t output,
                     const gpu::SampleList* list, bool reuseTable);
   void evaluatePixels(const FrameAttribs& f, FrameResult& r, const DirectionalMap& d);
@@ -552,8 +735,13 @@ struct Scattering::Impl {
 
   struct LocalLightRun;
   void runLocalLight(const FrameAttribs& f, FrameResult& r, const LocalLight& light,
-                     const Rectification& rect, const glm::dmat4& lightClipFromWorld, const ShadowMap* given,
-                     const GpuLightTexture* texture, LightResult result);
+                     const Rectification& rect, const ShadowPass& pass, std::uint32_t planMap,
+                     const ShadowMap* given, const GpuLightTexture* texture, LightResult result);
+  void runLocalLights(const FrameAttribs& f, FrameResult& r, const PlannedFrame& planned);
+  /// The map the engine rendered for plan pass `i` (FrameAttribs::planMaps), 0 without a plan.
+  static std::uint32_t planMap(const FrameAttribs& f, std::size_t i) {
+    return f.plan != nullptr && i < f.planMaps.size() ? f.planMaps[i] : 0u;
+  }
   /// Adds the local light's scattering to the output.
   void addLocalScattering(const FrameAttribs& f);
 };
@@ -574,14 +762,18 @@ std::size_t Scattering::memoryBytes() const noexcept {
   const std::size_t map =
       static_cast<std::size_t>(m.info.mapSize) * static_cast<std::size_t>(m.info.mapSize) * 4;
   // The R32F resampled map, and the D32F rasterized one once a frame has drawn casters into it.
-  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() +
-                      (m.rectified ? m.rectified->memoryBytes() : 0) + map;
+  std::size_t bytes = m.prefilter.memoryBytes() + m.evaluate.memoryBytes() + (m.rectified ? map : 0) + map;
   if (m.reduced)
     bytes += static_cast<std::size_t>(m.reduced->lowWidth()) *
              static_cast<std::size_t>(m.reduced->lowHeight()) * 20;
   if (m.trees) bytes += m.trees->memoryBytes();
   if (m.sampling) bytes += m.sampling->memoryBytes();
-  if (m.localRectified) bytes += m.localRectified->memoryBytes();
+  if (m.localRectified) bytes += map;
+  if (m.unreversedStandard || m.localUnreversedStandard) {
+    const std::size_t standard = static_cast<std::size_t>(m.info.ownShadowMapSize) *
+                                 static_cast<std::size_t>(m.info.ownShadowMapSize) * 4;
+    bytes += (m.unreversedStandard ? standard : 0) + (m.localUnreversedStandard ? standard : 0);
+  }
   for (const auto& [M, pass] : m.localPrefilters)
     bytes += pass.memoryBytes();
   for (const auto& [M, pass] : m.localEvaluates)
@@ -675,6 +867,17 @@ void Scattering::Impl::reportTimes(FrameResult& r) {
   r.gpuTimes = std::move(times);
 }
 
+ShadowPassPlan Scattering::plan(const FrameAttribs& f, const ShadowPassPlanOptions& options) const {
+  if (!impl_)
+    invalid("Scattering", "a moved-from object",
+            "owns no GPU resources: assign a constructed Scattering first");
+  const std::string p = "Scattering::FrameAttribs.";
+  if (!f.camera) invalid(p + "camera", "null", "must be set");
+  if (!f.light && f.spotLights.empty() && f.pointLights.empty())
+    invalid(p + "light", "null", "must be set unless local lights are given");
+  return planFrame(impl_->info, f, options, impl_->running ? impl_->frames - 1 : impl_->frames).plan;
+}
+
 void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
   if (!impl_)
     invalid("Scattering", "a moved-from object",
@@ -705,13 +908,19 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
       invalid(p + "froxels", "set with CreateInfo.method = Method::MinMaxMarch",
               "needs Method::Prefiltered (the fill evaluates the prefiltered basis)");
   }
-  if (f.light && !f.drawCasters && !f.shadowMap)
-    invalid(p + "drawCasters/shadowMap", "both empty", "one shadow input must be given");
+  if (f.light && !f.drawCasters && !f.shadowMap && !f.plan)
+    invalid(p + "drawCasters/shadowMap", "both empty, and no plan",
+            "one shadow input must be given (drawCasters, shadowMap, or plan and planMaps)");
   if (f.drawCasters && !impl_->gl)
     invalid(p + "drawCasters", "set on the " + std::string(b.name()) + " backend",
             "draws with GL, on the OpenGL backend only: give shadowMap, spotShadowMaps and pointShadowMaps");
   validateLocalShadowMaps(b, f, p);
   validateLightTextures(b, f, info.evaluate, p);
+  if (f.plan) {
+    // This run's index: inside run() it has been counted already.
+    const std::uint64_t run = impl_->running ? impl_->frames - 1 : impl_->frames;
+    validatePlan(b, f, planFrame(info, f, f.plan->options, run).plan, p);
+  }
   if (f.light && f.shadowMap) {
     gpu::requireTexture2DOf(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
     gpu::requireDepthFormatOf(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
@@ -729,20 +938,24 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
   Impl& m = *impl_;
   validate(f);
   FrameResult r;
+  // The frame's plan: the engine's (FrameAttribs::plan, checked equal by validate()), or the GL
+  // convenience's, whose maps drawCasters renders.
+  const PlannedFrame planned =
+      planFrame(m.info, f, f.plan ? f.plan->options : ShadowPassPlanOptions{}, m.frames - 1);
   if (!f.light) {
     // A night frame: the transmittance, then the local lights added.
     m.stage(r, "transmittance", [&] { m.writeTransmittance(f); });
-    runLocalLights(f, r);
+    m.runLocalLights(f, r, planned);
     if (m.gl) gl::checkError("Scattering::run");
     return r;
   }
-  r.rectification = rectify(*f.camera, *f.light, m.info.rectify);
+  r.rectification = planned.sun;
   Impl::DirectionalMap d;
   d.shadow = f.shadowMap;
   if (r.rectification.projective())
-    m.projectiveMap(f, r, d);
+    m.projectiveMap(f, r, d, planned.plan.passes[0], Impl::planMap(f, 0));
   else
-    m.epipolarMap(f, r, d);
+    m.epipolarMap(f, r, d, planned.plan.passes[0], Impl::planMap(f, 0));
   r.rectifiedMap = {d.layout, d.map, m.info.mapSize, m.info.mapSize};
   // Light textures (Klehm et al. 2014, Sec. 3.2): the colour of every texel's light ray on this frame's
   // layout (projective or epipolar), prefiltered per colour channel.
@@ -773,23 +986,28 @@ Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
       m.evaluate.run(e);
     });
   if (r.layout == Layout::Epipolar && pixels && !m.marching()) m.epipoleBlock(f, r, d);
-  runLocalLights(f, r);
+  m.runLocalLights(f, r, planned);
   if (m.gl) gl::checkError("Scattering::run");
   return r;
 }
 
-// Klehm et al. 2014, Sec. 4.2: the casters rendered once per split with its matrix, or the engine's map
-// resampled.
-void Scattering::Impl::projectiveMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d) {
+// Klehm et al. 2014, Sec. 4.2: the engine's map of the plan's pass, or the casters rendered once per split
+// with its matrix (drawCasters), or the engine's standard map resampled.
+void Scattering::Impl::projectiveMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d,
+                                     const ShadowPass& pass, std::uint32_t planMap) {
   r.layout = Layout::Projective;
   auto projective = std::make_shared<const ProjectiveLayout>(r.rectification);
   d.layout = projective;
-  if (f.drawCasters) {
-    stage(r, "shadow pass (rectified)", [&] {
-      rectified->run(
-          {&r.rectification, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
-    });
-    d.map = rectified->depthTexture();
+  if (planMap != 0) {
+    d.map = planMap;
+    if (f.plan->options.reversedZ)
+      stage(r, "reversed-Z map",
+            [&] { d.map = unreversed(planMap, pass, resampled, "Scattering: resampled map"); });
+  } else if (f.drawCasters) {
+    DepthTarget& target = DepthTarget::of(rectified, info.mapSize);
+    stage(r, "shadow pass (rectified)",
+          [&] { target.render("Scattering::FrameAttribs.drawCasters", pass, f.drawCasters); });
+    d.map = target.texture.get();
   } else {
     stage(r, "resample (projective)", [&] {
       resample.run({projective.get(), d.shadow->texture, d.shadow->lightClipFromWorld, resampled.id()});
@@ -800,22 +1018,30 @@ void Scattering::Impl::projectiveMap(const FrameAttribs& f, FrameResult& r, Dire
 
 // Sec. 4.1: the standard shadow map resampled into epipolar slices (mapSize of them, so the cost of the frame
 // stays that of a projective one).
-void Scattering::Impl::epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d) {
+void Scattering::Impl::epipolarMap(const FrameAttribs& f, FrameResult& r, DirectionalMap& d,
+                                   const ShadowPass& pass, std::uint32_t planMap) {
   r.layout = Layout::Epipolar;
   const EpipolarOptions options = epipolarOptions(info, info.epipolarDepthWarp, info.epipoleBlockRadius);
   auto epipolar =
       std::make_shared<const EpipolarLayout>(*f.camera, *f.light, info.width, info.height, options);
   d.layout = epipolar;
   if (!d.shadow) {
-    if (!ownShadowMap) ownShadowMap.emplace(info.ownShadowMapSize);
-    d.own.texture = ownShadowMap->texture.get();
-    // A standard map covering the frustum (casters between the light and it are kept by GL_DEPTH_CLAMP).
-    d.own.lightClipFromWorld = orthographicLightClipFromWorld(*f.light, f.camera->frustumCorners());
+    // The plan's standard map covering the frustum (casters between the light and it kept by depth clamp):
+    // the engine's, or rendered with drawCasters.
+    d.own.lightClipFromWorld = pass.glClipFromWorld;
     d.own.bias = info.ownShadowMapBias;
-    stage(r, "shadow pass (standard)", [&] {
-      ownShadowMap->render("Scattering::FrameAttribs.drawCasters",
-                           [&] { f.drawCasters(d.own.lightClipFromWorld); });
-    });
+    if (planMap != 0) {
+      d.own.texture = planMap;
+      if (f.plan->options.reversedZ)
+        stage(r, "reversed-Z map", [&] {
+          d.own.texture = unreversed(planMap, pass, unreversedStandard, "Scattering: standard map");
+        });
+    } else {
+      DepthTarget& target = DepthTarget::of(ownShadowMap, info.ownShadowMapSize);
+      d.own.texture = target.texture.get();
+      stage(r, "shadow pass (standard)",
+            [&] { target.render("Scattering::FrameAttribs.drawCasters", pass, f.drawCasters); });
+    }
     d.shadow = &d.own;
   }
   r.shadowMap = *d.shadow;
@@ -965,7 +1191,8 @@ struct Scattering::Impl::LocalLightRun {
   const FrameAttribs& f;
   FrameResult& r;
   const LocalLight& light;
-  const glm::dmat4& lightClipFromWorld;
+  const ShadowPass& pass; ///< the plan's (the engine's, or the GL convenience's)
+  std::uint32_t planMap;  ///< the engine's map of `pass`, or 0
   const ShadowMap* given;
   const GpuLightTexture* texture;
   LightResult& result;
@@ -978,27 +1205,31 @@ struct Scattering::Impl::LocalLightRun {
     result.gpuMilliseconds += s.gpuMilliseconds;
   }
 
-  // The light's perspective map (the given one, else its own matrix's rendered with drawCasters).
+  // The light's perspective map: the given one, else the plan's standard pass (the engine's map, or rendered
+  // with drawCasters).
   ShadowMap perspectiveMap() {
     if (given) return *given;
-    if (!m.localShadowMap) m.localShadowMap.emplace(m.info.ownShadowMapSize);
-    timed("local light: shadow pass (perspective)", [&] {
-      m.localShadowMap->render("Scattering::FrameAttribs.drawCasters",
-                               [&] { f.drawCasters(lightClipFromWorld); });
-    });
-    return ShadowMap{m.localShadowMap->texture.get(), lightClipFromWorld, m.info.ownShadowMapBias};
+    ShadowMap map{planMap, pass.glClipFromWorld, m.info.ownShadowMapBias};
+    if (planMap != 0) {
+      if (f.plan->options.reversedZ)
+        timed("local light: reversed-Z map", [&] {
+          map.texture =
+              m.unreversed(planMap, pass, m.localUnreversedStandard, "Scattering: local standard map");
+        });
+      return map;
+    }
+    DepthTarget& target = DepthTarget::of(m.localShadowMap, m.info.ownShadowMapSize);
+    timed("local light: shadow pass (perspective)",
+          [&] { target.render("Scattering::FrameAttribs.drawCasters", pass, f.drawCasters); });
+    map.texture = target.texture.get();
+    return map;
   }
 
   // Sec. 4.1's point resampling of a perspective map into `layout` (no casters drawn).
   std::uint32_t resampled(const RectifiedLayout& layout, const ShadowMap& shadow, const char* name) {
-    if (!m.localResampled)
-      m.localResampled =
-          gpu::Texture(*m.backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, m.info.mapSize,
-                                    m.info.mapSize, 1, "Scattering: local map"});
-    timed(name, [&] {
-      m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, m.localResampled.id()});
-    });
-    return m.localResampled.id();
+    const std::uint32_t target = m.localMap().id();
+    timed(name, [&] { m.resample.run({&layout, shadow.texture, shadow.lightClipFromWorld, target}); });
+    return target;
   }
 
   // The light's map on `layout` prefiltered with its light-side factor and evaluated into its image.
@@ -1050,20 +1281,22 @@ struct Scattering::Impl::LocalLightRun {
     });
   }
 
-  // The projective rectification: the given map resampled, or the casters rendered per split.
+  // The projective rectification: the engine's map of the plan's pass, the given map resampled, or the
+  // casters rendered per split (drawCasters).
   void projective(const Rectification& rect) {
     const ProjectiveLayout layout(rect);
-    std::uint32_t map = 0;
-    if (given) {
+    std::uint32_t map = planMap;
+    if (planMap != 0) {
+      if (f.plan->options.reversedZ)
+        timed("local light: reversed-Z map",
+              [&] { map = m.unreversed(planMap, pass, m.localMap(), "Scattering: local map"); });
+    } else if (given) {
       map = resampled(layout, *given, "local light: resample (projective)");
     } else {
-      if (!m.localRectified)
-        m.localRectified.emplace(RectifiedShadowPass::CreateInfo{m.info.mapSize, m.info.mapSize});
-      timed("local light: shadow pass (rectified)", [&] {
-        m.localRectified->run(
-            {&rect, [&](int, const glm::dmat4& clipFromWorld) { f.drawCasters(clipFromWorld); }});
-      });
-      map = m.localRectified->depthTexture();
+      DepthTarget& target = DepthTarget::of(m.localRectified, m.info.mapSize);
+      timed("local light: shadow pass (rectified)",
+            [&] { target.render("Scattering::FrameAttribs.drawCasters", pass, f.drawCasters); });
+      map = target.texture.get();
     }
     prefiltered(layout, map);
   }
@@ -1100,7 +1333,7 @@ void Scattering::Impl::addLocalScattering(const FrameAttribs& f) {
 }
 
 void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, const LocalLight& light,
-                                     const Rectification& rect, const glm::dmat4& lightClipFromWorld,
+                                     const Rectification& rect, const ShadowPass& pass, std::uint32_t planMap,
                                      const ShadowMap* given, const GpuLightTexture* texture,
                                      LightResult result) {
   result.status = rect.status;
@@ -1110,7 +1343,7 @@ void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, cons
     r.localLights.push_back(result);
     return;
   }
-  LocalLightRun run{*this, f, r, light, lightClipFromWorld, given, texture, result};
+  LocalLightRun run{*this, f, r, light, pass, planMap, given, texture, result};
   currentLight = static_cast<int>(r.localLights.size()); // its deferred spans are its LightResult's
   if (rect.projective())
     run.projective(rect);
@@ -1127,13 +1360,15 @@ void Scattering::Impl::runLocalLight(const FrameAttribs& f, FrameResult& r, cons
 // Klehm et al. 2014, Sec. 3.2 "Local Lights": every spot light and point-light face rectified for the camera,
 // prefiltered with its light-side factor on its projective layout, or in or near the view on its epipolar
 // layout (or marched in world space, CreateInfo::localLightFallback), and added.
-void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
-  Impl& m = *impl_;
-  const CreateInfo& info = m.info;
+void Scattering::Impl::runLocalLights(const FrameAttribs& f, FrameResult& r, const PlannedFrame& planned) {
+  Impl& m = *this;
   if (f.spotLights.empty() && f.pointLights.empty()) return;
   if (!m.localScattering)
     m.localScattering = gpu::Texture(*m.backend, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F,
                                                   info.width, info.height, 1, "Scattering: local light"});
+  // Plan pass first + k is local light k (the sun's pass first).
+  const std::size_t first = f.light ? 1 : 0;
+  std::size_t k = 0;
   for (std::size_t i = 0; i < f.spotLights.size(); ++i) {
     const SpotLight& spot = f.spotLights[i];
     LightResult result;
@@ -1142,23 +1377,24 @@ void Scattering::runLocalLights(const FrameAttribs& f, FrameResult& r) {
     const GpuLightTexture* texture = i < f.spotLightTextures.size() && f.spotLightTextures[i].texture != 0
                                          ? &f.spotLightTextures[i]
                                          : nullptr;
-    m.runLocalLight(f, r, LocalLight::spot(spot), rectify(*f.camera, spot, info.rectify),
-                    spot.lightClipFromWorld(), f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i],
-                    texture, result);
+    m.runLocalLight(f, r, LocalLight::spot(spot), planned.locals[k], planned.plan.passes[first + k],
+                    planMap(f, first + k), f.spotShadowMaps.empty() ? nullptr : &f.spotShadowMaps[i], texture,
+                    result);
+    ++k;
   }
   for (std::size_t i = 0; i < f.pointLights.size(); ++i) {
     const PointLight& point = f.pointLights[i];
-    const std::array<Rectification, 6> faces = rectifyPointLight(*f.camera, point, info.rectify);
     for (int face = 0; face < 6; ++face) {
       LightResult result;
       result.kind = LightResult::Kind::PointFace;
       result.index = static_cast<int>(i);
       result.face = face;
-      m.runLocalLight(f, r, LocalLight::pointFace(point, face), faces[static_cast<std::size_t>(face)],
-                      point.faceClipFromWorld(face),
+      m.runLocalLight(f, r, LocalLight::pointFace(point, face), planned.locals[k],
+                      planned.plan.passes[first + k], planMap(f, first + k),
                       f.pointShadowMaps.empty() ? nullptr
                                                 : &f.pointShadowMaps[6 * i + static_cast<std::size_t>(face)],
                       nullptr, result);
+      ++k;
     }
   }
 }

@@ -21,6 +21,7 @@
 #include <crep/core/medium.h>
 #include <crep/epipolar/epipolar_sampling.h>
 #include <crep/gpu/backend.h>
+#include <crep/pipeline/shadow_pass_plan.h>
 #include <crep/prefilter/prefilter.h>
 #include <crep/rectify/rectified_map.h>
 #include <crep/rectify/rectify.h>
@@ -150,8 +151,9 @@ public:
     /// GL_TEXTURE_2D RGBA32F width x height: RGB in-scattering, A transmittance. 0 only with `froxels` and no
     /// local light.
     std::uint32_t output = 0;
-    std::function<void(const glm::dmat4& clipFromWorld)> drawCasters; ///< draws your casters; may be empty
-    const ShadowMap* shadowMap = nullptr;                             ///< your standard map; may be null
+    /// Draws your casters (GL backend): the front door renders its plan's maps with it; may be empty.
+    std::function<void(const glm::dmat4& clipFromWorld)> drawCasters;
+    const ShadowMap* shadowMap = nullptr; ///< your standard map; may be null
     /// Local lights added to the result; they need drawCasters unless their maps are given.
     std::span<const SpotLight> spotLights;
     std::span<const PointLight> pointLights;    ///< six cube-map faces each
@@ -163,7 +165,20 @@ public:
     std::span<const GpuLightTexture> spotLightTextures;
     /// A volume to fill with this frame's basis, or null; needs `light`. At least one of output and froxels.
     const FroxelTarget* froxels = nullptr;
+    /// This frame's plan (plan() before the engine's shadow passes), whose maps the engine rasterized; null:
+    /// none. It must be the plan of this run (ShadowPassPlan::frame) for these camera, lights and given maps;
+    /// then drawCasters must be empty.
+    const ShadowPassPlan* plan = nullptr;
+    /// With `plan`: one texture per ShadowPass in its order: for a pass that needsMap(), the map the engine
+    /// rasterized for it (its width x height, a depth format or R32F); 0 for the others.
+    std::span<const std::uint32_t> planMaps;
   };
+  /// The frame's shadow passes for the engine to rasterize in its own clip conventions, before any GPU work
+  /// (crep/pipeline/shadow_pass_plan.h; docs/INTEGRATION.md, "The plan"). Reads the camera, the lights and
+  /// which shadow maps are given (those serve the standard passes); textures, output and medium are not read
+  /// (they may be 0 or null yet). CPU only: no GL or backend call. InvalidArgument naming the field for a
+  /// null camera, no light, or a light matrix validate() would refuse.
+  ShadowPassPlan plan(const FrameAttribs& frame, const ShadowPassPlanOptions& options = {}) const;
   /// Throws what run(frame) would for its inputs before any GL work: InvalidArgument naming the field after
   /// `owner` (e.g. "Scattering::FrameAttribs.camera"), or naming "Scattering" for a moved-from object.
   void validate(const FrameAttribs& frame, std::string_view owner = "Scattering::FrameAttribs") const;
@@ -175,8 +190,10 @@ public:
     int face = -1; ///< point light face 0-5 (+X, -X, +Y, -Y, +Z, -Z), -1 for a spot
     /// Projective, Fallback (in or near the view: `epipolar` or world-marched) or Empty (nothing done).
     RectifyStatus status = RectifyStatus::Empty;
-    bool epipolar = false;         ///< a Fallback light prefiltered on its epipolar layout, else marched
-    bool preRenderedMap = false;   ///< its shadow input was the given perspective map, not drawCasters
+    bool epipolar = false; ///< a Fallback light prefiltered on its epipolar layout, else marched
+    /// Its shadow input was the given perspective map (spotShadowMaps, pointShadowMaps), not a plan's map
+    /// or drawCasters.
+    bool preRenderedMap = false;
     std::string message;           ///< the rectification's explanation
     double wallMilliseconds = 0.0; ///< its stages' Stage::wallMilliseconds summed (0 without stageTimings)
     /// With blockingTimings the backend's GPU timer over its stages; else 0: a later frame's
@@ -260,7 +277,6 @@ public:
 
 private:
   FrameResult runFrame(const FrameAttribs& frame);
-  void runLocalLights(const FrameAttribs& frame, FrameResult& result);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
