@@ -103,3 +103,35 @@ TEST_CASE(
   }
   CHECK(std::filesystem::is_empty(dir.path()));
 }
+
+TEST_CASE("crep plan: the sun in view plans the fallback's standard map, a local-light scene one rectified map "
+          "per spot, the JSON is the plan's, and bad options are named") {
+  CREP_REQUIRE_GL();
+  const RunResult night = runCrep("plan --scene colonnade-night --size 320x180 --map-size 256");
+  INFO(night.output);
+  REQUIRE(night.status == 0);
+  CHECK(night.output.find("spot 2") != std::string::npos);
+  CHECK(night.output.find("rectified") != std::string::npos);
+  CHECK(night.output.find("maps to rasterize") != std::string::npos);
+
+  crep::test::TempDir dir;
+  const std::string file = (dir.path() / "plan.json").string();
+  const RunResult sunset =
+      runCrep("plan --scene sunset --size 320x180 --convention d3d12 --reversed-z --json '" + file + "'");
+  INFO(sunset.output);
+  REQUIRE(sunset.status == 0);
+  std::FILE* in = std::fopen(file.c_str(), "rb");
+  REQUIRE(in != nullptr);
+  std::string text;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, in)) > 0;)
+    text.append(buffer, n);
+  std::fclose(in);
+  for (const char* field : {"\"convention\": \"d3d12\"", "\"reversedZ\": true", "\"kind\": \"standard\"",
+                            "\"reason\": \"view-ray-parallel-to-light\"", "\"compare\": \"greater\"",
+                            "\"clearDepth\": 0", "\"viewport\": [0, 0, 2048, 2048]"})
+    CHECK_MESSAGE(text.find(field) != std::string::npos, field);
+
+  crep::test::expectFailure(runCrep("plan --convention dx"), 2, {"--convention", "dx"});
+  crep::test::expectFailure(runCrep("plan --map-size 1000"), 2, {"--map-size", "1000"});
+}
