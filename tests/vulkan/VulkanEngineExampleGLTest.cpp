@@ -333,14 +333,16 @@ TEST_CASE("Vulkan clip convention: a plan pass rasterized by the engine with the
                               << " by more than 1e-5");
     CHECK(covered > 0);
     // Not bit for bit, nor within one ulp: the two matrices differ in their z row only (Vulkan's is
-    // 0.5 z + 0.5 w of OpenGL's), so x, y and w are the same floats and every texel is covered alike;
+    // 0.5 z + 0.5 w of OpenGL's), so x, y and w are the same floats and the same texels are covered;
     // the depth is the z row evaluated in float (Vulkan: z' / w; GL: 0.5 z / w + 0.5 in the viewport
     // transform), rounded differently, and more so where the row's terms cancel (world coordinates far
     // larger than the light's depth range) and where w is small (a rectified split's projection).
     CHECK(d.coverage == 0);
-    // A few texels differ by more than that rounding (measured: one per pass; forest's clamped to 0 on GL,
-    // 0.03 on Vulkan). Candidate causes, not verified: the nearer of two surfaces a few 1e-5 apart changes,
-    // or a fragment's depth is ill-conditioned (a caster near the plane w = 0 of a split's projection).
+    // A few texels differ by more than that rounding (measured: one per pass, located by a CPU ray cast of
+    // the mesh at the texel). Forest's: a triangle crossing the plane w = 0 of split 6's projection (a
+    // vertex at w = -24), at depth -7.9 there, covers the texel on GL (clamped to 0) and not on Vulkan,
+    // where the next surface shows (0.0323777). Sunset's: a sliver triangle (its three vertices within
+    // 0.5 texel of one line), whose depth plane amplifies the rounding to 5.3e-5 on Vulkan.
     CHECK(d.over1e5 <= 2);
   }
 }
