@@ -265,17 +265,12 @@ GpuTimes timeGpu(const Setup& s, int bases, int repeat, const GpuRun& run = {}) 
 /// Stages of a method run that are per-frame work (not one-time set-up: shader builds, pass creation,
 /// or the rectified map, which every rectified method shares and which is reported on its own).
 bool perFrameStage(const std::string& stage) {
-  // --backend vulkan: the engine's maps read back from GL and the output's way back to GL are the tool's.
-  if (stage == "engine maps (read back from GL)" || stage == "read back (Vulkan)") return false;
+  // --backend vulkan: the engine's camera depth (the scene's frame on OpenGL has it before the methods) and
+  // the output's way back to GL are the tool's; the engine's shadow passes are "shadow pass" below.
+  if (stage == "engine: camera depth (Vulkan)" || stage == "read back (Vulkan)") return false;
   for (const char* skip : {"setup", "shader", "rectify", "shadow pass", "resample", "upload"})
     if (stage.find(skip) != std::string::npos) return false;
   return true;
-}
-
-/// --backend vulkan: one device for the whole run, so the warm-up builds its pipelines once.
-gpu::Backend& vulkanDevice() {
-  static const std::unique_ptr<gpu::Backend> device = tool::makeVulkanBackend();
-  return *device;
 }
 
 struct MethodRow {
@@ -298,15 +293,19 @@ std::vector<MethodRow> runMethods(const BenchOptions& o, const std::string& scen
   settings.mapSize = o.mapWidth;
   settings.prefilter.bases = o.bases;
   std::vector<MethodRow> rows;
+  // --backend vulkan: one engine and device for the scene's runs, so the warm-up builds its pipelines and
+  // depth images once.
+  std::unique_ptr<tool::VulkanSession> vulkan;
   for (const tool::Method& m : tool::methodRegistry()) {
     if (!only.empty() && std::find(only.begin(), only.end(), m.name) == only.end()) continue;
     std::map<std::string, std::vector<double>> stageMs;
     std::vector<std::string> order;
     std::string used;
     const bool onVulkan = o.backend == "vulkan" && tool::runsOnBackend(m.name);
+    if (onVulkan && !vulkan) vulkan = std::make_unique<tool::VulkanSession>(*s.scene);
     for (int i = 0; i < repeat + 1; ++i) { // first run: warm-up (shader compilation, map)
       tool::MethodOutput out =
-          onVulkan ? tool::runOnVulkan(s, m.name, settings, &vulkanDevice()) : m.run(*s.frame, settings);
+          onVulkan ? tool::runOnVulkan(s, m.name, settings, vulkan.get()) : m.run(*s.frame, settings);
       used = out.used + (onVulkan ? " on Vulkan" : "");
       if (i == 0) {
         for (const auto& r : out.timings.rows())
@@ -1511,7 +1510,7 @@ std::string benchHelp() {
   line("--backend B: opengl (default) | vulkan: crep::Scattering's methods (prefilter, minmax,");
   line("epipolar-sampling, epipolar-prefilter) on a Vulkan device in the sections that run the");
   line("tool's methods (methods, sun-in-view, post-effects, epipolar-sampling, local-lights' spot");
-  line("scene), the engine's maps read back from GL; the rest on OpenGL (backends: both)");
+  line("scene), the maps rasterized on Vulkan; the rest on OpenGL (backends: both)");
   line("--section NAME[,NAME...]: those sections alone (in the suite's order); the sections,");
   line("in the order the whole suite runs them:");
   for (const BenchSection& s : benchSections()) {

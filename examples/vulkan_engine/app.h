@@ -1,6 +1,7 @@
 // The example's frame loop (main.cpp, and the tests that drive it): a world, the engine of engine.h and the
-// volumetrics of volumetrics.h, and per frame the engine's depth pre-pass and shadow maps, crepuscular
-// recorded after them, one submission. The camera strafes sideways 0.1 units a frame.
+// volumetrics of volumetrics.h, and per frame crepuscular's plan, the engine's depth pre-pass and the plan's
+// shadow passes, crepuscular recorded after them, one submission. The camera strafes sideways 0.1 units a
+// frame.
 #pragma once
 
 #include <cstdint>
@@ -32,10 +33,10 @@ class App {
 public:
   struct Options {
     std::uint32_t width = 640, height = 360; ///< the camera depth's and the output's size
-    std::uint32_t sunMapSize = 1024;         ///< the engine's standard sun map, texels square
-    std::uint32_t spotMapSize = 512;         ///< each spot's perspective map
     Engine::Options engine{};                ///< frames in flight (3), validation
-    crep::Scattering::CreateInfo settings{}; ///< crepuscular's settings but the size and backend
+    /// crepuscular's settings but the size and backend; mapSize and ownShadowMapSize are the sizes of the
+    /// shadow maps the engine rasterizes for it (rectified, standard).
+    crep::Scattering::CreateInfo settings{};
     PFN_vkGetInstanceProcAddr loader = vkGetInstanceProcAddr; ///< what crepuscular resolves Vulkan through
   };
   App(World world, const Options& options);
@@ -49,7 +50,7 @@ public:
   const VolumetricImages& images() const { return images_; }
   Volumetrics& volumetrics() { return *volumetrics_; }
   const World& world() const { return world_; }
-  /// The last frame's camera and lights (shadow matrices in OpenGL's clip conventions).
+  /// The last frame's camera and lights; its plan and the engine's images of it: volumetrics().plan().
   const crep::Camera& camera() const { return camera_; }
   const VolumetricLights& lights() const { return lights_; }
 

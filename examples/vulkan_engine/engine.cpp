@@ -279,11 +279,13 @@ void Engine::createPipelines() {
   gp.pDynamicState = &dy;
   gp.layout = pipelineLayout_;
   gp.renderPass = renderPass_;
-  check(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &gp, nullptr, &pipeline_),
-        "vkCreateGraphicsPipelines");
-  rs.depthClampEnable = features_.depthClamp;
-  check(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &gp, nullptr, &clampedPipeline_),
-        "vkCreateGraphicsPipelines");
+  for (const int clamp : {0, 1})
+    for (const int greater : {0, 1}) {
+      rs.depthClampEnable = clamp != 0 && features_.depthClamp;
+      ds.depthCompareOp = greater != 0 ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_LESS;
+      check(vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &gp, nullptr, &pipelines_[clamp][greater]),
+            "vkCreateGraphicsPipelines");
+    }
   vkDestroyShaderModule(device_, vertex, nullptr);
 }
 
@@ -305,8 +307,9 @@ Engine::~Engine() {
     vkDestroyBuffer(device_, indices_, nullptr);
     vkFreeMemory(device_, vertexMemory_, nullptr);
     vkFreeMemory(device_, indexMemory_, nullptr);
-    vkDestroyPipeline(device_, pipeline_, nullptr);
-    vkDestroyPipeline(device_, clampedPipeline_, nullptr);
+    for (auto& row : pipelines_)
+      for (VkPipeline p : row)
+        vkDestroyPipeline(device_, p, nullptr);
     vkDestroyPipelineLayout(device_, pipelineLayout_, nullptr);
     vkDestroyRenderPass(device_, renderPass_, nullptr);
     for (Slot& s : slots_)
@@ -472,30 +475,39 @@ Engine::Frame Engine::beginFrame() {
   return {s.commands, index, index > n ? index - n : 0};
 }
 
-void Engine::drawDepth(const Frame& frame, const DepthImage& target, const glm::dmat4& clipFromWorld,
-                       bool depthClamp) {
+void Engine::drawDepthPass(const Frame& frame, const DepthImage& target, const DepthPassState& state,
+                           std::span<const DepthDraw> draws) {
   const VkCommandBuffer cb = frame.commandBuffer;
-  const VkClearValue clear{.depthStencil = {1.0f, 0}};
+  const VkClearValue clear{.depthStencil = {state.clearDepth, 0}};
   VkRenderPassBeginInfo rb{};
   rb.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
   rb.renderPass = renderPass_;
   rb.framebuffer = target.framebuffer;
   rb.renderArea = {{0, 0}, {target.width, target.height}};
   rb.clearValueCount = 1;
-  rb.pClearValues = &clear;
+  rb.pClearValues = &clear; // the whole target, once (the render pass's load operation)
   vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, depthClamp ? clampedPipeline_ : pipeline_);
-  // No y flip: row 0 of the image is NDC y = -1, as crepuscular reads its inputs (OpenGL's texel order).
-  const VkViewport viewport{0.0f, 0.0f, float(target.width), float(target.height), 0.0f, 1.0f};
-  vkCmdSetViewport(cb, 0, 1, &viewport);
-  vkCmdSetScissor(cb, 0, 1, &rb.renderArea);
-  const glm::mat4 matrix(clipFromWorld);
-  vkCmdPushConstants(cb, pipelineLayout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(matrix), &matrix);
+  vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipelines_[state.depthClamp][state.greater]);
   const VkDeviceSize offset = 0;
   vkCmdBindVertexBuffers(cb, 0, 1, &vertices_, &offset);
   vkCmdBindIndexBuffer(cb, indices_, 0, VK_INDEX_TYPE_UINT32);
-  vkCmdDrawIndexed(cb, indexCount_, 1, 0, 0, 0);
+  for (const DepthDraw& d : draws) {
+    vkCmdSetViewport(cb, 0, 1, &d.viewport);
+    vkCmdSetScissor(cb, 0, 1, &d.scissor);
+    const glm::mat4 matrix(d.clipFromWorld);
+    vkCmdPushConstants(cb, pipelineLayout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(matrix), &matrix);
+    vkCmdDrawIndexed(cb, indexCount_, 1, 0, 0, 0);
+  }
   vkCmdEndRenderPass(cb);
+}
+
+void Engine::drawDepth(const Frame& frame, const DepthImage& target, const glm::dmat4& clipFromWorld,
+                       bool depthClamp) {
+  // No y flip: row 0 of the image is NDC y = -1, as crepuscular reads its inputs (OpenGL's texel order).
+  const DepthDraw all{clipFromWorld,
+                      {0.0f, 0.0f, float(target.width), float(target.height), 0.0f, 1.0f},
+                      {{0, 0}, {target.width, target.height}}};
+  drawDepthPass(frame, target, {.clearDepth = 1.0f, .greater = false, .depthClamp = depthClamp}, {&all, 1});
 }
 
 void Engine::submit(const Frame& frame) {

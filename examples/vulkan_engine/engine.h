@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,22 @@ struct ColorImage {
   static constexpr VkImageUsageFlags kUsage =
       VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   static constexpr VkImageLayout kLayout = VK_IMAGE_LAYOUT_GENERAL;
+};
+
+/// One draw of the mesh in a depth pass: gl_Position = clipFromWorld * position (Vulkan's clip space, z in
+/// [0, w]) into `viewport` (its depth range [0, 1]), fragments kept inside `scissor`.
+struct DepthDraw {
+  glm::dmat4 clipFromWorld{1.0};
+  VkViewport viewport{};
+  VkRect2D scissor{};
+};
+
+/// The raster state of a depth pass: the target cleared once to `clearDepth`, the depth test LESS (or
+/// GREATER for reversed-Z) with writes on, depth clamp on or off, no culling.
+struct DepthPassState {
+  float clearDepth = 1.0f;
+  bool greater = false;
+  bool depthClamp = false;
 };
 
 /// Vulkan's clip space of an OpenGL-convention matrix: z from [-w, w] to [0, w], x and y unchanged. A depth
@@ -93,9 +110,14 @@ public:
   };
   /// Waits for the frame that last used this frame's slot (the oldest in flight), then begins recording.
   Frame beginFrame();
-  /// Records a depth pass of the mesh into `target`: cleared to 1, depth test LESS, no culling,
-  /// `clipFromWorld` in Vulkan's clip space (z in [0, w]); `depthClamp` for shadow maps (casters in front
-  /// of the light's near plane still cast).
+  /// Records a depth pass of the mesh into `target`: cleared once (state.clearDepth), then the mesh drawn
+  /// once per entry of `draws`, each with its own matrix (a push constant), viewport and scissor (dynamic
+  /// state): a shadow map of several splits, or one cascade atlas.
+  void drawDepthPass(const Frame& frame, const DepthImage& target, const DepthPassState& state,
+                     std::span<const DepthDraw> draws);
+  /// The common case: one draw over the whole target, cleared to 1, LESS, `clipFromWorld` in Vulkan's clip
+  /// space (z in [0, w]); `depthClamp` for shadow maps (casters in front of the light's near plane still
+  /// cast).
   void drawDepth(const Frame& frame, const DepthImage& target, const glm::dmat4& clipFromWorld,
                  bool depthClamp);
   /// Ends the frame's command buffer and submits it with the slot's fence: the frame's one submission.
@@ -139,7 +161,7 @@ private:
   std::uint64_t frameIndex_ = 0;
   VkRenderPass renderPass_ = VK_NULL_HANDLE;
   VkPipelineLayout pipelineLayout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE, clampedPipeline_ = VK_NULL_HANDLE;
+  VkPipeline pipelines_[2][2] = {}; ///< [depth clamp][GREATER]
   VkBuffer vertices_ = VK_NULL_HANDLE, indices_ = VK_NULL_HANDLE;
   VkDeviceMemory vertexMemory_ = VK_NULL_HANDLE, indexMemory_ = VK_NULL_HANDLE;
   std::uint32_t indexCount_ = 0;

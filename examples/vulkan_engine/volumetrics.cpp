@@ -5,24 +5,8 @@ namespace vkengine {
 
 namespace {
 
-crep::gpu::VulkanBackend::CreateInfo onEngineDevice(const Engine& e, PFN_vkGetInstanceProcAddr loader) {
-  crep::gpu::VulkanBackend::EngineDevice d;
-  d.instance = e.instance();
-  d.physicalDevice = e.physicalDevice();
-  d.device = e.device();
-  d.queueFamily = e.queueFamily();
-  d.queue = e.queue();
-  d.getInstanceProcAddr = loader;
-  d.apiVersion = e.apiVersion();
-  d.enabledExtensions = e.enabledExtensions();
-  d.enabledFeatures = e.enabledFeatures();
-  crep::gpu::VulkanBackend::CreateInfo info;
-  info.device = d;
-  return info;
-}
-
 template <class Image>
-crep::gpu::TextureId import(crep::gpu::VulkanBackend& vk, const Image& image, const char* label) {
+crep::gpu::TextureId importAny(crep::gpu::VulkanBackend& vk, const Image& image, const char* label) {
   return vk.importTexture({.image = image.image,
                            .view = image.view,
                            .format = Image::kFormat,
@@ -43,33 +27,109 @@ crep::Scattering::CreateInfo withBackend(crep::Scattering::CreateInfo info, crep
 
 } // namespace
 
-Volumetrics::Volumetrics(const Engine& engine, const VolumetricImages& images,
+crep::gpu::TextureId importImage(crep::gpu::VulkanBackend& backend, const DepthImage& image,
+                                 const char* label) {
+  return importAny(backend, image, label);
+}
+
+crep::gpu::TextureId importImage(crep::gpu::VulkanBackend& backend, const ColorImage& image,
+                                 const char* label) {
+  return importAny(backend, image, label);
+}
+
+DepthImagePool::Entry DepthImagePool::acquire(std::uint32_t width, std::uint32_t height) {
+  taken_.resize(entries_.size(), false);
+  for (std::size_t k = 0; k < entries_.size(); ++k)
+    if (!taken_[k] && entries_[k].image->width == width && entries_[k].image->height == height) {
+      taken_[k] = true;
+      return entries_[k];
+    }
+  // A size, or a count of maps of a size, not seen before: one more image, imported once.
+  const DepthImage& image = engine_.createDepthImage(width, height);
+  entries_.push_back({&image, importImage(backend_, image, "shadow map")});
+  taken_.push_back(true);
+  return entries_.back();
+}
+
+crep::gpu::VulkanBackend::CreateInfo backendOnEngine(const Engine& e, PFN_vkGetInstanceProcAddr loader) {
+  crep::gpu::VulkanBackend::EngineDevice d;
+  d.instance = e.instance();
+  d.physicalDevice = e.physicalDevice();
+  d.device = e.device();
+  d.queueFamily = e.queueFamily();
+  d.queue = e.queue();
+  d.getInstanceProcAddr = loader;
+  d.apiVersion = e.apiVersion();
+  d.enabledExtensions = e.enabledExtensions();
+  d.enabledFeatures = e.enabledFeatures();
+  crep::gpu::VulkanBackend::CreateInfo info;
+  info.device = d;
+  return info;
+}
+
+// ClipConvention::Vulkan: the matrices are in Vulkan's clip space (z in [0, w]) and the viewports are used as
+// they are (a positive height, no y flip: the first row in memory is NDC y = -1, as crepuscular reads its
+// maps).
+ShadowPassTarget targetOf(const crep::ShadowPass& pass, const DepthImage& image) {
+  ShadowPassTarget t;
+  t.pass = &pass;
+  t.image = &image;
+  t.state.clearDepth = static_cast<float>(pass.clearDepth);
+  t.state.greater = pass.compare == crep::DepthCompare::Greater;
+  t.state.depthClamp = pass.depthClamp;
+  for (const crep::ShadowPass::Split& s : pass.splits) {
+    const crep::ShadowPass::Rect& v = s.viewport;
+    const crep::ShadowPass::Rect& c = s.scissor;
+    t.draws.push_back({s.clipFromWorld,
+                       {float(v.x), float(v.y), float(v.width), float(v.height), 0.0f, 1.0f},
+                       {{c.x, c.y}, {std::uint32_t(c.width), std::uint32_t(c.height)}}});
+  }
+  return t;
+}
+
+Volumetrics::Volumetrics(Engine& engine, const VolumetricImages& images,
                          crep::Scattering::CreateInfo settings, PFN_vkGetInstanceProcAddr loader)
-    : backend_(onEngineDevice(engine, loader)),
-      cameraDepth_(import(backend_, *images.cameraDepth, "camera depth")),
-      sunMap_(images.sunMap != nullptr ? import(backend_, *images.sunMap, "sun map") : 0),
-      output_(import(backend_, *images.output, "volumetrics")),
-      scattering_(withBackend(settings, backend_, *images.cameraDepth)) {
-  for (const DepthImage* spot : images.spotMaps)
-    spotMaps_.push_back(import(backend_, *spot, "spot map"));
+    : backend_(backendOnEngine(engine, loader)),
+      cameraDepth_(importImage(backend_, *images.cameraDepth, "camera depth")),
+      output_(importImage(backend_, *images.output, "volumetrics")),
+      scattering_(withBackend(settings, backend_, *images.cameraDepth)), shadowMaps_(engine, backend_) {
   backend_.finish(); // the set-up's uploads (tables, buffers), once, before the first frame
 }
 
-crep::Scattering::FrameResult Volumetrics::record(const Engine::Frame& frame, const crep::Camera& camera,
-                                                  const VolumetricLights& lights) {
-  const crep::Scattering::ShadowMap sun{sunMap_, lights.sunClipFromWorld, lights.bias};
-  std::vector<crep::Scattering::ShadowMap> spots;
-  for (std::size_t i = 0; i < lights.spots.size(); ++i)
-    spots.push_back({spotMaps_.at(i), lights.spotClipFromWorld.at(i), lights.bias});
+crep::Scattering::FrameAttribs Volumetrics::attribs(const crep::Camera& camera,
+                                                    const VolumetricLights& lights) const {
   crep::Scattering::FrameAttribs f;
   f.camera = &camera;
   f.light = lights.sun;
   f.medium = lights.medium;
+  f.spotLights = lights.spots;
+  return f;
+}
+
+const std::vector<ShadowPassTarget>& Volumetrics::plan(const crep::Camera& camera,
+                                                       const VolumetricLights& lights) {
+  plan_ = scattering_.plan(attribs(camera, lights), {.convention = crep::ClipConvention::Vulkan});
+  targets_.clear();
+  planMaps_.assign(plan_.passes.size(), 0);
+  shadowMaps_.release();
+  for (std::size_t i = 0; i < plan_.passes.size(); ++i) {
+    const crep::ShadowPass& pass = plan_.passes[i];
+    if (!pass.needsMap()) continue;
+    const DepthImagePool::Entry map =
+        shadowMaps_.acquire(static_cast<std::uint32_t>(pass.width), static_cast<std::uint32_t>(pass.height));
+    planMaps_[i] = map.texture;
+    targets_.push_back(targetOf(pass, *map.image));
+  }
+  return targets_;
+}
+
+crep::Scattering::FrameResult Volumetrics::record(const Engine::Frame& frame, const crep::Camera& camera,
+                                                  const VolumetricLights& lights) {
+  crep::Scattering::FrameAttribs f = attribs(camera, lights);
   f.cameraDepth = cameraDepth_;
   f.output = output_;
-  f.shadowMap = lights.sun != nullptr ? &sun : nullptr;
-  f.spotLights = lights.spots;
-  f.spotShadowMaps = spots;
+  f.plan = &plan_;
+  f.planMaps = planMaps_;
   backend_.beginFrame({frame.commandBuffer, frame.index, frame.completed});
   try {
     const crep::Scattering::FrameResult result = scattering_.run(f);
