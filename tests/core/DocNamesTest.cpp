@@ -100,6 +100,8 @@ std::string withoutQuotes(const std::string& text) {
 bool foreign(const std::string& qualified) {
   for (const char* prefix : {"std::", "glm::", "Eigen::", "doctest::"})
     if (qualified.rfind(prefix, 0) == 0) return true;
+  for (const char* prefix : {"D3D12", "DXGI_", "MTL"})
+    if (qualified.rfind(prefix, 0) == 0) return true; // a D3D12 or Metal type, enum or member
   if (qualified.size() > 2 && qualified[0] == 'V' && qualified[1] == 'k' &&
       std::isupper(static_cast<unsigned char>(qualified[2])))
     return true; // a member of a Vulkan struct, e.g. VkPhysicalDeviceFeatures2::features

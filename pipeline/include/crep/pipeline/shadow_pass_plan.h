@@ -26,7 +26,7 @@ enum class ClipConvention {
   OpenGLZeroToOne, ///< NDC z in [0, 1] (glClipControl GL_LOWER_LEFT, GL_ZERO_TO_ONE)
   Vulkan,          ///< NDC z in [0, 1], a positive-height VkViewport (NDC y = -1 at the first row)
   Direct3D12,      ///< NDC z in [0, 1], NDC y = +1 at the first row: the matrices negate y
-  Metal,           ///< as Direct3D12
+  Metal,           ///< as Direct3D12 (the same clip space)
 };
 
 /// "opengl", "opengl-zero-to-one", "vulkan", "d3d12", "metal".
@@ -45,8 +45,8 @@ struct ShadowPassPlanOptions {
 /// at each texel what ShadowPassPlanOptions says (OpenGL's depth-buffer value, or 1 minus it).
 glm::dmat4 toClipConvention(const glm::dmat4& glClipFromWorld, const ShadowPassPlanOptions& options);
 
-/// The depth comparison of a pass (Vulkan VK_COMPARE_OP_LESS / GREATER, D3D12 D3D12_COMPARISON_FUNC_LESS /
-/// GREATER, Metal MTLCompareFunctionLess / Greater, GL GL_LESS / GL_GREATER).
+/// The depth comparison of a pass (Vulkan VK_COMPARE_OP_LESS / GREATER, D3D12_COMPARISON_FUNC_LESS /
+/// GREATER, Metal's MTLCompareFunctionLess / Greater, GL_LESS / GL_GREATER).
 enum class DepthCompare { Less, Greater };
 
 /// One light's shadow pass of a frame (the sun, a spot or one face of a point light).
@@ -57,8 +57,8 @@ struct ShadowPass {
     Rectified, ///< the rectified map (status Projective): one draw of the casters per split
     Standard,  ///< the standard map of the epipolar fallback or world march (status Fallback): one draw
   };
-  /// An integer rectangle in texels; y counts rows from the map's first row in memory (as GL's glViewport
-  /// on a texture, Vulkan's VkViewport and VkRect2D, D3D12's TopLeftY and Metal's originY all do).
+  /// An integer rectangle in texels; y counts rows from the map's first row in memory (as glViewport on a
+  /// texture, VkViewport and VkRect2D, D3D12_VIEWPORT::TopLeftY and MTLViewport::originY all do).
   struct Rect {
     int x = 0, y = 0, width = 0, height = 0;
     bool operator==(const Rect&) const = default;
@@ -88,9 +88,9 @@ struct ShadowPass {
   gpu::Format format = gpu::Format::Depth32F;
   double clearDepth = 1.0;                   ///< the whole target, once, before the first split (0 reversed)
   DepthCompare compare = DepthCompare::Less; ///< depth test on, depth writes on
-  /// Depth clamp on (VkPipelineRasterizationStateCreateInfo::depthClampEnable, D3D12 DepthClipEnable =
-  /// FALSE, Metal MTLDepthClipModeClamp, GL_DEPTH_CLAMP): casters between the light and the lit region
-  /// still cast. Always true.
+  /// Depth clamp on (VkPipelineRasterizationStateCreateInfo::depthClampEnable,
+  /// D3D12_RASTERIZER_DESC::DepthClipEnable = FALSE, MTLDepthClipModeClamp, GL_DEPTH_CLAMP): casters between
+  /// the light and the lit region still cast. Always true.
   bool depthClamp = true;
   /// Face culling off: a rectification may mirror the winding. Always false.
   bool cullFaces = false;
