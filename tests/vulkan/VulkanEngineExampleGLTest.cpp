@@ -7,7 +7,8 @@
 // with drawCasters (the scene's mesh through crep_scenes' renderer), the same camera and lights, and the
 // engine's camera depth uploaded to GL, so that only the shadow maps' path differs: relative RMSE of the
 // in-scattering (RGB) and of the transmittance (A) at most 1e-5, for forest (projective: the plan's
-// rectified map), sunset (sun in view: epipolar, the plan's standard map) and colonnade-night (three spots).
+// rectified map; colonnade likewise), sunset (sun in view: epipolar, the plan's standard map) and
+// colonnade-night (three spots).
 // Also: the library submits nothing and waits for nothing while the frames are recorded (counted through
 // the loader it was given), and the layer says nothing. And one plan pass rasterized by the engine in
 // Vulkan's clip convention against GL rasterizing the same pass in OpenGL's.
@@ -123,7 +124,7 @@ TEST_CASE("Vulkan engine example: its frames, the plan's maps rasterized by the 
           "door drawing the same casters, with no submission or wait by the library and no validation "
           "message") {
   CREP_REQUIRE_GL();
-  for (const char* name : {"forest", "sunset", "colonnade-night"}) {
+  for (const char* name : {"forest", "colonnade", "sunset", "colonnade-night"}) {
     const std::string sceneName = name;
     CAPTURE(sceneName);
     scenes::Scene scene = scenes::makeScene(name, double(kWidth) / kHeight);
