@@ -104,8 +104,9 @@ TEST_CASE(
   CHECK(std::filesystem::is_empty(dir.path()));
 }
 
-TEST_CASE("crep plan: the sun in view plans the fallback's standard map, a local-light scene one rectified map "
-          "per spot, the JSON is the plan's, and bad options are named") {
+TEST_CASE(
+    "crep plan: the sun in view plans the fallback's standard map, a local-light scene one rectified map "
+    "per spot, the JSON is the plan's, and bad options are named") {
   CREP_REQUIRE_GL();
   const RunResult night = runCrep("plan --scene colonnade-night --size 320x180 --map-size 256");
   INFO(night.output);
