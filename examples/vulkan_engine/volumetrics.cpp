@@ -87,6 +87,20 @@ ShadowPassTarget targetOf(const crep::ShadowPass& pass, const DepthImage& image)
   return t;
 }
 
+PlannedMaps acquireMaps(const crep::ShadowPassPlan& plan, DepthImagePool& pool) {
+  PlannedMaps m;
+  m.planMaps.assign(plan.passes.size(), 0);
+  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
+    const crep::ShadowPass& pass = plan.passes[i];
+    if (!pass.needsMap()) continue;
+    const DepthImagePool::Entry map =
+        pool.acquire(static_cast<std::uint32_t>(pass.width), static_cast<std::uint32_t>(pass.height));
+    m.planMaps[i] = map.texture;
+    m.targets.push_back(targetOf(pass, *map.image));
+  }
+  return m;
+}
+
 Volumetrics::Volumetrics(Engine& engine, const VolumetricImages& images,
                          crep::Scattering::CreateInfo settings, PFN_vkGetInstanceProcAddr loader)
     : backend_(backendOnEngine(engine, loader)),
@@ -109,18 +123,9 @@ crep::Scattering::FrameAttribs Volumetrics::attribs(const crep::Camera& camera,
 const std::vector<ShadowPassTarget>& Volumetrics::plan(const crep::Camera& camera,
                                                        const VolumetricLights& lights) {
   plan_ = scattering_.plan(attribs(camera, lights), {.convention = crep::ClipConvention::Vulkan});
-  targets_.clear();
-  planMaps_.assign(plan_.passes.size(), 0);
   shadowMaps_.release();
-  for (std::size_t i = 0; i < plan_.passes.size(); ++i) {
-    const crep::ShadowPass& pass = plan_.passes[i];
-    if (!pass.needsMap()) continue;
-    const DepthImagePool::Entry map =
-        shadowMaps_.acquire(static_cast<std::uint32_t>(pass.width), static_cast<std::uint32_t>(pass.height));
-    planMaps_[i] = map.texture;
-    targets_.push_back(targetOf(pass, *map.image));
-  }
-  return targets_;
+  maps_ = acquireMaps(plan_, shadowMaps_);
+  return maps_.targets;
 }
 
 crep::Scattering::FrameResult Volumetrics::record(const Engine::Frame& frame, const crep::Camera& camera,
@@ -129,7 +134,7 @@ crep::Scattering::FrameResult Volumetrics::record(const Engine::Frame& frame, co
   f.cameraDepth = cameraDepth_;
   f.output = output_;
   f.plan = &plan_;
-  f.planMaps = planMaps_;
+  f.planMaps = maps_.planMaps;
   backend_.beginFrame({frame.commandBuffer, frame.index, frame.completed});
   try {
     const crep::Scattering::FrameResult result = scattering_.run(f);

@@ -76,6 +76,13 @@ private:
 /// and its scissor.
 ShadowPassTarget targetOf(const crep::ShadowPass& pass, const DepthImage& image);
 
+/// The depth images of a plan's maps, taken from `pool` (after its release() for the frame).
+struct PlannedMaps {
+  std::vector<std::uint32_t> planMaps; ///< FrameAttribs::planMaps: one per plan pass, 0 where none is needed
+  std::vector<ShadowPassTarget> targets; ///< the passes that need a map, in the plan's order
+};
+PlannedMaps acquireMaps(const crep::ShadowPassPlan& plan, DepthImagePool& pool);
+
 class Volumetrics {
 public:
   /// `settings`: crep::Scattering's CreateInfo but its backend (the size is the camera depth's).
@@ -95,7 +102,7 @@ public:
                                        const VolumetricLights& lights);
 
   const crep::ShadowPassPlan& currentPlan() const { return plan_; }
-  const std::vector<ShadowPassTarget>& currentTargets() const { return targets_; }
+  const std::vector<ShadowPassTarget>& currentTargets() const { return maps_.targets; }
   crep::gpu::VulkanBackend& backend() { return backend_; }
 
 private:
@@ -106,8 +113,7 @@ private:
   crep::Scattering scattering_;
   DepthImagePool shadowMaps_;
   crep::ShadowPassPlan plan_;
-  std::vector<ShadowPassTarget> targets_;
-  std::vector<std::uint32_t> planMaps_; ///< one per plan pass, 0 for those that need no map
+  PlannedMaps maps_; ///< plan_'s
 };
 
 } // namespace vkengine

@@ -286,6 +286,13 @@ void requireOutputNotAnInput(const Scattering::FrameAttribs& f, const std::strin
     check(f.planMaps[i], "FrameAttribs.planMaps[" + std::to_string(i) + "]");
 }
 
+/// FrameAttribs::camera, and a light: what both plan() and validate() read first.
+void requireCameraAndLight(const Scattering::FrameAttribs& f, const std::string& prefix) {
+  if (!f.camera) invalid(prefix + "camera", "null", "must be set");
+  if (!f.light && f.spotLights.empty() && f.pointLights.empty())
+    invalid(prefix + "light", "null", "must be set unless local lights are given");
+}
+
 /// A frame's rectifications and the shadow-pass plan made of them (Scattering::plan; run() makes the same
 /// from the same inputs, deterministically).
 struct PlannedFrame {
@@ -738,6 +745,9 @@ struct Scattering::Impl {
                      const Rectification& rect, const ShadowPass& pass, std::uint32_t planMap,
                      const ShadowMap* given, const GpuLightTexture* texture, LightResult result);
   void runLocalLights(const FrameAttribs& f, FrameResult& r, const PlannedFrame& planned);
+  void validate(const FrameAttribs& f, const std::string& p, std::optional<PlannedFrame>* planned) const;
+  /// The index of the run a frame validated or planned now belongs to: inside run() it is counted already.
+  std::uint64_t thisRun() const { return running ? frames - 1 : frames; }
   /// The map the engine rendered for plan pass `i` (FrameAttribs::planMaps), 0 without a plan.
   static std::uint32_t planMap(const FrameAttribs& f, std::size_t i) {
     return f.plan != nullptr && i < f.planMaps.size() ? f.planMaps[i] : 0u;
@@ -871,23 +881,17 @@ ShadowPassPlan Scattering::plan(const FrameAttribs& f, const ShadowPassPlanOptio
   if (!impl_)
     invalid("Scattering", "a moved-from object",
             "owns no GPU resources: assign a constructed Scattering first");
-  const std::string p = "Scattering::FrameAttribs.";
-  if (!f.camera) invalid(p + "camera", "null", "must be set");
-  if (!f.light && f.spotLights.empty() && f.pointLights.empty())
-    invalid(p + "light", "null", "must be set unless local lights are given");
-  return planFrame(impl_->info, f, options, impl_->running ? impl_->frames - 1 : impl_->frames).plan;
+  requireCameraAndLight(f, "Scattering::FrameAttribs.");
+  return planFrame(impl_->info, f, options, impl_->thisRun()).plan;
 }
 
-void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
-  if (!impl_)
-    invalid("Scattering", "a moved-from object",
-            "owns no GPU resources: assign a constructed Scattering first");
-  const CreateInfo& info = impl_->info;
-  const gpu::Backend& b = *impl_->backend;
-  const std::string p = std::string(owner) + ".";
+// Scattering::validate's checks, `p` the owner with its dot. With a plan, the frame's own plan is made to
+// compare it with and left in `planned` for run().
+void Scattering::Impl::validate(const FrameAttribs& f, const std::string& p,
+                                std::optional<PlannedFrame>* planned) const {
+  const gpu::Backend& b = *backend;
   const bool local = !f.spotLights.empty() || !f.pointLights.empty();
-  if (!f.camera) invalid(p + "camera", "null", "must be set");
-  if (!f.light && !local) invalid(p + "light", "null", "must be set unless local lights are given");
+  requireCameraAndLight(f, p);
   if (!f.medium) invalid(p + "medium", "null", "must be set");
   if (f.output != 0 || !f.froxels) { // a froxel volume alone reads no camera depth
     gpu::requireTexture2DOf(b, (p + "cameraDepth").c_str(), f.cameraDepth, info.width, info.height);
@@ -911,15 +915,15 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
   if (f.light && !f.drawCasters && !f.shadowMap && !f.plan)
     invalid(p + "drawCasters/shadowMap", "both empty, and no plan",
             "one shadow input must be given (drawCasters, shadowMap, or plan and planMaps)");
-  if (f.drawCasters && !impl_->gl)
+  if (f.drawCasters && !gl)
     invalid(p + "drawCasters", "set on the " + std::string(b.name()) + " backend",
             "draws with GL, on the OpenGL backend only: give shadowMap, spotShadowMaps and pointShadowMaps");
   validateLocalShadowMaps(b, f, p);
   validateLightTextures(b, f, info.evaluate, p);
   if (f.plan) {
-    // This run's index: inside run() it has been counted already.
-    const std::uint64_t run = impl_->running ? impl_->frames - 1 : impl_->frames;
-    validatePlan(b, f, planFrame(info, f, f.plan->options, run).plan, p);
+    PlannedFrame expected = planFrame(info, f, f.plan->options, thisRun());
+    validatePlan(b, f, expected.plan, p);
+    if (planned) *planned = std::move(expected);
   }
   if (f.light && f.shadowMap) {
     gpu::requireTexture2DOf(b, (p + "shadowMap.texture").c_str(), f.shadowMap->texture);
@@ -934,14 +938,22 @@ void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
   }
 }
 
+void Scattering::validate(const FrameAttribs& f, std::string_view owner) const {
+  if (!impl_)
+    invalid("Scattering", "a moved-from object",
+            "owns no GPU resources: assign a constructed Scattering first");
+  impl_->validate(f, std::string(owner) + ".", nullptr);
+}
+
 Scattering::FrameResult Scattering::runFrame(const FrameAttribs& f) {
   Impl& m = *impl_;
-  validate(f);
+  std::optional<PlannedFrame> made; // the frame's plan, made by validate() when the engine gave one
+  m.validate(f, "Scattering::FrameAttribs.", &made);
   FrameResult r;
   // The frame's plan: the engine's (FrameAttribs::plan, checked equal by validate()), or the GL
   // convenience's, whose maps drawCasters renders.
-  const PlannedFrame planned =
-      planFrame(m.info, f, f.plan ? f.plan->options : ShadowPassPlanOptions{}, m.frames - 1);
+  if (!made) made = planFrame(m.info, f, ShadowPassPlanOptions{}, m.thisRun());
+  const PlannedFrame& planned = *made;
   if (!f.light) {
     // A night frame: the transmittance, then the local lights added.
     m.stage(r, "transmittance", [&] { m.writeTransmittance(f); });

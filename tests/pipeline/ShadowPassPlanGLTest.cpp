@@ -17,7 +17,6 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <limits>
 #include <random>
 #include <string>
 #include <vector>

@@ -94,9 +94,8 @@ namespace {
 /// A run's depth images (from the session's pool) and what the engine draws into them.
 struct VulkanMaps {
   vkengine::DepthImagePool::Entry cameraDepth;
-  std::vector<std::uint32_t> planMaps;             ///< FrameAttribs::planMaps
-  std::vector<vkengine::ShadowPassTarget> targets; ///< the plan's passes that need a map
-  bool sunStandard = false; ///< the sun's pass is served by the frame's standard map: rendered too
+  vkengine::PlannedMaps plan; ///< FrameAttribs::planMaps and the plan's passes that need a map
+  bool sunStandard = false;   ///< the sun's pass is served by the frame's standard map: rendered too
   vkengine::DepthImagePool::Entry sunMap;
 };
 
@@ -112,15 +111,7 @@ VulkanMaps rasterize(VulkanSession::Impl& v, const FrameInputs& frame, const Sha
   };
   const auto [cw, ch] = size(frame.width, frame.height);
   m.cameraDepth = v.maps.acquire(cw, ch);
-  m.planMaps.assign(plan.passes.size(), 0);
-  for (std::size_t i = 0; i < plan.passes.size(); ++i) {
-    const ShadowPass& pass = plan.passes[i];
-    if (!pass.needsMap()) continue;
-    const auto [w, h] = size(pass.width, pass.height);
-    const vkengine::DepthImagePool::Entry map = v.maps.acquire(w, h);
-    m.planMaps[i] = map.texture;
-    m.targets.push_back(vkengine::targetOf(pass, *map.image));
-  }
+  m.plan = vkengine::acquireMaps(plan, v.maps);
   m.sunStandard = frame.directional && !plan.passes.empty() &&
                   plan.passes[0].light == ShadowPass::Light::Sun && plan.passes[0].served;
   if (m.sunStandard) {
@@ -137,7 +128,7 @@ VulkanMaps rasterize(VulkanSession::Impl& v, const FrameInputs& frame, const Sha
   });
   timings.time("engine: shadow passes (Vulkan)", [&] {
     const vkengine::Engine::Frame f = engine.beginFrame();
-    for (const vkengine::ShadowPassTarget& t : m.targets)
+    for (const vkengine::ShadowPassTarget& t : m.plan.targets)
       engine.drawDepthPass(f, *t.image, t.state, t.draws);
     if (m.sunStandard)
       engine.drawDepth(f, *m.sunMap.image, vkengine::zeroToOne(frame.lightClipFromWorld), true);
@@ -215,7 +206,7 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
   sunMap.texture = maps.sunMap.texture;
   if (!maps.sunStandard) a.shadowMap = nullptr; // projective: the plan's rectified map alone (the same plan)
   a.plan = &plan;
-  a.planMaps = maps.planMaps;
+  a.planMaps = maps.plan.planMaps;
   const Scattering::FrameResult r = scattering.run(a);
   for (const Scattering::Stage& stage : r.stages)
     out.timings.append({{stage.name, stage.wallMilliseconds}});
@@ -227,7 +218,8 @@ MethodOutput runOnVulkan(const SceneFrame& s, const std::string& method, const M
                       texels.data());
   out.detail = std::string(scene.hasSun ? layoutToken(r.layout) : "no directional light") + " layout, map " +
                std::to_string(settings.mapSize) + "^2, " + std::to_string(r.localLights.size()) +
-               " local lights; camera depth and " + std::to_string(maps.targets.size() + maps.sunStandard) +
+               " local lights; camera depth and " +
+               std::to_string(maps.plan.targets.size() + maps.sunStandard) +
                " shadow maps rasterized on Vulkan (" + vk.deviceName() + ")";
   return out;
 }
