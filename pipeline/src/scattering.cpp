@@ -65,6 +65,7 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.rectify.layout", "not SplitLayout::Regions",
             "must be SplitLayout::Regions (the splits side by side in one map)");
   validate(info.prefilter, "Scattering::CreateInfo.prefilter");
+  requireGpuReconstruction(info.prefilter, "Scattering::CreateInfo.prefilter");
   validate(info.evaluate, "Scattering::CreateInfo.evaluate");
   if (info.localLightBases != 0)
     validateBases(info.localLightBases, "Scattering::CreateInfo.localLightBases");

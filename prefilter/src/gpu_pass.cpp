@@ -263,11 +263,18 @@ gpu::LocalLightParams localLightParams(const LocalLight& light, const Medium& me
   return p;
 }
 
+void requireGpuReconstruction(const PrefilterOptions& options, std::string_view owner) {
+  if (options.reconstruction != VisibilityReconstruction::Fourier)
+    invalid(std::string(owner) + ".reconstruction", visibilityReconstructionToken(options.reconstruction),
+            "the GPU passes reconstruct with the Fourier series only so far (Exact is the CPU reference's)");
+}
+
 PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.mapWidth", info.mapWidth, 1);
   requireAtLeast("PrefilterPass::CreateInfo.mapHeight", info.mapHeight, 1);
   const PrefilterOptions& o = info.options;
   crep::validate(o, "PrefilterPass::CreateInfo.options");
+  requireGpuReconstruction(o, "PrefilterPass::CreateInfo.options");
   if (o.regionsPerSplit > info.mapWidth)
     invalid("PrefilterPass::CreateInfo.options.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
             "must be in [1, width = " + str(info.mapWidth) + "]");

@@ -90,9 +90,15 @@ void validateBasis(const FilteredBasis& b) {
   if (b.regionsPerSplit < 1 || b.regions != b.layout->regionCount() * b.regionsPerSplit ||
       b.width % b.regions != 0)
     bad("regions " + std::to_string(b.regions));
-  if (b.texels.size() != static_cast<std::size_t>(b.colorBases() * b.layers) *
-                             static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.width) * 4)
+  const std::size_t area = static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.width);
+  const bool exact = b.reconstruction == VisibilityReconstruction::Exact;
+  if (!exact && b.reconstruction != VisibilityReconstruction::Fourier)
+    bad("reconstruction " + std::to_string(static_cast<int>(b.reconstruction)));
+  if (b.texels.size() != (exact ? 0 : static_cast<std::size_t>(b.colorBases() * b.layers) * area * 4))
     bad("texels size " + std::to_string(b.texels.size()));
+  if (b.depth.size() != (exact ? area : 0)) bad("depth size " + std::to_string(b.depth.size()));
+  if (b.mix.size() != (exact ? static_cast<std::size_t>(b.colorBases()) * area : 0))
+    bad("mix size " + std::to_string(b.mix.size()));
   if (b.meanColor.size() !=
       (b.textured ? static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.width) * 3 : 0))
     bad("meanColor size " + std::to_string(b.meanColor.size()));
@@ -152,9 +158,53 @@ glm::dvec3 sampleMeanColor(const FilteredBasis& b, Sampling sampling, int r, dou
   return out;
 }
 
+/// VisibilityReconstruction::Exact: the running average P_i = P_{i-1} + m_i ([z_i >= z] - P_{i-1}) of region
+/// r's texels in row y up to texel x1 (region-local), colour `color`'s mix factors; P at x0 <= x1 into
+/// `atX0`.
+double exactRunningPrefix(const FilteredBasis& b, int r, int y, int x0, int x1, double z, int color,
+                          double& atX0) {
+  const int n = b.regionWidth();
+  const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(b.width) +
+                          static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
+  const std::size_t mixRow = static_cast<std::size_t>(color) * static_cast<std::size_t>(b.height) *
+                                 static_cast<std::size_t>(b.width) +
+                             row;
+  double P = 0.0;
+  atX0 = 0.0;
+  for (int k = 0; k <= x1; ++k) {
+    const double lit = static_cast<double>(b.depth[row + static_cast<std::size_t>(k)]) >= z ? 1.0 : 0.0;
+    P += static_cast<double>(b.mix[mixRow + static_cast<std::size_t>(k)]) * (lit - P);
+    if (k == x0) atX0 = P;
+  }
+  return P;
+}
+
+/// VisibilityReconstruction::Exact: the prefix visibility of region r at boundary u for the ray depth z, in
+/// the ray's own (nearest) row: a neighbouring row's receiver texels near the ray's end lie on either side of
+/// z (shadow acne), so rows are not blended; Bilinear interpolates along the row at sampleFiltered's
+/// positions.
+double exactPrefixVisibility(const FilteredBasis& b, Sampling sampling, int r, double u, double row, double z,
+                             int color) {
+  const int n = b.regionWidth();
+  const double x = std::clamp(u * n - 1.0, 0.0, static_cast<double>(n - 1));
+  const int y = std::clamp(static_cast<int>(std::floor(row * b.height)), 0, b.height - 1);
+  double p0 = 0.0;
+  if (sampling == Sampling::Nearest) {
+    const int xi = static_cast<int>(std::floor(x + 0.5));
+    return exactRunningPrefix(b, r, y, xi, xi, z, color, p0);
+  }
+  const int x0 = static_cast<int>(std::floor(x)), x1 = std::min(x0 + 1, n - 1);
+  const double p1 = exactRunningPrefix(b, r, y, x0, x1, z, color, p0);
+  return p0 + (x - x0) * (p1 - p0);
+}
+
 } // namespace
 
 // ---------------------------------------------------------------------------------------------------
+
+const char* visibilityReconstructionToken(VisibilityReconstruction reconstruction) {
+  return reconstruction == VisibilityReconstruction::Exact ? "exact" : "fourier";
+}
 
 const char* storageFormatToken(StorageFormat format) {
   switch (format) {
@@ -188,6 +238,10 @@ void validate(const PrefilterOptions& o, std::string_view owner) {
     throw InvalidArgument(field("basesPerInvocation"), detail::formatValue(o.basesPerInvocation),
                           "must be a multiple of 4 in [4, " + std::to_string(kMaxBases) + "]");
   if (o.threads < 0) throw InvalidArgument(field("threads"), detail::formatValue(o.threads), "must be >= 0");
+  if (o.reconstruction != VisibilityReconstruction::Fourier &&
+      o.reconstruction != VisibilityReconstruction::Exact)
+    throw InvalidArgument(field("reconstruction"), detail::formatValue(static_cast<int>(o.reconstruction)),
+                          "must be Fourier or Exact");
 }
 
 void validate(const EvaluateOptions& o, std::string_view owner) {
@@ -316,10 +370,16 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
   b.textured = colors != nullptr;
   b.profiles = referenceProfiles(*map.layout, H, options.regionsPerSplit);
   const int C = b.colorBases();
-  b.texels.assign(static_cast<std::size_t>(C * b.layers) * static_cast<std::size_t>(H) *
-                      static_cast<std::size_t>(W) * 4,
-                  storeFiltered(0.0, options.format));
-  if (colors) b.meanColor.assign(static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 3, 0.0f);
+  const std::size_t area = static_cast<std::size_t>(H) * static_cast<std::size_t>(W);
+  b.reconstruction = options.reconstruction;
+  const bool exact = options.reconstruction == VisibilityReconstruction::Exact;
+  if (exact) {
+    b.depth.assign(map.depth.data().begin(), map.depth.data().end());
+    b.mix.assign(static_cast<std::size_t>(C) * area, 0.0f);
+  } else {
+    b.texels.assign(static_cast<std::size_t>(C * b.layers) * area * 4, storeFiltered(0.0, options.format));
+  }
+  if (colors) b.meanColor.assign(area * 3, 0.0f);
 
   const int n = W / R;
   const std::size_t layerStride = static_cast<std::size_t>(H) * static_cast<std::size_t>(W) * 4;
@@ -351,7 +411,7 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
       glm::dvec3 cbar(0.0); // light textures: the prefix mean colour (prefilter.h, "Light textures")
       for (int i = 0; i < n; ++i) {
         const int x = r * n + i;
-        fourierBasis(texelBasisDepth(map.depth.at(x, j), options.depthMargin), basisSpan);
+        if (!exact) fourierBasis(texelBasisDepth(map.depth.at(x, j), options.depthMargin), basisSpan);
         const double m = mix[static_cast<std::size_t>(i)];
         const std::size_t texel =
             (static_cast<std::size_t>(j) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x)) * 4;
@@ -363,6 +423,10 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
             cbar[c] += m * (ci - cbar[c]);
             if (cbar[c] > 0.0) mc = std::clamp(m * (ci / cbar[c]), 0.0, 1.0);
             b.meanColor[texel / 4 * 3 + static_cast<std::size_t>(c)] = static_cast<float>(cbar[c]);
+          }
+          if (exact) { // VisibilityReconstruction::Exact: the factors alone; evaluation walks the depths
+            b.mix[static_cast<std::size_t>(c) * area + texel / 4] = static_cast<float>(mc);
+            continue;
           }
           std::array<double, kMaxBases>& F = Fc[static_cast<std::size_t>(c)];
           // Listing 2: the normalized weighted prefix, F_i = F_{i-1} + m_i (B_i - F_{i-1}).
@@ -403,18 +467,28 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
   const int C = basis.colorBases();
   std::vector<double> table(static_cast<std::size_t>(H) * static_cast<std::size_t>(R) *
                             static_cast<std::size_t>(samples) * static_cast<std::size_t>(C));
-  const std::vector<double> a = visibilityTableCoefficients(samples, M, basis.depthMargin, ringing);
-  for (int j = 0; j < H; ++j)
+  const bool exact = basis.reconstruction == VisibilityReconstruction::Exact;
+  const std::vector<double> a =
+      exact ? std::vector<double>() : visibilityTableCoefficients(samples, M, basis.depthMargin, ringing);
+  parallelRows(H, 0, [&](int j) { // rows are independent: the same result for any thread count
     for (int r = 0; r < R; ++r) {
       const int x = r * n + n - 1; // the region's last texel: its whole weighted average
       for (int s = 0; s < samples; ++s)
         for (int c = 0; c < C; ++c) {
-          double dot = 0.0;
-          for (int k = 0; k < M; ++k)
-            dot +=
-                a[static_cast<std::size_t>(s) * static_cast<std::size_t>(M) + static_cast<std::size_t>(k)] *
-                basis.filtered(x, j, k, c);
-          double V = std::clamp(0.5 + dot, 0.0, 1.0);
+          double V = 0.0, unused = 0.0;
+          if (exact) {
+            // The exact region average at the sample's ray depth s / (Z - 1); sample 0 takes the limit from
+            // above (z > 0), so that casters clamped to depth 0 shadow every ray between samples 0 and 1.
+            const double z = s == 0 ? std::nextafter(0.0, 1.0) : static_cast<double>(s) / (samples - 1);
+            V = exactRunningPrefix(basis, r, j, n - 1, n - 1, z, c, unused);
+          } else {
+            double dot = 0.0;
+            for (int k = 0; k < M; ++k)
+              dot +=
+                  a[static_cast<std::size_t>(s) * static_cast<std::size_t>(M) + static_cast<std::size_t>(k)] *
+                  basis.filtered(x, j, k, c);
+            V = std::clamp(0.5 + dot, 0.0, 1.0);
+          }
           if (basis.textured) V *= basis.mean(x, j, c); // light textures: V_c = cbar_c clamp(...)
           table[((static_cast<std::size_t>(j) * static_cast<std::size_t>(R) + static_cast<std::size_t>(r)) *
                      static_cast<std::size_t>(samples) +
@@ -423,6 +497,7 @@ std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, Rin
                 static_cast<std::size_t>(c)] = V;
         }
     }
+  });
   return table;
 }
 
@@ -594,24 +669,26 @@ glm::dvec3 regionVisibility(const FilteredBasis& basis, const EvaluateOptions& o
       basis.textured ? sampleMeanColor(basis, options.sampling, r, ub, m.row) : glm::dvec3(1.0);
   const glm::dvec3 ca =
       basis.textured && !plain ? sampleMeanColor(basis, options.sampling, r, ua, m.row) : glm::dvec3(1.0);
-  for (int c = 0; c < C; ++c) {
-    sampleFiltered(basis, options.sampling, r, ub, m.row, Fb.data(), c);
+  // The prefix visibility P(u) of colour c: 0.5 + a . F(u) (Eq. 9), or the exact prefix (Exact).
+  const auto prefixAt = [&](double u, int c, std::array<double, kMaxBases>& F) {
+    if (basis.reconstruction == VisibilityReconstruction::Exact)
+      return exactPrefixVisibility(basis, options.sampling, r, u, m.row, std::clamp(m.depth, 0.0, 1.0), c);
+    sampleFiltered(basis, options.sampling, r, u, m.row, F.data(), c);
     double dot = 0.0;
+    for (int k = 0; k < M; ++k)
+      dot += a[static_cast<std::size_t>(k)] * F[static_cast<std::size_t>(k)];
+    return 0.5 + dot;
+  };
+  for (int c = 0; c < C; ++c) {
     if (plain) {
-      for (int k = 0; k < M; ++k)
-        dot += a[static_cast<std::size_t>(k)] * Fb[static_cast<std::size_t>(k)];
-      V[c] = std::clamp(0.5 + dot, 0.0, 1.0) * cb[c];
+      V[c] = std::clamp(prefixAt(ub, c, Fb), 0.0, 1.0) * cb[c];
       continue;
     }
     const double wbc = wb * cb[c], wac = wa * ca[c];
     if (!(wbc - wac > 0.0)) continue; // no weighted light in the segment: V = 0
-    sampleFiltered(basis, options.sampling, r, ua, m.row, Fa.data(), c);
-    for (int k = 0; k < M; ++k) {
-      const auto kk = static_cast<std::size_t>(k);
-      dot += a[kk] * (wbc * Fb[kk] - wac * Fa[kk]);
-    }
-    dot /= wbc - wac;
-    V[c] = (wbc - wac) / (wb - wa) * std::clamp(0.5 + dot, 0.0, 1.0);
+    // (wb Pb - wa Pa) / (wb - wa) = 0.5 + a . (wb Fb - wa Fa) / (wb - wa) for the series.
+    const double P = (wbc * prefixAt(ub, c, Fb) - wac * prefixAt(ua, c, Fa)) / (wbc - wac);
+    V[c] = (wbc - wac) / (wb - wa) * std::clamp(P, 0.0, 1.0);
   }
   return V;
 }

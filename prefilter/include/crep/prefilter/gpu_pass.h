@@ -24,6 +24,10 @@
 
 namespace crep {
 
+/// Throws InvalidArgument naming `<owner>.reconstruction` unless the GPU passes implement it: Fourier only so
+/// far (VisibilityReconstruction::Exact is the CPU reference's).
+void requireGpuReconstruction(const PrefilterOptions& options, std::string_view owner);
+
 /// A filtered basis on the GPU: the texture array and the parameters it was prefiltered with
 /// (everything evaluation needs besides the layout). Non-owning ids of the passes' backend (GL names).
 struct FilteredBasisView {

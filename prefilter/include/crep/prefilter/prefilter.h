@@ -40,6 +40,22 @@ enum class Sampling {
   Bilinear, ///< GL_LINEAR: hardware bilinear filtering of the array layer (paper Sec. 5) (default)
 };
 
+/// How evaluation reconstructs the weighted visibility of a row prefix for a view ray's depth z_r.
+enum class VisibilityReconstruction {
+  /// Klehm et al. 2014, Eq. 9: 0.5 + a(z_r) . F, the truncated Fourier series of the prefiltered basis
+  /// (default).
+  Fourier,
+  /// Not in the paper: the exact weighted prefix of the depth test, sum_i w_i [z_i >= z_r] / sum_i w_i,
+  /// walked
+  /// texel by texel over the region a ray ends in (at most n = width / R texels per pixel), and sampled
+  /// exactly
+  /// at the table's Z ray depths for the regions it crosses whole. No truncation error: the error budget in
+  /// docs/MEASUREMENTS.md. CPU reference only so far (the GPU passes refuse it).
+  Exact,
+};
+/// "fourier", "exact".
+const char* visibilityReconstructionToken(VisibilityReconstruction reconstruction);
+
 struct PrefilterOptions {
   int bases = kDefaultBases; ///< M: even, in [kMinBases, kMaxBases] (fourier.h); ceil(M / 4) RGBA layers
   WeightMode weights = WeightMode::Exact;      ///< weights.h (Sec. 3.2, Eq. 11-12)
@@ -51,10 +67,12 @@ struct PrefilterOptions {
   int basesPerInvocation = 16;
   LocalLightWeights localLightWeights = LocalLightWeights::Full; ///< local lights: light-side factors
   int threads = 0; ///< CPU workers, 0 = hardware concurrency; never changes the result
+  /// What the basis holds for evaluation: the Fourier basis (default), or the map's depths and mix factors.
+  VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
 };
 
 /// The one validation of the options (CPU and GPU): InvalidArgument naming `<owner>.bases`, `.format`,
-/// `.weights`, `.regionsPerSplit`, `.depthMargin`, `.basesPerInvocation` or `.threads`.
+/// `.weights`, `.regionsPerSplit`, `.depthMargin`, `.basesPerInvocation`, `.threads` or `.reconstruction`.
 void validate(const PrefilterOptions& options, std::string_view owner = "PrefilterOptions");
 
 /// RGBA layers of M bases: (M + 3) / 4 (channels beyond M store the encoded 0.5, F = 0).
@@ -112,6 +130,14 @@ struct FilteredBasis {
   bool textured = false;
   /// Textured only: cbar_c per texel as float, index (y * width + x) * 3 + c; empty otherwise.
   std::vector<float> meanColor;
+  /// Fourier: `texels` holds the basis. Exact: `texels` is empty and evaluation walks `depth` with `mix`.
+  VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
+  /// Exact only: the rectified map's depths, index y * width + x; empty otherwise.
+  std::vector<float> depth;
+  /// Exact only: the mix factor m_i = w_i / sum_{k <= i} w_k of each texel within its region (Listing 2's
+  /// running average; with a texture, colour c's factor m_i c_i / cbar_i), index (c * height + y) * width +
+  /// x.
+  std::vector<float> mix;
 
   int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
   int colorBases() const noexcept { return textured ? 3 : 1; } ///< bases stored: 3 with a texture, else 1
@@ -191,6 +217,8 @@ std::vector<double> visibilityTableCoefficients(int samples, int bases, double d
 
 /// The region visibility table of `basis` from its stored values, index (row * R + region) * Z + s (times 3,
 /// + c, when textured); what EvaluatePass builds in float (glsl/passes/prefilter/visibility_table.comp).
+/// Exact bases: the weighted average of [z_i >= s / (Z - 1)] over the region's texels, [z_i > 0] for s = 0
+/// (the limit from above: casters clamped to depth 0 shadow every ray of positive depth).
 std::vector<double> visibilityTable(const FilteredBasis& basis, int samples, RingingFilter ringing);
 
 /// The scattering prefix table of `basis` and visibilityTable() `visibility`, index ((row * R + region) * Z +
