@@ -5,6 +5,7 @@
 // figures.
 //
 //   build/bench/accuracy/crep_error_budget [--size WxH] [--section budget|split|flicker|all] [--case NAME]
+//                                          [--knob TEXT]
 //
 // It reuses the tests' analytic scenes (tests/common), so it is built with the tests.
 #define DOCTEST_CONFIG_IMPLEMENT // the test helpers' doctest symbols; no test runs here
@@ -39,6 +40,7 @@ using namespace crep;
 namespace {
 
 int gWidth = 320, gHeight = 180;
+std::string gKnob;                 // --knob: only the knobs whose name contains it (and the defaults)
 constexpr int kStandardMap = 2048; // the engine's standard map of the resampled input and the world march
 
 /// One analytic case: the ground camera, a light and its plane occluder (a sun's, or the local lights' wall).
@@ -220,6 +222,8 @@ struct Knob {
 std::vector<Knob> knobs() {
   return {
       {"defaults (M = 32, RGBA8, 1024^2, rasterized)", [](Scattering::CreateInfo&) {}},
+      {"reconstruction: exact (no truncation)",
+       [](Scattering::CreateInfo& i) { i.prefilter.reconstruction = VisibilityReconstruction::Exact; }},
       {"truncation: M = 64", [](Scattering::CreateInfo& i) { i.prefilter.bases = i.spotLightBases = 64; }},
       {"truncation: M = 128, RGBA32F",
        [](Scattering::CreateInfo& i) {
@@ -266,6 +270,7 @@ void budget(const std::vector<Case>& cases) {
   }
   std::vector<std::string> layouts(cases.size());
   for (const Knob& k : knobs()) {
+    if (!gKnob.empty() && k.name.find(gKnob) == std::string::npos && k.name.find("defaults") != 0) continue;
     Scattering::CreateInfo info = defaultInfo();
     k.change(info);
     Scattering s(info);
@@ -496,12 +501,13 @@ int main(int argc, char** argv) {
       }
     } else if (a == "--section" && i + 1 < argc) {
       section = argv[++i];
+    } else if (a == "--knob" && i + 1 < argc) {
+      gKnob = argv[++i];
     } else if (a == "--case" && i + 1 < argc) {
       only = argv[++i];
     } else {
-      std::fprintf(
-          stderr,
-          "usage: crep_error_budget [--size WxH] [--section budget|split|flicker|all] [--case NAME]\n");
+      std::fprintf(stderr, "usage: crep_error_budget [--size WxH] [--section budget|split|flicker|all] "
+                           "[--case NAME] [--knob TEXT]\n");
       return 2;
     }
   }

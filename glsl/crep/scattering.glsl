@@ -99,6 +99,14 @@
 #ifndef CREP_RINGING_LANCZOS
 #define CREP_RINGING_LANCZOS 0
 #endif
+// 1: crep::VisibilityReconstruction::Exact. Layer 0 of the basis array holds per texel (depth, mix factor m_i
+// of colour 0, 1, 2) in RGBA32F; evaluation walks it (crep_exactVisibility) instead of the Fourier series.
+#ifndef CREP_EXACT_VISIBILITY
+#define CREP_EXACT_VISIBILITY 0
+#endif
+#ifndef CREP_EXACT_NEAREST
+#define CREP_EXACT_NEAREST 0 // 1: crep::Sampling::Nearest of the exact prefix (the nearest texel)
+#endif
 
 // ---------------------------------------------------------------------------------------------------
 // Fourier basis and coefficients (Eq. 8). Harmonic h = 0, 1, ... is the paper's k = h + 1, with
@@ -585,6 +593,40 @@ vec4 crep_filteredBasisAt(int region, float u, float row, int layer) {
   return 2.0 * textureLod(crep_filteredBasis, coord, 0.0) - 1.0;
 }
 
+#if CREP_EXACT_VISIBILITY
+// crep::VisibilityReconstruction::Exact: the running average P_k = P_{k-1} + m_k ([depth_k >= z] - P_{k-1}) of
+// region r's texels in row y up to texel x1 (region-local); P at x0 <= x1 into atX0 (crep::evaluate's rule).
+// One RGBA32F fetch per texel, the same row for a pixel's whole walk (coherent along the row).
+vec3 crep_exactRunningPrefix(int region, int y, int x0, int x1, float z, out vec3 atX0) {
+  int n = crep_scattering.mapSize.x / crep_scattering.mapSize.z;
+  vec3 P = vec3(0.0);
+  atX0 = P;
+  for (int k = 0; k <= x1; ++k) {
+    vec4 t = texelFetch(crep_filteredBasis, ivec3(region * n + k, y, 0), 0);
+    P += t.gba * ((t.r >= z ? 1.0 : 0.0) - P);
+    if (k == x0) atX0 = P;
+  }
+  return P;
+}
+
+// The exact prefix visibility of region r at boundary u for the ray depth z, in the ray's own (nearest) row,
+// linear along the row at crep_filteredBasisAt's positions (or the nearest texel); per colour channel.
+vec3 crep_exactPrefix(int region, float u, float row, float z) {
+  int H = crep_scattering.mapSize.y, n = crep_scattering.mapSize.x / crep_scattering.mapSize.z;
+  float x = clamp(u * float(n) - 1.0, 0.0, float(n - 1));
+  int y = clamp(int(floor(row * float(H))), 0, H - 1);
+  vec3 P0;
+#if CREP_EXACT_NEAREST
+  int xi = int(floor(x + 0.5));
+  return crep_exactRunningPrefix(region, y, xi, xi, z, P0);
+#else
+  int x0 = int(floor(x)), x1 = min(x0 + 1, n - 1);
+  vec3 P1 = crep_exactRunningPrefix(region, y, x0, x1, z, P0);
+  return mix(P0, P1, x - float(x0));
+#endif
+}
+#endif
+
 #if CREP_LIGHT_TEXTURE
 // The prefix mean colour cbar at the same sample position as crep_filteredBasisAt.
 vec3 crep_meanColorAt(int region, float u, float row) {
@@ -596,7 +638,10 @@ vec3 crep_meanColorAt(int region, float u, float row) {
 
 // Light textures: the region's visibility per colour channel at prefix boundary u, V_c = cbar_c clamp(0.5 +
 // a . F_c, 0, 1) (crep::evaluate of a textured basis), F_c in layers [c L, (c + 1) L).
-vec3 crep_texturedVisibility(vec4 a[CREP_EVAL_MAX_LAYERS], int region, float u, float row) {
+vec3 crep_texturedVisibility(vec4 a[CREP_EVAL_MAX_LAYERS], int region, float u, float row, float depth) {
+#if CREP_EXACT_VISIBILITY
+  return clamp(crep_exactPrefix(region, u, row, clamp(depth, 0.0, 1.0)), 0.0, 1.0) * crep_meanColorAt(region, u, row);
+#endif
   vec3 V;
   for (int c = 0; c < 3; ++c) {
     float dotF = 0.0;
@@ -691,6 +736,7 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
   vec2 stepSC = crep_harmonicStep(zr);
   vec2 sc = crep_harmonic(0, zr);
   vec4 a[CREP_EVAL_MAX_LAYERS];
+#if !CREP_EXACT_VISIBILITY // the exact prefix needs no coefficients
   for (int l = 0; l < CREP_EVAL_LAYERS; ++l) {
     vec2 next = crep_rotate(sc, stepSC);
     a[l] = crep_coefficients4(2 * l, sc, next);
@@ -700,6 +746,7 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
     if (2 * l + 1 >= CREP_EVAL_HALF) a[l].zw = vec2(0.0); // M % 4 == 2: the last layer holds one harmonic
     sc = crep_rotate(next, stepSC);
   }
+#endif
 
   vec3 L = vec3(0.0);
   float ta = start;
@@ -739,11 +786,15 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
     vec3 lastSection = crep_sectionIntegral(origin, dir, sigma, ta, surface);
 #endif
 #if CREP_LIGHT_TEXTURE
-    L += crep_texturedVisibility(a, lastRegion, lastU, hit.row) * lastSection;
+    L += crep_texturedVisibility(a, lastRegion, lastU, hit.row, hit.depth) * lastSection;
+#else
+#if CREP_EXACT_VISIBILITY
+    L += clamp(crep_exactPrefix(lastRegion, lastU, hit.row, clamp(hit.depth, 0.0, 1.0)).x, 0.0, 1.0) * lastSection;
 #else
     float dotF = 0.0;
     for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(lastRegion, lastU, hit.row, l));
     L += clamp(0.5 + dotF, 0.0, 1.0) * lastSection;
+#endif
 #endif
     return vec4(C * L, transmittance);
   }
@@ -762,17 +813,26 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
       float wa = crep_regionWeightTotal(w, mode, s, n, ua), wb = crep_regionWeightTotal(w, mode, s, n, ub);
       if (wb - wa > 1e-12 * wb) {
         plain = false;
+#if CREP_EXACT_VISIBILITY
+        float z = clamp(hit.depth, 0.0, 1.0);
+        dotF = (wb * crep_exactPrefix(r, ub, hit.row, z).x - wa * crep_exactPrefix(r, ua, hit.row, z).x) / (wb - wa) - 0.5;
+#else
         for (int l = 0; l < CREP_EVAL_LAYERS; ++l)
           dotF += dot(a[l], wb * crep_filteredBasisAt(r, ub, hit.row, l) - wa * crep_filteredBasisAt(r, ua, hit.row, l));
         dotF /= wb - wa;
+#endif
       }
     }
 #endif
 #if CREP_LIGHT_TEXTURE
-    L += C * crep_texturedVisibility(a, r, ub, hit.row) * crep_sectionIntegral(origin, dir, sigma, ta, tb);
+    L += C * crep_texturedVisibility(a, r, ub, hit.row, hit.depth) * crep_sectionIntegral(origin, dir, sigma, ta, tb);
+#else
+#if CREP_EXACT_VISIBILITY
+    if (plain) dotF = crep_exactPrefix(r, ub, hit.row, clamp(hit.depth, 0.0, 1.0)).x - 0.5;
 #else
     if (plain)
       for (int l = 0; l < CREP_EVAL_LAYERS; ++l) dotF += dot(a[l], crep_filteredBasisAt(r, ub, hit.row, l));
+#endif
     float V = clamp(0.5 + dotF, 0.0, 1.0);
     L += C * V * crep_sectionIntegral(origin, dir, sigma, ta, tb);
 #endif

@@ -65,7 +65,6 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.rectify.layout", "not SplitLayout::Regions",
             "must be SplitLayout::Regions (the splits side by side in one map)");
   validate(info.prefilter, "Scattering::CreateInfo.prefilter");
-  requireGpuReconstruction(info.prefilter, "Scattering::CreateInfo.prefilter");
   validate(info.evaluate, "Scattering::CreateInfo.evaluate");
   if (info.localLightBases != 0)
     validateBases(info.localLightBases, "Scattering::CreateInfo.localLightBases");
@@ -484,8 +483,6 @@ EpipolarOptions epipolarOptions(const Scattering::CreateInfo& info, double depth
   return options;
 }
 
-} // namespace
-
 /// The passes' CreateInfos on the object's backend.
 PrefilterPass::CreateInfo prefilterInfo(int mapSize, const PrefilterOptions& options, gpu::Backend* backend) {
   PrefilterPass::CreateInfo c;
@@ -495,22 +492,27 @@ PrefilterPass::CreateInfo prefilterInfo(int mapSize, const PrefilterOptions& opt
   return c;
 }
 
-EvaluatePass::CreateInfo evaluateInfo(int bases, const EvaluateOptions& options, bool closedForm,
+EvaluatePass::CreateInfo evaluateInfo(int bases, const EvaluateOptions& options,
+                                      VisibilityReconstruction reconstruction, bool closedForm,
                                       gpu::Backend* backend) {
   EvaluatePass::CreateInfo c;
   c.bases = bases;
   c.options = options;
+  c.reconstruction = reconstruction;
   c.localClosedForm = closedForm;
   c.backend = backend;
   return c;
 }
+
+} // namespace
 
 struct Scattering::Impl {
   explicit Impl(const CreateInfo& i)
       : info(validated(i)), backend(&gpu::givenOrGl(i.backend, ownBackend)),
         gl(backend->kind() == gpu::BackendKind::OpenGL),
         prefilter(prefilterInfo(i.mapSize, i.prefilter, backend)),
-        evaluate(evaluateInfo(i.prefilter.bases, i.evaluate, i.localLightClosedForm, backend)),
+        evaluate(evaluateInfo(i.prefilter.bases, i.evaluate, i.prefilter.reconstruction,
+                              i.localLightClosedForm, backend)),
         resample({.mapWidth = i.mapSize, .mapHeight = i.mapSize, .backend = backend}),
         block({.options = i.epipoleBlock, .backend = backend}) {
     resampled = gpu::Texture(*backend, {gpu::TextureType::Texture2D, gpu::Format::R32F, i.mapSize, i.mapSize,
@@ -650,7 +652,8 @@ struct Scattering::Impl {
       EvaluateOptions options = info.evaluate;
       options.visibilityTableSamples = Z;
       it = localEvaluates
-               .emplace(std::pair(M, Z), evaluateInfo(M, options, info.localLightClosedForm, backend))
+               .emplace(std::pair(M, Z), evaluateInfo(M, options, info.prefilter.reconstruction,
+                                                      info.localLightClosedForm, backend))
                .first;
     }
     return it->second;

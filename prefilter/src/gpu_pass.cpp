@@ -60,6 +60,7 @@ int basesPerInvocation(const PrefilterPass::CreateInfo& info, bool local) {
 
 /// Invocations per row and region: groups of basesPerInvocation / 4 layers (the last may be partial).
 int baseGroups(const PrefilterPass::CreateInfo& info, bool local = false) {
+  if (info.options.reconstruction == VisibilityReconstruction::Exact) return 1; // no bases
   return ceilDiv(layerCount(info.options.bases), basesPerInvocation(info, local) / 4);
 }
 
@@ -89,6 +90,11 @@ void checkWorkgroup(const gpu::Backend& backend, const char* const names[3], con
     gpu::throwBeyondLimit(backend, std::string(names[0]) + " x " + names[1] + " x " + names[2],
                           str(invocations), "GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS",
                           "invocations per work group", limits.invocations);
+}
+
+/// The storage of the basis array: the options' format, or RGBA32F for the exact reconstruction's texels.
+StorageFormat arrayFormat(const PrefilterOptions& o) {
+  return o.reconstruction == VisibilityReconstruction::Exact ? StorageFormat::RGBA32F : o.format;
 }
 
 gpu::Format basisFormat(StorageFormat format) {
@@ -234,12 +240,15 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& info, bool local,
                                                bool textured = false) {
   const PrefilterOptions& o = info.options;
+  const bool exact = o.reconstruction == VisibilityReconstruction::Exact;
+  const StorageFormat format = exact ? StorageFormat::RGBA32F : o.format; // exact: depths and factors
   return {{ShaderStage::Compute,
            "passes/prefilter/prefilter.comp",
            {{"CREP_BASES_PER_INVOCATION", str(basesPerInvocation(info, local))},
-            {"CREP_BASIS_FORMAT", imageFormatQualifier(o.format)},
-            {"CREP_BASIS_UNORM8", o.format == StorageFormat::RGBA8 ? "1" : "0"},
-            {"CREP_BASIS_HALF", o.format == StorageFormat::RGBA16F ? "1" : "0"},
+            {"CREP_BASIS_FORMAT", imageFormatQualifier(format)},
+            {"CREP_BASIS_UNORM8", format == StorageFormat::RGBA8 ? "1" : "0"},
+            {"CREP_BASIS_HALF", format == StorageFormat::RGBA16F ? "1" : "0"},
+            {"CREP_EXACT_VISIBILITY", exact ? "1" : "0"},
             {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
             {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
             {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)},
@@ -263,18 +272,14 @@ gpu::LocalLightParams localLightParams(const LocalLight& light, const Medium& me
   return p;
 }
 
-void requireGpuReconstruction(const PrefilterOptions& options, std::string_view owner) {
-  if (options.reconstruction != VisibilityReconstruction::Fourier)
-    invalid(std::string(owner) + ".reconstruction", visibilityReconstructionToken(options.reconstruction),
-            "the GPU passes reconstruct with the Fourier series only so far (Exact is the CPU reference's)");
-}
-
 PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
   requireAtLeast("PrefilterPass::CreateInfo.mapWidth", info.mapWidth, 1);
   requireAtLeast("PrefilterPass::CreateInfo.mapHeight", info.mapHeight, 1);
   const PrefilterOptions& o = info.options;
   crep::validate(o, "PrefilterPass::CreateInfo.options");
-  requireGpuReconstruction(o, "PrefilterPass::CreateInfo.options");
+  if (info.memoryLimit && o.reconstruction == VisibilityReconstruction::Exact)
+    invalid("PrefilterPass::CreateInfo.options.reconstruction", "exact",
+            "must be fourier with CreateInfo.memoryLimit (a benchmark variant of the Fourier pass)");
   if (o.regionsPerSplit > info.mapWidth)
     invalid("PrefilterPass::CreateInfo.options.regionsPerSplit", detail::formatValue(o.regionsPerSplit),
             "must be in [1, width = " + str(info.mapWidth) + "]");
@@ -310,7 +315,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
 
   const ShaderStageSource stage = prefilterStages(info, false)[0];
   b.prepareProgram(stage.path, stage.defines);
-  texture_ = gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(o.format), info.mapWidth,
+  texture_ = gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(arrayFormat(o)), info.mapWidth,
                               info.mapHeight, layers(), "PrefilterPass: filtered basis"});
   paramsBuffer_ = gpu::Buffer(b, sizeof(gpu::PrefilterParams), "PrefilterPass: parameters");
 }
@@ -419,8 +424,8 @@ void PrefilterPass::prepareTextured(bool local) {
   if (!texturedTexture_) {
     // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
     texturedTexture_ =
-        gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(info_.options.format), W, H,
-                         3 * layers(), "PrefilterPass: filtered basis (light textures)"});
+        gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(arrayFormat(info_.options)), W, H,
+                         exact() ? 1 : 3 * layers(), "PrefilterPass: filtered basis (light textures)"});
     // RGBA32F: a light texture's HDR texels (projector images in physical units) are kept whole; half
     // floats clipped them at 65504. GPU: one fetch per region per pixel, so the extra bytes are cheap.
     meanColor_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, W, H, 1,
@@ -521,6 +526,7 @@ FilteredBasisView PrefilterPass::filteredBasis() const {
   v.weights = info_.options.weights;
   v.extinction = lastExtinction_;
   v.depthMargin = info_.options.depthMargin;
+  v.reconstruction = info_.options.reconstruction;
   return v;
 }
 
@@ -551,6 +557,8 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
         {"CREP_OUTPUT_FORMAT", list ? "rgba32f" : storageFormatToken(info.outputFormat)},
         {"CREP_NEAR_PLANE_CORRECTION", info.options.nearPlaneCorrection ? "1" : "0"},
         {"CREP_RINGING_LANCZOS", info.options.ringing == RingingFilter::Lanczos ? "1" : "0"},
+        {"CREP_EXACT_VISIBILITY", info.reconstruction == VisibilityReconstruction::Exact ? "1" : "0"},
+        {"CREP_EXACT_NEAREST", info.options.sampling == Sampling::Nearest ? "1" : "0"},
         {"CREP_LOCAL_SIZE_X", str(info.workgroupWidth)},
         {"CREP_LOCAL_SIZE_Y", str(info.workgroupHeight)},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
@@ -583,6 +591,7 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
        "passes/prefilter/scattering_prefix.comp",
        {{"CREP_BASES", str(info.bases)},
         {"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
+        {"CREP_EXACT_VISIBILITY", info.reconstruction == VisibilityReconstruction::Exact ? "1" : "0"},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   addLayoutDefines(stages[0].defines, layoutKind);
   if (local) {
@@ -600,15 +609,13 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
 
 std::size_t PrefilterPass::memoryBytes() const noexcept {
   if (backend_ == nullptr) return 0; // moved from
-  const std::size_t textured =
-      texturedTexture_
-          ? 3 * filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases,
-                                   info_.options.format) +
-                static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight) * 16
-          : 0;
-  return textured +
-         filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases, info_.options.format) +
-         weightsBuffer_.bytes() + sizeof(gpu::PrefilterParams) + raysBuffer_.bytes() +
+  const std::size_t area =
+      static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight);
+  const std::size_t basis = exact() ? area * 16
+                                    : filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases,
+                                                         info_.options.format);
+  const std::size_t textured = texturedTexture_ ? (exact() ? 1 : 3) * basis + area * 16 : 0;
+  return textured + basis + weightsBuffer_.bytes() + sizeof(gpu::PrefilterParams) + raysBuffer_.bytes() +
          (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }
 
@@ -619,6 +626,7 @@ ShaderStageSource tableStage(const EvaluatePass::CreateInfo& info) {
           "passes/prefilter/visibility_table.comp",
           {{"CREP_BASES", str(info.bases)},
            {"CREP_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
+           {"CREP_EXACT_VISIBILITY", info.reconstruction == VisibilityReconstruction::Exact ? "1" : "0"},
            {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}};
 }
 
@@ -714,7 +722,13 @@ void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateIn
   if (basis.bases != info.bases)
     invalid(f + "basis.bases", detail::formatValue(basis.bases),
             "must equal EvaluatePass::CreateInfo.bases = " + str(info.bases));
-  const int basisLayers = (basis.textured ? 3 : 1) * layerCount(basis.bases);
+  if (basis.reconstruction != info.reconstruction)
+    invalid(f + "basis.reconstruction", visibilityReconstructionToken(basis.reconstruction),
+            std::string("must equal EvaluatePass::CreateInfo.reconstruction = ") +
+                visibilityReconstructionToken(info.reconstruction));
+  const int basisLayers = basis.reconstruction == VisibilityReconstruction::Exact
+                              ? 1
+                              : (basis.textured ? 3 : 1) * layerCount(basis.bases);
   const gpu::TextureLevel b = gpu::textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
   if (b.type != gpu::TextureType::Texture2DArray || b.width != basis.width || b.height != basis.height ||
       b.depth < basisLayers)

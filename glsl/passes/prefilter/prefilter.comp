@@ -43,6 +43,9 @@
 #ifndef CREP_LIGHT_TEXTURE
 #define CREP_LIGHT_TEXTURE 0 // 1: a light texture's colour map (crep::prefilter(map, medium, lightColors))
 #endif
+// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact, from crep/scattering.glsl): no basis; layer 0
+// of an RGBA32F array gets (depth, m_i of colour 0, 1, 2) per texel, the factors of the same running average
+// (without a texture, m_i three times). One group of bases.
 
 #define CREP_GROUP_VEC4S (CREP_BASES_PER_INVOCATION / 4)
 
@@ -138,9 +141,12 @@ void main() {
     }
     continue;
 #endif
-    CrepDepth z = crep_texelBasisDepth(texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r, margin);
+    float texelDepth = texelFetch(crep_rectifiedDepth, ivec2(x, row), 0).r;
+#if !CREP_EXACT_VISIBILITY
+    CrepDepth z = crep_texelBasisDepth(texelDepth, margin);
     vec2 stepSC = crep_harmonicStep(z);
     vec2 sc = crep_harmonic(firstHarmonic, z);
+#endif
     // Listing 2: the normalized weighted prefix.
 #if CREP_LOCAL_LIGHT
     float tauRight = crep_regionDistance(w, CREP_WEIGHTS_EXACT, n, float(i + 1));
@@ -170,6 +176,13 @@ void main() {
       if (cbar[c] > 0.0) mc[c] = clamp(m * (ci[c] / cbar[c]), 0.0, 1.0);
     if (group == 0) imageStore(crep_meanColorOut, ivec2(x, row), vec4(cbar, 1.0));
 #endif
+#if CREP_EXACT_VISIBILITY
+#if CREP_LIGHT_TEXTURE
+    imageStore(crep_filteredBasisOut, ivec3(x, row, 0), vec4(texelDepth, mc));
+#else
+    imageStore(crep_filteredBasisOut, ivec3(x, row, 0), vec4(texelDepth, vec3(m)));
+#endif
+#else
     for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
       int layer = firstLayer + v;
       if (layer >= layers) break;
@@ -187,5 +200,6 @@ void main() {
 #endif
       sc = crep_rotate(second, stepSC);
     }
+#endif
   }
 }

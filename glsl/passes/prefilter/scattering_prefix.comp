@@ -21,6 +21,9 @@
 // CREP_LIGHT_TEXTURE 1 (a basis prefiltered with a light texture, crep/scattering.glsl): V_r' per colour
 // channel, cbar_c clamp(0.5 + a(z_s) . F_c, 0, 1) with F_c in layers [c L, (c + 1) L) and cbar at the
 // region's last texel (crep::visibilityTable of a textured basis).
+// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact): V_r' is the exact weighted average of the
+// region's depth test at z_s (the running average over its n texels; sample 0 as the limit from above, z > 0),
+// crep::visibilityTable of an exact basis: n fetches per region instead of M / 4.
 // Driven by crep::EvaluatePass.
 #include "crep/bindings.h"
 #ifndef CREP_BASES
@@ -84,7 +87,20 @@ void main() {
       continue;
     }
 #endif
+#if CREP_EXACT_VISIBILITY
+    float zs = float(s) / float(Z - 1);
+    vec3 P = vec3(0.0);
+    for (int k = 0; k < n; ++k) {
+      vec4 t = texelFetch(crep_filteredBasis, ivec3(r * n + k, j, 0), 0);
+      bool lit = s == 0 ? t.r > 0.0 : t.r >= zs;
+      P += t.gba * ((lit ? 1.0 : 0.0) - P);
+    }
 #if CREP_LIGHT_TEXTURE
+    vec3 V = P * texelFetch(crep_meanColor, ivec2(r * n + n - 1, j), 0).rgb;
+#else
+    vec3 V = vec3(P.x);
+#endif
+#elif CREP_LIGHT_TEXTURE
     vec3 V;
     for (int c = 0; c < 3; ++c) {
       float dotC = 0.0;

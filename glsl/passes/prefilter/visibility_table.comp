@@ -10,6 +10,8 @@
 // double on the CPU, with the ringing filter) from a storage buffer shared by all invocations: H R (M / 4
 // fetches + Z M multiply-adds) in all. Used only with EvaluateOptions::scatteringPrefix = false (the
 // default builds the scattering prefix table, passes/prefilter/scattering_prefix.comp, which includes this step).
+// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact): layer 0 holds (depth, mix factor) per texel;
+// V is the exact running average of the region's depth test at z_s = s / (Z - 1) (z > 0 for s = 0).
 // Driven by crep::EvaluatePass.
 #include "crep/bindings.h"
 #ifndef CREP_BASES
@@ -17,6 +19,9 @@
 #endif
 #ifndef CREP_TABLE_SAMPLES
 #define CREP_TABLE_SAMPLES 128
+#endif
+#ifndef CREP_EXACT_VISIBILITY
+#define CREP_EXACT_VISIBILITY 0
 #endif
 #ifndef CREP_MEMORY_LIMIT
 #define CREP_MEMORY_LIMIT 0 // 1: benchmark variant, the same fetches and stores without the math (writes 1)
@@ -39,6 +44,18 @@ void main() {
   int j = int(gl_GlobalInvocationID.x), r = int(gl_GlobalInvocationID.y);
   if (j >= crep_tableSize.x || r >= crep_tableSize.y) return;
   int x = r * crep_tableSize.z + crep_tableSize.z - 1;
+#if CREP_EXACT_VISIBILITY
+  int n = crep_tableSize.z;
+  for (int s = 0; s < CREP_TABLE_SAMPLES; ++s) {
+    float zs = float(s) / float(CREP_TABLE_SAMPLES - 1), P = 0.0;
+    for (int k = 0; k < n; ++k) {
+      vec4 t = texelFetch(crep_basis, ivec3(r * n + k, j, 0), 0);
+      P += t.g * (((s == 0 ? t.r > 0.0 : t.r >= zs)) ? 1.0 - P : -P);
+    }
+    imageStore(crep_tableOut, ivec2(r * CREP_TABLE_SAMPLES + s, j), vec4(P));
+  }
+  return;
+#endif
   vec4 F[CREP_TABLE_LAYERS];
   for (int l = 0; l < CREP_TABLE_LAYERS; ++l) F[l] = 2.0 * texelFetch(crep_basis, ivec3(x, j, l), 0) - 1.0;
 #if CREP_MEMORY_LIMIT

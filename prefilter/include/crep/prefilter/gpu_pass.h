@@ -24,10 +24,6 @@
 
 namespace crep {
 
-/// Throws InvalidArgument naming `<owner>.reconstruction` unless the GPU passes implement it: Fourier only so
-/// far (VisibilityReconstruction::Exact is the CPU reference's).
-void requireGpuReconstruction(const PrefilterOptions& options, std::string_view owner);
-
 /// A filtered basis on the GPU: the texture array and the parameters it was prefiltered with
 /// (everything evaluation needs besides the layout). Non-owning ids of the passes' backend (GL names).
 struct FilteredBasisView {
@@ -43,6 +39,8 @@ struct FilteredBasisView {
   double depthMargin = 0.0625;            ///< m of fourier.h used
   bool localLight = false;                ///< prefiltered with a local light's factor in the weights
   bool textured = false; ///< with a light texture: 3 ceil(M / 4) layers (colour c from layer c ceil(M / 4))
+  /// Exact: `texture` has one RGBA32F layer of (depth, mix factor of colour 0, 1, 2) per texel (prefilter.h).
+  VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
   std::uint32_t meanColor = 0; ///< textured: GL_TEXTURE_2D, width x height, GL_RGBA32F (rgb cbar)
 
   int regions() const noexcept { return layoutRegions * regionsPerSplit; } ///< R
@@ -104,7 +102,11 @@ public:
   void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
-  int layers() const noexcept { return layerCount(info_.options.bases); }
+  /// Layers of the basis array: ceil(M / 4), or 1 for VisibilityReconstruction::Exact.
+  int layers() const noexcept {
+    return info_.options.reconstruction == VisibilityReconstruction::Exact ? 1
+                                                                           : layerCount(info_.options.bases);
+  }
   /// GPU memory it owns, bytes: the filtered basis (filteredBasisBytes) and its buffers.
   std::size_t memoryBytes() const noexcept;
   /// 2D array texture of the last run's basis (linear, clamp to edge; 3 bases when textured).
@@ -122,6 +124,7 @@ private:
   struct Plan;
   Plan plan(const FrameAttribs& frame, std::string_view owner) const;
   void prepareTextured(bool local);
+  bool exact() const noexcept { return info_.options.reconstruction == VisibilityReconstruction::Exact; }
   std::size_t upload(const FrameAttribs& frame, const Plan& plan);
   void uploadLocalLight(const FrameAttribs& frame, const Plan& plan,
                         const std::vector<DistanceProfile>& profiles);
@@ -145,6 +148,8 @@ public:
   struct CreateInfo {
     int bases = kDefaultBases; ///< M compiled into the shader; must equal the filtered basis's M
     EvaluateOptions options;   ///< as crep::evaluate() takes them; `threads` is not used
+    /// Compiled into the shader; must equal the filtered basis's (FilteredBasisView::reconstruction).
+    VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
     StorageFormat outputFormat = StorageFormat::RGBA32F; ///< of the caller's output: RGBA32F or RGBA16F
     int workgroupWidth = 8;                              ///< local_size_x, pixels, >= 1
     int workgroupHeight = 8;                             ///< local_size_y, pixels, >= 1
