@@ -833,6 +833,66 @@ void reducedResolution(const BenchOptions& o) {
   }
 }
 
+/// The visibility reconstructions side by side (prefilter.h, VisibilityReconstruction): crep::Scattering with
+/// the Fourier series and with the exact prefix on the same frames of forest (projective) and sunset (the sun
+/// in view, epipolar), interleaved frame by frame so that the machine's load hits both alike; wall-clock
+/// medians of the frame without its shadow passes, and the exact image's difference to the Fourier one.
+void reconstructionBench(const BenchOptions& base) {
+  const int repeat = std::max(1, base.repeat);
+  std::printf(
+      "\nvisibility reconstruction (%dx%d, map %d^2, M = %d; crep::Scattering, wall-clock medians of %d\n"
+      "interleaved frames after a warm-up, shadow passes not counted):\n",
+      base.screenWidth, base.screenHeight, base.mapWidth, base.bases, repeat);
+  std::printf("%-8s %-10s %12s %12s %12s %12s\n", "scene", "layout", "fourier ms", "exact ms",
+              "exact/fourier", "difference");
+  for (const std::string name : {"forest", "sunset"}) {
+    BenchOptions o = base;
+    o.scene = name;
+    tool::StageTimings timings;
+    const ScatteringFrame input(o, timings);
+    const Scattering::FrameAttribs a = input.attribs();
+    Scattering::CreateInfo info = ScatteringFrame::createInfo(o);
+    Scattering fourier(info);
+    info.prefilter.reconstruction = VisibilityReconstruction::Exact;
+    Scattering exact(info);
+    std::map<std::string, std::vector<double>> stageMs[2];
+    const auto frameMs = [&](Scattering& s, Scattering::FrameResult* result = nullptr) {
+      Scattering::FrameResult r = s.run(a);
+      double ms = 0.0;
+      for (const Scattering::Stage& st : r.stages)
+        if (st.name.find("shadow") == std::string::npos) {
+          ms += st.wallMilliseconds;
+          stageMs[&s == &exact][st.name].push_back(st.wallMilliseconds);
+        }
+      if (result) *result = std::move(r);
+      return ms;
+    };
+    frameMs(fourier); // warm-up: shader specialization on the first dispatch
+    frameMs(exact);
+    std::vector<double> f, e;
+    for (int i = 0; i < repeat; ++i) {
+      f.push_back(frameMs(fourier));
+      e.push_back(frameMs(exact));
+    }
+    Scattering::FrameResult r;
+    frameMs(fourier, &r);
+    const Image fourierImage =
+        gl::readTexture(input.output.get(), o.screenWidth, o.screenHeight, gl::TexelData::Rgba);
+    frameMs(exact);
+    const Image exactImage =
+        gl::readTexture(input.output.get(), o.screenWidth, o.screenHeight, gl::TexelData::Rgba);
+    CompareOptions c;
+    c.channels = 3;
+    std::printf("%-8s %-10s %12.2f %12.2f %12.2f %11.2f%%\n", name.c_str(), layoutToken(r.layout), median(f),
+                median(e), median(e) / median(f),
+                100.0 * compareImages(exactImage, fourierImage, c).relativeRmse);
+    for (const auto& [stage, v] : stageMs[0])
+      if (stageMs[1].count(stage))
+        std::printf("  %-30s %10.2f %12.2f\n", stage.c_str(), median(v), median(stageMs[1][stage]));
+    std::fflush(stdout);
+  }
+}
+
 /// Constant cost (Klehm et al. 2014, Sec. 5): the GPU prefilter and evaluation of the four projective
 /// built-in scenes at the same sizes, timed interleaved (scene after scene, `repeat` rounds) so that a
 /// change of the machine's load hits every scene alike; medians per scene and the largest / smallest.
@@ -1474,6 +1534,8 @@ const std::vector<BenchSection>& benchSections() {
        [](BenchRun& r) { constantCost(r.options); }},
       {"reduced-resolution", "crep::Scattering at evaluation scales 1, 0.5 and 0.25",
        [](BenchRun& r) { reducedResolution(r.options); }},
+      {"reconstruction", "the Fourier series vs the exact prefix on forest and sunset, interleaved",
+       [](BenchRun& r) { reconstructionBench(r.options); }},
       {"methods", "every method of the tool's registry on the same frame",
        [](BenchRun& r) { methodsSideBySide(r.options); }},
       {"sun-in-view", "the sunset scene (epipolar) vs the forest's projective frame",

@@ -99,11 +99,13 @@
 #ifndef CREP_RINGING_LANCZOS
 #define CREP_RINGING_LANCZOS 0
 #endif
-// 1: crep::VisibilityReconstruction::Exact. Layer 0 of the basis array holds per texel (depth, mix factor m_i
-// of colour 0, 1, 2) in RGBA32F; evaluation walks it (crep_exactVisibility) instead of the Fourier series.
+// 1: crep::VisibilityReconstruction::Exact. Layer 0 of the basis array holds per texel (depth, mix factor m_i)
+// in RG32F (with a light texture (depth, m_i of colour 0, 1, 2) in RGBA32F); evaluation walks it
+// (crep_exactPrefix) instead of the Fourier series.
 #ifndef CREP_EXACT_VISIBILITY
 #define CREP_EXACT_VISIBILITY 0
 #endif
+#define CREP_EXACT_BLOCK 8 // texels per block of the exact reconstruction's (min, max) layer
 #ifndef CREP_EXACT_NEAREST
 #define CREP_EXACT_NEAREST 0 // 1: crep::Sampling::Nearest of the exact prefix (the nearest texel)
 #endif
@@ -594,19 +596,56 @@ vec4 crep_filteredBasisAt(int region, float u, float row, int layer) {
 }
 
 #if CREP_EXACT_VISIBILITY
-// crep::VisibilityReconstruction::Exact: the running average P_k = P_{k-1} + m_k ([depth_k >= z] - P_{k-1}) of
-// region r's texels in row y up to texel x1 (region-local); P at x0 <= x1 into atX0 (crep::evaluate's rule).
-// One RGBA32F fetch per texel, the same row for a pixel's whole walk (coherent along the row).
+#if CREP_LIGHT_TEXTURE
+#define CrepExactWeight vec3
+#define crep_exactWeightOf(t) (t).gba
+#else
+#define CrepExactWeight float // one colour: scalar arithmetic (GPU: fewer registers and instructions)
+#define crep_exactWeightOf(t) (t).g
+#endif
+// crep::VisibilityReconstruction::Exact: P_x = sum_{i <= x} [z_i >= z] (W_i - W_{i-1}) / W_x over region r's
+// texels in row y up to x1 (region-local; crep::evaluate's rule), P at x0 <= x1 into atX0. The blocks before
+// x0's block come from layer 1: a block whose depths all pass (min >= z) adds its weight W_end - W_before in one
+// step, one that all fail adds nothing; only a block that straddles z (a shadow edge, or the receiver's own
+// texels near the ray's end) is walked texel by texel. GPU: about (x0 / 8) * 2 + 8 fetches instead of x0, and
+// lanes that end far apart in a region diverge over a few blocks, not over n texels.
+float crep_exactRatio(float lit, float W) { return W > 0.0 ? lit / W : 0.0; }
+vec3 crep_exactRatio(vec3 lit, vec3 W) { return mix(vec3(0.0), lit / max(W, vec3(1e-30)), greaterThan(W, vec3(0.0))); }
+
 vec3 crep_exactRunningPrefix(int region, int y, int x0, int x1, float z, out vec3 atX0) {
-  int n = crep_scattering.mapSize.x / crep_scattering.mapSize.z;
-  vec3 P = vec3(0.0);
-  atX0 = P;
-  for (int k = 0; k <= x1; ++k) {
-    vec4 t = texelFetch(crep_filteredBasis, ivec3(region * n + k, y, 0), 0);
-    P += t.gba * ((t.r >= z ? 1.0 : 0.0) - P);
-    if (k == x0) atX0 = P;
+  int n = crep_scattering.mapSize.x / crep_scattering.mapSize.z, base = region * n;
+  CrepExactWeight lit = CrepExactWeight(0.0), previous = CrepExactWeight(0.0);
+  int firstTexel = (x0 / CREP_EXACT_BLOCK) * CREP_EXACT_BLOCK;
+  for (int b = 0; b * CREP_EXACT_BLOCK < firstTexel; ++b) {
+    vec2 range = texelFetch(crep_filteredBasis, ivec3(base + b, y, 1), 0).rg;
+    int last = b * CREP_EXACT_BLOCK + CREP_EXACT_BLOCK - 1;
+    if (z <= range.x || z > range.y) {
+      CrepExactWeight W = crep_exactWeightOf(texelFetch(crep_filteredBasis, ivec3(base + last, y, 0), 0));
+      if (z <= range.x) lit += W - previous;
+      previous = W;
+    } else {
+      for (int k = b * CREP_EXACT_BLOCK; k <= last; ++k) {
+        vec4 t = texelFetch(crep_filteredBasis, ivec3(base + k, y, 0), 0);
+        CrepExactWeight W = crep_exactWeightOf(t);
+        lit += step(z, t.r) * (W - previous);
+        previous = W;
+      }
+    }
   }
-  return P;
+  for (int k = firstTexel; k <= x0; ++k) {
+    vec4 t = texelFetch(crep_filteredBasis, ivec3(base + k, y, 0), 0);
+    CrepExactWeight W = crep_exactWeightOf(t);
+    lit += step(z, t.r) * (W - previous);
+    previous = W;
+  }
+  atX0 = vec3(crep_exactRatio(lit, previous));
+  if (x1 > x0) {
+    vec4 t = texelFetch(crep_filteredBasis, ivec3(base + x1, y, 0), 0);
+    CrepExactWeight W = crep_exactWeightOf(t);
+    lit += step(z, t.r) * (W - previous);
+    previous = W;
+  }
+  return vec3(crep_exactRatio(lit, previous));
 }
 
 // The exact prefix visibility of region r at boundary u for the ray depth z, in the ray's own (nearest) row,

@@ -92,9 +92,14 @@ void checkWorkgroup(const gpu::Backend& backend, const char* const names[3], con
                           "invocations per work group", limits.invocations);
 }
 
-/// The storage of the basis array: the options' format, or RGBA32F for the exact reconstruction's texels.
-StorageFormat arrayFormat(const PrefilterOptions& o) {
-  return o.reconstruction == VisibilityReconstruction::Exact ? StorageFormat::RGBA32F : o.format;
+gpu::Format basisFormat(StorageFormat format);
+
+/// The basis array's texel format: the options' storage, or for the exact reconstruction (depth, mix factor)
+/// in RG32F, (depth, three colours' factors) in RGBA32F with a light texture (GPU: 8 bytes per texel of the
+/// per-pixel walk instead of 16).
+gpu::Format arrayFormat(const PrefilterOptions& o, bool textured) {
+  if (o.reconstruction != VisibilityReconstruction::Exact) return basisFormat(o.format);
+  return textured ? gpu::Format::RGBA32F : gpu::Format::RG32F;
 }
 
 gpu::Format basisFormat(StorageFormat format) {
@@ -245,7 +250,7 @@ std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& 
   return {{ShaderStage::Compute,
            "passes/prefilter/prefilter.comp",
            {{"CREP_BASES_PER_INVOCATION", str(basesPerInvocation(info, local))},
-            {"CREP_BASIS_FORMAT", imageFormatQualifier(format)},
+            {"CREP_BASIS_FORMAT", exact && !textured ? "rg32f" : imageFormatQualifier(format)},
             {"CREP_BASIS_UNORM8", format == StorageFormat::RGBA8 ? "1" : "0"},
             {"CREP_BASIS_HALF", format == StorageFormat::RGBA16F ? "1" : "0"},
             {"CREP_EXACT_VISIBILITY", exact ? "1" : "0"},
@@ -315,7 +320,7 @@ PrefilterPass::PrefilterPass(const CreateInfo& info) : info_(info) {
 
   const ShaderStageSource stage = prefilterStages(info, false)[0];
   b.prepareProgram(stage.path, stage.defines);
-  texture_ = gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(arrayFormat(o)), info.mapWidth,
+  texture_ = gpu::Texture(b, {gpu::TextureType::Texture2DArray, arrayFormat(o, false), info.mapWidth,
                               info.mapHeight, layers(), "PrefilterPass: filtered basis"});
   paramsBuffer_ = gpu::Buffer(b, sizeof(gpu::PrefilterParams), "PrefilterPass: parameters");
 }
@@ -423,9 +428,9 @@ void PrefilterPass::prepareTextured(bool local) {
   gpu::Backend& b = *backend_;
   if (!texturedTexture_) {
     // Light textures (prefilter.h): three bases and the prefix mean colour, allocated on first use.
-    texturedTexture_ =
-        gpu::Texture(b, {gpu::TextureType::Texture2DArray, basisFormat(arrayFormat(info_.options)), W, H,
-                         exact() ? 1 : 3 * layers(), "PrefilterPass: filtered basis (light textures)"});
+    texturedTexture_ = gpu::Texture(b, {gpu::TextureType::Texture2DArray, arrayFormat(info_.options, true), W,
+                                        H, exact() ? layers() : 3 * layers(),
+                                        "PrefilterPass: filtered basis (light textures)"});
     // RGBA32F: a light texture's HDR texels (projector images in physical units) are kept whole; half
     // floats clipped them at 65504. GPU: one fetch per region per pixel, so the extra bytes are cheap.
     meanColor_ = gpu::Texture(b, {gpu::TextureType::Texture2D, gpu::Format::RGBA32F, W, H, 1,
@@ -492,7 +497,8 @@ void PrefilterPass::dispatch(const FrameAttribs& frame, const Plan& p, std::size
   d.resources = {
       gpu::Resource::sampled(CREP_PREFILTER_RECTIFIED_DEPTH_UNIT, frame.rectifiedDepth),
       gpu::Resource::image(CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE,
-                           textured ? texturedTexture_.id() : texture_.id(), gpu::Access::WriteOnly),
+                           textured ? texturedTexture_.id() : texture_.id(),
+                           exact() ? gpu::Access::ReadWrite : gpu::Access::WriteOnly), // exact: read back
       gpu::Resource::uniform(CREP_PREFILTER_PARAMS_BINDING, paramsBuffer_.id()),
       gpu::Resource::storage(CREP_PREFILTER_REGION_WEIGHTS_BINDING, weightsBuffer_.id(), 0, weightBytes)};
   if (textured) {
@@ -582,6 +588,12 @@ std::vector<ShaderStageSource> evaluateStages(const EvaluatePass::CreateInfo& in
   return stages;
 }
 
+/// Samples per workgroup of the scattering prefix table: 64, or 128 for the exact reconstruction, whose
+/// workgroups each build their row's histograms (one workgroup per row at the default Z = 128).
+int prefixLocalSize(const EvaluatePass::CreateInfo& info) {
+  return info.reconstruction == VisibilityReconstruction::Exact ? 128 : 64;
+}
+
 /// The scattering prefix table's program (EvaluateOptions::scatteringPrefix), on the same layout block as
 /// evaluateStages(info, layoutKind).
 std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info, int layoutKind,
@@ -592,6 +604,7 @@ std::vector<ShaderStageSource> prefixStages(const EvaluatePass::CreateInfo& info
        {{"CREP_BASES", str(info.bases)},
         {"CREP_VISIBILITY_TABLE_SAMPLES", str(info.options.visibilityTableSamples)},
         {"CREP_EXACT_VISIBILITY", info.reconstruction == VisibilityReconstruction::Exact ? "1" : "0"},
+        {"CREP_PREFIX_LOCAL_SIZE", str(prefixLocalSize(info))},
         {"CREP_MEMORY_LIMIT", info.memoryLimit ? "1" : "0"}}}};
   addLayoutDefines(stages[0].defines, layoutKind);
   if (local) {
@@ -727,7 +740,7 @@ void validateBasisView(const gpu::Backend& backend, const EvaluatePass::CreateIn
             std::string("must equal EvaluatePass::CreateInfo.reconstruction = ") +
                 visibilityReconstructionToken(info.reconstruction));
   const int basisLayers = basis.reconstruction == VisibilityReconstruction::Exact
-                              ? 1
+                              ? 2 // (depth, W) and the blocks' (min, max)
                               : (basis.textured ? 3 : 1) * layerCount(basis.bases);
   const gpu::TextureLevel b = gpu::textureLevelOf(backend, (f + "basis.texture").c_str(), basis.texture);
   if (b.type != gpu::TextureType::Texture2DArray || b.width != basis.width || b.height != basis.height ||
@@ -1025,7 +1038,8 @@ void EvaluatePass::buildTable(const FilteredBasisView& basis, const Plan& p) {
     if (p.local) appendLocalResources(d.resources);
     if (!p.projective)
       layoutBuffers_.appendResources(d.resources, CREP_EVALUATE_LAYOUT_BINDING, CREP_EVALUATE_SLICES_BINDING);
-    d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(Z, 64)), static_cast<unsigned>(basis.height), 1u);
+    d.groups = glm::uvec3(static_cast<unsigned>(ceilDiv(Z, prefixLocalSize(info_))),
+                          static_cast<unsigned>(basis.height), 1u);
     b.dispatch(d);
   } else {
     gpu::Dispatch d = dispatchOf("EvaluatePass: visibility table", {tableStage(info_)});

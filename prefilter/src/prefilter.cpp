@@ -97,8 +97,8 @@ void validateBasis(const FilteredBasis& b) {
   if (b.texels.size() != (exact ? 0 : static_cast<std::size_t>(b.colorBases() * b.layers) * area * 4))
     bad("texels size " + std::to_string(b.texels.size()));
   if (b.depth.size() != (exact ? area : 0)) bad("depth size " + std::to_string(b.depth.size()));
-  if (b.mix.size() != (exact ? static_cast<std::size_t>(b.colorBases()) * area : 0))
-    bad("mix size " + std::to_string(b.mix.size()));
+  if (b.weight.size() != (exact ? static_cast<std::size_t>(b.colorBases()) * area : 0))
+    bad("weight size " + std::to_string(b.weight.size()));
   if (b.meanColor.size() !=
       (b.textured ? static_cast<std::size_t>(b.height) * static_cast<std::size_t>(b.width) * 3 : 0))
     bad("meanColor size " + std::to_string(b.meanColor.size()));
@@ -158,25 +158,26 @@ glm::dvec3 sampleMeanColor(const FilteredBasis& b, Sampling sampling, int r, dou
   return out;
 }
 
-/// VisibilityReconstruction::Exact: the running average P_i = P_{i-1} + m_i ([z_i >= z] - P_{i-1}) of region
-/// r's texels in row y up to texel x1 (region-local), colour `color`'s mix factors; P at x0 <= x1 into
-/// `atX0`.
+/// VisibilityReconstruction::Exact: the weighted average P_x = sum_{i <= x} [z_i >= z] (W_i - W_{i-1}) / W_x
+/// of region r's texels in row y (region-local x, W_{-1} = 0; 0 where W_x = 0), colour `color`'s cumulative
+/// weights, at x1; P at x0 <= x1 into `atX0`.
 double exactRunningPrefix(const FilteredBasis& b, int r, int y, int x0, int x1, double z, int color,
                           double& atX0) {
   const int n = b.regionWidth();
   const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(b.width) +
                           static_cast<std::size_t>(r) * static_cast<std::size_t>(n);
-  const std::size_t mixRow = static_cast<std::size_t>(color) * static_cast<std::size_t>(b.height) *
-                                 static_cast<std::size_t>(b.width) +
-                             row;
-  double P = 0.0;
+  const std::size_t weightRow = static_cast<std::size_t>(color) * static_cast<std::size_t>(b.height) *
+                                    static_cast<std::size_t>(b.width) +
+                                row;
+  double lit = 0.0, previous = 0.0;
   atX0 = 0.0;
   for (int k = 0; k <= x1; ++k) {
-    const double lit = static_cast<double>(b.depth[row + static_cast<std::size_t>(k)]) >= z ? 1.0 : 0.0;
-    P += static_cast<double>(b.mix[mixRow + static_cast<std::size_t>(k)]) * (lit - P);
-    if (k == x0) atX0 = P;
+    const double W = b.weight[weightRow + static_cast<std::size_t>(k)];
+    if (static_cast<double>(b.depth[row + static_cast<std::size_t>(k)]) >= z) lit += W - previous;
+    previous = W;
+    if (k == x0) atX0 = W > 0.0 ? lit / W : 0.0;
   }
-  return P;
+  return previous > 0.0 ? lit / previous : 0.0;
 }
 
 /// VisibilityReconstruction::Exact: the prefix visibility of region r at boundary u for the ray depth z, in
@@ -375,7 +376,7 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
   const bool exact = options.reconstruction == VisibilityReconstruction::Exact;
   if (exact) {
     b.depth.assign(map.depth.data().begin(), map.depth.data().end());
-    b.mix.assign(static_cast<std::size_t>(C) * area, 0.0f);
+    b.weight.assign(static_cast<std::size_t>(C) * area, 0.0f);
   } else {
     b.texels.assign(static_cast<std::size_t>(C * b.layers) * area * 4, storeFiltered(0.0, options.format));
   }
@@ -389,6 +390,10 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
     std::array<std::array<double, kMaxBases>, 3> Fc{};
     std::array<double, kMaxBases> B{};
     const std::span<double> basisSpan(B.data(), static_cast<std::size_t>(M));
+    std::array<std::vector<double>, 3> exactMix; // VisibilityReconstruction::Exact: a region's mix factors
+    if (exact)
+      for (std::vector<double>& m : exactMix)
+        m.assign(static_cast<std::size_t>(n), 0.0);
     const double row = (j + 0.5) / H;
     const glm::dvec3 origin = map.layout->origin();
     for (int r = 0; r < R; ++r) {
@@ -424,8 +429,8 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
             if (cbar[c] > 0.0) mc = std::clamp(m * (ci / cbar[c]), 0.0, 1.0);
             b.meanColor[texel / 4 * 3 + static_cast<std::size_t>(c)] = static_cast<float>(cbar[c]);
           }
-          if (exact) { // VisibilityReconstruction::Exact: the factors alone; evaluation walks the depths
-            b.mix[static_cast<std::size_t>(c) * area + texel / 4] = static_cast<float>(mc);
+          if (exact) { // VisibilityReconstruction::Exact: the factors alone, made cumulative below
+            exactMix[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)] = mc;
             continue;
           }
           std::array<double, kMaxBases>& F = Fc[static_cast<std::size_t>(c)];
@@ -439,6 +444,16 @@ FilteredBasis prefilterImpl(const RectifiedMap& map, double extinction, const Pr
                 storeFiltered(F[static_cast<std::size_t>(k)], options.format);
         }
       }
+      if (exact) // W_i = prod_{k > i} (1 - m_k): the weights' cumulative sum over the region's total
+        for (int c = 0; c < C; ++c) {
+          double carry = 1.0;
+          for (int i = n - 1; i >= 0; --i) {
+            b.weight[static_cast<std::size_t>(c) * area +
+                     static_cast<std::size_t>(j) * static_cast<std::size_t>(W) +
+                     static_cast<std::size_t>(r * n + i)] = static_cast<float>(carry);
+            carry *= 1.0 - exactMix[static_cast<std::size_t>(c)][static_cast<std::size_t>(i)];
+          }
+        }
     }
   });
   return b;

@@ -1,14 +1,17 @@
 // VisibilityReconstruction::Exact on the GPU (crep/prefilter/gpu_pass.h) against the CPU reference: the
-// prefilter pass writes the map's depths and the mix factors, and the evaluation (every table path, both
-// samplings, the near-plane correction) gives crep::evaluate's image of the CPU basis, on the boxes scene's
-// map of 250 x 37 texels (10 prefilter regions of 25 texels) and a 161 x 93 screen.
+// prefilter pass writes the map's depths, the cumulative weights and the blocks' depth ranges, and the
+// evaluation (every table path, both samplings, the near-plane correction) gives crep::evaluate's image of
+// the CPU basis, on the boxes scene's map of 250 x 37 texels (10 prefilter regions of 25 texels) and a 161 x
+// 93 screen.
 //
 // Tolerances (measured on Mesa llvmpipe 22.3; each test prints its figures):
-//   depths: bit for bit (a copy); mix factors: |d| <= 1e-5 (float against double weights; measured 1.8e-7).
+//   depths and block ranges: bit for bit (copies); cumulative weights: |d| <= 1e-5 (float against double;
+//   measured 1.8e-7).
 //   evaluation: the depth test compares the ray's depth, float on the GPU and double on the CPU, with the
 //   texels' depths; a texel within float rounding of a ray's depth can flip, which moves that pixel by the
 //   texel's share. At most 0.5% of the samples may differ by more than 1e-4 of the peak, and the relative
 //   RMSE stays below 1e-5 (measured: none over, 9.1e-8 on every path).
+#include "common/analytic_reference.h"
 #include "common/error_checks.h"
 #include "common/gl_fixture.h"
 #include "common/gl_util.h"
@@ -49,12 +52,12 @@ PrefilterPass::CreateInfo exactInfo() {
 
 } // namespace
 
-TEST_CASE("prefilter GPU, exact reconstruction: depths and mix factors equal the CPU basis") {
+TEST_CASE("prefilter GPU, exact reconstruction: depths, cumulative weights and block ranges equal the CPU") {
   CREP_REQUIRE_GL();
   const GpuScene& s = boxesScene();
   const PrefilterPass::CreateInfo info = exactInfo();
   PrefilterPass pass(info);
-  CHECK(pass.layers() == 1);
+  CHECK(pass.layers() == 2);
   PrefilterPass::FrameAttribs frame;
   frame.rectifiedDepth = s.mapTexture.get();
   frame.layout = s.layout.get();
@@ -62,18 +65,34 @@ TEST_CASE("prefilter GPU, exact reconstruction: depths and mix factors equal the
   pass.run(frame);
   CHECK(pass.filteredBasis().reconstruction == VisibilityReconstruction::Exact);
   const FilteredBasis cpu = prefilter(s.map, s.scene.medium, info.options);
-  const std::vector<float> gpu = readTextureArray(pass.filteredBasisTexture(), kMapW, kMapH, 1);
-  REQUIRE(gpu.size() == std::size_t(kMapW) * kMapH * 4);
+  const std::vector<float> gpu = readTextureArray(pass.filteredBasisTexture(), kMapW, kMapH, 2);
+  REQUIRE(gpu.size() == std::size_t(kMapW) * kMapH * 8);
   int depthsDiffer = 0;
   double worstMix = 0.0;
   for (std::size_t i = 0; i < cpu.depth.size(); ++i) {
     depthsDiffer += gpu[4 * i] != cpu.depth[i];
-    for (int c = 1; c < 4; ++c) // untextured: the factor three times
-      worstMix = std::max(worstMix, static_cast<double>(std::abs(gpu[4 * i + c] - cpu.mix[i])));
+    worstMix = std::max(worstMix, static_cast<double>(std::abs(gpu[4 * i + 1] - cpu.weight[i]))); // RG32F
   }
-  MESSAGE("depths that differ: " << depthsDiffer << ", largest mix factor difference " << worstMix);
+  // Layer 1: each block of 8 texels of a region (the last one partial: n = 25) has its (min, max) depth at
+  // texel (region n + block).
+  const int n = kMapW / cpu.regions;
+  int blocksWrong = 0;
+  for (int j = 0; j < kMapH; ++j)
+    for (int r = 0; r < cpu.regions; ++r)
+      for (int b = 0; b * 8 < n; ++b) {
+        float lo = 2.0f, hi = -1.0f;
+        for (int i = b * 8; i < std::min(n, b * 8 + 8); ++i) {
+          lo = std::min(lo, s.map.depth.at(r * n + i, j));
+          hi = std::max(hi, s.map.depth.at(r * n + i, j));
+        }
+        const std::size_t t = (std::size_t(kMapH + j) * kMapW + std::size_t(r * n + b)) * 4;
+        blocksWrong += gpu[t] != lo || gpu[t + 1] != hi;
+      }
+  MESSAGE("depths that differ: " << depthsDiffer << ", largest cumulative weight difference " << worstMix
+                                 << ", blocks wrong: " << blocksWrong);
   CHECK(depthsDiffer == 0);
   CHECK(worstMix <= 1e-5);
+  CHECK(blocksWrong == 0);
 }
 
 TEST_CASE("prefilter GPU, exact reconstruction: evaluation equals the CPU on every table path and sampling") {
@@ -119,7 +138,7 @@ TEST_CASE("prefilter GPU, exact reconstruction: evaluation equals the CPU on eve
       t.relativeRmse = 1e-5;
       t.overThreshold = 1e-4 * peak;
       t.maxFractionOver = 0.005;
-      const ImageCheckResult r = evaluateImage(gpu, reference, t, name);
+      const ImageCheckResult r = evaluateImage(rgb(gpu), rgb(reference), t, name); // the radiance
       MESSAGE(name << ": " << r.message);
       CHECK_MESSAGE(r.passed, r.message);
     }

@@ -79,7 +79,7 @@ TEST_CASE("prefilter, exact reconstruction: the region table is the weighted ave
       }
     }
   MESSAGE("largest difference from the direct weighted sum: " << worst);
-  CHECK(worst < 1e-6); // the mix factors are stored as float
+  CHECK(worst < 1e-6); // the cumulative weights are stored as float
 }
 
 TEST_CASE("prefilter, exact reconstruction: without an occluder it is the closed form") {
@@ -146,6 +146,6 @@ TEST_CASE("prefilter, exact reconstruction: bad option and inconsistent basis ar
   const auto layout = test::projectiveLayout(camera, test::sideLight());
   const RectifiedMap map = makeRectifiedMap(layout, test::randomRunsDepth(64, 8, 3));
   FilteredBasis b = prefilter(map, test::colouredMedium(), exactOptions());
-  b.mix.pop_back();
+  b.weight.pop_back();
   CHECK(test::invalidParameter([&] { visibilityTable(b, 4, RingingFilter::None); }) == "FilteredBasis");
 }

@@ -43,16 +43,23 @@
 #ifndef CREP_LIGHT_TEXTURE
 #define CREP_LIGHT_TEXTURE 0 // 1: a light texture's colour map (crep::prefilter(map, medium, lightColors))
 #endif
-// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact, from crep/scattering.glsl): no basis; layer 0
-// of an RGBA32F array gets (depth, m_i of colour 0, 1, 2) per texel, the factors of the same running average
-// (without a texture, m_i three times). One group of bases.
+// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact, from crep/scattering.glsl): no basis. Layer 0
+// of an RG32F array gets (depth, W_i) per texel, W_i = prod_{k > i} (1 - m_k) the cumulative weight over the
+// region's total (with a light texture an RGBA32F array, (depth, W_i of colour 0, 1, 2)): the mix factors on
+// the way left to right, turned into W right to left. Layer 1 gets each block of CREP_EXACT_BLOCK texels' (min,
+// max) depth at texel (region n + block, row), which lets the evaluation pass a block whose texels all pass or
+// all fail the depth test in one step. One group of bases.
 
 #define CREP_GROUP_VEC4S (CREP_BASES_PER_INVOCATION / 4)
 
 layout(local_size_x = CREP_LOCAL_SIZE_X, local_size_y = CREP_LOCAL_SIZE_Y, local_size_z = CREP_LOCAL_SIZE_Z) in;
 
 layout(binding = CREP_PREFILTER_RECTIFIED_DEPTH_UNIT) uniform sampler2D crep_rectifiedDepth; // W x H depth-buffer values in [0, 1]
+#if CREP_EXACT_VISIBILITY // read back by the pass that writes it (the right-to-left sweep)
+layout(binding = CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE, CREP_BASIS_FORMAT) uniform restrict image2DArray crep_filteredBasisOut;
+#else
 layout(binding = CREP_PREFILTER_FILTERED_BASIS_OUT_IMAGE, CREP_BASIS_FORMAT) uniform writeonly restrict image2DArray crep_filteredBasisOut;
+#endif
 layout(std140, binding = CREP_PREFILTER_PARAMS_BINDING) uniform CrepPrefilterBlock { CrepPrefilterParams crep_prefilter; };
 layout(std430, binding = CREP_PREFILTER_REGION_WEIGHTS_BINDING) readonly restrict buffer CrepRegionWeightsBlock { CrepRegionWeights crep_regionWeights[]; };
 #if CREP_LIGHT_TEXTURE
@@ -128,6 +135,9 @@ void main() {
   float gLeft = crep_lightFactorAt(ray, tauLeft), weightSum = 0.0;
 #endif
 
+#if CREP_EXACT_VISIBILITY
+  vec2 blockRange = vec2(1e30, -1e30); // the current block's (min, max) depth
+#endif
   for (int i = 0; i < n; ++i) {
     int x = region * n + i;
     // Listing 3: the basis of the texel's depth (Eq. 8), computed here instead of read from a texture.
@@ -180,8 +190,13 @@ void main() {
 #if CREP_LIGHT_TEXTURE
     imageStore(crep_filteredBasisOut, ivec3(x, row, 0), vec4(texelDepth, mc));
 #else
-    imageStore(crep_filteredBasisOut, ivec3(x, row, 0), vec4(texelDepth, vec3(m)));
+    imageStore(crep_filteredBasisOut, ivec3(x, row, 0), vec4(texelDepth, m, 0.0, 0.0));
 #endif
+    blockRange = vec2(min(blockRange.x, texelDepth), max(blockRange.y, texelDepth));
+    if (i % CREP_EXACT_BLOCK == CREP_EXACT_BLOCK - 1 || i == n - 1) {
+      imageStore(crep_filteredBasisOut, ivec3(region * n + i / CREP_EXACT_BLOCK, row, 1), vec4(blockRange, 0.0, 0.0));
+      blockRange = vec2(1e30, -1e30);
+    }
 #else
     for (int v = 0; v < CREP_GROUP_VEC4S; ++v) {
       int layer = firstLayer + v;
@@ -202,4 +217,19 @@ void main() {
     }
 #endif
   }
+#if CREP_EXACT_VISIBILITY
+  // Right to left: W_i = prod_{k > i} (1 - m_k) in place of m_i (crep::prefilter's cumulative weights).
+  vec3 carry = vec3(1.0);
+  for (int i = n - 1; i >= 0; --i) {
+    ivec3 texel = ivec3(region * n + i, row, 0);
+    vec4 t = imageLoad(crep_filteredBasisOut, texel);
+#if CREP_LIGHT_TEXTURE
+    imageStore(crep_filteredBasisOut, texel, vec4(t.r, carry));
+    carry *= 1.0 - t.gba;
+#else
+    imageStore(crep_filteredBasisOut, texel, vec4(t.r, carry.x, 0.0, 0.0));
+    carry.x *= 1.0 - t.g;
+#endif
+  }
+#endif
 }

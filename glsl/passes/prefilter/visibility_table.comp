@@ -10,8 +10,9 @@
 // double on the CPU, with the ringing filter) from a storage buffer shared by all invocations: H R (M / 4
 // fetches + Z M multiply-adds) in all. Used only with EvaluateOptions::scatteringPrefix = false (the
 // default builds the scattering prefix table, passes/prefilter/scattering_prefix.comp, which includes this step).
-// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact): layer 0 holds (depth, mix factor) per texel;
-// V is the exact running average of the region's depth test at z_s = s / (Z - 1) (z > 0 for s = 0).
+// CREP_EXACT_VISIBILITY 1 (crep::VisibilityReconstruction::Exact): layer 0 holds (depth, cumulative weight W)
+// per texel; V = sum_i [z_i >= z_s] (W_i - W_{i-1}) over the region (W_{n-1} = 1), z_s = s / (Z - 1) (z > 0 for
+// s = 0).
 // Driven by crep::EvaluatePass.
 #include "crep/bindings.h"
 #ifndef CREP_BASES
@@ -47,12 +48,13 @@ void main() {
 #if CREP_EXACT_VISIBILITY
   int n = crep_tableSize.z;
   for (int s = 0; s < CREP_TABLE_SAMPLES; ++s) {
-    float zs = float(s) / float(CREP_TABLE_SAMPLES - 1), P = 0.0;
+    float zs = float(s) / float(CREP_TABLE_SAMPLES - 1), lit = 0.0, previous = 0.0;
     for (int k = 0; k < n; ++k) {
       vec4 t = texelFetch(crep_basis, ivec3(r * n + k, j, 0), 0);
-      P += t.g * (((s == 0 ? t.r > 0.0 : t.r >= zs)) ? 1.0 - P : -P);
+      if (s == 0 ? t.r > 0.0 : t.r >= zs) lit += t.g - previous;
+      previous = t.g;
     }
-    imageStore(crep_tableOut, ivec2(r * CREP_TABLE_SAMPLES + s, j), vec4(P));
+    imageStore(crep_tableOut, ivec2(r * CREP_TABLE_SAMPLES + s, j), vec4(previous > 0.0 ? lit / previous : 0.0));
   }
   return;
 #endif

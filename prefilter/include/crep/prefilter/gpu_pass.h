@@ -39,7 +39,10 @@ struct FilteredBasisView {
   double depthMargin = 0.0625;            ///< m of fourier.h used
   bool localLight = false;                ///< prefiltered with a local light's factor in the weights
   bool textured = false; ///< with a light texture: 3 ceil(M / 4) layers (colour c from layer c ceil(M / 4))
-  /// Exact: `texture` has one RGBA32F layer of (depth, mix factor of colour 0, 1, 2) per texel (prefilter.h).
+  /// Exact: `texture` has two layers: (depth, cumulative weight W) per texel in RG32F (RGBA32F with a light
+  /// texture: W of colour 0, 1, 2; prefilter.h), and each block of 8 texels' (min, max) depth at texel
+  /// (region n
+  /// + block) of layer 1.
   VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
   std::uint32_t meanColor = 0; ///< textured: GL_TEXTURE_2D, width x height, GL_RGBA32F (rgb cbar)
 
@@ -102,9 +105,10 @@ public:
   void run(const FrameAttribs& frame);
 
   const CreateInfo& createInfo() const noexcept { return info_; }
-  /// Layers of the basis array: ceil(M / 4), or 1 for VisibilityReconstruction::Exact.
+  /// Layers of the basis array: ceil(M / 4), or 2 for VisibilityReconstruction::Exact ((depth, W) per texel
+  /// and the blocks' (min, max) depth).
   int layers() const noexcept {
-    return info_.options.reconstruction == VisibilityReconstruction::Exact ? 1
+    return info_.options.reconstruction == VisibilityReconstruction::Exact ? 2
                                                                            : layerCount(info_.options.bases);
   }
   /// GPU memory it owns, bytes: the filtered basis (filteredBasisBytes) and its buffers.

@@ -67,7 +67,8 @@ struct PrefilterOptions {
   int basesPerInvocation = 16;
   LocalLightWeights localLightWeights = LocalLightWeights::Full; ///< local lights: light-side factors
   int threads = 0; ///< CPU workers, 0 = hardware concurrency; never changes the result
-  /// What the basis holds for evaluation: the Fourier basis (default), or the map's depths and mix factors.
+  /// What the basis holds for evaluation: the Fourier basis (default), or the map's depths and cumulative
+  /// weights.
   VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
 };
 
@@ -130,14 +131,15 @@ struct FilteredBasis {
   bool textured = false;
   /// Textured only: cbar_c per texel as float, index (y * width + x) * 3 + c; empty otherwise.
   std::vector<float> meanColor;
-  /// Fourier: `texels` holds the basis. Exact: `texels` is empty and evaluation walks `depth` with `mix`.
+  /// Fourier: `texels` holds the basis. Exact: `texels` is empty and evaluation walks `depth` with `weight`.
   VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
   /// Exact only: the rectified map's depths, index y * width + x; empty otherwise.
   std::vector<float> depth;
-  /// Exact only: the mix factor m_i = w_i / sum_{k <= i} w_k of each texel within its region (Listing 2's
-  /// running average; with a texture, colour c's factor m_i c_i / cbar_i), index (c * height + y) * width +
-  /// x.
-  std::vector<float> mix;
+  /// Exact only: the cumulative weight W_i = sum_{k <= i} w_k / sum_region w_k of each texel within its
+  /// region
+  /// (= prod_{k > i} (1 - m_k) of Listing 2's mix factors; with a texture, of colour c's weights w_i c_i),
+  /// index (c * height + y) * width + x. Texel i's share of a prefix is W_i - W_{i-1}.
+  std::vector<float> weight;
 
   int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
   int colorBases() const noexcept { return textured ? 3 : 1; } ///< bases stored: 3 with a texture, else 1
