@@ -916,6 +916,7 @@ void constantCost(const BenchOptions& o) {
     sc.prefilter = std::make_unique<PrefilterPass>(info);
     EvaluatePass::CreateInfo evalInfo;
     evalInfo.bases = o.bases;
+    evalInfo.reconstruction = info.options.reconstruction; // the front door's default (exact)
     sc.evaluate = std::make_unique<EvaluatePass>(evalInfo);
     scenes.push_back(std::move(sc));
   }
@@ -1265,6 +1266,7 @@ struct CpuTimes {
 
 CpuTimes timeCpu(const BenchOptions& o, const Setup& s) {
   PrefilterOptions options = Scattering::CreateInfo{}.prefilter;
+  options.reconstruction = VisibilityReconstruction::Fourier; // the paper's passes, as the GPU side measures
   options.bases = o.bases;
   const RectifiedMap map = makeRectifiedMap(s.layout, s.rectifiedImage);
   FilteredBasis basis;

@@ -618,11 +618,15 @@ struct Scattering::Impl {
   /// first use; the evaluations keyed by (M, Z).
   std::map<int, PrefilterPass> localPrefilters;
   std::map<std::pair<int, int>, EvaluatePass> localEvaluates;
-  int localBases() const { return info.localLightBases == 0 ? info.prefilter.bases : info.localLightBases; }
+  /// The exact reconstruction has no bases: every light shares the directional light's M (one pass each).
+  bool exact() const { return info.prefilter.reconstruction == VisibilityReconstruction::Exact; }
+  int localBases() const {
+    return info.localLightBases == 0 || exact() ? info.prefilter.bases : info.localLightBases;
+  }
   int spotBases() const {
-    return info.spotLightBases == -1  ? localBases()
-           : info.spotLightBases == 0 ? info.prefilter.bases
-                                      : info.spotLightBases;
+    return info.spotLightBases == -1             ? localBases()
+           : info.spotLightBases == 0 || exact() ? info.prefilter.bases
+                                                 : info.spotLightBases;
   }
   int localTableSamples() const {
     const int Z = info.evaluate.visibilityTableSamples;

@@ -624,10 +624,11 @@ std::size_t PrefilterPass::memoryBytes() const noexcept {
   if (backend_ == nullptr) return 0; // moved from
   const std::size_t area =
       static_cast<std::size_t>(info_.mapWidth) * static_cast<std::size_t>(info_.mapHeight);
-  const std::size_t basis = exact() ? area * 16
+  const std::size_t basis = exact() ? exactBasisBytes(info_.mapWidth, info_.mapHeight)
                                     : filteredBasisBytes(info_.mapWidth, info_.mapHeight, info_.options.bases,
                                                          info_.options.format);
-  const std::size_t textured = texturedTexture_ ? (exact() ? 1 : 3) * basis + area * 16 : 0;
+  // Light textures: three bases (exact: two RGBA32F layers, twice the RG32F pair) and the mean colour.
+  const std::size_t textured = texturedTexture_ ? (exact() ? 2 : 3) * basis + area * 16 : 0;
   return textured + basis + weightsBuffer_.bytes() + sizeof(gpu::PrefilterParams) + raysBuffer_.bytes() +
          (localBuffer_ ? sizeof(gpu::LocalLightParams) : 0);
 }

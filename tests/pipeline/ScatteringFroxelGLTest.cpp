@@ -138,7 +138,9 @@ TEST_CASE("Scattering froxels: a projective frame fills the volume as the passes
   const ProjectiveLayout layout(rect);
   PrefilterPass prefilter({kMap, kMap, smallInfo().prefilter});
   prefilter.run({map.get(), &layout, &f.scene.medium});
-  EvaluatePass evaluate({});
+  EvaluatePass::CreateInfo evaluateInfo;
+  evaluateInfo.reconstruction = smallInfo().prefilter.reconstruction; // the front door's
+  EvaluatePass evaluate(evaluateInfo);
   const gl::Handle byHandVolume = createVolume(grid);
   EvaluatePass::FrameAttribs e;
   e.camera = &f.scene.camera;

@@ -44,7 +44,9 @@ TEST_CASE("Scattering: a projective frame gives the image of the passes run by h
   const ProjectiveLayout layout(rect);
   PrefilterPass prefilter({kMap, kMap, smallInfo().prefilter}); // Scattering's: 2 regions per split
   prefilter.run({map.get(), &layout, &f.scene.medium});
-  EvaluatePass evaluate({});
+  EvaluatePass::CreateInfo evaluateInfo;
+  evaluateInfo.reconstruction = smallInfo().prefilter.reconstruction; // the front door's
+  EvaluatePass evaluate(evaluateInfo);
   const gl::Handle out = gl::createTexture2D(GL_RGBA32F, kWidth, kHeight);
   evaluate.run({f.cameraDepth.get(), out.get(), &f.scene.camera, &f.scene.sun, &f.scene.medium, &layout,
                 prefilter.filteredBasis()});
@@ -202,7 +204,9 @@ TEST_CASE("Scattering: memoryBytes() counts the GPU memory it owns") {
   const Scattering::CreateInfo info = smallInfo();
   Scattering scattering(info);
   const std::size_t map = std::size_t(kMap) * kMap * 4; // D32F rasterized + R32F resampled
-  const std::size_t basis = filteredBasisBytes(kMap, kMap, info.prefilter.bases, info.prefilter.format);
+  const std::size_t basis = info.prefilter.reconstruction == VisibilityReconstruction::Exact
+                                ? exactBasisBytes(kMap, kMap)
+                                : filteredBasisBytes(kMap, kMap, info.prefilter.bases, info.prefilter.format);
   const auto tables = [&](int regions) {
     const int Z = info.evaluate.visibilityTableSamples;
     return info.evaluate.scatteringPrefix ? scatteringPrefixBytes(kMap, regions, Z)

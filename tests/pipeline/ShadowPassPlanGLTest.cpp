@@ -296,7 +296,12 @@ TEST_CASE("Scattering with the engine's plan maps: the frame of the drawCasters 
     const std::vector<PointLight> points{pointBehindLeft(c)};
     Scattering::FrameAttribs a = planFrame(f, k.sun, spots, points);
     a.drawCasters = [&f](const glm::dmat4& clipFromWorld) { f.renderer.drawDepth(clipFromWorld); };
-    Scattering casters(smallInfo());
+    // The Fourier series: smooth in the maps' values, so the conventions' float differences stay below 1e-4.
+    // The exact reconstruction (the default) flips the depth test of texels those differences move across a
+    // ray's depth: measured up to 1.3e-4 (night, OpenGL [0, 1] and D3D12; docs/MEASUREMENTS.md).
+    Scattering::CreateInfo info = smallInfo();
+    info.prefilter.reconstruction = VisibilityReconstruction::Fourier;
+    Scattering casters(info);
     const Scattering::FrameResult rc = casters.run(a);
     const Image expected = f.read();
     a.drawCasters = nullptr;
@@ -305,7 +310,7 @@ TEST_CASE("Scattering with the engine's plan maps: the frame of the drawCasters 
       for (bool reversed : {false, true}) {
         const std::string name = std::string(conventionToken(convention)) + (reversed ? " reversed-Z" : "");
         CAPTURE(name);
-        Scattering scattering(smallInfo());
+        Scattering scattering(info);
         const ShadowPassPlan plan = scattering.plan(a, {convention, reversed});
         const EngineMaps maps(f, plan);
         a.plan = &plan;

@@ -215,7 +215,10 @@ TEST_CASE("Vulkan backend on an engine's device, with and without push descripto
       for (std::size_t i = 0; i < o.texels.size(); i += 4)
         lit += o.texels[i] > 0.0f;
       MESSAGE(o.name << ": " << lit << " of " << kWidth * kHeight << " pixels with in-scattering");
-      CHECK(lit > kWidth * kHeight / 2);
+      // The synthetic casters shadow whole rays of the sunset frame: the exact reconstruction gives those
+      // pixels exactly 0 (measured: forest all 14400 lit, sunset 4734), where the Fourier series' ringing
+      // left none at 0.
+      CHECK(lit > kWidth * kHeight / 5);
     }
   }
   const auto compare = [&](const std::string& backend, const std::vector<Output>& got) {

@@ -61,8 +61,10 @@ public:
     /// Splits (logarithmic) and fallback thresholds; layout must be SplitLayout::Regions. Default 8 splits
     /// x 2 prefilter regions. Cost: the casters are drawn once per split.
     RectifyOptions rectify{.splits = 8};
-    /// M (32), storage (RGBA8), weights (exact), regionsPerSplit P (2), ... of the directional light.
-    PrefilterOptions prefilter{.regionsPerSplit = 2};
+    /// M (32), storage (RGBA8), weights (exact), regionsPerSplit P (2), ... of the directional light, and the
+    /// visibility reconstruction of every light: Exact (default; the map's depths walked per pixel, no
+    /// truncation; then M, storage and the local lights' M are unused) or Fourier (Klehm et al. 2014, Eq. 9).
+    PrefilterOptions prefilter{.regionsPerSplit = 2, .reconstruction = VisibilityReconstruction::Exact};
     EvaluateOptions evaluate; ///< sampling (bilinear), near-plane correction, ringing filter
     /// M of the point-light faces (and of spots with spotLightBases -1): even, in [4, 128]; 0 =
     /// prefilter.bases. Cost when it differs: a second prefilter and evaluation pass; M / 4 basis fetches per

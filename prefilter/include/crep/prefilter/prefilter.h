@@ -90,6 +90,11 @@ inline std::size_t filteredBasisBytes(int width, int height, int bases, StorageF
   return static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
          static_cast<std::size_t>(layerCount(bases)) * texelBytes(format);
 }
+/// GPU bytes of a W x H exact basis (VisibilityReconstruction::Exact): two RG32F layers, (depth, cumulative
+/// weight) per texel and the blocks' depth ranges.
+inline std::size_t exactBasisBytes(int width, int height) {
+  return static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 16;
+}
 /// GPU bytes of the region visibility table (Z = EvaluateOptions::visibilityTableSamples): R Z x H, R32F.
 inline std::size_t visibilityTableBytes(int height, int regions, int samples) {
   return static_cast<std::size_t>(height) * static_cast<std::size_t>(regions) *

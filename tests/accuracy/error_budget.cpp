@@ -4,7 +4,7 @@
 // slow strafe and a slow rotation. Prints Markdown tables; docs/MEASUREMENTS.md, "Error budget", keeps the
 // figures.
 //
-//   build/bench/accuracy/crep_error_budget [--size WxH] [--section budget|split|flicker|all] [--case NAME]
+//   build/tests/accuracy/crep_error_budget [--size WxH] [--section budget|split|flicker|all] [--case NAME]
 //                                          [--knob TEXT]
 //
 // It reuses the tests' analytic scenes (tests/common), so it is built with the tests.
@@ -219,32 +219,57 @@ struct Knob {
   Input input = Input::Rasterized;
 };
 
+/// The Fourier series (Klehm et al. 2014, the former default) with a change.
+Knob fourier(std::string name, std::function<void(Scattering::CreateInfo&)> change,
+             Input input = Input::Rasterized) {
+  return {"Fourier, " + name,
+          [change](Scattering::CreateInfo& i) {
+            i.prefilter.reconstruction = VisibilityReconstruction::Fourier;
+            change(i);
+          },
+          input};
+}
+
 std::vector<Knob> knobs() {
+  const auto none = [](Scattering::CreateInfo&) {};
   return {
-      {"defaults (M = 32, RGBA8, 1024^2, rasterized)", [](Scattering::CreateInfo&) {}},
-      {"reconstruction: exact (no truncation)",
-       [](Scattering::CreateInfo& i) { i.prefilter.reconstruction = VisibilityReconstruction::Exact; }},
-      {"truncation: M = 64", [](Scattering::CreateInfo& i) { i.prefilter.bases = i.spotLightBases = 64; }},
-      {"truncation: M = 128, RGBA32F",
-       [](Scattering::CreateInfo& i) {
-         i.prefilter.bases = i.spotLightBases = 128;
-         i.prefilter.format = StorageFormat::RGBA32F;
-       }},
-      {"storage: RGBA32F", [](Scattering::CreateInfo& i) { i.prefilter.format = StorageFormat::RGBA32F; }},
-      {"map resolution: 2048^2", [](Scattering::CreateInfo& i) { i.mapSize = 2048; }},
-      {"resampling: from a 2048^2 standard map", [](Scattering::CreateInfo&) {}, Input::Resampled},
-      {"prefilter regions: P = 1", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 1; }},
-      {"prefilter regions: P = 8", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 8; }},
-      {"prefix table samples: Z = 512",
+      {"defaults: exact reconstruction, 1024^2, rasterized", none},
+      {"exact, map resolution 2048^2", [](Scattering::CreateInfo& i) { i.mapSize = 2048; }},
+      {"exact, resampled from a 2048^2 standard map", none, Input::Resampled},
+      {"exact, table samples Z = 512",
        [](Scattering::CreateInfo& i) {
          i.evaluate.visibilityTableSamples = 512;
          i.localLightTableSamples = i.spotLightTableSamples = 512;
        }},
-      {"prefix table: none (per-region sums)",
-       [](Scattering::CreateInfo& i) { i.evaluate.visibilityTableSamples = 0; }},
-      {"epipole block: none",
+      {"exact, prefilter regions P = 8", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 8; }},
+      fourier("M = 32, RGBA8 (the former defaults)", none),
+      fourier("truncation: M = 64",
+              [](Scattering::CreateInfo& i) { i.prefilter.bases = i.spotLightBases = 64; }),
+      fourier("truncation: M = 128, RGBA32F",
+              [](Scattering::CreateInfo& i) {
+                i.prefilter.bases = i.spotLightBases = 128;
+                i.prefilter.format = StorageFormat::RGBA32F;
+              }),
+      fourier("storage: RGBA32F",
+              [](Scattering::CreateInfo& i) { i.prefilter.format = StorageFormat::RGBA32F; }),
+      fourier("map resolution: 2048^2", [](Scattering::CreateInfo& i) { i.mapSize = 2048; }),
+      fourier("resampling: from a 2048^2 standard map", none, Input::Resampled),
+      fourier("prefilter regions: P = 1", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 1; }),
+      fourier("prefilter regions: P = 8", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 8; }),
+      fourier("prefix table samples: Z = 512",
+              [](Scattering::CreateInfo& i) {
+                i.evaluate.visibilityTableSamples = 512;
+                i.localLightTableSamples = i.spotLightTableSamples = 512;
+              }),
+      fourier("prefix table: none (per-region sums)",
+              [](Scattering::CreateInfo& i) { i.evaluate.visibilityTableSamples = 0; }),
+      fourier("epipole block: none",
+              [](Scattering::CreateInfo& i) { i.epipoleBlockRadius = i.localLightBlockRadius = 0; }),
+      fourier("depth warp: none (linear)",
+              [](Scattering::CreateInfo& i) { i.epipolarDepthWarp = i.localLightDepthWarp = 0.0; }),
+      {"exact, epipole block: none",
        [](Scattering::CreateInfo& i) { i.epipoleBlockRadius = i.localLightBlockRadius = 0; }},
-      {"depth warp: none (linear)",
+      {"exact, depth warp: none (linear)",
        [](Scattering::CreateInfo& i) { i.epipolarDepthWarp = i.localLightDepthWarp = 0.0; }},
   };
 }
@@ -462,24 +487,29 @@ void flicker(const std::vector<Case>& cases) {
   std::printf("\n## Flicker: frame-to-frame change of the error (%d frames), relative to the truth's RMS\n\n",
               kFrames);
   std::printf(
-      "| case | motion | world march (reference) | prefiltered | ratio | brute force, same map | ratio |\n");
-  std::printf("|---|---|---|---|---|---|---|\n");
+      "| case | motion | world march (reference) | exact (default) | ratio | Fourier M = 32 | ratio | "
+      "brute force, same map | ratio |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
   Scattering s(defaultInfo());
+  Scattering::CreateInfo fourierInfo = defaultInfo();
+  fourierInfo.prefilter.reconstruction = VisibilityReconstruction::Fourier;
+  Scattering fourier(fourierInfo);
   for (const Case& c : cases)
     for (const Motion& mo : motions) {
-      FlickerTrack reference, ours, same;
+      FlickerTrack reference, ours, series, same;
       for (int f = 0; f < kFrames; ++f) {
         const Camera camera = caseCamera(kCameraPosition + double(f) * mo.step, double(f) * mo.yaw);
         CaseFrame frame(c, camera);
         const Image truth = truthOf(c, camera, frame.depth(), frame.medium());
         Scattering::FrameResult r;
+        series.add(frame.run(fourier, Input::Rasterized), truth);
         ours.add(frame.run(s, Input::Rasterized, &r), truth);
         if (c.sun) same.add(frame.marchSameMap(r), truth);
         reference.add(frame.worldMarch(), truth);
       }
-      const double ref = reference.flicker(), f = ours.flicker();
-      std::printf("| %s | %s | %.3f%% | %.3f%% | %.2fx |", c.name.c_str(), mo.name, 100 * ref, 100 * f,
-                  f / ref);
+      const double ref = reference.flicker(), f = ours.flicker(), g = series.flicker();
+      std::printf("| %s | %s | %.3f%% | %.3f%% | %.2fx | %.3f%% | %.2fx |", c.name.c_str(), mo.name,
+                  100 * ref, 100 * f, f / ref, 100 * g, g / ref);
       if (c.sun)
         std::printf(" %.3f%% | %.2fx |\n", 100 * same.flicker(), same.flicker() / ref);
       else
