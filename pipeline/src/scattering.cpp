@@ -80,6 +80,15 @@ const Scattering::CreateInfo& validated(const Scattering::CreateInfo& info) {
     invalid("Scattering::CreateInfo.spotLightTableSamples", std::to_string(info.spotLightTableSamples),
             "must be 0 (localLightTableSamples) or in [2, " + std::to_string(kMaxVisibilityTableSamples) +
                 "]");
+  if (info.prefilter.reconstruction == VisibilityReconstruction::Exact) // its histograms' shared memory
+    for (const auto& [field, Z] :
+         {std::pair{"evaluate.visibilityTableSamples", info.evaluate.visibilityTableSamples},
+          std::pair{"localLightTableSamples", info.localLightTableSamples},
+          std::pair{"spotLightTableSamples", info.spotLightTableSamples}})
+      if (Z > kMaxExactTableSamples)
+        invalid(std::string("Scattering::CreateInfo.") + field, std::to_string(Z),
+                "must be at most kMaxExactTableSamples = " + std::to_string(kMaxExactTableSamples) +
+                    " with prefilter.reconstruction Exact");
   validate(info.epipoleBlock);
   const int regions = info.rectify.splits * info.prefilter.regionsPerSplit;
   if (info.mapSize % regions != 0)

@@ -658,6 +658,16 @@ gpu::Dispatch dispatchOf(const char* label, const std::vector<ShaderStageSource>
 EvaluatePass::EvaluatePass(const CreateInfo& info) : info_(info) {
   validateBases(info.bases, "EvaluatePass::CreateInfo.bases");
   crep::validate(info.options, "EvaluatePass::CreateInfo.options");
+  if (info.reconstruction != VisibilityReconstruction::Fourier &&
+      info.reconstruction != VisibilityReconstruction::Exact)
+    invalid("EvaluatePass::CreateInfo.reconstruction", str(static_cast<int>(info.reconstruction)),
+            "must be Fourier or Exact");
+  if (info.reconstruction == VisibilityReconstruction::Exact &&
+      info.options.visibilityTableSamples > kMaxExactTableSamples)
+    invalid("EvaluatePass::CreateInfo.options.visibilityTableSamples",
+            str(info.options.visibilityTableSamples),
+            "must be at most kMaxExactTableSamples = " + str(kMaxExactTableSamples) +
+                " with the exact reconstruction (its histograms in 32 KB of shared memory)");
   if (info.outputFormat != StorageFormat::RGBA32F && info.outputFormat != StorageFormat::RGBA16F)
     invalid("EvaluatePass::CreateInfo.outputFormat", storageFormatToken(info.outputFormat),
             "must be RGBA32F or RGBA16F");

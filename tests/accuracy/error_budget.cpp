@@ -11,6 +11,7 @@
 #define DOCTEST_CONFIG_IMPLEMENT // the test helpers' doctest symbols; no test runs here
 #include <doctest/doctest.h>
 
+#include "common/analytic_frames.h"
 #include "common/analytic_reference.h"
 #include "common/gl_fixture.h"
 #include "common/local_light_scene.h"
@@ -36,174 +37,12 @@
 #include <vector>
 
 using namespace crep;
+using namespace crep::test;
 
 namespace {
 
 int gWidth = 320, gHeight = 180;
-std::string gKnob;                 // --knob: only the knobs whose name contains it (and the defaults)
-constexpr int kStandardMap = 2048; // the engine's standard map of the resampled input and the world march
-
-/// One analytic case: the ground camera, a light and its plane occluder (a sun's, or the local lights' wall).
-struct Case {
-  std::string name;
-  std::optional<DirectionalLight> sun;
-  std::optional<SpotLight> spot;
-  test::HalfSpace plane;
-};
-
-/// The sun cases' occluder, oriented so that its shadowed side (normal side) faces away from the light.
-test::HalfSpace sunPlane(const glm::dvec3& direction) {
-  test::HalfSpace p;
-  if (glm::dot(p.normal, direction) < 0.0) p.normal = -p.normal;
-  return p;
-}
-
-Case sunCase(std::string name, const glm::dvec3& direction) {
-  return {std::move(name), DirectionalLight(direction, glm::dvec3(2.0, 1.8, 1.5)), std::nullopt,
-          sunPlane(glm::normalize(direction))};
-}
-
-std::vector<Case> allCases() {
-  return {sunCase("sun to the side", {1.0, -1.0, -0.3}),
-          sunCase("sun in view", {0.3, -0.3, 1.0}),
-          sunCase("sun oblique", {0.6, -0.5, -0.8}),
-          sunCase("sun behind", {0.2, -0.4, -1.0}),
-          {"spot near the view", std::nullopt, test::analyticViewSpot(), test::wall()},
-          {"spot to the side", std::nullopt, test::analyticSpot(), test::wall()}};
-}
-
-/// A square of half-size `extent` in the plane through `point` with `normal`: two triangles.
-void addQuad(scenes::Mesh& mesh, const glm::dvec3& point, const glm::dvec3& normal, double extent) {
-  const glm::dvec3 a = glm::normalize(
-      glm::cross(normal, std::abs(normal.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
-  const glm::dvec3 b = glm::cross(normal, a);
-  const auto base = static_cast<std::uint32_t>(mesh.positions.size());
-  for (const auto& [s, t] : {std::pair{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}}) {
-    mesh.positions.push_back(glm::vec3(point + extent * (s * a + t * b)));
-    mesh.normals.push_back(glm::vec3(normal));
-  }
-  for (const std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u})
-    mesh.indices.push_back(base + i);
-}
-
-/// The casters of a case: the ground (it shadows nothing above it, but it is in every map, as in an engine)
-/// and the occluder's plane, both 4000 units wide.
-scenes::Mesh casters(const Case& c) {
-  scenes::Mesh mesh;
-  addQuad(mesh, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 2000.0);
-  addQuad(mesh, c.plane.point, c.plane.normal, 2000.0);
-  return mesh;
-}
-
-/// A camera at `position` with the ground camera's orientation turned by `yaw` radians about +y.
-Camera caseCamera(const glm::dvec3& position, double yaw) {
-  const glm::dvec3 forward(std::sin(-yaw) * 10.0, -0.5, -std::cos(-yaw) * 10.0);
-  return Camera::lookAt(position, position + forward, {0, 1, 0}, glm::radians(60.0),
-                        static_cast<double>(gWidth) / gHeight, 0.1, 80.0);
-}
-
-Image truthOf(const Case& c, const Camera& camera, const Image& depth, const Medium& medium) {
-  if (c.sun) return test::closedForm(depth, camera, *c.sun, medium, c.plane);
-  return test::closedFormLocal(depth, camera, {LocalLight::spot(*c.spot)}, medium);
-}
-
-double relativeRmse(const Image& actual, const Image& reference) {
-  return test::rgbMetrics(actual, reference).relativeRmse;
-}
-
-/// How the frame gets its shadow maps.
-enum class Input { Rasterized, Resampled };
-
-/// The GL side of one case at one camera: camera depth, casters, the engine's standard map and the marches.
-class CaseFrame {
-public:
-  CaseFrame(const Case& c, const Camera& camera)
-      : case_(c), camera_(camera), medium_(test::colouredMedium()), renderer_(casters(c)) {
-    depth_ = test::groundDepth(camera_, gWidth, gHeight);
-    depthTexture_ =
-        gl::createTexture2D(GL_R32F, gWidth, gHeight); // (test::uploadR32F asserts through doctest)
-    glTextureSubImage2D(depthTexture_.get(), 0, 0, 0, gWidth, gHeight, GL_RED, GL_FLOAT,
-                        depth_.data().data());
-    output_ = gl::createTexture2D(GL_RGBA32F, gWidth, gHeight);
-    standard_.texture = standardTexture_.get();
-    standard_.bias = 1e-4;
-    standard_.lightClipFromWorld = c.sun ? test::analyticLightMatrix(*c.sun) : c.spot->lightClipFromWorld();
-    renderer_.renderDepth(standard_.lightClipFromWorld, standardTexture_.get(), 0, 0, 0, kStandardMap,
-                          kStandardMap, {.depthClamp = true});
-  }
-  const Image& depth() const { return depth_; }
-  const Medium& medium() const { return medium_; }
-
-  Image run(Scattering& s, Input input, Scattering::FrameResult* result = nullptr) {
-    Scattering::FrameAttribs a;
-    a.camera = &camera_;
-    a.medium = &medium_;
-    a.cameraDepth = depthTexture_.get();
-    a.output = output_.get();
-    if (input == Input::Rasterized)
-      a.drawCasters = [this](const glm::dmat4& clipFromWorld) { renderer_.drawDepth(clipFromWorld); };
-    if (case_.sun) {
-      a.light = &*case_.sun;
-      if (input == Input::Resampled) a.shadowMap = &standard_;
-    } else {
-      a.spotLights = std::span<const SpotLight>(&*case_.spot, 1);
-      if (input == Input::Resampled) a.spotShadowMaps = std::span<const Scattering::ShadowMap>(&standard_, 1);
-    }
-    Scattering::FrameResult r = s.run(a);
-    if (result) *result = std::move(r);
-    return read();
-  }
-
-  /// The world-space reference march (256 sections, 12 refinements) against the standard map.
-  Image worldMarch() {
-    static WorldMarchPass pass({{.steps = 256, .refinements = 12}});
-    WorldMarchPass::FrameAttribs f;
-    f.camera = &camera_;
-    const std::optional<LocalLight> local =
-        case_.spot ? std::optional<LocalLight>(LocalLight::spot(*case_.spot)) : std::nullopt;
-    if (case_.sun)
-      f.light = &*case_.sun;
-    else
-      f.localLight = &*local;
-    f.medium = &medium_;
-    f.cameraDepth = depthTexture_.get();
-    f.shadowMap = standard_.texture;
-    f.lightClipFromWorld = standard_.lightClipFromWorld;
-    f.bias = standard_.bias;
-    f.output = output_.get();
-    pass.run(f);
-    return read();
-  }
-
-  /// The brute-force march over the rectified map a sun frame used (exact visibility per texel).
-  Image marchSameMap(const Scattering::FrameResult& r) {
-    const Scattering::FrameResult::RectifiedMapView& m = r.rectifiedMap;
-    RectifiedMarchPass pass({m.width, m.height, RectifiedMarchPass::Mode::BruteForce});
-    RectifiedMarchPass::FrameAttribs a;
-    a.layout = m.layout.get();
-    a.camera = &camera_;
-    a.light = &*case_.sun;
-    a.medium = &medium_;
-    a.cameraDepth = depthTexture_.get();
-    a.rectifiedDepth = m.texture;
-    a.output = output_.get();
-    pass.run(a);
-    return read();
-  }
-
-private:
-  Image read() const { return gl::readTexture(output_.get(), gWidth, gHeight, gl::TexelData::Rgba); }
-
-  const Case& case_;
-  Camera camera_;
-  Medium medium_;
-  scenes::SceneRenderer renderer_;
-  Image depth_;
-  gl::Handle depthTexture_, output_,
-      standardTexture_ = scenes::createDepthTexture(kStandardMap, kStandardMap);
-  Scattering::ShadowMap standard_;
-};
-
+std::string gKnob; // --knob: only the knobs whose name contains it (and the defaults)
 Scattering::CreateInfo defaultInfo() {
   Scattering::CreateInfo info;
   info.width = gWidth;
@@ -242,6 +81,10 @@ std::vector<Knob> knobs() {
          i.localLightTableSamples = i.spotLightTableSamples = 512;
        }},
       {"exact, prefilter regions P = 8", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 8; }},
+      {"exact, spot table samples Z = 64 (as the point lights')",
+       [](Scattering::CreateInfo& i) { i.spotLightTableSamples = 64; }},
+      {"exact, spot table samples Z = 128", [](Scattering::CreateInfo& i) { i.spotLightTableSamples = 128; }},
+      {"exact, prefilter regions P = 4", [](Scattering::CreateInfo& i) { i.prefilter.regionsPerSplit = 4; }},
       fourier("M = 32, RGBA8 (the former defaults)", none),
       fourier("truncation: M = 64",
               [](Scattering::CreateInfo& i) { i.prefilter.bases = i.spotLightBases = 64; }),
@@ -289,9 +132,10 @@ void budget(const std::vector<Case>& cases) {
   std::vector<std::unique_ptr<CaseFrame>> frames;
   std::vector<Image> truths;
   for (const Case& c : cases) {
-    frames.push_back(std::make_unique<CaseFrame>(c, caseCamera(kCameraPosition, 0.0)));
-    truths.push_back(
-        truthOf(c, caseCamera(kCameraPosition, 0.0), frames.back()->depth(), frames.back()->medium()));
+    frames.push_back(std::make_unique<CaseFrame>(
+        c, caseCamera(kCameraPosition, 0.0, double(gWidth) / gHeight), gWidth, gHeight));
+    truths.push_back(truthOf(c, caseCamera(kCameraPosition, 0.0, double(gWidth) / gHeight),
+                             frames.back()->depth(), frames.back()->medium()));
   }
   std::vector<std::string> layouts(cases.size());
   for (const Knob& k : knobs()) {
@@ -303,7 +147,7 @@ void budget(const std::vector<Case>& cases) {
     for (std::size_t i = 0; i < cases.size(); ++i) {
       Scattering::FrameResult r;
       const Image img = frames[i]->run(s, k.input, &r);
-      std::printf(" %.2f%% |", 100.0 * relativeRmse(img, truths[i]));
+      std::printf(" %.2f%% |", 100.0 * rgbRelativeRmse(img, truths[i]));
       if (layouts[i].empty())
         layouts[i] = cases[i].sun ? layoutToken(r.layout)
                                   : (r.localLights.empty()       ? "-"
@@ -315,7 +159,7 @@ void budget(const std::vector<Case>& cases) {
   }
   std::printf("| reference: world march, 2048^2 standard map |");
   for (std::size_t i = 0; i < cases.size(); ++i)
-    std::printf(" %.2f%% |", 100.0 * relativeRmse(frames[i]->worldMarch(), truths[i]));
+    std::printf(" %.2f%% |", 100.0 * rgbRelativeRmse(frames[i]->worldMarch(), truths[i]));
   std::printf("\n| reference: brute-force march over the frame's rectified map |");
   {
     Scattering s(defaultInfo());
@@ -326,7 +170,7 @@ void budget(const std::vector<Case>& cases) {
       }
       Scattering::FrameResult r;
       frames[i]->run(s, Input::Rasterized, &r);
-      std::printf(" %.2f%% |", 100.0 * relativeRmse(frames[i]->marchSameMap(r), truths[i]));
+      std::printf(" %.2f%% |", 100.0 * rgbRelativeRmse(frames[i]->marchSameMap(r), truths[i]));
     }
   }
   std::printf("\n| layout |");
@@ -366,7 +210,7 @@ Image texelSum(const RectifiedMap& map, const Camera& camera, const Image& depth
 
 void split(const Case& c) {
   if (!c.sun) return;
-  const Camera camera = caseCamera(kCameraPosition, 0.0);
+  const Camera camera = caseCamera(kCameraPosition, 0.0, double(gWidth) / gHeight);
   Rectification rect = rectify(camera, *c.sun, defaultInfo().rectify);
   if (!rect.projective()) {
     std::printf("\n(%s: not projective; the split needs the projective layout)\n", c.name.c_str());
@@ -406,7 +250,7 @@ void split(const Case& c) {
   };
   const auto row = [&](const std::string& what, const TexelVisibility& v) {
     std::printf("| %s | %.2f%% |\n", what.c_str(),
-                100.0 * relativeRmse(texelSum(map, camera, depth, *c.sun, medium, v), truth));
+                100.0 * rgbRelativeRmse(texelSum(map, camera, depth, *c.sun, medium, v), truth));
     std::fflush(stdout);
   };
   std::printf(
@@ -419,11 +263,10 @@ void split(const Case& c) {
     const auto f = fourier(M);
     const std::string tag = "M = " + std::to_string(M) + ": ";
     row(tag + "truncated series everywhere", [&](int, int, int, double zt, double zr) { return f(zt, zr); });
-    row(tag + "exact in the last (partial) region, series before",
-        [&](int i, int last, int n, double zt, double zr) {
-          return i >= last / n * n ? exact(zt, zr) : f(zt, zr);
-        });
-    row(tag + "exact in the regions crossed whole, series in the last",
+    row(tag + "exact in the last split, series before", [&](int i, int last, int n, double zt, double zr) {
+      return i >= last / n * n ? exact(zt, zr) : f(zt, zr);
+    });
+    row(tag + "exact in the splits crossed whole, series in the last",
         [&](int i, int last, int n, double zt, double zr) {
           return i < last / n * n ? exact(zt, zr) : f(zt, zr);
         });
@@ -434,46 +277,12 @@ void split(const Case& c) {
   for (const int Z : {128, 256}) {
     const auto t = sampled(Z);
     row("exact visibility sampled at Z = " + std::to_string(Z) +
-            " ray depths in whole regions, exact in the last",
+            " ray depths in whole splits, exact in the last",
         [&](int i, int last, int n, double zt, double zr) {
           return i < last / n * n ? t(zt, zr) : exact(zt, zr);
         });
   }
 }
-
-/// The flicker of a method: the mean over consecutive frames of the RMS of the change of its error, relative
-/// to the RMS of the truth (Sec. "Flicker" of docs/MEASUREMENTS.md).
-struct FlickerTrack {
-  std::vector<Image> errors;
-  double rmsTruth = 0.0;
-  void add(const Image& image, const Image& truth) {
-    Image e(image.width(), image.height(), 3);
-    double t2 = 0.0;
-    for (int y = 0; y < image.height(); ++y)
-      for (int x = 0; x < image.width(); ++x)
-        for (int ch = 0; ch < 3; ++ch) {
-          e.at(x, y, ch) = image.at(x, y, ch) - truth.at(x, y, ch);
-          t2 += double(truth.at(x, y, ch)) * truth.at(x, y, ch);
-        }
-    rmsTruth += std::sqrt(t2 / (3.0 * image.width() * image.height()));
-    errors.push_back(std::move(e));
-  }
-  double flicker() const {
-    double sum = 0.0;
-    for (std::size_t f = 1; f < errors.size(); ++f) {
-      double d2 = 0.0;
-      const Image &a = errors[f - 1], &b = errors[f];
-      for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x)
-          for (int ch = 0; ch < 3; ++ch) {
-            const double d = double(b.at(x, y, ch)) - a.at(x, y, ch);
-            d2 += d * d;
-          }
-      sum += std::sqrt(d2 / (3.0 * a.width() * a.height()));
-    }
-    return sum / double(errors.size() - 1) / (rmsTruth / double(errors.size()));
-  }
-};
 
 void flicker(const std::vector<Case>& cases) {
   constexpr int kFrames = 5;
@@ -498,8 +307,9 @@ void flicker(const std::vector<Case>& cases) {
     for (const Motion& mo : motions) {
       FlickerTrack reference, ours, series, same;
       for (int f = 0; f < kFrames; ++f) {
-        const Camera camera = caseCamera(kCameraPosition + double(f) * mo.step, double(f) * mo.yaw);
-        CaseFrame frame(c, camera);
+        const Camera camera =
+            caseCamera(kCameraPosition + double(f) * mo.step, double(f) * mo.yaw, double(gWidth) / gHeight);
+        CaseFrame frame(c, camera, gWidth, gHeight);
         const Image truth = truthOf(c, camera, frame.depth(), frame.medium());
         Scattering::FrameResult r;
         series.add(frame.run(fourier, Input::Rasterized), truth);

@@ -66,15 +66,19 @@ layout(std430, binding = CREP_TABLE_COEFFICIENTS_BINDING) readonly restrict buff
 };
 
 #if CREP_EXACT_VISIBILITY
-#define CREP_EXACT_CHUNK 16 // regions per pass through shared memory
 #define CREP_EXACT_BINS (CREP_VISIBILITY_TABLE_SAMPLES + 1)
 #if CREP_LIGHT_TEXTURE
 #define CREP_EXACT_COLORS 3
 #else
 #define CREP_EXACT_COLORS 1
 #endif
-// Bin k of colour c of the chunk's region q at (c * CREP_EXACT_CHUNK + q) * CREP_EXACT_BINS + k: 8.3 KB, or
-// 24.8 KB with a light texture (within GL's 32 KB minimum).
+// Regions per pass through shared memory: 16, fewer where the bins of 16 would pass 32 KB (GL's minimum of
+// shared memory; EvaluatePass allows Z <= 2047 with the exact reconstruction, one region's bins of every
+// colour).
+#define CREP_EXACT_FIT (8192 / (CREP_EXACT_COLORS * CREP_EXACT_BINS))
+#define CREP_EXACT_CHUNK (CREP_EXACT_FIT > 16 ? 16 : CREP_EXACT_FIT < 1 ? 1 : CREP_EXACT_FIT)
+// Bin k of colour c of the chunk's region q at (c * CREP_EXACT_CHUNK + q) * CREP_EXACT_BINS + k: 8.3 KB at the
+// default Z = 128, or 24.8 KB with a light texture.
 shared float crep_exactBins[CREP_EXACT_COLORS * CREP_EXACT_CHUNK * CREP_EXACT_BINS];
 
 // Fills the bins of regions [first, first + CREP_EXACT_CHUNK) of row j (invocation `lane` of the workgroup's

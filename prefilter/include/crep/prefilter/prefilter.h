@@ -216,6 +216,9 @@ inline bool usesLocalSectionTable(const EvaluateOptions& options) {
   return usesScatteringPrefix(options) && options.localSectionTable;
 }
 inline constexpr int kMaxVisibilityTableSamples = 4096;
+/// The most table samples Z of the GPU passes with VisibilityReconstruction::Exact: the prefix table bins a
+/// region's Z + 1 depths per colour in shared memory, within GL's minimum of 32 KB.
+inline constexpr int kMaxExactTableSamples = 2047;
 
 /// a(z_s) of Eq. 8 (with `ringing`) at the ray basis depth of s / (samples - 1), index s * M + k: the one
 /// definition of the table's samples (visibilityTable() and EvaluatePass).
