@@ -286,13 +286,7 @@ void split(const Case& c) {
 
 void flicker(const std::vector<Case>& cases) {
   constexpr int kFrames = 5;
-  struct Motion {
-    const char* name;
-    glm::dvec3 step;
-    double yaw;
-  };
-  const Motion motions[] = {{"strafe 0.05 / frame", {0.05, 0.0, 0.0}, 0.0},
-                            {"rotation 0.25 deg / frame", {0.0, 0.0, 0.0}, glm::radians(0.25)}};
+  const std::vector<CameraMotion> motions = slowMotions();
   std::printf("\n## Flicker: frame-to-frame change of the error (%d frames), relative to the truth's RMS\n\n",
               kFrames);
   std::printf(
@@ -304,7 +298,7 @@ void flicker(const std::vector<Case>& cases) {
   fourierInfo.prefilter.reconstruction = VisibilityReconstruction::Fourier;
   Scattering fourier(fourierInfo);
   for (const Case& c : cases)
-    for (const Motion& mo : motions) {
+    for (const CameraMotion& mo : motions) {
       FlickerTrack reference, ours, series, same;
       for (int f = 0; f < kFrames; ++f) {
         const Camera camera =

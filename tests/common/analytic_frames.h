@@ -190,6 +190,18 @@ private:
   Scattering::ShadowMap standard_;
 };
 
+/// A slow camera motion per frame: a strafe along +x, or a turn about +y.
+struct CameraMotion {
+  const char* name;
+  glm::dvec3 step; ///< world units per frame
+  double yaw;      ///< radians per frame
+};
+/// The motions of the flicker figure: a strafe of 0.05 units and a rotation of 0.25 degrees per frame.
+inline std::vector<CameraMotion> slowMotions() {
+  return {{"strafe 0.05 / frame", {0.05, 0.0, 0.0}, 0.0},
+          {"rotation 0.25 deg / frame", {0.0, 0.0, 0.0}, glm::radians(0.25)}};
+}
+
 /// The flicker of a method: the mean over consecutive frames of the RMS of the change of its error, relative
 /// to the RMS of the truth (Sec. "Flicker" of docs/MEASUREMENTS.md).
 struct FlickerTrack {

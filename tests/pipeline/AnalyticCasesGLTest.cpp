@@ -58,16 +58,10 @@ TEST_CASE(
 TEST_CASE("analytic cases: the flicker under a strafe and a rotation against the reference march's") {
   CREP_REQUIRE_GL();
   Scattering exact(caseInfo(VisibilityReconstruction::Exact));
-  struct Motion {
-    const char* name;
-    glm::dvec3 step;
-    double yaw;
-  };
-  const Motion motions[] = {{"strafe 0.05 / frame", {0.05, 0.0, 0.0}, 0.0},
-                            {"rotation 0.25 deg / frame", {0.0, 0.0, 0.0}, glm::radians(0.25)}};
+  const std::vector<CameraMotion> motions = slowMotions();
   for (const Case& c : allCases()) {
     if (c.name != "sun to the side" && c.name != "sun in view") continue;
-    for (const Motion& m : motions) {
+    for (const CameraMotion& m : motions) {
       CAPTURE(c.name);
       CAPTURE(std::string(m.name));
       FlickerTrack reference, ours;

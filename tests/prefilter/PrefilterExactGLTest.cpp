@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -50,19 +51,27 @@ PrefilterPass::CreateInfo exactInfo() {
   return info;
 }
 
+/// The prefilter pass of `info` run on the boxes scene's map.
+std::unique_ptr<PrefilterPass> runOnBoxes(const PrefilterPass::CreateInfo& info) {
+  const GpuScene& s = boxesScene();
+  auto pass = std::make_unique<PrefilterPass>(info);
+  PrefilterPass::FrameAttribs frame;
+  frame.rectifiedDepth = s.mapTexture.get();
+  frame.layout = s.layout.get();
+  frame.medium = &s.scene.medium;
+  pass->run(frame);
+  return pass;
+}
+
 } // namespace
 
 TEST_CASE("prefilter GPU, exact reconstruction: depths, cumulative weights and block ranges equal the CPU") {
   CREP_REQUIRE_GL();
   const GpuScene& s = boxesScene();
   const PrefilterPass::CreateInfo info = exactInfo();
-  PrefilterPass pass(info);
+  const std::unique_ptr<PrefilterPass> passPtr = runOnBoxes(info);
+  PrefilterPass& pass = *passPtr;
   CHECK(pass.layers() == 2);
-  PrefilterPass::FrameAttribs frame;
-  frame.rectifiedDepth = s.mapTexture.get();
-  frame.layout = s.layout.get();
-  frame.medium = &s.scene.medium;
-  pass.run(frame);
   CHECK(pass.filteredBasis().reconstruction == VisibilityReconstruction::Exact);
   const FilteredBasis cpu = prefilter(s.map, s.scene.medium, info.options);
   const std::vector<float> gpu = readTextureArray(pass.filteredBasisTexture(), kMapW, kMapH, 2);
@@ -99,12 +108,8 @@ TEST_CASE("prefilter GPU, exact reconstruction: evaluation equals the CPU on eve
   CREP_REQUIRE_GL();
   const GpuScene& s = boxesScene();
   const PrefilterPass::CreateInfo info = exactInfo();
-  PrefilterPass pass(info);
-  PrefilterPass::FrameAttribs frame;
-  frame.rectifiedDepth = s.mapTexture.get();
-  frame.layout = s.layout.get();
-  frame.medium = &s.scene.medium;
-  pass.run(frame);
+  const std::unique_ptr<PrefilterPass> passPtr = runOnBoxes(info);
+  PrefilterPass& pass = *passPtr;
   const FilteredBasis cpu = prefilter(s.map, s.scene.medium, info.options);
   for (const Sampling sampling : {Sampling::Bilinear, Sampling::Nearest})
     for (const int option : {0, 1, 3, 4}) {
@@ -149,12 +154,8 @@ TEST_CASE("prefilter GPU, exact reconstruction: a basis of the other kind is nam
   const GpuScene& s = boxesScene();
   PrefilterPass::CreateInfo info = exactInfo();
   info.options.reconstruction = VisibilityReconstruction::Fourier;
-  PrefilterPass pass(info);
-  PrefilterPass::FrameAttribs frame;
-  frame.rectifiedDepth = s.mapTexture.get();
-  frame.layout = s.layout.get();
-  frame.medium = &s.scene.medium;
-  pass.run(frame);
+  const std::unique_ptr<PrefilterPass> passPtr = runOnBoxes(info);
+  PrefilterPass& pass = *passPtr;
   EvaluatePass::CreateInfo e;
   e.reconstruction = VisibilityReconstruction::Exact;
   EvaluatePass evaluatePass(e);
