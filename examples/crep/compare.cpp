@@ -254,7 +254,10 @@ std::vector<SheetColumn> sheetColumns(const CompareArgs& o, const std::vector<Re
 Image contactSheet(const CompareArgs& o, const std::vector<Result>& results) {
   const std::string header = "crep compare: scene " + o.sceneName + ", " + std::to_string(o.size.x) + "x" +
                              std::to_string(o.size.y) + ", map " + std::to_string(o.settings.mapSize) +
-                             "^2, M = " + std::to_string(o.settings.prefilter.bases) +
+                             "^2, " +
+                             (o.settings.prefilter.reconstruction == VisibilityReconstruction::Exact
+                                  ? std::string("exact visibility")
+                                  : "Fourier M = " + std::to_string(o.settings.prefilter.bases)) +
                              ", reference = world-space march, " + std::to_string(o.settings.steps) +
                              " steps; GL renderer: " + glRenderer();
   return composeSheet(header, sheetColumns(o, results), o.tileWidth, o.exposure, o.amplify);

@@ -15,6 +15,7 @@
 #include <doctest/doctest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -228,6 +229,38 @@ TEST_CASE("crep render --method froxel-prefilter: its warnings name froxel-prefi
   CHECK(r.output.find("crep: froxel-prefilter: the froxel fog lights the volume with the sun only") !=
         std::string::npos);
   CHECK(r.output.find("froxel-esm:") == std::string::npos);
+}
+
+TEST_CASE(
+    "crep render --reconstruction: exact by default, fourier on request, --bases matters to fourier only") {
+  CREP_REQUIRE_GL();
+  crep::test::TempDir dir{"crep-reconstruction"};
+  const auto render = [&](const std::string& name, std::vector<std::string> extra) {
+    std::vector<std::string> argv = {
+        "render", "--scene", "forest", "--size", "32x18", "--map-size", "64", "--out", (dir / name).string()};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    const ArgvResult r = runCrepArgv(argv);
+    INFO(r.output);
+    REQUIRE(r.status == 0);
+    crep::ExrReadOptions scattering;
+    scattering.layer = "scattering";
+    return crep::readExr(dir / (name + ".exr"), scattering);
+  };
+  const crep::Image byDefault = render("default", {}), exact = render("exact", {"--reconstruction", "exact"});
+  const crep::Image exact64 = render("exact64", {"--bases", "64"});
+  const crep::Image fourier = render("fourier", {"--reconstruction", "fourier"});
+  const crep::Image fourier64 = render("fourier64", {"--reconstruction", "fourier", "--bases", "64"});
+  const auto same = [](const crep::Image& a, const crep::Image& b) {
+    return std::equal(a.data().begin(), a.data().end(), b.data().begin(), b.data().end());
+  };
+  CHECK(same(byDefault, exact));
+  CHECK(same(exact64, exact)); // no bases in the exact reconstruction
+  CHECK(!same(fourier, exact));
+  CHECK(!same(fourier64, fourier));
+  const ArgvResult bad = runCrepArgv({"render", "--scene", "forest", "--size", "32x18", "--reconstruction",
+                                      "mean", "--out", (dir / "bad").string()});
+  CHECK(bad.status != 0);
+  CHECK(bad.output.find("option --reconstruction: 'mean' is not exact or fourier") != std::string::npos);
 }
 
 #if CREP_TOOL_HAS_BENCH

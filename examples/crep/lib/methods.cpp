@@ -433,9 +433,10 @@ MethodOutput runFrontDoor(FrameInputs& frame, const MethodSettings& settings, Sc
     out.timings.append({{stage.name, stage.wallMilliseconds}}); // comparable with the other methods' stages
   const PrefilterOptions& options = settings.prefilter;
   const std::string basis =
-      method == Scattering::Method::MinMaxMarch
-          ? std::string("min/max tree march")
-          : "M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
+      method == Scattering::Method::MinMaxMarch ? std::string("min/max tree march")
+      : options.reconstruction == VisibilityReconstruction::Exact
+          ? std::string("exact visibility")
+          : "Fourier, M = " + std::to_string(options.bases) + ", " + storageFormatToken(options.format);
   std::string local;
   if (!r.localLights.empty()) {
     // prefiltered (projective layout), prefiltered on the epipolar layout (in or near the view), marched,

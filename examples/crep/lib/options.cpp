@@ -11,6 +11,7 @@ const std::set<std::string> kMethodOptions = {"method",
                                               "map-size",
                                               "bases",
                                               "format",
+                                              "reconstruction",
                                               "splits",
                                               "steps",
                                               "scale",
@@ -24,8 +25,10 @@ const std::set<std::string> kMethodOptions = {"method",
 
 const char* const kMethodOptionsHelp =
     R"(            --map-size N        shadow map and rectified map size (default 1024, at most 16384)
-            --bases M           Fourier bases, even, in [4, 128] (default 32)
-            --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f
+            --reconstruction R  prefiltered methods' visibility: exact (default: the depth test per texel)
+                                | fourier (Klehm et al. 2014: the truncated series of --bases M)
+            --bases M           Fourier bases, even, in [4, 128] (default 32; with --reconstruction fourier)
+            --format F          filtered-basis storage rgba8 (default) | rgba16f | rgba32f (fourier)
             --splits K          rectification splits (default 8, 2 prefilter regions each; --map-size must
                                 be a multiple of 2 K and of 16, the epipolar fallback's 8 x 2 regions)
             --steps N           reference march: sections per view ray, changes bisected (default 256)
@@ -63,6 +66,13 @@ MethodSettings methodSettings(const Args& args) {
   s.prefilter.bases = args.integer("bases", s.prefilter.bases, kMinBases, kMaxBases);
   if (s.prefilter.bases % 2 != 0) throw UsageError("option --bases: must be even");
   s.prefilter.format = parseFormat(args.string("format", "rgba8"));
+  const std::string reconstruction = args.string("reconstruction", "exact");
+  if (reconstruction == "exact")
+    s.prefilter.reconstruction = VisibilityReconstruction::Exact;
+  else if (reconstruction == "fourier")
+    s.prefilter.reconstruction = VisibilityReconstruction::Fourier;
+  else
+    throw UsageError("option --reconstruction: '" + reconstruction + "' is not exact or fourier");
   s.rectify.splits = args.integer("splits", s.rectify.splits, 1, RectifyOptions::kMaxSplits);
   s.scale = args.number("scale", 1.0, 0.25, 1.0);
   if (s.scale != 1.0 && s.scale != 0.5 && s.scale != 0.25)
