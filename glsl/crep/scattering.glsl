@@ -99,9 +99,9 @@
 #ifndef CREP_RINGING_LANCZOS
 #define CREP_RINGING_LANCZOS 0
 #endif
-// 1: crep::VisibilityReconstruction::Exact. Layer 0 of the basis array holds per texel (depth, mix factor m_i)
-// in RG32F (with a light texture (depth, m_i of colour 0, 1, 2) in RGBA32F); evaluation walks it
-// (crep_exactPrefix) instead of the Fourier series.
+// 1: crep::VisibilityReconstruction::Exact. Layer 0 of the basis array holds per texel (depth, cumulative
+// weight W) in RG32F (with a light texture (depth, W of colour 0, 1, 2) in RGBA32F), layer 1 each block of
+// CREP_EXACT_BLOCK texels' (min, max) depth; evaluation walks them (crep_exactPrefix) instead of the series.
 #ifndef CREP_EXACT_VISIBILITY
 #define CREP_EXACT_VISIBILITY 0
 #endif
@@ -770,12 +770,12 @@ vec4 crep_inScatteringSegment(vec3 origin, vec3 dir, float start, float surface)
 #endif
 
   // Eq. 8 coefficients of the ray, by recurrence from one reduced sin/cos pair.
+  vec4 a[CREP_EVAL_MAX_LAYERS];
+#if !CREP_EXACT_VISIBILITY // the exact prefix needs no coefficients
   float margin = crep_scattering.depthMargin.x;
   CrepDepth zr = crep_rayBasisDepth(hit.depth, margin);
   vec2 stepSC = crep_harmonicStep(zr);
   vec2 sc = crep_harmonic(0, zr);
-  vec4 a[CREP_EVAL_MAX_LAYERS];
-#if !CREP_EXACT_VISIBILITY // the exact prefix needs no coefficients
   for (int l = 0; l < CREP_EVAL_LAYERS; ++l) {
     vec2 next = crep_rotate(sc, stepSC);
     a[l] = crep_coefficients4(2 * l, sc, next);

@@ -94,9 +94,9 @@ void checkWorkgroup(const gpu::Backend& backend, const char* const names[3], con
 
 gpu::Format basisFormat(StorageFormat format);
 
-/// The basis array's texel format: the options' storage, or for the exact reconstruction (depth, mix factor)
-/// in RG32F, (depth, three colours' factors) in RGBA32F with a light texture (GPU: 8 bytes per texel of the
-/// per-pixel walk instead of 16).
+/// The basis array's texel format: the options' storage, or for the exact reconstruction (depth, cumulative
+/// weight) in RG32F, (depth, three colours' weights) in RGBA32F with a light texture (GPU: 8 bytes per texel
+/// of the per-pixel walk instead of 16).
 gpu::Format arrayFormat(const PrefilterOptions& o, bool textured) {
   if (o.reconstruction != VisibilityReconstruction::Exact) return basisFormat(o.format);
   return textured ? gpu::Format::RGBA32F : gpu::Format::RG32F;
@@ -114,8 +114,18 @@ gpu::Format basisFormat(StorageFormat format) {
   return gpu::Format::RGBA32F;
 }
 
-const char* imageFormatQualifier(StorageFormat format) {
-  return storageFormatToken(format);
+/// The GLSL image format qualifier of a basis array's texel format (arrayFormat()).
+const char* imageFormatQualifier(gpu::Format format) {
+  switch (format) {
+  case gpu::Format::RGBA8:
+    return "rgba8";
+  case gpu::Format::RGBA16F:
+    return "rgba16f";
+  case gpu::Format::RG32F:
+    return "rg32f";
+  default:
+    return "rgba32f";
+  }
 }
 
 std::string sizeString(int w, int h) {
@@ -245,15 +255,14 @@ gpu::ScatteringParams makeScatteringParams(const FilteredBasisView& basis, const
 std::vector<ShaderStageSource> prefilterStages(const PrefilterPass::CreateInfo& info, bool local,
                                                bool textured = false) {
   const PrefilterOptions& o = info.options;
-  const bool exact = o.reconstruction == VisibilityReconstruction::Exact;
-  const StorageFormat format = exact ? StorageFormat::RGBA32F : o.format; // exact: depths and factors
+  const gpu::Format format = arrayFormat(o, textured);
   return {{ShaderStage::Compute,
            "passes/prefilter/prefilter.comp",
            {{"CREP_BASES_PER_INVOCATION", str(basesPerInvocation(info, local))},
-            {"CREP_BASIS_FORMAT", exact && !textured ? "rg32f" : imageFormatQualifier(format)},
-            {"CREP_BASIS_UNORM8", format == StorageFormat::RGBA8 ? "1" : "0"},
-            {"CREP_BASIS_HALF", format == StorageFormat::RGBA16F ? "1" : "0"},
-            {"CREP_EXACT_VISIBILITY", exact ? "1" : "0"},
+            {"CREP_BASIS_FORMAT", imageFormatQualifier(format)},
+            {"CREP_BASIS_UNORM8", format == gpu::Format::RGBA8 ? "1" : "0"},
+            {"CREP_BASIS_HALF", format == gpu::Format::RGBA16F ? "1" : "0"},
+            {"CREP_EXACT_VISIBILITY", o.reconstruction == VisibilityReconstruction::Exact ? "1" : "0"},
             {"CREP_LOCAL_SIZE_X", str(info.workgroupRows)},
             {"CREP_LOCAL_SIZE_Y", str(info.workgroupBaseGroups)},
             {"CREP_LOCAL_SIZE_Z", str(info.workgroupRegions)},

@@ -744,8 +744,11 @@ Image evaluateImpl(const FilteredBasis& basis, int w, int h, const RayAt& rayAt,
       if (!mapRay(layout, origin, ray, basis.regionsPerSplit, options.nearPlaneCorrection, m)) {
         L = segment.weighted(glm::dvec3(1.0), ray.start, ray.surface);
       } else {
-        fourierCoefficients(rayBasisDepth(m.depth, basis.depthMargin), aSpan);
-        applyRingingFilter(options.ringing, aSpan);
+        if (basis.reconstruction ==
+            VisibilityReconstruction::Fourier) { // the exact prefix needs no coefficients
+          fourierCoefficients(rayBasisDepth(m.depth, basis.depthMargin), aSpan);
+          applyRingingFilter(options.ringing, aSpan);
+        }
         const int nearestRow =
             std::clamp(static_cast<int>(std::floor(m.row * basis.height)), 0, basis.height - 1);
         PixelRay segments = ray; // what the region loop below integrates

@@ -40,9 +40,8 @@ struct FilteredBasisView {
   bool localLight = false;                ///< prefiltered with a local light's factor in the weights
   bool textured = false; ///< with a light texture: 3 ceil(M / 4) layers (colour c from layer c ceil(M / 4))
   /// Exact: `texture` has two layers: (depth, cumulative weight W) per texel in RG32F (RGBA32F with a light
-  /// texture: W of colour 0, 1, 2; prefilter.h), and each block of 8 texels' (min, max) depth at texel
-  /// (region n
-  /// + block) of layer 1.
+  /// texture: W of colour 0, 1, 2; prefilter.h), and in layer 1 each block of 8 texels' (min, max) depth at
+  /// texel (region n + block).
   VisibilityReconstruction reconstruction = VisibilityReconstruction::Fourier;
   std::uint32_t meanColor = 0; ///< textured: GL_TEXTURE_2D, width x height, GL_RGBA32F (rgb cbar)
 
@@ -107,10 +106,7 @@ public:
   const CreateInfo& createInfo() const noexcept { return info_; }
   /// Layers of the basis array: ceil(M / 4), or 2 for VisibilityReconstruction::Exact ((depth, W) per texel
   /// and the blocks' (min, max) depth).
-  int layers() const noexcept {
-    return info_.options.reconstruction == VisibilityReconstruction::Exact ? 2
-                                                                           : layerCount(info_.options.bases);
-  }
+  int layers() const noexcept { return exact() ? 2 : layerCount(info_.options.bases); }
   /// GPU memory it owns, bytes: the filtered basis (filteredBasisBytes) and its buffers.
   std::size_t memoryBytes() const noexcept;
   /// 2D array texture of the last run's basis (linear, clamp to edge; 3 bases when textured).

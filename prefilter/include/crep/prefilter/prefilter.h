@@ -47,10 +47,10 @@ enum class VisibilityReconstruction {
   Fourier,
   /// Not in the paper: the exact weighted prefix of the depth test, sum_i w_i [z_i >= z_r] / sum_i w_i,
   /// walked
-  /// texel by texel over the region a ray ends in (at most n = width / R texels per pixel), and sampled
-  /// exactly
-  /// at the table's Z ray depths for the regions it crosses whole. No truncation error: the error budget in
-  /// docs/MEASUREMENTS.md. CPU reference only so far (the GPU passes refuse it).
+  /// over the region a ray ends in (at most n = width / R texels per pixel; the GPU passes uniform blocks of
+  /// 8
+  /// in one step), and sampled exactly at the table's Z ray depths for the regions it crosses whole. No
+  /// truncation error: the error budget in docs/MEASUREMENTS.md. crep::Scattering's default.
   Exact,
 };
 /// "fourier", "exact".
@@ -141,9 +141,8 @@ struct FilteredBasis {
   /// Exact only: the rectified map's depths, index y * width + x; empty otherwise.
   std::vector<float> depth;
   /// Exact only: the cumulative weight W_i = sum_{k <= i} w_k / sum_region w_k of each texel within its
-  /// region
-  /// (= prod_{k > i} (1 - m_k) of Listing 2's mix factors; with a texture, of colour c's weights w_i c_i),
-  /// index (c * height + y) * width + x. Texel i's share of a prefix is W_i - W_{i-1}.
+  /// region (= prod_{k > i} (1 - m_k) of Listing 2's mix factors; with a texture, of colour c's weights
+  /// w_i c_i), index (c * height + y) * width + x. Texel i's share of a prefix is W_i - W_{i-1}.
   std::vector<float> weight;
 
   int regionWidth() const noexcept { return regions > 0 ? width / regions : 0; } ///< n
