@@ -164,6 +164,30 @@ inline UploadedBasis uploadBasis(const FilteredBasis& basis, StorageFormat forma
   return u;
 }
 
+/// The boxes frame of the GPU prefilter tests: a 250 x 37 map with 2 splits and a 161 x 93 screen, sizes that
+/// are deliberately not multiples of the workgroup sizes; rendered once per process.
+inline constexpr int kBoxesMapW = 250, kBoxesMapH = 37, kBoxesScreenW = 161, kBoxesScreenH = 93,
+                     kBoxesSplits = 2;
+inline const GpuScene& boxesGpuScene() {
+  static const GpuScene scene =
+      renderGpuScene("boxes", kBoxesMapW, kBoxesMapH, kBoxesSplits, kBoxesScreenW, kBoxesScreenH);
+  return scene;
+}
+
+/// Runs the GPU prefilter on the scene's map texture (or `mapTexture`); returns the pass (its texture holds
+/// the result).
+inline PrefilterPass runPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& info,
+                                  double extinctionOverride = -1.0, std::uint32_t mapTexture = 0) {
+  PrefilterPass pass(info);
+  PrefilterPass::FrameAttribs frame;
+  frame.rectifiedDepth = mapTexture != 0 ? mapTexture : s.mapTexture.get();
+  frame.layout = s.layout.get();
+  frame.medium = &s.scene.medium;
+  frame.extinctionOverride = extinctionOverride;
+  pass.run(frame);
+  return pass;
+}
+
 /// EvaluatePass's attributes for the sun of `s` with `basis`: the scene's camera depth, camera, sun, medium
 /// and layout; the output texture is `output`.
 inline EvaluatePass::FrameAttribs sunEvaluation(const GpuScene& s, const FilteredBasisView& basis,

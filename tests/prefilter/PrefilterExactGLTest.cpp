@@ -35,12 +35,7 @@ using namespace crep::test;
 
 namespace {
 
-constexpr int kMapW = 250, kMapH = 37, kScreenW = 161, kScreenH = 93, kSplits = 2;
-
-const GpuScene& boxesScene() {
-  static const GpuScene scene = renderGpuScene("boxes", kMapW, kMapH, kSplits, kScreenW, kScreenH);
-  return scene;
-}
+constexpr int kMapW = kBoxesMapW, kMapH = kBoxesMapH, kScreenW = kBoxesScreenW, kScreenH = kBoxesScreenH;
 
 PrefilterPass::CreateInfo exactInfo() {
   PrefilterPass::CreateInfo info;
@@ -51,26 +46,13 @@ PrefilterPass::CreateInfo exactInfo() {
   return info;
 }
 
-/// The prefilter pass of `info` run on the boxes scene's map.
-std::unique_ptr<PrefilterPass> runOnBoxes(const PrefilterPass::CreateInfo& info) {
-  const GpuScene& s = boxesScene();
-  auto pass = std::make_unique<PrefilterPass>(info);
-  PrefilterPass::FrameAttribs frame;
-  frame.rectifiedDepth = s.mapTexture.get();
-  frame.layout = s.layout.get();
-  frame.medium = &s.scene.medium;
-  pass->run(frame);
-  return pass;
-}
-
 } // namespace
 
 TEST_CASE("prefilter GPU, exact reconstruction: depths, cumulative weights and block ranges equal the CPU") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   const PrefilterPass::CreateInfo info = exactInfo();
-  const std::unique_ptr<PrefilterPass> passPtr = runOnBoxes(info);
-  PrefilterPass& pass = *passPtr;
+  const PrefilterPass pass = runPrefilter(s, info);
   CHECK(pass.layers() == 2);
   CHECK(pass.filteredBasis().reconstruction == VisibilityReconstruction::Exact);
   const FilteredBasis cpu = prefilter(s.map, s.scene.medium, info.options);
@@ -106,10 +88,9 @@ TEST_CASE("prefilter GPU, exact reconstruction: depths, cumulative weights and b
 
 TEST_CASE("prefilter GPU, exact reconstruction: evaluation equals the CPU on every table path and sampling") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   const PrefilterPass::CreateInfo info = exactInfo();
-  const std::unique_ptr<PrefilterPass> passPtr = runOnBoxes(info);
-  PrefilterPass& pass = *passPtr;
+  const PrefilterPass pass = runPrefilter(s, info);
   const FilteredBasis cpu = prefilter(s.map, s.scene.medium, info.options);
   for (const Sampling sampling : {Sampling::Bilinear, Sampling::Nearest})
     for (const int option : {0, 1, 3, 4}) {
@@ -151,11 +132,10 @@ TEST_CASE("prefilter GPU, exact reconstruction: evaluation equals the CPU on eve
 
 TEST_CASE("prefilter GPU, exact reconstruction: a basis of the other kind is named") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   PrefilterPass::CreateInfo info = exactInfo();
   info.options.reconstruction = VisibilityReconstruction::Fourier;
-  const std::unique_ptr<PrefilterPass> passPtr = runOnBoxes(info);
-  PrefilterPass& pass = *passPtr;
+  const PrefilterPass pass = runPrefilter(s, info);
   EvaluatePass::CreateInfo e;
   e.reconstruction = VisibilityReconstruction::Exact;
   EvaluatePass evaluatePass(e);

@@ -49,25 +49,7 @@ using namespace crep::test;
 
 namespace {
 
-constexpr int kMapW = 250, kMapH = 37, kScreenW = 161, kScreenH = 93, kSplits = 2;
-
-const GpuScene& boxesScene() {
-  static const GpuScene scene = renderGpuScene("boxes", kMapW, kMapH, kSplits, kScreenW, kScreenH);
-  return scene;
-}
-
-/// Runs the GPU prefilter on the scene's map texture; returns the pass (its texture holds the result).
-PrefilterPass runPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& info,
-                           double extinctionOverride = -1.0, std::uint32_t mapTexture = 0) {
-  PrefilterPass pass(info);
-  PrefilterPass::FrameAttribs frame;
-  frame.rectifiedDepth = mapTexture != 0 ? mapTexture : s.mapTexture.get();
-  frame.layout = s.layout.get();
-  frame.medium = &s.scene.medium;
-  frame.extinctionOverride = extinctionOverride;
-  pass.run(frame);
-  return pass;
-}
+constexpr int kMapW = kBoxesMapW, kMapH = kBoxesMapH, kScreenW = kBoxesScreenW, kScreenH = kBoxesScreenH;
 
 FilteredBasis cpuPrefilter(const GpuScene& s, const PrefilterPass::CreateInfo& info,
                            double extinctionOverride = -1.0, const RectifiedMap* map = nullptr) {
@@ -151,7 +133,7 @@ PrefilterPass::CreateInfo baseInfo() {
 
 TEST_CASE("prefilter GPU: the filtered basis equals the CPU reference in every storage format") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   for (const StorageFormat format : {StorageFormat::RGBA32F, StorageFormat::RGBA16F, StorageFormat::RGBA8}) {
     PrefilterPass::CreateInfo info = baseInfo();
     info.options.format = format;
@@ -162,7 +144,7 @@ TEST_CASE("prefilter GPU: the filtered basis equals the CPU reference in every s
 
 TEST_CASE("prefilter GPU: bases 4, 6, 30 and 128, partial base groups, odd and prime workgroup sizes") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   // M = 6 and 30 leave the last RGBA layer half used (its other channels store F = 0); 12 bases per
   // invocation do not divide 32 or 128, 128 exceeds M = 30: the last group of a row is partial.
   struct Config {
@@ -197,7 +179,7 @@ TEST_CASE("prefilter GPU: bases 4, 6, 30 and 128, partial base groups, odd and p
 
 TEST_CASE("prefilter GPU: every regionsPerSplit x basesPerInvocation configuration gives the CPU result") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   // W = 250 with K = 2 splits: P in {1, 5, 25} (R = 2, 10, 50 regions of 125, 25, 5 texels).
   for (const int perSplit : {1, 5, 25}) {
     Image first;
@@ -234,7 +216,7 @@ TEST_CASE("prefilter GPU: every regionsPerSplit x basesPerInvocation configurati
 
 TEST_CASE("prefilter GPU: every weight mode, the sigma -> 0 limit and a thick medium") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   const WeightMode modes[] = {WeightMode::Exact, WeightMode::ConstantStep, WeightMode::ConstantRatio,
                               WeightMode::AverageVisibility};
   // Scalar weight extinctions: the scene's medium, 0 (the phi series limit), 0.4 / world unit (the
@@ -264,7 +246,7 @@ TEST_CASE("prefilter GPU: every weight mode, the sigma -> 0 limit and a thick me
 
 TEST_CASE("prefilter GPU: evaluation equals the CPU evaluation for every format, sampling and option") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   for (const StorageFormat format : {StorageFormat::RGBA32F, StorageFormat::RGBA16F, StorageFormat::RGBA8}) {
     PrefilterPass::CreateInfo info = baseInfo();
     info.options.format = format;
@@ -316,7 +298,7 @@ TEST_CASE("prefilter GPU: evaluation equals the CPU evaluation for every format,
 
 TEST_CASE("prefilter GPU: a float map with exact 0 and 1 depths and random content, other scenes") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   // Random depths in a GL_R32F texture (the pass reads channel r of any format), a fifth of them
   // exactly 0 (caster clamped in front) or 1 (nothing): the texelBasisDepth end rules.
   std::mt19937 rng(4);
@@ -446,7 +428,7 @@ TEST_CASE("prefilter GPU: invalid create infos throw errors naming the parameter
 
 TEST_CASE("prefilter GPU: invalid frames throw errors naming the field") {
   CREP_REQUIRE_GL();
-  const GpuScene& s = boxesScene();
+  const GpuScene& s = boxesGpuScene();
   PrefilterPass pass(baseInfo());
   CHECK_THROWS_AS(pass.filteredBasis(), Error);
   const auto runWith = [&](auto change) {
